@@ -1,0 +1,40 @@
+// NodeID: the 128-bit UUID naming a Robot Raconteur node (wire.md §1.1).
+// On the wire it is 16 bytes in RFC 4122 order (the order of the hex digits of the text form).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+#include "core/error/rr_error.hpp"
+
+namespace rr {
+
+class NodeID {
+public:
+    using Bytes = std::array<std::byte, 16>;
+
+    NodeID() = default;  ///< the all-zero NodeID: "any node / unknown"
+    explicit NodeID(const Bytes& bytes) : bytes_(bytes) {}
+
+    /// Parses "{8-4-4-4-12}", "8-4-4-4-12" or 32 hex digits (upper or lower case); wire.md §13 URLs.
+    /// Errors: InvalidArgument.
+    static Result<NodeID> parse(std::string_view text);
+
+    const Bytes& bytes() const noexcept { return bytes_; }
+    bool is_any() const noexcept;
+
+    /// Lower-case "xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx" without braces.
+    std::string to_string() const;
+    /// Lower-case "{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}" (the form CORE prints).
+    std::string to_braced_string() const;
+
+    friend bool operator==(const NodeID&, const NodeID&) = default;
+    friend auto operator<=>(const NodeID&, const NodeID&) = default;
+
+private:
+    Bytes bytes_{};
+};
+
+}  // namespace rr

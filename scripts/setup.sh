@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs everything the build, the tests and the gateway need. Idempotent: a second run installs
+# nothing. Debian packages (apt), Python packages into ./.venv (pip, pinned), npm packages (later).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+APT_PACKAGES=(
+  cmake ninja-build g++ pkg-config ccache
+  libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev catch2 libyaml-cpp-dev
+  clang-14 libclang-rt-14-dev
+  python3-venv
+)
+
+missing=()
+for p in "${APT_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -q
+  # Never pull libboost-dev: it means Boost 1.74, which conflicts with 1.81.
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# Python: the official Robot Raconteur package (pinned) for interop tests, in a project venv.
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+req=test/interop/requirements.txt
+stamp=.venv/.requirements.sha
+want=$(sha256sum "$req" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing Python packages from $req"
+  .venv/bin/pip install -q --disable-pip-version-check -r "$req"
+  echo "$want" > "$stamp"
+fi
+echo "setup: ok"

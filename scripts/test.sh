@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The test command: installs what is missing, builds the debug preset (ASan + UBSan), runs every
+# test (unit, interop against the official library), then builds the libFuzzer targets and runs each
+# for RR_FUZZ_SECONDS (default 60). Exits non-zero on any failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/setup.sh
+
+jobs=${RR_JOBS:-$(nproc)}
+cmake --preset debug >/dev/null
+cmake --build --preset debug -j "$jobs"
+ctest --preset debug -j "$jobs"
+
+fuzz_seconds=${RR_FUZZ_SECONDS:-60}
+if [ "$fuzz_seconds" != 0 ]; then
+  ./scripts/fuzz.sh "$fuzz_seconds"
+fi
+echo "test: all passed"
