@@ -1,0 +1,53 @@
+#include <catch2/catch.hpp>
+
+#include "core/names/connection_url.hpp"
+
+using namespace rr;
+
+TEST_CASE("rr+tcp URL with nodeid, nodename and service") {
+    auto u = parse_connection_url(
+        "rr+tcp://localhost:29200/?nodeid={d835c41d-339c-47a8-84db-f00a8fefd2fa}&nodename=example.node&service=reynard");
+    REQUIRE(u);
+    CHECK(u->scheme == "rr+tcp");
+    CHECK(u->host == "localhost");
+    CHECK(u->port == 29200);
+    CHECK(u->node_id.to_string() == "d835c41d-339c-47a8-84db-f00a8fefd2fa");
+    CHECK(u->node_name == "example.node");
+    CHECK(u->service == "reynard");
+    CHECK_FALSE(u->is_tls());
+    CHECK_FALSE(u->is_websocket());
+}
+
+TEST_CASE("default ports per scheme and IPv6 hosts") {
+    CHECK(parse_connection_url("rr+tcp://h/?service=s")->port == 48653);
+    CHECK(parse_connection_url("rr+ws://h/?service=s")->port == 80);
+    CHECK(parse_connection_url("rr+wss://h/?service=s")->port == 443);
+    auto v6 = parse_connection_url("rr+tcp://[fe80::1234]:62222/?service=x");
+    REQUIRE(v6);
+    CHECK(v6->host == "fe80::1234");
+    CHECK(v6->port == 62222);
+    CHECK(v6->to_string() == "rr+tcp://[fe80::1234]:62222/?service=x");
+    auto wss = parse_connection_url("RRS+WSS://gw.example:8443/?service=create");
+    REQUIRE(wss);
+    CHECK(wss->is_tls());
+    CHECK(wss->is_secure_websocket());
+}
+
+TEST_CASE("legacy tcp:// form names node and service in the path") {
+    auto u = parse_connection_url("tcp://127.0.0.1:52222/{d835c41d-339c-47a8-84db-f00a8fefd2fa}/Create");
+    REQUIRE(u);
+    CHECK(u->service == "Create");
+    CHECK_FALSE(u->node_id.is_any());
+    auto n = parse_connection_url("tcp://127.0.0.1:52222/MyNode/Create");
+    REQUIRE(n);
+    CHECK(n->node_name == "MyNode");
+}
+
+TEST_CASE("malformed URLs are rejected with a reason") {
+    for (const char* bad : {"localhost:1234", "http://h/", "rr+tcp://h:99999/", "rr+tcp://h:x/",
+                            "rr+tcp://[::1/", "rr+tcp://h/?service", "rr+tcp://h/?nodeid=zz"}) {
+        auto u = parse_connection_url(bad);
+        CHECK_FALSE(u);
+        if (!u) CHECK(u.error().type == MessageErrorType::InvalidArgument);
+    }
+}
