@@ -77,6 +77,30 @@ const MemberDefinition* ServiceEntryDefinition::find_member(std::string_view mem
     return nullptr;
 }
 
+bool pipe_is_unreliable(const ServiceEntryDefinition& entry, const MemberDefinition& pipe) noexcept {
+    if (pipe.kind != MemberKind::pipe) return false;
+    if (pipe.has_modifier("unreliable")) return true;
+    auto blank = [](char c) { return c == ' ' || c == '\t'; };
+    for (const auto& o : entry.options) {
+        // `pipe <name> unreliable`, blank separated.
+        std::string_view s = o;
+        std::string_view words[3];
+        int n = 0;
+        std::size_t i = 0;
+        while (i < s.size() && n <= 3) {
+            while (i < s.size() && blank(s[i])) ++i;
+            if (i == s.size()) break;
+            std::size_t k = i;
+            while (k < s.size() && !blank(s[k])) ++k;
+            if (n < 3) words[n] = s.substr(i, k - i);
+            ++n;
+            i = k;
+        }
+        if (n == 3 && words[0] == "pipe" && words[1] == pipe.name && words[2] == "unreliable") return true;
+    }
+    return false;
+}
+
 std::string Version::to_string() const {
     std::string s = std::to_string(major) + "." + std::to_string(minor);
     if (patch || tweak) s += "." + std::to_string(patch);

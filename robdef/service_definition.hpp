@@ -104,6 +104,7 @@ struct EnumValue {
     bool hex = false;       ///< written in hex (for to_string)
     bool implicit = false;  ///< value not written; previous + 1
     std::vector<std::string> docstring;
+    int line = 0;  ///< physical line of the value (added: diagnostics); 0 = unknown
 };
 
 struct EnumDefinition {
@@ -138,9 +139,17 @@ struct ServiceEntryDefinition {
     std::vector<std::string> options;     ///< legacy `option` lines (text after `option `)
     std::vector<std::string> docstring;
     SourceLocation location;
+    /// Added for diagnostics: physical line of each `implements` / `option` line, parallel to
+    /// `implements` / `options` when filled by the parser (may be shorter for hand-built models).
+    std::vector<int> implements_lines;
+    std::vector<int> option_lines;
 
     const MemberDefinition* find_member(std::string_view member_name) const noexcept;
 };
+
+/// Pipe reliability (robdef.md §5.2): the `unreliable` modifier, or the legacy object option line
+/// `option pipe <name> unreliable`. Added helper.
+bool pipe_is_unreliable(const ServiceEntryDefinition& entry, const MemberDefinition& pipe) noexcept;
 
 /// Standard version from `stdver` or legacy `option version` (robdef.md §9).
 struct Version {
@@ -166,6 +175,11 @@ struct ServiceDefinition {
     std::vector<ServiceEntryDefinition> objects;
     std::vector<std::string> docstring;
     SourceLocation location;  ///< file, line of the `service` statement
+    /// Added for diagnostics: physical line of each `import` / top-level `option` line, parallel to
+    /// `imports` / `options` when filled by the parser, and of the version statement (0 = none).
+    std::vector<int> import_lines;
+    std::vector<int> option_lines;
+    int version_line = 0;
 
     /// Struct/pod/namedarray/object with this unqualified name, or nullptr.
     const ServiceEntryDefinition* find_entry(std::string_view entry_name) const noexcept;

@@ -1,0 +1,55 @@
+// Parser for service definition text (robdef.md §1–§9): one `.robdef` text in, one
+// ServiceDefinition out. Sans-IO: the caller reads files (and strips a UTF-8 BOM, robdef.md §1.1).
+//
+// Accepts stdver 0.9 / 0.10 files and the legacy forms without stdver (`option`, `option version`,
+// `option constant`, `option pipe X unreliable`, `end struct` / `end object`), LF and CRLF, line
+// continuations, comments and docstrings. The first problem stops parsing (as in the official
+// parser); `option` deprecation is a warning. Semantic checks live in verifier.hpp.
+#pragma once
+
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "core/error/rr_error.hpp"
+#include "robdef/diagnostic.hpp"
+#include "robdef/service_definition.hpp"
+
+namespace rr::robdef {
+
+struct ParseOutput {
+    ServiceDefinition definition;
+    std::vector<Diagnostic> warnings;  ///< `option keyword is deprecated` (robdef.md §2.2)
+};
+
+/// Parses one definition. Error: ServiceDefinitionError whose message is
+/// `<file>:<line>: <message>` (see parse_service_definition_report for the structured form).
+Result<ParseOutput> parse_service_definition(std::string_view text, std::string_view file_name);
+
+/// Same parse, with the failure as a Diagnostic (file, line, kind, official message text).
+struct ParseReport {
+    std::optional<ServiceDefinition> definition;  ///< set when parsing succeeded
+    std::vector<Diagnostic> diagnostics;          ///< warnings, then the error if any
+    bool ok() const noexcept { return definition.has_value(); }
+};
+ParseReport parse_service_definition_report(std::string_view text, std::string_view file_name);
+
+/// Parses a type token alone, optionally followed by a name: `double[3]{list}`, `svc.Pod[*]`,
+/// `varvalue{string}`, `int32 x` (robdef.md §6.1). Named types are kept as written (no `using`
+/// expansion, unresolved). Error: ServiceDefinitionError `Could not parse type "…"`.
+Result<TypeDefinition> parse_type(std::string_view text);
+
+/// True when `value` is a valid constant value for `type` (robdef.md §7). Integer ranges are the
+/// type's full range (the official 8-bit quirk is not copied); unsigned types also take negative
+/// decimal values, as the official parser does.
+bool is_valid_constant_value(const TypeDefinition& type, std::string_view value);
+
+/// One `field: constant` pair of a struct constant.
+struct StructConstantField {
+    std::string name;
+    std::string constant_name;
+};
+/// Fields of a struct constant value `{a: c1, b: c2}` / `{}`; nullopt when malformed.
+std::optional<std::vector<StructConstantField>> parse_struct_constant_fields(std::string_view value);
+
+}  // namespace rr::robdef
