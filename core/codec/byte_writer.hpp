@@ -1,0 +1,52 @@
+// ByteWriter: appends little-endian integers and byte strings to a std::vector<std::byte>.
+//
+// The writer never fails; callers reserve the final size first (the message writer computes every
+// size before writing) so appends do not reallocate. Not thread-safe (holds a reference to `out`).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "core/codec/endian.hpp"
+
+namespace rr {
+
+class ByteWriter {
+public:
+    explicit ByteWriter(std::vector<std::byte>& out) noexcept : out_(out), start_(out.size()) {}
+
+    /// Bytes appended since this writer was made.
+    std::size_t written() const noexcept { return out_.size() - start_; }
+    std::vector<std::byte>& buffer() noexcept { return out_; }
+
+    template <class T>
+    void write(T value) {
+        std::array<std::byte, sizeof(T)> b;
+        store_le(b.data(), value);
+        out_.insert(out_.end(), b.begin(), b.end());
+    }
+    void write_u8(std::uint8_t v) { out_.push_back(static_cast<std::byte>(v)); }
+    void write_u16(std::uint16_t v) { write(v); }
+    void write_u32(std::uint32_t v) { write(v); }
+    void write_u64(std::uint64_t v) { write(v); }
+    void write_i8(std::int8_t v) { write(v); }
+    void write_i16(std::int16_t v) { write(v); }
+    void write_i32(std::int32_t v) { write(v); }
+    void write_i64(std::int64_t v) { write(v); }
+
+    void write_bytes(std::span<const std::byte> bytes) { out_.insert(out_.end(), bytes.begin(), bytes.end()); }
+    void write_string(std::string_view s) {
+        auto p = reinterpret_cast<const std::byte*>(s.data());
+        out_.insert(out_.end(), p, p + s.size());
+    }
+
+private:
+    std::vector<std::byte>& out_;
+    std::size_t start_;
+};
+
+}  // namespace rr
