@@ -504,7 +504,7 @@ def main(argv=None):
     t.DisableStringTable = not args.enable_stringtable
     t.AcceptWebSockets = args.websocket
     if args.heartbeat is not None:
-        t.DefaultHeartbeatPeriod = args.heartbeat
+        t._SetDefaultHeartbeatPeriod(int(args.heartbeat * 1000))  # the property setter passes a float
     t.StartServer(args.port, not args.listen_all)
     RRN.RegisterTransport(t)
     port = t.GetListenPort()
