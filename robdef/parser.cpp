@@ -366,9 +366,9 @@ bool parse_modifiers(std::string_view s, std::vector<std::string_view>& out) {
             k = close + 1;
         }
         out.push_back(s.substr(start, k - start));
-        i = skip_blanks(s, k);
-        if (i == s.size()) return true;
-        if (s[i] != ',') return false;
+        if (k == s.size()) return true;
+        i = skip_blanks(s, k);  // blanks only before a comma (`[readonly ]` is rejected)
+        if (i == s.size() || s[i] != ',') return false;
         ++i;
         if (trim(s.substr(i)).empty()) return true;
     }
@@ -427,7 +427,9 @@ struct ParseFailure {
 
 class Parser {
 public:
-    Parser(std::string_view text, std::string_view file) : reader_(text), file_(file) {}
+    Parser(std::string_view text, std::string_view file) : reader_(text), file_(file) {
+        def_.location = loc(0);
+    }
 
     ParseReport run();
 
