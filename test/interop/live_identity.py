@@ -31,6 +31,7 @@ import os
 import selectors
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import tempfile
@@ -263,12 +264,55 @@ def run_mode(mode, args, workdir, python):
     return result
 
 
+def checker_selftest(checker, capture, workdir):
+    """Shows the checker can fail: two mutated copies of a v2 capture must be reported.
+
+    1. the reserved uint16 of one v2 entry set to 1 (decodes fine, CORE writes 0, so the re-encoded
+       bytes differ: a MISMATCH);
+    2. the magic of one message broken (a DECODE ERROR).
+    Returns a list of problems (empty = the checker caught both)."""
+    records = list(capture_summary.read_records(capture))
+    target = None
+    for i, (kind, conn, data) in enumerate(records):
+        if kind == "C" and data[8:10] == b"\x02\x00":
+            header_size = struct.unpack_from("<H", data, 10)[0]
+            if struct.unpack_from("<H", data, header_size + 4)[0] == 1111:
+                target = (i, header_size)
+                break
+    if target is None:
+        return ["self-test: no v2 PropertyGetReq in %s" % capture]
+    problems = []
+    for name, mutate, expect_text in [
+        ("reserved", lambda b, h: b[:h + 6] + b"\x01\x00" + b[h + 8:], "MISMATCH"),
+        ("magic", lambda b, h: b"XRAC" + b[4:], "DECODE ERROR"),
+    ]:
+        path = os.path.join(workdir, "selftest_%s.rrcap" % name)
+        with open(path, "wb") as fh:
+            fh.write(capture_summary.MAGIC)
+            for i, (kind, conn, data) in enumerate(records):
+                if i == target[0]:
+                    data = mutate(data, target[1])
+                fh.write(struct.pack("<BII", ord(kind), conn, len(data)) + data)
+        try:
+            ck = subprocess.run([checker, path, "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                stdin=subprocess.DEVNULL, timeout=CHECKER_S, preexec_fn=_die_with_parent)
+        except subprocess.TimeoutExpired:
+            problems.append("self-test %s: checker timed out" % name)
+            continue
+        out = ck.stdout.decode("utf-8", "replace")
+        if ck.returncode != 1 or expect_text not in out:
+            problems.append("self-test %s: checker status %d, expected 1 and %r in its output"
+                            % (name, ck.returncode, expect_text))
+    return problems
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--checker", help="capture checker executable (rr_capture_check); omitted = capture only")
     ap.add_argument("--modes", default="v4,v4st,v2", help="comma-separated: " + ",".join(MODES))
     ap.add_argument("--keep", help="write captures and logs to this directory and keep them")
     ap.add_argument("--verbose", action="store_true", help="print the checker's full output")
+    ap.add_argument("--no-selftest", action="store_true", help="skip the checker self-test on mutated captures")
     ap.add_argument("--python", default=sys.executable, help="Python with the robotraconteur package")
     args = ap.parse_args(argv)
     modes = [x for x in args.modes.split(",") if x]
@@ -300,6 +344,11 @@ def main(argv=None):
                 print("\n".join(lines if (args.verbose or not r["ok"]) else lines[-40:]), flush=True)
             if not r["ok"]:
                 print("   error: %s" % r.get("error"), flush=True)
+            if mode == "v2" and r["ok"] and args.checker and not args.no_selftest:
+                problems = checker_selftest(args.checker, r["capture"], workdir)
+                results.append({"mode": "checker-selftest", "ok": not problems, "error": "; ".join(problems)})
+                print("== checker self-test %s%s" % ("ok" if not problems else "FAILED: ", "; ".join(problems)),
+                      flush=True)
     finally:
         if not args.keep:
             shutil.rmtree(workdir, ignore_errors=True)
