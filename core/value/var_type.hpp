@@ -22,15 +22,10 @@ namespace rr {
 ///   null           → "" (a null varvalue has no type)
 std::string var_type_string(const Value& v);
 
-/// Parses a type string: `BASE [ARRAY] [CONTAINER] [name]` (robdef.md §6.1), e.g. "double[]",
-/// "int32[3,2]", "svc.Pose[*]", "varvalue{string}", "string value". BASE is a primitive keyword or a
-/// (qualified) named type; `structure`, `object`, `varobject` and `{generator}` are rejected.
-/// The result has `base`, `type_name` (named types), array and container fields and `name` filled.
-/// Errors: DataTypeError naming the bad text.
+/// Parses the type string of a value: robdef::parse_type (`BASE [ARRAY] [CONTAINER] [name]`, robdef.md
+/// §6.1, e.g. "double[]", "int32[3,2]", "svc.Pose[*]", "varvalue{string}", "string value"), then rejects
+/// what cannot be a value: `structure`, `object`, `varobject`, `{generator}`, void arrays/containers.
+/// Named types stay unresolved. Errors: DataTypeError naming the bad text.
 Result<robdef::TypeDefinition> parse_type_string(std::string_view text);
-
-/// DataTypes code of a primitive keyword ("double" … "bool", "string", "varvalue", "void"), or
-/// namedtype_t for anything else.
-DataTypes keyword_data_type(std::string_view word) noexcept;
 
 }  // namespace rr
