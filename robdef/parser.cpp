@@ -933,8 +933,12 @@ Result<ParseOutput> parse_service_definition(std::string_view text, std::string_
     if (!r.ok()) {
         const Diagnostic& d = r.diagnostics.back();
         std::string msg = d.file.empty() ? std::string("<text>") : d.file;
-        if (d.line > 0) msg += ":" + std::to_string(d.line);
-        msg += ": " + d.message;
+        if (d.line > 0) {
+            msg += ':';
+            msg += std::to_string(d.line);
+        }
+        msg += ": ";
+        msg += d.message;
         return fail(MessageErrorType::ServiceDefinitionError, std::move(msg));
     }
     ParseOutput out{std::move(*r.definition), std::move(r.diagnostics)};

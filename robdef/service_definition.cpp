@@ -102,9 +102,18 @@ bool pipe_is_unreliable(const ServiceEntryDefinition& entry, const MemberDefinit
 }
 
 std::string Version::to_string() const {
-    std::string s = std::to_string(major) + "." + std::to_string(minor);
-    if (patch || tweak) s += "." + std::to_string(patch);
-    if (tweak) s += "." + std::to_string(tweak);
+    // Appends piecewise (GCC 12 warns falsely on `"." + std::string` at -O2, bug 105651).
+    std::string s = std::to_string(major);
+    s += '.';
+    s += std::to_string(minor);
+    if (patch || tweak) {
+        s += '.';
+        s += std::to_string(patch);
+    }
+    if (tweak) {
+        s += '.';
+        s += std::to_string(tweak);
+    }
     return s;
 }
 
