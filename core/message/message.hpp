@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/codec/shared_bytes.hpp"
@@ -54,6 +55,9 @@ struct MessageElement {
 
     /// First child whose name equals `n` (numbers never match), or nullptr.
     const MessageElement* find(std::string_view n) const noexcept;
+
+    /// Field-by-field equality; `data` compares bytes, not owners.
+    friend bool operator==(const MessageElement&, const MessageElement&) = default;
 };
 
 /// One entry (wire.md §1.3, §2.4).
@@ -71,6 +75,8 @@ struct MessageEntry {
 
     /// First top-level element named `n`, or nullptr.
     const MessageElement* find(std::string_view n) const noexcept;
+
+    friend bool operator==(const MessageEntry&, const MessageEntry&) = default;
 };
 
 /// v4 header flags (wire.md §2.3).
@@ -84,6 +90,29 @@ inline constexpr std::uint8_t string_table = 0x20;
 inline constexpr std::uint8_t multiple_entries = 0x40;
 inline constexpr std::uint8_t extended = 0x80;
 }  // namespace message_flags
+
+/// v4 entry flags (wire.md §2.4).
+namespace entry_flags {
+inline constexpr std::uint8_t service_path_str = 0x01;
+inline constexpr std::uint8_t service_path_code = 0x02;
+inline constexpr std::uint8_t member_name_str = 0x04;
+inline constexpr std::uint8_t member_name_code = 0x08;
+inline constexpr std::uint8_t request_id = 0x10;
+inline constexpr std::uint8_t error = 0x20;
+inline constexpr std::uint8_t meta_info = 0x40;
+inline constexpr std::uint8_t extended = 0x80;
+}  // namespace entry_flags
+
+/// v4 element flags (wire.md §2.5). 0x40 is reserved.
+namespace element_flags {
+inline constexpr std::uint8_t element_name_str = 0x01;
+inline constexpr std::uint8_t element_name_code = 0x02;
+inline constexpr std::uint8_t element_number = 0x04;
+inline constexpr std::uint8_t element_type_name_str = 0x08;
+inline constexpr std::uint8_t element_type_name_code = 0x10;
+inline constexpr std::uint8_t meta_info = 0x20;
+inline constexpr std::uint8_t extended = 0x80;
+}  // namespace element_flags
 
 /// Message header (wire.md §1.2, §2.3).
 struct MessageHeader {
@@ -106,6 +135,8 @@ struct MessageHeader {
     /// Message-local string table (odd codes), in wire order.
     std::vector<std::pair<std::uint32_t, std::string>> string_table;
     std::string extended;
+
+    friend bool operator==(const MessageHeader&, const MessageHeader&) = default;
 };
 
 /// A whole message (wire.md §1, §2). `version` is 2 or 4: the version it was decoded from, or the
@@ -114,6 +145,8 @@ struct Message {
     std::uint16_t version = 2;
     MessageHeader header;
     std::vector<MessageEntry> entries;
+
+    friend bool operator==(const Message&, const Message&) = default;
 };
 
 }  // namespace rr

@@ -1,15 +1,37 @@
 // Decoding RR messages from bytes: message format v2 (wire.md §1) and v4 (wire.md §2).
 //
-// CONTRACT SKETCH — the codec implementation owns this file and may refine signatures, keeping the
-// names decode_message / MessageStreamReader.
+// decode_message() takes one whole message and dispatches on its MessageVersion field (2 or 4).
+// Element payloads (raw arrays, strings) in the result are SharedBytes views into the input buffer:
+// no copy and no allocation per payload.
 //
-// Errors: ProtocolError (bad magic, unknown version, sizes that do not add up, unknown data type,
-// unknown string-table code), BufferLimitViolation (a size over Limits). Never UB, crash or hang.
-// Memory: nothing is reserved before the length it depends on has been checked against the bytes
-// present and Limits.
+// Order of checks (message_v2.md §Common Message Header): magic "RRAC"; MessageSize at least
+// kMinMessageSize and at most Limits::max_message_size; MessageSize equal to the bytes given; version;
+// then every header/entry/element size is checked against the bytes that remain in its parent and must
+// end exactly where it says; every count is checked against the bytes left (each item has a minimum
+// size) and against Limits before anything is reserved.
+//
+// Errors: ProtocolError — bad magic, unknown version, truncation, sizes that do not add up, an unknown
+//         data type, a void element with DataCount ≠ 0, v4 varints in their 64-bit form, an unknown
+//         string-table code, a v4 field given both as string and as code (or name and number), nesting
+//         deeper than Limits::max_nesting_depth.
+//         BufferLimitViolation — MessageSize over Limits::max_message_size, more entries than
+//         Limits::max_entries, more elements (all levels) than Limits::max_elements.
+// Never UB, crash or hang on any input (fuzzed: test/fuzz/fuzz_message_reader.cpp).
+//
+// What the model records so that re-encoding is byte-identical (for inputs written with CORE's
+// rules, i.e. shortest varints and CORE's entry/element flag choices):
+//  * v4 header flags are kept in MessageHeader::v4_flags, string-table codes in the *_code fields,
+//    the local table in MessageHeader::string_table (wire order), Extended blobs as bytes.
+//  * Element numbers: v4 ELEMENT_NUMBER → MessageElement::number (name empty). In v2 a decimal
+//    name is read back as a number (name cleared) only where CORE writes numbers: children of
+//    vector_t, list_t and pod_array_t, and the top-level elements of PipePacketRet entries
+//    (CORE PipeMember.cpp acks), and only for canonical text (element_number.hpp).
+//  * Not kept: the v2 entry "reserved" field (CORE writes 0, ignores it), the v4 element flag 0x40
+//    (reserved), v4 entry/element flags that announce an empty or zero optional field.
 #pragma once
 
-#include <optional>
+#include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "core/codec/limits.hpp"
@@ -25,10 +47,39 @@ struct DecodeContext {
     NodeID remote_node_id;
     std::uint32_t local_endpoint = 0;
     std::uint32_t remote_endpoint = 0;
+    /// Even string-table codes are looked up in the standard table only if this is set (the
+    /// STANDARD_TABLE capability was negotiated); otherwise they are a ProtocolError, as in CORE.
+    /// Odd codes always use the message's own table. Without a context both are accepted.
+    bool standard_string_table = true;
 };
 
+/// "RRAC" + uint32 MessageSize: the first bytes of every message on a stream (wire.md §6).
+inline constexpr std::size_t kMessagePreambleBytes = 8;
+/// Smallest MessageSize that can hold a fixed header (v4: magic, size, version, HeaderLen, flags).
+inline constexpr std::size_t kMinMessageSize = 12;
+
+/// Checks the 8-byte preamble. Returns MessageSize.
+/// Errors: ProtocolError (fewer than 8 bytes, bad magic, MessageSize < kMinMessageSize),
+/// BufferLimitViolation (MessageSize > limits.max_message_size).
+Result<std::uint32_t> read_message_preamble(std::span<const std::byte> bytes, const Limits& limits = {});
+
+/// A decoded header with the framing fields the model does not carry.
+struct MessageHeaderInfo {
+    std::uint16_t version = 0;
+    std::uint32_t message_size = 0;  ///< bytes, whole message
+    std::uint32_t header_size = 0;   ///< bytes from offset 0 to the first entry
+    std::uint32_t entry_count = 0;
+    MessageHeader header;
+};
+
+/// Decodes only the header of the whole message in `message` (MessageSize must equal its size), e.g.
+/// to route a frame without decoding its entries. Errors: as decode_message, for the header.
+Result<MessageHeaderInfo> decode_message_header(std::span<const std::byte> message, const Limits& limits = {},
+                                                const DecodeContext* context = nullptr);
+
 /// Decodes one complete message held in `buffer` (exactly one message: MessageSize == buffer size).
-/// Element payloads in the result are views into `buffer`: no copy.
+/// Element payloads in the result are views into `buffer`: no copy. `context` fills the v4 header
+/// fields a sender omitted (all-zero NodeIDs and endpoints when null).
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits = {}, const DecodeContext* context = nullptr);
 
 }  // namespace rr

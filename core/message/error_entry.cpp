@@ -1,0 +1,43 @@
+#include "core/message/error_entry.hpp"
+
+namespace rr {
+namespace {
+
+std::optional<std::string> string_value(const MessageEntry& entry, std::string_view name) {
+    const MessageElement* e = entry.find(name);
+    if (!e || e->type != DataTypes::string_t) return std::nullopt;
+    // A char view of the payload bytes: aliasing-safe, no integer is read through the cast.
+    return std::string(reinterpret_cast<const char*>(e->data.data()), e->data.size());
+}
+
+}  // namespace
+
+MessageElement make_string_element(std::string name, std::string_view text) {
+    MessageElement e;
+    e.name = std::move(name);
+    e.type = DataTypes::string_t;
+    if (!text.empty()) e.data = SharedBytes::copy_of(text.data(), text.size());
+    return e;
+}
+
+void set_entry_error(MessageEntry& entry, const RRError& error) {
+    entry.error = error.type;
+    entry.elements.clear();
+    std::string_view name = error.name.empty() ? error_name(error.type) : std::string_view(error.name);
+    entry.elements.push_back(make_string_element("errorname", name));
+    entry.elements.push_back(make_string_element("errorstring", error.message));
+    if (!error.sub_name.empty()) entry.elements.push_back(make_string_element("errorsubname", error.sub_name));
+}
+
+std::optional<RRError> entry_error(const MessageEntry& entry) {
+    if (entry.error == MessageErrorType::None) return std::nullopt;
+    RRError e;
+    e.type = entry.error;
+    auto name = string_value(entry, "errorname");
+    e.name = name ? std::move(*name) : std::string(error_name(entry.error));
+    e.message = string_value(entry, "errorstring").value_or(std::string());
+    e.sub_name = string_value(entry, "errorsubname").value_or(std::string());
+    return e;
+}
+
+}  // namespace rr

@@ -1,0 +1,27 @@
+// Error entries (wire.md §5.2; CORE Error.cpp): an entry whose `error` field is non-zero carries,
+// instead of its normal elements, the string elements `errorname`, `errorstring` and, if non-empty,
+// `errorsubname` (plus an optional `errorparam` value, left to core/value).
+#pragma once
+
+#include <optional>
+
+#include "core/error/rr_error.hpp"
+#include "core/message/message.hpp"
+
+namespace rr {
+
+/// A string (string_t) element holding a copy of `text`.
+MessageElement make_string_element(std::string name, std::string_view text);
+
+/// Turns `entry` into an error reply: sets `entry.error = error.type` and replaces its elements by
+/// `errorname` (error.name, or error_name(error.type) when empty), `errorstring` and, if non-empty,
+/// `errorsubname`. EntryType, ServicePath, MemberName and RequestID are left as they are.
+void set_entry_error(MessageEntry& entry, const RRError& error);
+
+/// The error an entry carries, or nullopt when `entry.error` is None. The code decides the type (CORE
+/// maps errors by code, wire.md §5.1); the name comes from `errorname` (falling back to
+/// error_name(type) when the element is missing or not a string), the message from `errorstring`,
+/// the sub-name from `errorsubname`.
+std::optional<RRError> entry_error(const MessageEntry& entry);
+
+}  // namespace rr

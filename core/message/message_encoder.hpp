@@ -1,0 +1,62 @@
+// Internal: the two-pass encoder behind message_writer.hpp. measure() validates the message and
+// records every entry/element size in pre-order; write() replays them. Not part of the public API.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/codec/byte_writer.hpp"
+#include "core/message/message_writer.hpp"
+
+namespace rr::detail {
+
+class MessageEncoder {
+public:
+    explicit MessageEncoder(const Message& message) : m_(message) {}
+
+    /// Validates and measures; returns the total message size.
+    Result<std::uint32_t> measure();
+    /// Writes the measured message. Precondition: measure() succeeded.
+    void write(ByteWriter& w);
+
+private:
+    // message_writer_v2.cpp
+    Result<std::uint32_t> measure_v2();
+    Result<std::uint64_t> measure_entry_v2(const MessageEntry& entry);
+    Result<std::uint64_t> measure_element_v2(const MessageElement& e);
+    void write_v2(ByteWriter& w);
+    void write_entry_v2(ByteWriter& w, const MessageEntry& entry);
+    void write_element_v2(ByteWriter& w, const MessageElement& e);
+
+    // message_writer_v4.cpp
+    Result<std::uint32_t> measure_v4();
+    Result<std::uint64_t> measure_entry_v4(const MessageEntry& entry);
+    Result<std::uint64_t> measure_element_v4(const MessageElement& e);
+    Result<std::uint64_t> measure_name_v4(const std::string& s, const std::optional<std::uint32_t>& code);
+    void write_v4(ByteWriter& w);
+    void write_entry_v4(ByteWriter& w, const MessageEntry& entry);
+    void write_element_v4(ByteWriter& w, const MessageElement& e);
+
+    // message_writer.cpp
+    /// Checks type/data/children agree; returns the payload bytes of raw data (0 for nested/void).
+    Result<std::uint64_t> check_payload(const MessageElement& e) const;
+    /// Reserves a pre-order slot for a size computed after the children.
+    std::size_t reserve_size_slot();
+    std::uint32_t next_size();
+
+    const Message& m_;
+    std::vector<std::uint32_t> sizes_;  // entry and element sizes, pre-order
+    std::size_t cursor_ = 0;
+    std::uint32_t total_ = 0;
+    std::uint32_t header_size_ = 0;
+    std::uint8_t v4_flags_ = 0;
+    std::vector<std::uint32_t> local_codes_;  // codes of the local table being written, sorted
+};
+
+/// Bytes of a v4 XLen string (uint_x length + bytes).
+std::uint64_t xlen_size(std::size_t n) noexcept;
+
+}  // namespace rr::detail

@@ -1,0 +1,61 @@
+#include "core/message/message_stream_reader.hpp"
+
+#include <algorithm>
+
+namespace rr {
+
+Unexpected MessageStreamReader::stop(RRError e) {
+    error_ = e;
+    return fail(std::move(e));
+}
+
+Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
+    if (error_) return fail(*error_);
+    while (!bytes.empty()) {
+        if (expected_ == 0) {
+            // Preamble: check the magic as soon as its bytes are here, the size before allocating.
+            const std::size_t n = std::min(bytes.size(), kMessagePreambleBytes - preamble_fill_);
+            std::copy_n(bytes.begin(), n, preamble_.begin() + static_cast<std::ptrdiff_t>(preamble_fill_));
+            preamble_fill_ += n;
+            bytes = bytes.subspan(n);
+            static constexpr char kMagic[] = "RRAC";
+            for (std::size_t i = 0; i < std::min<std::size_t>(preamble_fill_, 4); ++i)
+                if (preamble_[i] != static_cast<std::byte>(kMagic[i]))
+                    return stop(make_error(MessageErrorType::ProtocolError, "bad message magic (expected RRAC)"));
+            if (preamble_fill_ < kMessagePreambleBytes) return {};
+            auto size = read_message_preamble(preamble_, limits_);
+            if (!size) return stop(size.error());
+            expected_ = *size;
+            body_.reserve(expected_);
+            body_.assign(preamble_.begin(), preamble_.end());
+            preamble_fill_ = 0;
+        }
+        const std::size_t n = std::min(bytes.size(), expected_ - body_.size());
+        body_.insert(body_.end(), bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+        bytes = bytes.subspan(n);
+        if (body_.size() == expected_) {
+            ready_.push_back(SharedBytes::adopt(std::move(body_)));
+            body_ = {};
+            expected_ = 0;
+        }
+    }
+    return {};
+}
+
+std::optional<SharedBytes> MessageStreamReader::take_frame() {
+    if (error_ || ready_.empty()) return std::nullopt;
+    SharedBytes frame = std::move(ready_.front());
+    ready_.pop_front();
+    return frame;
+}
+
+Result<std::optional<Message>> MessageStreamReader::take_message(const DecodeContext* context) {
+    if (error_) return fail(*error_);
+    auto frame = take_frame();
+    if (!frame) return std::optional<Message>{};
+    auto m = decode_message(std::move(*frame), limits_, context);
+    if (!m) return stop(m.error());
+    return std::optional<Message>(std::move(*m));
+}
+
+}  // namespace rr

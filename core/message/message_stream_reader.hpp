@@ -1,0 +1,71 @@
+// MessageStreamReader: incremental framing of the RR stream protocol (wire.md §6; STD
+// basic_stream_protocol.md). Messages follow each other on the byte stream, each starting with the
+// 8-byte preamble "RRAC" + uint32 MessageSize; there is no resynchronisation after an error.
+//
+// In: bytes in any split (feed). Out: whole messages in arrival order, as SharedBytes frames (one
+// owned buffer per message; forward it without copying, or decode it with element payloads as views
+// into it) or as decoded Messages. Not thread-safe.
+//
+// Limits: the magic is checked as soon as its bytes arrive; MessageSize is checked against
+// kMinMessageSize and Limits::max_message_size right after the preamble, before any buffer for the
+// message is allocated, and that buffer is exactly MessageSize bytes.
+// Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
+// below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
+// over the limit, or a decode limit). After the first error every call fails with that error and no
+// further frame is yielded, including frames completed before the error.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <deque>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/codec/limits.hpp"
+#include "core/codec/shared_bytes.hpp"
+#include "core/message/message_reader.hpp"
+
+namespace rr {
+
+class MessageStreamReader {
+public:
+    explicit MessageStreamReader(const Limits& limits = {}) : limits_(limits) {}
+
+    /// Consumes all of `bytes`; complete messages become available to take_frame/take_message.
+    /// Errors: see above; once failed, always failed.
+    Result<void> feed(std::span<const std::byte> bytes);
+
+    /// The next complete message, bytes exactly as received; nullopt if none is complete yet.
+    std::optional<SharedBytes> take_frame();
+
+    /// Decodes the next complete message. ok(nullopt) if none is complete; a decode error is fatal.
+    Result<std::optional<Message>> take_message(const DecodeContext* context = nullptr);
+
+    /// Changes the MessageSize limit (e.g. from Limits::max_pre_session_message_size to
+    /// max_message_size once a client session exists, wire.md §6.4). Applies to messages whose
+    /// preamble completes after the call; a message already being assembled keeps its checked size.
+    void set_max_message_size(std::size_t bytes) noexcept { limits_.max_message_size = bytes; }
+    std::size_t max_message_size() const noexcept { return limits_.max_message_size; }
+
+    /// Number of complete messages waiting.
+    std::size_t ready_count() const noexcept { return ready_.size(); }
+    /// Bytes of the message being assembled (0 between messages).
+    std::size_t partial_bytes() const noexcept { return preamble_fill_ + body_.size(); }
+    bool failed() const noexcept { return error_.has_value(); }
+    /// The error that stopped the reader, or nullptr.
+    const RRError* error() const noexcept { return error_ ? &*error_ : nullptr; }
+
+private:
+    Unexpected stop(RRError e);
+
+    Limits limits_;
+    std::array<std::byte, kMessagePreambleBytes> preamble_{};
+    std::size_t preamble_fill_ = 0;
+    std::size_t expected_ = 0;        // MessageSize of the message in body_, 0 while reading a preamble
+    std::vector<std::byte> body_;     // the whole message being assembled, preamble included
+    std::deque<SharedBytes> ready_;
+    std::optional<RRError> error_;
+};
+
+}  // namespace rr
