@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <set>
 
 #include "robdef/lexer.hpp"
 
@@ -706,6 +707,8 @@ bool Parser::parse_enum(const lex::LogicalLine& opener) {
     e.docstring = opener.docstring;
     e.location = loc(opener.line);
     bool comma_endl = true;
+    std::set<std::string> seen_names;
+    std::set<std::int32_t> seen_values;
     for (auto& l : body) {
         if (!comma_endl) return fail(l.line, DiagnosticKind::enumeration, "Enum parse error");
         std::string_view text = trim(l.text);
@@ -747,9 +750,8 @@ bool Parser::parse_enum(const lex::LogicalLine& opener) {
                 v.value = static_cast<std::int32_t>(neg ? -mag : mag);
                 v.hex = hex;
             }
-            for (const auto& o : e.values)
-                if (o.name == v.name || o.value == v.value)
-                    return fail(l.line, DiagnosticKind::enumeration, "Enum names or values not unique");
+            if (!seen_names.insert(v.name).second || !seen_values.insert(v.value).second)
+                return fail(l.line, DiagnosticKind::enumeration, "Enum names or values not unique");
             e.values.push_back(std::move(v));
         }
     }

@@ -110,7 +110,7 @@ private:
     void verify_imports(const ServiceDefinition& d);
     bool imports_cycle(const ServiceDefinition& d, std::vector<const ServiceDefinition*>& path,
                        std::set<const ServiceDefinition*>& done, std::string& a, std::string& b);
-    void add_high_level_name(std::vector<std::string>& names, const std::string& n, int line);
+    void add_high_level_name(std::set<std::string>& names, const std::string& n, int line);
     std::optional<std::string> verify_option_constant(const std::string& option, int line);
     std::optional<std::string> verify_constant(const ConstantDefinition& c,
                                                const std::vector<ConstantDefinition>& scope);
@@ -140,6 +140,7 @@ private:
     const ServiceDefinition* svc_ = nullptr;
     std::vector<const ServiceDefinition*> imported_;
     std::set<std::string> pods_acyclic_;
+    std::set<const ConstantDefinition*> struct_constants_ok_;  // verified without cycles
     std::map<std::string, DataTypes> namedarray_types_;
 };
 
@@ -191,11 +192,10 @@ bool Verifier::require_version_0_9(int line, const char* msg) {
     return true;
 }
 
-void Verifier::add_high_level_name(std::vector<std::string>& names, const std::string& n, int line) {
-    if (std::find(names.begin(), names.end(), n) != names.end())
+void Verifier::add_high_level_name(std::set<std::string>& names, const std::string& n, int line) {
+    if (!names.insert(n).second)
         error(line, DiagnosticKind::duplicate,
               "Service definition " + quoted(svc_->name) + " contains multiple high level names " + quoted(n));
-    names.push_back(n);
 }
 
 bool Verifier::imports_cycle(const ServiceDefinition& d, std::vector<const ServiceDefinition*>& path,
@@ -250,6 +250,7 @@ std::optional<std::string> Verifier::verify_option_constant(const std::string& o
 
 bool Verifier::verify_struct_constant(const ConstantDefinition& c, const std::vector<ConstantDefinition>& scope,
                                       std::vector<std::string>& parents, const ConstantDefinition& root) {
+    if (struct_constants_ok_.count(&c)) return true;
     auto fields = parse_struct_constant_fields(c.value);
     int line = root.location.line;
     if (!fields) {
@@ -282,6 +283,7 @@ bool Verifier::verify_struct_constant(const ConstantDefinition& c, const std::ve
             return false;
     }
     parents.pop_back();
+    struct_constants_ok_.insert(&c);
     return true;
 }
 
@@ -320,13 +322,14 @@ void Verifier::verify_using(const UsingDefinition& u) {
 
 void Verifier::verify_enum(const EnumDefinition& e) {
     int line = line_or_service(e.location.line);
-    for (std::size_t i = 0; i < e.values.size(); ++i)
-        for (std::size_t j = i + 1; j < e.values.size(); ++j)
-            if (e.values[i].value == e.values[j].value || e.values[i].name == e.values[j].name) {
-                error(e.values[j].line > 0 ? e.values[j].line : line, DiagnosticKind::enumeration,
-                      "Invalid constant in enum " + e.name);
-                return;
-            }
+    std::set<std::string> value_names;
+    std::set<std::int32_t> values;
+    for (const auto& v : e.values) {
+        if (!value_names.insert(v.name).second || !values.insert(v.value).second) {
+            error(v.line > 0 ? v.line : line, DiagnosticKind::enumeration, "Invalid constant in enum " + e.name);
+            return;
+        }
+    }
     if (!verify_name(e.name, line)) return;
     for (const auto& v : e.values)
         if (!verify_name(v.name, v.line > 0 ? v.line : line)) return;
@@ -635,12 +638,11 @@ void Verifier::verify_structure(const ServiceEntryDefinition& e) {
     if (!verify_name(e.name, line)) return;
     const bool is_pod = e.kind == EntryKind::pod;
     const bool is_na = e.kind == EntryKind::namedarray;
-    std::vector<std::string> names;
+    std::set<std::string> names;
     auto dup = [&](const std::string& n, int at, const char* what) {
-        if (std::find(names.begin(), names.end(), n) != names.end())
+        if (!names.insert(n).second)
             error(at, DiagnosticKind::duplicate,
                   std::string(what) + " " + quoted(e.name) + " contains multiple members named " + quoted(n));
-        names.push_back(n);
     };
     for (const auto& o : e.options) {
         if (lex::trim(o).substr(0, 8) != "constant" || (o.size() > 8 && !lex::is_blank(o[8]))) continue;
@@ -863,12 +865,11 @@ void Verifier::verify_implements(const ServiceEntryDefinition& obj) {
 void Verifier::verify_object(const ServiceEntryDefinition& e) {
     const int line = line_or_service(e.location.line);
     if (!verify_name(e.name, line)) return;
-    std::vector<std::string> names;
+    std::set<std::string> names;
     auto dup = [&](const std::string& n, int at) {
-        if (std::find(names.begin(), names.end(), n) != names.end())
+        if (!names.insert(n).second)
             error(at, DiagnosticKind::duplicate,
                   "Object " + quoted(e.name) + " contains multiple members named " + quoted(n));
-        names.push_back(n);
     };
     for (const auto& o : e.options) {
         if (lex::trim(o).substr(0, 8) != "constant" || (o.size() > 8 && !lex::is_blank(o[8]))) continue;
@@ -899,7 +900,7 @@ void Verifier::verify_service(const ServiceDefinition& d) {
 
     verify_imports(d);
 
-    std::vector<std::string> names;
+    std::set<std::string> names;
     for (std::size_t i = 0; i < d.options.size(); ++i) {
         const auto& o = d.options[i];
         if (lex::trim(o).substr(0, 8) != "constant" || (o.size() > 8 && !lex::is_blank(o[8]))) continue;
