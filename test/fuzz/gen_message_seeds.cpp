@@ -1,0 +1,126 @@
+// Writes a few small messages, made with our own encoder, as seed inputs for fuzz_message_reader.
+// Usage: gen_message_seeds <dir>   (the committed seeds are test/fuzz/seeds/fuzz_message_reader)
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/codec/endian.hpp"
+#include "core/message/error_entry.hpp"
+#include "core/message/message_writer.hpp"
+#include "core/message/string_table.hpp"
+
+namespace {
+
+using namespace rr;
+
+MessageElement u32(std::string name, std::uint32_t v) {
+    MessageElement e;
+    e.name = std::move(name);
+    e.type = DataTypes::uint32_t;
+    std::byte b[4];
+    store_le(b, v);
+    e.data = SharedBytes::copy_of(b, 4);
+    return e;
+}
+
+Message base(std::uint16_t version) {
+    Message m;
+    m.version = version;
+    m.header.sender_node_id = NodeID::parse("0123456789abcdef0123456789abcdef").value();
+    m.header.receiver_node_id = NodeID::parse("fedcba9876543210fedcba9876543210").value();
+    m.header.sender_endpoint = 1000;
+    m.header.receiver_endpoint = 70000;
+    return m;
+}
+
+Message heartbeat(std::uint16_t version, bool stripped) {
+    Message m = base(version);
+    if (stripped) m.header.v4_flags = std::uint8_t{0};
+    MessageEntry e;
+    e.entry_type = MessageEntryType::ConnectionTest;
+    m.entries.push_back(e);
+    return m;
+}
+
+Message call(std::uint16_t version) {
+    Message m = base(version);
+    MessageEntry e;
+    e.entry_type = MessageEntryType::FunctionCallReq;
+    e.service_path = "svc.obj[1]";
+    e.member_name = "move";
+    e.request_id = 300;
+    MessageElement list;
+    list.name = "points";
+    list.type = DataTypes::list_t;
+    for (int i = 0; i < 2; ++i) {
+        MessageElement p;
+        p.number = i;
+        p.type = DataTypes::structure_t;
+        p.type_name = "demo.Point";
+        p.elements.push_back(u32("x", 1));
+        p.elements.push_back(make_string_element("label", "ab"));
+        list.elements.push_back(p);
+    }
+    e.elements.push_back(list);
+    MessageElement nothing;
+    nothing.name = "opt";
+    e.elements.push_back(nothing);
+    m.entries.push_back(e);
+    return m;
+}
+
+Message pipe_ack(std::uint16_t version) {
+    Message m = base(version);
+    m.header.metadata = "unreliable\n";
+    MessageEntry e;
+    e.entry_type = MessageEntryType::PipePacketRet;
+    e.member_name = "p";
+    MessageElement ack = u32("", 5);
+    ack.number = -1;
+    e.elements.push_back(ack);
+    m.entries.push_back(e);
+    return m;
+}
+
+Message v4_extras() {
+    Message m = call(4);
+    m.header.priority = 2;
+    m.header.extended = "x";
+    m.header.message_id = 9;
+    m.entries[0].extended = "e";
+    MessageEntry err;
+    err.entry_type = MessageEntryType::PropertyGetRes;
+    err.member_name = "value";
+    set_entry_error(err, make_error(MessageErrorType::ValueNotSet, "not set"));
+    m.entries.push_back(err);
+    apply_string_table(m, StringTableOptions{});
+    return m;
+}
+
+bool write(const std::string& dir, const char* name, const Message& m) {
+    auto bytes = encode_message(m);
+    if (!bytes) return false;
+    std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
+    if (!f) return false;
+    bool ok = std::fwrite(bytes->data(), 1, bytes->size(), f) == bytes->size();
+    return std::fclose(f) == 0 && ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 2) {
+        std::fprintf(stderr, "usage: %s <seed-dir>\n", argv[0]);
+        return 2;
+    }
+    const std::string dir = argv[1];
+    bool ok = write(dir, "heartbeat_v2.bin", heartbeat(2, false)) && write(dir, "heartbeat_v4.bin", heartbeat(4, false)) &&
+              write(dir, "heartbeat_v4_stripped.bin", heartbeat(4, true)) && write(dir, "call_v2.bin", call(2)) &&
+              write(dir, "call_v4.bin", call(4)) && write(dir, "pipe_ack_v2.bin", pipe_ack(2)) &&
+              write(dir, "pipe_ack_v4.bin", pipe_ack(4)) && write(dir, "extras_v4.bin", v4_extras());
+    if (!ok) {
+        std::fprintf(stderr, "gen_message_seeds: could not write seeds to %s\n", dir.c_str());
+        return 1;
+    }
+    return 0;
+}
