@@ -5,6 +5,17 @@
 // `option constant`, `option pipe X unreliable`, `end struct` / `end object`), LF and CRLF, line
 // continuations, comments and docstrings. The first problem stops parsing (as in the official
 // parser); `option` deprecation is a warning. Semantic checks live in verifier.hpp.
+//
+// Deliberate differences from the official parser (robdef.md §20 lists the quirks):
+//  - line numbers are physical lines (no drift after continuations, robdef.md §1.2; enum errors at
+//    the offending value, not at `end`; member and type errors at the member line, not 0/-1);
+//  - 8-bit integer constants take their full range (the official single-digit quirk is a bug);
+//  - `objref T[]{int32}` is rejected (the official parser accepts it and then cannot print it);
+//  - constants with a container (`string{list}`) are rejected for every base type;
+//  - array sizes above 2^31-1 give `Could not parse type "…"` (the official text leaks
+//    `Parse error: bad lexical cast: …`);
+//  - modifier arguments may have blanks before any comma (`f(1 ,2 ,3)`);
+//  - `[0]`/`[0-]` are stored as `[]` (the official parser keeps a fixed length 0 that behaves as `[]`).
 #pragma once
 
 #include <optional>

@@ -8,6 +8,14 @@
 // line of the offending statement (robdef.md §11). Warnings (`Unknown member modifier: …`,
 // `Could not verify modifier parameters: …`, `Invalid member modifier combination: …`) are
 // returned in the same list with Severity::warning. Parse-time warnings are not repeated here.
+//
+// Differences from the official verifier: all errors are reported (not only the first); two
+// definitions with the same service name are an error (`… is defined more than once`); implements
+// cycles that do not pass through the object being verified are reported instead of recursing
+// forever; an inherited type missing from a base object's own list is reported when that base is
+// verified (once), not again for every object implementing it; errors from legacy
+// `option constant` lines inside an entry are reported at the entry's line (as the official tool
+// does; options keep no line of their own there).
 #pragma once
 
 #include <span>
