@@ -14,8 +14,9 @@
 // cycles that do not pass through the object being verified are reported instead of recursing
 // forever; an inherited type missing from a base object's own list is reported when that base is
 // verified (once), not again for every object implementing it; errors from legacy
-// `option constant` lines inside an entry are reported at the entry's line (as the official tool
-// does; options keep no line of their own there).
+// `option constant` lines inside an entry are reported at the entry's line, as the official tool
+// does (the seed examples' verdicts expect it), although ServiceEntryDefinition::option_lines has
+// the option's own line.
 #pragma once
 
 #include <span>
