@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <charconv>
 #include <exception>
+#include <optional>
 
 #include "core/json/json_numbers.hpp"
 #include "core/json/namedarray_shape.hpp"
@@ -59,11 +60,12 @@ private:
     Result<Value> structure(const json& j, const TypeDefinition& t, const NamedType& nt);
     Result<Value> enumeration(const json& j, const TypeDefinition& t, const NamedType& nt);
     Result<Value> pod(const json& j, const TypeDefinition& t, const NamedType& nt);
-    Result<PodArray> pod_items(std::span<const json> items, const NamedType& nt);
+    /// `scalar`: one item shown without an index in error paths (a scalar pod / namedarray).
+    Result<PodArray> pod_items(std::span<const json> items, const NamedType& nt, bool scalar = false);
     Result<std::span<const json>> array_items(const json& j, const NamedType& nt);
     Result<Value> pod_field(const json& j, const PodFieldPlan& plan);
     Result<Value> namedarray(const json& j, const TypeDefinition& t, const NamedType& nt);
-    Result<NamedArray> namedarray_items(std::span<const json> items, const NamedType& nt);
+    Result<NamedArray> namedarray_items(std::span<const json> items, const NamedType& nt, bool scalar = false);
     template <class T>
     Result<void> fill_namedarray(const json& obj, std::span<T> out, std::size_t& offset, const NamedArrayShape& shape);
     Result<Value> var(const json& j);
@@ -264,7 +266,7 @@ Result<Value> FromJson::pod(const json& j, const TypeDefinition& t, const NamedT
     }
     if (t.array == ArrayKind::none) {
         if (!j.is_object()) return expected(t, nt.qualified_name, j, "an object");
-        auto p = pod_items(std::span<const json>(&j, 1), nt);
+        auto p = pod_items(std::span<const json>(&j, 1), nt, true);
         if (!p) return p.take_error();
         return Value(std::move(*p));
     }
@@ -284,7 +286,7 @@ Result<std::span<const json>> FromJson::array_items(const json& j, const NamedTy
     return std::span<const json>(a.data(), a.size());
 }
 
-Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedType& nt) {
+Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedType& nt, bool scalar) {
     auto plans = pod_field_plans(nt, lookup_);
     if (!plans) return relay(plans.error());
     PodArray p;
@@ -292,7 +294,8 @@ Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedTyp
     for (const auto& plan : *plans) p.field_names.push_back(plan.member->name);
     p.values.reserve(items.size() * plans->size());
     for (std::size_t i = 0; i < items.size(); ++i) {
-        PathScope pi(path_, static_cast<std::int64_t>(i));
+        std::optional<PathScope> pi;
+        if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
         const json& item = items[i];
         if (!item.is_object())
             return err(MessageErrorType::DataTypeMismatch, "expected a " + nt.qualified_name + " object, got " +
@@ -377,7 +380,7 @@ Result<Value> FromJson::namedarray(const json& j, const TypeDefinition& t, const
     }
     if (t.array == ArrayKind::none) {
         if (!j.is_object()) return expected(t, nt.qualified_name, j, "an object");
-        auto a = namedarray_items(std::span<const json>(&j, 1), nt);
+        auto a = namedarray_items(std::span<const json>(&j, 1), nt, true);
         if (!a) return a.take_error();
         return Value(std::move(*a));
     }
@@ -389,7 +392,7 @@ Result<Value> FromJson::namedarray(const json& j, const TypeDefinition& t, const
     return Value(std::move(*a));
 }
 
-Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const NamedType& nt) {
+Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const NamedType& nt, bool scalar) {
     auto shape = namedarray_shape(nt, lookup_);
     if (!shape) return relay(shape.error());
     const NamedArrayShape& s = **shape;
@@ -399,7 +402,8 @@ Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const
         auto out = flat.mutable_span<T>();
         std::size_t offset = 0;
         for (std::size_t i = 0; i < items.size(); ++i) {
-            PathScope pi(path_, static_cast<std::int64_t>(i));
+            std::optional<PathScope> pi;
+            if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
             if (auto r = fill_namedarray<T>(items[i], out, offset, s); !r) return r;
         }
         return {};

@@ -1,5 +1,6 @@
 // Value → JSON (docs/json-mapping.md).
 #include <exception>
+#include <optional>
 
 #include "core/json/json_numbers.hpp"
 #include "core/json/namedarray_shape.hpp"
@@ -65,7 +66,8 @@ private:
     Result<json> named(const Value& v, const TypeDefinition& t, std::string_view ctx);
     Result<json> structure(const Value& v, const TypeDefinition& t, const NamedType& nt);
     Result<json> pod(const Value& v, const TypeDefinition& t, const NamedType& nt);
-    Result<json> pod_items(const PodArray& p, const NamedType& nt);
+    /// `scalar`: one item shown without an index in error paths.
+    Result<json> pod_items(const PodArray& p, const NamedType& nt, bool scalar = false);
     Result<json> pod_field(const Value& v, const PodFieldPlan& plan);
     Result<json> namedarray(const Value& v, const TypeDefinition& t, const NamedType& nt);
     Result<json> namedarray_items(const NamedArray& a, const NamedType& nt, std::size_t& items);
@@ -222,14 +224,14 @@ Result<json> ToJson::pod(const Value& v, const TypeDefinition& t, const NamedTyp
     }
     if (!p->dims.empty()) return err(MessageErrorType::DataTypeError, "multi-dim pod array where " + type_text(t, nt.qualified_name) + " expected");
     if (auto r = check_count(p->count, t); !r) return relay(r.error());
-    auto items = pod_items(*p, nt);
+    auto items = pod_items(*p, nt, t.array == ArrayKind::none);
     if (!items) return items;
     if (t.array == ArrayKind::none) return std::move((*items)[0]);
     return items;
 }
 
 // Array of item objects.
-Result<json> ToJson::pod_items(const PodArray& p, const NamedType& nt) {
+Result<json> ToJson::pod_items(const PodArray& p, const NamedType& nt, bool scalar) {
     auto plans = pod_field_plans(nt, lookup_);
     if (!plans) return relay(plans.error());
     const std::size_t nf = p.field_names.size();
@@ -246,7 +248,8 @@ Result<json> ToJson::pod_items(const PodArray& p, const NamedType& nt) {
     json::array_t out;
     out.reserve(p.count);
     for (std::size_t i = 0; i < p.count; ++i) {
-        PathScope pi(path_, static_cast<std::int64_t>(i));
+        std::optional<PathScope> pi;
+        if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
         json item = json::object();
         for (const auto& plan : *plans) {
             PathScope pf(path_, plan.member->name);
