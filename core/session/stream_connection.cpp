@@ -1,0 +1,441 @@
+#include "core/session/stream_connection.hpp"
+
+#include <algorithm>
+#include <string_view>
+
+#include "core/message/message_writer.hpp"
+#include "core/session/elements.hpp"
+
+namespace rr {
+namespace {
+
+using namespace capabilities;
+
+constexpr std::string_view kCreateConnection = "CreateConnection";
+
+// Value StreamCheckCapability answers for a capability name (wire.md §6.2 table).
+std::uint32_t stream_capability_value(std::string_view name, bool v4, bool string_table) {
+    if (name == "com.robotraconteur.message.v_max") return v4 ? 4 : 2;
+    if (name == "com.robotraconteur.v2" || name == "com.robotraconteur.v2.0") return 1;
+    if (name == "com.robotraconteur.message.v4" || name == "com.robotraconteur.message.v4.0") return v4 ? 1 : 0;
+    if (name == "com.robotraconteur.stringtable") return string_table ? 4 : 0;
+    if (name == "com.robotraconteur.stringtable.v4" || name == "com.robotraconteur.stringtable.v4.0")
+        return string_table ? 1 : 0;
+    return 0;
+}
+
+Message single_entry_message(MessageEntry entry) {
+    Message m;
+    m.version = 2;
+    m.entries.push_back(std::move(entry));
+    return m;
+}
+
+}  // namespace
+
+StreamConnection::StreamConnection(StreamRole role, StreamConfig config, MonoTime now)
+    : role_(role), config_(std::move(config)), reader_(config_.limits), started_(now), last_send_(now),
+      last_receive_(now) {
+    reader_.set_max_message_size(std::min(config_.limits.max_message_size, config_.limits.max_pre_session_message_size));
+    if (role_ == StreamRole::client) queue_create_connection(now);
+}
+
+void StreamConnection::queue_create_connection(MonoTime now) {
+    MessageEntry e;
+    e.entry_type = MessageEntryType::StreamOp;
+    e.member_name = std::string(kCreateConnection);
+    std::vector<std::uint32_t> caps{message2_basic_page | message2_basic_enable | message2_basic_connectcombined};
+    if (config_.enable_message4) {
+        caps.push_back(message4_basic_page | message4_basic_enable | message4_basic_connectcombined);
+        if (config_.enable_string_table)
+            caps.push_back(message4_stringtable_page | message4_stringtable_enable |
+                           message4_stringtable_message_local | message4_stringtable_standard_table);
+    }
+    e.elements.push_back(make_array_element("capabilities", std::span<const std::uint32_t>(caps)));
+    Message m = single_entry_message(std::move(e));
+    m.header.sender_node_id = config_.local_node_id;
+    m.header.sender_node_name = config_.local_node_name;
+    m.header.receiver_node_id = config_.target_node_id;
+    m.header.receiver_node_name = config_.target_node_name;
+    (void)queue(m, 2, now, false);
+}
+
+Result<void> StreamConnection::feed(std::span<const std::byte> bytes, MonoTime now) {
+    if (state_ == State::closed) return fail(MessageErrorType::ConnectionError, "connection closed");
+    if (bytes.empty()) return {};
+    last_receive_ = now;
+    if (auto r = reader_.feed(bytes); !r) {
+        close(r.error());
+        return r.take_error();
+    }
+    while (auto frame = reader_.take_frame()) {
+        if (auto r = handle_frame(std::move(*frame), now); !r) {
+            close(r.error());
+            return r.take_error();
+        }
+        if (state_ == State::closed) break;
+    }
+    return {};
+}
+
+Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
+    DecodeContext ctx = decode_context();
+    auto decoded = decode_message(frame, config_.limits, &ctx);
+    if (!decoded) return decoded.take_error();
+    Message& m = *decoded;
+    if (m.entries.empty()) return {};  // legal, nothing to do
+
+    const MessageEntry& first = m.entries.front();
+    const auto type = first.entry_type;
+    const bool transport_entry = is_transport_internal(type) || type == MessageEntryType::ConnectionTest ||
+                                 type == MessageEntryType::ConnectionTestRet;
+    if (transport_entry) {
+        if (m.entries.size() != 1)
+            return fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
+        return handle_transport_entry(m, first, now);
+    }
+    if (state_ != State::connected)
+        return fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
+    events_.push_back(StreamMessage{std::move(m), std::move(frame)});
+    return {};
+}
+
+Result<void> StreamConnection::handle_transport_entry(const Message& m, const MessageEntry& e, MonoTime now) {
+    switch (e.entry_type) {
+        case MessageEntryType::ConnectionTest: {
+            if (state_ != State::connected) return {};
+            MessageEntry r;
+            r.entry_type = MessageEntryType::ConnectionTestRet;
+            r.service_path = e.service_path;
+            r.member_name = e.member_name;
+            r.request_id = e.request_id;
+            Message reply = single_entry_message(std::move(r));
+            reply.header.sender_node_id = config_.local_node_id;
+            reply.header.sender_node_name = config_.local_node_name;
+            reply.header.receiver_node_id = m.header.sender_node_id;
+            reply.header.receiver_node_name = m.header.sender_node_name;
+            reply.header.sender_endpoint = m.header.receiver_endpoint;
+            reply.header.receiver_endpoint = m.header.sender_endpoint;
+            // CORE always answers a heartbeat in v4 without routing or endpoint info (wire.md §6.3).
+            if (send_version() == 4) reply.header.v4_flags = static_cast<std::uint8_t>(
+                default_v4_flags(reply) & ~(message_flags::routing_info | message_flags::endpoint_info));
+            return queue(reply, send_version(), now, false);
+        }
+        case MessageEntryType::ConnectionTestRet: return {};
+        case MessageEntryType::StreamOp:
+            if (e.member_name == kCreateConnection) return handle_create_connection_request(m, e, now);
+            if (e.member_name == "GetRemoteNodeID") {
+                MessageEntry r;
+                r.entry_type = MessageEntryType::StreamOpRet;
+                r.member_name = e.member_name;
+                Message reply = single_entry_message(std::move(r));
+                reply.header.sender_node_id = config_.local_node_id;
+                reply.header.sender_node_name = config_.local_node_name;
+                reply.header.receiver_node_id = m.header.sender_node_id;
+                return queue(reply, 2, now, false);
+            } else {
+                // STARTTLS and unknown operations: TLS is not offered on this transport.
+                MessageEntry r;
+                r.entry_type = MessageEntryType::StreamOpRet;
+                r.member_name = e.member_name;
+                RRError err = e.member_name == "STARTTLS"
+                                  ? make_error(MessageErrorType::ConnectionError, "Server certificate not loaded")
+                                  : make_error(MessageErrorType::ProtocolError, "Invalid Stream Operation");
+                set_entry_error(r, err);
+                Message reply = single_entry_message(std::move(r));
+                reply.header.sender_node_id = config_.local_node_id;
+                reply.header.sender_node_name = config_.local_node_name;
+                return queue(reply, 2, now, false);
+            }
+        case MessageEntryType::StreamOpRet:
+            if (role_ == StreamRole::client && state_ == State::negotiating && e.member_name == kCreateConnection)
+                return handle_create_connection_reply(m, e);
+            return {};
+        case MessageEntryType::StreamCheckCapability: {
+            MessageEntry r;
+            r.entry_type = MessageEntryType::StreamCheckCapabilityRet;
+            r.member_name = e.member_name;
+            std::uint32_t v = stream_capability_value(e.member_name, config_.enable_message4, config_.enable_string_table);
+            r.elements.push_back(make_scalar_element("return", v));
+            Message reply = single_entry_message(std::move(r));
+            reply.header.sender_node_id = config_.local_node_id;
+            reply.header.receiver_node_id = m.header.sender_node_id;
+            return queue(reply, 2, now, false);
+        }
+        default: return {};  // other transport-internal codes carry nothing for us
+    }
+}
+
+Result<void> StreamConnection::handle_create_connection_request(const Message& m, const MessageEntry& e,
+                                                                 MonoTime now) {
+    auto reply_with = [&](MessageEntry r) {
+        Message reply = single_entry_message(std::move(r));
+        reply.header.sender_node_id = config_.local_node_id;
+        reply.header.sender_node_name = config_.local_node_name;
+        reply.header.receiver_node_id = m.header.sender_node_id;
+        reply.header.receiver_node_name = m.header.sender_node_name;
+        return queue(reply, 2, now, false);
+    };
+    MessageEntry r;
+    r.entry_type = MessageEntryType::StreamOpRet;
+    r.member_name = std::string(kCreateConnection);
+
+    if (role_ != StreamRole::server || state_ != State::negotiating) {
+        set_entry_error(r, make_error(MessageErrorType::ProtocolError, "Invalid Stream Operation"));
+        return reply_with(std::move(r));
+    }
+    const auto& h = m.header;
+    const bool name_ok = h.receiver_node_name.empty() || h.receiver_node_name == config_.local_node_name;
+    const bool id_ok = h.receiver_node_id.is_any() || h.receiver_node_id == config_.local_node_id;
+    if (!name_ok || !id_ok) {
+        set_entry_error(r, make_error(MessageErrorType::NodeNotFound, "Node not found"));
+        return reply_with(std::move(r));
+    }
+
+    bool m2 = false, m2_combined = false, m4 = false, m4_combined = false, st = false;
+    std::vector<std::uint32_t> reply_caps;
+    const MessageElement* caps = e.find("capabilities");
+    if (caps) {
+        if (caps->type != DataTypes::uint32_t) {
+            set_entry_error(r, make_error(MessageErrorType::ProtocolError, "Invalid Stream Operation"));
+            return reply_with(std::move(r));
+        }
+        std::uint32_t m2_flags = 0, m4_flags = 0, st_flags = 0;
+        bool asked_m4 = false, asked_st = false;
+        auto words = read_array<std::uint32_t>(*caps);
+        for (std::uint32_t w : words) {
+            const std::uint32_t page = w & page_mask, flags = w & ~page_mask;
+            if (page == message2_basic_page) {
+                m2 = (flags & message2_basic_enable) != 0;
+                m2_flags = flags & (message2_basic_enable | message2_basic_connectcombined);
+            } else if (page == message4_basic_page) {
+                asked_m4 = (flags & message4_basic_enable) != 0;
+                m4_flags = flags & (message4_basic_enable | message4_basic_connectcombined);
+            } else if (page == message4_stringtable_page) {
+                asked_st = (flags & message4_stringtable_enable) != 0;
+                st_flags = flags & (message4_stringtable_enable | message4_stringtable_message_local |
+                                    message4_stringtable_standard_table);
+            }
+        }
+        if (!m2) {
+            set_entry_error(r, make_error(MessageErrorType::ProtocolError, "Invalid Stream Operation"));
+            return reply_with(std::move(r));
+        }
+        m2_combined = (m2_flags & message2_basic_connectcombined) != 0;
+        reply_caps.push_back(message2_basic_page | m2_flags);
+        if (asked_m4 && config_.enable_message4) {
+            m4 = true;
+            m4_combined = (m4_flags & message4_basic_connectcombined) != 0;
+            reply_caps.push_back(message4_basic_page | m4_flags);
+            if (asked_st && config_.enable_string_table) {
+                st = true;
+                reply_caps.push_back(message4_stringtable_page | st_flags);
+            }
+        }
+        r.elements.push_back(make_array_element("capabilities", std::span<const std::uint32_t>(reply_caps)));
+    }
+    if (auto q = reply_with(std::move(r)); !q) return q;
+
+    negotiated_.remote_node_id = h.sender_node_id;
+    negotiated_.remote_node_name = h.sender_node_name;
+    negotiated_.message4 = m4;
+    negotiated_.string_table = st;
+    negotiated_.connect_combined = m4 ? m4_combined : m2_combined;
+    state_ = State::connected;
+    events_.push_back(negotiated_);
+    return {};
+}
+
+Result<void> StreamConnection::handle_create_connection_reply(const Message& m, const MessageEntry& e) {
+    if (e.error != MessageErrorType::None) {
+        RRError err = *entry_error(e);
+        return fail(std::move(err));
+    }
+    const auto& h = m.header;
+    if (!config_.target_node_name.empty() && h.sender_node_name != config_.target_node_name)
+        return fail(MessageErrorType::NodeNotFound, "connected node has NodeName \"" + h.sender_node_name +
+                                                        "\", expected \"" + config_.target_node_name + "\"");
+    if (!config_.target_node_id.is_any() && h.sender_node_id != config_.target_node_id)
+        return fail(MessageErrorType::NodeNotFound, "connected node has NodeID " + h.sender_node_id.to_string() +
+                                                        ", expected " + config_.target_node_id.to_string());
+    bool m4 = false, st = false, combined = false;
+    if (const MessageElement* caps = e.find("capabilities")) {
+        if (caps->type != DataTypes::uint32_t)
+            return fail(MessageErrorType::ProtocolError, "capabilities element is not uint32[]");
+        for (std::uint32_t w : read_array<std::uint32_t>(*caps)) {
+            const std::uint32_t page = w & page_mask, flags = w & ~page_mask;
+            if (page == message2_basic_page) {
+                if (flags & ~(message2_basic_enable | message2_basic_connectcombined))
+                    return fail(MessageErrorType::ProtocolError, "unknown message2 capability flags");
+                if (!m4) combined = (flags & message2_basic_connectcombined) != 0;
+            } else if (page == message4_basic_page) {
+                if (flags & ~(message4_basic_enable | message4_basic_connectcombined))
+                    return fail(MessageErrorType::ProtocolError, "unknown message4 capability flags");
+                m4 = config_.enable_message4 && (flags & message4_basic_enable) != 0;
+                if (m4) combined = (flags & message4_basic_connectcombined) != 0;
+            } else if (page == message4_stringtable_page) {
+                if (flags & ~(message4_stringtable_enable | message4_stringtable_message_local |
+                              message4_stringtable_standard_table))
+                    return fail(MessageErrorType::ProtocolError, "unknown string table capability flags");
+                st = (flags & message4_stringtable_enable) != 0;
+            } else {
+                return fail(MessageErrorType::ProtocolError, "unknown capability page in CreateConnection reply");
+            }
+        }
+        if (st && !m4) return fail(MessageErrorType::ProtocolError, "string table offered without message4");
+    }
+    negotiated_.remote_node_id = h.sender_node_id;
+    negotiated_.remote_node_name = h.sender_node_name;
+    negotiated_.message4 = m4;
+    negotiated_.string_table = st;
+    negotiated_.connect_combined = combined;
+    state_ = State::connected;
+    events_.push_back(negotiated_);
+    return {};
+}
+
+void StreamConnection::on_transport_closed(RRError error) { close(std::move(error)); }
+
+Result<void> StreamConnection::send(const Message& message, MonoTime now) {
+    if (state_ != State::connected)
+        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
+    return queue(message, send_version(), now, true);
+}
+
+Result<void> StreamConnection::send_frame(std::span<const std::byte> frame, MonoTime now) {
+    if (state_ != State::connected)
+        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
+    if (frame.size() > send_limit())
+        return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
+    output_.insert(output_.end(), frame.begin(), frame.end());
+    last_send_ = now;
+    return {};
+}
+
+Result<void> StreamConnection::queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
+    const std::size_t before = output_.size();
+    Result<void> r;
+    const bool can_omit = omit_routing && version == 4 && session_established_ && m.entries.size() == 1 &&
+                          static_cast<std::uint16_t>(m.entries.front().entry_type) >= 500 &&
+                          m.header.sender_node_id == config_.local_node_id &&
+                          m.header.receiver_node_id == negotiated_.remote_node_id &&
+                          m.header.sender_endpoint == local_endpoint_ && m.header.receiver_endpoint == remote_endpoint_ &&
+                          m.header.sender_node_name.empty() && m.header.receiver_node_name.empty();
+    if (m.version == version && !(can_omit && !m.header.v4_flags)) {
+        r = encode_message(m, output_);
+    } else {
+        Message copy = m;
+        copy.version = version;
+        if (can_omit && !copy.header.v4_flags)
+            copy.header.v4_flags = static_cast<std::uint8_t>(
+                default_v4_flags(copy) & ~(message_flags::routing_info | message_flags::endpoint_info));
+        r = encode_message(copy, output_);
+    }
+    if (!r) {
+        output_.resize(before);
+        return r;
+    }
+    if (output_.size() - before > send_limit()) {
+        output_.resize(before);
+        return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
+    }
+    last_send_ = now;
+    return {};
+}
+
+void StreamConnection::set_session_established(std::uint32_t local_endpoint, std::uint32_t remote_endpoint) {
+    session_established_ = true;
+    local_endpoint_ = local_endpoint;
+    remote_endpoint_ = remote_endpoint;
+    reader_.set_max_message_size(config_.limits.max_message_size);
+}
+
+std::size_t StreamConnection::send_limit() const noexcept {
+    if (!session_established_) return config_.limits.max_pre_session_message_size;
+    // CORE refuses to send messages within 100 bytes of the limit (wire.md §13).
+    return config_.limits.max_message_size > 100 ? config_.limits.max_message_size - 100 : config_.limits.max_message_size;
+}
+
+std::size_t StreamConnection::receive_limit() const noexcept {
+    return session_established_ ? config_.limits.max_message_size : config_.limits.max_pre_session_message_size;
+}
+
+std::span<const std::byte> StreamConnection::pending_output() const noexcept {
+    return std::span<const std::byte>(output_).subspan(output_offset_);
+}
+
+void StreamConnection::consume_output(std::size_t n) {
+    output_offset_ += std::min(n, output_.size() - output_offset_);
+    if (output_offset_ == output_.size()) {
+        output_.clear();
+        output_offset_ = 0;
+    } else if (output_offset_ > (1u << 20) && output_offset_ * 2 > output_.size()) {
+        output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(output_offset_));
+        output_offset_ = 0;
+    }
+}
+
+void StreamConnection::take_output(std::vector<std::byte>& out) {
+    out.clear();
+    if (output_offset_ == 0) {
+        std::swap(out, output_);
+    } else {
+        out.assign(output_.begin() + static_cast<std::ptrdiff_t>(output_offset_), output_.end());
+        output_.clear();
+        output_offset_ = 0;
+    }
+}
+
+std::optional<StreamEvent> StreamConnection::poll_event() {
+    if (events_.empty()) return std::nullopt;
+    StreamEvent e = std::move(events_.front());
+    events_.pop_front();
+    return e;
+}
+
+std::optional<MonoTime> StreamConnection::next_deadline() const {
+    switch (state_) {
+        case State::closed: return std::nullopt;
+        case State::negotiating: return started_ + config_.connect_timeout;
+        case State::connected:
+            return std::min(last_send_ + config_.heartbeat_period, last_receive_ + config_.receive_timeout);
+    }
+    return std::nullopt;
+}
+
+void StreamConnection::on_timer(MonoTime now) {
+    if (state_ == State::negotiating) {
+        if (now >= started_ + config_.connect_timeout)
+            close(make_error(MessageErrorType::ConnectionError, "CreateConnection timed out"));
+        return;
+    }
+    if (state_ != State::connected) return;
+    if (now - last_receive_ > config_.receive_timeout) {
+        close(make_error(MessageErrorType::ConnectionError, "receive timeout: peer silent"));
+        return;
+    }
+    if (now - last_send_ >= config_.heartbeat_period) {
+        MessageEntry e;
+        e.entry_type = MessageEntryType::ConnectionTest;
+        Message m = single_entry_message(std::move(e));
+        m.header.sender_node_id = config_.local_node_id;
+        (void)queue(m, send_version(), now, false);
+    }
+}
+
+DecodeContext StreamConnection::decode_context() const noexcept {
+    DecodeContext c;
+    c.local_node_id = config_.local_node_id;
+    c.remote_node_id = negotiated_.remote_node_id;
+    c.local_endpoint = local_endpoint_;
+    c.remote_endpoint = remote_endpoint_;
+    return c;
+}
+
+void StreamConnection::close(RRError error) {
+    if (state_ == State::closed) return;
+    state_ = State::closed;
+    events_.push_back(StreamClosed{std::move(error)});
+}
+
+}  // namespace rr

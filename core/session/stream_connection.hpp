@@ -1,0 +1,165 @@
+// The basic stream protocol of one transport connection, sans-IO (wire.md §6; standards
+// draft/basic_stream_protocol.md): CreateConnection with capability negotiation (message format v4,
+// string table), node matching, heartbeats (ConnectionTest/ConnectionTestRet), the receive timeout,
+// StreamCheckCapability, GetRemoteNodeID, the 512 KiB pre-session limit, and the v4 routing omission
+// on a negotiated connection (wire.md §2.3).
+//
+// Bytes in: feed(bytes, now). Bytes out: pending_output() / consume_output(n). Events out:
+// poll_event(). Time: next_deadline() / on_timer(now). The object never reads a clock.
+// Not thread-safe: one owner drives it (a strand in server/, the JS event loop in wasm-client/).
+//
+// Fatal errors (malformed framing, limits, receive timeout, failed negotiation) queue a Closed event
+// and make is_closed() true; the host then drops the transport after flushing pending_output().
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/codec/limits.hpp"
+#include "core/message/message.hpp"
+#include "core/message/message_reader.hpp"
+#include "core/message/message_stream_reader.hpp"
+
+namespace rr {
+
+/// Monotonic time as passed in by the host.
+using MonoTime = std::chrono::steady_clock::time_point;
+
+/// Capability words of CreateConnection (wire.md §2.1).
+namespace capabilities {
+inline constexpr std::uint32_t page_mask = 0xFFF00000u;
+inline constexpr std::uint32_t message2_basic_page = 0x02000000u;
+inline constexpr std::uint32_t message2_basic_enable = 0x1u;
+inline constexpr std::uint32_t message2_basic_connectcombined = 0x2u;
+inline constexpr std::uint32_t message4_basic_page = 0x04000000u;
+inline constexpr std::uint32_t message4_basic_enable = 0x1u;
+inline constexpr std::uint32_t message4_basic_connectcombined = 0x2u;
+inline constexpr std::uint32_t message4_stringtable_page = 0x04100000u;
+inline constexpr std::uint32_t message4_stringtable_enable = 0x1u;
+inline constexpr std::uint32_t message4_stringtable_message_local = 0x2u;
+inline constexpr std::uint32_t message4_stringtable_standard_table = 0x4u;
+}  // namespace capabilities
+
+enum class StreamRole : std::uint8_t { client, server };
+
+struct StreamConfig {
+    NodeID local_node_id;
+    std::string local_node_name;
+    /// Client only: the node asked for in the URL (zero / empty = any).
+    NodeID target_node_id;
+    std::string target_node_name;
+    bool enable_message4 = true;
+    /// A stock CORE server disables string tables (wire.md §2.1); clients ask for them.
+    bool enable_string_table = false;
+    /// Heartbeat period: send ConnectionTest when nothing was sent for this long (TCP client 10 s,
+    /// server 12 s; wire.md §6.3).
+    std::chrono::milliseconds heartbeat_period{10000};
+    /// Close when nothing was received for this long (TCP 15 s).
+    std::chrono::milliseconds receive_timeout{15000};
+    /// Give up when CreateConnection is not answered (client) / not received (server) in time.
+    std::chrono::milliseconds connect_timeout{10000};
+    Limits limits;
+};
+
+/// Negotiation result.
+struct StreamConnected {
+    NodeID remote_node_id;
+    std::string remote_node_name;
+    bool message4 = false;
+    bool string_table = false;
+    bool connect_combined = false;  ///< the peer supports ConnectClientCombined
+};
+
+/// A message for the layer above (never transport-internal entries). `frame` holds the exact bytes
+/// received, for zero-copy forwarding.
+struct StreamMessage {
+    Message message;
+    SharedBytes frame;
+};
+
+struct StreamClosed {
+    RRError error;  ///< why; ConnectionError when the peer simply went away
+};
+
+using StreamEvent = std::variant<StreamConnected, StreamMessage, StreamClosed>;
+
+class StreamConnection {
+public:
+    /// A client queues its CreateConnection immediately (see pending_output()).
+    StreamConnection(StreamRole role, StreamConfig config, MonoTime now);
+
+    /// Consumes all of `bytes`. A framing, decoding or protocol error is fatal: the connection closes
+    /// (a Closed event is queued) and the error is returned.
+    Result<void> feed(std::span<const std::byte> bytes, MonoTime now);
+
+    /// The host reports the transport was closed by the peer or failed.
+    void on_transport_closed(RRError error);
+
+    /// Encodes and queues `message` in the negotiated format. Errors: InvalidState before the
+    /// connection is negotiated or after close; BufferLimitViolation when the encoded message is over
+    /// the limit (512 KiB until set_session_established(), then max_message_size − 100 as CORE).
+    Result<void> send(const Message& message, MonoTime now);
+    /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
+    Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);
+
+    /// The client session on this connection exists with these endpoints: lifts the pre-session
+    /// limit and enables v4 routing omission for messages matching them.
+    void set_session_established(std::uint32_t local_endpoint, std::uint32_t remote_endpoint);
+
+    std::span<const std::byte> pending_output() const noexcept;
+    void consume_output(std::size_t n);
+    /// Moves all pending output into `out` (cleared first). Swaps buffers when possible, so a writer
+    /// can hold `out` while new messages are queued here without copying or reallocation hazards.
+    void take_output(std::vector<std::byte>& out);
+    std::size_t pending_output_size() const noexcept { return output_.size() - output_offset_; }
+
+    std::optional<StreamEvent> poll_event();
+
+    std::optional<MonoTime> next_deadline() const;
+    void on_timer(MonoTime now);
+
+    bool is_connected() const noexcept { return state_ == State::connected; }
+    bool is_closed() const noexcept { return state_ == State::closed; }
+    const StreamConnected& negotiated() const noexcept { return negotiated_; }
+    StreamRole role() const noexcept { return role_; }
+    const StreamConfig& config() const noexcept { return config_; }
+    /// DecodeContext for v4 messages without routing info.
+    DecodeContext decode_context() const noexcept;
+    std::uint16_t send_version() const noexcept { return negotiated_.message4 ? 4 : 2; }
+
+private:
+    enum class State : std::uint8_t { negotiating, connected, closed };
+
+    Result<void> handle_frame(SharedBytes frame, MonoTime now);
+    Result<void> handle_transport_entry(const Message& m, const MessageEntry& e, MonoTime now);
+    Result<void> handle_create_connection_request(const Message& m, const MessageEntry& e, MonoTime now);
+    Result<void> handle_create_connection_reply(const Message& m, const MessageEntry& e);
+    void queue_create_connection(MonoTime now);
+    Result<void> queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
+    void close(RRError error);
+    std::size_t send_limit() const noexcept;
+    std::size_t receive_limit() const noexcept;
+
+    StreamRole role_;
+    StreamConfig config_;
+    State state_ = State::negotiating;
+    StreamConnected negotiated_;
+    MessageStreamReader reader_;
+    std::vector<std::byte> output_;
+    std::size_t output_offset_ = 0;
+    std::deque<StreamEvent> events_;
+    MonoTime started_;
+    MonoTime last_send_;
+    MonoTime last_receive_;
+    bool session_established_ = false;
+    std::uint32_t local_endpoint_ = 0;
+    std::uint32_t remote_endpoint_ = 0;
+};
+
+}  // namespace rr

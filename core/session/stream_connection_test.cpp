@@ -1,0 +1,242 @@
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <iterator>
+
+#include "core/message/message_writer.hpp"
+#include "core/session/elements.hpp"
+#include "core/session/stream_connection.hpp"
+
+using namespace rr;
+using namespace std::chrono_literals;
+
+namespace {
+
+const NodeID kClientId = *NodeID::parse("11111111-2222-3333-4444-555555555555");
+const NodeID kServerId = *NodeID::parse("aaaaaaaa-bbbb-cccc-dddd-eeeeeeeeeeee");
+
+StreamConfig client_config() {
+    StreamConfig c;
+    c.local_node_id = kClientId;
+    c.enable_message4 = true;
+    c.enable_string_table = true;
+    return c;
+}
+
+StreamConfig server_config(bool v4 = true) {
+    StreamConfig c;
+    c.local_node_id = kServerId;
+    c.local_node_name = "example.server";
+    c.enable_message4 = v4;
+    c.heartbeat_period = 12000ms;
+    return c;
+}
+
+std::vector<std::byte> drain(StreamConnection& s) {
+    auto out = s.pending_output();
+    std::vector<std::byte> v(out.begin(), out.end());
+    s.consume_output(v.size());
+    return v;
+}
+
+// Moves bytes both ways until neither side has output.
+void pump(StreamConnection& a, StreamConnection& b, MonoTime now) {
+    for (int i = 0; i < 10; ++i) {
+        auto x = drain(a);
+        auto y = drain(b);
+        if (x.empty() && y.empty()) return;
+        if (!x.empty()) (void)b.feed(x, now);
+        if (!y.empty()) (void)a.feed(y, now);
+    }
+}
+
+std::optional<std::vector<std::byte>> read_vector(const char* name) {
+    std::ifstream f(std::string(RR_SHARED_DIR) + "/protocol/vectors/" + name, std::ios::binary);
+    if (!f) return std::nullopt;
+    std::vector<char> c((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::vector<std::byte> out(c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) out[i] = static_cast<std::byte>(c[i]);
+    return out;
+}
+
+template <class T>
+std::optional<T> next_event(StreamConnection& s) {
+    while (auto e = s.poll_event())
+        if (auto* v = std::get_if<T>(&*e)) return std::move(*v);
+    return std::nullopt;
+}
+
+}  // namespace
+
+TEST_CASE("CreateConnection bytes match the documented vectors (wire.md 15.4 a, b)") {
+    auto req = read_vector("vec_createconnection_req_v2.bin");
+    auto res = read_vector("vec_createconnection_res_v2_only.bin");
+    if (!req || !res) {
+        WARN("shared protocol vectors not found under " RR_SHARED_DIR "; skipping");
+        return;
+    }
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    CHECK(drain(client) == *req);
+
+    StreamConnection server(StreamRole::server, server_config(false), t0);
+    REQUIRE(server.feed(*req, t0));
+    CHECK(drain(server) == *res);
+    auto connected = next_event<StreamConnected>(server);
+    REQUIRE(connected);
+    CHECK(connected->remote_node_id == kClientId);
+    CHECK_FALSE(connected->message4);
+    CHECK(connected->connect_combined);
+}
+
+TEST_CASE("client and server negotiate message format v4 or v2") {
+    for (bool server_v4 : {true, false}) {
+        MonoTime t0{};
+        StreamConnection client(StreamRole::client, client_config(), t0);
+        StreamConnection server(StreamRole::server, server_config(server_v4), t0);
+        pump(client, server, t0);
+        auto c = next_event<StreamConnected>(client);
+        auto s = next_event<StreamConnected>(server);
+        REQUIRE(c);
+        REQUIRE(s);
+        CHECK(c->message4 == server_v4);
+        CHECK(s->message4 == server_v4);
+        CHECK_FALSE(c->string_table);  // the server (like a stock CORE server) disables string tables
+        CHECK(c->connect_combined);
+        CHECK(c->remote_node_id == kServerId);
+        CHECK(c->remote_node_name == "example.server");
+        CHECK(client.send_version() == (server_v4 ? 4 : 2));
+
+        // A member message goes through in the negotiated format and arrives decoded.
+        Message m;
+        m.header.sender_node_id = kClientId;
+        m.header.receiver_node_id = kServerId;
+        m.header.sender_endpoint = 5;
+        m.header.receiver_endpoint = 9;
+        MessageEntry e;
+        e.entry_type = MessageEntryType::PropertyGetReq;
+        e.service_path = "svc";
+        e.member_name = "x";
+        e.request_id = 3;
+        m.entries.push_back(e);
+        client.set_session_established(5, 9);
+        server.set_session_established(9, 5);
+        REQUIRE(client.send(m, t0));
+        auto bytes = drain(client);
+        CHECK(static_cast<int>(bytes[8]) == (server_v4 ? 4 : 2));
+        REQUIRE(server.feed(bytes, t0));
+        auto got = next_event<StreamMessage>(server);
+        REQUIRE(got);
+        CHECK(got->message.entries.at(0).member_name == "x");
+        CHECK(got->message.entries.at(0).request_id == 3);
+        // v4 routing omission is restored from the connection on receipt.
+        CHECK(got->message.header.sender_node_id == kClientId);
+        CHECK(got->message.header.sender_endpoint == 5);
+        CHECK(got->message.header.receiver_endpoint == 9);
+        CHECK(got->frame.size() == bytes.size());
+    }
+}
+
+TEST_CASE("a server refuses CreateConnection for another node") {
+    MonoTime t0{};
+    auto cfg = client_config();
+    cfg.target_node_name = "other.node";
+    StreamConnection client(StreamRole::client, cfg, t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    auto closed = next_event<StreamClosed>(client);
+    REQUIRE(closed);
+    CHECK(closed->error.type == MessageErrorType::NodeNotFound);
+    CHECK_FALSE(server.is_connected());
+}
+
+TEST_CASE("heartbeats keep a connection alive; silence closes it") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    REQUIRE(client.is_connected());
+    REQUIRE(server.is_connected());
+
+    // After 10 s without sending, the client sends ConnectionTest; the server answers.
+    auto d = client.next_deadline();
+    REQUIRE(d);
+    CHECK(*d == t0 + 10s);
+    client.on_timer(t0 + 10s);
+    auto ping = drain(client);
+    REQUIRE_FALSE(ping.empty());
+    REQUIRE(server.feed(ping, t0 + 10s));
+    auto pong = drain(server);
+    REQUIRE_FALSE(pong.empty());
+    REQUIRE(client.feed(pong, t0 + 10s));
+    CHECK_FALSE(next_event<StreamMessage>(client));  // heartbeats never reach the layer above
+
+    // Nothing received for more than 15 s: closed.
+    client.on_timer(t0 + 26s);
+    auto closed = next_event<StreamClosed>(client);
+    REQUIRE(closed);
+    CHECK(closed->error.type == MessageErrorType::ConnectionError);
+    CHECK(client.is_closed());
+}
+
+TEST_CASE("an unanswered CreateConnection times out") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    (void)drain(client);
+    client.on_timer(t0 + 11s);
+    CHECK(client.is_closed());
+}
+
+TEST_CASE("a member message before CreateConnection closes the server side") {
+    MonoTime t0{};
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    Message m;
+    m.header.sender_node_id = kClientId;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::PropertyGetReq;
+    e.service_path = "svc";
+    m.entries.push_back(e);
+    std::vector<std::byte> bytes;
+    REQUIRE(encode_message(m, bytes));
+    CHECK_FALSE(server.feed(bytes, t0));
+    CHECK(server.is_closed());
+}
+
+TEST_CASE("the pre-session limit applies until the client session exists") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    Message m;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::FunctionCallReq;
+    std::vector<double> big(600 * 1024 / 8);
+    e.elements.push_back(make_array_element("d", std::span<const double>(big)));
+    m.entries.push_back(e);
+    auto r = client.send(m, t0);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::BufferLimitViolation);
+    client.set_session_established(1, 2);
+    CHECK(client.send(m, t0));
+}
+
+TEST_CASE("StreamCheckCapability is answered as CORE does") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    Message m;
+    m.header.sender_node_id = kClientId;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::StreamCheckCapability;
+    e.member_name = "com.robotraconteur.message.v4";
+    m.entries.push_back(e);
+    std::vector<std::byte> bytes;
+    REQUIRE(encode_message(m, bytes));
+    REQUIRE(server.feed(bytes, t0));
+    auto reply = drain(server);
+    REQUIRE(client.feed(reply, t0));
+    // StreamCheckCapabilityRet is transport-internal: it is consumed, not delivered.
+    CHECK_FALSE(next_event<StreamMessage>(client));
+    CHECK(client.is_connected());
+}

@@ -1,0 +1,205 @@
+#include "server/client/raw_client.hpp"
+
+#include <random>
+
+#include <boost/asio/ip/tcp.hpp>
+
+#include "server/client/tcp_connector.hpp"
+
+namespace rr::server {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+namespace {
+
+std::uint32_t random_u32() {
+    static thread_local std::mt19937 rng{std::random_device{}()};
+    std::uint32_t v;
+    do v = rng();
+    while (v == 0);
+    return v;
+}
+
+NodeID random_node_id() {
+    NodeID::Bytes b{};
+    for (std::size_t i = 0; i < 16; i += 4) {
+        auto v = random_u32();
+        for (std::size_t k = 0; k < 4; ++k) b[i + k] = static_cast<std::byte>((v >> (8 * k)) & 0xFF);
+    }
+    b[6] = static_cast<std::byte>((static_cast<unsigned>(b[6]) & 0x0F) | 0x40);
+    b[8] = static_cast<std::byte>((static_cast<unsigned>(b[8]) & 0x3F) | 0x80);
+    return NodeID(b);
+}
+
+}  // namespace
+
+/// The strand-side half: owns the ClientSession and routes its events.
+class RawClient::Logic : public ConnectionLogic {
+public:
+    Logic(ClientSessionConfig config, MonoTime now) : session_(std::move(config), now) {}
+
+    void on_bytes(std::span<const std::byte> bytes, MonoTime now) override {
+        (void)session_.feed(bytes, now);
+        dispatch();
+    }
+    bool has_output() const override { return session_.pending_output_size() != 0; }
+    void take_output(std::vector<std::byte>& out) override {
+        session_.take_output(out);
+        if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
+    }
+    std::optional<MonoTime> next_deadline() const override { return session_.next_deadline(); }
+    void on_timer(MonoTime now) override {
+        session_.on_timer(now);
+        dispatch();
+    }
+    bool wants_close() const override { return session_.is_closed(); }
+    void on_transport_closed(RRError error) override {
+        session_.on_transport_closed(std::move(error));
+        dispatch();
+    }
+
+    void request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done) {
+        auto id = session_.request(std::move(entry), mono_now(), timeout);
+        if (!id) {
+            done(id.take_error());
+            return;
+        }
+        replies_.emplace(*id, std::move(done));
+        if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
+    }
+    void send(MessageEntry entry) {
+        (void)session_.send_packet(std::move(entry), mono_now());
+        if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
+    }
+    void close() {
+        session_.disconnect(mono_now());
+        dispatch();
+    }
+
+    std::weak_ptr<RawClient> client_;
+    std::shared_ptr<RawClient> connecting_;  // held until the connect completes
+    ConnectHandler on_connect_;
+    IncomingHandler on_incoming_;
+    ClosedHandler on_closed_;
+    std::chrono::milliseconds request_timeout_{15000};
+
+private:
+    void dispatch() {
+        while (auto ev = session_.poll_event()) {
+            if (auto* c = std::get_if<ClientSessionConnected>(&*ev)) {
+                auto client = std::move(connecting_);
+                if (!client) continue;
+                client->info_ = c->info;
+                client->remote_node_id_ = session_.stream().negotiated().remote_node_id;
+                client->remote_node_name_ = session_.stream().negotiated().remote_node_name;
+                client->open_.store(true);
+                if (auto h = std::move(on_connect_)) h(std::move(client));
+            } else if (auto* r = std::get_if<ClientResponse>(&*ev)) {
+                auto it = replies_.find(r->request_id);
+                if (it == replies_.end()) continue;
+                auto done = std::move(it->second);
+                replies_.erase(it);
+                done(std::move(r->entry));
+            } else if (auto* in = std::get_if<ClientIncoming>(&*ev)) {
+                if (on_incoming_) on_incoming_(std::move(in->entry));
+            } else if (auto* closed = std::get_if<ClientSessionClosed>(&*ev)) {
+                for (auto& [id, done] : replies_) done(fail(make_error(MessageErrorType::ConnectionError, closed->error.message)));
+                replies_.clear();
+                if (auto h = std::move(on_connect_)) {
+                    connecting_.reset();
+                    h(fail(closed->error));  // the connect itself failed
+                    continue;
+                }
+                if (auto c = client_.lock()) c->open_.store(false);
+                if (auto h = std::move(on_closed_)) h(closed->error);
+            }
+        }
+    }
+
+    ClientSession session_;
+    std::map<std::uint32_t, ReplyHandler> replies_;
+};
+
+void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
+                        IncomingHandler incoming, ClosedHandler closed, ConnectHandler done) {
+    if (url.scheme != "rr+tcp" && url.scheme != "tcp") {
+        done(fail(MessageErrorType::ConnectionError, "unsupported transport \"" + url.scheme + "\" for this client"));
+        return;
+    }
+    if (url.service.empty()) {
+        done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + url.to_string()));
+        return;
+    }
+    auto strand = asio::make_strand(executor);
+    connect_tcp(strand, url.host, url.port, options.connect_timeout,
+                [strand, url, options, incoming = std::move(incoming), closed = std::move(closed),
+                 done = std::move(done)](Result<tcp::socket> socket) mutable {
+                    if (!socket) {
+                        done(socket.take_error());
+                        return;
+                    }
+                    ClientSessionConfig cfg;
+                    cfg.stream.local_node_id = options.local_node_id.is_any() ? random_node_id() : options.local_node_id;
+                    cfg.stream.local_node_name = options.local_node_name;
+                    cfg.stream.target_node_id = url.node_id;
+                    cfg.stream.target_node_name = url.node_name;
+                    cfg.stream.enable_message4 = options.enable_message4;
+                    cfg.stream.enable_string_table = options.enable_string_table;
+                    cfg.stream.limits = options.limits;
+                    cfg.service_name = url.service;
+                    cfg.username = options.username;
+                    cfg.password = options.password;
+                    cfg.request_timeout = options.request_timeout;
+                    cfg.local_endpoint = random_u32();
+
+                    std::shared_ptr<RawClient> client(new RawClient());
+                    auto logic = std::make_shared<Logic>(std::move(cfg), mono_now());
+                    logic->client_ = client;
+                    logic->connecting_ = client;
+                    logic->on_connect_ = std::move(done);
+                    logic->on_incoming_ = std::move(incoming);
+                    logic->on_closed_ = std::move(closed);
+                    logic->request_timeout_ = options.request_timeout;
+                    client->logic_ = logic;
+                    typename StreamPump<tcp::socket>::Strand pump_strand(strand);
+                    auto pump = std::make_shared<StreamPump<tcp::socket>>(std::move(*socket), pump_strand, logic);
+                    client->pump_ = pump;
+                    pump->start();
+                });
+}
+
+void RawClient::request(MessageEntry entry, ReplyHandler done) {
+    request(std::move(entry), std::chrono::milliseconds(-1), std::move(done));
+}
+
+void RawClient::request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done) {
+    auto pump = pump_.lock();
+    if (!pump || !open_.load()) {
+        done(fail(MessageErrorType::ConnectionError, "client connection closed"));
+        return;
+    }
+    auto logic = logic_;
+    pump->dispatch([logic, entry = std::move(entry), timeout, done = std::move(done)]() mutable {
+        auto t = timeout.count() < 0 ? logic->request_timeout_ : timeout;
+        logic->request(std::move(entry), t, std::move(done));
+    });
+}
+
+void RawClient::send(MessageEntry entry) {
+    auto pump = pump_.lock();
+    if (!pump) return;
+    auto logic = logic_;
+    pump->dispatch([logic, entry = std::move(entry)]() mutable { logic->send(std::move(entry)); });
+}
+
+RawClient::~RawClient() { close(); }
+
+void RawClient::close() {
+    auto pump = pump_.lock();
+    if (!pump) return;
+    auto logic = logic_;
+    pump->dispatch([logic] { logic->close(); });
+}
+
+}  // namespace rr::server

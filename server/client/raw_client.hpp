@@ -1,0 +1,79 @@
+// A native client session at the level of message entries: connects by URL (rr+tcp), runs core's
+// ClientSession on a strand, and hands out replies and unsolicited entries. The gateway uses it to
+// forward entries to devices without decoding them; the typed client is built the same way.
+//
+// Thread-safety: every public function may be called from any thread. Handlers run on the
+// connection's strand: do not block in them.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include <boost/asio/any_io_executor.hpp>
+
+#include "core/names/connection_url.hpp"
+#include "core/session/client_session.hpp"
+#include "server/node/connection_logic.hpp"
+#include "server/transport/stream_pump.hpp"
+
+namespace rr::server {
+
+struct RawClientOptions {
+    NodeID local_node_id;          ///< all-zero: random
+    std::string local_node_name;
+    std::string username, password;
+    bool enable_message4 = true;
+    bool enable_string_table = true;
+    std::chrono::milliseconds connect_timeout{5000};
+    std::chrono::milliseconds request_timeout{15000};
+    Limits limits;
+};
+
+class RawClient : public std::enable_shared_from_this<RawClient> {
+public:
+    using ConnectHandler = std::function<void(Result<std::shared_ptr<RawClient>>)>;
+    using ReplyHandler = std::function<void(Result<MessageEntry>)>;
+    using IncomingHandler = std::function<void(MessageEntry&&)>;
+    using ClosedHandler = std::function<void(const RRError&)>;
+
+    /// Connects to `url` (rr+tcp; the URL must name a service) and establishes the client session.
+    /// `incoming` receives entries the service sends unasked; `closed` is called once when the session
+    /// ends after a successful connect. Both are set before any traffic flows.
+    static void connect(boost::asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
+                        IncomingHandler incoming, ClosedHandler closed, ConnectHandler done);
+
+    /// Sends a request; `done` gets the reply entry (whose Error field may be set) or a local error.
+    void request(MessageEntry entry, ReplyHandler done);
+    /// Sends a request with its own timeout (0 = none).
+    void request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done);
+    /// Sends an entry that gets no reply (pipe/wire packets, callback replies).
+    void send(MessageEntry entry);
+    /// DisconnectClient, then close. Also done when the last reference goes.
+    void close();
+    ~RawClient();
+
+    const ClientSessionInfo& info() const noexcept { return info_; }
+    const NodeID& remote_node_id() const noexcept { return remote_node_id_; }
+    const std::string& remote_node_name() const noexcept { return remote_node_name_; }
+    bool is_open() const noexcept { return open_.load(); }
+    /// Bytes queued for sending (for backpressure decisions).
+    std::size_t queued_bytes() const noexcept { return queued_.load(); }
+
+    class Logic;
+
+private:
+    RawClient() = default;
+    friend class Logic;
+
+    std::shared_ptr<Logic> logic_;
+    std::weak_ptr<PumpHandle> pump_;
+    ClientSessionInfo info_;
+    NodeID remote_node_id_;
+    std::string remote_node_name_;
+    std::atomic<bool> open_{false};
+    std::atomic<std::size_t> queued_{0};
+};
+
+}  // namespace rr::server

@@ -1,0 +1,37 @@
+// The seam between a transport (bytes on a socket) and the sans-IO protocol objects of core/.
+// A transport pump calls these from its strand only; implementations are not thread-safe.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/error/rr_error.hpp"
+#include "core/session/stream_connection.hpp"
+
+namespace rr::server {
+
+/// The monotonic clock of the server: the only place core's MonoTime is read.
+inline MonoTime mono_now() noexcept { return std::chrono::steady_clock::now(); }
+
+class ConnectionLogic {
+public:
+    virtual ~ConnectionLogic() = default;
+    /// Bytes arrived. Protocol errors are handled inside (they make wants_close() true).
+    virtual void on_bytes(std::span<const std::byte> bytes, MonoTime now) = 0;
+    /// True when bytes are waiting to be written.
+    virtual bool has_output() const = 0;
+    /// Moves every pending byte into `out` (cleared first; swapping buffers keeps this copy-free).
+    /// The pump writes `out` while the logic keeps queueing into its own buffer.
+    virtual void take_output(std::vector<std::byte>& out) = 0;
+    virtual std::optional<MonoTime> next_deadline() const = 0;
+    virtual void on_timer(MonoTime now) = 0;
+    /// True once the logic is finished; the pump closes the socket after flushing pending_output().
+    virtual bool wants_close() const = 0;
+    /// The socket failed or the peer closed it; called once.
+    virtual void on_transport_closed(RRError error) = 0;
+};
+
+}  // namespace rr::server

@@ -1,0 +1,35 @@
+// Template part of Node.
+#pragma once
+
+#include <boost/asio/strand.hpp>
+
+#include "server/transport/stream_pump.hpp"
+
+namespace rr::server {
+
+/// ServerConnection plus the node's connection count (a shared counter, so no reference to the node
+/// is kept: connections live inside the node's io_context).
+class CountedServerConnection : public ServerConnection {
+public:
+    CountedServerConnection(const std::shared_ptr<Node>& node, std::shared_ptr<std::atomic<std::size_t>> counter,
+                            ServerConnectionConfig config, MonoTime now)
+        : ServerConnection(node, std::move(config), now), counter_(std::move(counter)) {
+        counter_->fetch_add(1);
+    }
+    ~CountedServerConnection() override { counter_->fetch_sub(1); }
+
+private:
+    std::shared_ptr<std::atomic<std::size_t>> counter_;
+};
+
+template <class Stream>
+void Node::serve_stream(Stream stream, std::vector<std::byte> initial) {
+    typename StreamPump<Stream>::Strand strand(boost::asio::make_strand(boost::asio::any_io_executor(io_.get_executor())));
+    auto logic = std::make_shared<CountedServerConnection>(shared_from_this(), connections_, options_.server, mono_now());
+    auto pump = std::make_shared<StreamPump<Stream>>(std::move(stream), strand, logic);
+    logic->attach(pump);
+    track(pump);
+    pump->start(initial);
+}
+
+}  // namespace rr::server

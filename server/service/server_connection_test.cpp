@@ -1,0 +1,302 @@
+// Node + ServerConnection + RawClient over real loopback TCP, with a hand-written entry-level service.
+#include <catch2/catch.hpp>
+
+#include <future>
+#include <thread>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/read.hpp>
+#include <boost/asio/write.hpp>
+
+#include "core/session/elements.hpp"
+#include "server/client/raw_client.hpp"
+#include "server/node/node.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace std::chrono_literals;
+
+namespace {
+
+constexpr const char* kDef = "service example.rawtest\n\nstdver 0.10\n\nobject Obj\n    property double x\n"
+                             "    function int32 add(int32 a, int32 b)\n    event changed(double v)\n"
+                             "    function void fire()\n    callback double cb(double v)\n    function double callme(double v)\nend\n";
+
+class RawTestService : public Service {
+public:
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override { return {kDef}; }
+    std::optional<std::string> service_definition(std::string_view type) const override {
+        if (type == "example.rawtest") return std::string(kDef);
+        return std::nullopt;
+    }
+    ObjectTypeInfo root_type() const override { return {"example.rawtest.Obj", {}}; }
+    void object_type(const SessionRef&, const std::string& path, std::function<void(Result<ObjectTypeInfo>)> done) override {
+        if (path == "svc") done(root_type());
+        else done(fail(MessageErrorType::ObjectNotFound, "Object not found"));
+    }
+    void on_session_open(const SessionRef& s) override { opened++; (void)s; }
+    void on_session_close(const SessionRef& s) override { closed++; (void)s; }
+
+    void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
+        if (e.entry_type == MessageEntryType::PropertyGetReq && e.member_name == "x") {
+            MessageEntry r;
+            r.elements.push_back(make_scalar_element("value", 42.5));
+            responder.respond(std::move(r));
+            return;
+        }
+        if (e.entry_type == MessageEntryType::FunctionCallReq && e.member_name == "add") {
+            std::int32_t a = 0, b = 0;
+            const auto* ea = e.find("a");
+            const auto* eb = e.find("b");
+            if (!ea || !eb || !read_scalar(*ea, a) || !read_scalar(*eb, b)) {
+                responder.fail(make_error(MessageErrorType::DataTypeError, "add takes two int32"));
+                return;
+            }
+            MessageEntry r;
+            r.elements.push_back(make_scalar_element<std::int32_t>("return", a + b));
+            responder.respond(std::move(r));
+            return;
+        }
+        if (e.entry_type == MessageEntryType::FunctionCallReq && e.member_name == "fire") {
+            MessageEntry ev;
+            ev.entry_type = MessageEntryType::EventReq;
+            ev.service_path = "svc";
+            ev.member_name = "changed";
+            ev.elements.push_back(make_scalar_element("v", 7.0));
+            REQUIRE(session.send(std::move(ev)));
+            MessageEntry r;
+            r.elements.push_back(make_scalar_element<std::int32_t>("return", 0));
+            responder.respond(std::move(r));
+            return;
+        }
+        if (e.entry_type == MessageEntryType::FunctionCallReq && e.member_name == "callme") {
+            double v = 0;
+            if (const auto* ev = e.find("v")) read_scalar(*ev, v);
+            MessageEntry call;
+            call.entry_type = MessageEntryType::CallbackCallReq;
+            call.service_path = "svc";
+            call.member_name = "cb";
+            call.elements.push_back(make_scalar_element("v", v));
+            auto shared = std::make_shared<Responder>(std::move(responder));
+            session.request(std::move(call), [shared](Result<MessageEntry> reply) {
+                if (!reply) {
+                    shared->fail(reply.error());
+                    return;
+                }
+                double ret = 0;
+                const auto* el = reply->find("return");
+                if (!el || !read_scalar(*el, ret)) {
+                    shared->fail(make_error(MessageErrorType::DataTypeError, "callback returned no double"));
+                    return;
+                }
+                MessageEntry r;
+                r.elements.push_back(make_scalar_element("return", ret));
+                shared->respond(std::move(r));
+            });
+            return;
+        }
+        responder.fail(make_error(MessageErrorType::MemberNotFound, "Member \"" + e.member_name + "\" not found"));
+    }
+
+    std::atomic<int> opened{0}, closed{0};
+
+private:
+    std::string name_ = "svc";
+};
+
+struct Fixture {
+    std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "rawtest.node", 2, {}, 0, 5000ms});
+    std::shared_ptr<RawTestService> service = std::make_shared<RawTestService>();
+    std::uint16_t port = 0;
+
+    Fixture() {
+        REQUIRE(node->register_service(service));
+        auto p = node->listen_tcp("127.0.0.1", 0);
+        REQUIRE(p);
+        port = *p;
+    }
+
+    std::shared_ptr<RawClient> connect(RawClient::IncomingHandler incoming = {}, RawClientOptions opts = {}) {
+        std::promise<Result<std::shared_ptr<RawClient>>> p;
+        auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc");
+        REQUIRE(url);
+        RawClient::connect(node->io_context().get_executor(), *url, opts, std::move(incoming), {},
+                           [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+        auto r = p.get_future().get();
+        REQUIRE(r);
+        return *r;
+    }
+
+    static Result<MessageEntry> call(RawClient& c, MessageEntry e) {
+        std::promise<Result<MessageEntry>> p;
+        c.request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
+        return p.get_future().get();
+    }
+};
+
+MessageEntry request(MessageEntryType type, std::string member) {
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = "svc";
+    e.member_name = std::move(member);
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("client connects with ConnectClientCombined and gets the service definition") {
+    for (bool v4 : {true, false}) {
+        Fixture f;
+        RawClientOptions opts;
+        opts.enable_message4 = v4;
+        auto c = f.connect({}, opts);
+        CHECK(c->info().object_type == "example.rawtest.Obj");
+        REQUIRE(c->info().service_definitions.size() == 1);
+        CHECK(c->info().service_definitions[0] == kDef);
+        CHECK(c->remote_node_name() == "rawtest.node");
+        CHECK(c->remote_node_id() == f.node->node_id());
+
+        auto get = Fixture::call(*c, request(MessageEntryType::PropertyGetReq, "x"));
+        REQUIRE(get);
+        double x = 0;
+        REQUIRE(get->find("value"));
+        CHECK(read_scalar(*get->find("value"), x));
+        CHECK(x == 42.5);
+
+        auto add = request(MessageEntryType::FunctionCallReq, "add");
+        add.elements.push_back(make_scalar_element<std::int32_t>("a", 40));
+        add.elements.push_back(make_scalar_element<std::int32_t>("b", 2));
+        auto sum = Fixture::call(*c, std::move(add));
+        REQUIRE(sum);
+        std::int32_t s = 0;
+        CHECK(read_scalar(*sum->find("return"), s));
+        CHECK(s == 42);
+    }
+}
+
+TEST_CASE("errors from a service arrive as RR error entries and the session stays up") {
+    Fixture f;
+    auto c = f.connect();
+    auto bad = Fixture::call(*c, request(MessageEntryType::FunctionCallReq, "nosuch"));
+    REQUIRE(bad);
+    CHECK(bad->error == MessageErrorType::MemberNotFound);
+    auto err = *entry_error(*bad);
+    CHECK(err.name == "RobotRaconteur.MemberNotFound");
+    CHECK(err.message == "Member \"nosuch\" not found");
+    auto ok = Fixture::call(*c, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(ok);
+    CHECK(ok->error == MessageErrorType::None);
+}
+
+TEST_CASE("events reach the client and callbacks reach back into it") {
+    Fixture f;
+    std::promise<MessageEntry> event;
+    std::weak_ptr<RawClient> weak;
+    bool event_set = false;
+    auto c = f.connect([&](MessageEntry&& e) {
+        if (e.entry_type == MessageEntryType::EventReq && !event_set) {
+            event_set = true;
+            event.set_value(std::move(e));
+        } else if (e.entry_type == MessageEntryType::CallbackCallReq) {
+            double v = 0;
+            read_scalar(*e.find("v"), v);
+            MessageEntry r;
+            r.entry_type = MessageEntryType::CallbackCallRet;
+            r.service_path = e.service_path;
+            r.member_name = e.member_name;
+            r.request_id = e.request_id;
+            r.elements.push_back(make_scalar_element("return", v * 2));
+            if (auto cl = weak.lock()) cl->send(std::move(r));
+        }
+    });
+    weak = c;
+    REQUIRE(Fixture::call(*c, request(MessageEntryType::FunctionCallReq, "fire")));
+    auto ev = event.get_future();
+    REQUIRE(ev.wait_for(5s) == std::future_status::ready);
+    auto e = ev.get();
+    CHECK(e.member_name == "changed");
+    double v = 0;
+    CHECK(read_scalar(*e.find("v"), v));
+    CHECK(v == 7.0);
+
+    auto callme = request(MessageEntryType::FunctionCallReq, "callme");
+    callme.elements.push_back(make_scalar_element("v", 21.0));
+    auto r = Fixture::call(*c, std::move(callme));
+    REQUIRE(r);
+    double ret = 0;
+    REQUIRE(r->find("return"));
+    CHECK(read_scalar(*r->find("return"), ret));
+    CHECK(ret == 42.0);
+}
+
+TEST_CASE("connecting to an unknown service fails with ServiceNotFound") {
+    Fixture f;
+    std::promise<Result<std::shared_ptr<RawClient>>> p;
+    auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(f.port) + "/?service=nosuch");
+    RawClient::connect(f.node->io_context().get_executor(), *url, {}, {}, {},
+                       [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+    auto r = p.get_future().get();
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::ServiceNotFound);
+}
+
+namespace {
+
+// Writes raw bytes on a fresh socket and reads until the server closes (or 5 s pass).
+std::string raw_exchange(std::uint16_t port, const std::string& bytes) {
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::socket s(io);
+    s.connect({boost::asio::ip::make_address("127.0.0.1"), port});
+    boost::asio::write(s, boost::asio::buffer(bytes));
+    std::string got;
+    std::array<char, 4096> buf;
+    boost::system::error_code ec;
+    auto deadline = std::chrono::steady_clock::now() + 5s;
+    s.non_blocking(true);
+    while (std::chrono::steady_clock::now() < deadline) {
+        auto n = s.read_some(boost::asio::buffer(buf), ec);
+        if (ec == boost::asio::error::would_block) {
+            std::this_thread::sleep_for(10ms);
+            continue;
+        }
+        if (ec) break;
+        got.append(buf.data(), n);
+    }
+    if (!ec || ec == boost::asio::error::would_block) got += "<still open>";
+    return got;
+}
+
+}  // namespace
+
+TEST_CASE("misbehaving peers are answered or dropped while other clients keep working") {
+    Fixture f;
+    auto good = f.connect();
+
+    // Not RR, not HTTP: 404 and close.
+    CHECK(raw_exchange(f.port, "XXXXhello").rfind("HTTP/1.1 404", 0) == 0);
+    // RRAC with a 4 GiB MessageSize: closed without allocating.
+    std::string huge = "RRAC";
+    huge += std::string("\xff\xff\xff\xff", 4);
+    CHECK(raw_exchange(f.port, huge).empty());
+    // A message before CreateConnection / truncated garbage after a valid preamble: closed.
+    std::string trunc = "RRAC";
+    trunc += std::string("\x40\x00\x00\x00", 4);
+    trunc += std::string(56, '\x01');
+    CHECK(raw_exchange(f.port, trunc).find("<still open>") == std::string::npos);
+
+    auto ok = Fixture::call(*good, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(ok);
+    CHECK(ok->error == MessageErrorType::None);
+}
+
+TEST_CASE("disconnect closes the session on the service") {
+    Fixture f;
+    {
+        auto c = f.connect();
+        CHECK(f.service->opened == 1);
+        c->close();
+    }
+    for (int i = 0; i < 100 && f.service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(f.service->closed == 1);
+}

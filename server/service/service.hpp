@@ -1,0 +1,120 @@
+// A service registered on a node, as the node's connections see it: what is needed to answer the
+// special requests (GetServiceDesc, ObjectTypeName, ConnectClient(Combined), GetServiceAttributes;
+// wire.md §6.4) and to dispatch member requests (wire.md §6.7).
+//
+// Two implementations: ObjectService (a tree of C++ ServiceObjects typed by robdef) and, in the
+// gateway, a mirror that forwards entries to a device.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error/rr_error.hpp"
+#include "core/message/message.hpp"
+
+namespace rr::server {
+
+class ServerSession;
+
+/// A client session as seen by a service: identity plus thread-safe sending. Obtained in
+/// Service::on_session_open and kept by services that push to the client (events, wires, pipes,
+/// callbacks).
+class SessionRef {
+public:
+    SessionRef() = default;
+    explicit SessionRef(std::weak_ptr<ServerSession> s);
+
+    /// This client's endpoint id (unique within the node while it lives).
+    std::uint32_t endpoint() const noexcept { return endpoint_; }
+    /// Authenticated user name, empty when none.
+    std::string username() const;
+    /// False once the client is gone.
+    bool alive() const;
+
+    /// Sends an entry the client did not ask for (EventReq, WirePacket, PipePacket, PipeClosed, …).
+    /// Thread-safe. Errors: ConnectionError when the client is gone; BufferLimitViolation when the
+    /// client's send queue is full (the caller decides: drop for wires, back off for pipes).
+    Result<void> send(MessageEntry entry) const;
+    /// Like send(), but a queued, unsent wire packet for the same service path and member is replaced
+    /// (wire.md §6.3: wires keep only the newest value).
+    Result<void> send_wire_packet(MessageEntry entry) const;
+    /// Sends a request to the client (CallbackCallReq) and calls `done` with the reply entry or an
+    /// error (RequestTimeout, ConnectionError). `done` runs on the session's strand.
+    void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) const;
+    /// Bytes waiting to be written to this client (for backpressure decisions).
+    std::size_t queued_bytes() const;
+
+    friend bool operator==(const SessionRef& a, const SessionRef& b) noexcept { return a.endpoint_ == b.endpoint_; }
+
+private:
+    std::weak_ptr<ServerSession> session_;
+    std::uint32_t endpoint_ = 0;
+};
+
+/// Completes one request exactly once, from any thread.
+class Responder {
+public:
+    Responder() = default;
+    Responder(std::function<void(MessageEntry)> send, MessageEntry request_header);
+    Responder(Responder&&) noexcept = default;
+    Responder& operator=(Responder&&) noexcept = default;
+    ~Responder();  // an unanswered request is answered with InternalError
+
+    /// Sends `reply` (EntryType, ServicePath, MemberName and RequestID are set from the request).
+    void respond(MessageEntry reply);
+    /// Sends an error reply (wire.md §5.2).
+    void fail(RRError error);
+    bool done() const noexcept { return !send_; }
+    const MessageEntry& request() const noexcept { return request_; }
+
+private:
+    std::function<void(MessageEntry)> send_;
+    MessageEntry request_;  // fields only, no elements
+};
+
+/// Root and implemented types of an object, answering ObjectTypeName.
+struct ObjectTypeInfo {
+    std::string object_type;                  ///< qualified, e.g. "experimental.create.Create"
+    std::vector<std::string> implements;      ///< qualified
+};
+
+class Service {
+public:
+    virtual ~Service() = default;
+
+    virtual const std::string& name() const = 0;
+    /// Definition texts: the root object's service definition first, then every definition it imports,
+    /// transitively (what ConnectClientCombined returns as `servicedefs`).
+    virtual std::vector<std::string> service_definitions() const = 0;
+    /// Definition text of one service definition by name (GetServiceDesc with ServiceType).
+    virtual std::optional<std::string> service_definition(std::string_view service_type) const = 0;
+    virtual ObjectTypeInfo root_type() const = 0;
+    /// `attributes`: a map{string} element of varvalues (may be an empty map).
+    virtual MessageElement attributes() const;
+
+    /// Type of the object at `path` (the root or a path reached through objrefs), for ObjectTypeName.
+    /// `done` may be called from any thread. Errors: ObjectNotFound.
+    virtual void object_type(const SessionRef& session, const std::string& path,
+                             std::function<void(Result<ObjectTypeInfo>)> done) = 0;
+
+    /// Whether a session must authenticate, and the check itself (username + credentials element).
+    virtual bool requires_authentication() const { return false; }
+    virtual Result<void> authenticate(const std::string& username, const MessageElement* credentials) {
+        return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
+    }
+
+    virtual void on_session_open(const SessionRef& session) {}
+    virtual void on_session_close(const SessionRef& session) {}
+
+    /// A member request from a client (EntryType ≥ 1111, odd), or a client-sent packet that needs no
+    /// answer (PipePacket, PipePacketRet, WirePacket: `responder` is then empty and must be ignored).
+    /// Runs on the session's strand; long work must be moved elsewhere and answered via `responder`.
+    virtual void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) = 0;
+};
+
+}  // namespace rr::server

@@ -1,0 +1,186 @@
+// Moves bytes and time between one Asio stream and one ConnectionLogic; never interprets them.
+// All work for a connection runs on the pump's strand; other threads reach the logic only through
+// post(). Reads are bounded by the logic's limits (it rejects oversized messages before buffering).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <memory>
+
+#include <boost/asio/bind_executor.hpp>
+#include <boost/asio/socket_base.hpp>
+#include <boost/asio/dispatch.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/write.hpp>
+
+#include "server/node/connection_logic.hpp"
+
+namespace rr::server {
+
+namespace asio = boost::asio;
+
+/// Type-erased handle a ConnectionLogic owner uses to run code on the connection's strand.
+class PumpHandle {
+public:
+    virtual ~PumpHandle() = default;
+    /// Runs `fn` on the strand, then flushes output and re-arms the timer.
+    virtual void post(std::function<void()> fn) = 0;
+    /// Like post(), but runs `fn` at once when already on the strand.
+    virtual void dispatch(std::function<void()> fn) = 0;
+    /// Closes the transport (after flushing what is pending).
+    virtual void close() = 0;
+};
+
+template <class Stream>
+class StreamPump : public PumpHandle, public std::enable_shared_from_this<StreamPump<Stream>> {
+public:
+    using Strand = asio::strand<asio::any_io_executor>;
+
+    StreamPump(Stream stream, Strand strand, std::shared_ptr<ConnectionLogic> logic)
+        : stream_(std::move(stream)), strand_(std::move(strand)), timer_(strand_), logic_(std::move(logic)) {}
+
+    /// Starts reading; `initial` bytes (already read while detecting the protocol) are fed first.
+    void start(std::span<const std::byte> initial = {}) {
+        auto self = this->shared_from_this();
+        std::vector<std::byte> first(initial.begin(), initial.end());
+        asio::dispatch(strand_, [self, first = std::move(first)] {
+            if (!first.empty()) self->logic_->on_bytes(first, mono_now());
+            self->read();
+            self->after_work();
+        });
+    }
+
+    void post(std::function<void()> fn) override {
+        auto self = this->shared_from_this();
+        asio::post(strand_, [self, fn = std::move(fn)] {
+            if (self->closed_) return;
+            fn();
+            self->after_work();
+        });
+    }
+
+    void dispatch(std::function<void()> fn) override {
+        auto self = this->shared_from_this();
+        asio::dispatch(strand_, [self, fn = std::move(fn)] {
+            if (self->closed_) return;
+            fn();
+            self->after_work();
+        });
+    }
+
+    void close() override {
+        auto self = this->shared_from_this();
+        asio::post(strand_, [self] {
+            self->close_requested_ = true;
+            self->after_work();
+        });
+    }
+
+    Stream& stream() { return stream_; }
+    const Strand& strand() const { return strand_; }
+
+private:
+    void read() {
+        auto self = this->shared_from_this();
+        stream_.async_read_some(asio::buffer(buffer_),
+                                asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t n) {
+                                    if (self->closed_) return;
+                                    if (ec) {
+                                        self->transport_failed(ec);
+                                        return;
+                                    }
+                                    self->logic_->on_bytes(std::span<const std::byte>(self->buffer_.data(), n), mono_now());
+                                    self->after_work();
+                                    if (!self->closed_ && !self->logic_->wants_close()) self->read();
+                                }));
+    }
+
+    void after_work() {
+        if (closed_) return;
+        flush();
+        arm_timer();
+    }
+
+    void flush() {
+        if (writing_ || closed_) return;
+        if (!logic_->has_output()) {
+            if (logic_->wants_close() || close_requested_) shutdown();
+            return;
+        }
+        logic_->take_output(write_buffer_);
+        writing_ = true;
+        auto self = this->shared_from_this();
+        asio::async_write(stream_, asio::buffer(write_buffer_.data(), write_buffer_.size()),
+                          asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t) {
+                              self->writing_ = false;
+                              self->write_buffer_.clear();
+                              if (self->closed_) return;
+                              if (ec) {
+                                  self->transport_failed(ec);
+                                  return;
+                              }
+                              self->after_work();
+                          }));
+    }
+
+    void arm_timer() {
+        auto deadline = logic_->next_deadline();
+        if (!deadline) {
+            timer_.cancel();
+            return;
+        }
+        if (timer_armed_ && *deadline == armed_for_) return;
+        timer_armed_ = true;
+        armed_for_ = *deadline;
+        timer_.expires_at(*deadline);
+        auto self = this->shared_from_this();
+        timer_.async_wait(asio::bind_executor(strand_, [self, when = *deadline](boost::system::error_code ec) {
+            if (ec || self->closed_ || when != self->armed_for_) return;
+            self->timer_armed_ = false;
+            self->logic_->on_timer(mono_now());
+            self->after_work();
+        }));
+    }
+
+    void transport_failed(boost::system::error_code ec) {
+        if (closed_) return;
+        transport_reported_ = true;
+        logic_->on_transport_closed(make_error(MessageErrorType::ConnectionError,
+                                               ec == asio::error::eof ? "connection closed by peer" : ec.message()));
+        shutdown();
+    }
+
+    void shutdown() {
+        if (closed_) return;
+        closed_ = true;
+        timer_.cancel();
+        boost::system::error_code ignored;
+        if constexpr (requires(Stream& s) { s.lowest_layer(); }) {
+            stream_.lowest_layer().shutdown(asio::socket_base::shutdown_both, ignored);
+            stream_.lowest_layer().close(ignored);
+        } else {
+            stream_.close(ignored);
+        }
+        if (!transport_reported_) {
+            transport_reported_ = true;
+            logic_->on_transport_closed(make_error(MessageErrorType::ConnectionError, "connection closed"));
+        }
+    }
+
+    Stream stream_;
+    Strand strand_;
+    asio::steady_timer timer_;
+    std::shared_ptr<ConnectionLogic> logic_;
+    std::array<std::byte, 64 * 1024> buffer_{};
+    std::vector<std::byte> write_buffer_;
+    bool writing_ = false;
+    bool closed_ = false;
+    bool close_requested_ = false;
+    bool timer_armed_ = false;
+    bool transport_reported_ = false;
+    MonoTime armed_for_{};
+};
+
+}  // namespace rr::server
