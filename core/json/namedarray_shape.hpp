@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <string_view>
 #include <vector>
 
@@ -27,5 +28,20 @@ struct NamedArrayShape {
 /// Shape of namedarray `type`. Errors as namedarray_layout (DataTypeError for invalid definitions).
 Result<std::shared_ptr<const NamedArrayShape>> namedarray_shape(const NamedType& type,
                                                                  const robdef::TypeLookup& lookup);
+
+/// Shapes computed once per JSON call, keyed by definition address.
+class NamedArrayShapeCache {
+public:
+    Result<std::shared_ptr<const NamedArrayShape>> get(const NamedType& type, const robdef::TypeLookup& lookup) {
+        for (const auto& [entry, shape] : shapes_)
+            if (entry == type.entry) return shape;
+        auto s = namedarray_shape(type, lookup);
+        if (s) shapes_.emplace_back(type.entry, *s);
+        return s;
+    }
+
+private:
+    std::vector<std::pair<const robdef::ServiceEntryDefinition*, std::shared_ptr<const NamedArrayShape>>> shapes_;
+};
 
 }  // namespace rr

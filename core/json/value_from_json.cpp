@@ -9,6 +9,7 @@
 #include "core/json/value_json.hpp"
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
+#include "core/value/type_cache.hpp"
 #include "core/value/value_path.hpp"
 #include "core/value/var_type.hpp"
 
@@ -32,7 +33,8 @@ std::optional<std::int32_t> canonical_int32(const std::string& key) {
 
 class FromJson {
 public:
-    FromJson(const robdef::TypeLookup& lookup, std::size_t max_depth) : lookup_(lookup), path_({}), max_depth_(max_depth) {}
+    FromJson(const robdef::TypeLookup& lookup, std::size_t max_depth)
+        : lookup_(lookup), cache_(lookup), path_({}), max_depth_(max_depth) {}
 
     Result<Value> from(const json& j, const TypeDefinition& t, std::string_view ctx);
 
@@ -71,6 +73,8 @@ private:
     Result<Value> var(const json& j);
 
     const robdef::TypeLookup& lookup_;
+    TypeCache cache_;
+    NamedArrayShapeCache shapes_;
     ValuePath path_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
@@ -287,12 +291,13 @@ Result<std::span<const json>> FromJson::array_items(const json& j, const NamedTy
 }
 
 Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedType& nt, bool scalar) {
-    auto plans = pod_field_plans(nt, lookup_);
-    if (!plans) return relay(plans.error());
+    auto cached = cache_.pod_plans(nt);
+    if (!cached) return relay(cached.error());
+    const std::vector<PodFieldPlan>& plans = **cached;
     PodArray p;
     p.type_name = nt.qualified_name;
-    for (const auto& plan : *plans) p.field_names.push_back(plan.member->name);
-    p.values.reserve(items.size() * plans->size());
+    for (const auto& plan : plans) p.field_names.push_back(plan.member->name);
+    p.values.reserve(items.size() * plans.size());
     for (std::size_t i = 0; i < items.size(); ++i) {
         std::optional<PathScope> pi;
         if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
@@ -300,7 +305,7 @@ Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedTyp
         if (!item.is_object())
             return err(MessageErrorType::DataTypeMismatch, "expected a " + nt.qualified_name + " object, got " +
                                                                std::string(item.type_name()));
-        if (item.size() != plans->size()) {
+        if (item.size() != plans.size()) {
             for (const auto& [key, v] : item.items()) {
                 if (p.field_index(key) < 0) {
                     PathScope pf(path_, key);
@@ -308,7 +313,7 @@ Result<PodArray> FromJson::pod_items(std::span<const json> items, const NamedTyp
                 }
             }
         }
-        for (const auto& plan : *plans) {
+        for (const auto& plan : plans) {
             PathScope pf(path_, plan.member->name);
             auto it = item.find(plan.member->name);
             if (it == item.end()) return err(MessageErrorType::DataTypeError, "missing field of " + nt.qualified_name);
@@ -393,7 +398,7 @@ Result<Value> FromJson::namedarray(const json& j, const TypeDefinition& t, const
 }
 
 Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const NamedType& nt, bool scalar) {
-    auto shape = namedarray_shape(nt, lookup_);
+    auto shape = shapes_.get(nt, lookup_);
     if (!shape) return relay(shape.error());
     const NamedArrayShape& s = **shape;
     NumericArray flat = NumericArray::zeros(s.element_type, items.size() * s.width);

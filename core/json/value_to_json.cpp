@@ -8,6 +8,7 @@
 #include "core/json/value_json.hpp"
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
+#include "core/value/type_cache.hpp"
 #include "core/value/value_path.hpp"
 #include "core/value/var_type.hpp"
 
@@ -32,7 +33,8 @@ json multidim_json(const std::vector<std::uint32_t>& dims, json array) {
 
 class ToJson {
 public:
-    ToJson(const robdef::TypeLookup& lookup, std::size_t max_depth) : lookup_(lookup), path_({}), max_depth_(max_depth) {}
+    ToJson(const robdef::TypeLookup& lookup, std::size_t max_depth)
+        : lookup_(lookup), cache_(lookup), path_({}), max_depth_(max_depth) {}
 
     Result<json> to(const Value& v, const TypeDefinition& t, std::string_view ctx);
 
@@ -75,6 +77,8 @@ private:
     Result<json> var(const Value& v);
 
     const robdef::TypeLookup& lookup_;
+    TypeCache cache_;
+    NamedArrayShapeCache shapes_;
     ValuePath path_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
@@ -232,28 +236,32 @@ Result<json> ToJson::pod(const Value& v, const TypeDefinition& t, const NamedTyp
 
 // Array of item objects.
 Result<json> ToJson::pod_items(const PodArray& p, const NamedType& nt, bool scalar) {
-    auto plans = pod_field_plans(nt, lookup_);
-    if (!plans) return relay(plans.error());
+    auto cached = cache_.pod_plans(nt);
+    if (!cached) return relay(cached.error());
+    const std::vector<PodFieldPlan>& plans = **cached;
     const std::size_t nf = p.field_names.size();
     if (p.values.size() != p.count * nf)
         return err(MessageErrorType::DataTypeError, "pod value holds a wrong number of field values");
-    for (auto& plan : *plans) {
-        plan.index = p.field_index(plan.member->name);
-        if (plan.index < 0) {
-            PathScope ps(path_, plan.member->name);
+    std::vector<std::size_t> index(plans.size());
+    for (std::size_t k = 0; k < plans.size(); ++k) {
+        auto at = p.field_index(plans[k].member->name);
+        if (at < 0) {
+            PathScope ps(path_, plans[k].member->name);
             return err(MessageErrorType::DataTypeError, "missing field of " + nt.qualified_name);
         }
+        index[k] = static_cast<std::size_t>(at);
     }
-    if (plans->size() != nf) return err(MessageErrorType::DataTypeError, "unknown or duplicate field in " + nt.qualified_name);
+    if (plans.size() != nf) return err(MessageErrorType::DataTypeError, "unknown or duplicate field in " + nt.qualified_name);
     json::array_t out;
     out.reserve(p.count);
     for (std::size_t i = 0; i < p.count; ++i) {
         std::optional<PathScope> pi;
         if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
         json item = json::object();
-        for (const auto& plan : *plans) {
+        for (std::size_t k = 0; k < plans.size(); ++k) {
+            const PodFieldPlan& plan = plans[k];
             PathScope pf(path_, plan.member->name);
-            auto j = pod_field(p.values[i * nf + static_cast<std::size_t>(plan.index)], plan);
+            auto j = pod_field(p.values[i * nf + index[k]], plan);
             if (!j) return j;
             item[plan.member->name] = std::move(*j);
         }
@@ -328,7 +336,7 @@ Result<json> ToJson::namedarray(const Value& v, const TypeDefinition& t, const N
 }
 
 Result<json> ToJson::namedarray_items(const NamedArray& a, const NamedType& nt, std::size_t& items) {
-    auto shape = namedarray_shape(nt, lookup_);
+    auto shape = shapes_.get(nt, lookup_);
     if (!shape) return relay(shape.error());
     const NamedArrayShape& s = **shape;
     if (a.array.type() != s.element_type)

@@ -43,7 +43,6 @@ struct PodFieldPlan {
     NamedType named;                   ///< resolved pod/namedarray for named fields
     bool multidim = false;             ///< declared multi-dim: the value carries `dims`
     std::vector<std::uint32_t> dims;   ///< declared dims of a multi-dim field
-    std::ptrdiff_t index = -1;         ///< scratch: position in a PodArray's field_names
 };
 
 /// Plans for every field of pod `pod`, in definition order. Fields must be numeric, pod or namedarray,

@@ -5,6 +5,7 @@
 
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
+#include "core/value/type_cache.hpp"
 #include "core/value/value_path.hpp"
 #include "core/value/var_type.hpp"
 
@@ -20,7 +21,7 @@ namespace {
 class Packer {
 public:
     Packer(const robdef::TypeLookup& lookup, std::string_view root, std::size_t max_depth)
-        : lookup_(lookup), path_(root), max_depth_(max_depth) {}
+        : lookup_(lookup), cache_(lookup), path_(root), max_depth_(max_depth) {}
 
     Result<MessageElement> pack(const Value& v, const TypeDefinition& t, std::string_view ctx);
 
@@ -58,6 +59,7 @@ private:
     Result<MessageElement> pack_var(const Value& v);
 
     const robdef::TypeLookup& lookup_;
+    TypeCache cache_;
     ValuePath path_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
@@ -245,22 +247,26 @@ Result<MessageElement> Packer::pack_pod(const Value& v, const TypeDefinition& t,
 
 Result<MessageElement> Packer::pack_pod_items(const PodArray& p, const TypeDefinition& t, const NamedType& nt) {
     if (auto r = check_count(p.count, t); !r) return err(r.error().type, r.error().message);
-    auto plans = pod_field_plans(nt, lookup_);
-    if (!plans) return err(plans.error().type, plans.error().message);
+    auto cached = cache_.pod_plans(nt);
+    if (!cached) return err(cached.error().type, cached.error().message);
+    const std::vector<PodFieldPlan>& plans = **cached;
     const std::size_t nf = p.field_names.size();
     if (p.values.size() != p.count * nf)
         return err(MessageErrorType::DataTypeError, "pod value holds " + std::to_string(p.values.size()) +
                                                         " field values for " + std::to_string(p.count) + " items");
-    for (auto& plan : *plans) {
-        plan.index = p.field_index(plan.member->name);
-        if (plan.index < 0) {
-            PathScope ps(path_, plan.member->name);
+    // Where each definition field sits in the value's field order.
+    std::vector<std::size_t> index(plans.size());
+    for (std::size_t k = 0; k < plans.size(); ++k) {
+        auto at = p.field_index(plans[k].member->name);
+        if (at < 0) {
+            PathScope ps(path_, plans[k].member->name);
             return err(MessageErrorType::DataTypeError, "missing field of " + nt.qualified_name);
         }
+        index[k] = static_cast<std::size_t>(at);
     }
-    if (plans->size() != nf) {
+    if (plans.size() != nf) {
         for (const auto& name : p.field_names) {
-            if (std::none_of(plans->begin(), plans->end(), [&](auto& pl) { return pl.member->name == name; })) {
+            if (std::none_of(plans.begin(), plans.end(), [&](auto& pl) { return pl.member->name == name; })) {
                 PathScope ps(path_, name);
                 return err(MessageErrorType::DataTypeError, "unknown field of " + nt.qualified_name);
             }
@@ -276,10 +282,11 @@ Result<MessageElement> Packer::pack_pod_items(const PodArray& p, const TypeDefin
         MessageElement item;
         item.number = static_cast<std::int32_t>(i);
         item.type = DataTypes::pod_t;
-        item.elements.reserve(plans->size());
-        for (const auto& plan : *plans) {
+        item.elements.reserve(plans.size());
+        for (std::size_t k = 0; k < plans.size(); ++k) {
+            const PodFieldPlan& plan = plans[k];
             PathScope pf(path_, plan.member->name);
-            const Value& fv = p.values[i * nf + static_cast<std::size_t>(plan.index)];
+            const Value& fv = p.values[i * nf + index[k]];
             auto c = pack_pod_field(fv, plan);
             if (!c) return c.take_error();
             c->name = plan.member->name;
@@ -363,7 +370,7 @@ Result<MessageElement> Packer::pack_namedarray(const Value& v, const TypeDefinit
 
 Result<MessageElement> Packer::pack_namedarray_items(const NamedArray& a, const TypeDefinition& t,
                                                      const NamedType& nt, std::size_t* items_out) {
-    auto layout = namedarray_layout(nt, lookup_);
+    auto layout = cache_.layout(nt);
     if (!layout) return err(layout.error().type, layout.error().message);
     if (a.array.type() != layout->element_type)
         return err(MessageErrorType::DataTypeMismatch,

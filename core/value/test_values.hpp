@@ -68,6 +68,41 @@ inline RRError unpack_error(const MessageElement& e, std::string_view type) {
     return r.error();
 }
 
+struct TypedValue {
+    Value value;
+    std::string type;
+};
+
+/// A few large values touching every kind (all strings ASCII, so truncation keeps them UTF-8).
+inline std::vector<TypedValue> rich_values() {
+    PodArray grid = samples({5, 6});
+    grid.dims = {2, 1};
+    PodArray pk{"example.test.Packet", {"s", "more", "grid", "n"}};
+    REQUIRE(pk.push_back({Value(samples({1})), Value(samples({2})), Value(grid), Value::scalar<std::uint16_t>(9)}));
+    MapString any;
+    any.entries.emplace_back("p", Value(samples({1})));
+    any.entries.emplace_back("l", Value(List{{inner(1, "a"), Value::array<double>({1, 2})}}));
+    any.entries.emplace_back("m", Value(MultiDimArray{{2, 1}, NumericArray::from<std::int32_t>({1, 2})}));
+    any.entries.emplace_back("n", Value(NamedArray{"example.test.Vec3", NumericArray::from<double>({1, 2, 3}), {1}}));
+    Structure outer{"example.test.Outer", {}};
+    outer.set("inner", inner(7, "seven"))
+        .set("maybe", Value())
+        .set("v", Value::array<double>({1, 2, 3}))
+        .set("b", Value::array<double>({1}))
+        .set("m", Value(MultiDimArray{{1, 2}, NumericArray::from<double>({9, 8})}))
+        .set("fixed", Value(MultiDimArray{{2, 2}, NumericArray::from<std::int32_t>({1, 2, 3, 4})}))
+        .set("names", Value(List{{Value("a")}}))
+        .set("by_name", Value(MapString{{{"k", inner(1, "x")}}}))
+        .set("any", Value(any))
+        .set("color", Value(Enum{"example.test.Color", 5}))
+        .set("c", Value::scalar(cdouble(0, -1)))
+        .set("flag", Value::scalar(true))
+        .set("bytes", Value::array<std::uint8_t>({0, 255}))
+        .set("next", Value());
+    return {{Value(outer), "Outer"}, {Value(pk), "Packet[]"}, {Value(any), "varvalue{string}"},
+            {Value(samples({1, 2})), "Sample[2]"}};
+}
+
 /// A numeric element built by hand (for malformed inputs).
 template <Numeric T>
 MessageElement numeric_element(std::string name, std::initializer_list<T> items) {

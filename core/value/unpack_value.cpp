@@ -1,8 +1,10 @@
 // MessageElement → Value (see pack_value.hpp for the layouts and errors).
 #include <cstring>
+#include <optional>
 
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
+#include "core/value/type_cache.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/value_path.hpp"
 
@@ -27,7 +29,9 @@ std::string element_type_text(const MessageElement& e) {
 class Unpacker {
 public:
     Unpacker(const robdef::TypeLookup* lookup, std::string_view root, std::size_t max_depth)
-        : lookup_(lookup), path_(root), max_depth_(max_depth) {}
+        : lookup_(lookup), path_(root), max_depth_(max_depth) {
+        if (lookup_) cache_.emplace(*lookup_);
+    }
 
     Result<Value> unpack(const MessageElement& e, const TypeDefinition& t, std::string_view ctx);
     Result<Value> unpack_var(const MessageElement& e);
@@ -80,6 +84,7 @@ private:
     Result<NamedArray> unpack_namedarray_untyped(const MessageElement& e);
 
     const robdef::TypeLookup* lookup_;
+    std::optional<TypeCache> cache_;  ///< set when lookup_ is
     ValuePath path_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
@@ -286,13 +291,14 @@ Result<PodArray> Unpacker::unpack_pod_items(const MessageElement& e, const TypeD
     if (e.type != DataTypes::pod_array_t) return expected(t, nt.qualified_name, e);
     if (auto r = check_type_name(e, nt); !r) return r.take_error();
     if (auto r = check_count(e.elements.size(), t); !r) return relay(r.error());
-    auto plans = pod_field_plans(nt, *lookup_);
-    if (!plans) return relay(plans.error());
+    auto cached = cache_->pod_plans(nt);
+    if (!cached) return relay(cached.error());
+    const std::vector<PodFieldPlan>& plans = **cached;
     PodArray p;
     p.type_name = nt.qualified_name;
-    p.field_names.reserve(plans->size());
-    for (const auto& plan : *plans) p.field_names.push_back(plan.member->name);
-    p.values.reserve(e.elements.size() * plans->size());
+    p.field_names.reserve(plans.size());
+    for (const auto& plan : plans) p.field_names.push_back(plan.member->name);
+    p.values.reserve(e.elements.size() * plans.size());
     for (std::size_t i = 0; i < e.elements.size(); ++i) {
         PathScope pi(path_, static_cast<std::int64_t>(i));
         const MessageElement& item = e.elements[i];
@@ -301,7 +307,7 @@ Result<PodArray> Unpacker::unpack_pod_items(const MessageElement& e, const TypeD
             return err(MessageErrorType::DataTypeError, "pod array items must be numbered 0..n-1 in order");
         if (item.type != DataTypes::pod_t)
             return err(MessageErrorType::DataTypeMismatch, "expected a pod item (109), got " + element_type_text(item));
-        for (const auto& plan : *plans) {
+        for (const auto& plan : plans) {
             auto c = child(item, plan.member->name);
             if (!c) return c.take_error();
             PathScope pf(path_, plan.member->name);
@@ -364,7 +370,7 @@ Result<NamedArray> Unpacker::unpack_namedarray_items(const MessageElement& e, co
                                                      const NamedType& nt, std::size_t* items_out) {
     if (e.type != DataTypes::namedarray_array_t) return expected(t, nt.qualified_name, e);
     if (auto r = check_type_name(e, nt); !r) return r.take_error();
-    auto layout = namedarray_layout(nt, *lookup_);
+    auto layout = cache_->layout(nt);
     if (!layout) return relay(layout.error());
     auto arr = child(e, "array");
     if (!arr) return arr.take_error();
