@@ -28,8 +28,12 @@ namespace rr {
 ///
 /// Identity: either `name` or `number`. An element "has a number" when `number` is set; then `name`
 /// is ignored on write (v2 writes the number as decimal text, v4 uses ELEMENT_NUMBER). The v2 reader
-/// sets `number` for children of numbered containers (vector_t, list_t, pod_array_t) whose name is a
-/// canonical decimal int32, so v2 and v4 decode to the same model.
+/// sets `number` (and clears `name`) for children of numbered containers (vector_t, list_t,
+/// pod_array_t) and for the top-level elements of PipePacketRet entries (CORE PipeMember.cpp numbers
+/// its acks) whose name is a canonical decimal int32, so v2 and v4 decode to the same model.
+///
+/// String-table codes: `name`/`type_name` always hold the text (the reader resolves codes); a code
+/// only tells the v4 writer to send the code instead of the text (see string_table.hpp).
 ///
 /// Payload: for is_nested(type) the children are in `elements` and `data` is empty; otherwise `data`
 /// holds the raw little-endian array (DataCount = data.size() / data_type_size(type); string_t holds
@@ -127,9 +131,11 @@ struct MessageHeader {
     std::uint16_t message_res_id = 0;
 
     // --- v4 only ---
-    /// Header flags. When decoding v4 this is what was on the wire. When encoding v4, `std::nullopt`
-    /// means "compute as CORE does" (wire.md §2.3, full routing); a value is honoured exactly, which is
-    /// how routing/endpoint omission on a negotiated connection is expressed.
+    /// Header flags. When decoding v4 this is what was on the wire (v2 decodes leave it empty). When
+    /// encoding v4, `std::nullopt` means "compute as CORE does" (default_v4_flags, full routing); a
+    /// value is honoured exactly, which is how routing/endpoint omission on a negotiated connection is
+    /// expressed (encode_message refuses flags that would drop a field holding data). Reset it before
+    /// re-sending a decoded message on another connection.
     std::optional<std::uint8_t> v4_flags;
     std::uint16_t priority = 0;
     /// Message-local string table (odd codes), in wire order.

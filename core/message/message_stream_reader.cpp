@@ -26,11 +26,13 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
             auto size = read_message_preamble(preamble_, limits_);
             if (!size) return stop(size.error());
             expected_ = *size;
-            body_.reserve(expected_);
+            body_.reserve(std::min(expected_, kInitialBufferBytes));
             body_.assign(preamble_.begin(), preamble_.end());
             preamble_fill_ = 0;
         }
         const std::size_t n = std::min(bytes.size(), expected_ - body_.size());
+        if (body_.size() + n > body_.capacity())  // grow with what arrived: doubling, capped at MessageSize
+            body_.reserve(std::min(expected_, std::max(body_.size() + n, 2 * body_.capacity())));
         body_.insert(body_.end(), bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
         bytes = bytes.subspan(n);
         if (body_.size() == expected_) {

@@ -8,7 +8,9 @@
 //
 // Limits: the magic is checked as soon as its bytes arrive; MessageSize is checked against
 // kMinMessageSize and Limits::max_message_size right after the preamble, before any buffer for the
-// message is allocated, and that buffer is exactly MessageSize bytes.
+// message is allocated. The buffer then grows with the bytes that actually arrive (first up to
+// 64 KiB, then doubling, never past MessageSize), so a peer cannot make the reader allocate much more
+// than it has sent.
 // Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
 // below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
 // over the limit, or a decode limit). After the first error every call fails with that error and no
@@ -52,12 +54,16 @@ public:
     std::size_t ready_count() const noexcept { return ready_.size(); }
     /// Bytes of the message being assembled (0 between messages).
     std::size_t partial_bytes() const noexcept { return preamble_fill_ + body_.size(); }
+    /// Bytes allocated for the message being assembled (for per-connection memory accounting).
+    std::size_t partial_capacity() const noexcept { return body_.capacity(); }
     bool failed() const noexcept { return error_.has_value(); }
     /// The error that stopped the reader, or nullptr.
     const RRError* error() const noexcept { return error_ ? &*error_ : nullptr; }
 
 private:
     Unexpected stop(RRError e);
+
+    static constexpr std::size_t kInitialBufferBytes = 64 * 1024;
 
     Limits limits_;
     std::array<std::byte, kMessagePreambleBytes> preamble_{};

@@ -161,3 +161,26 @@ TEST_CASE("message: encoded messages stream back through the reader") {
         CHECK((*r)[1].entries == m.entries);
     });
 }
+
+TEST_CASE("message: the stream reader's buffer grows with the bytes received, not with MessageSize") {
+    std::vector<std::byte> preamble = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                       std::byte{0x00}, std::byte{0x00}, std::byte{0xc0}, std::byte{0x00}};  // 12 MiB
+    MessageStreamReader reader;
+    REQUIRE(reader.feed(preamble));
+    CHECK(reader.partial_bytes() == 8);
+    CHECK(reader.partial_capacity() <= 64 * 1024);
+    std::vector<std::byte> chunk(100 * 1024, std::byte{0});
+    for (int i = 0; i < 3; ++i) {
+        REQUIRE(reader.feed(chunk));
+        CHECK(reader.partial_bytes() == 8 + (i + 1) * chunk.size());
+        CHECK(reader.partial_capacity() >= reader.partial_bytes());
+        CHECK(reader.partial_capacity() <= 2 * reader.partial_bytes());
+    }
+    CHECK(reader.ready_count() == 0);
+    // Small messages get buffers of their own size.
+    std::vector<std::byte> small = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                    std::byte{20},  std::byte{0},   std::byte{0},   std::byte{0}};
+    MessageStreamReader r2;
+    REQUIRE(r2.feed(small));
+    CHECK(r2.partial_capacity() == 20);
+}
