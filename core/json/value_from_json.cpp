@@ -397,33 +397,14 @@ Result<Value> FromJson::namedarray(const json& j, const TypeDefinition& t, const
     return Value(std::move(*a));
 }
 
-Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const NamedType& nt, bool scalar) {
-    auto shape = shapes_.get(nt, lookup_);
-    if (!shape) return relay(shape.error());
-    const NamedArrayShape& s = **shape;
-    NumericArray flat = NumericArray::zeros(s.element_type, items.size() * s.width);
-    Result<void> ok = dispatch_numeric(s.element_type, [&](auto tag) -> Result<void> {
-        using T = typename decltype(tag)::type;
-        auto out = flat.mutable_span<T>();
-        std::size_t offset = 0;
-        for (std::size_t i = 0; i < items.size(); ++i) {
-            std::optional<PathScope> pi;
-            if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
-            if (auto r = fill_namedarray<T>(items[i], out, offset, s); !r) return r;
-        }
-        return {};
-    });
-    if (!ok) return ok.take_error();
-    return NamedArray{nt.qualified_name, std::move(flat), {}};
-}
-
 template <class T>
 Result<void> FromJson::fill_namedarray(const json& obj, std::span<T> out, std::size_t& offset,
                                        const NamedArrayShape& shape) {
     if (!obj.is_object())
         return err(MessageErrorType::DataTypeMismatch, "expected a namedarray object, got " + std::string(obj.type_name()));
     if (obj.size() != shape.members.size()) {
-        for (const auto& [key, v] : obj.items()) {
+        for (const auto& item : obj.items()) {
+            const std::string& key = item.key();
             if (std::none_of(shape.members.begin(), shape.members.end(), [&](auto& m) { return m.name == key; })) {
                 PathScope ps(path_, key);
                 return err(MessageErrorType::DataTypeError, "unknown namedarray field");
@@ -455,6 +436,26 @@ Result<void> FromJson::fill_namedarray(const json& obj, std::span<T> out, std::s
         }
     }
     return {};
+}
+
+Result<NamedArray> FromJson::namedarray_items(std::span<const json> items, const NamedType& nt, bool scalar) {
+    auto shape = shapes_.get(nt, lookup_);
+    if (!shape) return relay(shape.error());
+    const NamedArrayShape& s = **shape;
+    NumericArray flat = NumericArray::zeros(s.element_type, items.size() * s.width);
+    Result<void> ok = dispatch_numeric(s.element_type, [&](auto tag) -> Result<void> {
+        using T = typename decltype(tag)::type;
+        auto out = flat.mutable_span<T>();
+        std::size_t offset = 0;
+        for (std::size_t i = 0; i < items.size(); ++i) {
+            std::optional<PathScope> pi;
+            if (!scalar) pi.emplace(path_, static_cast<std::int64_t>(i));
+            if (auto r = fill_namedarray<T>(items[i], out, offset, s); !r) return r;
+        }
+        return {};
+    });
+    if (!ok) return ok.take_error();
+    return NamedArray{nt.qualified_name, std::move(flat), {}};
 }
 
 Result<Value> FromJson::var(const json& j) {

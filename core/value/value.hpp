@@ -18,6 +18,7 @@
 // Moving is cheap. Values are not thread-safe for concurrent mutation (like std containers).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -78,9 +79,9 @@ struct PodArray {
     std::size_t count = 0;
     std::vector<std::uint32_t> dims;
 
-    PodArray() = default;
-    PodArray(std::string type, std::vector<std::string> names)
-        : type_name(std::move(type)), field_names(std::move(names)) {}
+    PodArray();
+    /// No items yet: add them with push_back.
+    PodArray(std::string type, std::vector<std::string> names);
 
     std::size_t size() const noexcept { return count; }
     /// Appends one item. Errors: DataTypeError when item.size() != field_names.size().
@@ -178,17 +179,18 @@ class Value {
 public:
     Value() noexcept = default;  ///< null
     Value(Null) noexcept {}
-    Value(NumericArray a) : v_(std::move(a)) {}
-    Value(std::string s) : v_(std::move(s)) {}
-    Value(const char* s) : v_(std::string(s)) {}
-    Value(MultiDimArray m) : v_(detail::Box<MultiDimArray>(std::move(m))) {}
-    Value(Structure s) : v_(detail::Box<Structure>(std::move(s))) {}
-    Value(PodArray p) : v_(detail::Box<PodArray>(std::move(p))) {}
-    Value(NamedArray n) : v_(detail::Box<NamedArray>(std::move(n))) {}
-    Value(MapInt32 m) : v_(std::move(m)) {}
-    Value(MapString m) : v_(std::move(m)) {}
-    Value(List l) : v_(std::move(l)) {}
-    Value(Enum e) : v_(std::move(e)) {}
+    Value(std::nullptr_t) noexcept {}  ///< null (never a string)
+    Value(NumericArray a);
+    Value(std::string s);
+    Value(const char* s);  ///< a string; `s` must not be null
+    Value(MultiDimArray m);
+    Value(Structure s);
+    Value(PodArray p);
+    Value(NamedArray n);
+    Value(MapInt32 m);
+    Value(MapString m);
+    Value(List l);
+    Value(Enum e);
 
     Value(const Value&);
     Value(Value&&) noexcept;
@@ -264,6 +266,22 @@ struct Field {
     Value value;
     friend bool operator==(const Field&, const Field&) = default;
 };
+
+// Defined here, where Field and Value are complete (containers of them need complete types).
+inline Value::Value(NumericArray a) : v_(std::move(a)) {}
+inline Value::Value(std::string s) : v_(std::move(s)) {}
+inline Value::Value(const char* s) : v_(std::string(s)) {}
+inline Value::Value(MultiDimArray m) : v_(detail::Box<MultiDimArray>(std::move(m))) {}
+inline Value::Value(Structure s) : v_(detail::Box<Structure>(std::move(s))) {}
+inline Value::Value(PodArray p) : v_(detail::Box<PodArray>(std::move(p))) {}
+inline Value::Value(NamedArray n) : v_(detail::Box<NamedArray>(std::move(n))) {}
+inline Value::Value(MapInt32 m) : v_(std::move(m)) {}
+inline Value::Value(MapString m) : v_(std::move(m)) {}
+inline Value::Value(List l) : v_(std::move(l)) {}
+inline Value::Value(Enum e) : v_(std::move(e)) {}
+inline PodArray::PodArray() = default;
+inline PodArray::PodArray(std::string type, std::vector<std::string> names)
+    : type_name(std::move(type)), field_names(std::move(names)) {}
 
 // --- Value::as -------------------------------------------------------------------------------------
 
