@@ -131,7 +131,7 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
         done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + url.to_string()));
         return;
     }
-    auto strand = asio::make_strand(executor);
+    asio::any_io_executor strand = asio::make_strand(executor);
     connect_tcp(strand, url.host, url.port, options.connect_timeout,
                 [strand, url, options, incoming = std::move(incoming), closed = std::move(closed),
                  done = std::move(done)](Result<tcp::socket> socket) mutable {

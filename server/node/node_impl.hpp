@@ -24,7 +24,10 @@ private:
 
 template <class Stream>
 void Node::serve_stream(Stream stream, std::vector<std::byte> initial) {
-    typename StreamPump<Stream>::Strand strand(boost::asio::make_strand(boost::asio::any_io_executor(io_.get_executor())));
+    // The stream's executor is a per-connection strand (TcpListener accepts onto one); the pump uses it
+    // as its own, so whatever the stream does internally (a WebSocket's control frames) is serialised
+    // with the pump's work.
+    typename StreamPump<Stream>::Strand strand(stream.get_executor());
     auto logic = std::make_shared<CountedServerConnection>(shared_from_this(), connections_, options_.server, mono_now());
     auto pump = std::make_shared<StreamPump<Stream>>(std::move(stream), strand, logic);
     logic->attach(pump);

@@ -36,7 +36,8 @@ public:
 template <class Stream>
 class StreamPump : public PumpHandle, public std::enable_shared_from_this<StreamPump<Stream>> {
 public:
-    using Strand = asio::strand<asio::any_io_executor>;
+    /// An executor that serialises work: a strand, type-erased (Beast needs the erased form to track work).
+    using Strand = asio::any_io_executor;
 
     StreamPump(Stream stream, Strand strand, std::shared_ptr<ConnectionLogic> logic)
         : stream_(std::move(stream)), strand_(std::move(strand)), timer_(strand_), logic_(std::move(logic)) {}

@@ -78,17 +78,10 @@ void TcpListener::detect(tcp::socket socket) {
         std::vector<std::byte> initial(h.begin(), h.end());
         if (is("RRAC")) {
             node->serve_stream(std::move(d->socket), std::move(initial));
-        } else if (is("GET ") || is("GET\t")) {
-            node->dispatch_http(std::move(d->socket), std::move(initial));
         } else {
-            static constexpr char kNotFound[] =
-                "HTTP/1.1 404 File Not Found\r\nConnection: close\r\nContent-Length: 0\r\n\r\n";
-            auto sock = std::make_shared<tcp::socket>(std::move(d->socket));
-            asio::async_write(*sock, asio::buffer(kNotFound, sizeof(kNotFound) - 1),
-                              [sock](boost::system::error_code, std::size_t) {
-                                  boost::system::error_code ignored3;
-                                  sock->close(ignored3);
-                              });
+            // Anything else is HTTP (plain requests and WebSocket upgrades); without an HTTP handler the
+            // node answers 404 and closes, as CORE does.
+            node->dispatch_http(std::move(d->socket), std::move(initial));
         }
     });
 }

@@ -1,0 +1,402 @@
+#include "server/http/http_server.hpp"
+
+#include <deque>
+#include <fstream>
+#include <sstream>
+
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "server/http/websocket_byte_stream.hpp"
+#include "server/node/node.hpp"
+
+namespace rr::server::http {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace bhttp = boost::beast::http;
+namespace websocket = boost::beast::websocket;
+using tcp = asio::ip::tcp;
+
+constexpr std::string_view kRRSubprotocol = "robotraconteur.robotraconteur.com";
+
+namespace {
+
+char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
+
+bool iequals(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (lower(a[i]) != lower(b[i])) return false;
+    return true;
+}
+
+std::vector<std::string_view> split_list(std::string_view s) {
+    std::vector<std::string_view> out;
+    while (!s.empty()) {
+        auto comma = s.find(',');
+        auto item = s.substr(0, comma);
+        while (!item.empty() && (item.front() == ' ' || item.front() == '\t')) item.remove_prefix(1);
+        while (!item.empty() && (item.back() == ' ' || item.back() == '\t')) item.remove_suffix(1);
+        if (!item.empty()) out.push_back(item);
+        if (comma == std::string_view::npos) break;
+        s.remove_prefix(comma + 1);
+    }
+    return out;
+}
+
+std::string_view mime_type(std::string_view path) {
+    auto dot = path.rfind('.');
+    auto ext = dot == std::string_view::npos ? std::string_view{} : path.substr(dot);
+    if (ext == ".html" || ext == ".htm") return "text/html; charset=utf-8";
+    if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+    if (ext == ".css") return "text/css; charset=utf-8";
+    if (ext == ".json" || ext == ".map") return "application/json";
+    if (ext == ".wasm") return "application/wasm";
+    if (ext == ".svg") return "image/svg+xml";
+    if (ext == ".png") return "image/png";
+    if (ext == ".ico") return "image/x-icon";
+    if (ext == ".ts" || ext == ".txt" || ext == ".md" || ext == ".robdef") return "text/plain; charset=utf-8";
+    return "application/octet-stream";
+}
+
+// Maps a URL path to a file under root; rejects anything that could leave it.
+std::optional<std::string> static_path(const std::string& root, std::string_view target) {
+    auto q = target.find_first_of("?#");
+    std::string_view path = target.substr(0, q);
+    if (path.empty() || path.front() != '/') return std::nullopt;
+    if (path.find("..") != std::string_view::npos || path.find('\\') != std::string_view::npos ||
+        path.find('\0') != std::string_view::npos)
+        return std::nullopt;
+    std::string full = root + std::string(path);
+    if (full.back() == '/') full += "index.html";
+    return full;
+}
+
+/// A JSON-subprotocol WebSocket session: text frames both ways, bounded outgoing queue.
+class JsonWebSocketSession : public JsonSocket, public std::enable_shared_from_this<JsonWebSocketSession> {
+public:
+    JsonWebSocketSession(websocket::stream<beast::tcp_stream> ws, const JsonSocketHandler* handler, std::size_t limit,
+                         std::string peer)
+        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)) {}
+
+    void start() {
+        ws_.text(true);
+        if (handler_->on_open) handler_->on_open(shared_from_this());
+        read();
+    }
+
+    void send(std::string text) override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self, text = std::move(text)]() mutable {
+            if (self->closed_) return;
+            if (self->queue_.size() >= self->limit_) {
+                self->queue_.pop_front();  // slow reader: oldest dropped, counted
+                ++self->dropped_;
+            }
+            self->queue_.push_back(std::move(text));
+            self->write();
+        });
+    }
+
+    void close() override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self] {
+            if (self->closed_) return;
+            self->closed_ = true;
+            self->ws_.async_close(websocket::close_code::normal, [self](beast::error_code) {});
+        });
+    }
+
+    std::string peer() const override { return peer_; }
+
+private:
+    void read() {
+        auto self = shared_from_this();
+        ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
+            if (ec) {
+                self->finish();
+                return;
+            }
+            std::string text = beast::buffers_to_string(self->buffer_.data());
+            self->buffer_.consume(self->buffer_.size());
+            if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
+            self->read();
+        });
+    }
+
+    void write() {
+        if (writing_ || queue_.empty() || closed_) return;
+        writing_ = true;
+        auto self = shared_from_this();
+        ws_.async_write(asio::buffer(queue_.front()), [self](beast::error_code ec, std::size_t) {
+            self->writing_ = false;
+            if (ec) {
+                self->finish();
+                return;
+            }
+            self->queue_.pop_front();
+            self->write();
+        });
+    }
+
+    void finish() {
+        if (finished_) return;
+        finished_ = true;
+        closed_ = true;
+        queue_.clear();
+        if (handler_->on_close) handler_->on_close(shared_from_this());
+    }
+
+    websocket::stream<beast::tcp_stream> ws_;
+    const JsonSocketHandler* handler_;
+    std::size_t limit_;
+    std::string peer_;
+    beast::flat_buffer buffer_;
+    std::deque<std::string> queue_;
+    std::size_t dropped_ = 0;
+    bool writing_ = false;
+    bool closed_ = false;
+    bool finished_ = false;
+};
+
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+public:
+    HttpSession(std::shared_ptr<HttpServer> server, tcp::socket socket)
+        : server_(std::move(server)), stream_(std::move(socket)) {}
+
+    void start(std::vector<std::byte> initial) {
+        if (!initial.empty()) {
+            auto b = buffer_.prepare(initial.size());
+            std::memcpy(b.data(), initial.data(), initial.size());
+            buffer_.commit(initial.size());
+        }
+        read();
+    }
+
+private:
+    void read() {
+        parser_.emplace();
+        parser_->body_limit(server_->options().max_body_bytes);
+        parser_->header_limit(16 * 1024);
+        stream_.expires_after(server_->options().read_timeout);
+        auto self = shared_from_this();
+        bhttp::async_read(stream_, buffer_, *parser_, [self](beast::error_code ec, std::size_t) {
+            if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout) {
+                self->shutdown();
+                return;
+            }
+            if (ec) {
+                // Malformed request or over a limit: answer 400/413 once and close.
+                Request dummy;
+                dummy.version(11);
+                auto status = (ec == bhttp::error::body_limit || ec == bhttp::error::header_limit)
+                                  ? bhttp::status::payload_too_large
+                                  : bhttp::status::bad_request;
+                auto r = make_response(dummy, status, ec.message() + "\n");
+                r.keep_alive(false);
+                self->write(std::move(r));
+                return;
+            }
+            self->on_request(self->parser_->release());
+        });
+    }
+
+    void on_request(Request req) {
+        const auto origin = req[bhttp::field::origin];
+        if (!origin.empty() && !origin_allowed(server_->options().allowed_origins, origin)) {
+            auto r = make_response(req, bhttp::status::forbidden, "Forbidden Origin\n");
+            r.keep_alive(false);
+            write(std::move(r));
+            return;
+        }
+        if (websocket::is_upgrade(req)) {
+            upgrade(std::move(req));
+            return;
+        }
+        std::string_view target(req.target().data(), req.target().size());
+        auto path = target.substr(0, target.find('?'));
+        if (const RouteHandler* route = server_->find_route(req.method(), path)) {
+            auto self = shared_from_this();
+            auto keep = std::make_shared<Request>(std::move(req));
+            auto ex = stream_.get_executor();
+            (*route)(*keep, [self, keep, ex](Response r) {
+                asio::post(ex, [self, r = std::move(r)]() mutable { self->write(std::move(r)); });
+            });
+            return;
+        }
+        if ((req.method() == bhttp::verb::get || req.method() == bhttp::verb::head) &&
+            !server_->options().static_root.empty()) {
+            serve_static(req);
+            return;
+        }
+        write(make_response(req, bhttp::status::not_found, "Not Found\n"));
+    }
+
+    void serve_static(const Request& req) {
+        std::string_view target(req.target().data(), req.target().size());
+        auto path = static_path(server_->options().static_root, target);
+        if (!path) {
+            write(make_response(req, bhttp::status::bad_request, "Bad path\n"));
+            return;
+        }
+        std::ifstream f(*path, std::ios::binary);
+        if (!f) {
+            write(make_response(req, bhttp::status::not_found, "Not Found\n"));
+            return;
+        }
+        std::ostringstream body;
+        body << f.rdbuf();
+        auto r = make_response(req, bhttp::status::ok, req.method() == bhttp::verb::head ? std::string() : body.str(),
+                               mime_type(*path));
+        r.set(bhttp::field::cache_control, "no-cache");
+        write(std::move(r));
+    }
+
+    void upgrade(Request req) {
+        auto protocols = split_list(std::string_view(req[bhttp::field::sec_websocket_protocol].data(),
+                                                     req[bhttp::field::sec_websocket_protocol].size()));
+        std::string chosen;
+        const JsonSocketHandler* json = nullptr;
+        if (protocols.empty()) {
+            chosen.clear();  // no list: raw RR, as CORE accepts
+        } else {
+            for (auto p : protocols) {
+                if (iequals(p, kRRSubprotocol)) {
+                    chosen = std::string(kRRSubprotocol);
+                    break;
+                }
+                if ((json = server_->find_subprotocol(p))) {
+                    chosen = std::string(p);
+                    break;
+                }
+            }
+            if (chosen.empty()) {
+                auto r = make_response(req, bhttp::status::upgrade_required, "Unsupported WebSocket subprotocol\n");
+                r.set(bhttp::field::sec_websocket_protocol, kRRSubprotocol);
+                r.set(bhttp::field::sec_websocket_version, "13");
+                r.keep_alive(false);
+                write(std::move(r));
+                return;
+            }
+        }
+        stream_.expires_never();
+        websocket::stream<beast::tcp_stream> ws(std::move(stream_));
+        ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
+            if (!chosen.empty()) res.set(bhttp::field::sec_websocket_protocol, chosen);
+        }));
+        ws.read_message_max(64u * 1024u * 1024u);
+        auto server = server_;
+        auto peer = remote();
+        auto holder = std::make_shared<websocket::stream<beast::tcp_stream>>(std::move(ws));
+        holder->async_accept(req, [holder, server, json, peer](beast::error_code ec) {
+            if (ec) return;
+            if (json) {
+                auto s = std::make_shared<JsonWebSocketSession>(std::move(*holder), json,
+                                                                server->options().json_socket_queue_limit, peer);
+                s->start();
+                return;
+            }
+            auto node = server->node();
+            if (!node) return;
+            holder->binary(true);
+            node->serve_stream(WebSocketByteStream<beast::tcp_stream>(std::move(*holder)));
+        });
+    }
+
+    std::string remote() const {
+        beast::error_code ec;
+        auto ep = beast::get_lowest_layer(stream_).socket().remote_endpoint(ec);
+        return ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
+    }
+
+    void write(Response r) {
+        auto self = shared_from_this();
+        auto res = std::make_shared<Response>(std::move(r));
+        res->prepare_payload();
+        bhttp::async_write(stream_, *res, [self, res](beast::error_code ec, std::size_t) {
+            if (ec || !res->keep_alive()) {
+                self->shutdown();
+                return;
+            }
+            self->read();
+        });
+    }
+
+    void shutdown() {
+        beast::error_code ec;
+        stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+        stream_.close();
+    }
+
+    std::shared_ptr<HttpServer> server_;
+    beast::tcp_stream stream_;
+    beast::flat_buffer buffer_;
+    std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+};
+
+}  // namespace
+
+bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin) {
+    for (const auto& entry : allowlist) {
+        std::string_view e(entry);
+        if (e == "*" || iequals(e, origin)) return true;
+        auto sep = e.find("://");
+        if (sep == std::string_view::npos) continue;
+        if (sep + 3 == e.size()) {  // "scheme://" matches any origin of that scheme
+            if (origin.size() > e.size() && iequals(origin.substr(0, e.size()), e)) return true;
+            continue;
+        }
+        auto osep = origin.find("://");
+        if (osep == std::string_view::npos || !iequals(origin.substr(0, osep), e.substr(0, sep))) continue;
+        auto ehost = e.substr(sep + 3);
+        auto ohost = origin.substr(osep + 3);
+        if (ehost.rfind("*.", 0) == 0) {  // "scheme://*.domain[:port]" matches subdomains
+            auto suffix = ehost.substr(1);
+            if (ohost.size() > suffix.size() && iequals(ohost.substr(ohost.size() - suffix.size()), suffix)) return true;
+        }
+    }
+    return false;
+}
+
+Response make_response(const Request& request, bhttp::status status, std::string body, std::string_view content_type) {
+    Response r{status, request.version()};
+    r.set(bhttp::field::server, "rr-gateway");
+    r.set(bhttp::field::content_type, content_type);
+    r.keep_alive(request.keep_alive());
+    r.body() = std::move(body);
+    return r;
+}
+
+HttpServer::HttpServer(std::weak_ptr<Node> node, HttpOptions options)
+    : node_(std::move(node)), options_(std::move(options)) {}
+
+void HttpServer::handle(tcp::socket socket, std::vector<std::byte> initial) {
+    auto session = std::make_shared<HttpSession>(shared_from_this(), std::move(socket));
+    session->start(std::move(initial));
+}
+
+void HttpServer::add_route(bhttp::verb method, std::string path, RouteHandler handler, bool prefix) {
+    routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
+}
+
+void HttpServer::add_subprotocol(std::string name, JsonSocketHandler handler) {
+    subprotocols_.emplace(std::move(name), std::move(handler));
+}
+
+const RouteHandler* HttpServer::find_route(bhttp::verb method, std::string_view path) const {
+    for (const auto& r : routes_) {
+        if (r.method != method) continue;
+        if (r.prefix ? path.rfind(r.path, 0) == 0 : path == r.path) return &r.handler;
+    }
+    return nullptr;
+}
+
+const JsonSocketHandler* HttpServer::find_subprotocol(std::string_view name) const {
+    auto it = subprotocols_.find(name);
+    return it == subprotocols_.end() ? nullptr : &it->second;
+}
+
+}  // namespace rr::server::http

@@ -1,0 +1,102 @@
+// The HTTP side of the gateway's single port (DESIGN: server/http): sockets whose first bytes are not
+// `RRAC` come here. Serves registered routes (JSON API, /livez, /readyz, /metrics), static files, and
+// WebSocket upgrades:
+//   * subprotocol `robotraconteur.robotraconteur.com` (or none): raw RR over binary frames, served by the
+//     node exactly like a TCP connection (wire.md §8) — what `rr+ws://host:port/?service=…` clients use;
+//   * other registered subprotocols (the JSON WebSocket API): handed to their handler.
+// Origins: a request carrying an Origin header must match the allowlist (403 otherwise); requests
+// without Origin (non-browser clients) are allowed. Matching follows CORE (wire.md §8): exact, or
+// `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/http/message.hpp>
+#include <boost/beast/http/string_body.hpp>
+
+namespace rr::server {
+
+class Node;
+
+namespace http {
+
+using Request = boost::beast::http::request<boost::beast::http::string_body>;
+using Response = boost::beast::http::response<boost::beast::http::string_body>;
+/// Route handlers answer through `respond`, from any thread, exactly once.
+using Responder = std::function<void(Response)>;
+using RouteHandler = std::function<void(const Request& request, Responder respond)>;
+
+/// A WebSocket session for a non-RR subprotocol: `send` queues a text message (thread-safe), `close`
+/// ends the session. The handler gets messages through on_message and on_close.
+class JsonSocket {
+public:
+    virtual ~JsonSocket() = default;
+    virtual void send(std::string text) = 0;
+    virtual void close() = 0;
+    /// Remote address, for logs.
+    virtual std::string peer() const = 0;
+};
+struct JsonSocketHandler {
+    std::function<void(std::shared_ptr<JsonSocket>)> on_open;
+    std::function<void(const std::shared_ptr<JsonSocket>&, std::string text)> on_message;
+    std::function<void(const std::shared_ptr<JsonSocket>&)> on_close;
+};
+
+struct HttpOptions {
+    /// Origins allowed for browser requests (see above). Empty = no browser origin allowed.
+    std::vector<std::string> allowed_origins;
+    /// Folder served for GET requests that match no route ("" = none). index.html for directories.
+    std::string static_root;
+    /// Largest request body, bytes.
+    std::size_t max_body_bytes = 1u << 20;
+    /// Time allowed for reading one request, ms.
+    std::chrono::milliseconds read_timeout{30000};
+    /// Text messages queued for one JSON WebSocket beyond this are dropped oldest-first and counted.
+    std::size_t json_socket_queue_limit = 1024;
+};
+
+bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin);
+
+class HttpServer : public std::enable_shared_from_this<HttpServer> {
+public:
+    HttpServer(std::weak_ptr<Node> node, HttpOptions options);
+
+    /// Entry point for the node (Node::set_http_handler).
+    void handle(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial);
+
+    /// Exact-path route for a method (GET, POST, PUT…); `prefix` routes match a path prefix.
+    void add_route(boost::beast::http::verb method, std::string path, RouteHandler handler, bool prefix = false);
+    /// WebSocket subprotocol served by a JSON handler.
+    void add_subprotocol(std::string name, JsonSocketHandler handler);
+
+    const HttpOptions& options() const noexcept { return options_; }
+
+    // Used by sessions.
+    const RouteHandler* find_route(boost::beast::http::verb method, std::string_view path) const;
+    const JsonSocketHandler* find_subprotocol(std::string_view name) const;
+    std::shared_ptr<Node> node() const { return node_.lock(); }
+
+private:
+    std::weak_ptr<Node> node_;
+    HttpOptions options_;
+    struct Route {
+        boost::beast::http::verb method;
+        std::string path;
+        bool prefix;
+        RouteHandler handler;
+    };
+    std::vector<Route> routes_;
+    std::map<std::string, JsonSocketHandler, std::less<>> subprotocols_;
+};
+
+/// A plain response with the given status, content type and body (keep-alive copied from `request`).
+Response make_response(const Request& request, boost::beast::http::status status, std::string body,
+                       std::string_view content_type = "text/plain; charset=utf-8");
+
+}  // namespace http
+}  // namespace rr::server

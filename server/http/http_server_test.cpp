@@ -1,0 +1,218 @@
+// HttpServer on the node's port: routes, static files, Origin policy, and RR over WebSocket.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "core/session/client_session.hpp"
+#include "core/session/elements.hpp"
+#include "server/http/http_server.hpp"
+#include "server/node/node.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace std::chrono_literals;
+namespace beast = boost::beast;
+namespace bhttp = boost::beast::http;
+namespace websocket = boost::beast::websocket;
+using tcp = boost::asio::ip::tcp;
+
+namespace {
+
+constexpr const char* kDef = "service example.wstest\n\nstdver 0.10\n\nobject Obj\n    property double x\nend\n";
+
+class TinyService : public Service {
+public:
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override { return {kDef}; }
+    std::optional<std::string> service_definition(std::string_view) const override { return std::string(kDef); }
+    ObjectTypeInfo root_type() const override { return {"example.wstest.Obj", {}}; }
+    void object_type(const SessionRef&, const std::string&, std::function<void(Result<ObjectTypeInfo>)> done) override {
+        done(root_type());
+    }
+    void handle_entry(const SessionRef&, MessageEntry&& e, Responder r) override {
+        MessageEntry m;
+        m.elements.push_back(make_scalar_element("value", 3.25));
+        r.respond(std::move(m));
+    }
+
+private:
+    std::string name_ = "ws";
+};
+
+struct Fixture {
+    std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "ws.node", 2, {}, 0, 5000ms});
+    std::shared_ptr<http::HttpServer> server;
+    std::filesystem::path root = std::filesystem::temp_directory_path() / ("rr_http_test_" + std::to_string(::getpid()));
+    std::uint16_t port = 0;
+
+    Fixture() {
+        std::filesystem::create_directories(root / "sub");
+        std::ofstream(root / "index.html") << "<h1>dash</h1>";
+        std::ofstream(root / "sub" / "app.wasm") << "wasm";
+        http::HttpOptions opts;
+        opts.allowed_origins = {"http://localhost:8080", "http://*.example.org"};
+        opts.static_root = root.string();
+        server = std::make_shared<http::HttpServer>(node, opts);
+        server->add_route(bhttp::verb::get, "/livez", [](const http::Request& req, http::Responder respond) {
+            respond(http::make_response(req, bhttp::status::ok, "ok\n"));
+        });
+        server->add_subprotocol("test.echo.v1", http::JsonSocketHandler{
+                                                    {},
+                                                    [](const std::shared_ptr<http::JsonSocket>& s, std::string text) {
+                                                        s->send("echo:" + text);
+                                                    },
+                                                    {}});
+        node->set_http_handler([s = server](tcp::socket sock, std::vector<std::byte> initial) {
+            s->handle(std::move(sock), std::move(initial));
+        });
+        REQUIRE(node->register_service(std::make_shared<TinyService>()));
+        port = *node->listen_tcp("127.0.0.1", 0);
+    }
+    ~Fixture() {
+        node->shutdown();
+        std::error_code ec;
+        std::filesystem::remove_all(root, ec);
+    }
+
+    bhttp::response<bhttp::string_body> get(std::string target, std::string origin = {}) {
+        boost::asio::io_context io;
+        beast::tcp_stream s(io);
+        s.connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+        bhttp::request<bhttp::string_body> req{bhttp::verb::get, target, 11};
+        req.set(bhttp::field::host, "localhost");
+        if (!origin.empty()) req.set(bhttp::field::origin, origin);
+        bhttp::write(s, req);
+        beast::flat_buffer b;
+        bhttp::response<bhttp::string_body> res;
+        bhttp::read(s, b, res);
+        return res;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("HTTP routes and static files share the RR port") {
+    Fixture f;
+    auto live = f.get("/livez");
+    CHECK(live.result() == bhttp::status::ok);
+    CHECK(live.body() == "ok\n");
+    auto index = f.get("/");
+    CHECK(index.result() == bhttp::status::ok);
+    CHECK(index.body() == "<h1>dash</h1>");
+    CHECK(index[bhttp::field::content_type] == "text/html; charset=utf-8");
+    auto wasm = f.get("/sub/app.wasm");
+    CHECK(wasm[bhttp::field::content_type] == "application/wasm");
+    CHECK(f.get("/nothing").result() == bhttp::status::not_found);
+    CHECK(f.get("/../etc/passwd").result() == bhttp::status::bad_request);
+}
+
+TEST_CASE("Origins outside the allowlist get 403") {
+    Fixture f;
+    CHECK(f.get("/livez", "http://localhost:8080").result() == bhttp::status::ok);
+    CHECK(f.get("/livez", "http://a.example.org").result() == bhttp::status::ok);
+    CHECK(f.get("/livez", "http://evil.test").result() == bhttp::status::forbidden);
+    CHECK(f.get("/livez", "http://example.org.evil.test").result() == bhttp::status::forbidden);
+}
+
+TEST_CASE("origin matching follows the allowlist forms") {
+    using http::origin_allowed;
+    std::vector<std::string> list{"null", "file://", "https://*.robotraconteur.com", "http://localhost:8080"};
+    CHECK(origin_allowed(list, "null"));
+    CHECK(origin_allowed(list, "file:///tmp/x.html"));
+    CHECK(origin_allowed(list, "https://www.robotraconteur.com"));
+    CHECK_FALSE(origin_allowed(list, "https://robotraconteur.com.evil"));
+    CHECK_FALSE(origin_allowed(list, "http://localhost:8081"));
+    CHECK(origin_allowed({"*"}, "http://anything"));
+}
+
+TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    ws.set_option(websocket::stream_base::decorator(
+        [](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, "test.echo.v1"); }));
+    websocket::response_type res;
+    ws.handshake(res, "localhost", "/");
+    CHECK(res[bhttp::field::sec_websocket_protocol] == "test.echo.v1");
+    ws.text(true);
+    ws.write(boost::asio::buffer(std::string("hi")));
+    beast::flat_buffer b;
+    ws.read(b);
+    CHECK(beast::buffers_to_string(b.data()) == "echo:hi");
+}
+
+TEST_CASE("an unknown subprotocol is refused with 426") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    ws.set_option(websocket::stream_base::decorator(
+        [](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, "nope"); }));
+    websocket::response_type res;
+    beast::error_code ec;
+    ws.handshake(res, "localhost", "/", ec);
+    CHECK(ec);
+    CHECK(res.result() == bhttp::status::upgrade_required);
+}
+
+TEST_CASE("RR messages travel over a WebSocket with the RR subprotocol") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
+        req.set(bhttp::field::sec_websocket_protocol, "robotraconteur.robotraconteur.com");
+    }));
+    websocket::response_type res;
+    ws.handshake(res, "localhost", "/");
+    CHECK(res[bhttp::field::sec_websocket_protocol] == "robotraconteur.robotraconteur.com");
+    ws.binary(true);
+
+    ClientSessionConfig cfg;
+    cfg.stream.local_node_id = *NodeID::parse("11111111-2222-3333-4444-555555555555");
+    cfg.service_name = "ws";
+    cfg.local_endpoint = 99;
+    auto now = std::chrono::steady_clock::now();
+    ClientSession session(cfg, now);
+    auto exchange = [&] {
+        auto out = session.pending_output();
+        if (!out.empty()) {
+            // Split in two frames: frame boundaries carry no meaning.
+            auto half = out.size() / 2;
+            ws.write(boost::asio::buffer(out.data(), half));
+            ws.write(boost::asio::buffer(out.data() + half, out.size() - half));
+            session.consume_output(out.size());
+        }
+        beast::flat_buffer b;
+        ws.read(b);
+        auto data = b.data();
+        REQUIRE(session.feed(std::span<const std::byte>(static_cast<const std::byte*>(data.data()), data.size()), now));
+    };
+    for (int i = 0; i < 10 && !session.is_connected(); ++i) exchange();
+    REQUIRE(session.is_connected());
+    CHECK(session.info().object_type == "example.wstest.Obj");
+
+    MessageEntry get;
+    get.entry_type = MessageEntryType::PropertyGetReq;
+    get.service_path = "ws";
+    get.member_name = "x";
+    auto id = session.request(get, now);
+    REQUIRE(id);
+    std::optional<ClientResponse> reply;
+    for (int i = 0; i < 10 && !reply; ++i) {
+        exchange();
+        while (auto ev = session.poll_event())
+            if (auto* r = std::get_if<ClientResponse>(&*ev)) reply = std::move(*r);
+    }
+    REQUIRE(reply);
+    REQUIRE(reply->entry);
+    double v = 0;
+    CHECK(read_scalar(*reply->entry->find("value"), v));
+    CHECK(v == 3.25);
+}
