@@ -116,7 +116,8 @@ Responder::~Responder() {
 
 void Responder::respond(MessageEntry reply) {
     if (!send_) return;
-    reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_.entry_type) + 1);
+    if (reply.entry_type == MessageEntryType::Null)
+        reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_.entry_type) + 1);
     reply.service_path = request_.service_path;
     reply.member_name = request_.member_name;
     reply.request_id = request_.request_id;
@@ -158,7 +159,9 @@ Result<void> ServerSession::send(MessageEntry entry) {
     if (queued_.load() + size > max_queue_)
         return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
     queued_.fetch_add(size);
-    pump->post([conn = connection_, entry = std::move(entry)]() mutable {
+    // dispatch: on the session's own strand (a handler sending an event or ServicePathReleased before
+    // answering) the entry is queued at once, so it reaches the client before the reply.
+    pump->dispatch([conn = connection_, entry = std::move(entry)]() mutable {
         if (auto c = conn.lock()) c->send_session_entry(std::move(entry));
     });
     return {};

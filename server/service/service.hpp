@@ -37,7 +37,8 @@ public:
     bool alive() const;
 
     /// Sends an entry the client did not ask for (EventReq, WirePacket, PipePacket, PipeClosed, …).
-    /// Thread-safe. Errors: ConnectionError when the client is gone; BufferLimitViolation when the
+    /// Thread-safe. Called on this session's strand (from a request handler) the entry is queued at
+    /// once, ahead of the handler's reply. Errors: ConnectionError when the client is gone; BufferLimitViolation when the
     /// client's send queue is full (the caller decides: drop for wires, back off for pipes).
     Result<void> send(MessageEntry entry) const;
     /// Like send(), but a queued, unsent wire packet for the same service path and member is replaced
@@ -65,7 +66,8 @@ public:
     Responder& operator=(Responder&&) noexcept = default;
     ~Responder();  // an unanswered request is answered with InternalError
 
-    /// Sends `reply` (EntryType, ServicePath, MemberName and RequestID are set from the request).
+    /// Sends `reply`: ServicePath, MemberName and RequestID are set from the request, and EntryType to
+    /// request + 1 unless the reply already has one (CORE answers MemoryWrite with MemoryReadRet).
     void respond(MessageEntry reply);
     /// Sends an error reply (wire.md §5.2).
     void fail(RRError error);

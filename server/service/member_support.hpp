@@ -1,0 +1,64 @@
+// Internal helpers shared by the member implementations of server/service (not a public API):
+// request element access with CORE's error codes, and packing/unpacking against a member's robdef.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "core/session/elements.hpp"
+#include "core/value/pack_value.hpp"
+#include "server/service/service_object.hpp"
+
+namespace rr::server::detail {
+
+/// The element `name` of `entry`. Errors: MessageElementNotFound ("Element <name> not found.", CORE's text).
+inline Result<const MessageElement*> require_element(const MessageEntry& entry, std::string_view name) {
+    if (const auto* e = entry.find(name)) return e;
+    return fail(MessageErrorType::MessageElementNotFound, "Element " + std::string(name) + " not found.");
+}
+
+/// A numeric scalar element of type T (the first item, as CORE's RRArrayToScalar).
+/// Errors: MessageElementNotFound, DataTypeMismatch ("Data type cast error"), OutOfRange (no items).
+template <class T>
+Result<T> require_scalar(const MessageEntry& entry, std::string_view name) {
+    auto e = require_element(entry, name);
+    if (!e) return e.take_error();
+    if ((*e)->type != data_type_of<T>()) return fail(MessageErrorType::DataTypeMismatch, "Data type cast error");
+    if ((*e)->data.size() < sizeof(T)) return fail(MessageErrorType::OutOfRange, "Index out of range");
+    T v;
+    std::memcpy(&v, (*e)->data.data(), sizeof(T));
+    return v;
+}
+
+inline Result<Value> unpack_member(const MemberInfo& info, const MessageElement& e, const robdef::TypeDefinition& type) {
+    return unpack_value(e, type, info.types->set(), info.service_name);
+}
+
+inline Result<MessageElement> pack_member(const MemberInfo& info, const Value& v, const robdef::TypeDefinition& type,
+                                          std::string_view name) {
+    return pack_value(v, type, name, info.types->set(), info.service_name);
+}
+
+/// `return` for a function/generator/callback reply: int32 0 for void (CORE's convention), else the
+/// value packed with `type`.
+inline Result<MessageElement> pack_return(const MemberInfo& info, const Value& v, const robdef::TypeDefinition& type) {
+    if (type.is_void()) return make_scalar_element<std::int32_t>("return", 0);
+    return pack_member(info, v, type, "return");
+}
+
+inline RRError member_not_found(std::string_view member) {
+    return make_error(MessageErrorType::MemberNotFound, "Member \"" + std::string(member) + "\" not found");
+}
+
+/// An entry for the client (event, packet, callback request) of `member` at `path`.
+inline MessageEntry member_entry(MessageEntryType type, std::string path, std::string member) {
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = std::move(path);
+    e.member_name = std::move(member);
+    return e;
+}
+
+}  // namespace rr::server::detail

@@ -1,0 +1,118 @@
+// ObjectService: a Service (service.hpp) made of ServiceObjects typed by robdef (service_object.hpp).
+//
+//   definitions     ConnectClientCombined `servicedefs` / GetServiceDesc: the root object's definition
+//                   first, then its imports, transitively (ServiceTypes::texts_for); one by name.
+//   object types    ObjectTypeName for any path (wire.md §6.5): the root, or `parent.member[index]…`
+//                   resolved through the objref resolvers, with the object's `implements` (qualified).
+//                   Resolved objects are kept per path (one object per path, shared by all clients, as
+//                   CORE keeps its skels) until release_path(); unknown paths → ObjectNotFound.
+//   member requests dispatched to the object at ServicePath and the member MemberName (§6.7); entry types
+//                   no member handles → ProtocolError "Unknown request type" (as CORE).
+//   generators      per-session table of open generators (generator.hpp).
+//   attributes      optional map{string} of varvalues (GetServiceAttributes, connect replies).
+//   authentication  optional user table (password_table.hpp): when set, every session must log in
+//                   (ConnectClientCombined `username` + `credentials{password}` or AuthenticateUser)
+//                   before member requests are accepted, and events skip sessions not logged in.
+//   object locks    not supported: RequestObjectLock & co. answer InvalidOperation.
+//
+// Threads: thread-safe. Requests run on the client's strand (see ServiceObject for handler rules).
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "server/service/password_table.hpp"
+#include "server/service/service_object.hpp"
+
+namespace rr::server {
+
+class ObjectService : public Service, public std::enable_shared_from_this<ObjectService> {
+public:
+    /// A service named `name` (`^[a-zA-Z][a-zA-Z0-9_]*$`) serving `root`, whose type must belong to `types`.
+    /// Errors: InvalidArgument (bad name, root of another ServiceTypes), InvalidOperation (root already
+    /// served by another service).
+    static Result<std::shared_ptr<ObjectService>> create(std::string name, std::shared_ptr<ServiceObject> root);
+    ~ObjectService() override;
+
+    const std::shared_ptr<ServiceObject>& root() const noexcept { return root_; }
+    const std::shared_ptr<const ServiceTypes>& types() const noexcept { return types_; }
+
+    /// Service attributes (each value packed as a varvalue). Errors: packing errors (nothing changes).
+    Result<void> set_attributes(MapString attributes);
+    /// Requires every session to log in against `users` (an empty table turns authentication off).
+    void set_users(PasswordTable users);
+
+    /// Releases `path` and every path below it: the objects are forgotten (their pipe endpoints and wire
+    /// connections at those paths are dropped) and every client gets ServicePathReleasedReq (1109) for
+    /// `path`. The next request for the path resolves it again. Errors: InvalidArgument for the root
+    /// path; ObjectNotFound when nothing is served at `path`.
+    Result<void> release_path(const std::string& path);
+
+    /// Client sessions currently open (logged-in ones only when authentication is on).
+    std::vector<SessionRef> sessions() const;
+
+    /// Drops every handler of every object this service ever served and forgets all paths: breaks
+    /// handler/object reference cycles before the application exits. The service answers nothing
+    /// useful afterwards.
+    void shutdown();
+
+    /// Generator table limits: open generators per client session, and the idle time after which an
+    /// untouched generator is dropped.
+    static constexpr std::size_t kMaxGeneratorsPerSession = 1024;
+    static constexpr std::chrono::minutes kGeneratorIdleTimeout{10};
+
+    // --- Service ---
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override;
+    std::optional<std::string> service_definition(std::string_view service_type) const override;
+    ObjectTypeInfo root_type() const override;
+    MessageElement attributes() const override;
+    void object_type(const SessionRef& session, const std::string& path,
+                     std::function<void(Result<ObjectTypeInfo>)> done) override;
+    bool requires_authentication() const override;
+    Result<void> authenticate(const std::string& username, const MessageElement* credentials) override;
+    void on_session_open(const SessionRef& session) override;
+    void on_session_close(const SessionRef& session) override;
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override;
+
+    // --- used by ServiceObject ---
+    /// Registers a generator for `session`; returns its index. Errors: BufferLimitViolation when the
+    /// session has kMaxGeneratorsPerSession open.
+    Result<std::int32_t> add_generator(const SessionRef& session, const std::string& path, const std::string& member,
+                                       std::shared_ptr<Generator> generator);
+
+private:
+    ObjectService(std::string name, std::shared_ptr<ServiceObject> root);
+    /// The object at `path`, resolving objrefs as needed. Errors: ObjectNotFound.
+    Result<std::shared_ptr<ServiceObject>> resolve(const SessionRef& session, const std::string& path);
+    void handle_generator_next(const SessionRef& session, MessageEntry&& entry, Responder responder);
+
+    struct GeneratorEntry {
+        std::uint32_t session = 0;
+        std::string path, member;
+        std::shared_ptr<Generator> generator;
+        std::chrono::steady_clock::time_point last_access;
+    };
+
+    const std::string name_;
+    const std::shared_ptr<ServiceObject> root_;
+    const std::shared_ptr<const ServiceTypes> types_;
+    mutable std::mutex mutex_;
+    std::unordered_map<std::string, std::shared_ptr<ServiceObject>> objects_;  // by service path
+    std::vector<std::weak_ptr<ServiceObject>> ever_bound_;                       // for shutdown()
+    std::map<std::uint32_t, SessionRef> sessions_;
+    std::unordered_map<std::int32_t, GeneratorEntry> generators_;
+    std::mt19937 rng_;
+    MessageElement attributes_;
+    PasswordTable users_;
+    bool shut_down_ = false;
+};
+
+}  // namespace rr::server

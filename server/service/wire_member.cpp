@@ -1,0 +1,385 @@
+#include "server/service/wire_member.hpp"
+
+#include <chrono>
+
+#include "server/service/member_support.hpp"
+
+namespace rr::server {
+
+namespace {
+
+template <class F>
+std::shared_ptr<const F> share(F f) {
+    if (!f) return nullptr;
+    return std::make_shared<const F>(std::move(f));
+}
+
+TimeSpec add_ns(TimeSpec t, std::int64_t ns) {
+    std::int64_t total = t.nanoseconds + ns;
+    t.seconds += total / 1'000'000'000;
+    t.nanoseconds = static_cast<std::int32_t>(total % 1'000'000'000);
+    return t;
+}
+
+RRError value_not_set() { return make_error(MessageErrorType::ValueNotSet, "Value not set"); }
+
+}  // namespace
+
+TimeSpec wall_clock_timespec() {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count();
+    TimeSpec t;
+    t.seconds = ns / 1'000'000'000;
+    t.nanoseconds = static_cast<std::int32_t>(ns % 1'000'000'000);
+    if (t.nanoseconds < 0) {  // before 1970: keep 0 ≤ ns < 1e9
+        t.nanoseconds += 1'000'000'000;
+        t.seconds -= 1;
+    }
+    return t;
+}
+
+// ---------------------------------------------------------------------------------------------
+// WireConnection
+
+std::optional<TimedValue> WireConnection::in_value() const {
+    std::lock_guard lock(mutex_);
+    return in_;
+}
+
+Result<void> WireConnection::set_out_value(const Value& value) {
+    if (!open_.load()) return fail(MessageErrorType::InvalidOperation, "Wire connection is closed");
+    auto member = member_.lock();
+    if (!member) return fail(MessageErrorType::InvalidOperation, "Wire connection is closed");
+    return member->send_to(*this, value);
+}
+
+void WireConnection::close() {
+    if (!open_.load()) return;
+    if (auto member = member_.lock()) member->remove(shared_from_this(), true);
+    open_.store(false);
+}
+
+// ---------------------------------------------------------------------------------------------
+// WireMember
+
+WireMember::WireMember(std::shared_ptr<const detail::MemberInfo> info) : info_(std::move(info)) {}
+
+const std::string& WireMember::name() const noexcept { return info_->def->name; }
+robdef::MemberDirection WireMember::direction() const noexcept { return info_->def->direction(); }
+
+void WireMember::on_connect(ConnectHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    on_connect_ = std::move(h);
+}
+
+void WireMember::on_value(ValueHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    on_value_ = std::move(h);
+}
+
+void WireMember::on_close(CloseHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    on_close_ = std::move(h);
+}
+
+void WireMember::set_peek_in_handler(PeekHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    peek_in_ = std::move(h);
+}
+
+void WireMember::set_peek_out_handler(PeekHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    peek_out_ = std::move(h);
+}
+
+void WireMember::set_poke_handler(PokeHandler handler) {
+    auto h = share(std::move(handler));
+    std::lock_guard lock(mutex_);
+    poke_ = std::move(h);
+}
+
+void WireMember::clear_handlers() {
+    std::shared_ptr<const void> a, b, c, d, e, f;
+    std::lock_guard lock(mutex_);
+    a = std::move(on_connect_);
+    b = std::move(on_value_);
+    c = std::move(on_close_);
+    d = std::move(peek_in_);
+    e = std::move(peek_out_);
+    f = std::move(poke_);
+}
+
+TimeSpec WireMember::next_time() {
+    TimeSpec t = wall_clock_timespec();
+    std::lock_guard lock(mutex_);
+    if (t <= last_time_) t = add_ns(last_time_, 1);
+    last_time_ = t;
+    return t;
+}
+
+Result<MessageEntry> WireMember::pack_packet(const Value& value, TimeSpec time, MessageEntryType type) const {
+    auto packed = detail::pack_member(*info_, value, info_->def->type, "packet");
+    if (!packed) return packed.take_error();
+    MessageEntry e = detail::member_entry(type, {}, info_->def->name);
+    if (type == MessageEntryType::WirePacket) e.metadata = "unreliable\n";
+    e.elements.reserve(2);
+    e.elements.push_back(pack_timespec(time, "packettime"));
+    e.elements.push_back(std::move(*packed));
+    return e;
+}
+
+Result<void> WireMember::set_out_value(Value value) {
+    if (direction() == robdef::MemberDirection::writeonly)
+        return fail(MessageErrorType::ReadOnlyMember, "wire " + name() + " is [writeonly]: only clients send");
+    const TimeSpec time = next_time();
+    auto entry = pack_packet(value, time, MessageEntryType::WirePacket);
+    if (!entry) return entry.take_error();
+    std::vector<std::shared_ptr<WireConnection>> targets;
+    {
+        std::lock_guard lock(mutex_);
+        out_ = TimedValue{std::move(value), time};
+        targets.reserve(connections_.size());
+        for (const auto& [k, c] : connections_) targets.push_back(c);
+    }
+    for (const auto& c : targets) {
+        MessageEntry e = *entry;
+        e.service_path = c->service_path();
+        (void)c->session().send_wire_packet(std::move(e));  // newest wins; a gone client is dropped on close
+    }
+    return {};
+}
+
+Result<void> WireMember::send_to(const WireConnection& connection, const Value& value) {
+    if (direction() == robdef::MemberDirection::writeonly)
+        return fail(MessageErrorType::ReadOnlyMember, "wire " + name() + " is [writeonly]: only clients send");
+    auto entry = pack_packet(value, next_time(), MessageEntryType::WirePacket);
+    if (!entry) return entry.take_error();
+    entry->service_path = connection.service_path();
+    return connection.session().send_wire_packet(std::move(*entry));
+}
+
+Result<TimedValue> WireMember::out_value() const {
+    std::lock_guard lock(mutex_);
+    if (!out_) return fail(value_not_set());
+    return *out_;
+}
+
+Result<TimedValue> WireMember::in_value() const {
+    std::lock_guard lock(mutex_);
+    if (!in_) return fail(value_not_set());
+    return *in_;
+}
+
+std::vector<std::shared_ptr<WireConnection>> WireMember::connections() const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::shared_ptr<WireConnection>> out;
+    for (const auto& [k, c] : connections_) out.push_back(c);
+    return out;
+}
+
+void WireMember::remove(const std::shared_ptr<WireConnection>& connection, bool notify_client) {
+    std::shared_ptr<const CloseHandler> on_close;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = connections_.find(Key{connection->session().endpoint(), connection->service_path()});
+        if (it == connections_.end() || it->second != connection) return;
+        connections_.erase(it);
+        on_close = on_close_;
+    }
+    connection->open_.store(false);
+    if (notify_client)
+        (void)connection->session().send(
+            detail::member_entry(MessageEntryType::WireClosed, connection->service_path(), name()));
+    if (on_close) (*on_close)(connection);
+}
+
+void WireMember::drop_if(const std::function<bool(const WireConnection&)>& pred) {
+    std::vector<std::shared_ptr<WireConnection>> dropped;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [k, c] : connections_)
+            if (pred(*c)) dropped.push_back(c);
+    }
+    for (const auto& c : dropped) remove(c, false);
+}
+
+void WireMember::drop_session(const SessionRef& session) {
+    drop_if([e = session.endpoint()](const WireConnection& c) { return c.session().endpoint() == e; });
+}
+
+void WireMember::drop_path(const std::string& path) {
+    drop_if([&](const WireConnection& c) { return c.service_path() == path; });
+}
+
+void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    const auto dir = direction();
+    switch (entry.entry_type) {
+        case MessageEntryType::WireConnectReq: {
+            std::shared_ptr<WireConnection> conn;
+            std::shared_ptr<const ConnectHandler> on_connect;
+            std::optional<TimedValue> current;
+            bool created = false;
+            {
+                std::lock_guard lock(mutex_);
+                auto& slot = connections_[Key{session.endpoint(), entry.service_path}];
+                if (!slot) {
+                    slot.reset(new WireConnection(weak_from_this(), session, entry.service_path));
+                    created = true;
+                }
+                conn = slot;
+                on_connect = on_connect_;
+                if (dir != robdef::MemberDirection::writeonly) current = out_;
+            }
+            if (on_connect) {
+                if (auto r = (*on_connect)(conn); !r) {
+                    if (created) {
+                        std::lock_guard lock(mutex_);
+                        auto it = connections_.find(Key{session.endpoint(), entry.service_path});
+                        if (it != connections_.end() && it->second == conn) connections_.erase(it);
+                        conn->open_.store(false);
+                    }
+                    responder.fail(r.error());
+                    return;
+                }
+            }
+            if (current) {
+                if (auto e = pack_packet(current->value, current->time, MessageEntryType::WirePacket)) {
+                    e->service_path = entry.service_path;
+                    (void)session.send_wire_packet(std::move(*e));
+                }
+            }
+            responder.respond(MessageEntry{});
+            return;
+        }
+        case MessageEntryType::WireDisconnectReq: {
+            std::shared_ptr<WireConnection> conn;
+            {
+                std::lock_guard lock(mutex_);
+                auto it = connections_.find(Key{session.endpoint(), entry.service_path});
+                if (it != connections_.end()) conn = it->second;
+            }
+            if (!conn) {
+                responder.fail(make_error(MessageErrorType::ServiceError, "Invalid wire connection"));
+                return;
+            }
+            remove(conn, false);
+            responder.respond(MessageEntry{});
+            return;
+        }
+        case MessageEntryType::WirePeekInValueReq:
+        case MessageEntryType::WirePeekOutValueReq: {
+            const bool in = entry.entry_type == MessageEntryType::WirePeekInValueReq;
+            if (in && dir == robdef::MemberDirection::writeonly) {
+                responder.fail(make_error(MessageErrorType::WriteOnlyMember, "Write only member"));
+                return;
+            }
+            if (!in && dir == robdef::MemberDirection::readonly) {
+                responder.fail(make_error(MessageErrorType::ReadOnlyMember, "Read only member"));
+                return;
+            }
+            std::shared_ptr<const PeekHandler> handler;
+            std::optional<TimedValue> stored;
+            {
+                std::lock_guard lock(mutex_);
+                handler = in ? peek_in_ : peek_out_;
+                stored = in ? out_ : in_;
+            }
+            Result<TimedValue> v = handler ? (*handler)(session) : (stored ? Result<TimedValue>(std::move(*stored))
+                                                                            : Result<TimedValue>(fail(value_not_set())));
+            if (!v) {
+                responder.fail(v.error());
+                return;
+            }
+            auto reply = pack_packet(v->value, v->time, MessageEntryType::Null);  // Responder sets the reply type
+            if (!reply) {
+                responder.fail(reply.error());
+                return;
+            }
+            responder.respond(std::move(*reply));
+            return;
+        }
+        case MessageEntryType::WirePokeOutValueReq: {
+            if (dir == robdef::MemberDirection::readonly) {
+                responder.fail(make_error(MessageErrorType::ReadOnlyMember, "Read only member"));
+                return;
+            }
+            auto te = detail::require_element(entry, "packettime");
+            if (!te) {
+                responder.fail(te.error());
+                return;
+            }
+            auto time = unpack_timespec(**te);
+            if (!time) {
+                responder.fail(time.error());
+                return;
+            }
+            auto pe = detail::require_element(entry, "packet");
+            if (!pe) {
+                responder.fail(pe.error());
+                return;
+            }
+            auto v = detail::unpack_member(*info_, **pe, info_->def->type);
+            if (!v) {
+                responder.fail(v.error());
+                return;
+            }
+            std::shared_ptr<const PokeHandler> poke;
+            std::shared_ptr<const ValueHandler> on_value;
+            {
+                std::lock_guard lock(mutex_);
+                poke = poke_;
+                on_value = on_value_;
+                if (!poke) in_ = TimedValue{*v, *time};
+            }
+            if (poke) {
+                if (auto r = (*poke)(session, std::move(*v), *time); !r) {
+                    responder.fail(r.error());
+                    return;
+                }
+            } else if (on_value) {
+                (*on_value)(nullptr, *v, *time);
+            }
+            responder.respond(MessageEntry{});
+            return;
+        }
+        default: responder.fail(make_error(MessageErrorType::InvalidOperation, "Invalid Command")); return;
+    }
+}
+
+void WireMember::handle_packet(const SessionRef& session, MessageEntry&& entry) {
+    if (direction() == robdef::MemberDirection::readonly) return;
+    std::shared_ptr<WireConnection> conn;
+    std::shared_ptr<const ValueHandler> on_value;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = connections_.find(Key{session.endpoint(), entry.service_path});
+        if (it == connections_.end()) return;
+        conn = it->second;
+        on_value = on_value_;
+    }
+    const auto* te = entry.find("packettime");
+    const auto* pe = entry.find("packet");
+    if (!te || !pe) return;
+    auto time = unpack_timespec(*te);
+    if (!time) return;
+    auto v = detail::unpack_member(*info_, *pe, info_->def->type);
+    if (!v) return;
+    {
+        std::lock_guard lock(conn->mutex_);
+        if (conn->in_ && !(*time > conn->in_->time)) return;  // older than the last accepted: dropped
+        conn->in_ = TimedValue{*v, *time};
+    }
+    {
+        std::lock_guard lock(mutex_);
+        in_ = TimedValue{*v, *time};
+    }
+    if (on_value) (*on_value)(conn, *v, *time);
+}
+
+}  // namespace rr::server
