@@ -32,8 +32,18 @@ Result<T> require_scalar(const MessageEntry& entry, std::string_view name) {
     return v;
 }
 
+/// Unpacks a value a client sent. A value that does not fit the type (wrong kind or numeric type, wrong
+/// count, null where not allowed, missing struct field) is DataTypeError, as the official library answers;
+/// the message names the path and the expected type.
 inline Result<Value> unpack_member(const MemberInfo& info, const MessageElement& e, const robdef::TypeDefinition& type) {
-    return unpack_value(e, type, info.types->set(), info.service_name);
+    auto r = unpack_value(e, type, info.types->set(), info.service_name);
+    if (!r) {
+        const auto t = r.error().type;
+        if (t == MessageErrorType::DataTypeMismatch || t == MessageErrorType::NullValue ||
+            t == MessageErrorType::MessageElementNotFound)
+            return fail(MessageErrorType::DataTypeError, r.error().message);
+    }
+    return r;
 }
 
 inline Result<MessageElement> pack_member(const MemberInfo& info, const Value& v, const robdef::TypeDefinition& type,
@@ -48,8 +58,9 @@ inline Result<MessageElement> pack_return(const MemberInfo& info, const Value& v
     return pack_member(info, v, type, "return");
 }
 
+/// MemberNotFound with the official library's text.
 inline RRError member_not_found(std::string_view member) {
-    return make_error(MessageErrorType::MemberNotFound, "Member \"" + std::string(member) + "\" not found");
+    return make_error(MessageErrorType::MemberNotFound, "Member " + std::string(member) + " not found");
 }
 
 /// An entry for the client (event, packet, callback request) of `member` at `path`.

@@ -15,7 +15,8 @@
 //                          others → InvalidOperation "Unknown parameter".
 // Errors: OutOfRange ("Index out of range") when pos + count passes the dimensions or `data` is too
 // short; ReadOnlyMember for writes to `[readonly]`, WriteOnlyMember for reads of `[writeonly]`;
-// MessageElementNotFound / DataTypeMismatch for missing or mistyped request elements.
+// MessageElementNotFound / DataTypeMismatch for missing or mistyped request elements; DataTypeError for
+// `data` that does not fit the memory type.
 //
 // Threads: every function is thread-safe; a block read or write is atomic with respect to others.
 #pragma once

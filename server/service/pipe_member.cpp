@@ -1,6 +1,8 @@
 #include "server/service/pipe_member.hpp"
 
 #include <charconv>
+#include <limits>
+#include <optional>
 
 #include "server/service/member_support.hpp"
 
@@ -198,15 +200,20 @@ void PipeMember::handle_request(const SessionRef& session, MessageEntry&& entry,
     std::shared_ptr<const ConnectHandler> on_connect;
     {
         std::lock_guard lock(mutex_);
+        // CORE's rule: when this client has an endpoint at or above the requested index, the new one
+        // gets one more than its highest; −1 with none gives 1. So an index in use is never refused.
         std::int32_t i = *index;
-        if (i == -1) {
-            i = 1;
-            for (const auto& [k, e] : endpoints_)
-                if (k.first == session.endpoint() && k.second >= i) i = k.second + 1;
-        } else if (endpoints_.count(Key{session.endpoint(), i})) {
-            responder.fail(make_error(MessageErrorType::InvalidArgument, "Pipe endpoint index in use"));
-            return;
+        std::optional<std::int32_t> highest;
+        for (const auto& [k, e] : endpoints_)
+            if (k.first == session.endpoint() && (!highest || k.second > *highest)) highest = k.second;
+        if (highest && *highest >= i) {
+            if (*highest == std::numeric_limits<std::int32_t>::max()) {
+                responder.fail(make_error(MessageErrorType::InvalidArgument, "Pipe endpoint index in use"));
+                return;
+            }
+            i = *highest + 1;
         }
+        if (i == -1) i = 1;
         ep.reset(new PipeEndpoint(weak_from_this(), info_, session, entry.service_path, i, unreliable));
         endpoints_.emplace(Key{session.endpoint(), i}, ep);
         on_connect = on_connect_;

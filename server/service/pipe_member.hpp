@@ -2,10 +2,11 @@
 // connected (client session, index). Entries: PipeConnectReq/Ret 1143/1144, PipeDisconnectReq/Ret
 // 1145/1146, PipePacket 1141 (both ways), PipePacketRet 1142 (acks), PipeClosed 1147.
 //
-//   connect     index −1: the service picks one more than the highest index this client has on the pipe
-//               (1 when none); an explicit index is used as given (InvalidArgument "Pipe endpoint index
-//               in use" when taken). `[unreliable]` pipes grant `unreliable` when asked. on_connect runs
-//               before the reply (it may refuse with an error, which becomes the reply).
+//   connect     the requested index is used unless this client already has an endpoint at or above it:
+//               then the new endpoint gets one more than the client's highest index (CORE's rule, so an
+//               index in use is never refused); −1 with no endpoint gives 1. The reply carries the index.
+//               `[unreliable]` pipes grant `unreliable` when asked. on_connect runs before the reply (it
+//               may refuse with an error, which becomes the reply).
 //   packets     numbered per endpoint from 1 (uint32, wrapping to 0 after 2^32−1); client packets are
 //               unpacked against the pipe type and passed to on_packet in arrival order (one stream
 //               transport keeps them ordered); `requestack` is answered with PipePacketRet.

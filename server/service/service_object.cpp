@@ -366,8 +366,7 @@ Result<void> ServiceObject::fire_event(std::string_view event, std::vector<Value
 Result<std::shared_ptr<ServiceObject>> ServiceObject::resolve_objref(const SessionRef& session, std::string_view member,
                                                                      std::string_view index_text, bool has_index) {
     Slot* s = find_slot(member);
-    if (!s || s->kind != MemberKind::objref)
-        return fail(MessageErrorType::ObjectNotFound, "Object not found: " + type_ + " has no objref \"" + std::string(member) + "\"");
+    if (!s || s->kind != MemberKind::objref) return fail(detail::member_not_found(member));
     const auto& type = s->info->def->type;
     ObjRefIndex index;
     switch (type.container) {

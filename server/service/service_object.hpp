@@ -13,11 +13,14 @@
 //   wire      wire(name) → WireMember (wire_member.hpp)                          1161–1167, 1181–1186
 //   memory    memory(name) → MemoryMember (memory_member.hpp)                    1171–1176
 //
-// Requests are checked against the robdef before a handler runs: a missing argument element gives
-// MessageElementNotFound, a value of the wrong type the unpacking error (DataTypeMismatch,
-// DataTypeError or NullValue; core/value/pack_value.hpp), a request for a member the type does not
-// have, or of the wrong kind, MemberNotFound; setting a [readonly] property ReadOnlyMember, reading a
-// [writeonly] one WriteOnlyMember. Values returned by handlers are checked the same way when packed.
+// Requests are checked against the robdef before a handler runs, with the errors the official library
+// sends: a missing argument element gives MessageElementNotFound ("Element b not found."), a value
+// that does not fit its type DataTypeError (wrong kind, numeric type or count, null where not allowed;
+// the message names the path), a member the type does not have MemberNotFound ("Member x not found"),
+// as does a request of the wrong kind (CORE's generated skeletons); setting a [readonly] property
+// ReadOnlyMember, reading a [writeonly] one WriteOnlyMember; entry types no member takes ProtocolError
+// "Unknown request type". Extra elements are ignored. Values returned by handlers are checked when
+// packed (a packing error is sent instead of the value).
 // A handler returns any RRError; user exceptions come from ServiceTypes::user_error (RemoteError 100,
 // errorname `svc.ExceptionName`).
 //

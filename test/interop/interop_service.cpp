@@ -924,6 +924,8 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
+volatile std::sig_atomic_t g_stop = 0;
+
 [[noreturn]] void usage(const char* argv0) {
     std::cerr << "usage: " << argv0
               << " [--port N] [--disable-message4] [--enable-stringtable] [--heartbeat S] [--listen-all]"
@@ -955,12 +957,12 @@ int main(int argc, char** argv) {
         else usage(argv[0]);
     }
 
-    // SIGTERM / SIGINT are taken synchronously by the main thread (blocked before any thread starts).
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGTERM);
-    sigaddset(&signals, SIGINT);
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    // SIGTERM / SIGINT only set a flag (whichever thread takes them); the main thread polls it.
+    struct sigaction sa {};
+    sa.sa_handler = [](int) { g_stop = 1; };
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGINT, &sa, nullptr);
 
     std::ifstream in(robdef_path);
     if (!in) {
@@ -1007,9 +1009,8 @@ int main(int argc, char** argv) {
               << ", \"stringtable\": " << (enable_stringtable ? "true" : "false") << "}" << std::endl;
 
     const auto started = std::chrono::steady_clock::now();
-    for (;;) {
-        timespec wait{0, 200'000'000};
-        if (sigtimedwait(&signals, nullptr, &wait) > 0) break;
+    while (!g_stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
         if (max_lifetime > 0 &&
             std::chrono::steady_clock::now() - started > std::chrono::duration<double>(max_lifetime)) {
             std::cerr << "[interop_service] max lifetime reached" << std::endl;
