@@ -1,0 +1,238 @@
+#include "server/gateway/device_mirror.hpp"
+
+#include "server/gateway/mirror_service.hpp"
+#include "server/node/node.hpp"
+
+namespace rr::server::gateway {
+
+std::string_view device_state_name(DeviceState s) noexcept {
+    switch (s) {
+        case DeviceState::connecting: return "connecting";
+        case DeviceState::connected: return "connected";
+        case DeviceState::failed: return "failed";
+    }
+    return "unknown";
+}
+
+void DeviceCounters::observe_latency(std::chrono::steady_clock::duration d) {
+    const double s = std::chrono::duration<double>(d).count();
+    std::size_t i = 0;
+    while (i < std::size(kLatencyBuckets) && s > kLatencyBuckets[i]) ++i;
+    latency_buckets[i].fetch_add(1);
+    latency_sum_us.fetch_add(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(d).count()));
+}
+
+Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node> node, DeviceConfig config) {
+    bool valid = !config.name.empty() && ((config.name[0] >= 'a' && config.name[0] <= 'z') ||
+                                          (config.name[0] >= 'A' && config.name[0] <= 'Z'));
+    for (char c : config.name)
+        valid = valid && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_');
+    if (!valid)
+        return fail(MessageErrorType::InvalidConfiguration,
+                    "device name \"" + config.name + "\" is not a valid service name (letters, digits, _; starts with a letter)");
+    auto url = parse_connection_url(config.url);
+    if (!url) return fail(MessageErrorType::InvalidConfiguration, "device \"" + config.name + "\": " + url.error().message);
+    if (url->service.empty())
+        return fail(MessageErrorType::InvalidConfiguration, "device \"" + config.name + "\": URL names no service (?service=…)");
+    if (url->scheme != "rr+tcp" && url->scheme != "tcp")
+        return fail(MessageErrorType::InvalidConfiguration,
+                    "device \"" + config.name + "\": transport \"" + url->scheme + "\" is not supported for devices");
+    std::shared_ptr<DeviceMirror> m(new DeviceMirror(std::move(node), std::move(config), std::move(*url)));
+    m->service_ = std::make_shared<MirrorService>(m, m->config_.name, m->url_.service);
+    return m;
+}
+
+DeviceMirror::DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url)
+    : node_(node), config_(std::move(config)), url_(std::move(url)), timer_(node->io_context()),
+      backoff_(config_.backoff_initial) {}
+
+DeviceMirror::~DeviceMirror() { stop(); }
+
+void DeviceMirror::start() {
+    {
+        std::lock_guard lock(mutex_);
+        stopped_ = false;
+    }
+    connect();
+}
+
+void DeviceMirror::stop() {
+    std::shared_ptr<RawClient> client;
+    {
+        std::lock_guard lock(mutex_);
+        stopped_ = true;
+        client = std::move(client_);
+        ++generation_;
+    }
+    timer_.cancel();
+    if (client) client->close();
+    if (auto node = node_.lock(); node && registered_) node->unregister_service(config_.name);
+}
+
+void DeviceMirror::connect() {
+    auto node = node_.lock();
+    if (!node) return;
+    std::uint64_t gen;
+    {
+        std::lock_guard lock(mutex_);
+        if (stopped_) return;
+        state_ = DeviceState::connecting;
+        gen = ++generation_;
+    }
+    RawClientOptions options;
+    options.local_node_name = node->node_name().empty() ? std::string() : node->node_name();
+    options.username = config_.username;
+    options.password = config_.password;
+    std::weak_ptr<DeviceMirror> weak = weak_from_this();
+    RawClient::connect(
+        node->io_context().get_executor(), url_, options,
+        [weak, gen](MessageEntry&& e) {
+            if (auto self = weak.lock()) {
+                std::lock_guard lock(self->mutex_);
+                if (self->generation_ != gen) return;
+            }
+            if (auto self = weak.lock()) self->on_upstream_entry(std::move(e));
+        },
+        [weak, gen](const RRError& error) {
+            auto self = weak.lock();
+            if (!self) return;
+            {
+                std::lock_guard lock(self->mutex_);
+                if (self->generation_ != gen) return;
+            }
+            self->on_disconnected(error);
+        },
+        [weak, gen](Result<std::shared_ptr<RawClient>> r) {
+            auto self = weak.lock();
+            if (!self) return;
+            {
+                std::lock_guard lock(self->mutex_);
+                if (self->generation_ != gen || self->stopped_) {
+                    if (r) (*r)->close();
+                    return;
+                }
+            }
+            if (r)
+                self->on_connected(std::move(*r));
+            else
+                self->on_disconnected(r.error());
+        });
+}
+
+void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
+    bool do_register = false;
+    {
+        std::lock_guard lock(mutex_);
+        client_ = client;
+        state_ = DeviceState::connected;
+        reason_.clear();
+        backoff_ = config_.backoff_initial;
+        definitions_ = client->info().service_definitions;
+        object_type_ = client->info().object_type;
+        implements_ = client->info().object_implements;
+        attributes_ = client->info().attributes;
+        do_register = !registered_;
+        registered_ = true;
+    }
+    if (do_register) {
+        if (auto node = node_.lock()) {
+            if (auto r = node->register_service(service_); !r) {
+                std::lock_guard lock(mutex_);
+                state_ = DeviceState::failed;
+                reason_ = r.error().message;
+                registered_ = false;
+                return;
+            }
+        }
+    }
+    service_->on_upstream_connected(client);
+}
+
+void DeviceMirror::on_disconnected(const RRError& error) {
+    bool was_connected;
+    {
+        std::lock_guard lock(mutex_);
+        was_connected = state_ == DeviceState::connected;
+        client_.reset();
+        state_ = DeviceState::failed;
+        reason_ = error.message.empty() ? std::string(error.name) : error.message;
+        if (was_connected) counters_.reconnects.fetch_add(1);
+    }
+    service_->on_upstream_lost(error);
+    schedule_reconnect();
+}
+
+void DeviceMirror::schedule_reconnect() {
+    std::chrono::milliseconds delay;
+    {
+        std::lock_guard lock(mutex_);
+        if (stopped_) return;
+        delay = backoff_;
+        backoff_ = std::min(backoff_ * 2, config_.backoff_max);
+    }
+    timer_.expires_after(delay);
+    std::weak_ptr<DeviceMirror> weak = weak_from_this();
+    timer_.async_wait([weak](boost::system::error_code ec) {
+        if (ec) return;
+        if (auto self = weak.lock()) self->connect();
+    });
+}
+
+void DeviceMirror::on_upstream_entry(MessageEntry&& entry) { service_->on_upstream_entry(std::move(entry)); }
+
+DeviceStatus DeviceMirror::status() const {
+    DeviceStatus s;
+    s.name = config_.name;
+    s.url = config_.url;
+    s.required = config_.required;
+    s.downstream_sessions = service_->session_count();
+    std::lock_guard lock(mutex_);
+    s.state = state_;
+    s.reason = reason_;
+    s.object_type = object_type_;
+    return s;
+}
+
+std::vector<std::string> DeviceMirror::service_definitions() const {
+    std::lock_guard lock(mutex_);
+    return definitions_;
+}
+
+std::string DeviceMirror::object_type() const {
+    std::lock_guard lock(mutex_);
+    return object_type_;
+}
+
+std::shared_ptr<RawClient> DeviceMirror::upstream() const {
+    std::lock_guard lock(mutex_);
+    return client_;
+}
+
+void DeviceMirror::request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {
+    auto c = upstream();
+    if (!c) {
+        done(fail(MessageErrorType::ConnectionError, "device \"" + config_.name + "\" is not connected"));
+        return;
+    }
+    entry.service_path = service_->to_upstream(entry.service_path);
+    counters_.requests.fetch_add(1);
+    auto start = std::chrono::steady_clock::now();
+    auto self = shared_from_this();
+    c->request(std::move(entry), [self, start, done = std::move(done)](Result<MessageEntry> r) {
+        self->counters_.observe_latency(std::chrono::steady_clock::now() - start);
+        if (r) r->service_path = self->service_->to_downstream(r->service_path);
+        if (!r || r->error != MessageErrorType::None) self->counters_.request_errors.fetch_add(1);
+        done(std::move(r));
+    });
+}
+
+std::uint64_t DeviceMirror::subscribe(std::string path, std::string member, bool is_wire,
+                                      std::function<void(const MessageEntry&)> on_entry,
+                                      std::function<void(Result<void>)> done) {
+    return service_->add_internal_subscriber(std::move(path), std::move(member), is_wire, std::move(on_entry),
+                                             std::move(done));
+}
+
+void DeviceMirror::unsubscribe(std::uint64_t id) { service_->remove_internal_subscriber(id); }
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,132 @@
+// A device behind the gateway (DESIGN "The gateway model"): one upstream client session to the device,
+// kept alive with reconnects and exponential backoff, and a MirrorService that re-hosts the device's
+// root object on the gateway's node under the device's name.
+//
+// Forwarding is at the message-entry level: requests are re-addressed (service path, RequestID,
+// endpoints) and their elements passed on without decoding values. Events and wires are subscribed
+// once upstream and fanned out to every downstream client (wires keep only the newest value per
+// client); pipes map each downstream endpoint to its own upstream endpoint; callbacks from the device
+// go to the downstream client that most recently called into the device; generators are owned by the
+// client that created them. A device that goes away fails pending requests with ConnectionError;
+// downstream wire connections stay open and are re-subscribed when the device returns.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <boost/asio/steady_timer.hpp>
+
+#include "core/names/connection_url.hpp"
+#include "server/client/raw_client.hpp"
+#include "server/service/service.hpp"
+
+namespace rr::server {
+class Node;
+}
+
+namespace rr::server::gateway {
+
+struct DeviceConfig {
+    std::string name;  ///< service name on the gateway (a valid RR service name)
+    std::string url;   ///< rr+tcp://host:port/?service=…
+    std::string username, password;
+    /// /readyz waits for required devices only.
+    bool required = true;
+    std::chrono::milliseconds backoff_initial{500};
+    std::chrono::milliseconds backoff_max{30000};
+};
+
+enum class DeviceState : std::uint8_t { connecting, connected, failed };
+std::string_view device_state_name(DeviceState s) noexcept;
+
+/// Request latency histogram bucket bounds, seconds (Prometheus `le`).
+inline constexpr double kLatencyBuckets[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10};
+
+struct DeviceCounters {
+    std::atomic<std::uint64_t> requests{0}, request_errors{0}, events{0}, wire_packets_in{0}, wire_packets_out{0},
+        pipe_packets{0}, pipe_drops{0}, event_drops{0}, callbacks{0}, reconnects{0};
+    std::atomic<std::uint64_t> latency_buckets[std::size(kLatencyBuckets) + 1]{};
+    std::atomic<std::uint64_t> latency_sum_us{0};
+    void observe_latency(std::chrono::steady_clock::duration d);
+};
+
+/// A snapshot for the JSON API and /metrics.
+struct DeviceStatus {
+    std::string name, url;
+    DeviceState state = DeviceState::connecting;
+    std::string reason;  ///< why it failed / last error
+    std::string object_type;
+    bool required = true;
+    std::size_t downstream_sessions = 0;
+};
+
+class MirrorService;
+
+class DeviceMirror : public std::enable_shared_from_this<DeviceMirror> {
+public:
+    /// Validates the config (name, URL). Errors: InvalidConfiguration naming the field.
+    static Result<std::shared_ptr<DeviceMirror>> create(std::shared_ptr<Node> node, DeviceConfig config);
+    ~DeviceMirror();
+
+    /// Starts connecting (and keeps reconnecting until stop()).
+    void start();
+    void stop();
+
+    DeviceStatus status() const;
+    const DeviceConfig& config() const noexcept { return config_; }
+    const DeviceCounters& counters() const noexcept { return counters_; }
+    /// The device's service definition texts (root first), empty before the first connect.
+    std::vector<std::string> service_definitions() const;
+    std::string object_type() const;
+    /// The upstream session when connected (for the JSON API), else nullptr.
+    std::shared_ptr<RawClient> upstream() const;
+
+    /// Sends a request to the device on behalf of the gateway itself (JSON API). The entry's service
+    /// path uses the gateway's name for the device; the reply's is rewritten back the same way.
+    void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
+    /// Subscribes the gateway itself to a wire or event (JSON API): `on_entry` gets upstream WirePacket /
+    /// EventReq entries for that member (paths in gateway naming). Returns an id for unsubscribe().
+    std::uint64_t subscribe(std::string path, std::string member, bool is_wire,
+                            std::function<void(const MessageEntry&)> on_entry,
+                            std::function<void(Result<void>)> done);
+    void unsubscribe(std::uint64_t id);
+
+private:
+    DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url);
+    void connect();
+    void on_connected(std::shared_ptr<RawClient> client);
+    void on_disconnected(const RRError& error);
+    void schedule_reconnect();
+    void on_upstream_entry(MessageEntry&& entry);
+
+    friend class MirrorService;
+
+    std::weak_ptr<Node> node_;
+    DeviceConfig config_;
+    ConnectionUrl url_;
+    std::shared_ptr<MirrorService> service_;
+    boost::asio::steady_timer timer_;
+    DeviceCounters counters_;
+
+    mutable std::mutex mutex_;
+    DeviceState state_ = DeviceState::connecting;
+    std::string reason_;
+    std::shared_ptr<RawClient> client_;
+    std::vector<std::string> definitions_;
+    std::string object_type_;
+    std::vector<std::string> implements_;
+    MessageElement attributes_;
+    std::chrono::milliseconds backoff_;
+    bool stopped_ = false;
+    bool registered_ = false;
+    std::uint64_t generation_ = 0;  // bumps on every (re)connect, so stale callbacks are ignored
+};
+
+}  // namespace rr::server::gateway

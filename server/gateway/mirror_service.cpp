@@ -1,0 +1,683 @@
+#include "server/gateway/mirror_service.hpp"
+
+#include <charconv>
+
+#include "core/names/service_path.hpp"
+#include "core/session/elements.hpp"
+#include "robdef/parser.hpp"
+
+namespace rr::server::gateway {
+namespace {
+
+RRError not_connected(const std::string& device) {
+    return make_error(MessageErrorType::ConnectionError, "device \"" + device + "\" is not connected");
+}
+
+std::optional<std::int32_t> parse_index(std::string_view s) {
+    std::int32_t v = 0;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size()) return std::nullopt;
+    return v;
+}
+
+std::int32_t element_index(const MessageEntry& e) {
+    std::int32_t idx = -1;
+    if (const auto* el = e.find("index")) read_scalar(*el, idx);
+    return idx;
+}
+
+void set_index(MessageEntry& e, std::int32_t idx) {
+    for (auto& el : e.elements)
+        if (!el.number && el.name == "index") {
+            el = make_scalar_element<std::int32_t>("index", idx);
+            return;
+        }
+    e.elements.push_back(make_scalar_element<std::int32_t>("index", idx));
+}
+
+}  // namespace
+
+MirrorService::MirrorService(std::weak_ptr<DeviceMirror> mirror, std::string name, std::string upstream_service)
+    : mirror_(std::move(mirror)), name_(std::move(name)), upstream_service_(std::move(upstream_service)) {}
+
+std::string MirrorService::to_upstream(std::string_view path) const { return replace_service_name(path, upstream_service_); }
+std::string MirrorService::to_downstream(std::string_view path) const { return replace_service_name(path, name_); }
+
+std::shared_ptr<RawClient> MirrorService::client() const {
+    auto m = mirror_.lock();
+    return m ? m->upstream() : nullptr;
+}
+
+std::vector<std::string> MirrorService::service_definitions() const {
+    auto m = mirror_.lock();
+    return m ? m->service_definitions() : std::vector<std::string>{};
+}
+
+std::optional<std::string> MirrorService::service_definition(std::string_view service_type) const {
+    for (auto& text : service_definitions()) {
+        auto parsed = robdef::parse_service_definition(text, "");
+        if (parsed && parsed->definition.name == service_type) return text;
+    }
+    return std::nullopt;
+}
+
+ObjectTypeInfo MirrorService::root_type() const {
+    auto m = mirror_.lock();
+    if (!m) return {};
+    std::lock_guard lock(m->mutex_);
+    return {m->object_type_, m->implements_};
+}
+
+MessageElement MirrorService::attributes() const {
+    auto m = mirror_.lock();
+    if (m) {
+        std::lock_guard lock(m->mutex_);
+        if (m->attributes_.type == DataTypes::dictionary_t) return m->attributes_;
+    }
+    return Service::attributes();
+}
+
+void MirrorService::object_type(const SessionRef& session, const std::string& path,
+                                std::function<void(Result<ObjectTypeInfo>)> done) {
+    if (path == name_) {
+        done(root_type());
+        return;
+    }
+    auto c = client();
+    if (!c) {
+        done(fail(not_connected(name_)));
+        return;
+    }
+    MessageEntry e;
+    e.entry_type = MessageEntryType::ObjectTypeName;
+    e.service_path = to_upstream(path);
+    e.elements.push_back(make_string_element("clientversion", "1.2.8"));
+    c->request(std::move(e), [done = std::move(done)](Result<MessageEntry> r) {
+        if (!r) {
+            done(r.take_error());
+            return;
+        }
+        if (auto err = entry_error(*r)) {
+            done(fail(*err));
+            return;
+        }
+        ObjectTypeInfo info;
+        if (const auto* t = r->find("objecttype")) info.object_type = std::string(read_string(*t));
+        if (const auto* i = r->find("objectimplements"))
+            for (const auto& item : i->elements) info.implements.emplace_back(read_string(item));
+        done(std::move(info));
+    });
+}
+
+void MirrorService::on_session_open(const SessionRef& session) {
+    std::lock_guard lock(mutex_);
+    sessions_.push_back(session);
+}
+
+void MirrorService::on_session_close(const SessionRef& session) { drop_session_state(session.endpoint()); }
+
+std::size_t MirrorService::session_count() const {
+    std::lock_guard lock(mutex_);
+    return sessions_.size();
+}
+
+void MirrorService::drop_session_state(std::uint32_t endpoint) {
+    std::vector<MessageEntry> to_device;
+    {
+        std::lock_guard lock(mutex_);
+        std::erase_if(sessions_, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
+        for (auto& [key, sub] : wires_)
+            std::erase_if(sub.sessions, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
+        for (auto it = pipes_by_downstream_.begin(); it != pipes_by_downstream_.end();) {
+            if (std::get<0>(it->first) != endpoint) {
+                ++it;
+                continue;
+            }
+            const auto& [ep, path, member, d] = it->first;
+            MessageEntry e;
+            e.entry_type = MessageEntryType::PipeDisconnectReq;
+            e.service_path = to_upstream(path);
+            e.member_name = member;
+            e.elements.push_back(make_scalar_element<std::int32_t>("index", it->second));
+            to_device.push_back(std::move(e));
+            pipes_by_upstream_.erase({path, member, it->second});
+            it = pipes_by_downstream_.erase(it);
+        }
+        std::erase_if(generators_, [&](const auto& g) { return g.first == endpoint; });
+    }
+    if (auto c = client())
+        for (auto& e : to_device) c->request(std::move(e), [](Result<MessageEntry>) {});
+}
+
+void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    auto mirror = mirror_.lock();
+    if (!mirror) return;
+    switch (entry.entry_type) {
+        case MessageEntryType::WireConnectReq: wire_connect(session, std::move(entry), std::move(responder)); return;
+        case MessageEntryType::WireDisconnectReq: wire_disconnect(session, std::move(entry), std::move(responder)); return;
+        case MessageEntryType::PipeConnectReq: pipe_connect(session, std::move(entry), std::move(responder)); return;
+        case MessageEntryType::PipeDisconnectReq: pipe_disconnect(session, std::move(entry), std::move(responder)); return;
+        case MessageEntryType::PipePacket:
+        case MessageEntryType::PipePacketRet: pipe_packets_from_client(session, std::move(entry)); return;
+        case MessageEntryType::WirePacket: {
+            // A client's OutValue is the device's InValue: passed on as it is.
+            if (auto c = client()) {
+                entry.service_path = to_upstream(entry.service_path);
+                c->send(std::move(entry));
+            }
+            return;
+        }
+        case MessageEntryType::GeneratorNextReq: {
+            std::int32_t idx = element_index(entry);
+            bool owned;
+            {
+                std::lock_guard lock(mutex_);
+                owned = generators_.count({session.endpoint(), idx}) != 0;
+            }
+            if (!owned) {
+                responder.fail(make_error(MessageErrorType::InvalidOperation, "generator index not owned by this client"));
+                return;
+            }
+            forward(session, std::move(entry), std::move(responder));
+            return;
+        }
+        default: forward(session, std::move(entry), std::move(responder)); return;
+    }
+}
+
+void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    auto mirror = mirror_.lock();
+    auto c = client();
+    if (!mirror || !c) {
+        if (!responder.done()) responder.fail(not_connected(name_));
+        return;
+    }
+    {
+        std::lock_guard lock(mutex_);
+        last_caller_ = session.endpoint();
+    }
+    const auto type = entry.entry_type;
+    const auto endpoint = session.endpoint();
+    const auto start = std::chrono::steady_clock::now();
+    entry.service_path = to_upstream(entry.service_path);
+    mirror->counters_.requests.fetch_add(1);
+    auto self = shared_from_this();
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    c->request(std::move(entry), [self, mirror, shared, type, endpoint, start](Result<MessageEntry> r) {
+        mirror->counters_.observe_latency(std::chrono::steady_clock::now() - start);
+        if (!r) {
+            mirror->counters_.request_errors.fetch_add(1);
+            shared->fail(r.error());
+            return;
+        }
+        if (r->error != MessageErrorType::None) mirror->counters_.request_errors.fetch_add(1);
+        if (type == MessageEntryType::FunctionCallReq && r->error == MessageErrorType::None && !r->find("return")) {
+            if (const auto* idx = r->find("index")) {
+                std::int32_t g = 0;
+                if (read_scalar(*idx, g)) {
+                    std::lock_guard lock(self->mutex_);
+                    self->generators_.insert({endpoint, g});
+                }
+            }
+        }
+        if (type == MessageEntryType::GeneratorNextReq && r->error != MessageErrorType::None) {
+            // StopIteration, close and abort end the generator (the request's index is not in the reply:
+            // ownership is dropped when the session closes or the device reconnects).
+        }
+        shared->respond(std::move(*r));
+    });
+}
+
+// --- wires -------------------------------------------------------------------------------------
+
+void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    MemberKey key{entry.service_path, entry.member_name};
+    std::optional<MessageEntry> last;
+    bool ready = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto& sub = wires_[key];
+        if (std::find(sub.sessions.begin(), sub.sessions.end(), session) == sub.sessions.end())
+            sub.sessions.push_back(session);
+        ready = sub.upstream_connected;
+        if (ready) {
+            last = sub.last_packet;
+        } else {
+            auto shared = std::make_shared<Responder>(std::move(responder));
+            sub.waiting.push_back([shared](Result<void> r) {
+                if (r)
+                    shared->respond(MessageEntry{});
+                else
+                    shared->fail(r.error());
+            });
+        }
+    }
+    if (ready) {
+        responder.respond(MessageEntry{});
+        if (last) (void)session.send_wire_packet(std::move(*last));  // the newest value, at once
+        return;
+    }
+    ensure_upstream_wire(key);
+}
+
+void MirrorService::ensure_upstream_wire(const MemberKey& key) {
+    auto c = client();
+    std::vector<std::function<void(Result<void>)>> fail_now;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = wires_.find(key);
+        if (it == wires_.end() || it->second.upstream_connected || it->second.connecting) return;
+        if (!c) {
+            fail_now.swap(it->second.waiting);
+        } else {
+            it->second.connecting = true;
+        }
+    }
+    for (auto& f : fail_now)
+        if (f) f(fail(not_connected(name_)));
+    if (!c) return;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::WireConnectReq;
+    e.service_path = to_upstream(key.first);
+    e.member_name = key.second;
+    auto self = shared_from_this();
+    c->request(std::move(e), [self, key](Result<MessageEntry> r) {
+        std::vector<std::function<void(Result<void>)>> waiting;
+        Result<void> outcome;
+        if (!r)
+            outcome = r.take_error();
+        else if (auto err = entry_error(*r))
+            outcome = fail(*err);
+        {
+            std::lock_guard lock(self->mutex_);
+            auto it = self->wires_.find(key);
+            if (it == self->wires_.end()) return;
+            it->second.connecting = false;
+            it->second.upstream_connected = outcome.ok();
+            waiting.swap(it->second.waiting);
+            if (!outcome.ok()) {
+                // Nobody gets a connection that does not exist upstream.
+                it->second.sessions.clear();
+                if (it->second.internal.empty()) self->wires_.erase(it);
+            }
+        }
+        for (auto& w : waiting)
+            if (w) w(outcome);
+    });
+}
+
+void MirrorService::wire_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    MemberKey key{entry.service_path, entry.member_name};
+    bool last = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = wires_.find(key);
+        if (it != wires_.end()) {
+            std::erase(it->second.sessions, session);
+            last = it->second.sessions.empty() && it->second.internal.empty() && it->second.upstream_connected;
+            if (last) wires_.erase(it);
+        }
+    }
+    responder.respond(MessageEntry{});
+    if (last) {
+        if (auto c = client()) {
+            MessageEntry e;
+            e.entry_type = MessageEntryType::WireDisconnectReq;
+            e.service_path = to_upstream(key.first);
+            e.member_name = key.second;
+            c->request(std::move(e), [](Result<MessageEntry>) {});
+        }
+    }
+}
+
+// --- pipes -------------------------------------------------------------------------------------
+
+void MirrorService::pipe_connect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    auto c = client();
+    if (!c) {
+        responder.fail(not_connected(name_));
+        return;
+    }
+    const std::string path = entry.service_path, member = entry.member_name;
+    const std::int32_t wanted = element_index(entry);
+    {
+        std::lock_guard lock(mutex_);
+        if (wanted >= 0 && pipes_by_downstream_.count({session.endpoint(), path, member, wanted})) {
+            responder.fail(make_error(MessageErrorType::InvalidArgument, "pipe endpoint index already in use"));
+            return;
+        }
+    }
+    // Upstream the gateway always lets the device choose: downstream indices are per client.
+    set_index(entry, -1);
+    entry.service_path = to_upstream(path);
+    auto self = shared_from_this();
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    c->request(std::move(entry), [self, session, shared, path, member, wanted](Result<MessageEntry> r) {
+        if (!r) {
+            shared->fail(r.error());
+            return;
+        }
+        if (auto err = entry_error(*r)) {
+            shared->fail(*err);
+            return;
+        }
+        const std::int32_t upstream = element_index(*r);
+        std::int32_t downstream = wanted;
+        {
+            std::lock_guard lock(self->mutex_);
+            if (downstream < 0) {
+                downstream = 0;
+                while (self->pipes_by_downstream_.count({session.endpoint(), path, member, downstream})) ++downstream;
+            }
+            self->pipes_by_downstream_[{session.endpoint(), path, member, downstream}] = upstream;
+            self->pipes_by_upstream_[{path, member, upstream}] = PipeLink{session, path, member, downstream, upstream};
+        }
+        set_index(*r, downstream);
+        shared->respond(std::move(*r));
+    });
+}
+
+void MirrorService::pipe_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    const std::int32_t d = element_index(entry);
+    std::optional<std::int32_t> u;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = pipes_by_downstream_.find({session.endpoint(), entry.service_path, entry.member_name, d});
+        if (it != pipes_by_downstream_.end()) {
+            u = it->second;
+            pipes_by_upstream_.erase({entry.service_path, entry.member_name, *u});
+            pipes_by_downstream_.erase(it);
+        }
+    }
+    if (!u) {
+        responder.fail(make_error(MessageErrorType::InvalidArgument, "pipe endpoint not connected"));
+        return;
+    }
+    set_index(entry, *u);
+    forward(session, std::move(entry), std::move(responder));
+}
+
+void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageEntry&& entry) {
+    auto c = client();
+    if (!c) return;
+    const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& el : entry.elements) {
+            // Packets name their pipe index; acks number it (wire.md §6.7).
+            std::optional<std::int32_t> d = acks ? el.number : parse_index(el.name);
+            if (!d) continue;
+            auto it = pipes_by_downstream_.find({session.endpoint(), entry.service_path, entry.member_name, *d});
+            if (it == pipes_by_downstream_.end()) continue;
+            if (acks)
+                el.number = it->second;
+            else
+                el.name = std::to_string(it->second);
+        }
+    }
+    if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
+    entry.service_path = to_upstream(entry.service_path);
+    c->send(std::move(entry));
+}
+
+void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
+    const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
+    std::string path = to_downstream(entry.service_path);
+    // Regroup the elements per owning client session.
+    std::map<std::uint32_t, std::pair<SessionRef, MessageEntry>> per_session;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& el : entry.elements) {
+            std::optional<std::int32_t> u = acks ? el.number : parse_index(el.name);
+            if (!u) continue;
+            auto it = pipes_by_upstream_.find({path, entry.member_name, *u});
+            if (it == pipes_by_upstream_.end()) continue;
+            auto& slot = per_session[it->second.session.endpoint()];
+            if (slot.second.elements.empty()) {
+                slot.first = it->second.session;
+                slot.second.entry_type = entry.entry_type;
+                slot.second.service_path = path;
+                slot.second.member_name = entry.member_name;
+                slot.second.metadata = entry.metadata;
+            }
+            if (acks)
+                el.number = it->second.downstream_index;
+            else
+                el.name = std::to_string(it->second.downstream_index);
+            slot.second.elements.push_back(std::move(el));
+        }
+    }
+    auto m = mirror_.lock();
+    for (auto& [ep, pair] : per_session) {
+        if (!pair.first.send(std::move(pair.second)) && m) m->counters_.pipe_drops.fetch_add(1);
+    }
+}
+
+// --- upstream traffic ----------------------------------------------------------------------------
+
+void MirrorService::fan_out(const MessageEntry& entry) {
+    std::vector<SessionRef> sessions;
+    std::vector<InternalSub> internal;
+    {
+        std::lock_guard lock(mutex_);
+        sessions = sessions_;
+        auto it = event_subscribers_.find({entry.service_path, entry.member_name});
+        if (it != event_subscribers_.end()) internal = it->second;
+    }
+    auto m = mirror_.lock();
+    for (const auto& s : sessions)
+        if (!s.send(entry) && m) m->counters_.event_drops.fetch_add(1);
+    for (const auto& i : internal) i.on_entry(entry);
+}
+
+void MirrorService::callback_from_device(MessageEntry&& entry) {
+    auto c = client();
+    SessionRef target;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& s : sessions_)
+            if (s.endpoint() == last_caller_ && s.alive()) target = s;
+        if (!target.alive())
+            for (const auto& s : sessions_)
+                if (s.alive()) target = s;
+    }
+    const std::uint32_t request_id = entry.request_id;
+    MessageEntry reply_header;
+    reply_header.entry_type = MessageEntryType::CallbackCallRet;
+    reply_header.service_path = entry.service_path;
+    reply_header.member_name = entry.member_name;
+    reply_header.request_id = request_id;
+    if (!target.alive()) {
+        if (c) {
+            set_entry_error(reply_header, make_error(MessageErrorType::OperationFailed, "no client connected through the gateway"));
+            c->send(std::move(reply_header));
+        }
+        return;
+    }
+    if (auto m = mirror_.lock()) m->counters_.callbacks.fetch_add(1);
+    entry.service_path = to_downstream(entry.service_path);
+    std::weak_ptr<DeviceMirror> weak = mirror_;
+    target.request(std::move(entry), [weak, reply_header](Result<MessageEntry> r) mutable {
+        auto m = weak.lock();
+        auto c = m ? m->upstream() : nullptr;
+        if (!c) return;
+        MessageEntry reply = reply_header;
+        if (!r) {
+            set_entry_error(reply, r.error());
+        } else {
+            reply.error = r->error;
+            reply.elements = std::move(r->elements);
+        }
+        c->send(std::move(reply));
+    });
+}
+
+void MirrorService::on_upstream_entry(MessageEntry&& entry) {
+    auto m = mirror_.lock();
+    switch (entry.entry_type) {
+        case MessageEntryType::EventReq:
+        case MessageEntryType::ServicePathReleasedReq:
+            if (m) m->counters_.events.fetch_add(1);
+            entry.service_path = to_downstream(entry.service_path);
+            fan_out(entry);
+            return;
+        case MessageEntryType::WirePacket: {
+            if (m) m->counters_.wire_packets_in.fetch_add(1);
+            entry.service_path = to_downstream(entry.service_path);
+            std::vector<SessionRef> sessions;
+            std::vector<InternalSub> internal;
+            {
+                std::lock_guard lock(mutex_);
+                auto it = wires_.find({entry.service_path, entry.member_name});
+                if (it == wires_.end()) return;
+                it->second.last_packet = entry;
+                sessions = it->second.sessions;
+                internal = it->second.internal;
+            }
+            for (const auto& s : sessions) {
+                if (s.send_wire_packet(entry) && m) m->counters_.wire_packets_out.fetch_add(1);
+            }
+            for (const auto& i : internal) i.on_entry(entry);
+            return;
+        }
+        case MessageEntryType::WireClosed: {
+            entry.service_path = to_downstream(entry.service_path);
+            std::vector<SessionRef> sessions;
+            {
+                std::lock_guard lock(mutex_);
+                auto it = wires_.find({entry.service_path, entry.member_name});
+                if (it == wires_.end()) return;
+                sessions = std::move(it->second.sessions);
+                wires_.erase(it);
+            }
+            for (const auto& s : sessions) (void)s.send(entry);
+            return;
+        }
+        case MessageEntryType::PipePacket:
+        case MessageEntryType::PipePacketRet: pipe_packets_from_device(std::move(entry)); return;
+        case MessageEntryType::PipeClosed: {
+            std::string path = to_downstream(entry.service_path);
+            const std::int32_t u = element_index(entry);
+            std::optional<PipeLink> link;
+            {
+                std::lock_guard lock(mutex_);
+                auto it = pipes_by_upstream_.find({path, entry.member_name, u});
+                if (it == pipes_by_upstream_.end()) return;
+                link = it->second;
+                pipes_by_downstream_.erase({link->session.endpoint(), path, entry.member_name, link->downstream_index});
+                pipes_by_upstream_.erase(it);
+            }
+            entry.service_path = path;
+            set_index(entry, link->downstream_index);
+            (void)link->session.send(std::move(entry));
+            return;
+        }
+        case MessageEntryType::CallbackCallReq: callback_from_device(std::move(entry)); return;
+        default: return;
+    }
+}
+
+void MirrorService::on_upstream_connected(const std::shared_ptr<RawClient>&) {
+    std::vector<MemberKey> resubscribe;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& [key, sub] : wires_) {
+            sub.upstream_connected = false;
+            sub.connecting = false;
+            if (!sub.sessions.empty() || !sub.internal.empty()) resubscribe.push_back(key);
+        }
+    }
+    for (const auto& key : resubscribe) ensure_upstream_wire(key);
+}
+
+void MirrorService::on_upstream_lost(const RRError& error) {
+    // Pipes cannot outlive the upstream session: their clients get PipeClosed. Wire connections stay,
+    // to be re-subscribed when the device returns. Generators are gone with the session.
+    std::vector<std::pair<SessionRef, MessageEntry>> closed;
+    std::vector<std::function<void(Result<void>)>> waiting;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& [key, link] : pipes_by_upstream_) {
+            MessageEntry e;
+            e.entry_type = MessageEntryType::PipeClosed;
+            e.service_path = link.path;
+            e.member_name = link.member;
+            e.elements.push_back(make_scalar_element<std::int32_t>("index", link.downstream_index));
+            closed.emplace_back(link.session, std::move(e));
+        }
+        pipes_by_upstream_.clear();
+        pipes_by_downstream_.clear();
+        generators_.clear();
+        for (auto& [key, sub] : wires_) {
+            sub.upstream_connected = false;
+            sub.connecting = false;
+            for (auto& w : sub.waiting) waiting.push_back(std::move(w));
+            sub.waiting.clear();
+        }
+    }
+    for (auto& [s, e] : closed) (void)s.send(std::move(e));
+    for (auto& w : waiting)
+        if (w) w(fail(not_connected(name_)));
+    (void)error;
+}
+
+std::uint64_t MirrorService::add_internal_subscriber(std::string path, std::string member, bool is_wire,
+                                                     std::function<void(const MessageEntry&)> on_entry,
+                                                     std::function<void(Result<void>)> done) {
+    std::uint64_t id;
+    MemberKey key{std::move(path), std::move(member)};
+    std::optional<MessageEntry> last;
+    bool ready = false;
+    {
+        std::lock_guard lock(mutex_);
+        id = next_internal_id_++;
+        if (!is_wire) {
+            event_subscribers_[key].push_back(InternalSub{id, std::move(on_entry)});
+            ready = true;
+        } else {
+            auto& sub = wires_[key];
+            sub.internal.push_back(InternalSub{id, on_entry});
+            ready = sub.upstream_connected;
+            if (ready) {
+                last = sub.last_packet;
+            } else {
+                sub.waiting.push_back(std::move(done));
+            }
+        }
+    }
+    if (ready) {
+        if (last && is_wire) on_entry(*last);
+        if (done) done({});
+        return id;
+    }
+    ensure_upstream_wire(key);
+    return id;
+}
+
+void MirrorService::remove_internal_subscriber(std::uint64_t id) {
+    std::vector<MemberKey> disconnect;
+    {
+        std::lock_guard lock(mutex_);
+        for (auto& [key, subs] : event_subscribers_) std::erase_if(subs, [&](const InternalSub& s) { return s.id == id; });
+        for (auto it = wires_.begin(); it != wires_.end();) {
+            std::erase_if(it->second.internal, [&](const InternalSub& s) { return s.id == id; });
+            if (it->second.internal.empty() && it->second.sessions.empty() && it->second.upstream_connected) {
+                disconnect.push_back(it->first);
+                it = wires_.erase(it);
+            } else {
+                ++it;
+            }
+        }
+    }
+    if (auto c = client()) {
+        for (const auto& key : disconnect) {
+            MessageEntry e;
+            e.entry_type = MessageEntryType::WireDisconnectReq;
+            e.service_path = to_upstream(key.first);
+            e.member_name = key.second;
+            c->request(std::move(e), [](Result<MessageEntry>) {});
+        }
+    }
+}
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,96 @@
+// The Service a DeviceMirror registers on the gateway node: the downstream half of the mirror (see
+// device_mirror.hpp for the forwarding rules). Thread-safe: called from downstream connection strands
+// and from the upstream client's strand.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <tuple>
+
+#include "server/gateway/device_mirror.hpp"
+
+namespace rr::server::gateway {
+
+class MirrorService : public Service, public std::enable_shared_from_this<MirrorService> {
+public:
+    explicit MirrorService(std::weak_ptr<DeviceMirror> mirror, std::string name, std::string upstream_service);
+
+    // Service
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override;
+    std::optional<std::string> service_definition(std::string_view service_type) const override;
+    ObjectTypeInfo root_type() const override;
+    MessageElement attributes() const override;
+    void object_type(const SessionRef& session, const std::string& path,
+                     std::function<void(Result<ObjectTypeInfo>)> done) override;
+    void on_session_open(const SessionRef& session) override;
+    void on_session_close(const SessionRef& session) override;
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override;
+
+    // Upstream side, called by DeviceMirror.
+    void on_upstream_entry(MessageEntry&& entry);
+    void on_upstream_connected(const std::shared_ptr<RawClient>& client);
+    void on_upstream_lost(const RRError& error);
+    std::size_t session_count() const;
+
+    /// Gateway-internal subscribers (JSON API), keyed by id.
+    std::uint64_t add_internal_subscriber(std::string path, std::string member, bool is_wire,
+                                          std::function<void(const MessageEntry&)> on_entry,
+                                          std::function<void(Result<void>)> done);
+    void remove_internal_subscriber(std::uint64_t id);
+
+    std::string to_upstream(std::string_view path) const;
+    std::string to_downstream(std::string_view path) const;
+
+private:
+    using MemberKey = std::pair<std::string, std::string>;  // downstream service path, member
+    struct InternalSub {
+        std::uint64_t id;
+        std::function<void(const MessageEntry&)> on_entry;
+    };
+    struct WireSubscription {
+        std::vector<SessionRef> sessions;
+        std::vector<InternalSub> internal;
+        bool upstream_connected = false;
+        bool connecting = false;
+        std::vector<std::function<void(Result<void>)>> waiting;  // connect requests waiting for upstream
+        std::optional<MessageEntry> last_packet;                 // newest value, for late subscribers
+    };
+    struct PipeLink {
+        SessionRef session;
+        std::string path, member;
+        std::int32_t downstream_index = 0;
+        std::int32_t upstream_index = 0;
+    };
+
+    std::shared_ptr<RawClient> client() const;
+    void forward(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void wire_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void ensure_upstream_wire(const MemberKey& key);
+    void pipe_connect(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void pipe_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void pipe_packets_from_client(const SessionRef& session, MessageEntry&& entry);
+    void pipe_packets_from_device(MessageEntry&& entry);
+    void callback_from_device(MessageEntry&& entry);
+    void fan_out(const MessageEntry& entry);
+    void drop_session_state(std::uint32_t endpoint);
+
+    std::weak_ptr<DeviceMirror> mirror_;
+    const std::string name_;
+    const std::string upstream_service_;
+
+    mutable std::mutex mutex_;
+    std::vector<SessionRef> sessions_;
+    std::uint32_t last_caller_ = 0;  // endpoint of the client that most recently called into the device
+    std::map<MemberKey, WireSubscription> wires_;
+    std::map<MemberKey, std::vector<InternalSub>> event_subscribers_;
+    std::map<std::tuple<std::string, std::string, std::int32_t>, PipeLink> pipes_by_upstream_;
+    std::map<std::tuple<std::uint32_t, std::string, std::string, std::int32_t>, std::int32_t> pipes_by_downstream_;
+    std::set<std::pair<std::uint32_t, std::int32_t>> generators_;  // (endpoint, generator index)
+    std::uint64_t next_internal_id_ = 1;
+};
+
+}  // namespace rr::server::gateway

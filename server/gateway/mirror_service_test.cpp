@@ -1,0 +1,232 @@
+// A device node behind a gateway node: forwarding, fan-out, callbacks and device restarts, at the entry
+// level with RawClient as the downstream client.
+#include <catch2/catch.hpp>
+
+#include <future>
+#include <thread>
+
+#include "server/client/raw_client.hpp"
+#include "server/gateway/device_mirror.hpp"
+#include "server/node/node.hpp"
+#include "server/service/test_raw_service.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace rr::server::gateway;
+using namespace std::chrono_literals;
+using testing::RawTestService;
+
+namespace {
+
+struct Device {
+    std::shared_ptr<Node> node;
+    std::shared_ptr<RawTestService> service = std::make_shared<RawTestService>();
+    std::uint16_t port = 0;
+
+    explicit Device(std::uint16_t want_port = 0) {
+        node = Node::create(NodeOptions{NodeID(), "device.node", 2, {}, 0, 5000ms});
+        REQUIRE(node->register_service(service));
+        auto p = node->listen_tcp("127.0.0.1", want_port);
+        REQUIRE(p);
+        port = *p;
+    }
+};
+
+struct Gateway {
+    std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "gateway.node", 2, {}, 0, 5000ms});
+    std::shared_ptr<DeviceMirror> mirror;
+    std::uint16_t port = 0;
+
+    explicit Gateway(std::uint16_t device_port) {
+        DeviceConfig cfg;
+        cfg.name = "dev";
+        cfg.url = "rr+tcp://127.0.0.1:" + std::to_string(device_port) + "/?service=svc";
+        cfg.backoff_initial = 100ms;
+        cfg.backoff_max = 400ms;
+        auto m = DeviceMirror::create(node, cfg);
+        REQUIRE(m);
+        mirror = *m;
+        mirror->start();
+        port = *node->listen_tcp("127.0.0.1", 0);
+    }
+    ~Gateway() {
+        mirror->stop();
+        node->shutdown();
+    }
+
+    bool wait_state(DeviceState s, std::chrono::milliseconds timeout = 5000ms) {
+        auto until = std::chrono::steady_clock::now() + timeout;
+        while (std::chrono::steady_clock::now() < until) {
+            if (mirror->status().state == s) return true;
+            std::this_thread::sleep_for(10ms);
+        }
+        return false;
+    }
+
+    std::shared_ptr<RawClient> connect(RawClient::IncomingHandler incoming = {}) {
+        std::promise<Result<std::shared_ptr<RawClient>>> p;
+        auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=dev");
+        RawClient::connect(node->io_context().get_executor(), *url, {}, std::move(incoming), {},
+                           [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+        auto r = p.get_future().get();
+        REQUIRE(r);
+        return *r;
+    }
+};
+
+Result<MessageEntry> call(RawClient& c, MessageEntry e) {
+    std::promise<Result<MessageEntry>> p;
+    c.request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
+    return p.get_future().get();
+}
+
+MessageEntry request(MessageEntryType type, std::string member, std::string path = "dev") {
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = std::move(path);
+    e.member_name = std::move(member);
+    return e;
+}
+
+double scalar(const MessageEntry& e, const char* name) {
+    double v = -1;
+    if (const auto* el = e.find(name)) read_scalar(*el, v);
+    return v;
+}
+
+}  // namespace
+
+TEST_CASE("the gateway re-hosts a device under its own name") {
+    Device device;
+    Gateway gw(device.port);
+    REQUIRE(gw.wait_state(DeviceState::connected));
+    auto c = gw.connect();
+    CHECK(c->info().object_type == "example.rawtest.Obj");
+    REQUIRE(c->info().service_definitions.size() == 1);
+
+    auto get = call(*c, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(get);
+    CHECK(get->service_path == "dev");
+    CHECK(scalar(*get, "value") == 42.5);
+
+    auto bad = call(*c, request(MessageEntryType::FunctionCallReq, "nosuch"));
+    REQUIRE(bad);
+    CHECK(bad->error == MessageErrorType::MemberNotFound);
+
+    auto status = gw.mirror->status();
+    CHECK(status.state == DeviceState::connected);
+    CHECK(status.downstream_sessions == 1);
+    CHECK(gw.mirror->counters().requests.load() >= 2);
+}
+
+TEST_CASE("events and wire values fan out to every client; callbacks go to the caller") {
+    Device device;
+    Gateway gw(device.port);
+    REQUIRE(gw.wait_state(DeviceState::connected));
+
+    struct Seen {
+        std::mutex m;
+        int events = 0, wires = 0;
+        double last_wire = 0;
+    };
+    std::vector<std::shared_ptr<Seen>> seen;
+    std::vector<std::shared_ptr<RawClient>> clients;
+    std::vector<std::weak_ptr<RawClient>> weak(3);
+    for (int i = 0; i < 3; ++i) {
+        auto s = std::make_shared<Seen>();
+        seen.push_back(s);
+        auto* slot = &weak[i];
+        clients.push_back(gw.connect([s, slot, i](MessageEntry&& e) {
+            std::lock_guard lock(s->m);
+            if (e.entry_type == MessageEntryType::EventReq) ++s->events;
+            if (e.entry_type == MessageEntryType::WirePacket) {
+                ++s->wires;
+                s->last_wire = scalar(e, "packet");
+            }
+            if (e.entry_type == MessageEntryType::CallbackCallReq) {
+                MessageEntry r;
+                r.entry_type = MessageEntryType::CallbackCallRet;
+                r.service_path = e.service_path;
+                r.member_name = e.member_name;
+                r.request_id = e.request_id;
+                r.elements.push_back(make_scalar_element("return", scalar(e, "v") + 100.0 * i));
+                if (auto c = slot->lock()) c->send(std::move(r));
+            }
+        }));
+        weak[i] = clients.back();
+    }
+    // Clients 0 and 1 connect the wire: one upstream connection serves both.
+    for (int i = 0; i < 2; ++i) {
+        auto r = call(*clients[i], request(MessageEntryType::WireConnectReq, "w"));
+        REQUIRE(r);
+        CHECK(r->error == MessageErrorType::None);
+    }
+    {
+        std::lock_guard lock(device.service->mutex);
+        CHECK(device.service->wire_sessions.size() == 1);
+    }
+    REQUIRE(call(*clients[2], request(MessageEntryType::FunctionCallReq, "fire")));
+    auto until = std::chrono::steady_clock::now() + 5s;
+    auto done = [&] {
+        for (int i = 0; i < 3; ++i) {
+            std::lock_guard lock(seen[i]->m);
+            if (seen[i]->events < 1) return false;
+            if (i < 2 && seen[i]->wires < 1) return false;
+        }
+        return true;
+    };
+    while (!done() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(10ms);
+    REQUIRE(done());
+    {
+        std::lock_guard lock(seen[2]->m);
+        CHECK(seen[2]->wires == 0);  // not connected to the wire
+    }
+    CHECK(seen[0]->last_wire == 9.5);
+
+    // The device calls back the gateway; the gateway routes to the client that called `callme`.
+    auto callme = request(MessageEntryType::FunctionCallReq, "callme");
+    callme.elements.push_back(make_scalar_element("v", 1.0));
+    auto r = call(*clients[1], std::move(callme));
+    REQUIRE(r);
+    CHECK(r->error == MessageErrorType::None);
+    CHECK(scalar(*r, "return") == 101.0);
+}
+
+TEST_CASE("a device that restarts: errors while it is gone, then everything works again") {
+    auto device = std::make_unique<Device>();
+    const auto port = device->port;
+    Gateway gw(port);
+    REQUIRE(gw.wait_state(DeviceState::connected));
+    auto c = gw.connect();
+    REQUIRE(call(*c, request(MessageEntryType::WireConnectReq, "w")));
+    REQUIRE(call(*c, request(MessageEntryType::PropertyGetReq, "x")));
+
+    device->node->shutdown();
+    device.reset();
+    REQUIRE(gw.wait_state(DeviceState::failed));
+    auto gone = call(*c, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(gone);
+    CHECK(gone->error == MessageErrorType::ConnectionError);
+    CHECK(entry_error(*gone)->message.find("not connected") != std::string::npos);
+    CHECK_FALSE(gw.mirror->status().reason.empty());
+
+    device = std::make_unique<Device>(port);
+    REQUIRE(gw.wait_state(DeviceState::connected, 10000ms));
+    auto back = call(*c, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(back);
+    CHECK(back->error == MessageErrorType::None);
+    CHECK(scalar(*back, "value") == 42.5);
+    // The downstream wire connection survived and was re-subscribed upstream.
+    auto until = std::chrono::steady_clock::now() + 5s;
+    std::size_t n = 0;
+    while (std::chrono::steady_clock::now() < until) {
+        {
+            std::lock_guard lock(device->service->mutex);
+            n = device->service->wire_sessions.size();
+        }
+        if (n == 1) break;
+        std::this_thread::sleep_for(10ms);
+    }
+    CHECK(n == 1);
+    CHECK(gw.mirror->counters().reconnects.load() == 1);
+}
