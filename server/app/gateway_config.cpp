@@ -1,0 +1,306 @@
+#include "server/app/gateway_config.hpp"
+
+#include <charconv>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "core/names/connection_url.hpp"
+#include "core/names/node_id.hpp"
+
+namespace rr::server::app {
+namespace {
+
+struct ConfigError {
+    std::string text;
+};
+
+class Reader {
+public:
+    explicit Reader(std::string_view source) : source_(source) {}
+
+    [[noreturn]] void error(const YAML::Node& at, const std::string& key, const std::string& problem) const {
+        std::string where = std::string(source_);
+        if (at.IsDefined() && at.Mark().line >= 0) where += ":" + std::to_string(at.Mark().line + 1);
+        throw ConfigError{where + ": " + key + ": " + problem};
+    }
+
+    void check_keys(const YAML::Node& map, const std::string& path, const std::set<std::string>& allowed) const {
+        if (!map.IsMap()) error(map, path, "expected a mapping");
+        for (const auto& kv : map) {
+            auto key = kv.first.as<std::string>();
+            if (!allowed.count(key)) {
+                std::string list;
+                for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+                error(kv.first, path.empty() ? key : path + "." + key, "unknown key (expected one of: " + list + ")");
+            }
+        }
+    }
+
+    std::string string(const YAML::Node& n, const std::string& key) const {
+        if (!n.IsScalar()) error(n, key, "expected a string");
+        return n.as<std::string>();
+    }
+
+    bool boolean(const YAML::Node& n, const std::string& key) const {
+        bool v = false;
+        if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) error(n, key, "expected true or false");
+        return v;
+    }
+
+    std::uint64_t unsigned_int(const YAML::Node& n, const std::string& key, std::uint64_t max) const {
+        if (!n.IsScalar()) error(n, key, "expected a number");
+        const auto& s = n.Scalar();
+        std::uint64_t v = 0;
+        auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+        if (s.empty() || ec != std::errc() || p != s.data() + s.size())
+            error(n, key, "expected a non-negative integer, got \"" + s + "\"");
+        if (v > max) error(n, key, "must be at most " + std::to_string(max));
+        return v;
+    }
+
+    std::vector<std::string> string_list(const YAML::Node& n, const std::string& key) const {
+        if (!n.IsSequence()) error(n, key, "expected a list of strings");
+        std::vector<std::string> out;
+        for (const auto& item : n) out.push_back(string(item, key));
+        return out;
+    }
+
+private:
+    std::string_view source_;
+};
+
+const std::set<std::string> kLogLevels{"trace", "debug", "info", "warning", "error", "fatal", "disable"};
+
+void validate(const GatewayConfig& c, const std::function<void(const std::string&, const std::string&)>& error) {
+    if (!c.node_id.empty() && !NodeID::parse(c.node_id)) error("gateway.node_id", "not a NodeID (UUID)");
+    if (!kLogLevels.count(c.log_level)) error("gateway.log_level", "unknown level \"" + c.log_level + "\"");
+    if (c.max_message_size < 16 * 1024 || c.max_message_size > 100u * 1024u * 1024u)
+        error("gateway.max_message_size", "must be between 16 KiB and 100 MiB");
+    std::set<std::string> names;
+    for (const auto& d : c.devices) {
+        if (!names.insert(d.name).second) error("devices." + d.name, "duplicate device name");
+    }
+}
+
+GatewayConfig parse(const YAML::Node& root, const Reader& r) {
+    GatewayConfig c;
+    if (!root.IsDefined() || root.IsNull()) return c;
+    r.check_keys(root, "", {"gateway", "demo", "devices"});
+    if (auto g = root["gateway"]) {
+        r.check_keys(g, "gateway",
+                     {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins",
+                      "max_message_size", "log_level"});
+        if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
+        if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
+        if (auto n = g["node_name"]) c.node_name = r.string(n, "gateway.node_name");
+        if (auto n = g["node_id"]) {
+            c.node_id = r.string(n, "gateway.node_id");
+            if (!NodeID::parse(c.node_id)) r.error(n, "gateway.node_id", "not a NodeID (UUID)");
+        }
+        if (auto n = g["threads"]) c.threads = static_cast<unsigned>(r.unsigned_int(n, "gateway.threads", 256));
+        if (auto n = g["web_root"]) c.web_root = r.string(n, "gateway.web_root");
+        if (auto n = g["allowed_origins"]) c.allowed_origins = r.string_list(n, "gateway.allowed_origins");
+        if (auto n = g["max_message_size"]) {
+            c.max_message_size = r.unsigned_int(n, "gateway.max_message_size", 100u * 1024u * 1024u);
+            if (c.max_message_size < 16 * 1024) r.error(n, "gateway.max_message_size", "must be at least 16384");
+        }
+        if (auto n = g["log_level"]) {
+            c.log_level = r.string(n, "gateway.log_level");
+            if (!kLogLevels.count(c.log_level)) r.error(n, "gateway.log_level", "unknown level \"" + c.log_level + "\"");
+        }
+    }
+    if (auto d = root["demo"]) {
+        r.check_keys(d, "demo", {"enabled", "port"});
+        if (auto n = d["enabled"]) c.demo = r.boolean(n, "demo.enabled");
+        if (auto n = d["port"]) c.demo_port = static_cast<std::uint16_t>(r.unsigned_int(n, "demo.port", 65535));
+    }
+    if (auto devs = root["devices"]) {
+        if (!devs.IsSequence()) r.error(devs, "devices", "expected a list of devices");
+        std::set<std::string> names;
+        for (const auto& d : devs) {
+            r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms"});
+            gateway::DeviceConfig dc;
+            if (!d["name"]) r.error(d, "devices[].name", "missing");
+            if (!d["url"]) r.error(d, "devices[].url", "missing");
+            dc.name = r.string(d["name"], "devices[].name");
+            const std::string key = "devices." + dc.name;
+            dc.url = r.string(d["url"], key + ".url");
+            auto url = parse_connection_url(dc.url);
+            if (!url) r.error(d["url"], key + ".url", url.error().message);
+            if (url->service.empty()) r.error(d["url"], key + ".url", "names no service (add ?service=NAME)");
+            if (auto n = d["username"]) dc.username = r.string(n, key + ".username");
+            if (auto n = d["password"]) dc.password = r.string(n, key + ".password");
+            if (auto n = d["required"]) dc.required = r.boolean(n, key + ".required");
+            if (auto n = d["backoff_max_ms"])
+                dc.backoff_max = std::chrono::milliseconds(r.unsigned_int(n, key + ".backoff_max_ms", 3600000));
+            if (!names.insert(dc.name).second) r.error(d["name"], key, "duplicate device name");
+            c.devices.push_back(std::move(dc));
+        }
+    }
+    return c;
+}
+
+}  // namespace
+
+Result<GatewayConfig> parse_gateway_config(std::string_view yaml_text, std::string_view source) {
+    Reader reader(source);
+    try {
+        YAML::Node root = YAML::Load(std::string(yaml_text));
+        return parse(root, reader);
+    } catch (const ConfigError& e) {
+        return fail(MessageErrorType::InvalidConfiguration, e.text);
+    } catch (const YAML::Exception& e) {
+        return fail(MessageErrorType::InvalidConfiguration,
+                    std::string(source) + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    }
+}
+
+Result<GatewayConfig> load_gateway_config(const std::string& path) {
+    std::ifstream f(path);
+    if (!f) return fail(MessageErrorType::InvalidConfiguration, path + ": cannot read the configuration file");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return parse_gateway_config(ss.str(), path);
+}
+
+namespace {
+
+// Flags that take a value, with their official RR spellings mapped to ours.
+const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
+                                        "--allow-origin", "--device",     "--demo-port", "--threads",
+                                        "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
+                                        "--robotraconteur-nodeid", "--robotraconteur-log-level"};
+const std::set<std::string> kBoolFlags{"--no-demo", "--check", "--help", "-h"};
+
+}  // namespace
+
+Result<CommandLine> parse_command_line(int argc, const char* const* argv) {
+    CommandLine cmd;
+    for (int i = 1; i < argc; ++i) {
+        std::string arg = argv[i];
+        std::string name = arg, value;
+        bool has_value = false;
+        if (auto eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+            name = arg.substr(0, eq);
+            value = arg.substr(eq + 1);
+            has_value = true;
+        }
+        if (kBoolFlags.count(name)) {
+            if (has_value) return fail(MessageErrorType::InvalidConfiguration, name + " takes no value");
+            if (name == "--help" || name == "-h") cmd.help = true;
+            else if (name == "--check") cmd.check_only = true;
+            else cmd.overrides.push_back(name);
+            continue;
+        }
+        if (kValueFlags.count(name)) {
+            if (!has_value) {
+                if (i + 1 >= argc) return fail(MessageErrorType::InvalidConfiguration, name + " needs a value");
+                value = argv[++i];
+            }
+            if (name == "--config")
+                cmd.config_file = value;
+            else
+                cmd.overrides.push_back(name + "=" + value);
+            continue;
+        }
+        // Other --robotraconteur-* options of the official library do not apply to the gateway.
+        if (name.rfind("--robotraconteur-", 0) == 0)
+            return fail(MessageErrorType::InvalidConfiguration, "flag " + name + " is not supported by rr-gateway");
+        return fail(MessageErrorType::InvalidConfiguration, "unknown flag \"" + arg + "\" (see --help)");
+    }
+    return cmd;
+}
+
+Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
+    auto number = [](const std::string& flag, const std::string& v, std::uint64_t max) -> Result<std::uint64_t> {
+        std::uint64_t n = 0;
+        auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+        if (v.empty() || ec != std::errc() || p != v.data() + v.size() || n > max)
+            return fail(MessageErrorType::InvalidConfiguration, flag + ": expected an integer up to " + std::to_string(max));
+        return n;
+    };
+    for (const auto& o : cmd.overrides) {
+        auto eq = o.find('=');
+        std::string flag = o.substr(0, eq);
+        std::string v = eq == std::string::npos ? std::string() : o.substr(eq + 1);
+        if (flag == "--port" || flag == "--robotraconteur-tcp-port") {
+            auto n = number(flag, v, 65535);
+            if (!n) return n.take_error();
+            c.port = static_cast<std::uint16_t>(*n);
+        } else if (flag == "--demo-port") {
+            auto n = number(flag, v, 65535);
+            if (!n) return n.take_error();
+            c.demo_port = static_cast<std::uint16_t>(*n);
+        } else if (flag == "--threads") {
+            auto n = number(flag, v, 256);
+            if (!n) return n.take_error();
+            c.threads = static_cast<unsigned>(*n);
+        } else if (flag == "--listen") {
+            c.listen = v;
+        } else if (flag == "--web-root") {
+            c.web_root = v;
+        } else if (flag == "--allow-origin") {
+            c.allowed_origins.push_back(v);
+        } else if (flag == "--no-demo") {
+            c.demo = false;
+        } else if (flag == "--robotraconteur-nodename") {
+            c.node_name = v;
+        } else if (flag == "--robotraconteur-nodeid") {
+            if (!NodeID::parse(v)) return fail(MessageErrorType::InvalidConfiguration, flag + ": not a NodeID");
+            c.node_id = v;
+        } else if (flag == "--log-level" || flag == "--robotraconteur-log-level") {
+            std::string level = v;
+            for (auto& ch : level) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+            if (!kLogLevels.count(level)) return fail(MessageErrorType::InvalidConfiguration, flag + ": unknown level \"" + v + "\"");
+            c.log_level = level;
+        } else if (flag == "--device") {
+            auto e2 = v.find('=');
+            if (e2 == std::string::npos)
+                return fail(MessageErrorType::InvalidConfiguration, "--device: expected NAME=URL");
+            gateway::DeviceConfig d;
+            d.name = v.substr(0, e2);
+            d.url = v.substr(e2 + 1);
+            auto url = parse_connection_url(d.url);
+            if (!url) return fail(MessageErrorType::InvalidConfiguration, "--device " + d.name + ": " + url.error().message);
+            if (url->service.empty())
+                return fail(MessageErrorType::InvalidConfiguration, "--device " + d.name + ": URL names no service");
+            std::erase_if(c.devices, [&](const gateway::DeviceConfig& x) { return x.name == d.name; });
+            c.devices.push_back(std::move(d));
+        }
+    }
+    std::string problem;
+    validate(c, [&](const std::string& key, const std::string& what) {
+        if (problem.empty()) problem = key + ": " + what;
+    });
+    if (!problem.empty()) return fail(MessageErrorType::InvalidConfiguration, problem);
+    return {};
+}
+
+std::string usage_text() {
+    return R"(Usage: rr-gateway [--config FILE] [options]
+
+Robot Raconteur gateway: devices re-exposed over WebSocket and HTTP.
+With no configuration it starts two demo devices (experimental.create, experimental.createwebcam).
+
+Options (override the configuration file):
+  --config FILE              YAML configuration (docs/gateway-config.md)
+  --port N                   RR + HTTP + WebSocket port (default 8080)
+  --listen ADDR              listen address (default 0.0.0.0)
+  --web-root DIR             dashboard files to serve
+  --allow-origin ORIGIN      allow a browser Origin (repeatable)
+  --device NAME=URL          add a device, e.g. reynard=rr+tcp://localhost:29200/?service=reynard
+  --no-demo                  do not start the demo devices
+  --demo-port N              RR port of the demo devices' node (default: ephemeral)
+  --threads N                worker threads (default: cores)
+  --log-level LEVEL          trace, debug, info, warning, error
+  --check                    validate the configuration and exit
+  --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
+  --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL
+                             the official library's flags, where they apply
+)";
+}
+
+}  // namespace rr::server::app

@@ -1,0 +1,62 @@
+// rr-gateway configuration: one YAML file (schema in docs/gateway-config.md) plus command-line flags
+// that override it. Validation is complete before anything starts: an error names the key and, for
+// the file, its line; nothing starts half-configured.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error/rr_error.hpp"
+#include "server/gateway/device_mirror.hpp"
+
+namespace rr::server::app {
+
+struct GatewayConfig {
+    // gateway:
+    std::string listen = "0.0.0.0";
+    std::uint16_t port = 8080;
+    std::string node_name = "rr.gateway";
+    std::string node_id;  ///< empty = random
+    unsigned threads = 0;
+    std::string web_root;  ///< empty = the built-in default (web/ next to the executable's project)
+    std::vector<std::string> allowed_origins;
+    std::size_t max_message_size = 12u * 1024u * 1024u;
+    std::string log_level = "info";
+    // demo:
+    bool demo = true;
+    std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)
+    // devices:
+    std::vector<gateway::DeviceConfig> devices;
+};
+
+/// Parses YAML text. `source` names the file in error messages. Errors: InvalidConfiguration with
+/// "<source>:<line>: <key>: <problem>".
+Result<GatewayConfig> parse_gateway_config(std::string_view yaml_text, std::string_view source);
+
+/// Reads and parses a file. Errors: as parse_gateway_config, or InvalidConfiguration when unreadable.
+Result<GatewayConfig> load_gateway_config(const std::string& path);
+
+/// What the command line asked for: a config file, overrides, and modes.
+struct CommandLine {
+    std::optional<std::string> config_file;
+    bool help = false;
+    bool check_only = false;  ///< --check: validate the configuration and exit
+    /// Applies the overrides to `config`. Errors: InvalidConfiguration naming the flag.
+    std::vector<std::string> overrides;  ///< raw flags, applied in order by apply_overrides
+};
+
+/// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
+/// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
+/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --check,
+/// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
+/// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
+Result<CommandLine> parse_command_line(int argc, const char* const* argv);
+Result<void> apply_overrides(GatewayConfig& config, const CommandLine& cmd);
+
+/// Usage text for --help.
+std::string usage_text();
+
+}  // namespace rr::server::app

@@ -1,0 +1,108 @@
+#include <catch2/catch.hpp>
+
+#include "server/app/gateway_config.hpp"
+
+using namespace rr;
+using namespace rr::server::app;
+
+TEST_CASE("a full configuration parses") {
+    auto c = parse_gateway_config(R"(
+gateway:
+  listen: 127.0.0.1
+  port: 9090
+  node_name: lab.gateway
+  allowed_origins: [http://localhost:9090]
+  log_level: debug
+demo:
+  enabled: false
+devices:
+  - name: reynard
+    url: rr+tcp://localhost:29200/?service=reynard
+  - name: arm
+    url: rr+tcp://10.0.0.5:48653/?service=robot
+    username: op
+    password: secret
+    required: false
+)", "test.yaml");
+    REQUIRE(c);
+    CHECK(c->listen == "127.0.0.1");
+    CHECK(c->port == 9090);
+    CHECK(c->node_name == "lab.gateway");
+    CHECK_FALSE(c->demo);
+    REQUIRE(c->devices.size() == 2);
+    CHECK(c->devices[1].username == "op");
+    CHECK_FALSE(c->devices[1].required);
+    CHECK(c->allowed_origins == std::vector<std::string>{"http://localhost:9090"});
+}
+
+TEST_CASE("an empty configuration gives the defaults (demo on, port 8080)") {
+    auto c = parse_gateway_config("", "empty.yaml");
+    REQUIRE(c);
+    CHECK(c->port == 8080);
+    CHECK(c->demo);
+    CHECK(c->devices.empty());
+}
+
+TEST_CASE("configuration errors name the key and the line") {
+    struct Case {
+        const char* yaml;
+        const char* expect;
+    };
+    for (auto [yaml, expect] : {
+             Case{"gateway:\n  port: 8080\n  prot: 1\n", "bad.yaml:3: gateway.prot: unknown key"},
+             Case{"gateway:\n  port: 70000\n", "bad.yaml:2: gateway.port: must be at most 65535"},
+             Case{"gateway:\n  port: eighty\n", "bad.yaml:2: gateway.port: expected a non-negative integer"},
+             Case{"devices:\n  - name: a\n    url: http://x/\n", "bad.yaml:3: devices.a.url: invalid connection URL"},
+             Case{"devices:\n  - name: a\n    url: rr+tcp://x:1/\n", "bad.yaml:3: devices.a.url: names no service"},
+             Case{"devices:\n  - name: a\n", "bad.yaml:2: devices[].url: missing"},
+             Case{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n  - name: a\n    url: rr+tcp://y/?service=s\n",
+                  "bad.yaml:4: devices.a: duplicate device name"},
+             Case{"demo:\n  enabled: maybe\n", "bad.yaml:2: demo.enabled: expected true or false"},
+             Case{"gateway: [1, 2]\n", "bad.yaml:1: gateway: expected a mapping"},
+             Case{"gateway:\n  port: [\n", "bad.yaml:"},
+             Case{"gateway:\n  log_level: loud\n", "bad.yaml:2: gateway.log_level: unknown level"},
+             Case{"gateway:\n  node_id: not-a-uuid\n", "bad.yaml:2: gateway.node_id: not a NodeID"},
+         }) {
+        auto c = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(c);
+        CHECK(c.error().type == MessageErrorType::InvalidConfiguration);
+        CHECK_THAT(c.error().message, Catch::StartsWith(expect));
+    }
+}
+
+TEST_CASE("command-line flags override the file, including the official RR flags") {
+    const char* argv[] = {"rr-gateway", "--config", "x.yaml", "--port=9000", "--robotraconteur-nodename=gw2",
+                          "--device", "reynard=rr+tcp://localhost:29200/?service=reynard", "--no-demo",
+                          "--robotraconteur-log-level", "WARNING"};
+    auto cmd = parse_command_line(10, argv);
+    REQUIRE(cmd);
+    CHECK(cmd->config_file == "x.yaml");
+    GatewayConfig c;
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK(c.port == 9000);
+    CHECK(c.node_name == "gw2");
+    CHECK_FALSE(c.demo);
+    CHECK(c.log_level == "warning");
+    REQUIRE(c.devices.size() == 1);
+    CHECK(c.devices[0].name == "reynard");
+}
+
+TEST_CASE("bad flags are refused with the flag's name") {
+    for (auto args : {std::vector<const char*>{"g", "--bogus"}, std::vector<const char*>{"g", "--port"},
+                      std::vector<const char*>{"g", "--robotraconteur-tcp-enable-ipv6=true"}}) {
+        auto cmd = parse_command_line(static_cast<int>(args.size()), args.data());
+        CHECK_FALSE(cmd);
+    }
+    const char* argv[] = {"g", "--port=99999"};
+    auto cmd = parse_command_line(2, argv);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    auto r = apply_overrides(c, *cmd);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("--port"));
+    const char* argv2[] = {"g", "--device", "noequals"};
+    auto cmd2 = parse_command_line(3, argv2);
+    REQUIRE(cmd2);
+    CHECK_FALSE(apply_overrides(c, *cmd2));
+}
