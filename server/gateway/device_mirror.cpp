@@ -119,6 +119,20 @@ void DeviceMirror::connect() {
         });
 }
 
+void DeviceMirror::set_state_listener(std::function<void(const DeviceStatus&)> listener) {
+    std::lock_guard lock(mutex_);
+    state_listener_ = std::move(listener);
+}
+
+void DeviceMirror::notify_state() {
+    std::function<void(const DeviceStatus&)> listener;
+    {
+        std::lock_guard lock(mutex_);
+        listener = state_listener_;
+    }
+    if (listener) listener(status());
+}
+
 void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
     bool do_register = false;
     {
@@ -135,17 +149,21 @@ void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
         registered_ = true;
     }
     if (do_register) {
-        if (auto node = node_.lock()) {
-            if (auto r = node->register_service(service_); !r) {
+        auto node = node_.lock();
+        auto r = node ? node->register_service(service_) : Result<void>(fail(MessageErrorType::InvalidState, "gateway stopped"));
+        if (!r) {
+            {
                 std::lock_guard lock(mutex_);
                 state_ = DeviceState::failed;
                 reason_ = r.error().message;
                 registered_ = false;
-                return;
             }
+            notify_state();
+            return;
         }
     }
     service_->on_upstream_connected(client);
+    notify_state();
 }
 
 void DeviceMirror::on_disconnected(const RRError& error) {
@@ -159,6 +177,7 @@ void DeviceMirror::on_disconnected(const RRError& error) {
         if (was_connected) counters_.reconnects.fetch_add(1);
     }
     service_->on_upstream_lost(error);
+    notify_state();
     schedule_reconnect();
 }
 

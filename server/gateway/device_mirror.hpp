@@ -98,6 +98,9 @@ public:
                             std::function<void(Result<void>)> done);
     void unsubscribe(std::uint64_t id);
 
+    /// Called (from any thread, without locks held) whenever the state changes; for logs and pushes.
+    void set_state_listener(std::function<void(const DeviceStatus&)> listener);
+
 private:
     DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url);
     void connect();
@@ -105,6 +108,7 @@ private:
     void on_disconnected(const RRError& error);
     void schedule_reconnect();
     void on_upstream_entry(MessageEntry&& entry);
+    void notify_state();
 
     friend class MirrorService;
 
@@ -127,6 +131,7 @@ private:
     bool stopped_ = false;
     bool registered_ = false;
     std::uint64_t generation_ = 0;  // bumps on every (re)connect, so stale callbacks are ignored
+    std::function<void(const DeviceStatus&)> state_listener_;
 };
 
 }  // namespace rr::server::gateway

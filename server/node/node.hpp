@@ -71,6 +71,7 @@ public:
     std::shared_ptr<Service> find_service(std::string_view name) const override;
     std::uint32_t new_endpoint_id() override;
     void release_endpoint_id(std::uint32_t id) override;
+    std::shared_ptr<NodeStats> stats() const override { return stats_; }
 
     /// Connections currently open (accepted).
     std::size_t connection_count() const noexcept { return connections_->load(); }
@@ -92,6 +93,7 @@ private:
     std::mt19937 rng_;
     std::shared_ptr<std::atomic<std::size_t>> connections_ = std::make_shared<std::atomic<std::size_t>>(0);
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
+    std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
     void track(const std::shared_ptr<PumpHandle>& pump);
     std::atomic<bool> stopped_{false};
     friend class TcpListener;

@@ -15,6 +15,7 @@ public:
                             ServerConnectionConfig config, MonoTime now)
         : ServerConnection(node, std::move(config), now), counter_(std::move(counter)) {
         counter_->fetch_add(1);
+        node->stats()->connections_total.fetch_add(1, std::memory_order_relaxed);
     }
     ~CountedServerConnection() override { counter_->fetch_sub(1); }
 

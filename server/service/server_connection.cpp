@@ -178,7 +178,8 @@ Result<void> ServerSession::send_wire_packet(MessageEntry entry) {
         post = inserted;  // an older packet not yet sent is replaced: wires keep only the newest value
     }
     if (post) {
-        pump->post([conn = connection_, key] {
+        // dispatch, as send(): from the session's own strand the packet goes out before the reply.
+        pump->dispatch([conn = connection_, key] {
             if (auto c = conn.lock()) c->send_wire_entry(key);
         });
     }
@@ -203,7 +204,8 @@ void ServerSession::request(MessageEntry entry, std::function<void(Result<Messag
 // ServerConnection
 
 ServerConnection::ServerConnection(const std::shared_ptr<NodeServices>& node, ServerConnectionConfig config, MonoTime now)
-    : node_(node), node_id_(node->node_id()), node_name_(node->node_name()), config_(std::move(config)),
+    : node_(node), stats_(node->stats()), node_id_(node->node_id()), node_name_(node->node_name()),
+      config_(std::move(config)),
       stream_(StreamRole::server, [&] {
           StreamConfig s = config_.stream;
           s.local_node_id = node_id_;
@@ -224,6 +226,7 @@ std::shared_ptr<Service> ServerConnection::find_service(std::string_view name) c
 }
 
 void ServerConnection::on_bytes(std::span<const std::byte> bytes, MonoTime now) {
+    stats_->bytes_in.fetch_add(bytes.size(), std::memory_order_relaxed);
     (void)stream_.feed(bytes, now);  // errors close the stream; the Closed event follows
     drain_events(now);
 }
@@ -241,6 +244,7 @@ void ServerConnection::drain_events(MonoTime now) {
 
 void ServerConnection::take_output(std::vector<std::byte>& out) {
     stream_.take_output(out);
+    stats_->bytes_out.fetch_add(out.size(), std::memory_order_relaxed);
     update_queue_estimate();
     flush_held_wires();
 }
@@ -288,6 +292,7 @@ void ServerConnection::update_queue_estimate() {
 }
 
 Message ServerConnection::session_message(MessageEntry entry) {
+    stats_->messages_out.fetch_add(1, std::memory_order_relaxed);
     Message m;
     m.version = 2;
     m.header.sender_node_id = node_id_;
@@ -392,6 +397,7 @@ Responder ServerConnection::make_responder(const MessageEntry& request) {
 }
 
 void ServerConnection::on_message(Message&& m, MonoTime now) {
+    stats_->messages_in.fetch_add(1, std::memory_order_relaxed);
     for (auto& e : m.entries) {
         if (stream_.is_closed()) return;
         const auto type = e.entry_type;

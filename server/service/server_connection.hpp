@@ -19,6 +19,11 @@
 
 namespace rr::server {
 
+/// Node-wide traffic counters (for /metrics).
+struct NodeStats {
+    std::atomic<std::uint64_t> connections_total{0}, messages_in{0}, messages_out{0}, bytes_in{0}, bytes_out{0};
+};
+
 /// What a connection needs from its node. Implemented by Node; thread-safe.
 class NodeServices {
 public:
@@ -29,6 +34,7 @@ public:
     /// A fresh, non-zero endpoint id unused in this node.
     virtual std::uint32_t new_endpoint_id() = 0;
     virtual void release_endpoint_id(std::uint32_t id) = 0;
+    virtual std::shared_ptr<NodeStats> stats() const = 0;
 };
 
 /// Per-connection settings.
@@ -118,6 +124,7 @@ private:
     void flush_held_wires();
 
     std::weak_ptr<NodeServices> node_;  // weak: connections live inside the node's io_context
+    std::shared_ptr<NodeStats> stats_;  // shared with the node, outlives it if need be
     NodeID node_id_;
     std::string node_name_;
     ServerConnectionConfig config_;

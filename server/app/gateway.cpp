@@ -1,0 +1,200 @@
+#include "server/app/gateway.hpp"
+
+#include <sstream>
+
+#include "server/app/log.hpp"
+
+namespace rr::server::app {
+
+namespace bhttp = boost::beast::http;
+
+namespace {
+
+std::string escape_label(std::string_view v) {
+    std::string out;
+    for (char c : v) {
+        if (c == '\\' || c == '"') out += '\\';
+        if (c == '\n') {
+            out += "\\n";
+            continue;
+        }
+        out += c;
+    }
+    return out;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarter demo, ApiInstaller api) {
+    std::unique_ptr<Gateway> g(new Gateway());
+    g->config_ = std::move(config);
+    const auto& c = g->config_;
+
+    NodeOptions opts;
+    if (!c.node_id.empty()) opts.node_id = *NodeID::parse(c.node_id);
+    opts.node_name = c.node_name;
+    opts.threads = c.threads;
+    opts.server.stream.limits.max_message_size = c.max_message_size;
+    opts.server.stream.heartbeat_period = std::chrono::milliseconds(12000);  // a server's period (wire.md §6.3)
+    g->node_ = Node::create(opts);
+
+    std::vector<gateway::DeviceConfig> devices = c.devices;
+    if (c.demo) {
+        if (!demo) return fail(MessageErrorType::InvalidConfiguration, "demo devices are not built into this binary");
+        NodeOptions dopts;
+        dopts.node_name = c.node_name + ".demo";
+        dopts.threads = 2;
+        g->demo_node_ = Node::create(dopts);
+        auto port = g->demo_node_->listen_tcp("127.0.0.1", c.demo_port);
+        if (!port) return port.take_error();
+        auto demo_devices = demo(g->demo_node_, *port);
+        if (!demo_devices) return demo_devices.take_error();
+        for (auto& d : *demo_devices) {
+            // A configured device of the same name wins over the demo one.
+            bool taken = false;
+            for (const auto& x : devices) taken |= x.name == d.name;
+            if (!taken) devices.push_back(std::move(d));
+        }
+    }
+
+    for (const auto& d : devices) {
+        auto m = gateway::DeviceMirror::create(g->node_, d);
+        if (!m) return m.take_error();
+        g->devices_.push_back(*m);
+    }
+
+    http::HttpOptions hopts;
+    hopts.allowed_origins = c.allowed_origins;
+    if (hopts.allowed_origins.empty()) {
+        // Default: the gateway's own pages on this machine.
+        for (const char* host : {"localhost", "127.0.0.1", "[::1]"})
+            hopts.allowed_origins.push_back(std::string("http://") + host + ":" + std::to_string(c.port));
+    }
+    hopts.static_root = c.web_root;
+    g->http_ = std::make_shared<http::HttpServer>(g->node_, hopts);
+    Gateway* self = g.get();
+    g->http_->add_route(bhttp::verb::get, "/livez", [](const http::Request& req, http::Responder respond) {
+        respond(http::make_response(req, bhttp::status::ok, "ok\n"));
+    });
+    g->http_->add_route(bhttp::verb::get, "/readyz", [self](const http::Request& req, http::Responder respond) {
+        std::string body;
+        for (const auto& d : self->devices_) {
+            auto s = d->status();
+            if (s.required && s.state != gateway::DeviceState::connected)
+                body += s.name + ": " + std::string(gateway::device_state_name(s.state)) +
+                        (s.reason.empty() ? "" : " (" + s.reason + ")") + "\n";
+        }
+        const bool ready = body.empty();
+        respond(http::make_response(req, ready ? bhttp::status::ok : bhttp::status::service_unavailable,
+                                    ready ? "ready\n" : "not ready:\n" + body));
+    });
+    g->http_->add_route(bhttp::verb::get, "/metrics", [self](const http::Request& req, http::Responder respond) {
+        respond(http::make_response(req, bhttp::status::ok, self->metrics_text(), "text/plain; version=0.0.4; charset=utf-8"));
+    });
+    if (api) api(*g->http_, g->devices_);
+    g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial) {
+        h->handle(std::move(s), std::move(initial));
+    });
+
+    for (auto& d : g->devices_) {
+        d->set_state_listener([](const gateway::DeviceStatus& s) {
+            log(s.state == gateway::DeviceState::connected ? LogLevel::info : LogLevel::warning,
+                "device " + s.name + ": " + std::string(gateway::device_state_name(s.state)) +
+                    (s.reason.empty() ? "" : " (" + s.reason + ")"));
+        });
+        d->start();
+    }
+
+    auto port = g->node_->listen_tcp(c.listen, c.port);
+    if (!port) return port.take_error();
+    g->port_ = *port;
+    return g;
+}
+
+Gateway::~Gateway() { stop(); }
+
+void Gateway::stop() {
+    for (auto& d : devices_) d->stop();
+    if (node_) node_->shutdown();
+    if (demo_node_) demo_node_->shutdown();
+}
+
+std::shared_ptr<gateway::DeviceMirror> Gateway::device(std::string_view name) const {
+    for (const auto& d : devices_)
+        if (d->config().name == name) return d;
+    return nullptr;
+}
+
+bool Gateway::ready() const {
+    for (const auto& d : devices_) {
+        auto s = d->status();
+        if (s.required && s.state != gateway::DeviceState::connected) return false;
+    }
+    return true;
+}
+
+std::string Gateway::metrics_text() const {
+    std::ostringstream o;
+    auto stats = node_->stats();
+    o << "# HELP rr_gateway_connections Open RR connections (TCP and WebSocket) to the gateway.\n"
+         "# TYPE rr_gateway_connections gauge\n"
+      << "rr_gateway_connections " << node_->connection_count() << "\n"
+      << "# HELP rr_gateway_connections_total RR connections accepted since start.\n"
+         "# TYPE rr_gateway_connections_total counter\n"
+      << "rr_gateway_connections_total " << stats->connections_total.load() << "\n"
+      << "# HELP rr_gateway_messages_total RR messages to and from clients.\n"
+         "# TYPE rr_gateway_messages_total counter\n"
+      << "rr_gateway_messages_total{direction=\"in\"} " << stats->messages_in.load() << "\n"
+      << "rr_gateway_messages_total{direction=\"out\"} " << stats->messages_out.load() << "\n"
+      << "# HELP rr_gateway_bytes_total Bytes to and from clients.\n"
+         "# TYPE rr_gateway_bytes_total counter\n"
+      << "rr_gateway_bytes_total{direction=\"in\"} " << stats->bytes_in.load() << "\n"
+      << "rr_gateway_bytes_total{direction=\"out\"} " << stats->bytes_out.load() << "\n";
+
+    o << "# HELP rr_gateway_device_up Device state: 1 when connected.\n# TYPE rr_gateway_device_up gauge\n";
+    for (const auto& d : devices_) {
+        auto s = d->status();
+        o << "rr_gateway_device_up{device=\"" << escape_label(s.name) << "\",state=\""
+          << gateway::device_state_name(s.state) << "\"} " << (s.state == gateway::DeviceState::connected ? 1 : 0)
+          << "\n";
+    }
+    auto counter = [&](const char* name, const char* help, auto field) {
+        o << "# HELP " << name << " " << help << "\n# TYPE " << name << " counter\n";
+        for (const auto& d : devices_)
+            o << name << "{device=\"" << escape_label(d->config().name) << "\"} " << field(d->counters()) << "\n";
+    };
+    counter("rr_gateway_device_requests_total", "Requests forwarded to the device.",
+            [](const gateway::DeviceCounters& c) { return c.requests.load(); });
+    counter("rr_gateway_device_request_errors_total", "Requests answered with an error.",
+            [](const gateway::DeviceCounters& c) { return c.request_errors.load(); });
+    counter("rr_gateway_device_events_total", "Events received from the device.",
+            [](const gateway::DeviceCounters& c) { return c.events.load(); });
+    counter("rr_gateway_device_wire_packets_total", "Wire values received from the device.",
+            [](const gateway::DeviceCounters& c) { return c.wire_packets_in.load(); });
+    counter("rr_gateway_device_pipe_packets_total", "Pipe packets forwarded.",
+            [](const gateway::DeviceCounters& c) { return c.pipe_packets.load(); });
+    counter("rr_gateway_device_drops_total", "Pipe packets and events a client could not take (queue full).",
+            [](const gateway::DeviceCounters& c) { return c.pipe_drops.load() + c.event_drops.load(); });
+    counter("rr_gateway_device_reconnects_total", "Times the device connection was lost.",
+            [](const gateway::DeviceCounters& c) { return c.reconnects.load(); });
+
+    o << "# HELP rr_gateway_request_duration_seconds Device request round trip through the gateway.\n"
+         "# TYPE rr_gateway_request_duration_seconds histogram\n";
+    for (const auto& d : devices_) {
+        const auto& c = d->counters();
+        const std::string label = "device=\"" + escape_label(d->config().name) + "\"";
+        std::uint64_t cumulative = 0;
+        for (std::size_t i = 0; i < std::size(gateway::kLatencyBuckets); ++i) {
+            cumulative += c.latency_buckets[i].load();
+            o << "rr_gateway_request_duration_seconds_bucket{" << label << ",le=\"" << gateway::kLatencyBuckets[i]
+              << "\"} " << cumulative << "\n";
+        }
+        cumulative += c.latency_buckets[std::size(gateway::kLatencyBuckets)].load();
+        o << "rr_gateway_request_duration_seconds_bucket{" << label << ",le=\"+Inf\"} " << cumulative << "\n";
+        o << "rr_gateway_request_duration_seconds_sum{" << label << "} " << (c.latency_sum_us.load() / 1e6) << "\n";
+        o << "rr_gateway_request_duration_seconds_count{" << label << "} " << cumulative << "\n";
+    }
+    return o.str();
+}
+
+}  // namespace rr::server::app

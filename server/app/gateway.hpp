@@ -1,0 +1,52 @@
+// The assembled gateway: the gateway node (RR + HTTP + WebSocket on one port), one DeviceMirror per
+// configured device, the embedded demo devices on their own node (reached over rr+tcp on loopback, so
+// the default path is the real path), health endpoints and the JSON API.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "server/app/gateway_config.hpp"
+#include "server/gateway/device_mirror.hpp"
+#include "server/http/http_server.hpp"
+#include "server/node/node.hpp"
+
+namespace rr::server::app {
+
+/// Starts demo devices on `demo_node` (already listening on `port`) and returns how to reach them.
+using DemoStarter = std::function<Result<std::vector<gateway::DeviceConfig>>(const std::shared_ptr<Node>& demo_node,
+                                                                             std::uint16_t port)>;
+/// Adds routes and subprotocols (the JSON API) once the devices exist.
+using ApiInstaller = std::function<void(http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices)>;
+
+class Gateway {
+public:
+    /// Starts everything or nothing. Errors: InvalidConfiguration, IOError (port in use, …).
+    static Result<std::unique_ptr<Gateway>> start(GatewayConfig config, DemoStarter demo = {}, ApiInstaller api = {});
+    ~Gateway();
+    void stop();
+
+    std::uint16_t port() const noexcept { return port_; }
+    const GatewayConfig& config() const noexcept { return config_; }
+    const std::shared_ptr<Node>& node() const noexcept { return node_; }
+    const std::shared_ptr<Node>& demo_node() const noexcept { return demo_node_; }
+    const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices() const noexcept { return devices_; }
+    std::shared_ptr<gateway::DeviceMirror> device(std::string_view name) const;
+
+    /// Ready when every required device is connected (/readyz).
+    bool ready() const;
+    /// Prometheus text exposition of the gateway's counters (/metrics).
+    std::string metrics_text() const;
+
+private:
+    Gateway() = default;
+    GatewayConfig config_;
+    std::shared_ptr<Node> node_;
+    std::shared_ptr<Node> demo_node_;
+    std::shared_ptr<http::HttpServer> http_;
+    std::vector<std::shared_ptr<gateway::DeviceMirror>> devices_;
+    std::uint16_t port_ = 0;
+};
+
+}  // namespace rr::server::app
