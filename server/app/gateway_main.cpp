@@ -1,0 +1,67 @@
+// rr-gateway: Robot Raconteur devices re-exposed over WebSocket and HTTP.
+// Usage: rr-gateway [--config FILE] [options]   (see --help and docs/gateway-config.md)
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <thread>
+
+#include "server/app/gateway.hpp"
+#include "server/app/gateway_extensions.hpp"
+#include "server/app/log.hpp"
+
+using namespace rr;
+using namespace rr::server::app;
+
+namespace {
+std::atomic<bool> g_stop{false};  // lock-free: safe to set from a signal handler
+void on_signal(int) { g_stop.store(true); }
+}  // namespace
+
+int main(int argc, char** argv) {
+    auto cmd = parse_command_line(argc, argv);
+    if (!cmd) {
+        std::cerr << "rr-gateway: " << cmd.error().message << "\n";
+        return 2;
+    }
+    if (cmd->help) {
+        std::cout << usage_text();
+        return 0;
+    }
+    GatewayConfig config;
+    if (cmd->config_file) {
+        auto loaded = load_gateway_config(*cmd->config_file);
+        if (!loaded) {
+            std::cerr << "rr-gateway: configuration error: " << loaded.error().message << "\n";
+            return 2;
+        }
+        config = std::move(*loaded);
+    }
+    if (auto r = apply_overrides(config, *cmd); !r) {
+        std::cerr << "rr-gateway: configuration error: " << r.error().message << "\n";
+        return 2;
+    }
+    if (config.web_root.empty()) config.web_root = default_web_root(argv[0]);
+    if (cmd->check_only) {
+        std::cout << "configuration ok: " << config.devices.size() << " device(s)" << (config.demo ? " + demo devices" : "")
+                  << ", port " << config.port << "\n";
+        return 0;
+    }
+    set_log_level(log_level_from_string(config.log_level));
+
+    auto gateway = Gateway::start(config, demo_starter(), api_installer());
+    if (!gateway) {
+        std::cerr << "rr-gateway: " << gateway.error().message << "\n";
+        return 1;
+    }
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    log(LogLevel::info, "rr-gateway listening on port " + std::to_string((*gateway)->port()) +
+                            " (RR rr+tcp and rr+ws, HTTP; dashboard http://localhost:" +
+                            std::to_string((*gateway)->port()) + "/)");
+    std::cout << "{\"port\": " << (*gateway)->port() << "}" << std::endl;
+    while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    log(LogLevel::info, "shutting down");
+    (*gateway)->stop();
+    return 0;
+}
