@@ -124,13 +124,28 @@ void DeviceMirror::set_state_listener(std::function<void(const DeviceStatus&)> l
     state_listener_ = std::move(listener);
 }
 
+std::uint64_t DeviceMirror::add_state_listener(std::function<void(const DeviceStatus&)> listener) {
+    std::lock_guard lock(mutex_);
+    const auto id = next_listener_id_++;
+    extra_listeners_.emplace(id, std::move(listener));
+    return id;
+}
+
+void DeviceMirror::remove_state_listener(std::uint64_t id) {
+    std::lock_guard lock(mutex_);
+    extra_listeners_.erase(id);
+}
+
 void DeviceMirror::notify_state() {
-    std::function<void(const DeviceStatus&)> listener;
+    std::vector<std::function<void(const DeviceStatus&)>> listeners;
     {
         std::lock_guard lock(mutex_);
-        listener = state_listener_;
+        if (state_listener_) listeners.push_back(state_listener_);
+        for (const auto& [id, l] : extra_listeners_) listeners.push_back(l);
     }
-    if (listener) listener(status());
+    if (listeners.empty()) return;
+    const auto s = status();
+    for (const auto& l : listeners) l(s);
 }
 
 void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {

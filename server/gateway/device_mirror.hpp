@@ -100,6 +100,13 @@ public:
 
     /// Called (from any thread, without locks held) whenever the state changes; for logs and pushes.
     void set_state_listener(std::function<void(const DeviceStatus&)> listener);
+    /// More listeners beside that one (the JSON API's pushes); same calling rules. Returns an id for
+    /// remove_state_listener.
+    std::uint64_t add_state_listener(std::function<void(const DeviceStatus&)> listener);
+    void remove_state_listener(std::uint64_t id);
+
+    /// The downstream half (for the JSON API's gateway-internal pipe endpoints).
+    const std::shared_ptr<MirrorService>& mirror_service() const noexcept { return service_; }
 
 private:
     DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url);
@@ -132,6 +139,8 @@ private:
     bool registered_ = false;
     std::uint64_t generation_ = 0;  // bumps on every (re)connect, so stale callbacks are ignored
     std::function<void(const DeviceStatus&)> state_listener_;
+    std::map<std::uint64_t, std::function<void(const DeviceStatus&)>> extra_listeners_;
+    std::uint64_t next_listener_id_ = 1;
 };
 
 }  // namespace rr::server::gateway

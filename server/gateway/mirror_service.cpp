@@ -421,6 +421,7 @@ void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageE
 }
 
 void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
+    if (internal_pipe_packets(entry)) return;
     const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
     std::string path = to_downstream(entry.service_path);
     // Regroup the elements per owning client session.
@@ -543,14 +544,17 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
         case MessageEntryType::WireClosed: {
             entry.service_path = to_downstream(entry.service_path);
             std::vector<SessionRef> sessions;
+            std::vector<InternalSub> internal;
             {
                 std::lock_guard lock(mutex_);
                 auto it = wires_.find({entry.service_path, entry.member_name});
                 if (it == wires_.end()) return;
                 sessions = std::move(it->second.sessions);
+                internal = std::move(it->second.internal);
                 wires_.erase(it);
             }
             for (const auto& s : sessions) (void)s.send(entry);
+            for (const auto& i : internal) i.on_entry(entry);  // internal subscribers see the WireClosed too
             return;
         }
         case MessageEntryType::PipePacket:
@@ -559,6 +563,21 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
             std::string path = to_downstream(entry.service_path);
             const std::int32_t u = element_index(entry);
             std::optional<PipeLink> link;
+            std::shared_ptr<const InternalPipeHandlers> internal;
+            {
+                std::lock_guard lock(mutex_);
+                if (auto it = internal_pipes_by_upstream_.find({path, entry.member_name, u});
+                    it != internal_pipes_by_upstream_.end()) {
+                    internal = internal_pipes_.at(it->second).handlers;
+                    internal_pipes_.erase(it->second);
+                    internal_pipes_by_upstream_.erase(it);
+                }
+            }
+            if (internal) {
+                if (internal->on_closed)
+                    internal->on_closed(make_error(MessageErrorType::ConnectionError, "pipe endpoint closed by the device"));
+                return;
+            }
             {
                 std::lock_guard lock(mutex_);
                 auto it = pipes_by_upstream_.find({path, entry.member_name, u});
@@ -595,8 +614,13 @@ void MirrorService::on_upstream_lost(const RRError& error) {
     // to be re-subscribed when the device returns. Generators are gone with the session.
     std::vector<std::pair<SessionRef, MessageEntry>> closed;
     std::vector<std::function<void(Result<void>)>> waiting;
+    std::vector<std::shared_ptr<const InternalPipeHandlers>> internal_closed;
     {
         std::lock_guard lock(mutex_);
+        for (auto& [id, p] : internal_pipes_)
+            if (p.connected) internal_closed.push_back(p.handlers);
+        internal_pipes_.clear();  // a connect still in flight fails with the connection
+        internal_pipes_by_upstream_.clear();
         for (auto& [key, link] : pipes_by_upstream_) {
             MessageEntry e;
             e.entry_type = MessageEntryType::PipeClosed;
@@ -618,6 +642,8 @@ void MirrorService::on_upstream_lost(const RRError& error) {
     for (auto& [s, e] : closed) (void)s.send(std::move(e));
     for (auto& w : waiting)
         if (w) w(fail(not_connected(name_)));
+    for (auto& h : internal_closed)
+        if (h->on_closed) h->on_closed(not_connected(name_));
     (void)error;
 }
 
@@ -661,9 +687,12 @@ void MirrorService::remove_internal_subscriber(std::uint64_t id) {
         for (auto& [key, subs] : event_subscribers_) std::erase_if(subs, [&](const InternalSub& s) { return s.id == id; });
         for (auto it = wires_.begin(); it != wires_.end();) {
             std::erase_if(it->second.internal, [&](const InternalSub& s) { return s.id == id; });
-            if (it->second.internal.empty() && it->second.sessions.empty() && it->second.upstream_connected) {
+            const bool unused = it->second.internal.empty() && it->second.sessions.empty();
+            if (unused && it->second.upstream_connected) {
                 disconnect.push_back(it->first);
                 it = wires_.erase(it);
+            } else if (unused && !it->second.connecting && it->second.waiting.empty()) {
+                it = wires_.erase(it);  // never connected upstream (refused, or the device was away)
             } else {
                 ++it;
             }
@@ -677,6 +706,201 @@ void MirrorService::remove_internal_subscriber(std::uint64_t id) {
             e.member_name = key.second;
             c->request(std::move(e), [](Result<MessageEntry>) {});
         }
+    }
+}
+
+// --- gateway-internal pipe endpoints (JSON API) ---------------------------------------------------
+
+bool MirrorService::internal_pipe_packets(MessageEntry& entry) {
+    const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
+    const std::string path = to_downstream(entry.service_path);
+    struct Delivery {
+        std::shared_ptr<const InternalPipeHandlers> handlers;
+        MessageElement packet;
+        std::uint32_t number = 0;
+    };
+    std::vector<Delivery> deliveries;
+    MessageEntry ack_entry;
+    {
+        std::lock_guard lock(mutex_);
+        if (internal_pipes_by_upstream_.empty()) return entry.elements.empty();
+        std::vector<MessageElement> rest;
+        for (auto& el : entry.elements) {
+            // Packets name their pipe index; acks number it (wire.md §6.7).
+            std::optional<std::int32_t> u = acks ? el.number : parse_index(el.name);
+            auto it = u ? internal_pipes_by_upstream_.find({path, entry.member_name, *u}) : internal_pipes_by_upstream_.end();
+            if (it == internal_pipes_by_upstream_.end()) {
+                rest.push_back(std::move(el));
+                continue;
+            }
+            const auto& handlers = internal_pipes_.at(it->second).handlers;
+            std::uint32_t number = 0;
+            if (acks) {
+                if (read_scalar(el, number)) deliveries.push_back(Delivery{handlers, MessageElement{}, number});
+                continue;
+            }
+            const MessageElement* pn = el.find("packetnumber");
+            if (!pn || !read_scalar(*pn, number)) continue;
+            MessageElement* packet = nullptr;
+            for (auto& child : el.elements)
+                if (!child.number && child.name == "packet") packet = &child;
+            if (!packet) continue;
+            if (el.find("requestack")) {
+                MessageElement ack = make_scalar_element<std::uint32_t>("", number);
+                ack.number = *u;
+                ack_entry.elements.push_back(std::move(ack));
+            }
+            deliveries.push_back(Delivery{handlers, std::move(*packet), number});
+        }
+        entry.elements = std::move(rest);
+    }
+    if (!ack_entry.elements.empty()) {
+        if (auto c = client()) {
+            ack_entry.entry_type = MessageEntryType::PipePacketRet;
+            ack_entry.service_path = entry.service_path;  // still the device's path here
+            ack_entry.member_name = entry.member_name;
+            c->send(std::move(ack_entry));
+        }
+    }
+    for (auto& d : deliveries) {
+        if (acks) {
+            if (d.handlers->on_ack) d.handlers->on_ack(d.number);
+        } else if (d.handlers->on_packet) {
+            d.handlers->on_packet(d.packet, d.number);
+        }
+    }
+    return entry.elements.empty();
+}
+
+void MirrorService::open_internal_pipe(std::string path, std::string member, bool unreliable,
+                                       InternalPipeHandlers handlers, std::function<void(Result<std::uint64_t>)> done) {
+    auto c = client();
+    if (!c) {
+        done(fail(not_connected(name_)));
+        return;
+    }
+    std::uint64_t id;
+    {
+        std::lock_guard lock(mutex_);
+        id = next_internal_id_++;
+        InternalPipe p;
+        p.path = path;
+        p.member = member;
+        p.unreliable = unreliable;
+        p.handlers = std::make_shared<const InternalPipeHandlers>(std::move(handlers));
+        internal_pipes_.emplace(id, std::move(p));
+    }
+    MessageEntry e;
+    e.entry_type = MessageEntryType::PipeConnectReq;
+    e.service_path = to_upstream(path);
+    e.member_name = member;
+    e.elements.push_back(make_scalar_element<std::int32_t>("index", -1));
+    if (unreliable) e.elements.push_back(make_scalar_element<std::int32_t>("unreliable", 1));
+    auto self = shared_from_this();
+    c->request(std::move(e), [self, id, path, member, done = std::move(done)](Result<MessageEntry> r) {
+        std::optional<RRError> error;
+        std::int32_t u = -1;
+        bool reply_unreliable = false;
+        if (!r) {
+            error = r.error();
+        } else if (auto err = entry_error(*r)) {
+            error = *err;
+        } else {
+            u = element_index(*r);
+            std::int32_t flag = 0;
+            reply_unreliable = r->find("unreliable") && read_scalar(*r->find("unreliable"), flag) && flag == 1;
+            if (u < 0) error = make_error(MessageErrorType::ProtocolError, "PipeConnectRet without an index");
+        }
+        bool orphan = false;
+        {
+            std::lock_guard lock(self->mutex_);
+            auto it = self->internal_pipes_.find(id);
+            if (it == self->internal_pipes_.end()) {
+                orphan = true;  // closed (or the device lost) while connecting
+            } else if (error) {
+                self->internal_pipes_.erase(it);
+            } else {
+                it->second.connected = true;
+                it->second.upstream_index = u;
+                it->second.unreliable = reply_unreliable;
+                self->internal_pipes_by_upstream_[{path, member, u}] = id;
+            }
+        }
+        if (error) {
+            done(fail(*error));
+            return;
+        }
+        if (orphan) {
+            if (auto c = self->client()) {
+                MessageEntry d;
+                d.entry_type = MessageEntryType::PipeDisconnectReq;
+                d.service_path = self->to_upstream(path);
+                d.member_name = member;
+                d.elements.push_back(make_scalar_element<std::int32_t>("index", u));
+                c->request(std::move(d), [](Result<MessageEntry>) {});
+            }
+            done(fail(MessageErrorType::OperationAborted, "pipe endpoint closed while connecting"));
+            return;
+        }
+        done(id);
+    });
+}
+
+Result<std::uint32_t> MirrorService::send_internal_pipe_packet(std::uint64_t id, MessageElement packet, bool request_ack) {
+    auto c = client();
+    if (!c) return fail(not_connected(name_));
+    // The same bound as a service's pipe backlog: a device that does not read gets no more packets.
+    constexpr std::size_t kMaxBacklogBytes = 8u << 20;
+    if (c->queued_bytes() > kMaxBacklogBytes)
+        return fail(MessageErrorType::BufferLimitViolation, "device connection backlog full");
+    MessageEntry e;
+    std::uint32_t number;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = internal_pipes_.find(id);
+        if (it == internal_pipes_.end() || !it->second.connected)
+            return fail(MessageErrorType::InvalidArgument, "pipe endpoint not open");
+        auto& p = it->second;
+        number = p.send_number == UINT32_MAX ? 0 : p.send_number + 1;
+        p.send_number = number;
+        e.entry_type = MessageEntryType::PipePacket;
+        e.service_path = to_upstream(p.path);
+        e.member_name = p.member;
+        if (p.unreliable) e.metadata = "unreliable\n";
+        MessageElement d;
+        d.name = std::to_string(p.upstream_index);  // a name, also in v4 (wire.md §6.7)
+        d.type = DataTypes::dictionary_t;
+        d.elements.push_back(make_scalar_element<std::uint32_t>("packetnumber", number));
+        packet.name = "packet";
+        packet.number.reset();
+        d.elements.push_back(std::move(packet));
+        if (request_ack) d.elements.push_back(make_scalar_element<std::uint32_t>("requestack", 1));
+        e.elements.push_back(std::move(d));
+        // Sent under the lock: packet numbers reach the device in order.
+        c->send(std::move(e));
+    }
+    if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
+    return number;
+}
+
+void MirrorService::close_internal_pipe(std::uint64_t id) {
+    std::optional<InternalPipe> p;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = internal_pipes_.find(id);
+        if (it == internal_pipes_.end()) return;
+        p = std::move(it->second);
+        internal_pipes_.erase(it);
+        if (p->connected) internal_pipes_by_upstream_.erase({p->path, p->member, p->upstream_index});
+    }
+    if (!p->connected) return;  // the connect reply disconnects it
+    if (auto c = client()) {
+        MessageEntry d;
+        d.entry_type = MessageEntryType::PipeDisconnectReq;
+        d.service_path = to_upstream(p->path);
+        d.member_name = p->member;
+        d.elements.push_back(make_scalar_element<std::int32_t>("index", p->upstream_index));
+        c->request(std::move(d), [](Result<MessageEntry>) {});
     }
 }
 

@@ -35,11 +35,33 @@ public:
     void on_upstream_lost(const RRError& error);
     std::size_t session_count() const;
 
-    /// Gateway-internal subscribers (JSON API), keyed by id.
+    /// Gateway-internal subscribers (JSON API), keyed by id. A wire subscriber's `on_entry` gets the
+    /// WirePackets and, when the device closes the wire, its WireClosed (the subscription is gone then).
     std::uint64_t add_internal_subscriber(std::string path, std::string member, bool is_wire,
                                           std::function<void(const MessageEntry&)> on_entry,
                                           std::function<void(Result<void>)> done);
     void remove_internal_subscriber(std::uint64_t id);
+
+    /// What a gateway-internal pipe endpoint (JSON API) hears. Called on the upstream strand, without
+    /// locks held. `on_packet` gets the packet's `packet` element and its packet number (acks for
+    /// packets sent with `requestack` are sent by the service itself); `on_ack` the packet number the
+    /// device acknowledged; `on_closed` once, when the device closes the endpoint (PipeClosed) or the
+    /// device connection is lost — not after close_internal_pipe().
+    struct InternalPipeHandlers {
+        std::function<void(const MessageElement& packet, std::uint32_t packet_number)> on_packet;
+        std::function<void(std::uint32_t packet_number)> on_ack;
+        std::function<void(const RRError& reason)> on_closed;
+    };
+    /// Connects a pipe endpoint of the gateway itself (PipeConnectReq with index −1 upstream: the device
+    /// chooses). `done` gets an id for the calls below, or the device's error (ConnectionError when it is
+    /// not connected).
+    void open_internal_pipe(std::string path, std::string member, bool unreliable, InternalPipeHandlers handlers,
+                            std::function<void(Result<std::uint64_t>)> done);
+    /// Sends `packet` (an element named "packet", packed for the pipe's type) on the endpoint; returns its
+    /// packet number (1, 2, …). Errors: InvalidArgument (unknown or closed id), ConnectionError.
+    Result<std::uint32_t> send_internal_pipe_packet(std::uint64_t id, MessageElement packet, bool request_ack);
+    /// Disconnects the endpoint (PipeDisconnectReq upstream); no handler is called afterwards.
+    void close_internal_pipe(std::uint64_t id);
 
     std::string to_upstream(std::string_view path) const;
     std::string to_downstream(std::string_view path) const;
@@ -90,6 +112,17 @@ private:
     std::map<std::tuple<std::string, std::string, std::int32_t>, PipeLink> pipes_by_upstream_;
     std::map<std::tuple<std::uint32_t, std::string, std::string, std::int32_t>, std::int32_t> pipes_by_downstream_;
     std::set<std::pair<std::uint32_t, std::int32_t>> generators_;  // (endpoint, generator index)
+    struct InternalPipe {
+        std::string path, member;
+        bool unreliable = false;
+        bool connected = false;  // PipeConnectRet received
+        std::int32_t upstream_index = -1;
+        std::uint32_t send_number = 0;  // last packet number sent
+        std::shared_ptr<const InternalPipeHandlers> handlers;
+    };
+    std::map<std::uint64_t, InternalPipe> internal_pipes_;
+    std::map<std::tuple<std::string, std::string, std::int32_t>, std::uint64_t> internal_pipes_by_upstream_;
+    bool internal_pipe_packets(MessageEntry& entry);
     std::uint64_t next_internal_id_ = 1;
 };
 

@@ -1,5 +1,6 @@
 #include "server/http/http_server.hpp"
 
+#include <atomic>
 #include <deque>
 #include <fstream>
 #include <sstream>
@@ -90,16 +91,28 @@ public:
 
     void send(std::string text) override {
         auto self = shared_from_this();
+        queued_count_.fetch_add(1);
+        queued_bytes_.fetch_add(text.size());
         asio::post(ws_.get_executor(), [self, text = std::move(text)]() mutable {
-            if (self->closed_) return;
-            if (self->queue_.size() >= self->limit_) {
-                self->queue_.pop_front();  // slow reader: oldest dropped, counted
-                ++self->dropped_;
+            if (self->closed_) {
+                self->unqueue(text);
+                return;
+            }
+            // Slow reader: the oldest message not being written is dropped, and counted.
+            if (self->queue_.size() >= self->limit_ && self->queue_.size() > (self->writing_ ? 1u : 0u)) {
+                auto victim = self->writing_ ? std::next(self->queue_.begin()) : self->queue_.begin();
+                self->unqueue(*victim);
+                self->queue_.erase(victim);
+                self->dropped_.fetch_add(1);
             }
             self->queue_.push_back(std::move(text));
             self->write();
         });
     }
+
+    std::size_t queued() const override { return queued_count_.load(); }
+    std::size_t queued_bytes() const override { return queued_bytes_.load(); }
+    std::uint64_t dropped() const override { return dropped_.load(); }
 
     void close() override {
         auto self = shared_from_this();
@@ -135,18 +148,32 @@ private:
             self->writing_ = false;
             if (ec) {
                 self->finish();
+                while (!self->queue_.empty()) {  // the message whose write just ended, if finish() kept it
+                    self->unqueue(self->queue_.front());
+                    self->queue_.pop_front();
+                }
                 return;
             }
+            self->unqueue(self->queue_.front());
             self->queue_.pop_front();
             self->write();
         });
+    }
+
+    void unqueue(const std::string& text) {
+        queued_count_.fetch_sub(1);
+        queued_bytes_.fetch_sub(text.size());
     }
 
     void finish() {
         if (finished_) return;
         finished_ = true;
         closed_ = true;
-        queue_.clear();
+        // A write in flight still reads the front message: it is released when that write completes.
+        while (queue_.size() > (writing_ ? 1u : 0u)) {
+            unqueue(queue_.back());
+            queue_.pop_back();
+        }
         if (handler_->on_close) handler_->on_close(shared_from_this());
     }
 
@@ -156,7 +183,8 @@ private:
     std::string peer_;
     beast::flat_buffer buffer_;
     std::deque<std::string> queue_;
-    std::size_t dropped_ = 0;
+    std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
+    std::atomic<std::uint64_t> dropped_{0};
     bool writing_ = false;
     bool closed_ = false;
     bool finished_ = false;

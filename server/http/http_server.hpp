@@ -9,6 +9,7 @@
 // `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -40,6 +41,12 @@ public:
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
+    /// Text messages accepted by send() and not yet written (the one being written included), and
+    /// their bytes: for backpressure decisions by the handler. Thread-safe.
+    virtual std::size_t queued() const { return 0; }
+    virtual std::size_t queued_bytes() const { return 0; }
+    /// Messages dropped because the queue was full (HttpOptions::json_socket_queue_limit).
+    virtual std::uint64_t dropped() const { return 0; }
 };
 struct JsonSocketHandler {
     std::function<void(std::shared_ptr<JsonSocket>)> on_open;

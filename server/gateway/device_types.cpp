@@ -1,0 +1,44 @@
+#include "server/gateway/device_types.hpp"
+
+namespace rr::server::gateway {
+
+Result<std::shared_ptr<const DeviceTypes>> DeviceTypes::parse(std::vector<std::string> texts) {
+    std::shared_ptr<DeviceTypes> t(new DeviceTypes());
+    for (std::size_t i = 0; i < texts.size(); ++i) {
+        auto r = t->set_.add_text(texts[i], "device definition " + std::to_string(i + 1));
+        if (!r) return r.take_error();
+    }
+    t->texts_ = std::move(texts);
+    return std::shared_ptr<const DeviceTypes>(std::move(t));
+}
+
+std::optional<DeviceTypes::Object> DeviceTypes::find_object(std::string_view qualified_name) const {
+    const auto dot = qualified_name.rfind('.');
+    if (dot == std::string_view::npos) return std::nullopt;
+    const auto* svc = set_.find_service(qualified_name.substr(0, dot));
+    if (!svc) return std::nullopt;
+    const auto* entry = svc->find_entry(qualified_name.substr(dot + 1));
+    if (!entry || entry->kind != robdef::EntryKind::object) return std::nullopt;
+    return Object{svc, entry};
+}
+
+nlohmann::json member_summary(const robdef::ServiceEntryDefinition& object) {
+    auto members = nlohmann::json::array();
+    for (const auto& m : object.members) {
+        nlohmann::json j;
+        j["name"] = m.name;
+        j["kind"] = std::string(robdef::member_kind_keyword(m.kind));
+        if (m.kind == robdef::MemberKind::event)
+            j["type"] = nullptr;
+        else
+            j["type"] = m.type.to_string();
+        j["modifiers"] = m.modifiers;
+        auto params = nlohmann::json::array();
+        for (const auto& p : m.parameters) params.push_back({{"name", p.name}, {"type", p.to_string()}});
+        j["parameters"] = std::move(params);
+        members.push_back(std::move(j));
+    }
+    return members;
+}
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,47 @@
+// The robdef types of one device as the JSON API needs them: the device's service definition texts
+// parsed into one ServiceDefinitionSet, object types looked up by qualified name, and member summaries
+// for GET /api/devices/{name} (docs/json-api.md).
+//
+// Immutable once built; shared between threads through shared_ptr<const DeviceTypes>.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error/rr_error.hpp"
+#include "robdef/service_definition_set.hpp"
+
+namespace rr::server::gateway {
+
+class DeviceTypes {
+public:
+    /// Parses every text (the root object's definition first, as ConnectClientCombined gives them).
+    /// Errors: ServiceDefinitionError naming the file and line.
+    static Result<std::shared_ptr<const DeviceTypes>> parse(std::vector<std::string> texts);
+
+    const std::vector<std::string>& texts() const noexcept { return texts_; }
+    const robdef::ServiceDefinitionSet& set() const noexcept { return set_; }
+
+    struct Object {
+        const robdef::ServiceDefinition* service = nullptr;  ///< defines the object: context for unqualified names
+        const robdef::ServiceEntryDefinition* entry = nullptr;
+    };
+    /// The object type `svc.Name` (qualified), or nothing.
+    std::optional<Object> find_object(std::string_view qualified_name) const;
+
+private:
+    DeviceTypes() = default;
+    std::vector<std::string> texts_;
+    robdef::ServiceDefinitionSet set_;
+};
+
+/// `[{"name", "kind", "type", "modifiers", "parameters": [{"name", "type"}]}, …]` for the members of an
+/// object, in definition order. `type` is the robdef type text (a function's return type; null for
+/// events); `kind` the robdef keyword (property, function, event, objref, pipe, callback, wire, memory).
+nlohmann::json member_summary(const robdef::ServiceEntryDefinition& object);
+
+}  // namespace rr::server::gateway

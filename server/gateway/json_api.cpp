@@ -1,0 +1,372 @@
+#include "server/gateway/json_api.hpp"
+
+#include "core/json/value_json.hpp"
+#include "core/message/error_entry.hpp"
+#include "core/names/service_path.hpp"
+#include "core/session/elements.hpp"
+#include "core/value/pack_value.hpp"
+#include "core/value/timespec.hpp"
+
+namespace rr::server::gateway {
+
+namespace {
+
+bool is_name_char(char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+bool is_hex(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F'); }
+
+// An index already in RR's service-path encoding: letters, digits, `_`, and `%hh` escapes.
+bool is_encoded_index(std::string_view s) {
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        if (is_name_char(s[i])) continue;
+        if (s[i] == '%' && i + 2 < s.size() && is_hex(s[i + 1]) && is_hex(s[i + 2])) {
+            i += 2;
+            continue;
+        }
+        return false;
+    }
+    return true;
+}
+
+std::string_view kind_word(robdef::MemberKind k) { return robdef::member_kind_keyword(k); }
+
+}  // namespace
+
+Result<std::string> normalize_object_path(std::string_view rel) {
+    const std::string quoted = "object path \"" + std::string(rel) + "\"";
+    if (rel.empty()) return fail(MessageErrorType::InvalidArgument, quoted + " is empty");
+    std::string out;
+    std::size_t i = 0;
+    while (i < rel.size()) {
+        const std::size_t start = i;
+        while (i < rel.size() && is_name_char(rel[i])) ++i;
+        if (i == start)
+            return fail(MessageErrorType::InvalidArgument,
+                        quoted + ": expected a member name at offset " + std::to_string(start));
+        std::string segment(rel.substr(start, i - start));
+        if (i < rel.size() && rel[i] == '[') {
+            const auto close = rel.find(']', i + 1);
+            if (close == std::string_view::npos) return fail(MessageErrorType::InvalidArgument, quoted + ": '[' without ']'");
+            const auto index = rel.substr(i + 1, close - i - 1);
+            if (index.empty()) return fail(MessageErrorType::InvalidArgument, quoted + ": empty index");
+            segment += '[';
+            segment += is_encoded_index(index) ? std::string(index) : encode_service_path_index(index);
+            segment += ']';
+            i = close + 1;
+        }
+        if (!out.empty()) out += '.';
+        out += segment;
+        if (i < rel.size()) {
+            if (rel[i] != '.')
+                return fail(MessageErrorType::InvalidArgument,
+                            quoted + ": unexpected '" + std::string(1, rel[i]) + "' at offset " + std::to_string(i));
+            if (++i == rel.size()) return fail(MessageErrorType::InvalidArgument, quoted + " ends with '.'");
+        }
+    }
+    return out;
+}
+
+Result<nlohmann::json> parse_request_json(std::string_view text) {
+    std::size_t depth = 0;
+    bool in_string = false, escaped = false;
+    for (char c : text) {
+        if (in_string) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') in_string = false;
+            continue;
+        }
+        if (c == '"') in_string = true;
+        else if (c == '[' || c == '{') {
+            if (++depth > kMaxRequestJsonDepth)
+                return fail(MessageErrorType::InvalidArgument,
+                            "JSON nested deeper than " + std::to_string(kMaxRequestJsonDepth) + " levels");
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    auto j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) return fail(MessageErrorType::InvalidArgument, "the request is not valid JSON");
+    return j;
+}
+
+nlohmann::json time_json(std::int64_t seconds, std::int32_t nanoseconds) {
+    return nlohmann::json{{"seconds", seconds}, {"nanoseconds", nanoseconds}};
+}
+
+JsonApi::JsonApi(std::vector<std::shared_ptr<DeviceMirror>> devices, JsonApiOptions options)
+    : devices_(std::move(devices)), options_(std::move(options)) {}
+
+std::shared_ptr<DeviceMirror> JsonApi::find_device(std::string_view name) const {
+    for (const auto& d : devices_)
+        if (d->config().name == name) return d;
+    return nullptr;
+}
+
+nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
+    nlohmann::json j;
+    j["name"] = s.name;
+    j["url"] = s.url;
+    j["state"] = std::string(device_state_name(s.state));
+    j["reason"] = s.reason.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.reason);
+    j["object_type"] = s.object_type.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.object_type);
+    j["required"] = s.required;
+    j["clients"] = s.downstream_sessions;
+    return j;
+}
+
+nlohmann::json JsonApi::device_list() const {
+    auto list = nlohmann::json::array();
+    for (const auto& d : devices_) list.push_back(status_json(d->status()));
+    return list;
+}
+
+std::shared_ptr<const DeviceTypes> JsonApi::types_for(const DeviceMirror& device, ApiError* error) const {
+    auto texts = device.service_definitions();
+    if (texts.empty()) {
+        if (error)
+            *error = api_error(503, MessageErrorType::ConnectionError,
+                               "device \"" + device.config().name + "\" has not connected yet");
+        return nullptr;
+    }
+    {
+        std::lock_guard lock(mutex_);
+        auto it = types_.find(&device);
+        if (it != types_.end() && it->second->texts() == texts) return it->second;
+    }
+    auto parsed = DeviceTypes::parse(std::move(texts));
+    if (!parsed) {
+        if (error)
+            *error = ApiError{502, std::string(error_name(MessageErrorType::ServiceDefinitionError)),
+                              "device \"" + device.config().name + "\": " + parsed.error().message};
+        return nullptr;
+    }
+    std::lock_guard lock(mutex_);
+    types_[&device] = *parsed;
+    return *parsed;
+}
+
+ApiResult JsonApi::device_info(std::string_view name) const {
+    auto d = find_device(name);
+    if (!d) return ApiResult::failed(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + std::string(name) + "\""));
+    const auto status = d->status();
+    auto j = status_json(status);
+    j["definitions"] = d->service_definitions();
+    j["members"] = nlohmann::json::array();
+    if (auto types = types_for(*d)) {
+        if (auto obj = types->find_object(d->object_type())) j["members"] = member_summary(*obj->entry);
+    }
+    return ApiResult::ok(std::move(j));
+}
+
+ApiResult JsonApi::definitions(std::string_view name) const {
+    auto d = find_device(name);
+    if (!d) return ApiResult::failed(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + std::string(name) + "\""));
+    return ApiResult::ok(nlohmann::json{{"definitions", d->service_definitions()}});
+}
+
+void JsonApi::resolve(const MemberAddress& address, std::function<void(Resolved)> done) {
+    auto device = find_device(address.device);
+    if (!device) {
+        done(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + address.device + "\""));
+        return;
+    }
+    const auto status = device->status();
+    if (status.state != DeviceState::connected) {
+        done(api_error(503, MessageErrorType::ConnectionError,
+                       "device \"" + address.device + "\" is not connected (" + std::string(device_state_name(status.state)) +
+                           (status.reason.empty() ? "" : ": " + status.reason) + ")"));
+        return;
+    }
+    ApiError error;
+    auto types = types_for(*device, &error);
+    if (!types) {
+        done(error);
+        return;
+    }
+    if (address.object.empty()) {
+        finish_resolve(device, types, address.device, device->object_type(), address.member, done);
+        return;
+    }
+    auto rel = normalize_object_path(address.object);
+    if (!rel) {
+        done(api_error(400, MessageErrorType::InvalidArgument, rel.error().message));
+        return;
+    }
+    std::string path = address.device + "." + *rel;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::ObjectTypeName;
+    e.service_path = path;
+    e.elements.push_back(make_string_element("clientversion", "1.2.8"));
+    auto self = shared_from_this();
+    device->request(std::move(e), [self, device, types, path, member = address.member,
+                                   done = std::move(done)](Result<MessageEntry> r) {
+        if (!r) {
+            done(device_error(r.error()));
+            return;
+        }
+        if (auto err = entry_error(*r)) {
+            done(device_error(*err));
+            return;
+        }
+        const auto* t = r->find("objecttype");
+        if (!t || t->type != DataTypes::string_t) {
+            done(api_error(502, MessageErrorType::MessageElementNotFound, "ObjectTypeName reply without objecttype"));
+            return;
+        }
+        self->finish_resolve(device, types, path, std::string(read_string(*t)), member, done);
+    });
+}
+
+void JsonApi::finish_resolve(std::shared_ptr<DeviceMirror> device, std::shared_ptr<const DeviceTypes> types,
+                             std::string path, std::string object_type, std::string member,
+                             const std::function<void(Resolved)>& done) const {
+    auto obj = types->find_object(object_type);
+    if (!obj) {
+        done(api_error(502, MessageErrorType::ServiceDefinitionError,
+                       "object type \"" + object_type + "\" of \"" + path + "\" is not in the device's definitions"));
+        return;
+    }
+    const auto* m = obj->entry->find_member(member);
+    if (!m) {
+        done(api_error(404, MessageErrorType::MemberNotFound,
+                       "object \"" + path + "\" (" + object_type + ") has no member \"" + member + "\""));
+        return;
+    }
+    MemberTarget t;
+    t.device = std::move(device);
+    t.types = std::move(types);
+    t.path = std::move(path);
+    t.object_type = std::move(object_type);
+    t.service = obj->service;
+    t.object = obj->entry;
+    t.member = m;
+    done(std::move(t));
+}
+
+ApiResult JsonApi::element_json(const MessageElement& element, const robdef::TypeDefinition& type,
+                                const MemberTarget& t) const {
+    if (type.is_void()) return ApiResult::ok(nullptr);
+    auto v = unpack_value(element, type, t.types->set(), t.context(), options_.limits);
+    if (!v) return ApiResult::failed(ApiError{502, v.error().name, "value from the device: " + v.error().message});
+    auto j = value_to_json(*v, type, t.types->set(), t.context(), options_.limits);
+    if (!j) return ApiResult::failed(ApiError{502, j.error().name, "value from the device: " + j.error().message});
+    return ApiResult::ok(std::move(*j));
+}
+
+Result<MessageElement> JsonApi::element_from_json(const nlohmann::json& json, const robdef::TypeDefinition& type,
+                                                  const MemberTarget& t, std::string_view name, ApiError& error,
+                                                  std::string_view where) const {
+    auto v = value_from_json(json, type, t.types->set(), t.context(), options_.limits);
+    if (!v) {
+        error = value_error(v.error(), where);
+        return v.take_error();
+    }
+    auto el = pack_value(*v, type, name, t.types->set(), t.context(), options_.limits);
+    if (!el) {
+        error = value_error(el.error(), where);
+        return el.take_error();
+    }
+    return el;
+}
+
+namespace {
+
+// 404 when the member is of another kind than the request needs.
+std::optional<ApiError> expect_kind(const MemberTarget& t, robdef::MemberKind kind) {
+    if (t.member->kind == kind) return std::nullopt;
+    return api_error(404, MessageErrorType::MemberNotFound,
+                     "member \"" + t.member->name + "\" of " + t.object_type + " is a " +
+                         std::string(kind_word(t.member->kind)) + ", not a " + std::string(kind_word(kind)));
+}
+
+MessageEntry member_request(MessageEntryType type, const MemberTarget& t) {
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = t.path;
+    e.member_name = t.member->name;
+    return e;
+}
+
+// Sends `e` to the device; transport errors and error replies end in `done`, a good reply goes to `ok`.
+void send_to_device(const MemberTarget& t, MessageEntry e, JsonApi::Done done,
+                    std::function<ApiResult(const MessageEntry&)> ok) {
+    t.device->request(std::move(e), [done = std::move(done), ok = std::move(ok)](Result<MessageEntry> r) {
+        if (!r) return done(ApiResult::failed(device_error(r.error())));
+        if (auto err = entry_error(*r)) return done(ApiResult::failed(device_error(*err)));
+        done(ok(*r));
+    });
+}
+
+ApiError missing_element(std::string_view name, std::string_view reply) {
+    return api_error(502, MessageErrorType::MessageElementNotFound,
+                     std::string(reply) + " from the device has no \"" + std::string(name) + "\" element");
+}
+
+}  // namespace
+
+void JsonApi::get_property(const MemberAddress& address, Done done) {
+    auto self = shared_from_this();
+    resolve(address, [self, done = std::move(done)](Resolved r) {
+        if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
+        const auto& t = std::get<MemberTarget>(r);
+        if (auto e = expect_kind(t, robdef::MemberKind::property)) return done(ApiResult::failed(*e));
+        if (t.member->direction() == robdef::MemberDirection::writeonly)
+            return done(ApiResult::failed(api_error(405, MessageErrorType::WriteOnlyMember,
+                                                    "property \"" + t.member->name + "\" is write-only")));
+        send_to_device(t, member_request(MessageEntryType::PropertyGetReq, t), done, [self, t](const MessageEntry& reply) {
+            const auto* v = reply.find("value");
+            if (!v) return ApiResult::failed(missing_element("value", "PropertyGetRes"));
+            auto j = self->element_json(*v, t.member->type, t);
+            if (!j) return j;
+            return ApiResult::ok(nlohmann::json{{"value", std::move(j.value)}});
+        });
+    });
+}
+
+void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& value, Done done) {
+    auto self = shared_from_this();
+    resolve(address, [self, value, done = std::move(done)](Resolved r) {
+        if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
+        const auto& t = std::get<MemberTarget>(r);
+        if (auto e = expect_kind(t, robdef::MemberKind::property)) return done(ApiResult::failed(*e));
+        if (t.member->direction() == robdef::MemberDirection::readonly)
+            return done(ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
+                                                    "property \"" + t.member->name + "\" is read-only")));
+        ApiError error;
+        auto el = self->element_from_json(value, t.member->type, t, "value", error, "value");
+        if (!el) return done(ApiResult::failed(error));
+        auto e = member_request(MessageEntryType::PropertySetReq, t);
+        e.elements.push_back(std::move(*el));
+        send_to_device(t, std::move(e), done, [](const MessageEntry&) { return ApiResult::ok(nlohmann::json::object()); });
+    });
+}
+
+void JsonApi::peek_wire(const MemberAddress& address, Done done) {
+    auto self = shared_from_this();
+    resolve(address, [self, done = std::move(done)](Resolved r) {
+        if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
+        const auto& t = std::get<MemberTarget>(r);
+        if (auto e = expect_kind(t, robdef::MemberKind::wire)) return done(ApiResult::failed(*e));
+        if (t.member->direction() == robdef::MemberDirection::writeonly)
+            return done(ApiResult::failed(api_error(405, MessageErrorType::WriteOnlyMember,
+                                                    "wire \"" + t.member->name + "\" is write-only")));
+        send_to_device(t, member_request(MessageEntryType::WirePeekInValueReq, t), done,
+                       [self, t](const MessageEntry& reply) {
+                           const auto* p = reply.find("packet");
+                           const auto* ts = reply.find("packettime");
+                           if (!p) return ApiResult::failed(missing_element("packet", "WirePeekInValueRet"));
+                           if (!ts) return ApiResult::failed(missing_element("packettime", "WirePeekInValueRet"));
+                           auto time = unpack_timespec(*ts);
+                           if (!time) return ApiResult::failed(ApiError{502, time.error().name, time.error().message});
+                           auto j = self->element_json(*p, t.member->type, t);
+                           if (!j) return j;
+                           return ApiResult::ok(nlohmann::json{{"value", std::move(j.value)},
+                                                               {"time", time_json(time->seconds, time->nanoseconds)}});
+                       });
+    });
+}
+
+}  // namespace rr::server::gateway

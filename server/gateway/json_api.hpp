@@ -1,0 +1,137 @@
+// The JSON API's operations (docs/json-api.md), shared by the REST routes (json_rest.hpp) and the JSON
+// WebSocket (json_socket.hpp): list and describe devices, get/set properties, call functions (generators
+// collected into a list), peek wires. Values travel as JSON per docs/json-mapping.md, typed by the
+// device's own service definitions.
+//
+// Requests go to the device through DeviceMirror::request on the gateway's own upstream session, with
+// service paths in gateway naming: the root object is `<device>`, an object below it
+// `<device>.<relative path>` (relative paths such as `Webcams[0]` are resolved with ObjectTypeName to
+// learn the object's type).
+//
+// Thread-safety: every function may be called from any thread; `done` callbacks run on the device
+// connection's strand (or inline when the request fails before reaching the device) and must not block.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/codec/limits.hpp"
+#include "server/gateway/device_mirror.hpp"
+#include "server/gateway/device_types.hpp"
+#include "server/gateway/json_api_error.hpp"
+
+namespace rr::server::gateway {
+
+/// Which member a request is about.
+struct MemberAddress {
+    std::string device;
+    std::string object;  ///< relative service path below the root object ("" = the root), e.g. `Webcams[0]`
+    std::string member;
+};
+
+/// A member resolved against the device's definitions. The pointers point into `types`.
+struct MemberTarget {
+    std::shared_ptr<DeviceMirror> device;
+    std::shared_ptr<const DeviceTypes> types;
+    std::string path;  ///< service path in gateway naming
+    std::string object_type;
+    const robdef::ServiceDefinition* service = nullptr;  ///< defines the object (context for unqualified names)
+    const robdef::ServiceEntryDefinition* object = nullptr;
+    const robdef::MemberDefinition* member = nullptr;
+
+    std::string_view context() const noexcept { return service->name; }
+};
+
+using Resolved = std::variant<MemberTarget, ApiError>;
+
+struct JsonApiOptions {
+    /// Generator items collected by one call when the request names no `max_items`.
+    std::size_t default_max_items = 100;
+    /// Largest `max_items` accepted (400 above).
+    std::size_t max_items_limit = 10000;
+    /// Limits for value conversions (nesting depth, sizes).
+    Limits limits;
+};
+
+/// Turns a relative object path into RR service-path form: segments `name` or `name[index]` joined
+/// by '.'; an index already in RR's encoding (letters, digits, `_`, `%hh`) is kept, any other index
+/// text (`-1`, `with space`) is encoded (wire.md §6.5). Errors: InvalidArgument.
+Result<std::string> normalize_object_path(std::string_view relative);
+
+class JsonApi : public std::enable_shared_from_this<JsonApi> {
+public:
+    using Done = std::function<void(ApiResult)>;
+
+    explicit JsonApi(std::vector<std::shared_ptr<DeviceMirror>> devices, JsonApiOptions options = {});
+
+    const std::vector<std::shared_ptr<DeviceMirror>>& devices() const noexcept { return devices_; }
+    const JsonApiOptions& options() const noexcept { return options_; }
+    std::shared_ptr<DeviceMirror> find_device(std::string_view name) const;
+
+    /// `{"name", "url", "state", "reason", "object_type", "required", "clients"}` of one device.
+    static nlohmann::json status_json(const DeviceStatus& status);
+    /// GET /api/devices: `[status_json…]`, in configuration order.
+    nlohmann::json device_list() const;
+    /// GET /api/devices/{name}: status_json plus `definitions` (texts) and `members` (member_summary of
+    /// the root object; empty before the first connect). Errors: 404.
+    ApiResult device_info(std::string_view name) const;
+    /// GET /api/devices/{name}/definitions: `{"definitions": [texts]}`. Errors: 404.
+    ApiResult definitions(std::string_view name) const;
+
+    /// Finds device, object and member. Errors: 404 (unknown device / object / member), 400 (malformed
+    /// object path), 503 (device not connected), 502 (definitions unusable), 504.
+    void resolve(const MemberAddress& address, std::function<void(Resolved)> done);
+
+    /// `{"value": …}`. Errors: as resolve; 404 not a property; 405 writeonly; device errors.
+    void get_property(const MemberAddress& address, Done done);
+    /// `{}`. Errors: as resolve; 400 value does not fit; 405 readonly; device errors.
+    void set_property(const MemberAddress& address, const nlohmann::json& value, Done done);
+    /// `{"return": …}` (null for void); generator functions: `{"items": […]}` with at most `max_items`
+    /// items (0 = options().default_max_items), the generator closed afterwards. `args` is an array
+    /// (positional), an object (by parameter name) or null (no parameters); a generator parameter takes
+    /// an array of items, each sent with one GeneratorNextReq.
+    void call_function(const MemberAddress& address, const nlohmann::json& args, std::size_t max_items, Done done);
+    /// `{"value": …, "time": {"seconds", "nanoseconds"}}`: the newest value of a wire (WirePeekInValue).
+    void peek_wire(const MemberAddress& address, Done done);
+
+    /// The element as JSON for `type` of `target`'s service. Errors: 502 (the device sent a value
+    /// that does not fit its own definition).
+    ApiResult element_json(const MessageElement& element, const robdef::TypeDefinition& type,
+                           const MemberTarget& target) const;
+    /// JSON as an element named `name` packed for `type`. Errors: 400 (value_error, `where` names it).
+    Result<MessageElement> element_from_json(const nlohmann::json& json, const robdef::TypeDefinition& type,
+                                             const MemberTarget& target, std::string_view name,
+                                             ApiError& error, std::string_view where) const;
+    /// The device's parsed definitions (cached while the texts stay the same), or nullptr when unusable.
+    std::shared_ptr<const DeviceTypes> types_for(const DeviceMirror& device, ApiError* error = nullptr) const;
+
+private:
+    void finish_resolve(std::shared_ptr<DeviceMirror> device, std::shared_ptr<const DeviceTypes> types,
+                        std::string path, std::string object_type, std::string member,
+                        const std::function<void(Resolved)>& done) const;
+
+    std::vector<std::shared_ptr<DeviceMirror>> devices_;
+    JsonApiOptions options_;
+    mutable std::mutex mutex_;
+    mutable std::map<const DeviceMirror*, std::shared_ptr<const DeviceTypes>> types_;
+};
+
+/// `{"seconds": s, "nanoseconds": ns}`.
+nlohmann::json time_json(std::int64_t seconds, std::int32_t nanoseconds);
+
+/// Deepest nesting of arrays/objects accepted in a request (the JSON mapping itself stops at
+/// Limits::max_nesting_depth, 64).
+inline constexpr std::size_t kMaxRequestJsonDepth = 100;
+
+/// Parses a request body or WebSocket message. Errors: InvalidArgument with the parser's message, or
+/// when arrays/objects nest deeper than kMaxRequestJsonDepth (checked before parsing).
+Result<nlohmann::json> parse_request_json(std::string_view text);
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,755 @@
+#include "server/gateway/json_socket.hpp"
+
+#include <boost/asio/steady_timer.hpp>
+
+#include "core/session/elements.hpp"
+#include "core/value/timespec.hpp"
+#include "server/gateway/mirror_service.hpp"
+#include "server/node/node.hpp"
+#include "server/service/wire_member.hpp"
+
+namespace rr::server::gateway {
+
+namespace {
+
+enum class SubKind : std::uint8_t { wire, event, pipe };
+
+std::string_view kind_name(SubKind k) {
+    switch (k) {
+        case SubKind::wire: return "wire";
+        case SubKind::event: return "event";
+        case SubKind::pipe: return "pipe";
+    }
+    return "?";
+}
+
+ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
+
+}  // namespace
+
+/// One JSON WebSocket: requests, subscriptions and their pushes (see json_socket.hpp). Thread-safe: the
+/// socket's strand delivers messages, device strands deliver pushes and replies.
+class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession> {
+public:
+    JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
+                      boost::asio::any_io_executor executor, const JsonSocketOptions& options)
+        : api_(std::move(api)), socket_(std::move(socket)), options_(options), timer_(executor) {}
+
+    void on_message(std::string text) {
+        if (text.size() > options_.max_message_bytes) {
+            send_reply(nullptr, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
+                                                            "message of " + std::to_string(text.size()) +
+                                                                " bytes is over the limit of " +
+                                                                std::to_string(options_.max_message_bytes))));
+            return;
+        }
+        auto msg = parse_request_json(text);
+        if (!msg) return send_reply(nullptr, ApiResult::failed(bad_request(msg.error().message)));
+        nlohmann::json id = nullptr;
+        try {
+            if (!msg->is_object()) return send_reply(nullptr, ApiResult::failed(bad_request("a request is a JSON object")));
+            if (auto it = msg->find("id"); it != msg->end()) id = *it;
+            if (!id.is_number_integer() && !id.is_string())
+                return send_reply(nullptr, ApiResult::failed(bad_request("a request needs an \"id\" (integer or string)")));
+            handle(id, *msg);
+        } catch (const std::exception& e) {
+            // A nlohmann type error would be a bug here; the socket and the gateway carry on.
+            send_reply(id, ApiResult::failed(api_error(500, MessageErrorType::InternalError, e.what())));
+        }
+    }
+
+    /// Ends every subscription; nothing is sent afterwards.
+    void close() {
+        std::map<std::uint64_t, Subscription> subs;
+        {
+            std::lock_guard lock(mutex_);
+            if (closed_) return;
+            closed_ = true;
+            subs.swap(subs_);
+            timer_.cancel();
+        }
+        for (auto& [sid, s] : subs)
+            if (s.mirror_known) unsubscribe_upstream(s.kind, s.target, s.mirror_id);
+    }
+
+    void push_device_state(const DeviceStatus& status) {
+        std::lock_guard lock(mutex_);
+        if (closed_) return;
+        send_text(nlohmann::json{{"kind", "device_state"}, {"device", JsonApi::status_json(status)}});
+    }
+
+    JsonSocketStats stats() const {
+        JsonSocketStats s;
+        std::lock_guard lock(mutex_);
+        s.subscriptions = subs_.size();
+        s.queued = socket_->queued();
+        s.queued_bytes = socket_->queued_bytes();
+        s.socket_dropped = socket_->dropped();
+        s.push_drops = push_drops_;
+        s.wire_coalesced = wire_coalesced_;
+        for (const auto& [sid, sub] : subs_) s.pending_wires += sub.pending_wire ? 1 : 0;
+        return s;
+    }
+
+private:
+    struct Subscription {
+        SubKind kind = SubKind::event;
+        MemberTarget target;
+        std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, or internal pipe id
+        bool mirror_known = false;
+        bool active = false;  // subscribe answered: pushes may go
+        bool failed = false;  // subscribe failed before mirror_id was known
+        std::optional<MessageEntry> pending_wire;
+        std::uint64_t dropped = 0;  // pushes dropped since the last one sent
+    };
+
+    // --- replies ----------------------------------------------------------------------------------
+
+    void send_text(const nlohmann::json& j) { socket_->send(json_text(j)); }
+
+    void send_reply(const nlohmann::json& id, const ApiResult& r) {
+        if (r.error) {
+            send_text(nlohmann::json{{"id", id}, {"error", error_object(*r.error)}});
+        } else {
+            send_text(nlohmann::json{{"id", id}, {"result", r.value}});
+        }
+    }
+
+    // An asynchronous request: counted until answered.
+    bool begin_request(const nlohmann::json& id) {
+        {
+            std::lock_guard lock(mutex_);
+            if (in_flight_ < options_.max_in_flight) {
+                ++in_flight_;
+                return true;
+            }
+        }
+        send_reply(id, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
+                                                   "more than " + std::to_string(options_.max_in_flight) +
+                                                       " requests in flight on this socket")));
+        return false;
+    }
+    void end_request() {
+        std::lock_guard lock(mutex_);
+        if (in_flight_) --in_flight_;
+    }
+    JsonApi::Done replier(const nlohmann::json& id) {
+        auto self = shared_from_this();
+        return [self, id](ApiResult r) {
+            self->send_reply(id, r);
+            self->end_request();
+        };
+    }
+
+    // --- requests ---------------------------------------------------------------------------------
+
+    static std::optional<ApiError> read_address(const nlohmann::json& msg, MemberAddress& a) {
+        auto d = msg.find("device");
+        auto m = msg.find("member");
+        if (d == msg.end() || !d->is_string() || m == msg.end() || !m->is_string())
+            return bad_request("\"device\" and \"member\" (strings) are required");
+        a.device = d->get<std::string>();
+        a.member = m->get<std::string>();
+        if (auto o = msg.find("object"); o != msg.end() && !o->is_null()) {
+            if (!o->is_string()) return bad_request("\"object\" must be a string (a relative service path)");
+            a.object = o->get<std::string>();
+        }
+        return std::nullopt;
+    }
+
+    static std::optional<ApiError> read_subscription(const nlohmann::json& msg, std::uint64_t& sid) {
+        auto s = msg.find("subscription");
+        if (s == msg.end() || !s->is_number_unsigned()) return bad_request("\"subscription\" (a subscription id) is required");
+        sid = s->get<std::uint64_t>();
+        return std::nullopt;
+    }
+
+    void handle(const nlohmann::json& id, const nlohmann::json& msg) {
+        auto op_it = msg.find("op");
+        if (op_it == msg.end() || !op_it->is_string())
+            return send_reply(id, ApiResult::failed(bad_request("a request needs an \"op\" (string)")));
+        const std::string op = op_it->get<std::string>();
+        auto fail_with = [&](ApiError e) { send_reply(id, ApiResult::failed(std::move(e))); };
+
+        if (op == "devices") return send_reply(id, ApiResult::ok(api_->device_list()));
+        if (op == "device") {
+            auto d = msg.find("device");
+            if (d == msg.end() || !d->is_string()) return fail_with(bad_request("\"device\" (string) is required"));
+            return send_reply(id, api_->device_info(d->get<std::string>()));
+        }
+        if (op == "unsubscribe") {
+            std::uint64_t sid = 0;
+            if (auto e = read_subscription(msg, sid)) return fail_with(*e);
+            return unsubscribe(id, sid);
+        }
+        if (op == "set_out_value" || op == "send") {
+            std::uint64_t sid = 0;
+            if (auto e = read_subscription(msg, sid)) return fail_with(*e);
+            auto v = msg.find("value");
+            if (v == msg.end()) return fail_with(bad_request("\"value\" is required"));
+            if (op == "set_out_value") return set_out_value(id, sid, *v);
+            bool ack = false;
+            if (auto a = msg.find("requestack"); a != msg.end()) {
+                if (!a->is_boolean()) return fail_with(bad_request("\"requestack\" must be true or false"));
+                ack = a->get<bool>();
+            }
+            return send_packet(id, sid, *v, ack);
+        }
+        if (op != "get" && op != "set" && op != "call" && op != "peek" && op != "subscribe")
+            return fail_with(bad_request("unknown op \"" + op + "\""));
+
+        MemberAddress address;
+        if (auto e = read_address(msg, address)) return fail_with(*e);
+        nlohmann::json value, args;
+        std::size_t max_items = 0;
+        if (op == "set") {
+            auto v = msg.find("value");
+            if (v == msg.end()) return fail_with(bad_request("\"value\" is required"));
+            value = *v;
+        }
+        if (op == "call") {
+            if (auto a = msg.find("args"); a != msg.end()) args = *a;
+            if (auto m = msg.find("max_items"); m != msg.end()) {
+                if (!m->is_number_unsigned()) return fail_with(bad_request("\"max_items\" must be a non-negative integer"));
+                max_items = m->get<std::size_t>();
+            }
+        }
+        if (!begin_request(id)) return;
+        if (op == "get") return api_->get_property(address, replier(id));
+        if (op == "set") return api_->set_property(address, value, replier(id));
+        if (op == "call") return api_->call_function(address, args, max_items, replier(id));
+        if (op == "peek") return api_->peek_wire(address, replier(id));
+        subscribe(id, std::move(address));
+    }
+
+    // --- subscriptions ----------------------------------------------------------------------------
+
+    void subscribe(const nlohmann::json& id, MemberAddress address) {
+        auto self = shared_from_this();
+        api_->resolve(address, [self, id](Resolved r) {
+            if (auto* e = std::get_if<ApiError>(&r)) {
+                self->send_reply(id, ApiResult::failed(*e));
+                return self->end_request();
+            }
+            self->start_subscription(id, std::get<MemberTarget>(std::move(r)));
+        });
+    }
+
+    void start_subscription(const nlohmann::json& id, MemberTarget t) {
+        SubKind kind;
+        switch (t.member->kind) {
+            case robdef::MemberKind::wire: kind = SubKind::wire; break;
+            case robdef::MemberKind::event: kind = SubKind::event; break;
+            case robdef::MemberKind::pipe: kind = SubKind::pipe; break;
+            default:
+                send_reply(id, ApiResult::failed(api_error(404, MessageErrorType::MemberNotFound,
+                                                           "member \"" + t.member->name + "\" is a " +
+                                                               std::string(robdef::member_kind_keyword(t.member->kind)) +
+                                                               "; subscribe takes a wire, an event or a pipe")));
+                return end_request();
+        }
+        std::uint64_t sid = 0;
+        {
+            std::lock_guard lock(mutex_);
+            if (closed_) {
+                if (in_flight_) --in_flight_;
+                return;
+            }
+            if (subs_.size() >= options_.max_subscriptions) {
+                if (in_flight_) --in_flight_;
+                send_reply(id, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
+                                                           "more than " + std::to_string(options_.max_subscriptions) +
+                                                               " subscriptions on this socket")));
+                return;
+            }
+            sid = next_sid_++;
+            Subscription s;
+            s.kind = kind;
+            s.target = t;
+            subs_.emplace(sid, std::move(s));
+        }
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+
+        if (kind == SubKind::pipe) {
+            MirrorService::InternalPipeHandlers h;
+            h.on_packet = [weak, sid](const MessageElement& packet, std::uint32_t) {
+                if (auto s = weak.lock()) s->on_pipe_packet(sid, packet);
+            };
+            h.on_ack = [weak, sid](std::uint32_t number) {
+                if (auto s = weak.lock()) s->on_pipe_ack(sid, number);
+            };
+            h.on_closed = [weak, sid](const RRError& reason) {
+                if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
+            };
+            auto svc = t.device->mirror_service();
+            const bool unreliable = robdef::pipe_is_unreliable(*t.object, *t.member);
+            svc->open_internal_pipe(t.path, t.member->name, unreliable, std::move(h),
+                                    [weak, sid, id, svc](Result<std::uint64_t> r) {
+                                        auto s = weak.lock();
+                                        if (!s) {
+                                            if (r) svc->close_internal_pipe(*r);
+                                            return;
+                                        }
+                                        s->pipe_opened(sid, id, std::move(r), svc);
+                                    });
+            return;
+        }
+
+        const bool is_wire = kind == SubKind::wire;
+        const std::uint64_t mid = t.device->subscribe(
+            t.path, t.member->name, is_wire,
+            [weak, sid, is_wire](const MessageEntry& e) {
+                auto s = weak.lock();
+                if (!s) return;
+                if (is_wire)
+                    s->on_wire(sid, e);
+                else
+                    s->on_event(sid, e);
+            },
+            [weak, sid, id](Result<void> r) {
+                if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
+            });
+        bool drop = false;
+        {
+            // `subscribed` may have run already (inside subscribe), or the socket closed meanwhile.
+            std::lock_guard lock(mutex_);
+            auto it = subs_.find(sid);
+            if (it == subs_.end()) {
+                drop = true;
+            } else if (it->second.failed) {
+                subs_.erase(it);
+                drop = true;
+            } else {
+                it->second.mirror_id = mid;
+                it->second.mirror_known = true;
+            }
+        }
+        if (drop) t.device->unsubscribe(mid);
+    }
+
+    void subscribed(std::uint64_t sid, const nlohmann::json& id, std::optional<ApiError> error) {
+        std::optional<std::pair<MemberTarget, std::uint64_t>> unsubscribe;
+        bool flush = false;
+        {
+            std::lock_guard lock(mutex_);
+            if (in_flight_) --in_flight_;
+            auto it = subs_.find(sid);
+            if (it == subs_.end()) {
+                if (!closed_) send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::OperationAborted, "subscription ended")));
+                return;
+            }
+            if (error) {
+                if (it->second.mirror_known) {
+                    unsubscribe.emplace(it->second.target, it->second.mirror_id);
+                    subs_.erase(it);
+                } else {
+                    it->second.failed = true;
+                }
+                send_reply(id, ApiResult::failed(*error));
+            } else {
+                // Under the lock: the reply is queued before any push of this subscription.
+                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(it->second.kind)}}));
+                it->second.active = true;
+                flush = it->second.pending_wire.has_value();
+            }
+        }
+        if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
+        if (flush) flush_wires();
+    }
+
+    void pipe_opened(std::uint64_t sid, const nlohmann::json& id, Result<std::uint64_t> r,
+                     const std::shared_ptr<MirrorService>& svc) {
+        std::optional<std::uint64_t> orphan;
+        {
+            std::lock_guard lock(mutex_);
+            if (in_flight_) --in_flight_;
+            auto it = subs_.find(sid);
+            if (it == subs_.end()) {
+                if (r) orphan = *r;  // the socket closed while connecting
+                if (!closed_) send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::OperationAborted, "subscription ended")));
+            } else if (!r) {
+                subs_.erase(it);
+                send_reply(id, ApiResult::failed(device_error(r.error())));
+            } else {
+                it->second.mirror_id = *r;
+                it->second.mirror_known = true;
+                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", "pipe"}}));
+                it->second.active = true;
+            }
+        }
+        if (orphan) svc->close_internal_pipe(*orphan);
+    }
+
+    void unsubscribe_upstream(SubKind kind, const MemberTarget& t, std::uint64_t mirror_id) {
+        if (kind == SubKind::pipe)
+            t.device->mirror_service()->close_internal_pipe(mirror_id);
+        else
+            t.device->unsubscribe(mirror_id);
+    }
+
+    void unsubscribe(const nlohmann::json& id, std::uint64_t sid) {
+        std::optional<Subscription> sub;
+        {
+            std::lock_guard lock(mutex_);
+            auto it = subs_.find(sid);
+            if (it != subs_.end() && it->second.active) {
+                sub = std::move(it->second);
+                subs_.erase(it);
+            }
+        }
+        if (!sub) return send_reply(id, ApiResult::failed(bad_request("no subscription " + std::to_string(sid))));
+        if (sub->mirror_known) unsubscribe_upstream(sub->kind, sub->target, sub->mirror_id);
+        send_reply(id, ApiResult::ok(nlohmann::json::object()));
+    }
+
+    // Finds an active subscription of `kind` and copies its target.
+    std::optional<ApiError> find_active(std::uint64_t sid, SubKind kind, MemberTarget& t, std::uint64_t& mirror_id) {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        if (it == subs_.end() || !it->second.active) return bad_request("no subscription " + std::to_string(sid));
+        if (it->second.kind != kind)
+            return bad_request("subscription " + std::to_string(sid) + " is a " + std::string(kind_name(it->second.kind)) +
+                               " subscription, not a " + std::string(kind_name(kind)));
+        t = it->second.target;
+        mirror_id = it->second.mirror_id;
+        return std::nullopt;
+    }
+
+    void set_out_value(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value) {
+        MemberTarget t;
+        std::uint64_t mid = 0;
+        if (auto e = find_active(sid, SubKind::wire, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        if (t.member->direction() == robdef::MemberDirection::readonly)
+            return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
+                                                              "wire \"" + t.member->name + "\" is read-only")));
+        ApiError error;
+        auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
+        if (!packet) return send_reply(id, ApiResult::failed(error));
+        auto client = t.device->upstream();
+        if (!client)
+            return send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::ConnectionError,
+                                                              "device \"" + t.device->config().name + "\" is not connected")));
+        // A client's OutValue is the device's InValue (wire.md §6.7: WirePacket, newest wins).
+        MessageEntry e;
+        e.entry_type = MessageEntryType::WirePacket;
+        e.service_path = t.device->mirror_service()->to_upstream(t.path);
+        e.member_name = t.member->name;
+        e.metadata = "unreliable\n";
+        e.elements.push_back(pack_timespec(wall_clock_timespec(), "packettime"));
+        e.elements.push_back(std::move(*packet));
+        client->send(std::move(e));
+        send_reply(id, ApiResult::ok(nlohmann::json::object()));
+    }
+
+    void send_packet(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value, bool request_ack) {
+        MemberTarget t;
+        std::uint64_t mid = 0;
+        if (auto e = find_active(sid, SubKind::pipe, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        if (t.member->direction() == robdef::MemberDirection::readonly)
+            return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
+                                                              "pipe \"" + t.member->name + "\" is read-only")));
+        ApiError error;
+        auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
+        if (!packet) return send_reply(id, ApiResult::failed(error));
+        auto n = t.device->mirror_service()->send_internal_pipe_packet(mid, std::move(*packet), request_ack);
+        if (!n) return send_reply(id, ApiResult::failed(device_error(n.error())));
+        send_reply(id, ApiResult::ok(nlohmann::json{{"packetnumber", *n}}));
+    }
+
+    // --- pushes -----------------------------------------------------------------------------------
+
+    bool push_congested() const {
+        return socket_->queued() >= options_.push_queue_limit || socket_->queued_bytes() >= options_.push_bytes_limit;
+    }
+    bool wire_congested() const {
+        return socket_->queued() >= options_.wire_queue_threshold || socket_->queued_bytes() >= options_.push_bytes_limit;
+    }
+
+    // Takes a push slot for subscription `sid`: false (and counted) when the client is too far behind.
+    bool take_push(std::uint64_t sid, MemberTarget& t, std::uint64_t& dropped) {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        if (it == subs_.end() || !it->second.active || closed_) return false;
+        if (push_congested()) {
+            ++it->second.dropped;
+            ++push_drops_;
+            return false;
+        }
+        t = it->second.target;
+        dropped = std::exchange(it->second.dropped, 0);
+        return true;
+    }
+
+    void on_event(std::uint64_t sid, const MessageEntry& e) {
+        MemberTarget t;
+        std::uint64_t dropped = 0;
+        if (!take_push(sid, t, dropped)) return;
+        nlohmann::json msg{{"subscription", sid}, {"kind", "event"}};
+        auto args = nlohmann::json::object();
+        for (const auto& p : t.member->parameters) {
+            const auto* el = e.find(p.name);
+            if (!el) {
+                msg["error"] = error_object(api_error(502, MessageErrorType::MessageElementNotFound,
+                                                      "event from the device has no \"" + p.name + "\" element"));
+                break;
+            }
+            auto j = api_->element_json(*el, p, t);
+            if (!j) {
+                msg["error"] = error_object(*j.error);
+                break;
+            }
+            args[p.name] = std::move(j.value);
+        }
+        if (!msg.contains("error")) msg["args"] = std::move(args);
+        if (dropped) msg["dropped"] = dropped;
+        send_text(msg);
+    }
+
+    void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
+        MemberTarget t;
+        std::uint64_t dropped = 0;
+        if (!take_push(sid, t, dropped)) return;
+        nlohmann::json msg{{"subscription", sid}, {"kind", "pipe"}};
+        auto j = api_->element_json(packet, t.member->type, t);
+        if (j)
+            msg["value"] = std::move(j.value);
+        else
+            msg["error"] = error_object(*j.error);
+        if (dropped) msg["dropped"] = dropped;
+        send_text(msg);
+    }
+
+    void on_pipe_ack(std::uint64_t sid, std::uint32_t number) {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        if (it == subs_.end() || !it->second.active || closed_) return;
+        send_text(nlohmann::json{{"subscription", sid}, {"kind", "pipe_ack"}, {"packetnumber", number}});
+    }
+
+    void on_subscription_closed(std::uint64_t sid, const RRError& reason) {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        if (it == subs_.end()) return;
+        const bool active = it->second.active;
+        subs_.erase(it);
+        if (active && !closed_)
+            send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
+    }
+
+    void on_wire(std::uint64_t sid, const MessageEntry& e) {
+        if (e.entry_type == MessageEntryType::WireClosed) {
+            on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));
+            return;
+        }
+        {
+            std::lock_guard lock(mutex_);
+            auto it = subs_.find(sid);
+            if (it == subs_.end()) return;
+            if (it->second.pending_wire) ++wire_coalesced_;
+            it->second.pending_wire = e;  // newest wins
+            if (!it->second.active) return;
+        }
+        flush_wires();
+    }
+
+    // Sends the waiting wire values unless the client is behind; then they wait (coalescing) and retry.
+    // One flusher at a time, so values of one subscription are never reordered.
+    void flush_wires() {
+        {
+            std::lock_guard lock(mutex_);
+            if (flushing_) {
+                flush_again_ = true;
+                return;
+            }
+            flushing_ = true;
+        }
+        struct Item {
+            std::uint64_t sid;
+            MessageEntry entry;
+            MemberTarget target;
+        };
+        std::vector<Item> batch;
+        for (;;) {
+            batch.clear();
+            {
+                std::lock_guard lock(mutex_);
+                flush_again_ = false;
+                if (closed_) {
+                    flushing_ = false;
+                    return;
+                }
+                bool waiting = false;
+                for (auto& [sid, sub] : subs_) waiting |= sub.active && sub.pending_wire.has_value();
+                if (!waiting) {
+                    flushing_ = false;
+                    return;
+                }
+                if (wire_congested()) {
+                    arm_retry();
+                    flushing_ = false;
+                    return;
+                }
+                for (auto& [sid, sub] : subs_) {
+                    if (!sub.active || !sub.pending_wire) continue;
+                    batch.push_back(Item{sid, std::move(*sub.pending_wire), sub.target});
+                    sub.pending_wire.reset();
+                }
+            }
+            for (auto& item : batch) send_text(wire_message(item.sid, item.entry, item.target));
+            std::lock_guard lock(mutex_);
+            if (!flush_again_) {
+                flushing_ = false;
+                return;
+            }
+        }
+    }
+
+    nlohmann::json wire_message(std::uint64_t sid, const MessageEntry& e, const MemberTarget& t) const {
+        nlohmann::json msg{{"subscription", sid}, {"kind", "wire"}};
+        const auto* p = e.find("packet");
+        const auto* ts = e.find("packettime");
+        if (!p || !ts) {
+            msg["error"] = error_object(api_error(502, MessageErrorType::MessageElementNotFound,
+                                                  "WirePacket from the device without packet / packettime"));
+            return msg;
+        }
+        auto time = unpack_timespec(*ts);
+        auto j = api_->element_json(*p, t.member->type, t);
+        if (!time) {
+            msg["error"] = error_object(ApiError{502, time.error().name, time.error().message});
+        } else if (!j) {
+            msg["error"] = error_object(*j.error);
+        } else {
+            msg["value"] = std::move(j.value);
+            msg["time"] = time_json(time->seconds, time->nanoseconds);
+        }
+        return msg;
+    }
+
+    // Under mutex_.
+    void arm_retry() {
+        if (timer_armed_) return;
+        timer_armed_ = true;
+        timer_.expires_after(options_.wire_retry);
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        timer_.async_wait([weak](boost::system::error_code ec) {
+            auto s = weak.lock();
+            if (!s) return;
+            {
+                std::lock_guard lock(s->mutex_);
+                s->timer_armed_ = false;
+            }
+            if (!ec) s->flush_wires();
+        });
+    }
+
+    std::shared_ptr<JsonApi> api_;
+    std::shared_ptr<http::JsonSocket> socket_;
+    JsonSocketOptions options_;
+    mutable std::mutex mutex_;
+    boost::asio::steady_timer timer_;
+    bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
+    std::map<std::uint64_t, Subscription> subs_;
+    std::uint64_t next_sid_ = 1;
+    std::size_t in_flight_ = 0;
+    std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
+};
+
+// --- server ---------------------------------------------------------------------------------------
+
+JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor,
+                                   JsonSocketOptions options)
+    : api_(std::move(api)), executor_(std::move(executor)), options_(options) {}
+
+std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
+                                                           boost::asio::any_io_executor executor,
+                                                           JsonSocketOptions options) {
+    std::shared_ptr<JsonSocketServer> s(new JsonSocketServer(std::move(api), std::move(executor), options));
+    std::weak_ptr<JsonSocketServer> weak = s;
+    for (const auto& d : s->api_->devices()) {
+        const auto id = d->add_state_listener([weak](const DeviceStatus& status) {
+            if (auto self = weak.lock()) self->on_device_state(status);
+        });
+        s->listeners_.emplace_back(d, id);
+    }
+    return s;
+}
+
+JsonSocketServer::~JsonSocketServer() {
+    for (auto& [d, id] : listeners_) d->remove_state_listener(id);
+    std::map<const http::JsonSocket*, std::shared_ptr<JsonSocketSession>> sessions;
+    {
+        std::lock_guard lock(mutex_);
+        sessions.swap(sessions_);
+    }
+    for (auto& [k, s] : sessions) s->close();
+}
+
+http::JsonSocketHandler JsonSocketServer::handler() {
+    auto self = shared_from_this();
+    return http::JsonSocketHandler{
+        [self](std::shared_ptr<http::JsonSocket> s) { self->on_open(s); },
+        [self](const std::shared_ptr<http::JsonSocket>& s, std::string text) { self->on_message(s, std::move(text)); },
+        [self](const std::shared_ptr<http::JsonSocket>& s) { self->on_close(s); },
+    };
+}
+
+void JsonSocketServer::on_open(const std::shared_ptr<http::JsonSocket>& socket) {
+    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, options_);
+    std::lock_guard lock(mutex_);
+    sessions_[socket.get()] = std::move(session);
+}
+
+void JsonSocketServer::on_message(const std::shared_ptr<http::JsonSocket>& socket, std::string text) {
+    std::shared_ptr<JsonSocketSession> session;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = sessions_.find(socket.get());
+        if (it == sessions_.end()) return;
+        session = it->second;
+    }
+    session->on_message(std::move(text));
+}
+
+void JsonSocketServer::on_close(const std::shared_ptr<http::JsonSocket>& socket) {
+    std::shared_ptr<JsonSocketSession> session;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = sessions_.find(socket.get());
+        if (it == sessions_.end()) return;
+        session = std::move(it->second);
+        sessions_.erase(it);
+    }
+    session->close();
+}
+
+void JsonSocketServer::on_device_state(const DeviceStatus& status) {
+    std::vector<std::shared_ptr<JsonSocketSession>> sessions;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [k, s] : sessions_) sessions.push_back(s);
+    }
+    for (const auto& s : sessions) s->push_device_state(status);
+}
+
+std::vector<JsonSocketStats> JsonSocketServer::stats() const {
+    std::vector<std::shared_ptr<JsonSocketSession>> sessions;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [k, s] : sessions_) sessions.push_back(s);
+    }
+    std::vector<JsonSocketStats> out;
+    for (const auto& s : sessions) out.push_back(s->stats());
+    return out;
+}
+
+std::shared_ptr<JsonSocketServer> install_json_socket(http::HttpServer& http, std::shared_ptr<JsonApi> api,
+                                                      JsonSocketOptions options) {
+    auto node = http.node();
+    boost::asio::any_io_executor executor = node ? node->io_context().get_executor() : boost::asio::any_io_executor{};
+    auto server = JsonSocketServer::create(std::move(api), executor, options);
+    http.add_subprotocol(std::string(kJsonSubprotocol), server->handler());
+    return server;
+}
+
+}  // namespace rr::server::gateway

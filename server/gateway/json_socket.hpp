@@ -1,0 +1,89 @@
+// The WebSocket half of the JSON API (docs/json-api.md §WebSocket): subprotocol `rr-gateway.json.v1`
+// on the gateway's HttpServer. Text messages, one JSON object each.
+//
+// Client → gateway: requests {"id", "op", …}; op ∈ devices, device, get, set, call, peek, subscribe,
+// unsubscribe, set_out_value, send. Each is answered once with {"id", "result"} or {"id", "error"}.
+// Gateway → client, unasked: {"subscription", "kind": "wire"|"event"|"pipe"|"pipe_ack"|"closed", …} for
+// subscriptions, and {"kind": "device_state", "device": {…}} whenever a device's state changes.
+//
+// Backpressure (a client that reads slowly never grows the gateway's memory without bound):
+//   * the socket's own queue holds at most HttpOptions::json_socket_queue_limit messages (oldest dropped);
+//   * wire values are coalesced per subscription: the newest value waits while `wire_queue_threshold`
+//     messages are queued, and replaces an older waiting one;
+//   * events and pipe packets are dropped (counted, and reported as "dropped" in the next push of that
+//     subscription) while `push_queue_limit` messages or `push_bytes_limit` bytes are queued;
+//   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
+//     answered at once, and messages over `max_message_bytes` are refused.
+// Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include <boost/asio/any_io_executor.hpp>
+
+#include "server/gateway/json_api.hpp"
+#include "server/http/http_server.hpp"
+
+namespace rr::server::gateway {
+
+inline constexpr std::string_view kJsonSubprotocol = "rr-gateway.json.v1";
+
+struct JsonSocketOptions {
+    std::size_t push_queue_limit = 768;             ///< messages queued: events / pipe packets dropped from here
+    std::size_t push_bytes_limit = 8u << 20;        ///< bytes queued: pushes dropped / wire values wait from here
+    std::size_t wire_queue_threshold = 8;           ///< messages queued: wire values wait (coalesced) from here
+    std::chrono::milliseconds wire_retry{10};       ///< how often waiting wire values retry
+    std::size_t max_in_flight = 64;                 ///< requests per socket being answered at once
+    std::size_t max_subscriptions = 256;            ///< per socket
+    std::size_t max_message_bytes = 1u << 20;       ///< largest request message
+};
+
+/// What one socket holds, for tests and diagnostics.
+struct JsonSocketStats {
+    std::size_t subscriptions = 0;
+    std::size_t queued = 0, queued_bytes = 0;  ///< the socket's queue now
+    std::uint64_t socket_dropped = 0;          ///< dropped by the socket's queue limit
+    std::uint64_t push_drops = 0;              ///< events / pipe packets dropped by this layer
+    std::uint64_t wire_coalesced = 0;          ///< wire values replaced by a newer one before sending
+    std::size_t pending_wires = 0;             ///< subscriptions with a wire value waiting
+};
+
+class JsonSocketSession;
+
+/// Serves the subprotocol: one JsonSocketSession per socket.
+class JsonSocketServer : public std::enable_shared_from_this<JsonSocketServer> {
+public:
+    /// `executor` runs the wire retry timers (the gateway node's io_context).
+    static std::shared_ptr<JsonSocketServer> create(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor,
+                                                    JsonSocketOptions options = {});
+    ~JsonSocketServer();
+
+    /// The handler to register with HttpServer::add_subprotocol(kJsonSubprotocol, …).
+    http::JsonSocketHandler handler();
+    /// One entry per open socket.
+    std::vector<JsonSocketStats> stats() const;
+    const JsonSocketOptions& options() const noexcept { return options_; }
+
+private:
+    JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor, JsonSocketOptions options);
+    void on_open(const std::shared_ptr<http::JsonSocket>& socket);
+    void on_message(const std::shared_ptr<http::JsonSocket>& socket, std::string text);
+    void on_close(const std::shared_ptr<http::JsonSocket>& socket);
+    void on_device_state(const DeviceStatus& status);
+
+    std::shared_ptr<JsonApi> api_;
+    boost::asio::any_io_executor executor_;
+    JsonSocketOptions options_;
+    std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
+    mutable std::mutex mutex_;
+    std::map<const http::JsonSocket*, std::shared_ptr<JsonSocketSession>> sessions_;
+};
+
+/// Registers the subprotocol on `http`; returns the server (kept alive by the registered handler too).
+std::shared_ptr<JsonSocketServer> install_json_socket(http::HttpServer& http, std::shared_ptr<JsonApi> api,
+                                                      JsonSocketOptions options = {});
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,295 @@
+// The JSON WebSocket (`rr-gateway.json.v1`) against rr_interop_service behind a Gateway: requests,
+// subscriptions to wires, events and pipes, their end, device state pushes, and a client that never reads.
+#include "server/gateway/json_api_test_fixture.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace rr::server::gateway;
+using namespace rr::server::gateway::testing;
+
+namespace {
+
+json op(std::string name, json fields = json::object()) {
+    fields["op"] = std::move(name);
+    return fields;
+}
+json member(std::string op_name, std::string m, json more = json::object()) {
+    more["device"] = "interop";
+    more["member"] = std::move(m);
+    return op(std::move(op_name), std::move(more));
+}
+std::string error_name(const json& reply) {
+    return reply.contains("error") ? reply["error"]["name"].get<std::string>() : "<no error: " + reply.dump() + ">";
+}
+std::uint64_t subscribe(WsClient& ws, const std::string& m, const std::string& kind) {
+    auto r = ws.request(member("subscribe", m));
+    INFO(r.dump());
+    REQUIRE(r.contains("result"));
+    CHECK(r["result"]["kind"] == kind);
+    return r["result"]["subscription"].get<std::uint64_t>();
+}
+auto push_of(std::uint64_t sid, std::string kind) {
+    return [sid, kind](const json& j) { return j.value("subscription", std::uint64_t{0}) == sid && j["kind"] == kind; };
+}
+
+}  // namespace
+
+TEST_CASE("json socket: requests are answered by id") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    WsClient ws(gw.port());
+    CHECK(ws.handshake_response()[bhttp::field::sec_websocket_protocol] == kJsonSubprotocol);
+
+    auto devices = ws.request(op("devices"));
+    REQUIRE(devices["result"].is_array());
+    CHECK(devices["result"][0]["name"] == "interop");
+    CHECK(devices["result"][0]["state"] == "connected");
+    auto info = ws.request(op("device", {{"device", "interop"}}));
+    CHECK(info["result"]["object_type"] == "experimental.interop_test.Root");
+    CHECK(error_name(ws.request(op("device", {{"device", "nosuch"}}))) == "RobotRaconteur.ServiceNotFound");
+
+    CHECK(ws.request(member("get", "p_int32"))["result"] == json{{"value", -2147483648}});
+    CHECK(ws.request(member("set", "p_int32", {{"value", 2147483647}}))["result"] == json::object());
+    CHECK(ws.request(member("get", "p_int32"))["result"] == json{{"value", 2147483647}});
+    CHECK(error_name(ws.request(member("set", "p_int32", {{"value", "x"}}))) == "RobotRaconteur.DataTypeMismatch");
+    CHECK(error_name(ws.request(member("set", "p_int32", {{"value", 3}}))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(member("get", "wo_value"))) == "RobotRaconteur.WriteOnlyMember");
+    CHECK(ws.request(member("get", "value", {{"object", "child_by_int[7]"}}))["result"] == json{{"value", 107}});
+    CHECK(error_name(ws.request(member("get", "value", {{"object", "child_by_int[8]"}}))) == "RobotRaconteur.ObjectNotFound");
+    CHECK(ws.request(member("call", "add", {{"args", {1, 2}}}))["result"] == json{{"return", 3}});
+    CHECK(ws.request(member("call", "count_up", {{"args", {1, 50}}, {"max_items", 2}}))["result"] == json{{"items", {1, 2}}});
+    CHECK(error_name(ws.request(member("call", "throw_user", {{"args", {"bad"}}}))) == "experimental.interop_test.InteropError");
+    CHECK(ws.request(member("peek", "w_both"))["result"]["value"] == json{0.0});
+
+    // Malformed requests: answered, never fatal to the socket.
+    ws.send_text("{not json");
+    auto r = ws.next();
+    REQUIRE(r);
+    CHECK((*r)["id"].is_null());
+    CHECK(error_name(*r) == "RobotRaconteur.InvalidArgument");
+    ws.send(json{{"op", "devices"}});  // no id
+    r = ws.next();
+    REQUIRE(r);
+    CHECK((*r)["id"].is_null());
+    ws.send(json::array({1, 2}));
+    r = ws.next();
+    REQUIRE(r);
+    CHECK(error_name(*r) == "RobotRaconteur.InvalidArgument");
+    ws.send_text(std::string(2u << 20, ' '));  // over max_message_bytes
+    r = ws.next();
+    REQUIRE(r);
+    CHECK(error_name(*r) == "RobotRaconteur.BufferLimitViolation");
+    auto string_id = json{{"id", "a-1"}, {"op", "devices"}};
+    ws.send(string_id);
+    r = ws.next();
+    REQUIRE(r);
+    CHECK((*r)["id"] == "a-1");
+    CHECK(error_name(ws.request(op("frobnicate"))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(op("get", {{"device", "interop"}}))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(member("set", "p_int32"))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(op("unsubscribe", {{"subscription", 99}}))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(op("send", {{"subscription", 99}, {"value", 1}}))) == "RobotRaconteur.InvalidArgument");
+    CHECK(error_name(ws.request(member("subscribe", "p_int32"))) == "RobotRaconteur.MemberNotFound");
+    CHECK(error_name(ws.request(member("subscribe", "nosuch"))) == "RobotRaconteur.MemberNotFound");
+    // Still serving.
+    CHECK(ws.request(member("get", "ro_value"))["result"] == json{{"value", 17}});
+}
+
+TEST_CASE("json socket: subscribe to wires, events and pipes; unsubscribe") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    WsClient ws(gw.port());
+
+    // Wire: pushed values with their time; a value set on demand arrives.
+    const auto state = subscribe(ws, "w_state", "wire");
+    auto first = ws.wait_push(push_of(state, "wire"));
+    REQUIRE(first);
+    CHECK((*first)["value"]["values"].is_array());
+    CHECK((*first)["time"]["seconds"].get<std::int64_t>() > 1600000000);
+    CHECK(ws.request(member("call", "update_state", {{"args", {424242}}}))["result"] == json{{"return", nullptr}});
+    auto demand = ws.wait_push([&](const json& j) {
+        return push_of(state, "wire")(j) && j["value"]["id"] == 424242;
+    });
+    REQUIRE(demand);
+    CHECK((*demand)["value"] == json{{"id", 424242}, {"label", "demand"}, {"values", {106060.5}}});
+
+    // Events, by parameter name.
+    const auto values = subscribe(ws, "ev_values", "event");
+    const auto empty = subscribe(ws, "ev_empty", "event");
+    CHECK(ws.request(member("call", "fire_events", {{"args", {3}}}))["result"] == json{{"return", nullptr}});
+    for (int seq = 0; seq < 3; ++seq) {
+        auto ev = ws.wait_push([&](const json& j) { return push_of(values, "event")(j) && j["args"]["seq"] == seq; });
+        REQUIRE(ev);
+        CHECK((*ev)["args"]["text"] == "event " + std::to_string(seq) + " \u2713");
+        CHECK((*ev)["args"]["data"] == json{{"id", seq}, {"label", "event"}, {"values", {seq * 1.5}}});
+    }
+    auto ev_empty = ws.wait_push(push_of(empty, "event"));
+    REQUIRE(ev_empty);
+    CHECK((*ev_empty)["args"] == json::object());
+
+    // Pipe: a packet sent with requestack is echoed, and acknowledged.
+    const auto echo = subscribe(ws, "p_echo", "pipe");
+    const json inner{{"id", 5}, {"label", "packet"}, {"values", {1.0, 2.0}}};
+    auto sent = ws.request(op("send", {{"subscription", echo}, {"value", inner}, {"requestack", true}}));
+    REQUIRE(sent.contains("result"));
+    const auto number = sent["result"]["packetnumber"].get<std::uint32_t>();
+    auto echoed = ws.wait_push(push_of(echo, "pipe"));
+    REQUIRE(echoed);
+    CHECK((*echoed)["value"] == inner);
+    auto ack = ws.wait_push(push_of(echo, "pipe_ack"));
+    REQUIRE(ack);
+    CHECK((*ack)["packetnumber"] == number);
+    CHECK(error_name(ws.request(op("send", {{"subscription", echo}, {"value", 1}}))) == "RobotRaconteur.DataTypeMismatch");
+    CHECK(error_name(ws.request(op("set_out_value", {{"subscription", echo}, {"value", inner}}))) ==
+          "RobotRaconteur.InvalidArgument");
+
+    // A read-only pipe: packets from the device, then closed by the device.
+    const auto stream = subscribe(ws, "p_stream", "pipe");
+    CHECK(error_name(ws.request(op("send", {{"subscription", stream}, {"value", {1.0}}}))) == "RobotRaconteur.ReadOnlyMember");
+    ws.request(member("call", "send_stream", {{"args", {3}}}));
+    for (int i = 0; i < 3; ++i) {
+        auto p = ws.wait_push([&](const json& j) { return push_of(stream, "pipe")(j) && j["value"][0] == double(i); });
+        REQUIRE(p);
+        CHECK((*p)["value"] == json{double(i), i * 0.5});
+    }
+    ws.request(member("call", "close_stream"));
+    auto closed = ws.wait_push(push_of(stream, "closed"));
+    REQUIRE(closed);
+    CHECK((*closed)["error"]["name"] == "RobotRaconteur.ConnectionError");
+    CHECK(error_name(ws.request(op("unsubscribe", {{"subscription", stream}}))) == "RobotRaconteur.InvalidArgument");
+
+    // Wires the other way: the device echoes w_both reversed; w_sink keeps the last value.
+    const auto both = subscribe(ws, "w_both", "wire");
+    CHECK(ws.request(op("set_out_value", {{"subscription", both}, {"value", {1.0, 2.0, 3.0}}}))["result"] == json::object());
+    auto reversed = ws.wait_push([&](const json& j) { return push_of(both, "wire")(j) && j["value"].size() == 3; });
+    REQUIRE(reversed);
+    CHECK((*reversed)["value"] == json{3.0, 2.0, 1.0});
+    CHECK(error_name(ws.request(op("set_out_value", {{"subscription", both}, {"value", "x"}}))) ==
+          "RobotRaconteur.DataTypeMismatch");
+    CHECK(error_name(ws.request(op("set_out_value", {{"subscription", state}, {"value", inner}}))) ==
+          "RobotRaconteur.ReadOnlyMember");
+    const auto sink = subscribe(ws, "w_sink", "wire");
+    CHECK(ws.request(op("set_out_value", {{"subscription", sink}, {"value", 77}}))["result"] == json::object());
+    json last;
+    for (int i = 0; i < 100; ++i) {
+        last = ws.request(member("call", "w_sink_value"))["result"];
+        if (last == json{{"return", 77}}) break;
+        std::this_thread::sleep_for(20ms);
+    }
+    CHECK(last == json{{"return", 77}});
+
+    // Unsubscribe: no more values for that subscription.
+    CHECK(ws.request(op("unsubscribe", {{"subscription", state}}))["result"] == json::object());
+    std::this_thread::sleep_for(100ms);  // a value already on its way may still arrive
+    ws.pushes().clear();
+    while (ws.next(50ms)) {
+    }
+    CHECK_FALSE(ws.wait_push(push_of(state, "wire"), 700ms));  // w_state ticks every 200 ms
+    CHECK(error_name(ws.request(op("unsubscribe", {{"subscription", state}}))) == "RobotRaconteur.InvalidArgument");
+    CHECK(gw.sockets().stats().at(0).subscriptions == 5);  // values, empty, echo, both, sink
+}
+
+TEST_CASE("json socket: subscriptions end with the socket; device state is pushed") {
+    if (!interop_service_built()) return;
+    auto device = std::make_unique<InteropProcess>();
+    TestGateway gw(device->url());
+    {
+        WsClient ws(gw.port());
+        subscribe(ws, "w_state", "wire");
+        subscribe(ws, "ev_values", "event");
+        subscribe(ws, "p_echo", "pipe");
+        CHECK(gw.sockets().stats().size() == 1);
+        ws.close();
+    }
+    for (int i = 0; i < 200 && !gw.sockets().stats().empty(); ++i) std::this_thread::sleep_for(10ms);
+    CHECK(gw.sockets().stats().empty());
+
+    WsClient ws(gw.port());
+    const auto echo = subscribe(ws, "p_echo", "pipe");
+    const auto state = subscribe(ws, "w_state", "wire");
+    device->stop();
+    auto down = ws.wait_push([](const json& j) { return j["kind"] == "device_state" && j["device"]["state"] != "connected"; });
+    REQUIRE(down);
+    CHECK((*down)["device"]["name"] == "interop");
+    auto closed = ws.wait_push(push_of(echo, "closed"));
+    REQUIRE(closed);
+    CHECK((*closed)["error"]["name"] == "RobotRaconteur.ConnectionError");
+    CHECK(error_name(ws.request(member("get", "p_int32"))) == "RobotRaconteur.ConnectionError");
+    CHECK(error_name(ws.request(member("subscribe", "w_state"))) == "RobotRaconteur.ConnectionError");
+    // The wire subscription stays, waiting for the device to return.
+    CHECK(gw.sockets().stats().at(0).subscriptions == 1);
+    (void)state;
+}
+
+TEST_CASE("json socket: a client that never reads stays within the queue limits") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    JsonSocketOptions options;
+    TestGateway gw(device.url(), true, options);
+    const std::size_t socket_limit = http::HttpOptions{}.json_socket_queue_limit;
+
+    // Subscribe first (reading the replies), then stop reading for good.
+    WsClient slow(gw.port(), /*read=*/true, std::string(kJsonSubprotocol), /*receive_buffer=*/4096);
+    const auto events = subscribe(slow, "ev_values", "event");
+    const auto both = subscribe(slow, "w_both", "wire");
+    const auto echo = subscribe(slow, "p_echo", "pipe");
+    slow.pause_reading();
+    WsClient never(gw.port(), /*read=*/false, std::string(kJsonSubprotocol), /*receive_buffer=*/4096);
+
+    // Large wire values and pipe packets (each echoed by the device) and many events.
+    std::vector<double> big(20000);
+    for (std::size_t i = 0; i < big.size(); ++i) big[i] = i * 0.001;
+    const json inner{{"id", 1}, {"label", "big"}, {"values", big}};
+    WsClient driver(gw.port());
+    auto observe = [&] {
+        for (const auto& s : gw.sockets().stats()) {
+            CHECK(s.queued <= socket_limit);
+            // Bounded in bytes too: pushes stop at push_bytes_limit, plus what was in flight then.
+            CHECK(s.queued_bytes <= options.push_bytes_limit + (4u << 20));
+        }
+    };
+    for (int round = 0; round < 30; ++round) {
+        slow.send(op("set_out_value", {{"subscription", both}, {"value", big}, {"id", 1000 + round}}));
+        slow.send(op("send", {{"subscription", echo}, {"value", inner}, {"id", 2000 + round}}));
+        never.send(op("devices", {{"id", 3000 + round}}));
+        if (round % 5 == 0) driver.request(member("call", "fire_events", {{"args", {500}}}));
+        observe();
+    }
+    // A healthy client is served meanwhile.
+    CHECK(driver.request(member("get", "ro_value"))["result"] == json{{"value", 17}});
+    bool limited = false;
+    for (int i = 0; i < 300 && !limited; ++i) {
+        observe();
+        for (const auto& s : gw.sockets().stats())
+            limited |= s.push_drops > 0 || s.wire_coalesced > 0 || s.pending_wires > 0;
+        std::this_thread::sleep_for(20ms);
+    }
+    CHECK(limited);  // the slow socket's pushes were dropped or coalesced instead of queued
+    observe();
+    driver.close();
+    slow.close();
+    never.close();
+    for (int i = 0; i < 300 && !gw.sockets().stats().empty(); ++i) std::this_thread::sleep_for(10ms);
+    CHECK(gw.sockets().stats().empty());
+    (void)events;
+}
+
+TEST_CASE("json socket: a disallowed Origin cannot open the socket") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), gw.port()));
+    ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
+        req.set(bhttp::field::sec_websocket_protocol, kJsonSubprotocol);
+        req.set(bhttp::field::origin, "http://evil.test");
+    }));
+    websocket::response_type res;
+    beast::error_code ec;
+    ws.handshake(res, "localhost", "/", ec);
+    CHECK(ec);
+    CHECK(res.result() == bhttp::status::forbidden);
+}
