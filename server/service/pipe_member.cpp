@@ -3,6 +3,7 @@
 #include <charconv>
 #include <limits>
 #include <optional>
+#include <thread>
 
 #include "server/service/member_support.hpp"
 
@@ -56,8 +57,16 @@ Result<std::uint32_t> PipeEndpoint::send(const Value& packet, bool request_ack) 
     entry.elements.push_back(std::move(pe));
 
     // Numbers are assigned and packets queued in one step, so the client sees them in order and never
-    // waits for a number that was refused.
+    // waits for a number that was refused. Queueing runs inline on the session's strand; should that
+    // end the session and a close handler send on this endpoint again, fail instead of deadlocking.
+    if (send_owner_.load() == std::this_thread::get_id())
+        return fail(MessageErrorType::InvalidOperation, "pipe endpoint send re-entered from a handler");
     std::lock_guard lock(send_mutex_);
+    send_owner_.store(std::this_thread::get_id());
+    struct Release {
+        std::atomic<std::thread::id>& owner;
+        ~Release() { owner.store(std::thread::id()); }
+    } release{send_owner_};
     const std::size_t queued = session_.queued_bytes();
     if (queued > member->max_backlog_bytes())
         return fail(MessageErrorType::BufferLimitViolation,

@@ -27,6 +27,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "server/service/service_object.hpp"
@@ -65,6 +66,7 @@ private:
     const bool unreliable_;
     std::atomic<bool> open_{true};
     std::mutex send_mutex_;  // packet numbers are assigned and queued in one step
+    std::atomic<std::thread::id> send_owner_{};
     std::uint32_t send_number_ = 0;
 };
 

@@ -607,7 +607,9 @@ void ServerConnection::handle_session_entry(const MessageHeader& h, MessageEntry
         return;
     }
     if (session_->service()->requires_authentication() && !authenticated_) {
-        reply_session(error_reply(e, make_error(MessageErrorType::AuthenticationError, "User not authenticated")));
+        // CORE (ServerContext::ProcessMessageEntry, requirevaliduser): PermissionDenied until the user logs in.
+        reply_session(error_reply(e, make_error(MessageErrorType::PermissionDenied,
+                                                "User must authenticate before accessing this service")));
         return;
     }
     auto service = session_->service();

@@ -350,10 +350,11 @@ Result<void> ServiceObject::fire_event(std::string_view event, std::vector<Value
     if (!b.service || b.paths.empty()) return {};
     const auto sessions = b.service->sessions();
     Result<void> result;
-    for (const auto& path : b.paths) {
-        entry.service_path = path;
-        for (const auto& session : sessions) {
-            auto r = session.send(entry);
+    for (std::size_t p = 0; p < b.paths.size(); ++p) {
+        entry.service_path = b.paths[p];
+        for (std::size_t i = 0; i < sessions.size(); ++i) {
+            const bool last = p + 1 == b.paths.size() && i + 1 == sessions.size();
+            auto r = sessions[i].send(last ? std::move(entry) : entry);  // copies share the packed data
             if (!r && r.error().type == MessageErrorType::BufferLimitViolation && result.ok()) result = r.take_error();
         }
     }

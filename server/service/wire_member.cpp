@@ -147,10 +147,10 @@ Result<void> WireMember::set_out_value(Value value) {
         targets.reserve(connections_.size());
         for (const auto& [k, c] : connections_) targets.push_back(c);
     }
-    for (const auto& c : targets) {
-        MessageEntry e = *entry;
-        e.service_path = c->service_path();
-        (void)c->session().send_wire_packet(std::move(e));  // newest wins; a gone client is dropped on close
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+        MessageEntry e = i + 1 == targets.size() ? std::move(*entry) : *entry;  // copies share the packed data
+        e.service_path = targets[i]->service_path();
+        (void)targets[i]->session().send_wire_packet(std::move(e));  // newest wins; a gone client is dropped on close
     }
     return {};
 }
