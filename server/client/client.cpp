@@ -1,0 +1,858 @@
+#include "server/client/client.hpp"
+
+#include <map>
+#include <random>
+
+#include <boost/asio/ip/tcp.hpp>
+
+#include "server/client/tcp_connector.hpp"
+
+namespace rr::client {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+using namespace std::chrono_literals;
+using server::connect_tcp;
+using server::mono_now;
+using server::StreamPump;
+
+namespace {
+
+std::uint32_t random_u32() {
+    static thread_local std::mt19937 rng{std::random_device{}()};
+    std::uint32_t v;
+    do v = rng();
+    while (v == 0);
+    return v;
+}
+
+NodeID random_node_id() {
+    NodeID::Bytes b{};
+    for (std::size_t i = 0; i < 16; i += 4) {
+        auto v = random_u32();
+        for (std::size_t k = 0; k < 4; ++k) b[i + k] = static_cast<std::byte>((v >> (8 * k)) & 0xFF);
+    }
+    b[6] = static_cast<std::byte>((static_cast<unsigned>(b[6]) & 0x0F) | 0x40);
+    b[8] = static_cast<std::byte>((static_cast<unsigned>(b[8]) & 0x3F) | 0x80);
+    return NodeID(b);
+}
+
+// rr+tcp: resolve, connect (TCP_NODELAY), then a StreamPump over the socket.
+void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
+                   std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done) {
+    connect_tcp(strand, url.host, url.port, options.connect_timeout,
+                [strand, logic = std::move(logic), done = std::move(done)](Result<tcp::socket> socket) mutable {
+                    if (!socket) return done(socket.take_error());
+                    auto pump = std::make_shared<StreamPump<tcp::socket>>(std::move(*socket), strand, logic);
+                    done(std::shared_ptr<PumpHandle>(pump));
+                    pump->start();
+                });
+}
+
+struct TransportRegistry {
+    std::mutex mutex;
+    std::map<std::string, ClientTransport, std::less<>> transports{{"rr+tcp", tcp_transport}, {"tcp", tcp_transport}};
+};
+
+TransportRegistry& registry() {
+    static TransportRegistry r;
+    return r;
+}
+
+ClientTransport find_transport(std::string_view scheme) {
+    auto& r = registry();
+    std::lock_guard lock(r.mutex);
+    auto it = r.transports.find(scheme);
+    return it == r.transports.end() ? ClientTransport{} : it->second;
+}
+
+}  // namespace
+
+void register_client_transport(std::string scheme, ClientTransport transport) {
+    auto& r = registry();
+    std::lock_guard lock(r.mutex);
+    r.transports[std::move(scheme)] = std::move(transport);
+}
+
+TimeSpec wall_clock_now() {
+    auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    TimeSpec t;
+    t.seconds = ns / 1'000'000'000;
+    t.nanoseconds = static_cast<std::int32_t>(ns % 1'000'000'000);
+    if (t.nanoseconds < 0) {
+        t.nanoseconds += 1'000'000'000;
+        --t.seconds;
+    }
+    return t;
+}
+
+// --- IoThreads -------------------------------------------------------------------------------------
+
+IoThreads::IoThreads(unsigned threads) : work_(io_.get_executor()) {
+    if (threads == 0) threads = 1;
+    for (unsigned i = 0; i < threads; ++i) threads_.emplace_back([this] { io_.run(); });
+}
+
+IoThreads::~IoThreads() {
+    work_.reset();
+    io_.stop();
+    for (auto& t : threads_) t.join();
+}
+
+// --- Client ----------------------------------------------------------------------------------------
+
+/// The strand-side half: owns the ClientContext.
+class Client::Logic : public ConnectionLogic {
+public:
+    explicit Logic(ClientContextConfig config) : ctx(std::move(config), mono_now()) {}
+    void on_bytes(std::span<const std::byte> bytes, MonoTime now) override { (void)ctx.feed(bytes, now); }
+    bool has_output() const override { return ctx.pending_output_size() != 0; }
+    void take_output(std::vector<std::byte>& out) override { ctx.take_output(out); }
+    std::optional<MonoTime> next_deadline() const override { return ctx.next_deadline(); }
+    void on_timer(MonoTime now) override { ctx.on_timer(now); }
+    bool wants_close() const override { return ctx.is_closed(); }
+    void on_transport_closed(RRError error) override { ctx.on_transport_closed(std::move(error)); }
+
+    ClientContext ctx;
+    std::function<void(const RRError&)> user_closed;  // strand only
+};
+
+void Client::connect(asio::any_io_executor executor, std::string_view url_text, ClientOptions options,
+                     ConnectHandler done) {
+    auto url = parse_connection_url(url_text);
+    if (!url) return done(url.take_error());
+    if (url->service.empty())
+        return done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + std::string(url_text)));
+    auto transport = find_transport(url->scheme);
+    if (!transport)
+        return done(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
+
+    ClientContextConfig cfg;
+    cfg.session.stream.local_node_id = options.local_node_id.is_any() ? random_node_id() : options.local_node_id;
+    cfg.session.stream.local_node_name = options.local_node_name;
+    cfg.session.stream.target_node_id = url->node_id;
+    cfg.session.stream.target_node_name = url->node_name;
+    cfg.session.stream.enable_message4 = options.enable_message4;
+    cfg.session.stream.enable_string_table = options.enable_string_table;
+    cfg.session.stream.heartbeat_period = options.heartbeat_period;
+    cfg.session.stream.receive_timeout = options.receive_timeout;
+    cfg.session.stream.limits = options.limits;
+    cfg.session.service_name = url->service;
+    cfg.session.username = options.username;
+    cfg.session.password = options.password;
+    cfg.session.request_timeout = options.request_timeout;
+    cfg.session.local_endpoint = random_u32();
+    cfg.memory_max_transfer_size = options.memory_max_transfer_size;
+
+    std::shared_ptr<Client> client(new Client());
+    client->strand_.emplace(asio::make_strand(executor));
+    client->wait_limit_ = options.request_timeout + 5s;
+    auto logic = std::make_shared<Logic>(std::move(cfg));
+    client->logic_ = logic;
+    std::weak_ptr<Client> weak = client;
+    Logic* lp = logic.get();
+    // The connect handler holds the client until the connect completes (the context then drops it).
+    logic->ctx.set_connect_handler([client, lp, done](Result<ObjectRef> r) mutable {
+        auto c = std::move(client);
+        if (!r) return done(r.take_error());
+        c->info_ = lp->ctx.info();
+        c->root_ = *r;
+        c->remote_node_id_ = lp->ctx.session().stream().negotiated().remote_node_id;
+        c->open_.store(true);
+        done(std::move(c));
+    });
+    logic->ctx.set_closed_handler([weak, lp](const RRError& e) {
+        auto h = std::move(lp->user_closed);
+        if (auto c = weak.lock()) {
+            c->open_.store(false);
+            c->closed_promise_->set_value();
+        }
+        if (h) h(e);
+    });
+    transport(*client->strand_, *url, options, logic,
+              [client, logic](Result<std::shared_ptr<PumpHandle>> pump) mutable {
+                  if (!pump) {
+                      auto h = std::move(client);
+                      // Never connected: hand the error to the connect handler (and drop it).
+                      ClientContext& ctx = logic->ctx;
+                      ctx.on_transport_closed(pump.error());
+                      return;
+                  }
+                  client->pump_ = *pump;
+              });
+}
+
+Result<std::shared_ptr<Client>> Client::connect(asio::any_io_executor executor, std::string_view url,
+                                                ClientOptions options) {
+    auto timeout = options.connect_timeout + options.request_timeout + 5s;
+    auto w = std::make_shared<detail::SyncWaiter<std::shared_ptr<Client>>>();
+    auto f = w->promise.get_future();
+    connect(executor, url, std::move(options), [w](Result<std::shared_ptr<Client>> r) { w->set(std::move(r)); });
+    w.reset();
+    if (f.wait_for(timeout) != std::future_status::ready)
+        return fail(MessageErrorType::ConnectionError, "connect timed out");
+    return f.get();
+}
+
+Client::~Client() {
+    if (auto pump = pump_.lock()) {
+        auto logic = logic_;
+        pump->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
+    }
+}
+
+ObjectProxy Client::root() { return ObjectProxy(shared_from_this(), root_); }
+
+ObjectProxy Client::object(ObjectRef ref) { return ObjectProxy(shared_from_this(), std::move(ref)); }
+
+void Client::set_closed_handler(std::function<void(const RRError&)> handler) {
+    run([handler = std::move(handler), logic = logic_](ClientContext&, MonoTime) mutable {
+        logic->user_closed = std::move(handler);
+    });
+}
+
+void Client::close() {
+    run([](ClientContext& ctx, MonoTime now) { ctx.disconnect(now); });
+}
+
+Result<void> Client::close_wait(std::chrono::milliseconds timeout) {
+    if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
+    close();
+    if (!pump_.lock() && !open_.load()) return {};
+    if (closed_future_.wait_for(timeout) != std::future_status::ready && open_.load())
+        return fail(MessageErrorType::OperationTimeout, "connection did not close in time");
+    return {};
+}
+
+void Client::run(std::function<void(ClientContext&, MonoTime)> fn) {
+    auto pump = pump_.lock();
+    if (!pump) return;
+    auto logic = logic_;
+    pump->dispatch([logic, fn = std::move(fn)] { fn(logic->ctx, mono_now()); });
+}
+
+namespace {
+
+Unexpected no_client() { return fail(MessageErrorType::InvalidOperation, "empty object proxy"); }
+
+// Calls `done` exactly once: with the operation's result, or with ConnectionError when the connection
+// is gone before the operation could start (the guard is dropped uncalled).
+template <class T>
+class AsyncGuard {
+public:
+    explicit AsyncGuard(Completion<T> done) : done_(std::move(done)) {}
+    ~AsyncGuard() {
+        if (done_) done_(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    }
+    void operator()(Result<T> r) {
+        if (auto d = std::exchange(done_, nullptr)) d(std::move(r));
+    }
+
+private:
+    Completion<T> done_;
+};
+
+template <class T, class Start>
+void async_op(Client& c, Completion<T> done, Start start) {
+    auto guard = std::make_shared<AsyncGuard<T>>(std::move(done));
+    c.run([guard, start = std::move(start)](ClientContext& ctx, MonoTime now) mutable {
+        start(ctx, now, [guard](Result<T> r) { (*guard)(std::move(r)); });
+    });
+}
+
+}  // namespace
+
+// --- Generator -------------------------------------------------------------------------------------
+
+Result<Value> Generator::next(std::optional<Value> parameter) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no generator");
+    auto h = handle_;
+    return client_->wait<Value>([h, parameter = std::move(parameter)](ClientContext& ctx, MonoTime now,
+                                                                       Completion<Value> done) mutable {
+        ctx.generator_next(h, std::move(parameter), now, std::move(done));
+    });
+}
+
+void Generator::async_next(std::optional<Value> parameter, Completion<Value> done) {
+    if (!client_) return done(fail(MessageErrorType::InvalidOperation, "no generator"));
+    auto h = handle_;
+    async_op<Value>(*client_, std::move(done), [h, parameter = std::move(parameter)](ClientContext& ctx, MonoTime now,
+                                                                                      Completion<Value> d) mutable {
+        ctx.generator_next(h, std::move(parameter), now, std::move(d));
+    });
+}
+
+Result<std::vector<Value>> Generator::next_all() {
+    std::vector<Value> out;
+    for (;;) {
+        auto v = next();
+        if (!v) {
+            if (v.error().type == MessageErrorType::StopIteration) return out;
+            return v.take_error();
+        }
+        out.push_back(std::move(*v));
+    }
+}
+
+Result<void> Generator::close() {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no generator");
+    auto h = handle_;
+    return client_->wait<void>(
+        [h](ClientContext& ctx, MonoTime now, Completion<void> done) { ctx.generator_close(h, now, std::move(done)); });
+}
+
+Result<void> Generator::abort() {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no generator");
+    auto h = handle_;
+    return client_->wait<void>(
+        [h](ClientContext& ctx, MonoTime now, Completion<void> done) { ctx.generator_abort(h, now, std::move(done)); });
+}
+
+// --- PipeEndpoint ----------------------------------------------------------------------------------
+
+struct PipeEndpoint::State {
+    mutable std::mutex mutex;
+    mutable std::condition_variable cv;
+    std::deque<Value> packets;
+    std::vector<std::uint32_t> acks;
+    bool closed = false;
+    RRError close_error;
+    PipeEndpointHandle handle;
+    // strand only
+    std::function<void(Value&&)> on_packet;
+    std::function<void(const RRError&)> on_closed;
+};
+
+Result<std::uint32_t> PipeEndpoint::send(Value packet) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no pipe endpoint");
+    auto h = state_->handle;
+    return client_->query<std::uint32_t>([h, packet = std::move(packet)](ClientContext& ctx, MonoTime now) {
+        return ctx.pipe_send(h, packet, now);
+    });
+}
+
+void PipeEndpoint::async_send(Value packet, Completion<std::uint32_t> done) {
+    if (!client_) return done(fail(MessageErrorType::InvalidOperation, "no pipe endpoint"));
+    auto h = state_->handle;
+    async_op<std::uint32_t>(*client_, std::move(done), [h, packet = std::move(packet)](ClientContext& ctx, MonoTime now,
+                                                                                        Completion<std::uint32_t> d) {
+        d(ctx.pipe_send(h, packet, now));
+    });
+}
+
+Result<void> PipeEndpoint::set_request_ack(bool request_ack) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no pipe endpoint");
+    auto h = state_->handle;
+    return client_->query<void>([h, request_ack](ClientContext& ctx, MonoTime) { return ctx.set_pipe_request_ack(h, request_ack); });
+}
+
+Result<Value> PipeEndpoint::receive(std::chrono::milliseconds timeout) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no pipe endpoint");
+    if (client_->on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking receive on the client's strand");
+    std::unique_lock lock(state_->mutex);
+    state_->cv.wait_for(lock, timeout, [&] { return !state_->packets.empty() || state_->closed; });
+    if (!state_->packets.empty()) {
+        Value v = std::move(state_->packets.front());
+        state_->packets.pop_front();
+        return v;
+    }
+    if (state_->closed) return fail(MessageErrorType::ConnectionError, "pipe endpoint closed: " + state_->close_error.message);
+    return fail(MessageErrorType::OperationTimeout, "no pipe packet in time");
+}
+
+std::optional<Value> PipeEndpoint::try_receive() {
+    if (!state_) return std::nullopt;
+    std::lock_guard lock(state_->mutex);
+    if (state_->packets.empty()) return std::nullopt;
+    Value v = std::move(state_->packets.front());
+    state_->packets.pop_front();
+    return v;
+}
+
+std::size_t PipeEndpoint::available() const {
+    if (!state_) return 0;
+    std::lock_guard lock(state_->mutex);
+    return state_->packets.size();
+}
+
+std::vector<std::uint32_t> PipeEndpoint::acks() const {
+    if (!state_) return {};
+    std::lock_guard lock(state_->mutex);
+    return state_->acks;
+}
+
+Result<void> PipeEndpoint::wait_acks(std::size_t n, std::chrono::milliseconds timeout) const {
+    if (!state_) return fail(MessageErrorType::InvalidOperation, "no pipe endpoint");
+    std::unique_lock lock(state_->mutex);
+    if (!state_->cv.wait_for(lock, timeout, [&] { return state_->acks.size() >= n; }))
+        return fail(MessageErrorType::OperationTimeout, std::to_string(state_->acks.size()) + " of " + std::to_string(n) + " acks in time");
+    return {};
+}
+
+bool PipeEndpoint::is_closed() const {
+    if (!state_) return true;
+    std::lock_guard lock(state_->mutex);
+    return state_->closed;
+}
+
+Result<void> PipeEndpoint::wait_closed(std::chrono::milliseconds timeout) const {
+    if (!state_) return {};
+    std::unique_lock lock(state_->mutex);
+    if (!state_->cv.wait_for(lock, timeout, [&] { return state_->closed; }))
+        return fail(MessageErrorType::OperationTimeout, "pipe endpoint not closed in time");
+    return {};
+}
+
+void PipeEndpoint::set_packet_handler(std::function<void(Value&&)> handler) {
+    if (!client_) return;
+    client_->run([st = state_, handler = std::move(handler)](ClientContext&, MonoTime) mutable {
+        st->on_packet = std::move(handler);
+        if (!st->on_packet) return;
+        std::deque<Value> queued;
+        {
+            std::lock_guard lock(st->mutex);
+            queued.swap(st->packets);
+        }
+        for (auto& v : queued) st->on_packet(std::move(v));
+    });
+}
+
+void PipeEndpoint::set_closed_handler(std::function<void(const RRError&)> handler) {
+    if (!client_) return;
+    client_->run([st = state_, handler = std::move(handler)](ClientContext&, MonoTime) mutable {
+        st->on_closed = std::move(handler);
+    });
+}
+
+Result<void> PipeEndpoint::close() {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no pipe endpoint");
+    auto h = state_->handle;
+    return client_->wait<void>(
+        [h](ClientContext& ctx, MonoTime now, Completion<void> done) { ctx.pipe_close(h, now, std::move(done)); });
+}
+
+// --- WireConnection --------------------------------------------------------------------------------
+
+struct WireConnection::State {
+    static constexpr std::size_t kRecent = 256;
+    mutable std::mutex mutex;
+    mutable std::condition_variable cv;
+    std::deque<std::shared_ptr<const WireValue>> recent;
+    std::uint64_t seq = 0;  ///< values received so far
+    bool closed = false;
+    RRError close_error;
+    WireConnectionHandle handle;
+    // strand only
+    std::function<void(const WireValue&)> on_value;
+    std::function<void(const RRError&)> on_closed;
+};
+
+Result<WireValue> WireConnection::in_value() const {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    auto h = state_->handle;
+    return client_->query<WireValue>([h](ClientContext& ctx, MonoTime now) { return ctx.wire_in_value(h, now); });
+}
+
+Result<WireValue> WireConnection::out_value() const {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    auto h = state_->handle;
+    return client_->query<WireValue>([h](ClientContext& ctx, MonoTime now) { return ctx.wire_out_value(h, now); });
+}
+
+Result<void> WireConnection::set_out_value(Value value) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    auto h = state_->handle;
+    return client_->query<void>([h, value = std::move(value)](ClientContext& ctx, MonoTime now) {
+        return ctx.wire_set_out_value(h, value, wall_clock_now(), now);
+    });
+}
+
+Result<void> WireConnection::set_lifespans(std::int32_t in_ms, std::int32_t out_ms) {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    auto h = state_->handle;
+    return client_->query<void>(
+        [h, in_ms, out_ms](ClientContext& ctx, MonoTime) { return ctx.set_wire_lifespans(h, in_ms, out_ms); });
+}
+
+Result<WireValue> WireConnection::wait_value(std::function<bool(const WireValue&)> pred, std::chrono::milliseconds timeout,
+                                             std::optional<std::uint64_t> after) const {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    if (client_->on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking wait on the client's strand");
+    auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::unique_lock lock(state_->mutex);
+    std::uint64_t checked = after ? std::min(*after, state_->seq) : state_->seq;  // values numbered 1..seq
+    for (;;) {
+        const std::uint64_t first = state_->seq - state_->recent.size() + 1;  // number of recent.front()
+        for (std::uint64_t n = std::max(checked + 1, first); n <= state_->seq; ++n) {
+            const auto& v = state_->recent[static_cast<std::size_t>(n - first)];
+            if (pred(*v)) return *v;
+        }
+        checked = state_->seq;
+        if (state_->closed) return fail(MessageErrorType::ConnectionError, "wire connection closed: " + state_->close_error.message);
+        if (state_->cv.wait_until(lock, deadline) == std::cv_status::timeout && state_->seq == checked)
+            return fail(MessageErrorType::OperationTimeout, "no matching wire value in time");
+    }
+}
+
+std::uint64_t WireConnection::values_received() const {
+    if (!state_) return 0;
+    std::lock_guard lock(state_->mutex);
+    return state_->seq;
+}
+
+void WireConnection::set_value_handler(std::function<void(const WireValue&)> handler) {
+    if (!client_) return;
+    client_->run([st = state_, handler = std::move(handler)](ClientContext&, MonoTime) mutable {
+        st->on_value = std::move(handler);
+    });
+}
+
+void WireConnection::set_closed_handler(std::function<void(const RRError&)> handler) {
+    if (!client_) return;
+    client_->run([st = state_, handler = std::move(handler)](ClientContext&, MonoTime) mutable {
+        st->on_closed = std::move(handler);
+    });
+}
+
+bool WireConnection::is_closed() const {
+    if (!state_) return true;
+    std::lock_guard lock(state_->mutex);
+    return state_->closed;
+}
+
+Result<void> WireConnection::wait_closed(std::chrono::milliseconds timeout) const {
+    if (!state_) return {};
+    std::unique_lock lock(state_->mutex);
+    if (!state_->cv.wait_for(lock, timeout, [&] { return state_->closed; }))
+        return fail(MessageErrorType::OperationTimeout, "wire connection not closed in time");
+    return {};
+}
+
+Result<void> WireConnection::close() {
+    if (!client_) return fail(MessageErrorType::InvalidOperation, "no wire connection");
+    auto h = state_->handle;
+    return client_->wait<void>(
+        [h](ClientContext& ctx, MonoTime now, Completion<void> done) { ctx.wire_close(h, now, std::move(done)); });
+}
+
+// --- ObjectProxy -----------------------------------------------------------------------------------
+
+
+Result<Value> ObjectProxy::get(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<Value>([p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now, Completion<Value> done) {
+        ctx.property_get(p, m, now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::set(std::string_view member, Value value) const {
+    if (!client_) return no_client();
+    return client_->wait<void>([p = ref_.path, m = std::string(member), value = std::move(value)](
+                                   ClientContext& ctx, MonoTime now, Completion<void> done) mutable {
+        ctx.property_set(p, m, std::move(value), now, std::move(done));
+    });
+}
+
+Result<Value> ObjectProxy::call(std::string_view member, std::vector<Value> args) const {
+    if (!client_) return no_client();
+    return client_->wait<Value>([p = ref_.path, m = std::string(member), args = std::move(args)](
+                                    ClientContext& ctx, MonoTime now, Completion<Value> done) mutable {
+        ctx.call(p, m, std::move(args), now, std::move(done));
+    });
+}
+
+Result<Generator> ObjectProxy::generator(std::string_view member, std::vector<Value> args) const {
+    if (!client_) return no_client();
+    auto h = client_->wait<GeneratorHandle>([p = ref_.path, m = std::string(member), args = std::move(args)](
+                                                ClientContext& ctx, MonoTime now, Completion<GeneratorHandle> done) mutable {
+        ctx.call_generator(p, m, std::move(args), now, std::move(done));
+    });
+    if (!h) return h.take_error();
+    return Generator(client_, *h);
+}
+
+Result<ObjectProxy> ObjectProxy::objref(std::string_view member, ObjRefIndex index) const {
+    if (!client_) return no_client();
+    auto r = client_->wait<ObjectRef>([p = ref_.path, m = std::string(member), index = std::move(index)](
+                                          ClientContext& ctx, MonoTime now, Completion<ObjectRef> done) mutable {
+        ctx.objref(p, m, std::move(index), now, std::move(done));
+    });
+    if (!r) return r.take_error();
+    return ObjectProxy(client_, std::move(*r));
+}
+
+Result<std::uint64_t> ObjectProxy::subscribe(std::string_view member, EventHandler handler) const {
+    if (!client_) return no_client();
+    return client_->query<std::uint64_t>([p = ref_.path, m = std::string(member), handler = std::move(handler)](
+                                             ClientContext& ctx, MonoTime) { return ctx.subscribe_event(p, m, handler); });
+}
+
+void ObjectProxy::unsubscribe(std::uint64_t subscription) const {
+    if (!client_) return;
+    client_->run([subscription](ClientContext& ctx, MonoTime) { ctx.unsubscribe_event(subscription); });
+}
+
+Result<void> ObjectProxy::set_callback(std::string_view member, CallbackHandler handler) const {
+    if (!client_) return no_client();
+    return client_->query<void>([p = ref_.path, m = std::string(member), handler = std::move(handler)](
+                                    ClientContext& ctx, MonoTime) { return ctx.set_callback(p, m, handler); });
+}
+
+Result<PipeEndpoint> ObjectProxy::pipe_connect(std::string_view member, std::int32_t index) const {
+    if (!client_) return no_client();
+    auto client = client_;
+    return client_->wait<PipeEndpoint>([client, p = ref_.path, m = std::string(member), index](
+                                           ClientContext& ctx, MonoTime now, Completion<PipeEndpoint> done) {
+        ClientContext* cp = &ctx;
+        ctx.pipe_connect(p, m, index, now, [client, cp, done = std::move(done)](Result<PipeEndpointHandle> h) {
+            if (!h) return done(h.take_error());
+            // On the strand, in the same turn as the connect: no packet can slip past the handlers.
+            auto st = std::make_shared<PipeEndpoint::State>();
+            st->handle = *h;
+            std::weak_ptr<PipeEndpoint::State> weak = st;
+            auto drain = [cp, weak](PipeEndpointHandle ep) {
+                auto s = weak.lock();
+                if (!s) return;
+                while (auto v = cp->pipe_receive(ep)) {
+                    if (s->on_packet) {
+                        s->on_packet(std::move(*v));
+                    } else {
+                        std::lock_guard lock(s->mutex);
+                        s->packets.push_back(std::move(*v));
+                    }
+                }
+                s->cv.notify_all();
+            };
+            PipeEndpointHandlers handlers;
+            handlers.packets = drain;
+            handlers.ack = [weak](PipeEndpointHandle, std::uint32_t n) {
+                auto s = weak.lock();
+                if (!s) return;
+                {
+                    std::lock_guard lock(s->mutex);
+                    s->acks.push_back(n);
+                }
+                s->cv.notify_all();
+            };
+            handlers.closed = [weak](PipeEndpointHandle, const RRError& e) {
+                auto s = weak.lock();
+                if (!s) return;
+                {
+                    std::lock_guard lock(s->mutex);
+                    s->closed = true;
+                    s->close_error = e;
+                }
+                s->cv.notify_all();
+                if (auto f = s->on_closed) f(e);
+            };
+            (void)cp->set_pipe_handlers(*h, std::move(handlers));
+            drain(*h);  // packets that came before the PipeConnectRet
+            PipeEndpoint ep;
+            ep.client_ = client;
+            ep.state_ = std::move(st);
+            ep.info_ = cp->pipe_info(*h).value();
+            done(std::move(ep));
+        });
+    });
+}
+
+Result<WireConnection> ObjectProxy::wire_connect(std::string_view member) const {
+    if (!client_) return no_client();
+    auto client = client_;
+    return client_->wait<WireConnection>([client, p = ref_.path, m = std::string(member)](
+                                             ClientContext& ctx, MonoTime now, Completion<WireConnection> done) {
+        ClientContext* cp = &ctx;
+        ctx.wire_connect(p, m, now, [client, cp, done = std::move(done)](Result<WireConnectionHandle> h) {
+            if (!h) return done(h.take_error());
+            auto st = std::make_shared<WireConnection::State>();
+            st->handle = *h;
+            std::weak_ptr<WireConnection::State> weak = st;
+            WireConnectionHandlers handlers;
+            handlers.value = [weak](WireConnectionHandle, const WireValue& v) {
+                auto s = weak.lock();
+                if (!s) return;
+                {
+                    std::lock_guard lock(s->mutex);
+                    s->recent.push_back(std::make_shared<const WireValue>(v));
+                    if (s->recent.size() > WireConnection::State::kRecent) s->recent.pop_front();
+                    ++s->seq;
+                }
+                s->cv.notify_all();
+                if (auto f = s->on_value) f(v);
+            };
+            handlers.closed = [weak](WireConnectionHandle, const RRError& e) {
+                auto s = weak.lock();
+                if (!s) return;
+                {
+                    std::lock_guard lock(s->mutex);
+                    s->closed = true;
+                    s->close_error = e;
+                }
+                s->cv.notify_all();
+                if (auto f = s->on_closed) f(e);
+            };
+            (void)cp->set_wire_handlers(*h, std::move(handlers));
+            // A value that came before the WireConnectRet counts as received.
+            if (auto v = cp->wire_in_value(*h, cp->now())) {
+                std::lock_guard lock(st->mutex);
+                st->recent.push_back(std::make_shared<const WireValue>(std::move(*v)));
+                ++st->seq;
+            }
+            WireConnection wc;
+            wc.client_ = client;
+            wc.state_ = std::move(st);
+            wc.info_ = cp->wire_info(*h).value();
+            done(std::move(wc));
+        });
+    });
+}
+
+Result<WireValue> ObjectProxy::peek_in_value(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<WireValue>([p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                                             Completion<WireValue> done) {
+        ctx.wire_peek_in_value(p, m, now, std::move(done));
+    });
+}
+
+Result<WireValue> ObjectProxy::peek_out_value(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<WireValue>([p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                                             Completion<WireValue> done) {
+        ctx.wire_peek_out_value(p, m, now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::poke_out_value(std::string_view member, Value value) const {
+    if (!client_) return no_client();
+    return client_->wait<void>([p = ref_.path, m = std::string(member), value = std::move(value)](
+                                   ClientContext& ctx, MonoTime now, Completion<void> done) mutable {
+        ctx.wire_poke_out_value(p, m, std::move(value), wall_clock_now(), now, std::move(done));
+    });
+}
+
+Result<std::uint64_t> ObjectProxy::memory_length(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<std::uint64_t>([p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                                                 Completion<std::uint64_t> done) {
+        ctx.memory_length(p, m, now, std::move(done));
+    });
+}
+
+Result<std::uint64_t> ObjectProxy::memory_dim_count(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<std::uint64_t>([p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                                                 Completion<std::uint64_t> done) {
+        ctx.memory_dim_count(p, m, now, std::move(done));
+    });
+}
+
+Result<std::vector<std::uint64_t>> ObjectProxy::memory_dimensions(std::string_view member) const {
+    if (!client_) return no_client();
+    return client_->wait<std::vector<std::uint64_t>>(
+        [p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                 Completion<std::vector<std::uint64_t>> done) {
+            ctx.memory_dimensions(p, m, now, std::move(done));
+        });
+}
+
+Result<Value> ObjectProxy::memory_read(std::string_view member, std::uint64_t pos, std::uint64_t count) const {
+    if (!client_) return no_client();
+    return client_->wait<Value>([p = ref_.path, m = std::string(member), pos, count](ClientContext& ctx, MonoTime now,
+                                                                                     Completion<Value> done) {
+        ctx.memory_read(p, m, pos, count, now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::memory_write(std::string_view member, std::uint64_t pos, Value data) const {
+    if (!client_) return no_client();
+    return client_->wait<void>([p = ref_.path, m = std::string(member), pos, data = std::move(data)](
+                                   ClientContext& ctx, MonoTime now, Completion<void> done) mutable {
+        ctx.memory_write(p, m, pos, std::move(data), now, std::move(done));
+    });
+}
+
+Result<Value> ObjectProxy::memory_read(std::string_view member, std::vector<std::uint64_t> pos,
+                                       std::vector<std::uint64_t> count) const {
+    if (!client_) return no_client();
+    return client_->wait<Value>([p = ref_.path, m = std::string(member), pos = std::move(pos), count = std::move(count)](
+                                    ClientContext& ctx, MonoTime now, Completion<Value> done) mutable {
+        ctx.memory_read(p, m, std::move(pos), std::move(count), now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::memory_write(std::string_view member, std::vector<std::uint64_t> pos, Value data) const {
+    if (!client_) return no_client();
+    return client_->wait<void>([p = ref_.path, m = std::string(member), pos = std::move(pos), data = std::move(data)](
+                                   ClientContext& ctx, MonoTime now, Completion<void> done) mutable {
+        ctx.memory_write(p, m, std::move(pos), std::move(data), now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::monitor_enter(std::int32_t timeout_ms) const {
+    if (!client_) return no_client();
+    return client_->wait<void>([p = ref_.path, timeout_ms](ClientContext& ctx, MonoTime now, Completion<void> done) {
+        ctx.monitor_enter(p, timeout_ms, now, std::move(done));
+    });
+}
+
+Result<void> ObjectProxy::monitor_exit() const {
+    if (!client_) return no_client();
+    return client_->wait<void>(
+        [p = ref_.path](ClientContext& ctx, MonoTime now, Completion<void> done) { ctx.monitor_exit(p, now, std::move(done)); });
+}
+
+void ObjectProxy::async_get(std::string_view member, Completion<Value> done) const {
+    if (!client_) return done(no_client());
+    async_op<Value>(*client_, std::move(done), [p = ref_.path, m = std::string(member)](ClientContext& ctx, MonoTime now,
+                                                                                         Completion<Value> d) {
+        ctx.property_get(p, m, now, std::move(d));
+    });
+}
+
+void ObjectProxy::async_set(std::string_view member, Value value, Completion<void> done) const {
+    if (!client_) return done(no_client());
+    async_op<void>(*client_, std::move(done), [p = ref_.path, m = std::string(member), value = std::move(value)](
+                                                  ClientContext& ctx, MonoTime now, Completion<void> d) mutable {
+        ctx.property_set(p, m, std::move(value), now, std::move(d));
+    });
+}
+
+void ObjectProxy::async_call(std::string_view member, std::vector<Value> args, Completion<Value> done) const {
+    if (!client_) return done(no_client());
+    async_op<Value>(*client_, std::move(done), [p = ref_.path, m = std::string(member), args = std::move(args)](
+                                                   ClientContext& ctx, MonoTime now, Completion<Value> d) mutable {
+        ctx.call(p, m, std::move(args), now, std::move(d));
+    });
+}
+
+void ObjectProxy::async_objref(std::string_view member, ObjRefIndex index, Completion<ObjectProxy> done) const {
+    if (!client_) return done(no_client());
+    async_op<ObjectProxy>(*client_, std::move(done),
+                          [client = client_, p = ref_.path, m = std::string(member), index = std::move(index)](
+                              ClientContext& ctx, MonoTime now, Completion<ObjectProxy> d) mutable {
+                              ctx.objref(p, m, std::move(index), now, [client, d = std::move(d)](Result<ObjectRef> r) {
+                                  if (!r) return d(r.take_error());
+                                  d(ObjectProxy(client, std::move(*r)));
+                              });
+                          });
+}
+
+void ObjectProxy::async_peek_in_value(std::string_view member, Completion<WireValue> done) const {
+    if (!client_) return done(no_client());
+    async_op<WireValue>(*client_, std::move(done), [p = ref_.path, m = std::string(member)](
+                                                       ClientContext& ctx, MonoTime now, Completion<WireValue> d) {
+        ctx.wire_peek_in_value(p, m, now, std::move(d));
+    });
+}
+
+void ObjectProxy::async_memory_read(std::string_view member, std::uint64_t pos, std::uint64_t count,
+                                    Completion<Value> done) const {
+    if (!client_) return done(no_client());
+    async_op<Value>(*client_, std::move(done), [p = ref_.path, m = std::string(member), pos, count](
+                                                   ClientContext& ctx, MonoTime now, Completion<Value> d) {
+        ctx.memory_read(p, m, pos, count, now, std::move(d));
+    });
+}
+
+}  // namespace rr::client

@@ -1,0 +1,332 @@
+// The native typed client (namespace rr::client; the service side's object model is rr::server): connects to a service by URL, runs core's ClientContext on a strand, and
+// offers every member kind by name through object proxies (ObjectProxy) and handles (PipeEndpoint,
+// WireConnection, Generator).
+//
+// Two layers:
+//   * asynchronous: `async_*` functions and Client::run(); completions and handlers run on the
+//     connection's strand (no thread hand-off: the strand sends the request and runs the reply handler);
+//   * blocking: the plain functions wait for the answer (at most the request timeout plus a margin) and
+//     return Result<T>. They must not be called from the strand (a handler), which would deadlock; they
+//     return InvalidOperation there.
+//
+// Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`)
+// are built in.
+//
+// Thread-safety: every public function may be called from any thread. Handlers must not block.
+// Lifetime: handlers that capture a Client or ObjectProxy keep the connection alive until close().
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/any_io_executor.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/strand.hpp>
+
+#include "core/names/connection_url.hpp"
+#include "core/session/client_context.hpp"
+#include "server/node/connection_logic.hpp"
+#include "server/transport/stream_pump.hpp"
+
+namespace rr::client {
+
+using server::ConnectionLogic;
+using server::PumpHandle;
+
+struct ClientOptions {
+    NodeID local_node_id;  ///< all-zero: random
+    std::string local_node_name;
+    std::string username, password;
+    bool enable_message4 = true;
+    bool enable_string_table = true;
+    std::chrono::milliseconds connect_timeout{5000};      ///< TCP connect (wire.md §13)
+    std::chrono::milliseconds request_timeout{15000};     ///< per request, and the client session connect
+    std::chrono::milliseconds heartbeat_period{10000};    ///< ConnectionTest when idle (wire.md §6.3)
+    std::chrono::milliseconds receive_timeout{15000};     ///< close when nothing arrives for this long
+    std::uint32_t memory_max_transfer_size = 102400;      ///< bytes per memory transfer
+    Limits limits;
+};
+
+using ClientStrand = boost::asio::strand<boost::asio::any_io_executor>;
+/// Opens the byte stream for `url` and creates a pump that drives `logic` on `strand`. Calls `done`
+/// (on the strand) with the pump before starting it, or with the error (ConnectionError).
+using ClientTransport =
+    std::function<void(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
+                       std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done)>;
+/// Registers (or replaces) the transport for a URL scheme, e.g. "rr+ws".
+void register_client_transport(std::string scheme, ClientTransport transport);
+
+/// An io_context with worker threads, for programs that have no executor of their own.
+class IoThreads {
+public:
+    explicit IoThreads(unsigned threads = 1);
+    ~IoThreads();
+    IoThreads(const IoThreads&) = delete;
+    IoThreads& operator=(const IoThreads&) = delete;
+    boost::asio::any_io_executor executor() { return io_.get_executor(); }
+
+private:
+    boost::asio::io_context io_;
+    boost::asio::executor_work_guard<boost::asio::io_context::executor_type> work_;
+    std::vector<std::thread> threads_;
+};
+
+class ObjectProxy;
+
+class Client : public std::enable_shared_from_this<Client> {
+public:
+    using ConnectHandler = std::function<void(Result<std::shared_ptr<Client>>)>;
+
+    /// Connects to `url` (must name a service) and establishes the client session; `done` runs on the
+    /// connection's strand (or at once for a bad URL / unknown scheme).
+    static void connect(boost::asio::any_io_executor executor, std::string_view url, ClientOptions options,
+                        ConnectHandler done);
+    /// Blocking connect. Errors: those of the transport and of the connect exchange.
+    static Result<std::shared_ptr<Client>> connect(boost::asio::any_io_executor executor, std::string_view url,
+                                                   ClientOptions options = {});
+
+    ~Client();
+    Client(const Client&) = delete;
+    Client& operator=(const Client&) = delete;
+
+    /// Proxy of the root object.
+    ObjectProxy root();
+    /// Proxy of a known object (from ObjectProxy::objref).
+    ObjectProxy object(ObjectRef ref);
+
+    const ClientSessionInfo& info() const noexcept { return info_; }
+    const NodeID& remote_node_id() const noexcept { return remote_node_id_; }
+    bool is_open() const noexcept { return open_.load(); }
+    /// Called on the strand once the established session ends.
+    void set_closed_handler(std::function<void(const RRError&)> handler);
+    /// DisconnectClient, then close; returns at once.
+    void close();
+    /// close(), then waits (up to `timeout`) until the connection is closed. Not on the strand.
+    Result<void> close_wait(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000));
+
+    /// Runs `fn` on the strand (inline when already there) with the context and the current time.
+    /// Not run at all when the connection is already gone.
+    void run(std::function<void(ClientContext&, MonoTime)> fn);
+    /// Starts an operation on the strand and waits for its completion (blocking layer).
+    /// Errors: InvalidOperation on the strand, RequestTimeout after request timeout + 5 s,
+    /// ConnectionError when the connection is gone.
+    template <class T>
+    Result<T> wait(std::function<void(ClientContext&, MonoTime, Completion<T>)> start);
+    /// Runs `fn` on the strand and waits for its result (for non-network context calls).
+    template <class T>
+    Result<T> query(std::function<Result<T>(ClientContext&, MonoTime)> fn);
+    /// True on a thread currently running the strand.
+    bool on_strand() const noexcept { return strand_ && strand_->running_in_this_thread(); }
+
+    class Logic;
+
+private:
+    Client() = default;
+    friend class Logic;
+
+    std::shared_ptr<Logic> logic_;
+    std::weak_ptr<PumpHandle> pump_;
+    std::optional<ClientStrand> strand_;
+    ClientSessionInfo info_;
+    ObjectRef root_;
+    NodeID remote_node_id_;
+    std::atomic<bool> open_{false};
+    std::chrono::milliseconds wait_limit_{20000};
+    std::shared_ptr<std::promise<void>> closed_promise_ = std::make_shared<std::promise<void>>();
+    std::shared_future<void> closed_future_ = closed_promise_->get_future().share();
+};
+
+/// The wall clock as a wire time stamp.
+TimeSpec wall_clock_now();
+
+/// A generator (wire.md §6.7).
+class Generator {
+public:
+    Generator() = default;
+    /// Next value; error StopIteration at the end. `parameter` for generators with a generator parameter.
+    Result<Value> next(std::optional<Value> parameter = std::nullopt);
+    void async_next(std::optional<Value> parameter, Completion<Value> done);
+    /// Calls next() until StopIteration; returns every value.
+    Result<std::vector<Value>> next_all();
+    Result<void> close();
+    Result<void> abort();
+    explicit operator bool() const noexcept { return client_ && handle_; }
+
+private:
+    friend class ObjectProxy;
+    Generator(std::shared_ptr<Client> c, GeneratorHandle h) : client_(std::move(c)), handle_(h) {}
+    std::shared_ptr<Client> client_;
+    GeneratorHandle handle_;
+};
+
+/// A connected pipe endpoint. Received packets are queued here (receive()) unless a packet handler
+/// is set. Destroying the last copy does not close the endpoint: call close().
+class PipeEndpoint {
+public:
+    PipeEndpoint() = default;
+    const PipeEndpointInfo& info() const noexcept { return info_; }
+    std::int32_t index() const noexcept { return info_.index; }
+    /// Sends a packet; returns its packet number once it is queued for sending.
+    Result<std::uint32_t> send(Value packet);
+    void async_send(Value packet, Completion<std::uint32_t> done);
+    Result<void> set_request_ack(bool request_ack);
+    /// Waits up to `timeout` for the next packet. Errors: OperationTimeout, ConnectionError (closed, none left).
+    Result<Value> receive(std::chrono::milliseconds timeout);
+    std::optional<Value> try_receive();
+    std::size_t available() const;
+    /// Packet numbers acknowledged by the service so far.
+    std::vector<std::uint32_t> acks() const;
+    /// Waits until at least `n` acks arrived. Errors: OperationTimeout.
+    Result<void> wait_acks(std::size_t n, std::chrono::milliseconds timeout) const;
+    bool is_closed() const;
+    /// Waits until the service closed the endpoint. Errors: OperationTimeout.
+    Result<void> wait_closed(std::chrono::milliseconds timeout) const;
+    /// Handlers on the strand: every packet (instead of queueing), and the close.
+    void set_packet_handler(std::function<void(Value&&)> handler);
+    void set_closed_handler(std::function<void(const RRError&)> handler);
+    Result<void> close();
+    explicit operator bool() const noexcept { return client_ && state_; }
+
+    struct State;
+
+private:
+    friend class ObjectProxy;
+    std::shared_ptr<Client> client_;
+    std::shared_ptr<State> state_;
+    PipeEndpointInfo info_;
+};
+
+/// A connected wire connection.
+class WireConnection {
+public:
+    WireConnection() = default;
+    const WireConnectionInfo& info() const noexcept { return info_; }
+    /// InValue (lifespan applied). Errors as ClientContext::wire_in_value.
+    Result<WireValue> in_value() const;
+    Result<WireValue> out_value() const;
+    Result<void> set_out_value(Value value);
+    Result<void> set_lifespans(std::int32_t in_ms, std::int32_t out_ms);
+    /// Waits up to `timeout` for an InValue that satisfies `pred`, among the values numbered above
+    /// `after` (values are numbered 1, 2, … as they arrive; values_received() is the current number;
+    /// the last 256 are kept). Default: only values that arrive after this call.
+    /// Errors: OperationTimeout, ConnectionError (closed).
+    Result<WireValue> wait_value(std::function<bool(const WireValue&)> pred, std::chrono::milliseconds timeout,
+                                 std::optional<std::uint64_t> after = std::nullopt) const;
+    /// Number of InValues received so far (a value that came with the connect counts).
+    std::uint64_t values_received() const;
+    /// Handlers on the strand.
+    void set_value_handler(std::function<void(const WireValue&)> handler);
+    void set_closed_handler(std::function<void(const RRError&)> handler);
+    bool is_closed() const;
+    Result<void> wait_closed(std::chrono::milliseconds timeout) const;
+    Result<void> close();
+    explicit operator bool() const noexcept { return client_ && state_; }
+
+    struct State;
+
+private:
+    friend class ObjectProxy;
+    std::shared_ptr<Client> client_;
+    std::shared_ptr<State> state_;
+    WireConnectionInfo info_;
+};
+
+/// An object of the service, addressed by its service path; members by name.
+class ObjectProxy {
+public:
+    ObjectProxy() = default;
+    ObjectProxy(std::shared_ptr<Client> client, ObjectRef ref) : client_(std::move(client)), ref_(std::move(ref)) {}
+    const ObjectRef& ref() const noexcept { return ref_; }
+    const std::string& path() const noexcept { return ref_.path; }
+    const std::string& type() const noexcept { return ref_.type; }
+    Client& client() const { return *client_; }
+    explicit operator bool() const noexcept { return client_ != nullptr; }
+
+    // blocking
+    Result<Value> get(std::string_view member) const;
+    Result<void> set(std::string_view member, Value value) const;
+    Result<Value> call(std::string_view member, std::vector<Value> args = {}) const;
+    Result<Generator> generator(std::string_view member, std::vector<Value> args = {}) const;
+    Result<ObjectProxy> objref(std::string_view member, ObjRefIndex index = {}) const;
+    Result<std::uint64_t> subscribe(std::string_view member, EventHandler handler) const;
+    void unsubscribe(std::uint64_t subscription) const;
+    Result<void> set_callback(std::string_view member, CallbackHandler handler) const;
+    Result<PipeEndpoint> pipe_connect(std::string_view member, std::int32_t index = -1) const;
+    Result<WireConnection> wire_connect(std::string_view member) const;
+    Result<WireValue> peek_in_value(std::string_view member) const;
+    Result<WireValue> peek_out_value(std::string_view member) const;
+    Result<void> poke_out_value(std::string_view member, Value value) const;
+    Result<std::uint64_t> memory_length(std::string_view member) const;
+    Result<std::uint64_t> memory_dim_count(std::string_view member) const;
+    Result<std::vector<std::uint64_t>> memory_dimensions(std::string_view member) const;
+    Result<Value> memory_read(std::string_view member, std::uint64_t pos, std::uint64_t count) const;
+    Result<void> memory_write(std::string_view member, std::uint64_t pos, Value data) const;
+    Result<Value> memory_read(std::string_view member, std::vector<std::uint64_t> pos,
+                              std::vector<std::uint64_t> count) const;
+    Result<void> memory_write(std::string_view member, std::vector<std::uint64_t> pos, Value data) const;
+    Result<void> monitor_enter(std::int32_t timeout_ms) const;
+    Result<void> monitor_exit() const;
+
+    // asynchronous (completions on the strand)
+    void async_get(std::string_view member, Completion<Value> done) const;
+    void async_set(std::string_view member, Value value, Completion<void> done) const;
+    void async_call(std::string_view member, std::vector<Value> args, Completion<Value> done) const;
+    void async_objref(std::string_view member, ObjRefIndex index, Completion<ObjectProxy> done) const;
+    void async_peek_in_value(std::string_view member, Completion<WireValue> done) const;
+    void async_memory_read(std::string_view member, std::uint64_t pos, std::uint64_t count, Completion<Value> done) const;
+
+private:
+    std::shared_ptr<Client> client_;
+    ObjectRef ref_;
+};
+
+// --- Client::wait / query ----------------------------------------------------------------------
+
+namespace detail {
+/// Holds the promise of a blocking call; fails it with ConnectionError when dropped unanswered.
+template <class T>
+struct SyncWaiter {
+    std::promise<Result<T>> promise;
+    std::atomic<bool> done{false};
+    void set(Result<T> r) {
+        if (!done.exchange(true)) promise.set_value(std::move(r));
+    }
+    ~SyncWaiter() {
+        if (!done.exchange(true))
+            promise.set_value(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    }
+};
+}  // namespace detail
+
+template <class T>
+Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T>)> start) {
+    if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
+    auto w = std::make_shared<detail::SyncWaiter<T>>();
+    auto f = w->promise.get_future();
+    run([w, start = std::move(start)](ClientContext& ctx, MonoTime now) {
+        start(ctx, now, [w](Result<T> r) { w->set(std::move(r)); });
+    });
+    w.reset();
+    if (f.wait_for(wait_limit_) != std::future_status::ready)
+        return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");
+    return f.get();
+}
+
+template <class T>
+Result<T> Client::query(std::function<Result<T>(ClientContext&, MonoTime)> fn) {
+    return wait<T>([fn = std::move(fn)](ClientContext& ctx, MonoTime now, Completion<T> done) { done(fn(ctx, now)); });
+}
+
+}  // namespace rr::client
