@@ -264,7 +264,9 @@ void ClientContext::on_pipe_entry(MessageEntry&& e, MonoTime now) {
             pipes_.emplace(id, std::move(st));
             pipe_index_[k] = id;
         }
-        PipeState& p = *pipes_.at(id);
+        auto pit = pipes_.find(id);
+        if (pit == pipes_.end()) continue;
+        PipeState& p = *pit->second;
         std::uint32_t number = 0;
         const auto* pn = el.find("packetnumber");
         const auto* pk = el.find("packet");

@@ -163,7 +163,9 @@ void ClientContext::on_wire_entry(MessageEntry&& e, MonoTime now) {
     WireState* w = nullptr;
     std::shared_ptr<const WireValue>* early = nullptr;
     if (idx != wire_index_.end()) {
-        w = wires_.at(idx->second).get();
+        auto wit = wires_.find(idx->second);
+        if (wit == wires_.end()) return;
+        w = wit->second.get();
         if (!w->readable) return;
     } else if (auto c = wire_connecting_.find(key); c != wire_connecting_.end()) {
         early = &c->second;  // before the WireConnectRet: keep the newest

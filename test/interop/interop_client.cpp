@@ -7,7 +7,7 @@
 // 2 = could not connect, 3 = overall timeout.
 //
 // Usage:
-//   rr_interop_client URL [--disable-message4] [--timeout S] [--verbose] [--only SECTION,...]
+//   rr_interop_client URL [--disable-message4] [--timeout S] [--idle S] [--verbose] [--only SECTION,...]
 //   rr_interop_client --reynard URL [--timeout S] [--verbose] [--chat]
 // With --chat (Reynard), the client prints a line `CHAT <json string>` on stdout when it is ready for
 // a web-UI chat message with that text (the orchestrator, our_client_interop.py, sends it with a
@@ -1286,7 +1286,7 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }
 
 int usage() {
-    std::cerr << "usage: rr_interop_client URL [--disable-message4] [--timeout S] [--verbose] [--only SECTION,...]\n"
+    std::cerr << "usage: rr_interop_client URL [--disable-message4] [--timeout S] [--idle S] [--verbose] [--only SECTION,...]\n"
                  "       rr_interop_client --reynard URL [--timeout S] [--verbose] [--chat]\n";
     return 2;
 }
@@ -1296,7 +1296,7 @@ int usage() {
 int main(int argc, char** argv) {
     std::string url;
     bool reynard = false, chat = false, verbose = false, disable_message4 = false;
-    double timeout_s = 120;
+    double timeout_s = 120, idle_s = 0;
     std::vector<std::string> only;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
@@ -1305,6 +1305,7 @@ int main(int argc, char** argv) {
         else if (a == "--verbose") verbose = true;
         else if (a == "--disable-message4") disable_message4 = true;
         else if (a == "--timeout" && i + 1 < argc) timeout_s = std::stod(argv[++i]);
+        else if (a == "--idle" && i + 1 < argc) idle_s = std::stod(argv[++i]);
         else if (a == "--only" && i + 1 < argc) only = split(argv[++i], ',');
         else if (!a.empty() && a[0] != '-' && url.empty()) url = a;
         else return usage();
@@ -1346,6 +1347,16 @@ int main(int argc, char** argv) {
             r.run(only);
             results = std::move(r.results);
             summary["sections"] = only;
+        }
+        if (idle_s > 0) {
+            // Stay connected and idle: heartbeats (and keep-alives) must keep the session up.
+            std::this_thread::sleep_for(std::chrono::duration<double>(idle_s));
+            bool open = (*client)->is_open();
+            results.push_back({"session", "still connected after idle", open, open ? "" : "connection dropped while idle"});
+            if (open && !reynard) {
+                auto v = (*client)->root().get("ro_value");
+                results.push_back({"session", "request after idle", bool(v), v ? "" : error_text(v.error())});
+            }
         }
         if (auto closed = (*client)->close_wait(); !closed) results.push_back({"session", "disconnect", false, error_text(closed.error())});
         client = fail(MessageErrorType::ConnectionError, "released");
