@@ -4,10 +4,12 @@
 // the same errors. official_client.py must pass every check against it.
 //
 // Usage:
-//   rr_interop_service [--port N] [--disable-message4] [--enable-stringtable] [--heartbeat S]
-//                      [--listen-all] [--max-lifetime S] [--robdef PATH]
+//   rr_interop_service [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
+//                      [--heartbeat S] [--listen-all] [--max-lifetime S] [--robdef PATH]
 // When ready it prints one JSON line, like official_service.py:
 //   {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
+// (with "ws_url": "rr+ws://127.0.0.1:PORT/?service=interop" under --websocket: RR over WebSocket on the
+// same port, server/http).
 // and runs until SIGTERM / SIGINT (or --max-lifetime), then shuts the node down.
 #include <condition_variable>
 #include <csignal>
@@ -24,6 +26,7 @@
 #include <thread>
 
 #include "core/value/pack_value.hpp"
+#include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/service/callback_member.hpp"
 #include "server/service/memory_member.hpp"
@@ -928,8 +931,8 @@ volatile std::sig_atomic_t g_stop = 0;
 
 [[noreturn]] void usage(const char* argv0) {
     std::cerr << "usage: " << argv0
-              << " [--port N] [--disable-message4] [--enable-stringtable] [--heartbeat S] [--listen-all]"
-                 " [--max-lifetime S] [--robdef PATH]\n";
+              << " [--port N] [--websocket] [--disable-message4] [--enable-stringtable] [--heartbeat S]"
+                 " [--listen-all] [--max-lifetime S] [--robdef PATH]\n";
     std::exit(2);
 }
 
@@ -937,7 +940,7 @@ volatile std::sig_atomic_t g_stop = 0;
 
 int main(int argc, char** argv) {
     std::uint16_t port = 0;
-    bool disable_message4 = false, enable_stringtable = false, listen_all = false;
+    bool disable_message4 = false, enable_stringtable = false, listen_all = false, websocket = false;
     std::optional<double> heartbeat;
     double max_lifetime = 0;
     std::string robdef_path = RR_INTEROP_ROBDEF;
@@ -948,6 +951,7 @@ int main(int argc, char** argv) {
             return argv[++i];
         };
         if (a == "--port") port = static_cast<std::uint16_t>(std::stoi(value()));
+        else if (a == "--websocket") websocket = true;
         else if (a == "--disable-message4") disable_message4 = true;
         else if (a == "--enable-stringtable") enable_stringtable = true;
         else if (a == "--heartbeat") heartbeat = std::stod(value());
@@ -989,6 +993,13 @@ int main(int argc, char** argv) {
 
     auto node = Node::create(options);
     must(node->register_service(interop->service), "register");
+    if (websocket) {
+        // RR over WebSocket on the same port; non-browser clients send no Origin and are let in.
+        auto http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
+        node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial) {
+            http_server->handle(std::move(socket), std::move(initial));
+        });
+    }
     const std::uint16_t bound = must(node->listen_tcp(listen_all ? "0.0.0.0" : "127.0.0.1", port), "listen");
 
     std::mutex tick_mutex;
@@ -1006,7 +1017,9 @@ int main(int argc, char** argv) {
     std::cout << "{\"url\": " << json_string("rr+tcp://127.0.0.1:" + std::to_string(bound) + "/?service=interop")
               << ", \"port\": " << bound << ", \"nodeid\": " << json_string(node->node_id().to_braced_string())
               << ", \"nodename\": \"interop_service\", \"message4\": " << (disable_message4 ? "false" : "true")
-              << ", \"stringtable\": " << (enable_stringtable ? "true" : "false") << "}" << std::endl;
+              << ", \"stringtable\": " << (enable_stringtable ? "true" : "false");
+    if (websocket) std::cout << ", \"ws_url\": " << json_string("rr+ws://127.0.0.1:" + std::to_string(bound) + "/?service=interop");
+    std::cout << "}" << std::endl;
 
     const auto started = std::chrono::steady_clock::now();
     while (!g_stop) {
