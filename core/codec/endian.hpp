@@ -3,6 +3,7 @@
 // single loads/stores on little-endian targets.
 #pragma once
 
+#include "core/codec/bit_cast.hpp"
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -31,9 +32,9 @@ constexpr void store_le(std::byte* p, T value) noexcept {
 }
 
 /// IEEE-754 values travel as their bit patterns, little-endian.
-inline double load_le_double(const std::byte* p) noexcept { return std::bit_cast<double>(load_le<std::uint64_t>(p)); }
-inline float load_le_float(const std::byte* p) noexcept { return std::bit_cast<float>(load_le<std::uint32_t>(p)); }
-inline void store_le_double(std::byte* p, double v) noexcept { store_le(p, std::bit_cast<std::uint64_t>(v)); }
-inline void store_le_float(std::byte* p, float v) noexcept { store_le(p, std::bit_cast<std::uint32_t>(v)); }
+inline double load_le_double(const std::byte* p) noexcept { return rr::bit_cast<double>(load_le<std::uint64_t>(p)); }
+inline float load_le_float(const std::byte* p) noexcept { return rr::bit_cast<float>(load_le<std::uint32_t>(p)); }
+inline void store_le_double(std::byte* p, double v) noexcept { store_le(p, rr::bit_cast<std::uint64_t>(v)); }
+inline void store_le_float(std::byte* p, float v) noexcept { store_le(p, rr::bit_cast<std::uint32_t>(v)); }
 
 }  // namespace rr

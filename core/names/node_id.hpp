@@ -31,7 +31,12 @@ public:
     std::string to_braced_string() const;
 
     friend bool operator==(const NodeID&, const NodeID&) = default;
-    friend auto operator<=>(const NodeID&, const NodeID&) = default;
+    /// Byte-wise order (for maps); spelled out because libc++ 14 (Emscripten) has no <=> for std::array.
+    friend bool operator<(const NodeID& a, const NodeID& b) noexcept {
+        for (std::size_t i = 0; i < a.bytes_.size(); ++i)
+            if (a.bytes_[i] != b.bytes_[i]) return a.bytes_[i] < b.bytes_[i];
+        return false;
+    }
 
 private:
     Bytes bytes_{};

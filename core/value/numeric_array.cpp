@@ -4,10 +4,11 @@ namespace rr {
 
 namespace {
 
-// Typed heap storage for `count` items of T, zero-filled. One allocation (object + control block).
+// Typed heap storage for `count` items of T, zero-filled. (std::make_shared<T[]> would save the second
+// allocation, but libc++ 14 — Emscripten's — does not have it.)
 template <class T>
 std::pair<std::shared_ptr<void>, void*> allocate_typed(std::size_t count) {
-    std::shared_ptr<T[]> p = std::make_shared<T[]>(count);
+    std::shared_ptr<T[]> p(new T[count]());
     void* data = p.get();
     return {std::shared_ptr<void>(std::move(p), data), data};
 }

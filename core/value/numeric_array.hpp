@@ -15,6 +15,7 @@
 // they share a buffer; one object must not be mutated while another thread reads it.
 #pragma once
 
+#include "core/codec/bit_cast.hpp"
 #include <array>
 #include <bit>
 #include <complex>
@@ -116,7 +117,7 @@ T load_item(const std::byte* p) noexcept {
     } else {
         std::array<std::byte, sizeof(T)> b;
         std::memcpy(b.data(), p, sizeof(T));
-        return std::bit_cast<T>(b);
+        return rr::bit_cast<T>(b);
     }
 }
 
@@ -130,7 +131,7 @@ void store_item(std::byte* p, T v) noexcept {
         store_item<R>(p, v.real());
         store_item<R>(p + sizeof(R), v.imag());
     } else {
-        auto b = std::bit_cast<std::array<std::byte, sizeof(T)>>(v);
+        auto b = rr::bit_cast<std::array<std::byte, sizeof(T)>>(v);
         std::memcpy(p, b.data(), sizeof(T));
     }
 }
