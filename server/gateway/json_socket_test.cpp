@@ -96,7 +96,7 @@ TEST_CASE("json socket: requests are answered by id") {
     CHECK(ws.request(member("get", "ro_value"))["result"] == json{{"value", 17}});
 }
 
-TEST_CASE("json socket: subscribe to wires, events and pipes; unsubscribe") {
+TEST_CASE("json socket: subscribe to wires; events; pipes; unsubscribe") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());

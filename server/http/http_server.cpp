@@ -234,7 +234,8 @@ private:
 
     void on_request(Request req) {
         const auto origin = req[bhttp::field::origin];
-        if (!origin.empty() && !origin_allowed(server_->options().allowed_origins, origin)) {
+        if (!origin.empty() && !same_origin(origin, req[bhttp::field::host]) &&
+            !origin_allowed(server_->options().allowed_origins, origin)) {
             auto r = make_response(req, bhttp::status::forbidden, "Forbidden Origin\n");
             r.keep_alive(false);
             write(std::move(r));
@@ -366,6 +367,16 @@ private:
 };
 
 }  // namespace
+
+bool same_origin(std::string_view origin, std::string_view host) {
+    if (host.empty()) return false;
+    for (std::string_view scheme : {"http://", "https://"}) {
+        if (origin.size() == scheme.size() + host.size() && iequals(origin.substr(0, scheme.size()), scheme) &&
+            iequals(origin.substr(scheme.size()), host))
+            return true;
+    }
+    return false;
+}
 
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin) {
     for (const auto& entry : allowlist) {

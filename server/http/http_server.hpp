@@ -4,8 +4,8 @@
 //   * subprotocol `robotraconteur.robotraconteur.com` (or none): raw RR over binary frames, served by the
 //     node exactly like a TCP connection (wire.md §8) — what `rr+ws://host:port/?service=…` clients use;
 //   * other registered subprotocols (the JSON WebSocket API): handed to their handler.
-// Origins: a request carrying an Origin header must match the allowlist (403 otherwise); requests
-// without Origin (non-browser clients) are allowed. Matching follows CORE (wire.md §8): exact, or
+// Origins: a request carrying an Origin header must be same-origin (its Host) or match the allowlist
+// (403 otherwise); requests without Origin (non-browser clients) are allowed. Matching follows CORE (wire.md §8): exact, or
 // `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
 #pragma once
 
@@ -68,6 +68,9 @@ struct HttpOptions {
 };
 
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin);
+/// True when `origin` is "http://" or "https://" followed by the request's Host header: a page served
+/// by this server (also behind a reverse proxy that forwards Host). Always allowed.
+bool same_origin(std::string_view origin, std::string_view host);
 
 class HttpServer : public std::enable_shared_from_this<HttpServer> {
 public:

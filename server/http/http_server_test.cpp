@@ -128,6 +128,11 @@ TEST_CASE("origin matching follows the allowlist forms") {
     CHECK_FALSE(origin_allowed(list, "https://robotraconteur.com.evil"));
     CHECK_FALSE(origin_allowed(list, "http://localhost:8081"));
     CHECK(origin_allowed({"*"}, "http://anything"));
+    CHECK(http::same_origin("http://127.0.0.1:8080", "127.0.0.1:8080"));
+    CHECK(http::same_origin("https://gw.example.org", "GW.example.org"));
+    CHECK_FALSE(http::same_origin("http://evil.test", "127.0.0.1:8080"));
+    CHECK_FALSE(http::same_origin("http://127.0.0.1:8080", ""));
+    CHECK_FALSE(http::same_origin("http://127.0.0.1:80801", "127.0.0.1:8080"));
 }
 
 TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {

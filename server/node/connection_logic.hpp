@@ -30,6 +30,9 @@ public:
     virtual void on_timer(MonoTime now) = 0;
     /// True once the logic is finished; the pump closes the socket after flushing pending_output().
     virtual bool wants_close() const = 0;
+    /// False while the logic has too much output queued: the pump stops reading (TCP backpressure on
+    /// a peer that sends requests but does not read the replies) and resumes once output drains.
+    virtual bool wants_read() const { return true; }
     /// The socket failed or the peer closed it; called once.
     virtual void on_transport_closed(RRError error) = 0;
 };

@@ -44,6 +44,9 @@ struct ServerConnectionConfig {
     /// BufferLimitViolation; wire packets are held back (newest kept) above `wire_hold_bytes`.
     std::size_t max_send_queue_bytes = 8u * 1024u * 1024u;
     std::size_t wire_hold_bytes = 256u * 1024u;
+    /// Stop reading requests from a client while this many bytes of output wait for it (it is not
+    /// reading its replies); resume when they drain.
+    std::size_t read_pause_bytes = 4u * 1024u * 1024u;
     std::chrono::milliseconds callback_timeout{15000};
 };
 
@@ -100,6 +103,7 @@ public:
     std::optional<MonoTime> next_deadline() const override;
     void on_timer(MonoTime now) override;
     bool wants_close() const override { return stream_.is_closed() || close_after_flush_; }
+    bool wants_read() const override { return stream_.pending_output_size() < config_.read_pause_bytes; }
     void on_transport_closed(RRError error) override;
 
     // Strand-side operations used by ServerSession / Responder.

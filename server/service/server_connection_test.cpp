@@ -217,3 +217,64 @@ TEST_CASE("disconnect closes the session on the service") {
     for (int i = 0; i < 100 && f.service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
     CHECK(f.service->closed == 1);
 }
+
+TEST_CASE("a client that sends requests but never reads replies is throttled, others are unaffected") {
+    Fixture f;
+    auto good = f.connect();
+
+    // A misbehaving client: connects properly, then floods property gets and never reads.
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::socket s(io);
+    s.connect({boost::asio::ip::make_address("127.0.0.1"), f.port});
+    ClientSessionConfig cfg;
+    cfg.stream.local_node_id = *NodeID::parse("99999999-2222-3333-4444-555555555555");
+    cfg.service_name = "svc";
+    cfg.local_endpoint = 7;
+    auto now = std::chrono::steady_clock::now();
+    ClientSession session(cfg, now);
+    std::array<std::byte, 65536> buf;
+    for (int i = 0; i < 50 && !session.is_connected(); ++i) {
+        auto out = session.pending_output();
+        boost::asio::write(s, boost::asio::buffer(out.data(), out.size()));
+        session.consume_output(out.size());
+        auto n = s.read_some(boost::asio::buffer(buf));
+        REQUIRE(session.feed(std::span<const std::byte>(buf.data(), n), now));
+    }
+    REQUIRE(session.is_connected());
+
+    s.non_blocking(true);
+    std::size_t written = 0;
+    auto last_progress = std::chrono::steady_clock::now();
+    const auto give_up = last_progress + 30s;
+    std::vector<std::byte> pending;
+    MessageEntry get;
+    get.entry_type = MessageEntryType::PropertyGetReq;
+    get.service_path = "svc";
+    get.member_name = "x";
+    while (std::chrono::steady_clock::now() < give_up && written < (256u << 20)) {
+        if (pending.empty()) {
+            for (int k = 0; k < 1000; ++k) REQUIRE(session.request(get, now));
+            auto out = session.pending_output();
+            pending.assign(out.begin(), out.end());
+            session.consume_output(out.size());
+        }
+        boost::system::error_code ec;
+        auto n = s.write_some(boost::asio::buffer(pending.data(), pending.size()), ec);
+        if (ec == boost::asio::error::would_block) {
+            if (std::chrono::steady_clock::now() - last_progress > 1500ms) break;  // the server stopped reading
+            std::this_thread::sleep_for(5ms);
+            continue;
+        }
+        REQUIRE_FALSE(ec);
+        written += n;
+        pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(n));
+        last_progress = std::chrono::steady_clock::now();
+    }
+    INFO("bytes the server accepted from the flooding client: " << written);
+    CHECK(written < (64u << 20));
+
+    // Meanwhile a well-behaved client is served normally.
+    auto ok = Fixture::call(*good, request(MessageEntryType::PropertyGetReq, "x"));
+    REQUIRE(ok);
+    CHECK(ok->error == MessageErrorType::None);
+}

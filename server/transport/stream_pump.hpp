@@ -84,9 +84,17 @@ public:
 
 private:
     void read() {
+        if (reading_) return;
+        if (!logic_->wants_read()) {
+            read_paused_ = true;  // resumed by after_work() once the output has drained
+            return;
+        }
+        read_paused_ = false;
+        reading_ = true;
         auto self = this->shared_from_this();
         stream_.async_read_some(asio::buffer(buffer_),
                                 asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t n) {
+                                    self->reading_ = false;
                                     if (self->closed_) return;
                                     if (ec) {
                                         self->transport_failed(ec);
@@ -102,6 +110,7 @@ private:
         if (closed_) return;
         flush();
         arm_timer();
+        if (read_paused_ && !closed_ && logic_->wants_read() && !logic_->wants_close()) read();
     }
 
     void flush() {
@@ -177,6 +186,8 @@ private:
     std::array<std::byte, 64 * 1024> buffer_{};
     std::vector<std::byte> write_buffer_;
     bool writing_ = false;
+    bool reading_ = false;
+    bool read_paused_ = false;
     bool closed_ = false;
     bool close_requested_ = false;
     bool timer_armed_ = false;
