@@ -2,6 +2,7 @@
 // started with the JSON API, plus small HTTP and WebSocket clients.
 #pragma once
 
+#include <filesystem>
 #include <catch2/catch.hpp>
 
 #include <condition_variable>
@@ -37,11 +38,20 @@ namespace bhttp = boost::beast::http;
 namespace websocket = boost::beast::websocket;
 using tcp = boost::asio::ip::tcp;
 
-#ifdef RR_INTEROP_SERVICE_BIN
-inline constexpr const char* kInteropServiceBin = RR_INTEROP_SERVICE_BIN;
+/// rr_interop_service's path: RR_INTEROP_SERVICE_REL is relative to this test executable's folder, so
+/// the compile flags are the same in every build folder (ccache hits across build/<name>).
+inline const char* interop_service_bin() {
+#ifdef RR_INTEROP_SERVICE_REL
+    static const std::string path = [] {
+        std::error_code ec;
+        auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+        return ec ? std::string() : (exe.parent_path() / RR_INTEROP_SERVICE_REL).lexically_normal().string();
+    }();
+    return path.empty() ? nullptr : path.c_str();
 #else
-inline constexpr const char* kInteropServiceBin = nullptr;
+    return nullptr;
 #endif
+}
 
 /// rr_interop_service as a child process on an ephemeral port; SIGTERM when destroyed.
 class InteropProcess {
@@ -53,7 +63,7 @@ public:
         posix_spawn_file_actions_init(&actions);
         posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
         posix_spawn_file_actions_addclose(&actions, fds[0]);
-        std::string bin = kInteropServiceBin;
+        std::string bin = interop_service_bin();
         std::vector<std::string> args = {bin, "--port", "0", "--max-lifetime", "300"};
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
@@ -337,7 +347,7 @@ private:
 
 /// False (tests skip with a warning) when rr_interop_service is not part of the build.
 inline bool interop_service_built() {
-    if (kInteropServiceBin) return true;
+    if (interop_service_bin()) return true;
     WARN("SKIP: rr_interop_service is not built (test/interop); JSON API test skipped");
     return false;
 }
