@@ -524,6 +524,15 @@ void ClientContext::on_event(MessageEntry&& e) {
 // --- callbacks -------------------------------------------------------------------------------------
 
 Result<void> ClientContext::set_callback(std::string_view path, std::string_view member, CallbackHandler handler) {
+    if (!handler) return set_deferred_callback(path, member, nullptr);
+    return set_deferred_callback(path, member,
+                                 [h = std::move(handler)](std::vector<Value>& args, Completion<Value> reply) {
+                                     reply(h(args));
+                                 });
+}
+
+Result<void> ClientContext::set_deferred_callback(std::string_view path, std::string_view member,
+                                                  DeferredCallbackHandler handler) {
     auto m = find_member(path, member, MemberKind::callback);
     if (!m) return m.take_error();
     auto key = member_key(path, member);
@@ -531,14 +540,26 @@ Result<void> ClientContext::set_callback(std::string_view path, std::string_view
         callbacks_.erase(key);
         return {};
     }
-    callbacks_[key] = std::make_shared<CallbackHandler>(std::move(handler));
+    callbacks_[key] = std::make_shared<DeferredCallbackHandler>(std::move(handler));
     return {};
 }
 
 void ClientContext::on_callback_call(MessageEntry&& e, MonoTime now) {
     MessageEntry ret = member_entry(MessageEntryType::CallbackCallRet, e.service_path, e.member_name);
     ret.request_id = e.request_id;
-    auto result = [&]() -> Result<MessageElement> {
+    auto send = [this](MessageEntry ret, Result<MessageElement> result) {
+        if (result) {
+            ret.elements.push_back(std::move(*result));
+        } else {
+            set_entry_error(ret, result.error());
+        }
+        (void)session_.reply(std::move(ret), now_);
+    };
+    std::shared_ptr<DeferredCallbackHandler> handler;
+    std::vector<Value> args;
+    robdef::TypeDefinition return_type;
+    std::string svc;
+    auto found = [&]() -> Result<void> {
         auto obj = objects_.find(e.service_path);
         if (obj == objects_.end())
             return fail(MessageErrorType::ServiceError, "no object at service path " + e.service_path);
@@ -548,9 +569,9 @@ void ClientContext::on_callback_call(MessageEntry&& e, MonoTime now) {
         auto h = callbacks_.find(member_key(e.service_path, e.member_name));
         if (h == callbacks_.end())
             return fail(MessageErrorType::InvalidOperation, "callback \"" + e.member_name + "\" not set");
-        auto handler = h->second;  // the handler may clear itself
-        const std::string& svc = obj->second->service->name;
-        std::vector<Value> args;
+        handler = h->second;  // the handler may clear itself
+        svc = obj->second->service->name;
+        return_type = m->type;  // copied: the reply may come after the definitions changed
         args.reserve(m->parameters.size());
         for (const auto& p : m->parameters) {
             const auto* el = e.find(p.name);
@@ -559,17 +580,16 @@ void ClientContext::on_callback_call(MessageEntry&& e, MonoTime now) {
             if (!v) return v.take_error();
             args.push_back(std::move(*v));
         }
-        auto r = (*handler)(args);
-        if (!r) return r.take_error();
-        if (m->type.is_void()) return make_scalar_element<std::int32_t>("return", 0);
-        return pack(*r, m->type, "return", svc);
+        return {};
     }();
-    if (result) {
-        ret.elements.push_back(std::move(*result));
-    } else {
-        set_entry_error(ret, result.error());
-    }
-    (void)session_.reply(std::move(ret), now);
+    if (!found) return send(std::move(ret), found.take_error());
+    (*handler)(args, [this, send, ret = std::move(ret), return_type = std::move(return_type),
+                      svc = std::move(svc), answered = false](Result<Value> r) mutable {
+        if (std::exchange(answered, true)) return;
+        if (!r) return send(std::move(ret), r.take_error());
+        if (return_type.is_void()) return send(std::move(ret), make_scalar_element<std::int32_t>("return", 0));
+        send(std::move(ret), pack(*r, return_type, "return", svc));
+    });
 }
 
 // --- session operations ----------------------------------------------------------------------------

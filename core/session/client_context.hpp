@@ -132,6 +132,10 @@ public:
     // --- callbacks (1151/1152) ---------------------------------------------------------------------
     /// Sets (or with an empty handler clears) the handler of callback `member` at `path`.
     Result<void> set_callback(std::string_view path, std::string_view member, CallbackHandler handler);
+    /// As set_callback, with a handler that may answer after it returns; the CallbackCallRet is sent when
+    /// it calls `reply` (nothing is sent if the connection closed meanwhile).
+    Result<void> set_deferred_callback(std::string_view path, std::string_view member,
+                                       DeferredCallbackHandler handler);
 
     // --- pipes (1141–1147) -------------------------------------------------------------------------
     /// PipeConnectReq with `index` (−1 = the service chooses).
@@ -267,7 +271,7 @@ private:
         std::shared_ptr<EventHandler> handler;
     };
     std::map<std::uint64_t, EventSubscription> events_;
-    std::map<std::string, std::shared_ptr<CallbackHandler>, std::less<>> callbacks_;  // key: path + '\n' + member
+    std::map<std::string, std::shared_ptr<DeferredCallbackHandler>, std::less<>> callbacks_;  // key: path + '\n' + member
     /// Pipe connects in flight: key path + '\n' + member → requested indexes (for early packets).
     std::map<std::string, std::vector<std::int32_t>, std::less<>> pipe_connecting_;
     /// Open pipe endpoints: key path + '\n' + member + '\n' + index → id.

@@ -641,6 +641,40 @@ TEST_CASE("callbacks: the handler's result or error becomes the CallbackCallRet"
     CHECK(zero == 0);
 }
 
+TEST_CASE("callbacks: a deferred handler answers when it calls reply, once") {
+    Fixture f;
+    std::vector<MessageEntry> rets;
+    f.s.script = [&](const MessageEntry& e) -> std::optional<MessageEntry> {
+        if (e.entry_type == MessageEntryType::CallbackCallRet) rets.push_back(e);
+        return std::nullopt;
+    };
+    Completion<Value> later;
+    double seen = 0;
+    REQUIRE(f.c.set_deferred_callback("svc", "scale", [&](std::vector<Value>& args, Completion<Value> reply) {
+        seen = args[0].as<double>().value();
+        later = std::move(reply);
+    }));
+    MessageEntry call;
+    call.entry_type = MessageEntryType::CallbackCallReq;
+    call.service_path = "svc";
+    call.member_name = "scale";
+    call.request_id = 44;
+    call.elements.push_back(make_scalar_element("x", 2.5));
+    f.s.send(call, f.t0);
+    f.run();
+    CHECK(seen == 2.5);
+    CHECK(rets.empty());  // nothing is sent before the handler replies
+    REQUIRE(later);
+    later(Value::scalar(7.0));
+    later(Value::scalar(8.0));  // a second reply is ignored
+    f.run();
+    REQUIRE(rets.size() == 1);
+    CHECK(rets[0].request_id == 44);
+    double v = 0;
+    REQUIRE(read_scalar(*rets[0].find("return"), v));
+    CHECK(v == 7.0);
+}
+
 TEST_CASE("pipes: connect, numbered packets, acks both ways, order, early packets, closed by the service") {
     Fixture f;
     std::vector<MessageEntry> packets;

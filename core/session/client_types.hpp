@@ -99,6 +99,11 @@ using EventHandler = std::function<void(const std::string& path, std::vector<Val
 /// callback) or an error, which the service receives as an error reply (user errors keep their name).
 using CallbackHandler = std::function<Result<Value>(std::vector<Value>& args)>;
 
+/// Callback handler that answers later (e.g. a JavaScript async function): gets the unpacked parameters
+/// and a `reply` to call exactly once with the value or error to send back. `reply` may be called from
+/// within the handler or later from the context's owner, but only while the context exists.
+using DeferredCallbackHandler = std::function<void(std::vector<Value>& args, Completion<Value> reply)>;
+
 /// Pipe endpoint handlers (any may be empty). `packets` is called after one or more packets were
 /// queued on the endpoint (take them with ClientContext::pipe_receive); `ack` for every packet
 /// acknowledgement (PipePacketRet, the packet number given by pipe_send); `closed` once when the service
