@@ -9,6 +9,7 @@ APT_PACKAGES=(
   libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev catch2 libyaml-cpp-dev
   clang-14 libclang-rt-14-dev
   python3-venv
+  chromium fonts-liberation
 )
 
 missing=()
@@ -33,6 +34,21 @@ want=$(sha256sum "$req" | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "setup: installing Python packages from $req"
   .venv/bin/pip install -q --disable-pip-version-check -r "$req"
+  echo "$want" > "$stamp"
+fi
+# npm: the dashboard's packages (web/package.json, pinned; package-lock.json). No browser downloads:
+# the browser tests use Debian's /usr/bin/chromium.
+export PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1
+if ! command -v npm >/dev/null; then   # (a nodesource nodejs brings its own npm; Debian's is separate)
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends nodejs npm
+fi
+lock=web/package-lock.json
+stamp=web/node_modules/.lock.sha
+want=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing npm packages from $lock"
+  (cd web && npm ci --no-audit --no-fund --loglevel=error)
   echo "$want" > "$stamp"
 fi
 echo "setup: ok"

@@ -1,0 +1,121 @@
+// Processes for the browser tests: Reynard the Robot (test/interop/reynard_harness.py), rr-gateway
+// with its demo devices and Reynard behind it, and headless Debian Chromium through playwright-core
+// (web/node_modules, pinned in web/package.json). Every process is stopped by its PID.
+
+import { spawn } from "node:child_process";
+import { createRequire } from "node:module";
+import { fileURLToPath } from "node:url";
+import path from "node:path";
+import readline from "node:readline";
+
+export const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
+/** require() that resolves in web/node_modules. */
+export const webRequire = createRequire(path.join(ROOT, "web", "package.json"));
+
+export const CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
+  "--disable-component-update", "--disable-sync", "--no-first-run"];
+
+/** Settings from the environment (test/browser/CMakeLists.txt sets them). */
+export function settings() {
+  const env = process.env;
+  return {
+    gateway: env.RR_GATEWAY,
+    python: env.RR_PYTHON || path.join(ROOT, ".venv/bin/python"),
+    webRoot: env.RR_WEB_ROOT || path.join(ROOT, "web/dist"),
+    artifacts: env.RR_ARTIFACTS || path.join(ROOT, "build/test-artifacts/browser"),
+  };
+}
+
+/** A child process whose stdout lines are read for a JSON object holding `key`. */
+class Child {
+  constructor(name, cmd, args) {
+    this.name = name;
+    this.proc = spawn(cmd, args, { stdio: ["ignore", "pipe", "pipe"] });
+    this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
+    this.lines = readline.createInterface({ input: this.proc.stdout });
+    this.stderr = [];
+    this.proc.stderr.on("data", (d) => {
+      this.stderr.push(d.toString());
+      if (this.stderr.length > 400) this.stderr.splice(0, 200);
+      if (process.env.RR_BROWSER_VERBOSE) process.stderr.write(`[${name}] ${d}`);
+    });
+  }
+
+  /** The first stdout line that is JSON with `key`; rejects on exit or after timeoutMs. */
+  jsonLine(key, timeoutMs) {
+    return new Promise((resolve, reject) => {
+      const timer = setTimeout(() => done(new Error(`${this.name}: no JSON line with "${key}" within ${timeoutMs} ms\n${this.stderr.join("").slice(-3000)}`)), timeoutMs);
+      const onLine = (line) => {
+        try {
+          const obj = JSON.parse(line);
+          if (obj && key in obj) done(null, obj);
+        } catch { /* not JSON */ }
+      };
+      const onExit = () => done(new Error(`${this.name} exited before its JSON line\n${this.stderr.join("").slice(-3000)}`));
+      const done = (err, obj) => {
+        clearTimeout(timer);
+        this.lines.off("line", onLine);
+        this.proc.off("exit", onExit);
+        if (err) reject(err); else resolve(obj);
+      };
+      this.lines.on("line", onLine);
+      this.proc.once("exit", onExit);
+    });
+  }
+
+  /** SIGTERM, then SIGKILL after graceMs. Resolves with the exit status. */
+  async stop(graceMs = 8000) {
+    if (this.proc.exitCode !== null || this.proc.signalCode !== null) return this.exited;
+    this.proc.kill("SIGTERM");
+    const timer = setTimeout(() => this.proc.kill("SIGKILL"), graceMs);
+    const status = await this.exited;
+    clearTimeout(timer);
+    return status;
+  }
+}
+
+/** Starts Reynard headless (rrPort 0 = ephemeral). Resolves { child, info } with the harness's JSON line. */
+export async function startReynard(s, rrPort = 0) {
+  const child = new Child("reynard", s.python, [path.join(ROOT, "test/interop/reynard_harness.py"),
+    "--rr-port", String(rrPort), "--max-lifetime", "600", "--start-timeout", "40"]);
+  const info = await child.jsonLine("url", 60000);
+  return { child, info };
+}
+
+/** Starts rr-gateway on 127.0.0.1, ephemeral port, demo devices on, plus `devices` {name: url}. */
+export async function startGateway(s, devices = {}) {
+  const args = ["--listen", "127.0.0.1", "--port", "0", "--web-root", s.webRoot, "--log-level", "warning"];
+  for (const [name, url] of Object.entries(devices)) args.push("--device", `${name}=${url}`);
+  const child = new Child("rr-gateway", s.gateway, args);
+  const { port } = await child.jsonLine("port", 30000);
+  return { child, port, base: `http://127.0.0.1:${port}` };
+}
+
+/** Polls `fn` until it returns a truthy value; rejects with `what` after timeoutMs. */
+export async function waitFor(fn, what, timeoutMs = 20000, everyMs = 100) {
+  const deadline = Date.now() + timeoutMs;
+  let last;
+  for (;;) {
+    try {
+      const v = await fn();
+      if (v) return v;
+    } catch (e) {
+      last = e;
+    }
+    if (Date.now() > deadline) throw new Error(`timed out waiting for ${what}${last ? `: ${last.message}` : ""}`);
+    await new Promise((r) => setTimeout(r, everyMs));
+  }
+}
+
+/** GET /api/devices of the gateway (no Origin header: not a browser). */
+export async function apiDevices(base) {
+  const r = await fetch(`${base}/api/devices`);
+  if (!r.ok) throw new Error(`GET /api/devices: ${r.status}`);
+  return r.json();
+}
+
+/** Headless Debian Chromium. */
+export async function launchChromium() {
+  const { chromium } = webRequire("playwright-core");
+  return chromium.launch({ executablePath: "/usr/bin/chromium", headless: true, args: CHROMIUM_ARGS });
+}

@@ -1,0 +1,87 @@
+// One browser RR session to a device through the gateway (rr+ws://<gateway>/?service=<device>), made
+// with the client package (vendor/rr/robotraconteur.mjs) and kept up: after a failed connect or a
+// close it connects again with backoff (0.5 s doubling to 5 s).
+//
+// Events (EventTarget): "state" with detail { state: "connecting" | "connected" | "closed" | "stopped",
+// client (when connected), error (why the last attempt failed or the session ended) }.
+
+const BACKOFF_MIN_MS = 500;
+const BACKOFF_MAX_MS = 5000;
+const CONNECT_TIMEOUT_MS = 15000;
+
+let rrModule = null;
+/** The client package, loaded once (a missing package is reported as the connect error). */
+export function loadClientPackage() {
+  rrModule ??= import("../vendor/rr/robotraconteur.mjs");
+  return rrModule;
+}
+
+/** The RR URL of device `name` on the gateway that served this page. */
+export function deviceUrl(name, loc = window.location) {
+  const scheme = loc.protocol === "https:" ? "rrs+ws" : "rr+ws";
+  return `${scheme}://${loc.host}/?service=${encodeURIComponent(name)}`;
+}
+
+export class DeviceSession extends EventTarget {
+  constructor(url) {
+    super();
+    this.url = url;
+    this.stopped = false;
+    this.client = null;
+    this.wake = null;
+    this.attempts = 0;
+  }
+
+  emit(state, extra = {}) {
+    this.state = state;
+    this.dispatchEvent(new CustomEvent("state", { detail: { state, ...extra } }));
+  }
+
+  /** Starts the connect loop (once). */
+  start() {
+    if (!this.loop) this.loop = this.run();
+    return this;
+  }
+
+  /** Ends a waiting backoff now (e.g. the gateway reports the device back). */
+  retryNow() { this.wake?.(); }
+
+  async run() {
+    let backoff = BACKOFF_MIN_MS;
+    while (!this.stopped) {
+      this.attempts++;
+      this.emit("connecting", { attempt: this.attempts });
+      let error = null;
+      try {
+        const { connect } = await loadClientPackage();
+        const c = await connect(this.url, { timeoutMs: CONNECT_TIMEOUT_MS });
+        if (this.stopped) { c.$client.close(); break; }
+        backoff = BACKOFF_MIN_MS;
+        this.client = c;
+        const closed = new Promise((resolve) => c.$client.onClose((why) => resolve(why)));
+        this.emit("connected", { client: c });
+        error = await closed;
+        this.client = null;
+        if (this.stopped) break;
+        this.emit("closed", { error: error ?? "session closed" });
+      } catch (e) {
+        error = e;
+        this.emit("closed", { error: e });
+      }
+      await new Promise((resolve) => {
+        this.wake = resolve;
+        setTimeout(resolve, backoff);
+      });
+      this.wake = null;
+      backoff = Math.min(backoff * 2, BACKOFF_MAX_MS);
+    }
+    this.emit("stopped");
+  }
+
+  /** Closes the session and stops reconnecting. */
+  stop() {
+    this.stopped = true;
+    this.wake?.();
+    try { this.client?.$client.close(); } catch { /* already closed */ }
+  }
+}

@@ -1,0 +1,31 @@
+// Entry point: the device list on the left, the selected device (#/<name>) on the right.
+
+import { h } from "./dom.js";
+import { DeviceList } from "./device_list.js";
+import { DeviceView } from "./device_view.js";
+
+const list = new DeviceList(document.getElementById("device-list"), document.getElementById("gateway-status"));
+const main = document.getElementById("device-view");
+let view = null;
+
+function route() {
+  const name = decodeURIComponent(location.hash.replace(/^#\/?/, ""));
+  if (view && view.name === name) return;
+  view?.close();
+  view = null;
+  main.replaceChildren();
+  list.setSelected(name || null);
+  if (!name) {
+    main.append(h("p", { class: "hint", text: "Choose a device on the left." }));
+    return;
+  }
+  view = new DeviceView(main, name, list);
+}
+
+// Without a device in the address, open the first one once the list is known.
+list.addEventListener("update", (ev) => {
+  if (!location.hash && ev.detail.length) location.replace(`#/${encodeURIComponent(ev.detail[0].name)}`);
+});
+window.addEventListener("hashchange", route);
+list.start();
+route();

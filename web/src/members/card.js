@@ -1,0 +1,66 @@
+// The frame every member is shown in: name, kind, robdef type (linked to its definition), a body,
+// and an error line that shows device errors in place.
+
+import { h, errorText } from "../dom.js";
+import { parseType } from "../rr_types.js";
+
+/** The member's signature as robdef writes it (for functions and callbacks, with parameters). */
+export function signature(member) {
+  const params = (member.params || []).map((p) => `${p.type} ${p.name}`).join(", ");
+  if (member.kind === "function" || member.kind === "callback") return `${member.type} ${member.name}(${params})`;
+  if (member.kind === "event") return `${member.name}(${params})`;
+  return `${member.type} ${member.name}`;
+}
+
+function modifiers(member) {
+  const mods = [];
+  if (member.readonly) mods.push("readonly");
+  if (member.writeonly) mods.push("writeonly");
+  if (member.generator) mods.push("generator");
+  return mods;
+}
+
+/**
+ * A member card. ctx.linkType(name) makes a link to a named type's definition (or null).
+ * Returns { el, body, tools, showError(err), clearError() }.
+ */
+export function memberCard(ctx, member) {
+  const typeEl = h("code", { class: "member-type" });
+  const words = signature(member).split(/([\s,()<>{}\[\]]+)/);
+  for (const w of words) {
+    const base = parseType(w).base;
+    const link = w && /^[A-Za-z_][\w.]*$/.test(base) ? ctx.linkType?.(base) : null;
+    typeEl.append(link || w);
+  }
+  const error = h("div", { class: "member-error", role: "alert", hidden: true });
+  const tools = h("div", { class: "member-tools" });
+  const body = h("div", { class: "member-body" });
+  const el = h("section", { class: `member member-${member.kind}`, dataset: { member: member.name, kind: member.kind } },
+    h("header", { class: "member-title" },
+      h("span", { class: "member-name", text: member.name }),
+      h("span", { class: `kind kind-${member.kind}`, text: member.kind }),
+      ...modifiers(member).map((m) => h("span", { class: "modifier", text: m })),
+      tools),
+    typeEl, body, error);
+  return {
+    el, body, tools,
+    showError(err) { error.textContent = errorText(err); error.hidden = false; el.classList.add("has-error"); },
+    clearError() { error.hidden = true; error.textContent = ""; el.classList.remove("has-error"); },
+  };
+}
+
+/** An input for a value of `type`: a checkbox for bool, a text field for numbers, numeric vectors,
+ * strings and enums, a JSON text area for everything else. `.read()` gives the text (or bool). */
+export function valueInput(type, label, outline, scope) {
+  const t = parseType(type);
+  if (t.base === "bool" && !t.array && !t.container) {
+    const box = h("input", { type: "checkbox", "aria-label": label });
+    return { el: box, read: () => String(box.checked), write: (text) => { box.checked = text === "true"; } };
+  }
+  const simple = !t.container && (t.array === null || (t.array === "vector" && t.base !== "string"))
+    && (t.base === "string" || !outline?.typeOf(t.base, scope)?.fields);
+  const el = simple
+    ? h("input", { type: "text", "aria-label": label, placeholder: t.array ? "1, 2, 3" : t.base, spellcheck: "false" })
+    : h("textarea", { rows: 2, "aria-label": label, placeholder: "JSON", spellcheck: "false" });
+  return { el, read: () => el.value, write: (text) => { el.value = text; } };
+}

@@ -1,0 +1,81 @@
+// A property: its value (read on open), an editor typed from the robdef for writable properties, and
+// for numeric properties a live plot fed by polling get().
+
+import { h } from "../dom.js";
+import { memberCard, valueInput } from "./card.js";
+import { formatValue, parseInput, editorText } from "../value_codec.js";
+import { isPlottable } from "../rr_types.js";
+import { numericFields } from "../numeric_fields.js";
+import { LivePlot } from "../live_plot.js";
+
+const POLL_MS = 250;
+
+export function propertyView(ctx, member) {
+  const card = memberCard(ctx, member);
+  const prop = ctx.obj[member.name];
+  const out = h("output", { class: "value" });
+  let plot = null, timer = 0, inFlight = false, disposed = false;
+
+  async function read() {
+    inFlight = true;
+    try {
+      const v = await prop.get();
+      if (disposed) return undefined;
+      out.textContent = formatValue(v);
+      out.dataset.value = editorText(member.type, v);
+      card.clearError();
+      plot?.push(numericFields(v, null, member.name));
+      return v;
+    } catch (e) {
+      if (!disposed) card.showError(e);
+      return undefined;
+    } finally {
+      inFlight = false;
+    }
+  }
+
+  if (!member.writeonly) {
+    card.tools.append(h("button", { type: "button", class: "small", text: "Read", onclick: read }));
+    card.body.append(out);
+  }
+  let input = null;
+  if (!member.readonly) {
+    input = valueInput(member.type, `${member.name} value`, ctx.outline, ctx.scope);
+    const set = async () => {
+      try {
+        const v = parseInput(member.type, input.read(), ctx.outline, ctx.scope);
+        await prop.set(v);
+        card.clearError();
+        if (!member.writeonly) await read();
+      } catch (e) {
+        card.showError(e);
+      }
+    };
+    card.body.append(h("div", { class: "editor" }, input.el, h("button", { type: "button", text: "Set", onclick: set })));
+  }
+
+  const memoryKey = `${ctx.path}${member.name}:plot`;
+  function setPlotting(on) {
+    ctx.memory.set(memoryKey, on);
+    if (on && !plot) {
+      plot = new LivePlot(card.body, { height: 110 });
+      timer = setInterval(() => { if (!inFlight) read(); }, POLL_MS);
+    } else if (!on && plot) {
+      clearInterval(timer);
+      plot.dispose();
+      plot = null;
+    }
+  }
+  if (isPlottable(member.type) && !member.writeonly) {
+    const on = ctx.memory.get(memoryKey) ?? Boolean(member.readonly);
+    const box = h("input", { type: "checkbox", checked: on, onchange: () => setPlotting(box.checked) });
+    card.tools.prepend(h("label", { class: "toggle" }, box, "plot"));
+    setPlotting(on);
+  }
+
+  if (!member.writeonly) read().then((v) => { if (input && v !== undefined) input.write(editorText(member.type, v)); });
+  return {
+    el: card.el,
+    dispose() { disposed = true; clearInterval(timer); plot?.dispose(); },
+  };
+}

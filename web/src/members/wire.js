@@ -1,0 +1,65 @@
+// A wire: connected while the device page is open (readonly and read-write wires), newest in-value
+// shown and plotted; writable wires get an out-value editor. Peek reads the value without connecting.
+
+import { h } from "../dom.js";
+import { memberCard, valueInput } from "./card.js";
+import { formatValue, parseInput } from "../value_codec.js";
+import { parseType } from "../rr_types.js";
+import { StreamDisplay } from "./stream_display.js";
+
+export function wireView(ctx, member) {
+  const card = memberCard(ctx, member);
+  const wire = ctx.obj[member.name];
+  const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
+  let conn = null, display = null, disposed = false;
+
+  async function open() {
+    try {
+      conn = await wire.connect();
+      if (disposed) { await conn.close(); return; }
+      card.clearError();
+      display = new StreamDisplay(card.body, qualified);
+      conn.onChange((v) => display.push(v));
+      try {
+        const v = conn.inValue;
+        if (v !== undefined) display.push(v);
+      } catch {
+        // no value received yet: the first onChange brings it
+      }
+    } catch (e) {
+      if (!disposed) card.showError(e);
+    }
+  }
+
+  if (!member.writeonly) {
+    card.tools.append(h("button", {
+      type: "button", class: "small", text: "Peek", onclick: async () => {
+        try { peekOut.textContent = formatValue(await wire.peekInValue()); card.clearError(); } catch (e) { card.showError(e); }
+      },
+    }));
+  }
+  const peekOut = h("output", { class: "peek" });
+  card.body.append(peekOut);
+  if (!member.readonly) {
+    const input = valueInput(member.type, `${member.name} out value`, ctx.outline, ctx.scope);
+    const send = async () => {
+      try {
+        const v = parseInput(member.type, input.read(), ctx.outline, ctx.scope);
+        if (conn) conn.outValue = v; else await wire.pokeOutValue(v);
+        card.clearError();
+      } catch (e) {
+        card.showError(e);
+      }
+    };
+    card.body.append(h("div", { class: "editor" }, input.el, h("button", { type: "button", text: "Send", onclick: send })));
+  }
+  if (!member.writeonly) open();
+  return {
+    el: card.el,
+    dispose() {
+      disposed = true;
+      display?.dispose();
+      if (conn) conn.close().catch(() => {});
+    },
+  };
+}

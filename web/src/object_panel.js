@@ -1,0 +1,51 @@
+// The members of one RR object (the device's root object, or one reached through an objref), grouped
+// by kind, each in its own card. ctx: { obj, outline, definitions, log, memory, path }.
+
+import { h } from "./dom.js";
+import { propertyView } from "./members/property.js";
+import { functionView } from "./members/function.js";
+import { eventView } from "./members/event.js";
+import { wireView } from "./members/wire.js";
+import { pipeView } from "./members/pipe.js";
+import { memoryView } from "./members/memory.js";
+import { objrefView } from "./members/objref.js";
+import { callbackView } from "./members/callback.js";
+
+const SECTIONS = [
+  ["property", "Properties", propertyView],
+  ["function", "Functions", functionView],
+  ["wire", "Wires", wireView],
+  ["pipe", "Pipes", pipeView],
+  ["event", "Events", eventView],
+  ["objref", "Objects", objrefView],
+  ["memory", "Memories", memoryView],
+  ["callback", "Callbacks", callbackView],
+];
+
+export class ObjectPanel {
+  constructor(parent, ctx) {
+    this.views = [];
+    const scope = ctx.outline.serviceOfObject(ctx.obj.$type);
+    const full = { ...ctx, scope, linkType: (name) => ctx.definitions?.link(name, scope) ?? null };
+    this.el = h("div", { class: "object-panel", dataset: { type: ctx.obj.$type ?? "" } });
+    const members = ctx.obj.$members || [];
+    for (const [kind, title, view] of SECTIONS) {
+      const list = members.filter((m) => m.kind === kind);
+      if (!list.length) continue;
+      const grid = h("div", { class: `member-grid grid-${kind}` });
+      this.el.append(h("section", { class: "member-section", dataset: { section: kind } }, h("h3", { text: title }), grid));
+      for (const m of list) {
+        const v = view(full, m, ObjectPanel);
+        grid.append(v.el);
+        this.views.push(v);
+      }
+    }
+    parent.append(this.el);
+  }
+
+  dispose() {
+    for (const v of this.views) v.dispose();
+    this.views = [];
+    this.el.remove();
+  }
+}
