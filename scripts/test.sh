@@ -9,6 +9,12 @@ cd "$(dirname "$0")/.."
 jobs=${RR_JOBS:-$(nproc)}
 cmake --preset debug >/dev/null
 cmake --build --preset debug -j "$jobs"
+# The dashboard (web/dist) on the client package, for the browser tests (they skip without it).
+if [ -f wasm-client/dist/robotraconteur.mjs ]; then
+  ./web/build.sh
+else
+  echo "test: wasm-client/dist missing: the browser tests will be skipped"
+fi
 ctest --preset debug -j "$jobs"
 
 fuzz_seconds=${RR_FUZZ_SECONDS:-60}

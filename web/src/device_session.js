@@ -12,7 +12,10 @@ const CONNECT_TIMEOUT_MS = 15000;
 let rrModule = null;
 /** The client package, loaded once (a missing package is reported as the connect error). */
 export function loadClientPackage() {
-  rrModule ??= import("../vendor/rr/robotraconteur.mjs");
+  rrModule ??= import("../vendor/rr/robotraconteur.mjs").catch((e) => {
+    rrModule = null; // try again next time (the package may be deployed later)
+    throw e;
+  });
   return rrModule;
 }
 
