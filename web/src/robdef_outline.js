@@ -5,9 +5,12 @@
 
 const BLOCK = /^(struct|pod|namedarray|object|enum)\s+([A-Za-z_]\w*)/;
 
-/** Parses one definition text. Returns { name, imports, entries: [{ kind, name, line, fields, values, members }] }. */
+/**
+ * Parses one definition text. Returns { name, imports, usings: { alias: qualified },
+ * entries: [{ kind, name, line, fields, values, members }] }.
+ */
 export function outlineDefinition(text) {
-  const service = { name: "", imports: [], entries: [] };
+  const service = { name: "", imports: [], usings: {}, entries: [] };
   let current = null;
   String(text).split(/\r?\n/).forEach((raw, i) => {
     const line = raw.replace(/#.*$/, "").trim();
@@ -16,6 +19,10 @@ export function outlineDefinition(text) {
     if (!current) {
       if (words[0] === "service") service.name = words[1] || "";
       else if (words[0] === "import") service.imports.push(words[1]);
+      else if (words[0] === "using" && words[1]) {
+        // "using a.b.C" or "using a.b.C as D": C (or D) names a.b.C in this service
+        service.usings[words[2] === "as" && words[3] ? words[3] : words[1].split(".").pop()] = words[1];
+      }
       const m = BLOCK.exec(line);
       if (m) {
         current = { kind: m[1], name: m[2], line: i + 1, fields: [], values: [], members: [] };
@@ -60,6 +67,7 @@ export class RobdefOutline {
     if (this.types.has(name)) return this.types.get(name);
     const order = [];
     const home = this.services.find((s) => s.name === scope);
+    if (home?.usings[name] && this.types.has(home.usings[name])) return this.types.get(home.usings[name]);
     if (home) order.push(home.name, ...home.imports);
     order.push(...this.services.map((s) => s.name));
     for (const s of order) {

@@ -1,0 +1,80 @@
+// Editor text <-> values typed by robdef (src/value_codec.js, src/rr_types.js).
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { parseType, parseNumber, isPlottable } from "../src/rr_types.js";
+import { parseInput, formatValue, editorText, toPlain } from "../src/value_codec.js";
+import { RobdefOutline } from "../src/robdef_outline.js";
+
+const outline = new RobdefOutline({
+  "experimental.t": `service experimental.t
+stdver 0.10
+enum Mode
+    off = 0, slow = 2,
+    fast
+end
+struct Point
+    field double x
+    field int64 id
+    field uint8[] raw
+end
+object T
+    property Point p
+end
+`,
+});
+
+test("type texts split into base, array and container", () => {
+  assert.deepEqual(parseType("double[]"), { text: "double[]", base: "double", array: "vector", dims: null, container: null });
+  assert.deepEqual(parseType("uint8[*]").array, "multidim");
+  assert.deepEqual(parseType("int32[2,3]"), { text: "int32[2,3]", base: "int32", array: "multidim", dims: [2, 3], container: null });
+  assert.deepEqual(parseType("string{int32}"), { text: "string{int32}", base: "string", array: null, dims: null, container: "int32" });
+  assert.equal(parseType("double[3]{list}").container, "list");
+  assert.equal(parseType("double[3]{list}").array, "vector");
+  assert.ok(isPlottable("int32") && isPlottable("double[]") && !isPlottable("uint8[*]") && !isPlottable("Point"));
+});
+
+test("numbers are checked against their type", () => {
+  assert.equal(parseNumber("int16", "-32768"), -32768);
+  assert.throws(() => parseNumber("int16", "32768"), /out of range for int16/);
+  assert.throws(() => parseNumber("uint8", "1.5"), /not an integer/);
+  assert.throws(() => parseNumber("double", "abc"), /not a number/);
+  assert.equal(parseNumber("int64", "-9007199254740993"), -9007199254740993n);
+  assert.throws(() => parseNumber("uint64", "-1"), /negative/);
+  assert.equal(parseNumber("bool", "true"), true);
+});
+
+test("plain text gives scalars and typed arrays", () => {
+  const v = parseInput("double[]", "0.2, 0.4 0.6", outline, "experimental.t");
+  assert.ok(v instanceof Float64Array);
+  assert.deepEqual(Array.from(v), [0.2, 0.4, 0.6]);
+  assert.ok(parseInput("int64[]", "1,2", outline) instanceof BigInt64Array);
+  assert.equal(parseInput("string", "  spaced  ", outline), "  spaced  ");
+  assert.equal(parseInput("Mode", "fast", outline, "experimental.t"), 3);
+  assert.equal(parseInput("Mode", "2", outline, "experimental.t"), 2);
+  assert.throws(() => parseInput("uint8[]", "1, 300", outline), /out of range/);
+});
+
+test("JSON gives structs typed field by field", () => {
+  const p = parseInput("Point", '{"x": 1.5, "id": "12345678901234567", "raw": [1, 2]}', outline, "experimental.t");
+  assert.equal(p.x, 1.5);
+  assert.equal(p.id, 12345678901234567n);
+  assert.ok(p.raw instanceof Uint8Array);
+  assert.throws(() => parseInput("Point", '{"x": 1}', outline, "experimental.t"), /field id missing/);
+  const list = parseInput("Point{list}", '[{"x": 0, "id": 1, "raw": []}]', outline, "experimental.t");
+  assert.equal(list.length, 1);
+  const map = parseInput("double{int32}", '{"3": 1.5}', outline);
+  assert.ok(map instanceof Map && map.get(3) === 1.5);
+  const md = parseInput("uint8[*]", '{"dims": [2, 1], "array": [7, 8]}', outline);
+  assert.deepEqual([Array.from(md.dims), Array.from(md.array)], [[2, 1], [7, 8]]);
+});
+
+test("values format for display and back for editors", () => {
+  assert.equal(formatValue(Float64Array.of(0.2, 0.4, 0.6)), "[0.2, 0.4, 0.6]");
+  assert.equal(formatValue(new Uint8Array(40), 4), "[0, 0, 0, 0, … 36 more]");
+  assert.equal(formatValue({ a: 1n, b: "x" }), '{a: 1, b: "x"}');
+  assert.equal(formatValue(new Map([[0, "Left"]])), '{0: "Left"}');
+  assert.equal(formatValue({ dims: Uint32Array.of(2, 2), array: Uint8Array.of(1, 2, 3, 4) }), "2×2 [1, 2, 3, 4]");
+  assert.equal(editorText("double[]", Float64Array.of(1, 2.5)), "1, 2.5");
+  assert.equal(editorText("Point", { x: 1, id: 2n, raw: Uint8Array.of(3) }), '{"x":1,"id":"2","raw":[3]}');
+  assert.deepEqual(toPlain(new Map([[1, BigInt64Array.of(5n)]])), { 1: ["5"] });
+});
