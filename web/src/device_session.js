@@ -21,7 +21,7 @@ export function loadClientPackage() {
 
 /** The RR URL of device `name` on the gateway that served this page. */
 export function deviceUrl(name, loc = window.location) {
-  const scheme = loc.protocol === "https:" ? "rrs+ws" : "rr+ws";
+  const scheme = loc.protocol === "https:" ? "rr+wss" : "rr+ws";
   return `${scheme}://${loc.host}/?service=${encodeURIComponent(name)}`;
 }
 

@@ -1,4 +1,4 @@
-// A memory: its length, a read form (start, count; for multidim memories one number per dimension),
+// A memory: its length (dimensions for multidim memories), a read form (start, count; for multidim memories one number per dimension),
 // the contents as a table of offsets and values (uint8 as hex), images drawn when the contents are
 // one, and a write form.
 
@@ -28,7 +28,7 @@ export function memoryView(ctx, member) {
 
   async function length() {
     try {
-      const n = await mem.length();
+      const n = multidim ? await mem.dimensions() : await mem.length();
       lengthOut.textContent = Array.isArray(n) || ArrayBuffer.isView(n) ? Array.from(n).join(" × ") : String(n);
       if (multidim && !count.value && (Array.isArray(n) || ArrayBuffer.isView(n))) {
         count.value = Array.from(n).join(", ");
@@ -89,8 +89,8 @@ export function memoryView(ctx, member) {
     }
   }
 
-  card.tools.append(h("button", { type: "button", class: "small", text: "Length", onclick: length }));
-  card.body.append(h("div", {}, h("span", { text: "length: " }), lengthOut),
+  card.tools.append(h("button", { type: "button", class: "small", text: multidim ? "Dimensions" : "Length", onclick: length }));
+  card.body.append(h("div", {}, h("span", { text: multidim ? "dimensions: " : "length: " }), lengthOut),
     h("form", { class: "memory-form", onsubmit: read },
       h("label", { class: "param" }, h("span", { text: "start" }), start),
       h("label", { class: "param" }, h("span", { text: "count" }), count), h("button", { type: "submit", text: "Read" })),

@@ -1,5 +1,6 @@
 // A pipe: connect an endpoint on request; packets are shown as they arrive (images drawn on a canvas,
-// numbers plotted). An open endpoint is reopened after a reconnect. Writable pipes can send.
+// numbers plotted). An endpoint that the device or gateway closes is reopened after REOPEN_MS, and an
+// open endpoint is reopened after the page reconnects. Writable pipes can send.
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
@@ -7,12 +8,14 @@ import { parseInput } from "../value_codec.js";
 import { parseType } from "../rr_types.js";
 import { StreamDisplay } from "./stream_display.js";
 
+const REOPEN_MS = 2000;
+
 export function pipeView(ctx, member) {
   const card = memberCard(ctx, member);
   const pipe = ctx.obj[member.name];
   const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
   const memoryKey = `${ctx.path}${member.name}:open`;
-  let ep = null, display = null, disposed = false;
+  let ep = null, display = null, disposed = false, reopen = 0;
 
   const toggle = h("button", { type: "button", class: "small", text: "Connect", onclick: () => (ep ? close(true) : open()) });
   card.tools.append(toggle);
@@ -26,17 +29,28 @@ export function pipeView(ctx, member) {
       card.clearError();
       display = new StreamDisplay(card.body, qualified);
       ep.onPacket((v) => display.push(v));
+      const mine = ep;
+      ep.onClose((err) => {
+        if (disposed || ep !== mine) return; // closed by us
+        close(false);
+        card.showError(err ?? new Error("pipe endpoint closed"));
+        reopen = setTimeout(open, REOPEN_MS);
+      });
       toggle.textContent = "Disconnect";
       card.el.dataset.open = "true";
     } catch (e) {
       ep = null;
-      if (!disposed) card.showError(e);
+      if (!disposed) {
+        card.showError(e);
+        if (ctx.memory.get(memoryKey)) reopen = setTimeout(open, REOPEN_MS);
+      }
     } finally {
       toggle.disabled = false;
     }
   }
 
   async function close(byUser) {
+    clearTimeout(reopen);
     const e = ep;
     ep = null;
     if (byUser) ctx.memory.set(memoryKey, false);

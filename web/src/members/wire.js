@@ -1,5 +1,6 @@
 // A wire: connected while the device page is open (readonly and read-write wires), newest in-value
 // shown and plotted; writable wires get an out-value editor. Peek reads the value without connecting.
+// A wire connection that closes while the page is open is connected again after REOPEN_MS.
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
@@ -7,19 +8,27 @@ import { formatValue, parseInput } from "../value_codec.js";
 import { parseType } from "../rr_types.js";
 import { StreamDisplay } from "./stream_display.js";
 
+const REOPEN_MS = 2000;
+
 export function wireView(ctx, member) {
   const card = memberCard(ctx, member);
   const wire = ctx.obj[member.name];
   const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
-  let conn = null, display = null, disposed = false;
+  let conn = null, display = null, disposed = false, reopen = 0;
 
   async function open() {
     try {
       conn = await wire.connect();
       if (disposed) { await conn.close(); return; }
       card.clearError();
-      display = new StreamDisplay(card.body, qualified);
+      display ??= new StreamDisplay(card.body, qualified);
       conn.onChange((v) => display.push(v));
+      conn.onClose((err) => {
+        conn = null;
+        if (disposed) return;
+        card.showError(err ?? new Error("wire connection closed"));
+        reopen = setTimeout(open, REOPEN_MS);
+      });
       try {
         const v = conn.inValue;
         if (v !== undefined) display.push(v);
@@ -27,7 +36,9 @@ export function wireView(ctx, member) {
         // no value received yet: the first onChange brings it
       }
     } catch (e) {
-      if (!disposed) card.showError(e);
+      if (disposed) return;
+      card.showError(e);
+      reopen = setTimeout(open, REOPEN_MS);
     }
   }
 
@@ -58,6 +69,7 @@ export function wireView(ctx, member) {
     el: card.el,
     dispose() {
       disposed = true;
+      clearTimeout(reopen);
       display?.dispose();
       if (conn) conn.close().catch(() => {});
     },
