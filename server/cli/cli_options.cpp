@@ -1,0 +1,228 @@
+#include "server/cli/cli_options.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <map>
+
+namespace rr::cli {
+
+namespace {
+
+Unexpected usage(std::string message) { return fail(MessageErrorType::InvalidArgument, std::move(message)); }
+
+const std::map<std::string, CommandKind, std::less<>> kCommands = {
+    {"info", CommandKind::info}, {"get", CommandKind::get},     {"set", CommandKind::set},
+    {"call", CommandKind::call}, {"watch", CommandKind::watch},
+};
+
+Result<double> parse_seconds(std::string_view flag, std::string_view text) {
+    double v = 0;
+    auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || p != text.data() + text.size() || !std::isfinite(v) || v <= 0)
+        return usage(std::string(flag) + " needs a positive number of seconds, not \"" + std::string(text) + "\"");
+    return v;
+}
+
+}  // namespace
+
+Result<std::vector<PathSegment>> parse_member_path(std::string_view text) {
+    std::vector<PathSegment> out;
+    std::size_t i = 0;
+    auto bad = [&](std::string why) {
+        return usage("bad member path \"" + std::string(text) + "\": " + why);
+    };
+    if (text.empty()) return bad("empty");
+    for (;;) {
+        PathSegment seg;
+        while (i < text.size() && text[i] != '.' && text[i] != '[' && text[i] != ']') seg.name += text[i++];
+        if (seg.name.empty()) return bad("empty name at offset " + std::to_string(i));
+        if (i < text.size() && text[i] == ']') return bad("']' without '['");
+        if (i < text.size() && text[i] == '[') {
+            auto close = text.find(']', i + 1);
+            if (close == std::string_view::npos) return bad("unterminated '['");
+            seg.key = std::string(text.substr(i + 1, close - i - 1));
+            i = close + 1;
+            if (i < text.size() && text[i] != '.') return bad("'.' expected after ']'");
+        }
+        out.push_back(std::move(seg));
+        if (i == text.size()) return out;
+        ++i;  // the '.'
+        if (i == text.size()) return bad("ends with '.'");
+    }
+}
+
+Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
+    CommandLine cl;
+    std::vector<std::string> positional;
+    std::optional<std::string> object_path;
+    bool want_help = false;
+    bool flags_done = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        // Single-dash tokens other than -h are values (negative numbers in JSON arguments).
+        if (flags_done || !(a.rfind("--", 0) == 0 || a == "-h")) {
+            positional.push_back(a);
+            continue;
+        }
+        if (a == "--") {
+            flags_done = true;
+            continue;
+        }
+        if (a == "-h" || a == "--help") {
+            want_help = true;
+            continue;
+        }
+        if (a == "--disable-message4") {
+            cl.disable_message4 = true;
+            continue;
+        }
+        std::string flag = a, value;
+        if (auto eq = a.find('='); eq != std::string::npos) {
+            flag = a.substr(0, eq);
+            value = a.substr(eq + 1);
+        } else {
+            static const char* kWithValue[] = {"--timeout", "--username", "--password",
+                                               "--object",  "--count",    "--seconds"};
+            bool known = false;
+            for (const char* k : kWithValue) known = known || flag == k;
+            if (!known) return usage("unknown option " + flag);
+            if (i + 1 >= args.size()) return usage(flag + " needs a value");
+            value = args[++i];
+        }
+        if (flag == "--timeout") {
+            auto v = parse_seconds(flag, value);
+            if (!v) return v.take_error();
+            cl.timeout_s = *v;
+        } else if (flag == "--seconds") {
+            auto v = parse_seconds(flag, value);
+            if (!v) return v.take_error();
+            cl.seconds = *v;
+        } else if (flag == "--count") {
+            std::uint64_t n = 0;
+            auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
+            if (ec != std::errc() || p != value.data() + value.size() || n == 0)
+                return usage("--count needs a positive integer, not \"" + value + "\"");
+            cl.count = n;
+        } else if (flag == "--username") {
+            cl.username = value;
+        } else if (flag == "--password") {
+            cl.password = value;
+        } else if (flag == "--object") {
+            object_path = value;
+        } else {
+            return usage("unknown option " + flag);
+        }
+    }
+
+    if (positional.empty()) {
+        cl.kind = CommandKind::help;
+        if (!want_help) return usage("no command given (try rr --help)");
+        return cl;
+    }
+    auto it = kCommands.find(positional[0]);
+    if (positional[0] == "help") {
+        cl.kind = CommandKind::help;
+        if (positional.size() > 1) cl.help_topic = positional[1];
+        return cl;
+    }
+    if (it == kCommands.end()) return usage("unknown command \"" + positional[0] + "\" (try rr --help)");
+    if (want_help) {
+        cl.kind = CommandKind::help;
+        cl.help_topic = positional[0];
+        return cl;
+    }
+    cl.kind = it->second;
+    const std::string& name = positional[0];
+    auto need = [&](std::size_t min, std::size_t max) -> Result<void> {
+        std::size_t n = positional.size() - 1;
+        if (n < min || n > max) return usage("wrong number of arguments for \"" + name + "\" (try rr " + name + " --help)");
+        return {};
+    };
+    Result<void> shape = {};
+    switch (cl.kind) {
+        case CommandKind::info: shape = need(1, 1); break;
+        case CommandKind::get: shape = need(2, 2); break;
+        case CommandKind::set: shape = need(3, 3); break;
+        case CommandKind::call: shape = need(2, SIZE_MAX); break;
+        case CommandKind::watch: shape = need(2, 2); break;
+        case CommandKind::help: break;
+    }
+    if (!shape) return shape.take_error();
+    cl.url = positional[1];
+
+    if (object_path) {
+        auto segs = parse_member_path(*object_path);
+        if (!segs) return segs.take_error();
+        cl.objects = std::move(*segs);
+    }
+    if (cl.kind != CommandKind::info) {
+        auto segs = parse_member_path(positional[2]);
+        if (!segs) return segs.take_error();
+        cl.member = segs->back();
+        segs->pop_back();
+        cl.objects.insert(cl.objects.end(), segs->begin(), segs->end());
+        if (cl.member->key) return usage("the member itself takes no [key]: \"" + positional[2] + "\"");
+        cl.values.assign(positional.begin() + 3, positional.end());
+    }
+    if ((cl.count || cl.seconds) && cl.kind != CommandKind::watch)
+        return usage("--count and --seconds apply to watch only");
+    return cl;
+}
+
+std::string help_text(std::string_view topic) {
+    static const std::string kGeneral =
+        "rr: command-line client for Robot Raconteur services (docs/cli.md)\n"
+        "\n"
+        "usage: rr COMMAND URL [MEMBER] [JSON...] [options]\n"
+        "\n"
+        "commands:\n"
+        "  info  URL                    service definitions and the object's members\n"
+        "  get   URL MEMBER             read a property (or peek a wire's InValue)\n"
+        "  set   URL MEMBER JSON        write a property (or poke a wire's OutValue)\n"
+        "  call  URL FUNCTION [JSON...] call a function; a generator prints each item\n"
+        "  watch URL MEMBER             stream a wire's values, an event or a pipe's packets\n"
+        "\n"
+        "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rr+ws://...).\n"
+        "MEMBER: name, or a path through objrefs: child.leaf.x, child_by_int[7].value.\n"
+        "Values are JSON as in docs/json-mapping.md; output is one JSON value per line.\n"
+        "\n"
+        "options:\n"
+        "  --object PATH        objref path of the object (prepended to MEMBER)\n"
+        "  --timeout S          connect and request timeout in seconds (default 15)\n"
+        "  --count N            watch: stop after N values\n"
+        "  --seconds S          watch: stop after S seconds\n"
+        "  --username U --password P   credentials for services that require a login\n"
+        "  --disable-message4   use message format v2 only\n"
+        "  -h, --help           this text; rr COMMAND --help for one command\n"
+        "\n"
+        "exit status: 0 ok, 1 RR error (name and message on stderr), 2 usage error,\n"
+        "3 connect failure\n";
+    if (topic.empty()) return kGeneral;
+    if (topic == "info")
+        return "usage: rr info URL [--object PATH]\n"
+               "Prints the service definitions the service sent, then the root object's (or the object at\n"
+               "PATH's) type and members, one per line: KIND NAME TYPE [MODIFIERS].\n"
+               "Without service= in the URL, lists the node's services (RobotRaconteurServiceIndex).\n";
+    if (topic == "get")
+        return "usage: rr get URL MEMBER [--object PATH]\n"
+               "Prints the value of property MEMBER as one JSON line. For a wire, prints its InValue\n"
+               "(PeekInValue).\n";
+    if (topic == "set")
+        return "usage: rr set URL MEMBER JSON [--object PATH]\n"
+               "Writes JSON (typed by the member's robdef type) to property MEMBER, or to a wire's\n"
+               "OutValue (PokeOutValue). Prints nothing on success.\n";
+    if (topic == "call")
+        return "usage: rr call URL FUNCTION [JSON...] [--object PATH]\n"
+               "Calls FUNCTION with one JSON argument per parameter. Prints the result as one JSON\n"
+               "line (nothing for void). A generator function prints each item as one JSON line\n"
+               "until the generator ends.\n";
+    if (topic == "watch")
+        return "usage: rr watch URL MEMBER [--count N] [--seconds S] [--object PATH]\n"
+               "Streams JSON lines until SIGINT/SIGTERM, N values or S seconds:\n"
+               "  wire   each InValue\n"
+               "  event  an object of the event's parameters by name\n"
+               "  pipe   each packet received on a new endpoint\n";
+    return {};
+}
+
+}  // namespace rr::cli

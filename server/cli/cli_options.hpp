@@ -1,0 +1,64 @@
+// Command line of `rr`, the command-line client (docs/cli.md): the parsed command, its options, and
+// the member path syntax that reaches members of sub-objects through objrefs.
+//
+// Member paths: `member`, or `objref.member`, `objref[key].member`, … Each segment before the last
+// names an objref of the object reached so far; `[key]` is its index (an int32 or a string, as the
+// objref's `{int32}` / `{string}` type says; keys may hold any character except `]`). `--object PATH`
+// gives the same objref segments separately and is prepended to the member path.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error/rr_error.hpp"
+
+namespace rr::cli {
+
+/// Exit status of `rr` (docs/cli.md §Exit status).
+enum class ExitCode : int {
+    ok = 0,
+    rr_error = 1,         ///< the service (or the typed client) answered with an RR error
+    usage_error = 2,      ///< bad command line, bad URL, JSON that does not parse
+    connect_failure = 3,  ///< no client session: unreachable, ServiceNotFound, authentication, …
+};
+
+enum class CommandKind { help, info, get, set, call, watch };
+
+/// One segment of a member path: an objref (or, last, the member) name and an optional index key.
+struct PathSegment {
+    std::string name;
+    std::optional<std::string> key;  ///< text between `[` and `]`
+
+    friend bool operator==(const PathSegment&, const PathSegment&) = default;
+};
+
+/// A parsed command line.
+struct CommandLine {
+    CommandKind kind = CommandKind::help;
+    std::string help_topic;            ///< command whose help was asked for ("" = general)
+    std::string url;
+    std::vector<PathSegment> objects;  ///< objref segments (from --object and the member path)
+    std::optional<PathSegment> member; ///< the member (not for info)
+    std::vector<std::string> values;   ///< JSON texts: set's value, call's arguments
+    double timeout_s = 15;             ///< connect and per-request timeout, seconds
+    std::optional<std::uint64_t> count;  ///< watch: stop after this many values
+    std::optional<double> seconds;       ///< watch: stop after this long
+    std::string username, password;
+    bool disable_message4 = false;
+};
+
+/// Parses a member path (`a.b[3].c`). Errors: InvalidArgument (empty segment, unterminated `[`, text
+/// after `]` other than `.`).
+Result<std::vector<PathSegment>> parse_member_path(std::string_view text);
+
+/// Parses argv[1..]. Errors: InvalidArgument with a message for the user (unknown command or flag,
+/// missing argument, bad number).
+Result<CommandLine> parse_command_line(const std::vector<std::string>& args);
+
+/// Help text: general (topic "") or for one command. Empty for an unknown topic.
+std::string help_text(std::string_view topic);
+
+}  // namespace rr::cli

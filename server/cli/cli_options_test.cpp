@@ -1,0 +1,93 @@
+#include "server/cli/cli_options.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace rr;
+using namespace rr::cli;
+
+namespace {
+Result<CommandLine> parse(std::vector<std::string> a) { return parse_command_line(a); }
+}  // namespace
+
+TEST_CASE("cli: member paths through objrefs") {
+    auto p = parse_member_path("child_by_name[with space.and]dots].leaf.x");
+    // the key ends at the first ']'
+    REQUIRE_FALSE(p);
+    auto q = parse_member_path("child_by_name[with space.and dots].leaf.x");
+    REQUIRE(q);
+    REQUIRE(q->size() == 3);
+    CHECK((*q)[0] == PathSegment{"child_by_name", "with space.and dots"});
+    CHECK((*q)[1] == PathSegment{"leaf", std::nullopt});
+    CHECK((*q)[2] == PathSegment{"x", std::nullopt});
+    auto e = parse_member_path("child_by_int[-1]");
+    REQUIRE(e);
+    CHECK((*e)[0].key == "-1");
+    for (const char* bad : {"", ".x", "a..b", "a.", "a[1", "a]", "a[1]b", "[1]"}) {
+        INFO(bad);
+        auto r = parse_member_path(bad);
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::InvalidArgument);
+    }
+}
+
+TEST_CASE("cli: commands and their arguments") {
+    auto c = parse({"call", "rr+tcp://h:1/?service=s", "child.leaf.scaled", "-2.5", "--timeout", "3"});
+    REQUIRE(c);
+    CHECK(c->kind == CommandKind::call);
+    CHECK(c->url == "rr+tcp://h:1/?service=s");
+    REQUIRE(c->objects.size() == 2);
+    CHECK(c->objects[1].name == "leaf");
+    CHECK(c->member->name == "scaled");
+    CHECK(c->values == std::vector<std::string>{"-2.5"});  // a negative number is an argument
+    CHECK(c->timeout_s == 3);
+
+    auto o = parse({"get", "--object=child_by_int[7]", "u", "value"});
+    REQUIRE(o);
+    REQUIRE(o->objects.size() == 1);
+    CHECK(o->objects[0] == PathSegment{"child_by_int", "7"});
+    CHECK(o->member->name == "value");
+
+    auto w = parse({"watch", "u", "w_state", "--count", "3", "--seconds", "1.5"});
+    REQUIRE(w);
+    CHECK(w->count == 3u);
+    CHECK(w->seconds == 1.5);
+
+    auto i = parse({"info", "u", "--username", "a", "--password", "b"});
+    REQUIRE(i);
+    CHECK(i->kind == CommandKind::info);
+    CHECK(i->username == "a");
+    CHECK(i->password == "b");
+    CHECK_FALSE(i->member);
+
+    auto h = parse({"get", "--help"});
+    REQUIRE(h);
+    CHECK(h->kind == CommandKind::help);
+    CHECK(h->help_topic == "get");
+    CHECK(help_text("get").find("usage: rr get") == 0);
+    CHECK(help_text("nosuch").empty());
+}
+
+TEST_CASE("cli: usage errors") {
+    const std::vector<std::vector<std::string>> bad = {
+        {},
+        {"frobnicate", "u"},
+        {"get", "u"},
+        {"set", "u", "m"},
+        {"info", "u", "extra"},
+        {"get", "u", "m", "--timeout", "0"},
+        {"get", "u", "m", "--timeout"},
+        {"get", "u", "m", "--count", "2"},
+        {"watch", "u", "m", "--count", "x"},
+        {"get", "u", "m", "--bogus", "1"},
+        {"get", "u", "m[1]"},
+    };
+    for (const auto& a : bad) {
+        std::string joined;
+        for (const auto& s : a) joined += s + " ";
+        INFO(joined);
+        auto r = parse(a);
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::InvalidArgument);
+        CHECK_FALSE(r.error().message.empty());
+    }
+}

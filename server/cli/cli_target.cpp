@@ -1,0 +1,120 @@
+#include "server/cli/cli_target.hpp"
+
+#include <charconv>
+#include <cmath>
+
+#include "core/json/value_json.hpp"
+#include "core/names/connection_url.hpp"
+
+namespace rr::cli {
+
+using client::Client;
+using client::ObjectProxy;
+
+Target::~Target() {
+    object = {};
+    if (client) (void)client->close_wait(std::chrono::milliseconds(2000));
+    client.reset();
+    io.reset();
+}
+
+Result<std::string> url_with_service(const std::string& url, const std::string& service) {
+    auto parsed = parse_connection_url(url);
+    if (!parsed) return parsed.take_error();
+    if (!service.empty()) parsed->service = service;
+    return parsed->to_string();
+}
+
+namespace {
+
+// An objref segment's index: by the objref's declared key type.
+Result<ObjRefIndex> objref_index(const MemberInfo& m, const PathSegment& seg) {
+    using robdef::ContainerKind;
+    const auto c = m.def.type.container;
+    if (!seg.key) {
+        if (c == ContainerKind::none) return ObjRefIndex{};
+        return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " needs an index: " + seg.name + "[key]");
+    }
+    if (c == ContainerKind::map_string) return ObjRefIndex{*seg.key};
+    if (c == ContainerKind::map_int32) {
+        std::int32_t k = 0;
+        const auto& s = *seg.key;
+        auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), k);
+        if (ec != std::errc() || p != s.data() + s.size())
+            return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " takes an int32 index, not \"" + s + "\"");
+        return ObjRefIndex{k};
+    }
+    return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " takes no index");
+}
+
+}  // namespace
+
+std::optional<Failure> connect_target(const CommandLine& cl, const std::string& url, Target& target) {
+    client::ClientOptions options;
+    const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(cl.timeout_s * 1000)));
+    options.connect_timeout = timeout;
+    options.request_timeout = timeout;
+    options.username = cl.username;
+    options.password = cl.password;
+    options.enable_message4 = !cl.disable_message4;
+    target.io = std::make_unique<client::IoThreads>(1);
+    auto c = Client::connect(target.io->executor(), url, options);
+    if (!c) return Failure{ExitCode::connect_failure, c.error()};
+    target.client = *c;
+    target.object = target.client->root();
+    for (const auto& seg : cl.objects) {
+        auto m = member_info(target.object, seg.name);
+        if (!m) return Failure{ExitCode::rr_error, m.error()};
+        if (m->def.kind != robdef::MemberKind::objref)
+            return Failure{ExitCode::rr_error, make_error(MessageErrorType::InvalidArgument,
+                                                          seg.name + " is a " +
+                                                              std::string(robdef::member_kind_keyword(m->def.kind)) +
+                                                              ", not an objref")};
+        auto index = objref_index(*m, seg);
+        if (!index) return Failure{ExitCode::rr_error, index.error()};
+        auto next = target.object.objref(seg.name, *index);
+        if (!next) return Failure{ExitCode::rr_error, next.error()};
+        target.object = *next;
+    }
+    return std::nullopt;
+}
+
+Result<MemberInfo> member_info(const ObjectProxy& object, const std::string& member) {
+    const std::string path = object.path();
+    return object.client().query<MemberInfo>([path, member](ClientContext& ctx, MonoTime) -> Result<MemberInfo> {
+        auto def = ctx.member_definition(path, member);
+        if (!def) return def.take_error();
+        auto ref = ctx.object(path);
+        std::string service;
+        if (ref) service = ref->type.substr(0, ref->type.rfind('.'));
+        return MemberInfo{**def, service};
+    });
+}
+
+Result<nlohmann::json> to_json(Client& client, const Value& value, const robdef::TypeDefinition& type,
+                               const std::string& service) {
+    return client.query<nlohmann::json>([&](ClientContext& ctx, MonoTime) {
+        return value_to_json(value, type, ctx.definitions(), service);
+    });
+}
+
+Result<Value> from_json(Client& client, const nlohmann::json& json, const robdef::TypeDefinition& type,
+                        const std::string& service) {
+    return client.query<Value>([&](ClientContext& ctx, MonoTime) {
+        return value_from_json(json, type, ctx.definitions(), service);
+    });
+}
+
+Result<nlohmann::json> parse_json_argument(const std::string& text, const std::string& what) {
+    try {
+        return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        return fail(MessageErrorType::InvalidArgument, what + " is not valid JSON: " + e.what());
+    }
+}
+
+std::string json_line(const nlohmann::json& j) {
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+}  // namespace rr::cli
