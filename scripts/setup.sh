@@ -10,6 +10,7 @@ APT_PACKAGES=(
   clang-14 libclang-rt-14-dev
   python3-venv
   chromium fonts-liberation
+  emscripten node-acorn
 )
 
 missing=()
@@ -49,6 +50,15 @@ want=$(sha256sum "$lock" | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "setup: installing npm packages from $lock"
   (cd web && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$want" > "$stamp"
+fi
+# npm: the WebAssembly client's test dependency (`ws`, wasm-client/package-lock.json).
+lock=wasm-client/package-lock.json
+stamp=wasm-client/node_modules/.lock.sha
+want=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing npm packages from $lock"
+  (cd wasm-client && npm ci --no-audit --no-fund --loglevel=error)
   echo "$want" > "$stamp"
 fi
 echo "setup: ok"
