@@ -224,7 +224,14 @@ void CreateDevice::advance(std::chrono::nanoseconds dt) {
                 }
             }
         }
-        if (streaming && bumps > 0) play = true;
+        // A bump while a call is outstanding is remembered and played once that call returns: the
+        // bump call is the one a client waits for; periodic ones may be skipped.
+        if (streaming && bumps > 0) bump_play_pending_ = true;
+        if (!streaming) bump_play_pending_ = false;
+        if (bump_play_pending_ && !play_outstanding_) {
+            bump_play_pending_ = false;
+            play = true;
+        }
         if (play && (play_outstanding_ || !streaming)) play = false;
         if (play) {
             play_outstanding_ = true;

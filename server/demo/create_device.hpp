@@ -13,10 +13,12 @@
 //                             SensorPacket every packet_period (20 Hz) while at least one session
 //                             streams, and the service calls `play_callback` on the most recent
 //                             streaming client (the paper's pattern: the robot asks its client what to
-//                             play) on every bump and every play_period (5 s)
+//                             play) on every bump and every play_period (5 s); a bump during an
+//                             outstanding call is played right after that call returns
 //   StopStreaming()           the calling session stops streaming (a session that closes stops too)
 //   packets                   wire SensorPacket [readonly]; holds the last packet sent (one is set at
-//                             start, so a new connection always gets a value)
+//                             start, so PeekInValue always answers; the copy sent with a WireConnectRet
+//                             is dropped by the official client, as with CORE's WireBroadcaster)
 //   play_callback(DistanceTraveled, AngleTraveled) → uint8[]
 //                             the reply is kept as the robot's "song" (Create OI song bytes: note,
 //                             duration pairs); its length and first byte travel in the packets. At most
@@ -145,6 +147,7 @@ private:
     std::uint16_t sequence_ = 0;
     PlayStats play_stats_;
     bool play_outstanding_ = false;
+    bool bump_play_pending_ = false;  // a bump came while a call was outstanding
 
     // Real-time driver (start()); touched only on strand_.
     std::unique_ptr<boost::asio::strand<boost::asio::io_context::executor_type>> strand_;

@@ -278,6 +278,43 @@ TEST_CASE("demo create over the wire: Drive, properties, Bump, packets wire, pla
     devices->create_service->shutdown();
 }
 
+TEST_CASE("demo create: a bump during an outstanding play_callback is played when that call returns") {
+    NodeFixture f;
+    DemoOptions opts;
+    opts.create.play_period = 1000ms;
+    auto devices = make_demo_devices(opts);
+    REQUIRE(devices);
+    auto& dev = *devices->create;
+    REQUIRE(f.node->register_service(devices->create_service));
+    auto c = connect(f.node->io_context().get_executor(), f.port, "create");
+    c.ok(req(MessageEntryType::FunctionCallReq, "create", "StartStreaming"));
+    c.ok(drive(300, 32767));
+
+    // 1 s: the periodic call, left unanswered; the wall (1335 mm away) is hit at 4.45 s.
+    for (int i = 0; i < 230; ++i) dev.advance(20ms);  // 4.6 s
+    auto periodic = c.inbox->take(MessageEntryType::CallbackCallReq, "play_callback");
+    REQUIRE(periodic);
+    CHECK(scalar<std::int32_t>(*periodic, "DistanceTraveled") == 300);
+    REQUIRE(c.inbox->take(MessageEntryType::EventReq, "Bump"));
+    CHECK_FALSE(c.inbox->take(MessageEntryType::CallbackCallReq, "play_callback", 100ms));
+
+    MessageEntry ret = req(MessageEntryType::CallbackCallRet, periodic->service_path, periodic->member_name);
+    ret.request_id = periodic->request_id;
+    ret.elements.push_back(make_array_element<std::uint8_t>("return", std::vector<std::uint8_t>{60, 8}));
+    c.raw->send(std::move(ret));
+    for (int i = 0; i < 250 && dev.play_stats().replies == 0; ++i) std::this_thread::sleep_for(20ms);
+    REQUIRE(dev.play_stats().replies == 1);
+
+    // The next step (4.62 s, before the 5 s period) makes the bump's call, at the wall.
+    dev.advance(20ms);
+    auto at_wall = c.inbox->take(MessageEntryType::CallbackCallReq, "play_callback");
+    REQUIRE(at_wall);
+    CHECK(scalar<std::int32_t>(*at_wall, "DistanceTraveled") == 1335);
+    CHECK(dev.play_stats().calls == 2);
+    c.raw->close();
+    devices->create_service->shutdown();
+}
+
 TEST_CASE("demo webcam over the wire: frames on FrameStream, memories, backpressure") {
     NodeFixture f;
     auto devices = make_demo_devices();
