@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Builds the WebAssembly client package into wasm-client/dist (idempotent and incremental):
+#   robotraconteur.mjs (JS API), robotraconteur_wasm.mjs + .wasm (Emscripten module), index.d.ts,
+#   package.json, README.md. Build folder: build/wasm (private). Needs Debian's emscripten + node-acorn.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(dirname "$here")"
+build="$root/build/wasm"
+dist="$here/dist"
+export NODE_PATH=/usr/share/nodejs   # emscripten 3.1.6 finds acorn there (package node-acorn)
+
+if ! command -v emcmake >/dev/null; then
+  echo "wasm-client/build.sh: emscripten (emcmake) not found; run scripts/setup.sh" >&2
+  exit 77
+fi
+if [ ! -f "$build/build.ninja" ]; then
+  emcmake cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="${RR_WASM_BUILD_TYPE:-Release}" \
+    -DCMAKE_CROSSCOMPILING_EMULATOR=/usr/bin/node >/dev/null
+fi
+cmake --build "$build" -j "${RR_JOBS:-2}"
+
+mkdir -p "$dist"
+copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || cp "$1" "$2"; }
+copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
+copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
+for f in robotraconteur.mjs errors.mjs proxy.mjs index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
+copy_if_changed "$here/README.md" "$dist/README.md"
+copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
+echo "wasm-client: package in $dist"

@@ -1,0 +1,18 @@
+// RRError: how every failure reaches JS (the error name and message the service or the client core gave).
+
+/** An RR error: `errorName` is the RR name ("RobotRaconteur.InvalidArgument", or a user exception name). */
+export class RRError extends Error {
+  constructor(errorName, message, code = 0) {
+    super(message);
+    this.name = "RRError";
+    this.errorName = errorName;
+    this.code = code;
+  }
+}
+
+export function toRRError(e) {
+  if (e instanceof RRError) return e;
+  if (e && typeof e === "object" && typeof e.name === "string" && "code" in e)
+    return new RRError(e.name, e.message ?? "", e.code);
+  return new RRError("RobotRaconteur.UnknownError", String(e?.message ?? e));
+}

@@ -1,0 +1,287 @@
+// Robot Raconteur client for browsers and node (>= 18): the C++ sans-IO client core compiled to
+// WebAssembly (robotraconteur_wasm.mjs), a WebSocket transport, and object proxies built from the
+// service's robdef. API and value mapping: README.md; types: index.d.ts.
+import createRRModule from "./robotraconteur_wasm.mjs";
+import { RRError, toRRError } from "./errors.mjs";
+import { makeProxy } from "./proxy.mjs";
+
+export { RRError, toRRError };
+
+/** Subprotocol of RR over WebSocket (wire.md §8). */
+export const WEBSOCKET_PROTOCOL = "robotraconteur.robotraconteur.com";
+
+const isNode = typeof process !== "undefined" && !!process.versions?.node && typeof window === "undefined";
+
+let modulePromise = null;
+/** Loads and instantiates the WebAssembly module once. */
+export function loadModule() {
+  if (!modulePromise) {
+    modulePromise = (async () => {
+      const opts = {};
+      if (isNode) {
+        // The module is built for the web; in node it gets the bytes instead of fetching a file: URL.
+        const fs = await import("node:fs/promises");
+        opts.wasmBinary = await fs.readFile(new URL("./robotraconteur_wasm.wasm", import.meta.url));
+      }
+      return createRRModule(opts);
+    })();
+  }
+  return modulePromise;
+}
+
+async function webSocketClass(options) {
+  if (options.WebSocket) return options.WebSocket;
+  if (typeof globalThis.WebSocket === "function") return globalThis.WebSocket;
+  const name = "ws";  // node: the `ws` package (kept out of bundlers' static analysis)
+  const m = await import(/* @vite-ignore */ name);
+  return m.WebSocket ?? m.default;
+}
+
+/**
+ * Splits an RR URL (`rr+ws://host:port/?service=name&nodeid=…&nodename=…`, also rr+wss) into the
+ * WebSocket URL and the query. rrs+ (TLS inside RR) is not supported: use rr+wss.
+ */
+export function parseUrl(url) {
+  const m = /^([a-z+]+):\/\/(.*)$/i.exec(url);
+  if (!m) throw new RRError("RobotRaconteur.InvalidArgument", `not an RR URL: ${url}`, 18);
+  const scheme = m[1].toLowerCase();
+  const wsScheme = { "rr+ws": "ws", "rr+wss": "wss", ws: "ws", wss: "wss" }[scheme];
+  if (!wsScheme)
+    throw new RRError("RobotRaconteur.InvalidArgument", `unsupported scheme "${scheme}" (use rr+ws or rr+wss)`, 18);
+  const u = new URL(`${wsScheme}://${m[2]}`);
+  const service = u.searchParams.get("service") ?? "";
+  if (!service) throw new RRError("RobotRaconteur.InvalidArgument", `URL names no service: ${url}`, 18);
+  return {
+    wsUrl: u.toString(),
+    service,
+    nodeId: u.searchParams.get("nodeid") ?? "",
+    nodeName: u.searchParams.get("nodename") ?? "",
+  };
+}
+
+const now = () => performance.now();
+
+function randomBytes(n) {
+  const b = new Uint8Array(n);
+  globalThis.crypto.getRandomValues(b);
+  return b;
+}
+
+/** One transport connection with one client session (the NativeClient) on it. */
+export class Connection {
+  constructor(M, url, options, WebSocketImpl) {
+    this.url = url;
+    this.options = options;
+    this.state = "connecting";
+    this.closeListeners = new Set();
+    this.proxies = new Map();
+    this.flushQueued = false;
+    this.timer = null;
+    this.timerAt = -1;
+    const endpoint = new Uint32Array(randomBytes(4).buffer)[0] || 1;
+    this.native = new M.NativeClient({
+      service: url.service,
+      targetNodeId: url.nodeId,
+      targetNodeName: url.nodeName,
+      nodeName: options.nodeName ?? "",
+      username: options.username ?? "",
+      password: options.password ?? "",
+      requestTimeoutMs: options.timeoutMs ?? 15000,
+      nodeId: randomBytes(16),
+      endpoint,
+      now: now(),
+    });
+    this.ws = new WebSocketImpl(url.wsUrl, WEBSOCKET_PROTOCOL);
+    this.ws.binaryType = "arraybuffer";
+  }
+
+  /** Resolves with the root object's proxy once the client session is established. */
+  open() {
+    return new Promise((resolve, reject) => {
+      const timeoutMs = this.options.timeoutMs ?? 15000;
+      const guard = setTimeout(() => this.fail(`connect timed out after ${timeoutMs} ms`), timeoutMs);
+      this.native.setHandlers(
+        (err, root) => {
+          clearTimeout(guard);
+          if (err) {
+            reject(toRRError(err));
+            return;
+          }
+          this.state = "connected";
+          const info = this.native.info();
+          this.nodeName = info.nodeName;
+          this.nodeId = info.nodeId;
+          this.definitions = info.definitions;
+          queueMicrotask(() => {
+            try {
+              resolve(this.proxy(root.path));
+            } catch (e) {
+              reject(toRRError(e));
+            }
+          });
+        },
+        (err) => this.onClosed(toRRError(err)),
+        (path) => this.forget(path),
+      );
+      this.ws.onopen = () => this.flush();
+      this.ws.onmessage = (ev) => {
+        if (this.state === "closed") return;
+        if (typeof ev.data === "string") return this.fail("text frame on an RR WebSocket");
+        const r = this.native.feed(new Uint8Array(ev.data), now());
+        this.scheduleFlush();
+        if (!r.ok) this.flush();
+      };
+      this.ws.onerror = () => this.fail(`WebSocket error (${this.url.wsUrl})`);
+      this.ws.onclose = (ev) => this.fail(`WebSocket closed${ev?.code ? ` (code ${ev.code})` : ""}`);
+    });
+  }
+
+  /** The transport went away: the native client fails what is pending and reports the close. */
+  fail(message) {
+    if (this.state === "closed" || this.deleted) return;
+    this.native.transportClosed(message);
+    this.flush();
+    this.onClosed(new RRError("RobotRaconteur.ConnectionError", message, 1));
+  }
+
+  onClosed(error) {
+    if (this.state === "closed") return;
+    this.state = "closed";
+    this.closeError = error;
+    if (this.timer) clearTimeout(this.timer);
+    try {
+      this.ws.close();
+    } catch {
+      // already closed
+    }
+    for (const fn of this.closeListeners) queueMicrotask(() => fn(error));
+    // Free the native object once no C++ frame is on the stack.
+    setTimeout(() => {
+      if (!this.deleted) {
+        this.deleted = true;
+        this.native.delete();
+      }
+    }, 0);
+  }
+
+  forget(path) {
+    for (const p of this.proxies.keys()) if (p === path || p.startsWith(path + ".")) this.proxies.delete(p);
+  }
+
+  scheduleFlush() {
+    if (this.flushQueued) return;
+    this.flushQueued = true;
+    queueMicrotask(() => {
+      this.flushQueued = false;
+      this.flush();
+    });
+  }
+
+  /** Sends pending output and re-arms the timer at the native client's next deadline. */
+  flush() {
+    if (this.deleted) return;
+    if (this.ws.readyState === 1) {
+      for (let out = this.native.takeOutput(); out; out = this.native.takeOutput()) this.ws.send(out);
+    }
+    if (this.native.isClosed() && this.state !== "closed") {
+      this.onClosed(this.closeError ?? new RRError("RobotRaconteur.ConnectionError", "connection closed", 1));
+      return;
+    }
+    const d = this.native.nextDeadline();
+    if (d >= 0 && d !== this.timerAt) {
+      if (this.timer) clearTimeout(this.timer);
+      this.timerAt = d;
+      this.timer = setTimeout(() => {
+        this.timer = null;
+        this.timerAt = -1;
+        if (this.deleted) return;
+        this.native.onTimer(now());
+        this.flush();
+      }, Math.max(0, d - now()));
+    }
+  }
+
+  /** Runs `start(cb)` on the native client; resolves/rejects with what cb receives. */
+  op(start) {
+    return new Promise((resolve, reject) => {
+      if (this.deleted || this.state === "closed")
+        return reject(new RRError("RobotRaconteur.ConnectionError", "connection closed", 1));
+      start((err, value) => (err ? reject(toRRError(err)) : resolve(value)));
+      this.scheduleFlush();
+    });
+  }
+
+  /** Runs a synchronous native call returning {ok, value | error}; throws RRError on error. */
+  sync(fn) {
+    if (this.deleted || this.state === "closed")
+      throw new RRError("RobotRaconteur.ConnectionError", "connection closed", 1);
+    const r = fn(this.native);
+    this.scheduleFlush();
+    if (!r.ok) throw toRRError(r.error);
+    return r.value;
+  }
+
+  proxy(path) {
+    let p = this.proxies.get(path);
+    if (!p) {
+      const desc = this.sync((n) => n.describe(path));
+      p = makeProxy(this, desc);
+      this.proxies.set(path, p);
+    }
+    return p;
+  }
+
+  close() {
+    if (this.state === "closed") return Promise.resolve();
+    return new Promise((resolve) => {
+      this.closeListeners.add(() => resolve());
+      this.native.disconnect(now());
+      this.flush();
+    });
+  }
+
+  /** The `$client` object of every proxy. */
+  get clientApi() {
+    if (!this._clientApi) {
+      const c = this;
+      this._clientApi = {
+        close: () => c.close(),
+        get state() {
+          return c.state;
+        },
+        onClose(fn) {
+          c.closeListeners.add(fn);
+          return () => c.closeListeners.delete(fn);
+        },
+        get nodeName() {
+          return c.nodeName;
+        },
+        get nodeId() {
+          return c.nodeId;
+        },
+        get url() {
+          return c.url.wsUrl;
+        },
+      };
+    }
+    return this._clientApi;
+  }
+}
+
+/**
+ * Connects to the service named in `url` (rr+ws:// or rr+wss://) and returns the root object's proxy.
+ * Options: timeoutMs (connect and per request, default 15000), username, password, nodeName,
+ * WebSocket (a WebSocket class; default globalThis.WebSocket, else the `ws` package in node).
+ */
+export async function connect(url, options = {}) {
+  const u = parseUrl(url);
+  const M = await loadModule();
+  const WS = await webSocketClass(options);
+  const c = new Connection(M, u, options, WS);
+  try {
+    return await c.open();
+  } catch (e) {
+    c.fail(String(e.message));
+    throw e;
+  }
+}
