@@ -9,6 +9,8 @@ cd "$(dirname "$0")/.."
 jobs=${RR_JOBS:-$(nproc)}
 cmake --preset debug >/dev/null
 cmake --build --preset debug -j "$jobs"
+# The WebAssembly client package (wasm-client/dist; build folder build/wasm), tested by ctest.
+./wasm-client/build.sh
 # The dashboard (web/dist) on the client package, for the browser tests (they skip without it).
 if [ -f wasm-client/dist/robotraconteur.mjs ]; then
   ./web/build.sh
