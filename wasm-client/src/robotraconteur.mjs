@@ -61,9 +61,10 @@ export function parseUrl(url) {
 
 const now = () => performance.now();
 
+let webcrypto = globalThis.crypto;
 function randomBytes(n) {
   const b = new Uint8Array(n);
-  globalThis.crypto.getRandomValues(b);
+  webcrypto.getRandomValues(b);
   return b;
 }
 
@@ -275,6 +276,7 @@ export class Connection {
  */
 export async function connect(url, options = {}) {
   const u = parseUrl(url);
+  if (!webcrypto) webcrypto = (await import("node:crypto")).webcrypto;  // node 18 has no global crypto
   const M = await loadModule();
   const WS = await webSocketClass(options);
   const c = new Connection(M, u, options, WS);

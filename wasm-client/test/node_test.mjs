@@ -115,5 +115,22 @@ for (const name of chosen) {
   failed += report.failed.length;
   stopAll();
 }
+// The service goes away: onClose reports ConnectionError, pending and later calls reject with it.
+if (!arg("--target") && !only) {
+  const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--max-lifetime", "300"]);
+  const url = (await readyLine(svc, "ws_url")).ws_url;
+  const c = await rr.connect(url, { timeoutMs: 5000 });
+  const closed = new Promise((resolve) => c.$client.onClose(resolve));
+  const pending = c.count_up(0, 3).then((g) => new Promise((r) => setTimeout(r, 300)).then(() => g.next()));
+  svc.kill("SIGKILL");
+  const err = await Promise.race([closed, new Promise((r) => setTimeout(() => r(null), 20000))]);
+  const late = await c.add(1, 2).then(() => null, (e) => e);
+  const pend = await pending.then(() => null, (e) => e);
+  const okLost = err?.errorName === "RobotRaconteur.ConnectionError" && c.$client.state === "closed" &&
+    late?.errorName === "RobotRaconteur.ConnectionError" && pend?.errorName === "RobotRaconteur.ConnectionError";
+  console.log(`== service killed: onClose ${err?.errorName}, state ${c.$client.state}, call after ${late?.errorName}, ` +
+    `pending ${pend?.errorName}: ${okLost ? "ok" : "FAIL"}`);
+  if (!okLost) failed++;
+}
 console.log(failed ? `FAILED: ${failed} checks` : "all checks passed");
 process.exit(failed ? 1 : 0);
