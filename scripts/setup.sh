@@ -11,6 +11,7 @@ APT_PACKAGES=(
   python3-venv
   chromium fonts-liberation
   emscripten node-acorn
+  nginx openssl
 )
 
 missing=()
