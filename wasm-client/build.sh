@@ -13,8 +13,10 @@ if ! command -v emcmake >/dev/null; then
   echo "wasm-client/build.sh: emscripten (emcmake) not found; run scripts/setup.sh" >&2
   exit 77
 fi
-if [ ! -f "$build/build.ninja" ]; then
-  emcmake cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="${RR_WASM_BUILD_TYPE:-Release}" \
+# MinSizeRel (-Os): half the .wasm of -O3 (450 KB against 930 KB), which matters more to a browser.
+type="${RR_WASM_BUILD_TYPE:-MinSizeRel}"
+if ! grep -qx "CMAKE_BUILD_TYPE:STRING=$type" "$build/CMakeCache.txt" 2>/dev/null; then
+  emcmake cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$type" \
     -DCMAKE_CROSSCOMPILING_EMULATOR=/usr/bin/node >/dev/null
 fi
 cmake --build "$build" -j "${RR_JOBS:-2}"
