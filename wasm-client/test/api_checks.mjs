@@ -228,6 +228,23 @@ check("properties: errors (service and local)", async ({ c }) => {
   await rejects(c.wo_value.get(), "RobotRaconteur.WriteOnlyMember", "writeonly get");
 });
 
+check("values: what JS cannot give exactly is refused before sending", async ({ c }) => {
+  await rejects(c.p_int64.set(2 ** 60), "RobotRaconteur.OutOfRange", "number beyond 2^53 for int64");
+  await rejects(c.p_uint64.set(-1n), "RobotRaconteur.OutOfRange", "negative BigInt for uint64");
+  await rejects(c.p_int32.set(1.5), "RobotRaconteur.OutOfRange", "fraction for int32");
+  await rejects(c.p_uint8.set(256), "RobotRaconteur.OutOfRange", "256 for uint8");
+  await rejects(c.p_bool.set(1), "RobotRaconteur.DataTypeMismatch", "number for bool");
+  await rejects(c.p_enum.set("purple"), "RobotRaconteur.InvalidArgument", "unknown enum name");
+  await rejects(c.a_int16.set(["x"]), "RobotRaconteur.DataTypeMismatch", "string item in int16[]");
+  await rejects(c.p_cdouble.set(1.5), "RobotRaconteur.DataTypeMismatch", "number for cdouble");
+  await rejects(c.m_double.set({ dims: [2, 2], array: Float64Array.from([1]) }), "RobotRaconteur.DataTypeError",
+    "dims product differs from the item count");
+  await rejects(c.s_inner.set({ id: 1, label: "x" }), "RobotRaconteur.NullValue", "struct field missing");
+  await rejects(c.map_int.set(new Map([["a", 1]])), "RobotRaconteur.OutOfRange", "non-numeric int32 map key");
+  await rejects(c.v_any.set({ type: "no such type!", value: 1 }), "RobotRaconteur.DataTypeError", "bad varvalue type");
+  eq(await c.p_int64.get(), -(2n ** 63n), "nothing was sent");
+});
+
 check("functions: results, parameters, errors", async ({ c }) => {
   eq(await c.add(2, 3), 5, "add");
   eq(await c.make_inner(4, "x", [1, 2]), inner(4, "x", [1, 2]), "make_inner");
