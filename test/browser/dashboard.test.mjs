@@ -7,10 +7,10 @@ import assert from "node:assert/strict";
 import http from "node:http";
 import fs from "node:fs";
 import path from "node:path";
-import { settings, startReynard, startGateway, launchChromium, apiDevices, waitFor, webRequire } from "./harness.mjs";
+import { settings, startReynard, startGateway, launchChromium, apiDevices, waitFor, webRequire, TcpRelay } from "./harness.mjs";
 
 const s = settings();
-let reynard, gateway, browser, page, chat;
+let reynard, relay, gateway, browser, page, chat;
 const pageErrors = [];
 
 /** Reynard's web UI chat as a socket.io client (what reynard's own page is): it repeats every text
@@ -73,7 +73,9 @@ function canvasDigest(locator) {
 before(async () => {
   assert.ok(s.gateway, "RR_GATEWAY (path of rr-gateway) must be set");
   reynard = await startReynard(s);
-  gateway = await startGateway(s, { reynard: reynard.info.url });
+  relay = new TcpRelay(reynard.info.port);
+  await relay.listen();
+  gateway = await startGateway(s, { reynard: `rr+tcp://127.0.0.1:${relay.port}/?service=reynard` });
   await waitFor(async () => (await apiDevices(gateway.base)).every((d) => d.state === "connected"), "every device connected", 30000);
   chat = startChat(reynard.info.http_url);
   browser = await launchChromium();
@@ -86,6 +88,7 @@ after(async () => {
   chat?.socket.close();
   await browser?.close();
   const status = gateway ? await gateway.child.stop() : null;
+  await relay?.drop();
   await reynard?.child.stop();
   if (status) assert.equal(status.code, 0, `rr-gateway exited with ${JSON.stringify(status)}`);
 });
@@ -235,11 +238,16 @@ test("a page from a disallowed Origin is refused", async () => {
 
 test("keeps working when a device drops and comes back", async () => {
   await openDevice("reynard");
-  await reynard.child.stop();
+  await relay.drop();
   await page.locator('#device-list li[data-device="reynard"]:not([data-state="connected"])').waitFor({ timeout: 30000 });
   await page.locator(".device-error").waitFor({ state: "visible" });
+  // a request while the device is away fails in place
+  const color = card("color");
+  await color.locator("button", { hasText: "Read" }).click();
+  await waitFor(async () => !(await color.locator(".member-error").isHidden()), "the read's error shown");
+  assert.match(await color.locator(".member-error").textContent(), /RobotRaconteur\.\w+/);
   await shot("07-reynard-down");
-  reynard = await startReynard(s, reynard.info.port);
+  await relay.listen();
   await page.locator('#device-list li[data-device="reynard"][data-state="connected"]').waitFor({ timeout: 60000 });
   await page.locator(".device-error").waitFor({ state: "hidden", timeout: 30000 });
   const samples = async () => Number(await card("state").locator(".plot").getAttribute("data-samples"));

@@ -119,3 +119,45 @@ export async function launchChromium() {
   const { chromium } = webRequire("playwright-core");
   return chromium.launch({ executablePath: "/usr/bin/chromium", headless: true, args: CHROMIUM_ARGS });
 }
+
+/**
+ * A TCP relay in front of a device: the gateway is configured with the relay's port, so the test can
+ * make the device drop (close every connection and stop listening) and come back (listen again on
+ * the same port) without restarting the device, whose own port could still be held in TIME_WAIT.
+ */
+export class TcpRelay {
+  constructor(targetPort, targetHost = "127.0.0.1") {
+    this.target = { port: targetPort, host: targetHost };
+    this.sockets = new Set();
+    this.port = 0;
+  }
+
+  async listen() {
+    const net = await import("node:net");
+    this.server = net.createServer((client) => {
+      const upstream = net.connect(this.target);
+      for (const s of [client, upstream]) {
+        this.sockets.add(s);
+        s.on("close", () => this.sockets.delete(s));
+        s.on("error", () => {});
+      }
+      client.pipe(upstream);
+      upstream.pipe(client);
+      client.on("close", () => upstream.destroy());
+      upstream.on("close", () => client.destroy());
+    });
+    await new Promise((resolve, reject) => {
+      this.server.once("error", reject);
+      this.server.listen(this.port, "127.0.0.1", resolve);
+    });
+    this.port = this.server.address().port;
+    return this.port;
+  }
+
+  /** Drops every connection and refuses new ones until listen() again. */
+  async drop() {
+    const closed = new Promise((resolve) => this.server.close(resolve));
+    for (const s of this.sockets) s.destroy();
+    await closed;
+  }
+}

@@ -7,6 +7,11 @@ import { h } from "./dom.js";
 const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"];
 const HIDDEN = /(^|[.\]])(time|timestamp|ts|seq|seqno|sequence|seqnum)$/i;
 
+/** Axis label of a time in seconds since the epoch: local clock time, whole seconds. */
+function clockLabel(t) {
+  return new Date(t * 1000).toLocaleTimeString([], { hour12: false });
+}
+
 export class LivePlot {
   /**
    * @param {HTMLElement} parent  where the plot goes
@@ -77,7 +82,7 @@ export class LivePlot {
           h("span", { class: "readout-name", text: name }), h("output", { class: "readout-value" }));
         this.readout.append(item);
       }
-      item.querySelector("output").value = Number.isInteger(value) ? String(value) : value.toPrecision(5);
+      item.querySelector("output").value = Number.isInteger(value) ? String(value) : String(Number(value.toPrecision(5)));
       item.dataset.value = String(value);
       item.classList.toggle("off", this.hiddenNames.has(name));
     }
@@ -95,12 +100,16 @@ export class LivePlot {
     this.chart?.destroy();
     const series = [{}].concat(this.names.map((name, i) => ({
       label: name, stroke: COLORS[i % COLORS.length], width: 1.5, show: !this.hiddenNames.has(name), spanGaps: true,
+      points: { show: false },
     })));
     this.chart = new uPlot({
       ...this.size(), series, legend: { show: false },
       cursor: { drag: { x: false, y: false } },
       scales: { x: { time: true } },
-      axes: [{ stroke: "#555", grid: { stroke: "#eee" } }, { stroke: "#555", grid: { stroke: "#eee" }, size: 60 }],
+      axes: [
+        { stroke: "#555", grid: { stroke: "#eee" }, values: (u, splits) => splits.map(clockLabel) },
+        { stroke: "#555", grid: { stroke: "#eee" }, size: 60 },
+      ],
     }, this.data, this.chartEl);
   }
 

@@ -13,7 +13,7 @@ export function callbackView(ctx, member) {
   let n = 0;
   card.body.append(h("label", { class: "toggle" }, box, "answer calls"),
     reply ? h("label", { class: "param" }, h("span", { text: "reply" }), reply.el) : null,
-    h("span", { text: " calls: " }), count);
+    h("div", {}, "calls: ", count));
   const handler = (...args) => {
     count.textContent = String(++n);
     const argText = args.map((a) => formatValue(a)).join(", ");

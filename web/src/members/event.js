@@ -7,7 +7,7 @@ import { formatValue } from "../value_codec.js";
 export function eventView(ctx, member) {
   const card = memberCard(ctx, member);
   const count = h("output", { class: "count", text: "0" });
-  card.body.append(h("span", { text: "received: " }), count);
+  card.body.append(h("div", {}, "received: ", count));
   let n = 0, off = null;
   try {
     off = ctx.obj[member.name].on((...args) => {

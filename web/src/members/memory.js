@@ -1,6 +1,6 @@
-// A memory: its length (dimensions for multidim memories), a read form (start, count; for multidim memories one number per dimension),
-// the contents as a table of offsets and values (uint8 as hex), images drawn when the contents are
-// one, and a write form.
+// A memory: its length (dimensions for multidim memories), a read form (start, count; for multidim
+// memories one number per dimension), the contents as a table of offsets and values (uint8 as hex),
+// images drawn when the contents are one, and a write form.
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
@@ -71,7 +71,7 @@ export function memoryView(ctx, member) {
     table.dataset.count = String(values.length);
   }
 
-  const writeStart = h("input", { type: "text", "aria-label": "write start", value: "0", spellcheck: "false" });
+  const writeStart = h("input", { type: "text", "aria-label": "write start", value: multidim ? "0, 0, 0" : "0", spellcheck: "false" });
   const writeValues = h("input", { type: "text", "aria-label": "values to write", placeholder: multidim ? '{"dims": [...], "array": [...]}' : "1, 2, 3", spellcheck: "false" });
   async function write(ev) {
     ev.preventDefault();
