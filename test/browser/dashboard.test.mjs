@@ -26,9 +26,10 @@ function startChat(httpUrl) {
   return { socket, said };
 }
 
-async function shot(name) {
+/** Saves a screenshot of the whole page (fullPage) or of the laptop-sized viewport. */
+async function shot(name, fullPage = true) {
   fs.mkdirSync(s.artifacts, { recursive: true });
-  await page.screenshot({ path: path.join(s.artifacts, `${name}.png`), fullPage: true });
+  await page.screenshot({ path: path.join(s.artifacts, `${name}.png`), fullPage });
 }
 
 function card(member, within = page) {
@@ -162,6 +163,8 @@ test("reynard: say shows in the event log (new_message)", async () => {
   await entry.waitFor({ timeout: 15000 });
   assert.equal(await card("new_message").locator("output.count").textContent(), "1");
   await shot("04-reynard-event-log");
+  await page.evaluate(() => window.scrollTo(0, 0));
+  await shot("04-reynard-viewport", false);
 });
 
 test("webcam: streamed frames render on a canvas", async () => {
@@ -180,6 +183,7 @@ test("webcam: streamed frames render on a canvas", async () => {
   assert.ok(a.lit > 1000, "the frame is not blank");
   await waitFor(async () => (await canvasDigest(canvas)).sum !== a.sum, "the next frame drawn");
   await shot("05-webcam-stream");
+  await shot("05-webcam-viewport", false);
   // memory viewer: the multidim buffer drawn as an image after CaptureFrameToBuffer
   await callFunction(card("CaptureFrameToBuffer", cam));
   const mem = card("multidimbuffer", cam);

@@ -107,7 +107,7 @@ export class LivePlot {
       cursor: { drag: { x: false, y: false } },
       scales: { x: { time: true } },
       axes: [
-        { stroke: "#555", grid: { stroke: "#eee" }, values: (u, splits) => splits.map(clockLabel) },
+        { stroke: "#555", grid: { stroke: "#eee" }, incrs: [1, 2, 5, 10, 15, 30, 60, 120, 300], values: (u, splits) => splits.map(clockLabel) },
         { stroke: "#555", grid: { stroke: "#eee" }, size: 60 },
       ],
     }, this.data, this.chartEl);

@@ -11,14 +11,15 @@ import { memoryView } from "./members/memory.js";
 import { objrefView } from "./members/objref.js";
 import { callbackView } from "./members/callback.js";
 
+// Live data first (wires, pipes), then what a person reads and changes most.
 const SECTIONS = [
-  ["property", "Properties", propertyView],
-  ["function", "Functions", functionView],
   ["wire", "Wires", wireView],
   ["pipe", "Pipes", pipeView],
-  ["event", "Events", eventView],
+  ["property", "Properties", propertyView],
+  ["function", "Functions", functionView],
   ["objref", "Objects", objrefView],
   ["memory", "Memories", memoryView],
+  ["event", "Events", eventView],
   ["callback", "Callbacks", callbackView],
 ];
 
