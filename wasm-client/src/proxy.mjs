@@ -45,9 +45,9 @@ export function makeProxy(conn, desc) {
     $path: desc.path,
     $implements: desc.implements,
     $members: desc.members,
-    $definitions: conn.definitions,
     $client: conn.clientApi,
   };
+  Object.defineProperty(proxy, "$definitions", { get: () => conn.definitions, enumerable: true });
   for (const m of desc.members) {
     const make = MEMBER_KINDS[m.kind];
     if (make) proxy[m.name] = make(conn, desc.path, m);

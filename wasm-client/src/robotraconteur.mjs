@@ -226,6 +226,8 @@ export class Connection {
     let p = this.proxies.get(path);
     if (!p) {
       const desc = this.sync((n) => n.describe(path));
+      // An objref may have pulled definitions of another service.
+      if (this.proxies.size) this.definitions = this.native.info().definitions;
       p = makeProxy(this, desc);
       this.proxies.set(path, p);
     }

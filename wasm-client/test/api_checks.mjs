@@ -322,6 +322,7 @@ check("events: subscribe, parameters, unsubscribe", async ({ c }) => {
 check("objrefs: plain, int32 and string index, nested, varobject", async ({ c }) => {
   const child = await c.child.get();
   eq(child.$type, `${SVC}.Child`, "child type");
+  ok(/object Child/.test(child.$definitions[SVC]), "child $definitions");
   eq(typeof (await child.name.get()), "string", "child name");
   const byInt = await c.child_by_int.get(7);
   eq(await byInt.name.get(), "child[7]", "child_by_int[7]");
