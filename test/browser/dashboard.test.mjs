@@ -184,6 +184,12 @@ test("webcam: streamed frames render on a canvas", async () => {
   await waitFor(async () => (await canvasDigest(canvas)).sum !== a.sum, "the next frame drawn");
   await shot("05-webcam-stream");
   await shot("05-webcam-viewport", false);
+  // a function's image result is drawn too
+  const capture = card("CaptureFrame", cam);
+  await callFunction(capture);
+  const c = await canvasDigest(capture.locator("canvas.image"));
+  assert.deepEqual([c.width, c.height], [320, 240]);
+  assert.ok(c.lit > 1000, "the captured frame is not blank");
   // memory viewer: the multidim buffer drawn as an image after CaptureFrameToBuffer
   await callFunction(card("CaptureFrameToBuffer", cam));
   const mem = card("multidimbuffer", cam);
@@ -196,10 +202,13 @@ test("webcam: streamed frames render on a canvas", async () => {
   await callFunction(card("StopStreaming", cam));
 });
 
-test("create: driving moves the plotted distance", async () => {
+test("create: driving moves the plotted distance; play_callback is answered", async () => {
   await openDevice("create");
   const dist = card("DistanceTraveled");
   const d0 = await readout(dist, "DistanceTraveled");
+  const cb = card("play_callback");
+  await cb.locator('[aria-label="play_callback reply"]').fill("60, 16, 64, 16");
+  await cb.locator("input[type=checkbox]").check();
   await callFunction(card("StartStreaming"));
   await callFunction(card("Drive"), { velocity: 200, radius: 32767 });
   await waitFor(async () => (await readout(dist, "DistanceTraveled")) >= d0 + 100, "distance +100 mm plotted");
@@ -208,6 +217,11 @@ test("create: driving moves the plotted distance", async () => {
   await waitFor(async () => (await readout(packets, "DistanceTraveled")) >= d0 + 100, "packets plot the distance");
   await shot("06-create-drive");
   await callFunction(card("Drive"), { velocity: 0, radius: 32767 });
+  // while streaming the device calls play_callback (every 5 s, and on bumps); our reply comes back
+  // in the packets (song length and first byte)
+  await waitFor(async () => (await readout(packets, "song_length")) === 4, "the reply's length in the packets", 20000);
+  assert.equal(await readout(packets, "song_first"), 60);
+  await page.locator('.event-log li[data-member="play_callback"]', { hasText: "-> [60, 16, 64, 16]" }).first().waitFor();
   await callFunction(card("StopStreaming"));
 });
 
@@ -260,4 +274,22 @@ test("keeps working when a device drops and comes back", async () => {
   await callFunction(card("teleport"), { x: 0.25, y: 0 });
   await waitFor(async () => Math.abs((await readout(card("state"), "robot_position[0]")) - 250) < 1, "x = 250 mm plotted", 15000);
   await shot("08-reynard-back");
+});
+
+test("reconnects when the gateway itself restarts", async () => {
+  await openDevice("create");
+  const session = page.locator('.device-view[data-device="create"] .badge').nth(1);
+  const port = gateway.port;
+  const status = await gateway.child.stop();
+  assert.equal(status.code, 0, `rr-gateway exited with ${JSON.stringify(status)}`);
+  await page.locator('#gateway-status[data-state="failed"]').waitFor({ timeout: 15000 });
+  await waitFor(async () => (await session.textContent()) !== "connected", "the page's session down");
+  gateway = await startGateway(s, { reynard: `rr+tcp://127.0.0.1:${relay.port}/?service=reynard` }, port);
+  await page.locator('#gateway-status[data-state="connected"]').waitFor({ timeout: 15000 });
+  await waitFor(async () => (await session.textContent()) === "connected", "the page's session back", 30000);
+  const dist = card("DistanceTraveled");
+  const samples = async () => Number(await dist.locator(".plot").getAttribute("data-samples"));
+  const n = await waitFor(samples, "distance samples after the restart");
+  await waitFor(async () => (await samples()) > n + 3, "the property polled again");
+  await shot("09-gateway-back");
 });

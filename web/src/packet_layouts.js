@@ -17,7 +17,8 @@ function createSensorPacket(v) {
     ["heading", d.getInt32(20, true) / 100, true], ["velocity", d.getInt16(24, true), true],
     ["radius", d.getInt16(26, true), true], ["bumpers", d.getUint8(1), true],
     ["wall_hits", d.getUint16(32, true), true], ["seq", d.getUint16(2, true), true],
-    ["time", d.getUint32(28, true) / 1000, true],
+    ["time", d.getUint32(28, true) / 1000, true], ["song_length", d.getUint8(34), true],
+    ["song_first", d.getUint8(35), true],
   ];
 }
 

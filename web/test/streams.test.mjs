@@ -18,9 +18,10 @@ test("the demo Create's SensorPacket bytes decode", () => {
   d.setUint16(2, 9, true); d.setInt32(4, -1234, true); d.setInt32(8, 90, true);
   d.setInt32(12, 500, true); d.setInt32(16, -40, true); d.setInt32(20, 18000, true);
   d.setInt16(24, 200, true); d.setInt16(26, 32767, true); d.setUint32(28, 2500, true); d.setUint16(32, 3, true);
+  data[34] = 4; data[35] = 60;
   const series = Object.fromEntries(numericFields({ ID: 19, Data: data }, "experimental.create.SensorPacket").map(([n, v]) => [n, v]));
   assert.deepEqual(series, { DistanceTraveled: -1234, AngleTraveled: 90, x: 500, y: -40, heading: 180, velocity: 200,
-    radius: 32767, bumpers: 2, wall_hits: 3, seq: 9, time: 2.5 });
+    radius: 32767, bumpers: 2, wall_hits: 3, seq: 9, time: 2.5, song_length: 4, song_first: 60 });
   // another layout version is not guessed at: generic flattening instead
   data[0] = 2;
   assert.deepEqual(numericFields({ ID: 19, Data: data }, "experimental.create.SensorPacket"), [["ID", 19]]);
