@@ -2,6 +2,7 @@
 //   1. rr_interop_service --websocket (our C++ service), rr+ws
 //   2. rr-gateway in front of it (device over rr+tcp, client over rr+ws to the gateway)
 //   3. the official Python service (test/interop/official_service.py), rr+ws on its TCP port
+//   4. the official service with message format v2 only; 5. ours with v4 string tables
 //
 // Usage: node node_test.mjs --interop-service PATH --gateway PATH --python PATH [--only REGEX] [--target NAME]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
@@ -90,6 +91,18 @@ const targets = {
   async official() {
     const py = arg("--python", join(root, ".venv", "bin", "python"));
     const svc = start(py, [join(root, "test", "interop", "official_service.py"), "--port", "0", "--websocket",
+      "--max-lifetime", "300"]);
+    return (await readyLine(svc, "ws_url")).ws_url;
+  },
+  // Message format v2 only (no v4 negotiated), and v4 with string tables.
+  async "official-v2"() {
+    const py = arg("--python", join(root, ".venv", "bin", "python"));
+    const svc = start(py, [join(root, "test", "interop", "official_service.py"), "--port", "0", "--websocket",
+      "--disable-message4", "--max-lifetime", "300"]);
+    return (await readyLine(svc, "ws_url")).ws_url;
+  },
+  async "ours-stringtable"() {
+    const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--enable-stringtable",
       "--max-lifetime", "300"]);
     return (await readyLine(svc, "ws_url")).ws_url;
   },
