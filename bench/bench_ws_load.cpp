@@ -1,0 +1,239 @@
+// rr_bench_ws_load: a Beast WebSocket load generator for the gateway's JSON API (docs/json-api.md,
+// subprotocol rr-gateway.json.v1). One thread, one io_context, N connections.
+//
+// Usage:
+//   rr_bench_ws_load --port P --clients N fanout [--seconds S] [--device D] [--member M] [--hz H]
+//       each client subscribes to wire M of device D (default bench / Ticks, whose values are
+//       [stamp_us, sequence, ...]); after every client has its first value, values are counted for
+//       S seconds (default 5). Prints one JSON line: delivered values/s (all clients), the expected
+//       rate N × H, latency from the device's stamp to arrival (p50/p99/max µs), the load
+//       generator's own CPU%.
+//   rr_bench_ws_load --port P --clients N idle
+//       opens N connections (no subscription), prints {"opened": N, …} and keeps them open until a
+//       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
+// Connections are opened at most 64 at a time (the gateway's listen backlog is finite).
+#include <deque>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/read_until.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/streambuf.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "bench/bench_common.hpp"
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using clock_type = std::chrono::steady_clock;
+
+namespace {
+
+constexpr const char* kJsonSubprotocol = "rr-gateway.json.v1";
+constexpr std::size_t kMaxConnecting = 64;
+
+struct Stats {
+    bool measuring = false;
+    std::size_t with_value = 0;     // clients that received at least one value
+    std::size_t opened = 0, failed = 0;
+    std::uint64_t delivered = 0;    // values counted while measuring
+    std::vector<double> latency_us; // while measuring
+    std::string first_error;
+};
+
+class Connection : public std::enable_shared_from_this<Connection> {
+public:
+    Connection(asio::io_context& io, Stats& stats, std::function<void()> on_open_done)
+        : ws_(io), stats_(stats), on_open_done_(std::move(on_open_done)) {}
+
+    void open(tcp::endpoint endpoint, std::string host, std::optional<nlohmann::json> subscribe) {
+        subscribe_ = std::move(subscribe);
+        auto self = shared_from_this();
+        beast::get_lowest_layer(ws_).async_connect(endpoint, [self, host](beast::error_code ec) {
+            if (ec) return self->failed("connect: " + ec.message());
+            beast::get_lowest_layer(self->ws_).socket().set_option(tcp::no_delay(true));
+            self->ws_.set_option(websocket::stream_base::decorator(
+                [](websocket::request_type& req) { req.set(beast::http::field::sec_websocket_protocol, kJsonSubprotocol); }));
+            self->ws_.async_handshake(host, "/", [self](beast::error_code ec) {
+                if (ec) return self->failed("handshake: " + ec.message());
+                ++self->stats_.opened;
+                self->opened_done();
+                if (self->subscribe_) {
+                    self->out_ = self->subscribe_->dump();
+                    self->ws_.text(true);
+                    self->ws_.async_write(asio::buffer(self->out_), [self](beast::error_code ec, std::size_t) {
+                        if (ec) self->failed("subscribe: " + ec.message());
+                    });
+                }
+                self->read();
+            });
+        });
+    }
+
+    void close() {
+        beast::error_code ec;
+        beast::get_lowest_layer(ws_).socket().close(ec);
+    }
+
+private:
+    void opened_done() {
+        if (on_open_done_) std::exchange(on_open_done_, nullptr)();
+    }
+    void failed(const std::string& what) {
+        if (stats_.first_error.empty()) stats_.first_error = what;
+        if (on_open_done_) ++stats_.failed;
+        opened_done();
+    }
+    void read() {
+        auto self = shared_from_this();
+        ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
+            if (ec) return;
+            self->on_message(beast::buffers_to_string(self->buffer_.data()));
+            self->buffer_.consume(self->buffer_.size());
+            self->read();
+        });
+    }
+    void on_message(const std::string& text) {
+        const double now = rr::bench::wall_clock_us();
+        auto msg = nlohmann::json::parse(text, nullptr, false);
+        if (msg.is_discarded() || msg.value("kind", "") != "wire") return;
+        const auto& v = msg["value"];
+        if (!v.is_array() || v.size() < 2 || v[1].get<double>() < 0) return;
+        if (!got_value_) {
+            got_value_ = true;
+            ++stats_.with_value;
+        }
+        if (!stats_.measuring) return;
+        ++stats_.delivered;
+        stats_.latency_us.push_back(now - v[0].get<double>());
+    }
+
+    websocket::stream<beast::tcp_stream> ws_;
+    Stats& stats_;
+    std::function<void()> on_open_done_;
+    std::optional<nlohmann::json> subscribe_;
+    beast::flat_buffer buffer_;
+    std::string out_;
+    bool got_value_ = false;
+};
+
+void raise_fd_limit() {
+    rlimit r{};
+    getrlimit(RLIMIT_NOFILE, &r);
+    r.rlim_cur = r.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &r);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::uint16_t port = 0;
+    std::size_t clients = 10;
+    double seconds = 5, hz = 100;
+    std::string mode, device = "bench", member = "Ticks";
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        if (a == "--port") port = static_cast<std::uint16_t>(std::stoi(value()));
+        else if (a == "--clients") clients = std::stoul(value());
+        else if (a == "--seconds") seconds = std::stod(value());
+        else if (a == "--hz") hz = std::stod(value());
+        else if (a == "--device") device = value();
+        else if (a == "--member") member = value();
+        else if (a == "fanout" || a == "idle") mode = a;
+        else {
+            std::cerr << "usage: " << argv[0] << " --port P --clients N (fanout [--seconds S] [--hz H] | idle)\n";
+            return 2;
+        }
+    }
+    if (port == 0 || mode.empty()) {
+        std::cerr << "need --port and a mode (fanout | idle)\n";
+        return 2;
+    }
+    raise_fd_limit();
+
+    asio::io_context io;
+    Stats stats;
+    const tcp::endpoint endpoint(asio::ip::make_address("127.0.0.1"), port);
+    const std::string host = "127.0.0.1:" + std::to_string(port);
+    std::optional<nlohmann::json> subscribe;
+    if (mode == "fanout") subscribe = nlohmann::json{{"id", 1}, {"op", "subscribe"}, {"device", device}, {"member", member}};
+
+    // Open the connections, at most kMaxConnecting in progress.
+    std::vector<std::shared_ptr<Connection>> conns;
+    std::size_t next = 0, in_progress = 0;
+    std::function<void()> pump = [&] {
+        while (next < clients && in_progress < kMaxConnecting) {
+            ++in_progress;
+            ++next;
+            auto c = std::make_shared<Connection>(io, stats, [&] {
+                --in_progress;
+                pump();
+            });
+            conns.push_back(c);
+            c->open(endpoint, host, subscribe);
+        }
+    };
+    const auto open_t0 = clock_type::now();
+    pump();
+    while (stats.opened + stats.failed < clients) io.run_one();
+    const double open_s = rr::bench::elapsed_us(open_t0, clock_type::now()) / 1e6;
+
+    if (mode == "idle") {
+        std::cout << nlohmann::json{{"mode", "idle"}, {"clients", clients}, {"opened", stats.opened},
+                                    {"failed", stats.failed}, {"open_s", open_s}, {"error", stats.first_error}}
+                         .dump()
+                  << std::endl;
+        // Serve the sockets (pings, closes) until the caller writes a line or closes stdin.
+        asio::posix::stream_descriptor in(io, ::dup(0));
+        asio::streambuf line;
+        bool done = false;
+        asio::async_read_until(in, line, '\n', [&](beast::error_code, std::size_t) { done = true; });
+        while (!done) io.run_one();
+        for (auto& c : conns) c->close();
+        return 0;
+    }
+
+    // fanout: wait (at most 30 s) until every open client has its first value, then measure.
+    const auto wait_until = clock_type::now() + std::chrono::seconds(30);
+    while (stats.with_value < stats.opened && clock_type::now() < wait_until) io.run_for(std::chrono::milliseconds(10));
+    stats.latency_us.reserve(static_cast<std::size_t>(double(clients) * hz * seconds * 1.2));
+    const auto cpu0 = rr::bench::CpuSnapshot::now();
+    stats.measuring = true;
+    const auto t0 = clock_type::now();
+    io.run_for(std::chrono::duration_cast<clock_type::duration>(std::chrono::duration<double>(seconds)));
+    stats.measuring = false;
+    const double wall = rr::bench::elapsed_us(t0, clock_type::now());
+    const auto cpu1 = rr::bench::CpuSnapshot::now();
+    for (auto& c : conns) c->close();
+    std::cout << nlohmann::json{{"mode", "fanout"},
+                                {"clients", clients},
+                                {"opened", stats.opened},
+                                {"failed", stats.failed},
+                                {"with_value", stats.with_value},
+                                {"open_s", open_s},
+                                {"seconds", wall / 1e6},
+                                {"delivered_per_s", double(stats.delivered) * 1e6 / wall},
+                                {"expected_per_s", double(stats.opened) * hz},
+                                {"p50_us", rr::bench::percentile(stats.latency_us, 0.5)},
+                                {"p99_us", rr::bench::percentile(stats.latency_us, 0.99)},
+                                {"max_us", stats.latency_us.empty() ? 0.0
+                                                                    : *std::max_element(stats.latency_us.begin(), stats.latency_us.end())},
+                                {"loadgen_cpu_pct", 100.0 * (cpu1.cpu_us - cpu0.cpu_us) / wall},
+                                {"error", stats.first_error}}
+                     .dump()
+              << std::endl;
+    return 0;
+}
