@@ -472,11 +472,11 @@ check("memories: 1-D, multi-dim, pod, namedarray, readonly", async ({ c }) => {
 });
 
 /** Runs every check against `url`; the last one closes the connection. */
-export async function runChecks(rr, url, { log = () => {}, only = null, timeoutMs = 15000 } = {}) {
+export async function runChecks(rr, url, { log = () => {}, only = null, timeoutMs = 15000, options = {} } = {}) {
   const report = { passed: [], failed: [] };
   let c;
   try {
-    c = await rr.connect(url, { timeoutMs });
+    c = await rr.connect(url, { timeoutMs, ...options });
   } catch (e) {
     report.failed.push({ name: "connect", error: `${e.errorName ?? ""} ${e.message}` });
     return report;

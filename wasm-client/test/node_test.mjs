@@ -2,12 +2,15 @@
 //   1. rr_interop_service --websocket (our C++ service), rr+ws
 //   2. rr-gateway in front of it (device over rr+tcp, client over rr+ws to the gateway)
 //   3. the official Python service (test/interop/official_service.py), rr+ws on its TCP port
-//   4. the official service with message format v2 only; 5. ours with v4 string tables
+//   4. the official service with message format v2 only; 5. ours with v4 string tables;
+//   6. ours behind nginx terminating TLS (rr+wss), when nginx and openssl are installed
 //
 // Usage: node node_test.mjs --interop-service PATH --gateway PATH --python PATH [--only REGEX] [--target NAME]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
 import { spawn, spawnSync } from "node:child_process";
-import { existsSync } from "node:fs";
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { createServer, connect as connectTcp } from "node:net";
+import { tmpdir } from "node:os";
 import { createInterface } from "node:readline";
 import { fileURLToPath } from "node:url";
 import { dirname, join } from "node:path";
@@ -101,6 +104,54 @@ const targets = {
       "--disable-message4", "--max-lifetime", "300"]);
     return (await readyLine(svc, "ws_url")).ws_url;
   },
+  // rr+wss: nginx terminates TLS (self-signed certificate for 127.0.0.1) in front of ours.
+  async wss() {
+    const nginx = ["/usr/sbin/nginx", "/usr/bin/nginx"].find((p) => existsSync(p));
+    if (!nginx || spawnSync("sh", ["-c", "command -v openssl"]).status !== 0) return null;
+    const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--max-lifetime", "300"]);
+    const { port } = await readyLine(svc, "ws_url");
+    const tmp = mkdtempSync(join(tmpdir(), "rr-wasm-wss-"));
+    process.on("exit", () => rmSync(tmp, { recursive: true, force: true }));
+    const cert = join(tmp, "cert.pem");
+    const key = join(tmp, "key.pem");
+    const gen = spawnSync("openssl", ["req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
+      "-nodes", "-days", "1", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1", "-keyout", key,
+      "-out", cert]);
+    if (gen.status !== 0) throw new Error(`openssl: ${gen.stderr}`);
+    const tlsPort = await freePort();
+    writeFileSync(join(tmp, "nginx.conf"), `pid ${tmp}/nginx.pid; error_log ${tmp}/error.log;
+events {}
+http {
+  access_log off; client_body_temp_path ${tmp}/body; proxy_temp_path ${tmp}/proxy;
+  server {
+    listen 127.0.0.1:${tlsPort} ssl;
+    ssl_certificate ${cert}; ssl_certificate_key ${key};
+    location / {
+      proxy_pass http://127.0.0.1:${port}; proxy_http_version 1.1; proxy_read_timeout 300s;
+      proxy_set_header Upgrade $http_upgrade; proxy_set_header Connection "upgrade";
+    }
+  }
+}
+`);
+    start(nginx, ["-p", tmp, "-c", join(tmp, "nginx.conf"), "-g", "daemon off;"]);
+    const ca = readFileSync(cert);
+    const { WebSocket } = await import("ws");
+    options.WebSocket = class extends WebSocket {
+      constructor(url, protocols) {
+        super(url, protocols, { ca });
+      }
+    };
+    for (let i = 0; ; i++) {  // until nginx listens
+      const up = await new Promise((resolve) => {
+        const s = connectTcp(tlsPort, "127.0.0.1", () => resolve(true)).on("error", () => resolve(false));
+        s.unref();
+      });
+      if (up) break;
+      if (i > 100) throw new Error("nginx did not start");
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    return `rr+wss://127.0.0.1:${tlsPort}/?service=interop`;
+  },
   async "ours-stringtable"() {
     const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--enable-stringtable",
       "--max-lifetime", "300"]);
@@ -108,7 +159,17 @@ const targets = {
   },
 };
 
+function freePort() {
+  return new Promise((resolve) => {
+    const srv = createServer().listen(0, "127.0.0.1", () => {
+      const { port } = srv.address();
+      srv.close(() => resolve(port));
+    });
+  });
+}
+
 const rr = await import(dist);
+let options = {};
 const { runChecks } = await import("./api_checks.mjs");
 const only = arg("--only") ? new RegExp(arg("--only")) : null;
 const chosen = arg("--target") ? [arg("--target")] : Object.keys(targets);
@@ -122,8 +183,13 @@ for (const name of chosen) {
     stopAll();
     process.exit(2);
   }
+  if (url === null) {
+    console.log(`== ${name}: SKIP (nginx or openssl not installed)`);
+    continue;
+  }
   console.log(`== ${name}: ${url}`);
-  const report = await runChecks(rr, url, { log: (l) => console.log(`  ${l}`), only });
+  const report = await runChecks(rr, url, { log: (l) => console.log(`  ${l}`), only, options });
+  options = {};
   console.log(`== ${name}: ${report.passed.length} passed, ${report.failed.length} failed`);
   failed += report.failed.length;
   stopAll();
