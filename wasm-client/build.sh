@@ -9,6 +9,11 @@ build="$root/build/wasm"
 dist="$here/dist"
 export NODE_PATH=/usr/share/nodejs   # emscripten 3.1.6 finds acorn there (package node-acorn)
 
+# One build at a time: scripts/test.sh, scripts/run.sh and people share this folder and dist/.
+mkdir -p "$build"
+exec 9>"$build.lock"
+flock 9
+
 if ! command -v emcmake >/dev/null; then
   echo "wasm-client/build.sh: emscripten (emcmake) not found; run scripts/setup.sh" >&2
   exit 77
@@ -22,7 +27,8 @@ fi
 cmake --build "$build" -j "${RR_JOBS:-2}"
 
 mkdir -p "$dist"
-copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || cp "$1" "$2"; }
+# Replace each file in one step (readers never see half a file).
+copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || { cp "$1" "$2.tmp$$" && mv -f "$2.tmp$$" "$2"; }; }
 copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
 copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
 for f in robotraconteur.mjs errors.mjs proxy.mjs index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
