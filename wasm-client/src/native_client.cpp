@@ -1,11 +1,11 @@
 // NativeClient (native_client.hpp): ClientContext operations with their values converted to/from JS.
+#include "wasm-client/src/native_client.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <string>
-
-#include "wasm-client/src/native_client.hpp"
 
 #include "core/value/var_type.hpp"
 #include "robdef/canonical_text.hpp"
@@ -569,7 +569,7 @@ std::optional<std::vector<std::uint64_t>> NativeClient::u64_list(const val& v) {
 }
 
 Result<val> NativeClient::values_to_js(const std::vector<Value>& values,
-                                   const std::vector<robdef::TypeDefinition>& types, const std::string& ctx) const {
+                                       const std::vector<robdef::TypeDefinition>& types, const std::string& ctx) const {
     val a = val::array();
     for (std::size_t i = 0; i < values.size() && i < types.size(); ++i) {
         auto js = to_js(values[i], types[i], ctx_.definitions(), ctx);
