@@ -6,8 +6,9 @@
 //       each client subscribes to wire M of device D (default bench / Ticks, whose values are
 //       [stamp_us, sequence, ...]); after every client has its first value, values are counted for
 //       S seconds (default 5). Prints one JSON line: delivered values/s (all clients), the expected
-//       rate N × H, latency from the device's stamp to arrival (p50/p99/max µs), the load
-//       generator's own CPU%.
+//       rate N × H, the fraction of the values the device sent in each client's window that reached
+//       it (delivered_of_sent; below 1: coalesced, as wires keep only the newest value), latency
+//       from the device's stamp to arrival (p50/p99/max µs), the load generator's own CPU%.
 //   rr_bench_ws_load --port P --clients N idle
 //       opens N connections (no subscription), prints {"opened": N, …} and keeps them open until a
 //       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
@@ -82,6 +83,9 @@ public:
         });
     }
 
+    /// Values the device sent while this client was measuring (sequence numbers first..last seen).
+    double sent_span() const { return first_seq_ < 0 ? 0 : last_seq_ - first_seq_ + 1; }
+
     void close() {
         beast::error_code ec;
         beast::get_lowest_layer(ws_).socket().close(ec);
@@ -116,6 +120,9 @@ private:
             ++stats_.with_value;
         }
         if (!stats_.measuring) return;
+        const double seq = v[1].get<double>();
+        if (first_seq_ < 0) first_seq_ = seq;
+        last_seq_ = seq;
         ++stats_.delivered;
         stats_.latency_us.push_back(now - v[0].get<double>());
     }
@@ -127,6 +134,7 @@ private:
     beast::flat_buffer buffer_;
     std::string out_;
     bool got_value_ = false;
+    double first_seq_ = -1, last_seq_ = -1;
 };
 
 void raise_fd_limit() {
@@ -217,7 +225,11 @@ int main(int argc, char** argv) {
     stats.measuring = false;
     const double wall = rr::bench::elapsed_us(t0, clock_type::now());
     const auto cpu1 = rr::bench::CpuSnapshot::now();
-    for (auto& c : conns) c->close();
+    double device_sent = 0;  // per client: values the device sent in its window (wires keep the newest only)
+    for (auto& c : conns) {
+        device_sent += c->sent_span();
+        c->close();
+    }
     std::cout << nlohmann::json{{"mode", "fanout"},
                                 {"clients", clients},
                                 {"opened", stats.opened},
@@ -227,6 +239,7 @@ int main(int argc, char** argv) {
                                 {"seconds", wall / 1e6},
                                 {"delivered_per_s", double(stats.delivered) * 1e6 / wall},
                                 {"expected_per_s", double(stats.opened) * hz},
+                                {"delivered_of_sent", device_sent > 0 ? double(stats.delivered) / device_sent : 0.0},
                                 {"p50_us", rr::bench::percentile(stats.latency_us, 0.5)},
                                 {"p99_us", rr::bench::percentile(stats.latency_us, 0.99)},
                                 {"max_us", stats.latency_us.empty() ? 0.0

@@ -1,37 +1,79 @@
 #!/usr/bin/env bash
-# Where the time of a Nop() round trip goes: runs rr_bench_service under valgrind's callgrind, zeroes
-# its counters after a warm-up, drives N Nop() calls with rr_bench_client (rr+tcp), dumps, and writes
-# the top functions by inclusive and self instruction count to bench/results/profile_nop.txt.
-# Instruction counts do not depend on machine load. Needs valgrind (apt-get install valgrind) and a
-# build from bench/run.sh (RR_BENCH_BUILD, default build/bench).
-# Usage: bench/profile.sh [N]   (default 5000)
+# Where the time of a Nop() round trip goes, counted in instructions (valgrind's callgrind: the counts
+# do not depend on machine load).
+#   service side: rr_bench_service runs under callgrind; its counters are zeroed after a warm-up and
+#                 dumped after N Nop() calls over rr+tcp: instructions per call = total / N.
+#   client side:  rr_bench_client runs under callgrind twice (N and 2N calls): per call = difference / N
+#                 (connect and close cancel out).
+# Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self).
+# Needs valgrind (apt-get install valgrind) and a build from bench/run.sh (RR_BENCH_BUILD, default
+# build/bench).  Usage: bench/profile.sh [N]   (default 2000)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${RR_BENCH_BUILD:-build/bench}
-N=${1:-5000}
+N=${1:-2000}
 OUT=bench/results
 command -v valgrind >/dev/null || { echo "profile.sh: valgrind is not installed (apt-get install valgrind)" >&2; exit 2; }
 mkdir -p "$OUT"
 tmp=$(mktemp -d)
-trap 'kill $svc 2>/dev/null || true; rm -rf "$tmp"' EXIT
-valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --dump-instr=no \
+svc=""
+trap '[ -n "$svc" ] && kill $svc 2>/dev/null; rm -rf "$tmp"' EXIT
+total_ir() { callgrind_annotate "$1" 2>/dev/null | awk '/PROGRAM TOTALS/ && !done { gsub(",", "", $1); print $1; done = 1 }'; }
+
+valgrind --tool=callgrind --callgrind-out-file="$tmp/svc.out" \
   "$BUILD/bench/rr_bench_service" --memory-mib 0.01 --threads 2 > "$tmp/ready" 2> "$tmp/valgrind.log" &
 svc=$!
 for _ in $(seq 1 600); do [ -s "$tmp/ready" ] && break; sleep 0.1; done
 url=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/ready")
 "$BUILD/bench/rr_bench_client" --url "$url" --count 200 --ops nop > /dev/null   # warm-up
 callgrind_control -z "$svc" > /dev/null
-"$BUILD/bench/rr_bench_client" --url "$url" --count "$N" --ops nop | tee "$tmp/client.json"
+"$BUILD/bench/rr_bench_client" --url "$url" --count "$N" --ops nop > /dev/null
 callgrind_control -d "$svc" > /dev/null
-sleep 1
-kill -TERM "$svc"; wait "$svc" || true
-dump=$(ls -t "$tmp"/cg.out.* 2>/dev/null | head -1)
+for c in "$N" $((2 * N)); do
+  valgrind --tool=callgrind --callgrind-out-file="$tmp/client.$c.out" \
+    "$BUILD/bench/rr_bench_client" --url "$url" --count "$c" --ops nop > /dev/null 2>> "$tmp/valgrind.log"
+done
+kill -TERM "$svc"; wait "$svc" || true; svc=""
+# System calls per call on the service side, on a service without valgrind (valgrind makes its own
+# system calls); strace slows the calls down, only the counts matter.
+if command -v strace > /dev/null; then
+  "$BUILD/bench/rr_bench_service" --memory-mib 0.01 --threads 2 > "$tmp/ready2" &
+  plain=$!
+  for _ in $(seq 1 100); do [ -s "$tmp/ready2" ] && break; sleep 0.1; done
+  url2=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/ready2")
+  "$BUILD/bench/rr_bench_client" --url "$url2" --count 200 --ops nop > /dev/null
+  strace -f -c -o "$tmp/strace.txt" -p "$plain" 2> /dev/null &
+  st=$!
+  sleep 1
+  "$BUILD/bench/rr_bench_client" --url "$url2" --count "$N" --ops nop > /dev/null
+  kill -INT "$st"; wait "$st" || true
+  kill -TERM "$plain"; wait "$plain" || true
+fi
+dump=$(ls -t "$tmp"/svc.out.* | head -1)
+svc_ir=$(total_ir "$dump")
+c1=$(total_ir "$tmp/client.$N.out"); c2=$(total_ir "$tmp/client.$((2 * N)).out")
+# Annotations only for frames in our code (names start with rr::) and the allocator, to stay readable.
+annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[0-9,]+ \(' | grep -E 'rr::|malloc|free|operator new|operator delete|asio' | cut -c1-240 | sed -n 1,40p; }
 {
-  echo "# callgrind of rr_bench_service while serving $N Nop() calls (plus connect/close of one client session)"
-  echo "# Ir per call = total Ir / $N"
-  callgrind_annotate --inclusive=yes "$dump" 2>/dev/null | head -60
+  echo "# callgrind instruction counts for Nop() over rr+tcp (our client -> our service), N = $N"
+  echo "service instructions per call: $((svc_ir / N))"
+  echo "client instructions per call:  $(((c2 - c1) / N))   (blocking layer: the caller thread waits on a future)"
+  bench/callgrind_calls.py "$dump" malloc free | awk -v n="$N" '{ printf "service %s calls per call: %.1f\n", $1, $2 / n }'
+  paste <(bench/callgrind_calls.py "$tmp/client.$N.out" malloc) <(bench/callgrind_calls.py "$tmp/client.$((2 * N)).out" malloc) |
+    awk -v n="$N" '{ printf "client malloc calls per call: %.1f\n", ($4 - $2) / n }'
+  if [ -s "$tmp/strace.txt" ]; then
+    echo
+    echo "## service system calls per call (strace -c, $N calls; the first lines of its table)"
+    awk -v n="$N" 'NR > 2 && $NF != "total" && $4 ~ /^[0-9]+$/ { printf "%-16s %.2f\n", $NF, $4 / n }' "$tmp/strace.txt" | sort -k2 -rn | head -8
+  fi
   echo
-  echo "# self cost"
-  callgrind_annotate "$dump" 2>/dev/null | head -45
+  echo "## service, inclusive (top frames in rr::, asio and the allocator)"
+  annotate --inclusive=yes "$dump"
+  echo
+  echo "## service, self"
+  annotate --inclusive=no "$dump"
+  echo
+  echo "## client ($((2 * N)) calls plus one connect), self"
+  annotate --inclusive=no "$tmp/client.$((2 * N)).out"
 } > "$OUT/profile_nop.txt"
 echo "wrote $OUT/profile_nop.txt" >&2
