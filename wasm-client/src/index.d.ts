@@ -77,7 +77,7 @@ export interface PipeEndpoint<T = RRValue> extends AsyncIterable<T> {
   /** The index the service assigned. */
   readonly index: number;
   readonly closed: boolean;
-  /** `fn(packet)` for every packet; while any listener is set, packets are not queued for iteration. */
+  /** `fn(packet)` for every packet (first those queued so far); while any listener is set, packets are not queued for iteration. */
   onPacket(fn: (packet: T) => void): () => void;
   onClose(fn: (error: RRError | null) => void): () => void;
   /** `fn(packetNumber)` for every acknowledgement the service sends. */

@@ -219,9 +219,10 @@ class PipeEndpoint {
     this.queue.end();
     for (const fn of this.closeListeners) later(fn, error);
   }
-  /** `fn(packet)` for every packet received; returns the function that removes it. */
+  /** `fn(packet)` for every packet received (and those queued so far); returns the function that removes it. */
   onPacket(fn) {
     this.listeners.add(fn);
+    for (const pkt of this.queue.items.splice(0)) later(fn, pkt);
     return () => this.listeners.delete(fn);
   }
   onClose(fn) {

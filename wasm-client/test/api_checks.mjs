@@ -366,6 +366,14 @@ check("pipes: echo, service stream with onPacket and iteration, closed by the se
   eq(iter[1], Float64Array.from([1, 0.5]), "iterated packet");
   ok(s.closed, "break closes the endpoint");
 
+  const s3 = await c.p_stream.connect();
+  await c.send_stream(2);
+  await sleep(100);
+  const late = [];
+  s3.onPacket((x) => late.push(x));
+  await until(() => late.length === 2, "packets queued before onPacket reach it");
+  await s3.close();
+
   const s2 = await c.p_stream.connect();
   let closedBy = null;
   s2.onClose((e) => (closedBy = e ?? "closed"));
