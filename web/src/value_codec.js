@@ -1,6 +1,8 @@
 // Values between the page and the client package: text in editors -> typed values (typed arrays for
-// numeric arrays, BigInt for int64, plain objects for structs, {dims, array} for multidim arrays),
-// and values -> short display text. JSON text (JSON.parse) is used for structured inputs.
+// numeric arrays, BigInt for int64, plain objects for structs, {dims, array} for multidim arrays,
+// {real, imag} for complex numbers, {type, value} for varvalues), and values -> short display text.
+// Structured inputs are JSON (JSON.parse); numbers JSON cannot hold are written as strings there
+// ("NaN", "Infinity", "-Infinity", "-0"), as are 64-bit integers.
 
 import { NUMERIC_ARRAYS, parseType, parseNumber, isNumericBase } from "./rr_types.js";
 
@@ -44,6 +46,7 @@ function toArray(base, items) {
 /** Converts parsed JSON to a value typed by `typeText` (see parseInput). */
 export function fromJson(typeText, json, outline, scope) {
   const t = parseType(typeText);
+  if (json === null && (t.container || t.array || !isNumericBase(t.base))) return null;
   if (t.container) {
     const inner = typeText.replace(/\{(int32|string|list)\}\s*$/, "");
     if (t.container === "list") return asList(json).map((x) => fromJson(inner, x, outline, scope));
@@ -58,7 +61,7 @@ export function fromJson(typeText, json, outline, scope) {
     if (!json || !Array.isArray(json.dims) || !Array.isArray(json.array)) {
       throw new Error(`${typeText}: {"dims": [...], "array": [...]} expected (column-major)`);
     }
-    return { dims: Uint32Array.from(json.dims), array: fromJson(`${t.base}[]`, json.array, outline, scope) };
+    return { dims: json.dims.map(Number), array: fromJson(`${t.base}[]`, json.array, outline, scope) };
   }
   if (t.array === "vector") {
     const items = asList(json);
@@ -67,7 +70,17 @@ export function fromJson(typeText, json, outline, scope) {
   }
   if (isNumericBase(t.base)) return parseNumber(t.base, String(json));
   if (t.base === "string") return String(json);
-  if (t.base === "varvalue") return json;
+  if (t.base === "cdouble" || t.base === "csingle") {
+    if (!json || typeof json !== "object") throw new Error(`${typeText}: {"real": …, "imag": …} expected`);
+    return { real: parseNumber("double", String(json.real)), imag: parseNumber("double", String(json.imag)) };
+  }
+  if (t.base === "varvalue") {
+    // {type, value}: the value is typed by its own type text
+    if (json && typeof json === "object" && typeof json.type === "string" && "value" in json) {
+      return { type: json.type, value: fromJson(json.type, json.value, outline, scope) };
+    }
+    return json;
+  }
   const def = outline?.typeOf(t.base, scope);
   if (def?.kind === "enum") return parseEnum(def.values, String(json));
   if (def && def.fields) {
@@ -87,10 +100,21 @@ function asList(json) {
   return json;
 }
 
-/** Plain JSON-able form of a value (typed arrays as arrays, BigInt as text, Maps as objects). */
+/** A number as editor text: shortest round-trip form, keeping the sign of -0. */
+export function numberText(x) {
+  return Object.is(x, -0) ? "-0" : String(x);
+}
+
+function plainNumber(x) {
+  return Number.isFinite(x) && !Object.is(x, -0) ? x : numberText(x);
+}
+
+/** Plain JSON-able form of a value (typed arrays as arrays, BigInt and non-finite numbers as text,
+ * Maps as objects). */
 export function toPlain(v) {
   if (typeof v === "bigint") return v.toString();
-  if (ArrayBuffer.isView(v)) return Array.from(v, (x) => (typeof x === "bigint" ? x.toString() : x));
+  if (typeof v === "number") return plainNumber(v);
+  if (ArrayBuffer.isView(v)) return Array.from(v, (x) => (typeof x === "bigint" ? x.toString() : plainNumber(x)));
   if (v instanceof Map) return Object.fromEntries([...v].map(([k, x]) => [String(k), toPlain(x)]));
   if (Array.isArray(v)) return v.map(toPlain);
   if (v && typeof v === "object") return Object.fromEntries(Object.entries(v).map(([k, x]) => [k, toPlain(x)]));
@@ -110,7 +134,9 @@ export function formatValue(v, maxItems = 32) {
     return `[${items.join(", ")}${more}]`;
   }
   if (v instanceof Map) {
-    return `{${[...v].slice(0, maxItems).map(([k, x]) => `${k}: ${formatValue(x, maxItems)}`).join(", ")}}`;
+    // maps have no order in RR: shown by key
+    const entries = [...v].sort(([a], [b]) => (a < b ? -1 : a > b ? 1 : 0));
+    return `{${entries.slice(0, maxItems).map(([k, x]) => `${k}: ${formatValue(x, maxItems)}`).join(", ")}}`;
   }
   if (typeof v === "object") {
     if (v.dims && v.array) return `${Array.from(v.dims).join("×")} ${formatValue(v.array, maxItems)}`;
@@ -120,15 +146,20 @@ export function formatValue(v, maxItems = 32) {
 }
 
 function formatNumber(x) {
-  if (Number.isInteger(x)) return String(x);
+  if (Number.isInteger(x) || !Number.isFinite(x)) return numberText(x);
   return String(Number(x.toPrecision(6)));
 }
 
 /** Editor text for a value (inverse of parseInput for the shapes parseInput reads as plain text). */
 export function editorText(typeText, v) {
   const t = parseType(typeText);
-  if (v === undefined || v === null) return "";
-  if (!t.container && !t.array && (isNumericBase(t.base) || t.base === "string")) return String(v);
-  if (!t.container && t.array === "vector" && isNumericBase(t.base)) return Array.from(v, String).join(", ");
+  const plainText = !t.container && (!t.array || (t.array === "vector" && isNumericBase(t.base)))
+    && (isNumericBase(t.base) || t.base === "string");
+  if (v === undefined || v === null) return plainText ? "" : "null";
+  if (!t.container && !t.array && t.base === "string") return v;
+  if (!t.container && !t.array && isNumericBase(t.base)) return typeof v === "number" ? numberText(v) : String(v);
+  if (!t.container && t.array === "vector" && isNumericBase(t.base)) {
+    return Array.from(v, (x) => (typeof x === "number" ? numberText(x) : String(x))).join(", ");
+  }
   return JSON.stringify(toPlain(v));
 }

@@ -78,3 +78,25 @@ test("values format for display and back for editors", () => {
   assert.equal(editorText("Point", { x: 1, id: 2n, raw: Uint8Array.of(3) }), '{"x":1,"id":"2","raw":[3]}');
   assert.deepEqual(toPlain(new Map([[1, BigInt64Array.of(5n)]])), { 1: ["5"] });
 });
+
+test("numbers JSON cannot hold, nulls, complex numbers and varvalues survive an editor round trip", () => {
+  const a = Float64Array.of(0, -0, Infinity, -Infinity, NaN, 5e-324);
+  const text = editorText("double[]", a);
+  assert.equal(text, "0, -0, Infinity, -Infinity, NaN, 5e-324");
+  const back = parseInput("double[]", text, outline);
+  assert.ok(Object.is(back[1], -0) && Number.isNaN(back[4]) && back[5] === 5e-324);
+  const map = new Map([[-1, -0], [0, NaN]]);
+  const m = parseInput("double{int32}", editorText("double{int32}", map), outline);
+  assert.ok(Object.is(m.get(-1), -0) && Number.isNaN(m.get(0)));
+  assert.equal(editorText("Point", null), "null");
+  assert.equal(parseInput("Point", "null", outline, "experimental.t"), null);
+  assert.equal(editorText("string", "two\nlines"), "two\nlines");
+  const c = parseInput("cdouble[]", editorText("cdouble[]", [{ real: -0, imag: Infinity }]), outline);
+  assert.ok(Object.is(c[0].real, -0) && c[0].imag === Infinity);
+  const v = { type: "experimental.t.Point[]", value: [{ x: NaN, id: 9007199254740993n, raw: Uint8Array.of(1) }] };
+  const vb = parseInput("varvalue", editorText("varvalue", v), outline, "experimental.t");
+  assert.equal(vb.type, "experimental.t.Point[]");
+  assert.ok(Number.isNaN(vb.value[0].x) && vb.value[0].id === 9007199254740993n && vb.value[0].raw instanceof Uint8Array);
+  assert.equal(formatValue(new Map([[5, "b"], [-1, "a"]])), '{-1: "a", 5: "b"}');
+  assert.equal(formatValue(-0), "-0");
+});

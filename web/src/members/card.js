@@ -2,7 +2,7 @@
 // and an error line that shows device errors in place.
 
 import { h, errorText } from "../dom.js";
-import { parseType } from "../rr_types.js";
+import { parseType, isNumericBase } from "../rr_types.js";
 
 /** The member's signature as robdef writes it (for functions and callbacks, with parameters). */
 export function signature(member) {
@@ -49,8 +49,9 @@ export function memberCard(ctx, member) {
   };
 }
 
-/** An input for a value of `type`: a checkbox for bool, a text field for numbers, numeric vectors,
- * strings and enums, a JSON text area for everything else. `.read()` gives the text (or bool). */
+/** An input for a value of `type`: a checkbox for bool, a text field for numbers, numeric vectors
+ * and enums, a text area for strings (they may hold line breaks), a JSON text area for everything
+ * else. `.read()` gives the text ("true"/"false" for the checkbox). */
 export function valueInput(type, label, outline, scope) {
   const t = parseType(type);
   if (t.base === "bool" && !t.array && !t.container) {
@@ -58,9 +59,10 @@ export function valueInput(type, label, outline, scope) {
     return { el: box, read: () => String(box.checked), write: (text) => { box.checked = text === "true"; } };
   }
   const simple = !t.container && (t.array === null || (t.array === "vector" && t.base !== "string"))
-    && (t.base === "string" || !outline?.typeOf(t.base, scope)?.fields);
-  const el = simple
-    ? h("input", { type: "text", "aria-label": label, placeholder: t.array ? "1, 2, 3" : t.base, spellcheck: "false" })
-    : h("textarea", { rows: 2, "aria-label": label, placeholder: "JSON", spellcheck: "false" });
+    && (isNumericBase(t.base) || Boolean(outline?.enumOf(t.base, scope)));
+  let el;
+  if (simple) el = h("input", { type: "text", "aria-label": label, placeholder: t.array ? "1, 2, 3" : t.base, spellcheck: "false" });
+  else if (t.base === "string" && !t.array && !t.container) el = h("textarea", { rows: 1, "aria-label": label, placeholder: "string", spellcheck: "false" });
+  else el = h("textarea", { rows: 2, "aria-label": label, placeholder: "JSON", spellcheck: "false" });
   return { el, read: () => el.value, write: (text) => { el.value = text; } };
 }

@@ -14,7 +14,7 @@ export function propertyView(ctx, member) {
   const card = memberCard(ctx, member);
   const prop = ctx.obj[member.name];
   const out = h("output", { class: "value" });
-  let plot = null, timer = 0, inFlight = false, disposed = false;
+  let plot = null, timer = 0, inFlight = false, disposed = false, reads = 0;
 
   async function read() {
     inFlight = true;
@@ -23,6 +23,7 @@ export function propertyView(ctx, member) {
       if (disposed) return undefined;
       out.textContent = formatValue(v);
       out.dataset.value = editorText(member.type, v);
+      out.dataset.reads = String(++reads);
       card.clearError();
       plot?.push(numericFields(v, null, member.name));
       return v;
