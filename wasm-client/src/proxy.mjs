@@ -202,6 +202,7 @@ class PipeEndpoint {
       ),
     );
     conn.closeListeners.add((this.connClosed = (e) => this.onClosed(e)));
+    this.drain();  // packets that arrived with the connect reply, before the handlers were set
   }
   drain() {
     for (;;) {
