@@ -6,7 +6,7 @@
 #
 # Base image: debian:bookworm from a registry when one answers; otherwise a local one made once with
 # mmdebstrap from the Debian mirror and imported as localhost/debian:bookworm-local (set
-# RR_BASE_IMAGE to choose). The build context holds the tracked files (git ls-files) plus web/dist
+# RR_BASE_IMAGE to choose). The build context is the committed tree (git archive HEAD) plus web/dist
 # when the dashboard was built. --smoke then runs the image (runc, low ulimits: crun cannot set the
 # default ones in this kind of VM) and checks /livez and the demo devices over HTTP.
 set -euo pipefail
@@ -48,7 +48,8 @@ echo "build: base image $base"
 
 ctx=$(mktemp -d)
 trap 'rm -rf "$ctx"' EXIT
-git ls-files -z | tar --null --ignore-failed-read -T - -cf - | tar -xf - -C "$ctx"
+# The committed tree (HEAD), so that edits in progress never reach the image.
+git archive --format=tar HEAD | tar -xf - -C "$ctx"
 if [ -f web/dist/index.html ]; then
   mkdir -p "$ctx/web/dist" && cp -r web/dist/. "$ctx/web/dist/"
 else
