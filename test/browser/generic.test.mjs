@@ -110,6 +110,20 @@ test("an editor refuses a value that does not fit, before sending", async () => 
   assert.match(await errorOf(c), /out of range for int16/);
 });
 
+test("enum and bool editors", async () => {
+  const e = card("p_enum");
+  assert.equal(await e.locator("select").inputValue(), "blue");
+  await e.locator("select").selectOption("minus");
+  await e.locator(".editor button").click();
+  await waitFor(async () => (await e.locator("output.value").textContent()) === "-5", "minus (-5) read back");
+  const b = card("p_bool");
+  await b.locator('.editor input[type="checkbox"]').setChecked(false);
+  await b.locator(".editor button").click();
+  await waitFor(async () => (await b.locator("output.value").textContent()) === "false", "false read back");
+  assert.equal(await errorOf(e), null);
+  assert.equal(await errorOf(b), null);
+});
+
 test("functions: result, generator items, user error", async () => {
   assert.deepEqual(await call(card("add"), { a: 2, b: 40 }), { error: null, result: "42" });
   const gen = await call(card("count_up"), { start: 3, count: 4 });

@@ -49,8 +49,8 @@ export function memberCard(ctx, member) {
   };
 }
 
-/** An input for a value of `type`: a checkbox for bool, a text field for numbers, numeric vectors
- * and enums, a text area for strings (they may hold line breaks), a JSON text area for everything
+/** An input for a value of `type`: a checkbox for bool, a list of names for enums, a text field for
+ * numbers and numeric vectors, a text area for strings (they may hold line breaks), a JSON text area for everything
  * else. `.read()` gives the text ("true"/"false" for the checkbox). */
 export function valueInput(type, label, outline, scope) {
   const t = parseType(type);
@@ -58,8 +58,18 @@ export function valueInput(type, label, outline, scope) {
     const box = h("input", { type: "checkbox", "aria-label": label });
     return { el: box, read: () => String(box.checked), write: (text) => { box.checked = text === "true"; } };
   }
+  const values = !t.container && !t.array ? outline?.enumOf(t.base, scope) : null;
+  if (values) {
+    const select = h("select", { "aria-label": label },
+      ...values.map((v) => h("option", { value: v.name, text: `${v.name} (${v.value})` })));
+    const write = (text) => {
+      const found = values.find((v) => v.name === text || String(v.value) === String(text).trim());
+      if (found) select.value = found.name;
+    };
+    return { el: select, read: () => select.value, write };
+  }
   const simple = !t.container && (t.array === null || (t.array === "vector" && t.base !== "string"))
-    && (isNumericBase(t.base) || Boolean(outline?.enumOf(t.base, scope)));
+    && isNumericBase(t.base);
   let el;
   if (simple) el = h("input", { type: "text", "aria-label": label, placeholder: t.array ? "1, 2, 3" : t.base, spellcheck: "false" });
   else if (t.base === "string" && !t.array && !t.container) el = h("textarea", { rows: 1, "aria-label": label, placeholder: "string", spellcheck: "false" });
