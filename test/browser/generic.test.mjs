@@ -152,3 +152,53 @@ test("objrefs by name and pipes that echo", async () => {
   await waitFor(async () => Number(await pipe.locator(".stream").getAttribute("data-count")) >= 1, "the echo");
   assert.match(await pipe.locator(".stream output.value").textContent(), /id: 7, label: "seven", values: \[1\.5, 2\]/);
 });
+
+test("callbacks answered from the page", async () => {
+  for (const [name, reply] of [["cb_compute", "2.5"], ["cb_notify", null]]) {
+    const c = card(name);
+    if (reply !== null) await c.locator(`[aria-label="${name} reply"]`).fill(reply);
+    await c.locator("input[type=checkbox]").check();
+  }
+  assert.deepEqual(await call(card("call_callbacks"), { x: 1 }), { error: null, result: "3.5" });
+  await page.locator('.event-log li[data-member="cb_compute"]', { hasText: "-> 2.5" }).first().waitFor();
+  await page.locator('.event-log li[data-member="cb_notify"]').first().waitFor();
+});
+
+test("wires: out value echoed, write-only poke, stream plotted", async () => {
+  const both = card("w_both");
+  await both.locator('[aria-label="w_both out value"]').fill("1, 2, 3");
+  await both.locator(".editor button").click();
+  await waitFor(async () => (await both.locator(".stream output.value").textContent()) === "[3, 2, 1]", "the reversed echo");
+  const sink = card("w_sink");
+  await sink.locator('[aria-label="w_sink out value"]').fill("77");
+  await sink.locator(".editor button").click();
+  await waitFor(async () => (await call(card("w_sink_value"))).result === "77", "the service got 77");
+  const state = card("w_state");
+  await waitFor(async () => Number(await state.locator(".plot").getAttribute("data-samples")) >= 3, "w_state plotted");
+});
+
+test("memories: write and read back, pods as values", async () => {
+  const mem = card("mem_double");
+  await mem.locator('[aria-label="write start"]').fill("2");
+  await mem.locator('[aria-label="values to write"]').fill("1.5, -2.25");
+  await mem.locator("button", { hasText: "Write" }).click();
+  await mem.locator('[aria-label="start"]').fill("2");
+  await mem.locator('[aria-label="count"]').fill("2");
+  await mem.locator("button", { hasText: "Read" }).click();
+  await waitFor(async () => (await mem.locator(".memory-row .cells").first().textContent()) === "1.5 -2.25", "1.5 -2.25 read back");
+  assert.equal(await errorOf(mem), null);
+  const pods = card("mem_pod");
+  await pods.locator('[aria-label="count"]').fill("1");
+  await pods.locator("button", { hasText: "Read" }).click();
+  await waitFor(async () => /^\{x: /.test(await pods.locator(".memory-row .cells").first().textContent()), "a pod shown");
+});
+
+test("a readonly pipe streams what the service sends", async () => {
+  const pipe = card("p_stream");
+  await pipe.locator("button", { hasText: "Connect" }).click();
+  await waitFor(async () => (await pipe.getAttribute("data-open")) === "true", "connected");
+  assert.equal((await call(card("send_stream"), { count: 5 })).error, null);
+  await waitFor(async () => Number(await pipe.locator(".stream").getAttribute("data-count")) === 5, "5 packets");
+  assert.equal(await pipe.locator(".stream output.value").textContent(), "[4, 2]");
+  assert.equal(Number(await pipe.locator('.plot-readout [data-series="[0]"]').getAttribute("data-value")), 4);
+});

@@ -4,7 +4,7 @@
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
-import { parseInput } from "../value_codec.js";
+import { parseInput, formatValue } from "../value_codec.js";
 import { parseType, parseNumber } from "../rr_types.js";
 import { asImage, drawImage } from "../image_view.js";
 
@@ -59,11 +59,13 @@ export function memoryView(ctx, member) {
     const values = multidim ? result.array : result;
     const shown = Array.from(values.slice(0, MAX_CELLS));
     const hex = t.base === "uint8";
+    const perRow = shown.every((x) => typeof x === "number" || typeof x === "bigint") ? PER_ROW : 1;
+    const cell = (x) => (hex ? x.toString(16).padStart(2, "0") : formatValue(x));
     const rows = [];
-    for (let i = 0; i < shown.length; i += PER_ROW) {
+    for (let i = 0; i < shown.length; i += perRow) {
       const offset = multidim ? i : s[0] + i;
       rows.push(h("div", { class: "memory-row" }, h("span", { class: "offset", text: String(offset) }),
-        h("span", { class: "cells", text: shown.slice(i, i + PER_ROW).map((x) => (hex ? x.toString(16).padStart(2, "0") : String(x))).join(" ") })));
+        h("span", { class: "cells", text: shown.slice(i, i + perRow).map(cell).join(" ") })));
     }
     const note = values.length > MAX_CELLS ? h("div", { class: "hint", text: `first ${MAX_CELLS} of ${values.length} values` }) : null;
     const dims = multidim ? h("div", { class: "hint", text: `dims ${Array.from(result.dims).join(" × ")} (column-major)` }) : null;
