@@ -5,7 +5,10 @@
 #                 dumped after N Nop() calls over rr+tcp: instructions per call = total / N.
 #   client side:  rr_bench_client runs under callgrind twice (N and 2N calls): per call = difference / N
 #                 (connect and close cancel out).
-# Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self).
+#   gateway fan-out: rr-gateway runs under callgrind while 20 JSON WebSocket clients receive a 100 Hz
+#                 device wire for 4 s: instructions and mallocs per delivered message.
+# Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self)
+# and bench/results/profile_fanout.txt.
 # Needs valgrind (apt-get install valgrind) and a build from bench/run.sh (RR_BENCH_BUILD, default
 # build/bench).  Usage: bench/profile.sh [N]   (default 2000)
 set -euo pipefail
@@ -76,4 +79,35 @@ annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[
   echo "## client ($((2 * N)) calls plus one connect), self"
   annotate --inclusive=no "$tmp/client.$((2 * N)).out"
 } > "$OUT/profile_nop.txt"
-echo "wrote $OUT/profile_nop.txt" >&2
+
+# Gateway fan-out.
+"$BUILD/bench/rr_bench_service" --tick-hz 100 --memory-mib 0.01 > "$tmp/dev" &
+dev=$!
+for _ in $(seq 1 100); do [ -s "$tmp/dev" ] && break; sleep 0.1; done
+durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/dev")
+valgrind --tool=callgrind --callgrind-out-file="$tmp/gw.out" "$BUILD/server/app/rr-gateway" --no-demo --port 0 \
+  --log-level warning --device "bench=$durl" > "$tmp/gw" 2>> "$tmp/valgrind.log" &
+gw=$!
+for _ in $(seq 1 600); do [ -s "$tmp/gw" ] && break; sleep 0.1; done
+gport=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['port'])" "$tmp/gw")
+sleep 3
+"$BUILD/bench/rr_bench_ws_load" --port "$gport" --clients 20 fanout --seconds 2 > /dev/null   # warm-up
+callgrind_control -z "$gw" > /dev/null
+"$BUILD/bench/rr_bench_ws_load" --port "$gport" --clients 20 fanout --seconds 4 > "$tmp/fanout.json"
+callgrind_control -d "$gw" > /dev/null
+kill -TERM "$gw"; wait "$gw" || true
+kill -TERM "$dev"; wait "$dev" || true
+gdump=$(ls -t "$tmp"/gw.out.* | head -1)
+msgs=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" "$tmp/fanout.json")
+{
+  echo "# callgrind of rr-gateway: a 100 Hz device wire fanned out to 20 JSON WebSocket clients for 4 s"
+  echo "# (under valgrind the gateway is slower: counts matter, not rates)"
+  echo "delivered messages: $msgs"
+  echo "gateway instructions per delivered message: $(( $(total_ir "$gdump") / msgs ))"
+  bench/callgrind_calls.py "$gdump" malloc | awk -v n="$msgs" '{ printf "gateway malloc calls per delivered message: %.1f\n", $2 / n }'
+  echo
+  echo "## inclusive (top frames)"
+  callgrind_annotate --inclusive=yes --threshold=100 "$gdump" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
+    grep -E 'rr::|nlohmann|beast|malloc|free' | cut -c1-240 | sed -n 1,45p
+} > "$OUT/profile_fanout.txt"
+echo "wrote $OUT/profile_nop.txt and $OUT/profile_fanout.txt" >&2
