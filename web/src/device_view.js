@@ -58,7 +58,8 @@ export class DeviceView {
     if (before === undefined || before === state) return;
     this.log.add("session", "", `device ${state}${d?.reason && state !== "connected" ? `: ${d.reason}` : ""}`);
     if (state !== "connected") {
-      this.showBanner(`The device is ${state}${d?.reason ? `: ${d.reason}` : ""}. The gateway keeps reconnecting; this page follows.`);
+      const what = state === "connecting" ? "The gateway is connecting to the device" : `Device ${state}`;
+      this.showBanner(`${what}${d?.reason ? `: ${d.reason}` : ""}. The gateway keeps reconnecting; this page follows.`);
     } else {
       this.showBanner("");
       if (this.client) this.render(this.client);
