@@ -2,6 +2,8 @@
 
 #include <boost/asio/write.hpp>
 
+#include "robdef/builtin/service_index.hpp"
+#include "server/node/service_index.hpp"
 #include "server/transport/tcp_listener.hpp"
 
 namespace rr::server {
@@ -22,8 +24,17 @@ NodeID random_node_id(std::mt19937& rng) {
 
 }  // namespace
 
+std::string tcp_base_url(const tcp::endpoint& local) {
+    std::string host = local.address().to_string();
+    if (local.address().is_v6()) host = "[" + host.substr(0, host.find('%')) + "]";
+    return "rr+tcp://" + host + ":" + std::to_string(local.port()) + "/";
+}
+
 std::shared_ptr<Node> Node::create(NodeOptions options) {
     std::shared_ptr<Node> node(new Node(std::move(options)));
+    // Built from the built-in definition: cannot fail short of a broken build, and then the node
+    // simply has no index (find_service answers ServiceNotFound as before).
+    if (auto index = make_service_index(node)) node->service_index_ = std::move(*index);
     node->start_threads();
     return node;
 }
@@ -80,6 +91,7 @@ Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t
     {
         std::lock_guard lock(mutex_);
         listeners_.push_back(listener);
+        listen_endpoints_.emplace_back(addr, bound);
     }
     listener->start();
     return bound;
@@ -142,7 +154,19 @@ std::vector<std::string> Node::service_names() const {
 std::shared_ptr<Service> Node::find_service(std::string_view name) const {
     std::lock_guard lock(mutex_);
     auto it = services_.find(name);
-    return it == services_.end() ? nullptr : it->second;
+    if (it != services_.end()) return it->second;
+    return name == robdef::kServiceIndexServiceName ? service_index_ : nullptr;
+}
+
+std::string Node::listen_base_url() const {
+    std::lock_guard lock(mutex_);
+    if (listen_endpoints_.empty()) return "rr+tcp://127.0.0.1:0/";
+    auto ep = listen_endpoints_.front();
+    // A wildcard listener has no one address; loopback is the one every client of this host can use.
+    if (ep.address().is_unspecified())
+        ep.address(ep.address().is_v6() ? asio::ip::address(asio::ip::address_v6::loopback())
+                                         : asio::ip::address(asio::ip::address_v4::loopback()));
+    return tcp_base_url(ep);
 }
 
 std::uint32_t Node::new_endpoint_id() {

@@ -36,6 +36,10 @@ using HttpHandler = std::function<void(boost::asio::ip::tcp::socket socket, std:
 
 class TcpListener;
 
+/// `rr+tcp://<address>:<port>/` for a local TCP endpoint (IPv6 in brackets, without scope), the base of
+/// the URLs the service index reports (wire.md §11.2).
+std::string tcp_base_url(const boost::asio::ip::tcp::endpoint& local);
+
 class Node : public NodeServices, public std::enable_shared_from_this<Node> {
 public:
     static std::shared_ptr<Node> create(NodeOptions options = {});
@@ -55,7 +59,10 @@ public:
     /// Registers a service under its name. Errors: InvalidArgument when the name is taken or invalid.
     Result<void> register_service(std::shared_ptr<Service> service);
     void unregister_service(const std::string& name);
+    /// Names of the registered services (the built-in service index is not among them).
     std::vector<std::string> service_names() const;
+    /// Base URL for connections whose transport gave none (WebSocket): the first TCP listener's.
+    std::string listen_base_url() const;
 
     /// Serves an already-connected stream (used by transports other than TCP: WebSocket, local).
     /// `initial` are bytes already read from it.
@@ -68,6 +75,8 @@ public:
     // NodeServices
     const NodeID& node_id() const override { return options_.node_id; }
     const std::string& node_name() const override { return options_.node_name; }
+    /// A registered service, else for `RobotRaconteurServiceIndex` the node's built-in service index
+    /// (service_index.hpp), as every CORE node serves it (wire.md §11.2).
     std::shared_ptr<Service> find_service(std::string_view name) const override;
     std::uint32_t new_endpoint_id() override;
     void release_endpoint_id(std::uint32_t id) override;
@@ -89,6 +98,8 @@ private:
     HttpHandler http_handler_;
     mutable std::mutex mutex_;
     std::map<std::string, std::shared_ptr<Service>, std::less<>> services_;
+    std::shared_ptr<Service> service_index_;  // set once in create()
+    std::vector<boost::asio::ip::tcp::endpoint> listen_endpoints_;
     std::set<std::uint32_t> endpoints_;
     std::mt19937 rng_;
     std::shared_ptr<std::atomic<std::size_t>> connections_ = std::make_shared<std::atomic<std::size_t>>(0);

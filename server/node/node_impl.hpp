@@ -30,6 +30,11 @@ void Node::serve_stream(Stream stream, std::vector<std::byte> initial) {
     // with the pump's work.
     typename StreamPump<Stream>::Strand strand(stream.get_executor());
     auto logic = std::make_shared<CountedServerConnection>(shared_from_this(), connections_, options_.server, mono_now());
+    if constexpr (requires(boost::system::error_code& ec) { stream.local_endpoint(ec); }) {
+        boost::system::error_code ec;
+        auto local = stream.local_endpoint(ec);
+        if (!ec) logic->set_local_url(tcp_base_url(local));
+    }
     auto pump = std::make_shared<StreamPump<Stream>>(std::move(stream), strand, logic);
     logic->attach(pump);
     track(pump);

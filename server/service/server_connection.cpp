@@ -105,6 +105,16 @@ std::size_t SessionRef::queued_bytes() const {
     return p ? p->queued_bytes() : 0;
 }
 
+std::string SessionRef::local_url() const {
+    auto p = session_.lock();
+    return p ? p->local_url() : std::string();
+}
+
+std::string ServerSession::local_url() const {
+    auto c = connection_.lock();
+    return c ? c->local_url() : std::string();
+}
+
 Responder::Responder(std::function<void(MessageEntry)> send, MessageEntry request_header)
     : send_(std::move(send)), request_(std::move(request_header)) {
     request_.elements.clear();

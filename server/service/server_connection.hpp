@@ -71,6 +71,8 @@ public:
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     std::size_t queued_bytes() const noexcept { return queued_.load(); }
     void set_queued_bytes(std::size_t n) noexcept { queued_.store(n); }
+    /// The connection's local_url() (empty once the connection is gone).
+    std::string local_url() const;
 
 private:
     friend class ServerConnection;
@@ -95,6 +97,9 @@ public:
 
     /// Must be called once the pump exists, before bytes flow.
     void attach(std::weak_ptr<PumpHandle> pump) { pump_ = std::move(pump); }
+    /// Base URL of the accepting transport (SessionRef::local_url); set before bytes flow, then fixed.
+    void set_local_url(std::string url) { local_url_ = std::move(url); }
+    const std::string& local_url() const noexcept { return local_url_; }
 
     // ConnectionLogic
     void on_bytes(std::span<const std::byte> bytes, MonoTime now) override;
@@ -134,6 +139,7 @@ private:
     ServerConnectionConfig config_;
     StreamConnection stream_;
     std::weak_ptr<PumpHandle> pump_;
+    std::string local_url_;
     std::shared_ptr<ServerSession> session_;
     bool authenticated_ = false;
     bool close_after_flush_ = false;

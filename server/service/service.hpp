@@ -49,6 +49,9 @@ public:
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) const;
     /// Bytes waiting to be written to this client (for backpressure decisions).
     std::size_t queued_bytes() const;
+    /// Base URL of the transport this client came in on, as CORE's service index reports it
+    /// (`rr+tcp://<local address>:<port>/`, wire.md §11.2); empty when the transport did not say.
+    std::string local_url() const;
 
     friend bool operator==(const SessionRef& a, const SessionRef& b) noexcept { return a.endpoint_ == b.endpoint_; }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "robdef/builtin/service_index.hpp"
 #include "robdef/parser.hpp"
 #include "robdef/verifier.hpp"
 
@@ -30,7 +31,9 @@ Result<std::shared_ptr<const ServiceTypes>> ServiceTypes::create(std::vector<std
             continue;
         }
         std::string name = parsed->definition.name;
-        if (types->set_.find_service(name)) {
+        // The set starts with the built-in service index; a node's own index service gives it again.
+        const bool replaces_builtin = name == robdef::kServiceIndexServiceName && !types->text(name);
+        if (types->set_.find_service(name) && !replaces_builtin) {
             if (!errors.empty()) errors += '\n';
             errors += file + ": error: service definition " + name + " is defined more than once";
             continue;

@@ -1,0 +1,26 @@
+// The built-in `RobotRaconteurServiceIndex` service of a node (wire.md §11.2, robdef.md §13): discovery
+// and `rr info` without `service=` connect to it and call GetLocalNodeServices() to list a node's services.
+//
+//   GetLocalNodeServices()  one ServiceInfo per registered service plus the index itself, keys 0,1,…
+//                           in name order: Name, RootObjectType, RootObjectImplements (keys 0..n−1),
+//                           ConnectionURL {1: `<base>?nodeid=<id>&service=<name>`} with the base of the
+//                           transport the request came in on (SessionRef::local_url, else the node's
+//                           first TCP listener), Attributes (only string / numeric array values, as CORE).
+//   GetRoutedNodes(), GetDetectedNodes()   empty maps (deprecated; CORE's routed list is empty too).
+//   LocalNodeServicesChanged              never fired (not yet).
+#pragma once
+
+#include <memory>
+
+#include "core/error/rr_error.hpp"
+#include "server/service/service.hpp"
+
+namespace rr::server {
+
+class Node;
+
+/// The service index of `node` (held weakly: the node owns the service). Errors: those of building the
+/// typed service from the built-in definition (not expected).
+Result<std::shared_ptr<Service>> make_service_index(std::weak_ptr<Node> node);
+
+}  // namespace rr::server
