@@ -1,0 +1,326 @@
+// Connection limits and misbehaving peers over real loopback TCP (issue 3's list; the basic cases are in
+// server_connection_test.cpp): the 512 KiB per-message limit before a client session exists, a
+// configurable max_message_size afterwards, max_connections, wrong magic and a truncated message inside
+// an established stream, unknown special requests, and in the typed client a request timeout and
+// pending requests failed at once when the connection drops.
+#include <catch2/catch.hpp>
+
+#include <future>
+#include <thread>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/write.hpp>
+
+#include "core/session/elements.hpp"
+#include "core/session/stream_connection.hpp"
+#include "server/client/client.hpp"
+#include "server/client/raw_client.hpp"
+#include "server/node/node.hpp"
+#include "server/service/test_raw_service.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace std::chrono_literals;
+namespace asio = boost::asio;
+
+namespace {
+
+std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> service, std::uint16_t& port) {
+    options.node_name = "limits.node";
+    options.threads = 2;
+    auto node = Node::create(std::move(options));
+    REQUIRE(node->register_service(std::move(service)));
+    auto p = node->listen_tcp("127.0.0.1", 0);
+    REQUIRE(p);
+    port = *p;
+    return node;
+}
+
+// A client-role StreamConnection driven over a blocking socket: CreateConnection only, no client
+// session, so special requests and raw bytes can be sent at will.
+struct RawStream {
+    asio::io_context io;
+    asio::ip::tcp::socket socket{io};
+    StreamConnection conn;
+    NodeID remote;
+
+    RawStream(std::uint16_t port, StreamConfig config)
+        : conn(StreamRole::client, with_id(std::move(config)), std::chrono::steady_clock::now()) {
+        socket.connect({asio::ip::make_address("127.0.0.1"), port});
+        socket.non_blocking(true);
+        auto e = next_event(5s);
+        REQUIRE(e);
+        auto* c = std::get_if<StreamConnected>(&*e);
+        REQUIRE(c);
+        remote = c->remote_node_id;
+    }
+
+    static StreamConfig with_id(StreamConfig c) {
+        c.local_node_id = *NodeID::parse("12345678-2222-3333-4444-555555555555");
+        return c;
+    }
+
+    void flush() {
+        socket.non_blocking(false);
+        auto out = conn.pending_output();
+        if (!out.empty()) {
+            boost::system::error_code ec;
+            asio::write(socket, asio::buffer(out.data(), out.size()), ec);
+            conn.consume_output(out.size());
+        }
+        socket.non_blocking(true);
+    }
+
+    void write_raw(const std::vector<std::byte>& bytes) {
+        socket.non_blocking(false);
+        boost::system::error_code ec;
+        asio::write(socket, asio::buffer(bytes), ec);
+        socket.non_blocking(true);
+    }
+
+    // The next event, a StreamClosed when the server closed the socket, or nullopt after `timeout`.
+    std::optional<StreamEvent> next_event(std::chrono::milliseconds timeout) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        std::array<std::byte, 65536> buf;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (auto e = conn.poll_event()) return e;
+            flush();
+            boost::system::error_code ec;
+            auto n = socket.read_some(asio::buffer(buf), ec);
+            if (ec == asio::error::would_block) {
+                std::this_thread::sleep_for(5ms);
+                continue;
+            }
+            if (ec) return StreamEvent{StreamClosed{make_error(MessageErrorType::ConnectionError, ec.message())}};
+            (void)conn.feed(std::span<const std::byte>(buf.data(), n), std::chrono::steady_clock::now());
+        }
+        return std::nullopt;
+    }
+
+    // Sends a special request (no client session) whose entry carries `padding` extra bytes.
+    void send_special(MessageEntryType type, std::string path, std::size_t padding) {
+        Message m;
+        m.header.sender_node_id = RawStream::with_id({}).local_node_id;
+        m.header.receiver_node_id = remote;
+        MessageEntry e;
+        e.entry_type = type;
+        e.service_path = std::move(path);
+        std::vector<std::uint8_t> pad(padding, 0x5a);
+        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
+        m.entries.push_back(std::move(e));
+        REQUIRE(conn.send(m, std::chrono::steady_clock::now()));
+    }
+};
+
+bool is_closed_event(const std::optional<StreamEvent>& e) { return e && std::holds_alternative<StreamClosed>(*e); }
+
+const MessageEntry* reply_entry(const std::optional<StreamEvent>& e) {
+    if (!e) return nullptr;
+    auto* m = std::get_if<StreamMessage>(&*e);
+    return m && !m->message.entries.empty() ? &m->message.entries.front() : nullptr;
+}
+
+Result<MessageEntry> call(RawClient& c, MessageEntry e) {
+    std::promise<Result<MessageEntry>> p;
+    c.request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
+    return p.get_future().get();
+}
+
+Result<std::shared_ptr<RawClient>> raw_connect(asio::any_io_executor ex, std::uint16_t port, RawClientOptions opts = {}) {
+    std::promise<Result<std::shared_ptr<RawClient>>> p;
+    auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc");
+    RawClient::connect(ex, *url, opts, {}, {}, [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+    return p.get_future().get();
+}
+
+MessageEntry padded_get(std::size_t padding) {
+    MessageEntry e;
+    e.entry_type = MessageEntryType::PropertyGetReq;
+    e.service_path = "svc";
+    e.member_name = "x";
+    std::vector<std::uint8_t> pad(padding, 0x33);
+    e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("limits: a message over 512 KiB before the client session exists closes the connection") {
+    std::uint16_t port = 0;
+    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+    StreamConfig big;
+    big.limits.max_pre_session_message_size = 4u << 20;  // our side may send it; the node must refuse
+
+    RawStream under(port, big);
+    under.send_special(MessageEntryType::GetServiceDesc, "svc", 400u * 1024u);
+    auto r = under.next_event(5s);
+    const MessageEntry* reply = reply_entry(r);
+    REQUIRE(reply);
+    CHECK(reply->entry_type == MessageEntryType::GetServiceDescRet);
+    CHECK(reply->error == MessageErrorType::None);
+
+    RawStream over(port, big);
+    over.send_special(MessageEntryType::GetServiceDesc, "svc", 600u * 1024u);
+    CHECK(is_closed_event(over.next_event(5s)));
+    node->shutdown();
+}
+
+TEST_CASE("limits: max_message_size is configurable and applies once the session exists") {
+    std::uint16_t port = 0;
+    NodeOptions options;
+    options.server.stream.limits.max_message_size = 1u << 20;
+    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    client::IoThreads io{1};
+
+    auto c = raw_connect(io.executor(), port);
+    REQUIRE(c);
+    // 700 KiB: over the pre-session limit, under the configured one: answered.
+    auto ok = call(**c, padded_get(700u * 1024u));
+    REQUIRE(ok);
+    CHECK(ok->error == MessageErrorType::None);
+    // 2 MiB: over the configured limit: the node drops the connection.
+    auto over = call(**c, padded_get(2u << 20));
+    REQUIRE_FALSE(over);
+    CHECK(over.error().type == MessageErrorType::ConnectionError);
+    for (int i = 0; i < 100 && (*c)->is_open(); ++i) std::this_thread::sleep_for(10ms);
+    CHECK_FALSE((*c)->is_open());
+
+    // Others are unaffected.
+    auto d = raw_connect(io.executor(), port);
+    REQUIRE(d);
+    CHECK(call(**d, padded_get(0)));
+    node->shutdown();
+}
+
+TEST_CASE("limits: max_connections refuses further connections until one closes") {
+    std::uint16_t port = 0;
+    NodeOptions options;
+    options.max_connections = 2;
+    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    client::IoThreads io{1};
+    RawClientOptions quick;
+    quick.connect_timeout = 2000ms;
+    quick.request_timeout = 2000ms;
+
+    auto a = raw_connect(io.executor(), port, quick);
+    auto b = raw_connect(io.executor(), port, quick);
+    REQUIRE(a);
+    REQUIRE(b);
+    CHECK(node->connection_count() == 2);
+    auto third = raw_connect(io.executor(), port, quick);
+    REQUIRE_FALSE(third);
+    CHECK(third.error().type == MessageErrorType::ConnectionError);
+
+    (*a)->close();
+    for (int i = 0; i < 200 && node->connection_count() >= 2; ++i) std::this_thread::sleep_for(10ms);
+    auto again = raw_connect(io.executor(), port, quick);
+    REQUIRE(again);
+    CHECK(call(**again, padded_get(0)));
+    node->shutdown();
+}
+
+TEST_CASE("limits: wrong magic or a truncated message inside an established stream closes it") {
+    std::uint16_t port = 0;
+    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+
+    SECTION("wrong magic") {
+        RawStream s(port, {});
+        std::vector<std::byte> bad(64, std::byte{0});
+        const char* magic = "RRAX";
+        for (int i = 0; i < 4; ++i) bad[i] = static_cast<std::byte>(magic[i]);
+        bad[4] = std::byte{64};
+        s.write_raw(bad);
+        CHECK(is_closed_event(s.next_event(5s)));
+    }
+    SECTION("truncated: MessageSize covers the bytes, the entries inside do not fit") {
+        RawStream s(port, {});
+        // A v2 header: RRAC, size 60, version 2, header size 52, then zeros, entry count 3 with no entries.
+        std::vector<std::byte> bad(60, std::byte{0});
+        const char* magic = "RRAC";
+        for (int i = 0; i < 4; ++i) bad[i] = static_cast<std::byte>(magic[i]);
+        bad[4] = std::byte{60};
+        bad[8] = std::byte{2};
+        bad[10] = std::byte{52};
+        bad[56] = std::byte{3};
+        s.write_raw(bad);
+        CHECK(is_closed_event(s.next_event(5s)));
+    }
+    SECTION("unknown special request: answered with ProtocolError, the stream stays up") {
+        RawStream s(port, {});
+        s.send_special(static_cast<MessageEntryType>(151), "svc", 0);
+        auto r = s.next_event(5s);
+        const MessageEntry* reply = reply_entry(r);
+        REQUIRE(reply);
+        CHECK(reply->error == MessageErrorType::ProtocolError);
+        s.send_special(MessageEntryType::GetServiceDesc, "svc", 0);
+        auto next = s.next_event(5s);
+        const MessageEntry* desc = reply_entry(next);
+        REQUIRE(desc);
+        CHECK(desc->entry_type == MessageEntryType::GetServiceDescRet);
+    }
+    node->shutdown();
+}
+
+namespace {
+
+// A service that never answers function calls (the responder is kept), for client timeouts.
+class SilentService : public testing::RawTestService {
+public:
+    void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
+        if (e.entry_type == MessageEntryType::FunctionCallReq) {
+            std::lock_guard lock(mutex);
+            held.push_back(std::move(responder));
+            return;
+        }
+        RawTestService::handle_entry(session, std::move(e), std::move(responder));
+    }
+    std::vector<Responder> held;
+};
+
+}  // namespace
+
+TEST_CASE("client: an unanswered request times out, and a dropped connection fails pending requests at once") {
+    std::uint16_t port = 0;
+    auto service = std::make_shared<SilentService>();
+    auto node = make_node({}, service, port);
+    client::IoThreads io{1};
+    const std::string url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
+
+    client::ClientOptions opts;
+    opts.request_timeout = 800ms;
+    auto c = client::Client::connect(io.executor(), url, opts);
+    REQUIRE(c);
+    auto t0 = std::chrono::steady_clock::now();
+    auto r = (*c)->root().call("add", {Value::scalar(std::int32_t{1}), Value::scalar(std::int32_t{2})});
+    auto took = std::chrono::steady_clock::now() - t0;
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::RequestTimeout);
+    CHECK(took >= 700ms);
+    CHECK(took < 5s);
+    CHECK((*c)->is_open());  // a timeout does not end the session
+
+    // Default timeout (15 s): the node goes away while a call waits; the call fails long before 15 s.
+    auto d = client::Client::connect(io.executor(), url);
+    REQUIRE(d);
+    auto pending = std::async(std::launch::async, [&] {
+        return (*d)->root().call("add", {Value::scalar(std::int32_t{1}), Value::scalar(std::int32_t{2})});
+    });
+    for (int i = 0; i < 200; ++i) {
+        {
+            std::lock_guard lock(service->mutex);
+            if (service->held.size() >= 2) break;
+        }
+        std::this_thread::sleep_for(10ms);
+    }
+    t0 = std::chrono::steady_clock::now();
+    node->shutdown();
+    REQUIRE(pending.wait_for(5s) == std::future_status::ready);
+    auto lost = pending.get();
+    REQUIRE_FALSE(lost);
+    CHECK(lost.error().type == MessageErrorType::ConnectionError);
+    CHECK(std::chrono::steady_clock::now() - t0 < 5s);
+    {
+        std::lock_guard lock(service->mutex);
+        service->held.clear();
+    }
+}
