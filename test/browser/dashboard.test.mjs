@@ -79,6 +79,7 @@ before(async () => {
   gateway = await startGateway(s, { reynard: `rr+tcp://127.0.0.1:${relay.port}/?service=reynard` });
   await waitFor(async () => (await apiDevices(gateway.base)).every((d) => d.state === "connected"), "every device connected", 30000);
   chat = startChat(reynard.info.http_url);
+  await waitFor(() => chat.socket.connected, "socket.io connected to Reynard's web UI");
   browser = await launchChromium();
   const context = await browser.newContext({ viewport: { width: 1366, height: 900 } });
   page = await context.newPage();
