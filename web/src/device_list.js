@@ -29,7 +29,9 @@ export class DeviceList extends EventTarget {
       if (!r.ok) throw new Error(`GET api/devices: HTTP ${r.status}`);
       this.devices = await r.json();
       this.setGatewayStatus("connected", "gateway connected");
-      this.render();
+      const key = JSON.stringify(this.devices);
+      if (key !== this.shown) this.render();
+      this.shown = key;
       this.dispatchEvent(new CustomEvent("update", { detail: this.devices }));
     } catch (e) {
       this.setGatewayStatus("failed", `gateway unreachable: ${errorText(e)}`);
