@@ -181,7 +181,7 @@ def main(argv=None):
     try:
         ours = Proc([exe["rr_bench_service"], "--websocket"], "bench_service")
         procs.append(ours)
-        official = Proc([PY, os.path.join(HERE, "py", "official_service.py")], "official_service")
+        official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket"], "official_service")
         procs.append(official)
         gw = Proc([exe["rr-gateway"], "--no-demo", "--port", "0", "--log-level", "warning",
                    "--device", "bench=" + ours.ready["url"]], "rr-gateway")
@@ -200,6 +200,7 @@ def main(argv=None):
             ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp")),
             ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp")),
             ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws")),
+            ("official->official rr+ws", lambda: pyc(official.ready["ws_url"], "official->official rr+ws")),
             ("official->ours rr+tcp", lambda: pyc(ours.ready["url"], "official->ours rr+tcp")),
             ("ours->official rr+tcp", lambda: cpp(official.ready["url"], "ours->official rr+tcp", ops)),
             ("ours->gateway->ours rr+tcp", lambda: cpp(gw_url, "ours->gateway->ours rr+tcp")),
@@ -301,7 +302,8 @@ def main(argv=None):
 LATENCY_OPS = ("nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set", "peek", "wire")
 OP_ORDER = ["tcp_64", "unix_64", "tcp_bulk", "nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set",
             "peek", "wire", "wire_rate", "pipe", "memory_read", "memory_write"]
-PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "official->official rr+tcp", "official->ours rr+tcp",
+PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "official->official rr+tcp", "official->official rr+ws",
+              "official->ours rr+tcp",
               "ours->official rr+tcp", "ours->gateway->ours rr+tcp", "official->gateway->ours rr+tcp"]
 
 
@@ -327,8 +329,10 @@ def summarize(raw, fanout, scale):
         if bulk and row.get("mb_s") and (op == "echo100000" or op.startswith("memory")):
             e["pct_tcp_bulk"] = 100 * row["mb_s"] / bulk  # target: >= 50 %
         if label.startswith("ours->") and "gateway" not in label and "official" not in label:
-            off = rows.get(("official->official rr+tcp", op))
+            # the official library over the same transport (rr+ws streams run only on rr+tcp for it)
+            off = rows.get(("official->official " + label.split()[-1], op)) or rows.get(("official->official rr+tcp", op))
             if off:
+                e["official_path"] = off["label"]
                 if op in ("pipe", "wire_rate") or "p50_us" not in off:
                     if off.get("ops_per_s") and row.get("ops_per_s"):
                         e["official_ops_per_s"] = off["ops_per_s"]
@@ -384,15 +388,18 @@ def markdown(res):
            "References measured in this run: TCP floor p50 **%s µs** (64 B ping-pong, TCP_NODELAY), Unix socket floor "
            "p50 %s µs, TCP bulk round trip (800,000 B each way) **%s MB/s**." % (
                fmt(refs.get("tcp_floor_p50_us"), 2), fmt(refs.get("unix_floor_p50_us"), 2), fmt(refs.get("tcp_bulk_mb_s"))), "",
-           "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor | % TCP bulk | official p50 µs (ops/s) | speed-up vs official |",
+           "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in res["rows"]:
         off = fmt(e.get("official_p50_us")) if "official_p50_us" in e else (
             "(%s)" % fmt(e["official_ops_per_s"], 0) if "official_ops_per_s" in e else "")
+        if off and e.get("official_path", "").split()[-1] != e["path"].split()[-1]:
+            off += "*"
         out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             e["op"], e["path"], fmt(e.get("p50_us")), fmt(e.get("p99_us")), fmt(e.get("max_us")), fmt(e.get("ops_per_s"), 0),
             fmt(e.get("mb_s")), fmt(e.get("x_tcp_floor"), 2), fmt(e.get("pct_tcp_bulk")), off,
             (fmt(e["speedup_vs_official"], 2) + "×") if "speedup_vs_official" in e else ""))
+    out += ["", "\\* the official library over rr+tcp (it ran the streaming rows on rr+tcp only)."]
     if res["gateway_hops"]:
         out += ["", "The gateway hop (client → gateway → device minus client → device, p50):", "",
                 "| path | op | direct µs | through gateway µs | hop µs | hop × TCP floor |", "|---|---|---|---|---|---|"]
