@@ -96,7 +96,7 @@ after(async () => {
 });
 
 afterEach(() => {
-  assert.deepEqual(pageErrors.map(String), [], "uncaught errors in the page");
+  assert.deepEqual(pageErrors.splice(0).map(String), [], "uncaught errors in the page");
 });
 
 test("lists the devices with their live state", async () => {
