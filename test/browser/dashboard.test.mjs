@@ -226,6 +226,14 @@ test("create: driving moves the plotted distance; play_callback is answered", as
   await callFunction(card("StopStreaming"));
 });
 
+test("a device the gateway does not have shows the connect error in place", async () => {
+  await page.goto(`${gateway.base}/#/nosuch`);
+  const banner = page.locator('.device-view[data-device="nosuch"] .device-error');
+  await banner.waitFor({ state: "visible", timeout: 20000 });
+  assert.match(await banner.textContent(), /rr\+ws:\/\/127\.0\.0\.1:\d+\/\?service=nosuch: RobotRaconteur\.\w+/);
+  await page.locator('.event-log li[data-kind="error"]').first().waitFor();
+});
+
 test("a page from a disallowed Origin is refused", async () => {
   const other = http.createServer((req, res) => {
     res.writeHead(200, { "Content-Type": "text/html" });
