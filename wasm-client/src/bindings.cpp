@@ -46,5 +46,6 @@ EMSCRIPTEN_BINDINGS(robotraconteur) {
         .function("wirePoke", &NativeClient::wire_poke)
         .function("memoryParam", &NativeClient::memory_param)
         .function("memoryRead", &NativeClient::memory_read)
-        .function("memoryWrite", &NativeClient::memory_write);
+        .function("memoryWrite", &NativeClient::memory_write)
+        .function("monitor", &NativeClient::monitor);
 }

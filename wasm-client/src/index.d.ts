@@ -142,6 +142,9 @@ export interface ObjectProxy {
   /** Service definitions the client holds: name → robdef text. */
   readonly $definitions: Record<string, string>;
   readonly $client: ClientHandle;
+  /** Takes the object's monitor lock (timeoutMs −1: wait as long as it takes). */
+  $monitorEnter(timeoutMs?: number): Promise<void>;
+  $monitorExit(): Promise<void>;
   /** Members by name: PropertyMember, function, EventMember, ObjRefMember, PipeMember, CallbackMember,
    *  WireMember or MemoryMember according to the member's kind. */
   [member: string]: any;

@@ -579,6 +579,11 @@ Result<val> NativeClient::values_to_js(const std::vector<Value>& values,
     return a;
 }
 
+void NativeClient::monitor(std::string path, bool enter, int timeout_ms, double now, val cb) {
+    if (enter) ctx_.monitor_enter(path, timeout_ms, mono(now), void_completion(cb));
+    else ctx_.monitor_exit(path, mono(now), void_completion(cb));
+}
+
 void NativeClient::on_timer(double now) { ctx_.on_timer(mono(now)); }
 void NativeClient::disconnect(double now) { ctx_.disconnect(mono(now)); }
 bool NativeClient::is_connected() const { return ctx_.is_connected(); }

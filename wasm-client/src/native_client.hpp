@@ -107,6 +107,10 @@ public:
     void memory_read(std::string path, std::string member, val start, val count, double now, val cb);
     void memory_write(std::string path, std::string member, val start, val data, double now, val cb);
 
+    // --- monitor lock (ClientSessionOp 1107/1108) -----------------------------------------------------
+    /// MonitorEnter on the object at `path` (`timeout_ms`, −1 = wait forever) or, with `enter` false, MonitorExit.
+    void monitor(std::string path, bool enter, int timeout_ms, double now, val cb);
+
 private:
     struct GeneratorTypes {
         robdef::TypeDefinition return_type;

@@ -46,6 +46,9 @@ export function makeProxy(conn, desc) {
     $implements: desc.implements,
     $members: desc.members,
     $client: conn.clientApi,
+    /** Monitor lock of this object (`timeoutMs` −1: wait as long as it takes). */
+    $monitorEnter: (timeoutMs = -1) => conn.op((cb) => conn.native.monitor(desc.path, true, timeoutMs, now(), cb)),
+    $monitorExit: () => conn.op((cb) => conn.native.monitor(desc.path, false, 0, now(), cb)),
   };
   Object.defineProperty(proxy, "$definitions", { get: () => conn.definitions, enumerable: true });
   for (const m of desc.members) {

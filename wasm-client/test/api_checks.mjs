@@ -218,6 +218,12 @@ check("properties: second values from plain JS (numbers, BigInt, names, Map, nul
   eq(await c.p_double.get(), -1.7976931348623157e308, "p_double after reset");
 });
 
+check("monitor lock: enter, use, exit", async ({ c }) => {
+  await c.$monitorEnter(5000);
+  eq(await c.ro_value.get(), 17, "read under the monitor lock");
+  await c.$monitorExit();
+});
+
 check("properties: errors (service and local)", async ({ c }) => {
   await rejects(c.p_double.set(1.0), "RobotRaconteur.InvalidArgument", "service rejects a third value");
   await rejects(c.p_int8.set(1000), "RobotRaconteur.OutOfRange", "int8 out of range");
