@@ -1,6 +1,7 @@
 // Runs api_checks.mjs with the BUILT package (wasm-client/dist) in node against three services:
 //   1. rr_interop_service --websocket (our C++ service), rr+ws
-//   2. rr-gateway in front of it (device over rr+tcp, client over rr+ws to the gateway)
+//   2. rr-gateway in front of it (device over rr+tcp, client over rr+ws to the gateway), and in front of
+//      the official service
 //   3. the official Python service (test/interop/official_service.py), rr+ws on its TCP port
 //   4. the official service with message format v2 only; 5. ours with v4 string tables;
 //   6. ours behind nginx terminating TLS (rr+wss), when nginx and openssl are installed
@@ -84,6 +85,16 @@ const targets = {
   },
   async gateway() {
     const svc = start(arg("--interop-service"), ["--port", "0", "--max-lifetime", "300"]);
+    const dev = await readyLine(svc, "url");
+    const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
+      "--device", `interop=${dev.url}`]);
+    const { port } = await readyLine(gw, "port");
+    await gatewayReady(port);
+    return `rr+ws://127.0.0.1:${port}/?service=interop`;
+  },
+  async "gateway-official"() {
+    const py = arg("--python", join(root, ".venv", "bin", "python"));
+    const svc = start(py, [join(root, "test", "interop", "official_service.py"), "--port", "0", "--max-lifetime", "300"]);
     const dev = await readyLine(svc, "url");
     const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
       "--device", `interop=${dev.url}`]);
