@@ -82,9 +82,13 @@ export async function startReynard(s, rrPort = 0) {
   return { child, info };
 }
 
-/** Starts rr-gateway on 127.0.0.1 (port 0 = ephemeral), demo devices on, plus `devices` {name: url}. */
-export async function startGateway(s, devices = {}, listenPort = 0) {
-  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning"];
+/**
+ * Starts rr-gateway on 127.0.0.1 (port 0 = ephemeral), demo devices on, plus `devices` {name: url}
+ * and `extraArgs` (e.g. ["--allow-origin", ORIGIN]).
+ */
+export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = []) {
+  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning",
+    ...extraArgs];
   for (const [name, url] of Object.entries(devices)) args.push("--device", `${name}=${url}`);
   const child = new Child("rr-gateway", s.gateway, args);
   const { port } = await child.jsonLine("port", 30000);
