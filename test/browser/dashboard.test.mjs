@@ -62,12 +62,13 @@ async function callFunction(c, args = {}) {
 function canvasDigest(locator) {
   return locator.evaluate((cv) => {
     const d = cv.getContext("2d").getImageData(0, 0, cv.width, cv.height).data;
-    let sum = 0, lit = 0;
+    let sum = 0, lit = 0, blue96 = 0;
     for (let i = 0; i < d.length; i += 4) {
       sum = (sum * 31 + d[i] + 3 * d[i + 1] + 7 * d[i + 2]) >>> 0;
       if (d[i] + d[i + 1] + d[i + 2] > 30) lit++;
+      if (d[i + 2] === 96) blue96++;
     }
-    return { sum, lit, width: cv.width, height: cv.height };
+    return { sum, lit, blue96, width: cv.width, height: cv.height };
   });
 }
 
@@ -182,6 +183,9 @@ test("webcam: streamed frames render on a canvas", async () => {
   const a = await canvasDigest(canvas);
   assert.deepEqual([a.width, a.height], [320, 240]);
   assert.ok(a.lit > 1000, "the frame is not blank");
+  // camera 0's background has blue = 96 everywhere (server/demo/webcam_image.hpp): channels and rows
+  // are where they belong
+  assert.ok(a.blue96 > 0.8 * 320 * 240, `${a.blue96} background pixels`);
   await waitFor(async () => (await canvasDigest(canvas)).sum !== a.sum, "the next frame drawn");
   await shot("05-webcam-stream");
   await shot("05-webcam-viewport", false);
@@ -190,7 +194,7 @@ test("webcam: streamed frames render on a canvas", async () => {
   await callFunction(capture);
   const c = await canvasDigest(capture.locator("canvas.image"));
   assert.deepEqual([c.width, c.height], [320, 240]);
-  assert.ok(c.lit > 1000, "the captured frame is not blank");
+  assert.ok(c.blue96 > 0.8 * 320 * 240, `${c.blue96} background pixels in the captured frame`);
   // memory viewer: the multidim buffer drawn as an image after CaptureFrameToBuffer
   await callFunction(card("CaptureFrameToBuffer", cam));
   const mem = card("multidimbuffer", cam);
@@ -199,6 +203,7 @@ test("webcam: streamed frames render on a canvas", async () => {
   await waitFor(async () => Number(await mem.locator(".memory-table").getAttribute("data-count")) === 240 * 320 * 3, "memory read");
   const m = await canvasDigest(mem.locator("canvas.image"));
   assert.ok(m.lit > 1000, "the memory image is not blank");
+  assert.ok(m.blue96 > 0.8 * 320 * 240, `${m.blue96} background pixels (column-major [y, x, c] drawn right)`);
   await pipe.locator("button", { hasText: "Disconnect" }).click();
   await callFunction(card("StopStreaming", cam));
 });
