@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs everything the build, the tests and the gateway need. Idempotent: a second run installs
-# nothing. Debian packages (apt), Python packages into ./.venv (pip, pinned), npm packages (later).
+# nothing. Debian packages (apt), Python packages into ./.venv (pip, pinned), npm packages (npm ci in
+# web/ and wasm-client/, pinned by their package-lock.json).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -43,6 +44,7 @@ fi
 export PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1
 if ! command -v npm >/dev/null; then   # (a nodesource nodejs brings its own npm; Debian's is separate)
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends nodejs npm
 fi
 lock=web/package-lock.json
