@@ -18,9 +18,12 @@ http_port=${REYNARD_HTTP_PORT:-29201}
 reynard_pid=$!
 config=gateway-config/reynard.yaml
 cleanup() {
+  local rc=$?  # the gateway's exit status is the script's
   # SIGTERM: a background job of a non-interactive shell ignores SIGINT.
-  kill -TERM "$reynard_pid" 2>/dev/null && wait "$reynard_pid" 2>/dev/null
+  kill -TERM "$reynard_pid" 2>/dev/null || true
+  wait "$reynard_pid" 2>/dev/null || true
   [ "$config" = gateway-config/reynard.yaml ] || rm -f "$config"
+  exit "$rc"
 }
 trap cleanup EXIT
 echo "run-reynard: Reynard starting (RR port $rr_port, web UI http://localhost:$http_port/)"
