@@ -133,15 +133,22 @@ Result<void> Node::register_service(std::shared_ptr<Service> service) {
     for (char c : name)
         valid = valid && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_');
     if (!valid) return fail(MessageErrorType::InvalidArgument, "invalid service name \"" + name + "\"");
-    std::lock_guard lock(mutex_);
-    if (services_.count(name)) return fail(MessageErrorType::InvalidArgument, "service \"" + name + "\" already registered");
-    services_.emplace(name, std::move(service));
+    {
+        std::lock_guard lock(mutex_);
+        if (services_.count(name)) return fail(MessageErrorType::InvalidArgument, "service \"" + name + "\" already registered");
+        services_.emplace(name, std::move(service));
+    }
+    local_node_services_changed(service_index_);
     return {};
 }
 
 void Node::unregister_service(const std::string& name) {
-    std::lock_guard lock(mutex_);
-    services_.erase(name);
+    bool erased = false;
+    {
+        std::lock_guard lock(mutex_);
+        erased = services_.erase(name) != 0;
+    }
+    if (erased) local_node_services_changed(service_index_);
 }
 
 std::vector<std::string> Node::service_names() const {

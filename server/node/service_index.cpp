@@ -81,4 +81,9 @@ Result<std::shared_ptr<Service>> make_service_index(std::weak_ptr<Node> weak_nod
     return std::shared_ptr<Service>(*service);
 }
 
+void local_node_services_changed(const std::shared_ptr<Service>& index) {
+    // Clients that cannot take it (full queue) miss it, as any event.
+    if (auto s = std::dynamic_pointer_cast<ObjectService>(index)) (void)s->root()->fire_event("LocalNodeServicesChanged", {});
+}
+
 }  // namespace rr::server

@@ -7,7 +7,8 @@
 //                           transport the request came in on (SessionRef::local_url, else the node's
 //                           first TCP listener), Attributes (only string / numeric array values, as CORE).
 //   GetRoutedNodes(), GetDetectedNodes()   empty maps (deprecated; CORE's routed list is empty too).
-//   LocalNodeServicesChanged              never fired (not yet).
+//   LocalNodeServicesChanged              fired to the index's clients when a service is registered or
+//                                         unregistered (local_node_services_changed).
 #pragma once
 
 #include <memory>
@@ -22,5 +23,8 @@ class Node;
 /// The service index of `node` (held weakly: the node owns the service). Errors: those of building the
 /// typed service from the built-in definition (not expected).
 Result<std::shared_ptr<Service>> make_service_index(std::weak_ptr<Node> node);
+
+/// Fires LocalNodeServicesChanged on `index` (one made by make_service_index; others are ignored).
+void local_node_services_changed(const std::shared_ptr<Service>& index);
 
 }  // namespace rr::server

@@ -2,6 +2,9 @@
 // (The official Python client against it: test/cli/service_index_official.py.)
 #include <catch2/catch.hpp>
 
+#include <atomic>
+#include <thread>
+
 #include "core/value/pack_value.hpp"
 #include "robdef/service_definition_set.hpp"
 #include "server/client/client.hpp"
@@ -96,8 +99,16 @@ TEST_CASE("node: RobotRaconteurServiceIndex lists the registered services with t
     CHECK((*direct)->root().type() == "example.rawtest.Obj");
     CHECK((*direct)->close_wait().ok());
 
-    // The list follows registrations.
+    // The list follows registrations, and the index's clients hear of each change.
+    std::atomic<int> changes{0};
+    auto sub = root.subscribe("LocalNodeServicesChanged", [&](const std::string&, std::vector<Value>&) { ++changes; });
+    REQUIRE(sub);
     node->unregister_service("svc");
+    for (int i = 0; i < 200 && changes.load() < 1; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(changes.load() == 1);
+    node->unregister_service("svc");  // nothing to remove: no event
+    std::this_thread::sleep_for(100ms);
+    CHECK(changes.load() == 1);
     r = root.call("GetLocalNodeServices");
     REQUIRE(r);
     REQUIRE(r->get_if<MapInt32>()->entries.size() == 1);
