@@ -3,6 +3,7 @@
 asserts its output and exit status.
 
 Targets:
+  --target url       a running interop service at --url (e.g. through the gateway) experimental.interop_test
   --target ours      test/interop/rr_interop_service (--service PATH)   experimental.interop_test
   --target official  test/interop/official_service.py (this Python)    experimental.interop_test
   --target reynard   test/interop/reynard_harness.py (Reynard headless) experimental.reynard_the_robot
@@ -279,13 +280,16 @@ def node_index_checks(rr, service_url, name, root_type):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rr", required=True)
-    ap.add_argument("--target", choices=["ours", "official", "reynard"], required=True)
+    ap.add_argument("--target", choices=["url", "ours", "official", "reynard"], required=True)
+    ap.add_argument("--url", help="service URL (--target url)")
     ap.add_argument("--service", help="rr_interop_service executable (--target ours)")
     ap.add_argument("--no-node-index", action="store_true", help="skip `rr info` without service=")
     args = ap.parse_args()
 
     usage_checks(args.rr)
-    if args.target == "ours":
+    if args.target == "url":
+        proc, ready = None, {"url": args.url}
+    elif args.target == "ours":
         proc, ready = start([args.service, "--port", "0", "--max-lifetime", "280"])
     elif args.target == "official":
         proc, ready = start([sys.executable, os.path.join(INTEROP, "official_service.py"), "--port", "0",
@@ -309,7 +313,8 @@ def main():
             if not args.no_node_index:
                 node_index_checks(rr, ready["url"], "interop", "experimental.interop_test.Root")
     finally:
-        stop(proc)
+        if proc is not None:
+            stop(proc)
     if args.target == "ours":
         check(proc.returncode == 0, "service exits cleanly", f"rc={proc.returncode}")
     print(json.dumps({"target": args.target, "checks": checks_run[0], "failures": len(failures)}))
