@@ -99,7 +99,7 @@ std::optional<Failure> print_node_services(Target& t, std::ostream& out) {
     return std::nullopt;
 }
 
-std::optional<Failure> run_info(const CommandLine& cl, Target& t, bool node_index, std::ostream& out) {
+std::optional<Failure> run_info(Target& t, bool node_index, std::ostream& out) {
     if (node_index) {
         if (auto f = print_node_services(t, out)) return f;
         out << "\n";
@@ -256,7 +256,7 @@ ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err
     std::optional<Failure> f = connect_target(cl, *url, t);
     if (!f) {
         switch (cl.kind) {
-            case CommandKind::info: f = run_info(cl, t, node_index, out); break;
+            case CommandKind::info: f = run_info(t, node_index, out); break;
             case CommandKind::get: f = run_get(cl, t, out); break;
             case CommandKind::set: f = run_set(cl, t, json.at(0)); break;
             case CommandKind::call: f = run_call(cl, t, json, out); break;

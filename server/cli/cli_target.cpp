@@ -93,14 +93,15 @@ Result<MemberInfo> member_info(const ObjectProxy& object, const std::string& mem
 
 Result<nlohmann::json> to_json(Client& client, const Value& value, const robdef::TypeDefinition& type,
                                const std::string& service) {
-    return client.query<nlohmann::json>([&](ClientContext& ctx, MonoTime) {
+    // Copies: the lambda may outlive this call if the strand does not answer in time.
+    return client.query<nlohmann::json>([value, type, service](ClientContext& ctx, MonoTime) {
         return value_to_json(value, type, ctx.definitions(), service);
     });
 }
 
 Result<Value> from_json(Client& client, const nlohmann::json& json, const robdef::TypeDefinition& type,
                         const std::string& service) {
-    return client.query<Value>([&](ClientContext& ctx, MonoTime) {
+    return client.query<Value>([json, type, service](ClientContext& ctx, MonoTime) {
         return value_from_json(json, type, ctx.definitions(), service);
     });
 }

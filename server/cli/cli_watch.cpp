@@ -17,15 +17,17 @@ using Clock = std::chrono::steady_clock;
 
 constexpr auto kPoll = 100ms;  // how often the loop looks at the stop flag
 
-// When a watch ends: stop flag, --count, --seconds.
+// When a watch ends: stop flag, --count, --seconds, or nobody reads the output any more
+// (`rr watch … | head -1`: SIGPIPE is ignored, the failed write marks the stream bad).
 struct StopRule {
     const std::atomic<bool>& stop;
+    const std::ostream& out;
     std::optional<std::uint64_t> count;
     std::optional<Clock::time_point> deadline;
     std::uint64_t printed = 0;
 
     bool done() const {
-        return stop.load() || (count && printed >= *count) || (deadline && Clock::now() >= *deadline);
+        return stop.load() || !out.good() || (count && printed >= *count) || (deadline && Clock::now() >= *deadline);
     }
 };
 
@@ -151,7 +153,7 @@ std::optional<Failure> watch_event(Target& t, const MemberInfo& m, std::ostream&
 std::optional<Failure> run_watch(const CommandLine& cl, Target& t, std::ostream& out, const std::atomic<bool>& stop) {
     auto m = member_info(t.object, cl.member->name);
     if (!m) return rr_failure(m.error());
-    StopRule rule{stop, cl.count, std::nullopt};
+    StopRule rule{stop, out, cl.count, std::nullopt};
     if (cl.seconds)
         rule.deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*cl.seconds));
     switch (m->def.kind) {

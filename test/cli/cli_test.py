@@ -248,6 +248,18 @@ def interop_checks(rr, service_url):
     check(p.returncode == OK and first.startswith("{"), "watch ends with status 0 on SIGINT",
           f"rc={p.returncode} first={first!r} {err}")
 
+    # a reader that goes away (rr watch ... | head -1) ends the watch
+    p = rr.popen("watch", "w_state")
+    first = p.stdout.readline()
+    p.stdout.close()
+    try:
+        p.wait(timeout=15)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+    p.stderr.close()
+    check(first.startswith("{") and p.returncode == OK, "watch ends when its output is closed", f"rc={p.returncode}")
+
     # connection-level failures
     rr.fails(CONNECT, r"RobotRaconteur\.ConnectionError", "get", "p_int32",
              url=f"rr+tcp://127.0.0.1:{closed_port()}/?service=interop")
