@@ -227,6 +227,14 @@ def interop_checks(rr, service_url):
     rr.ok("set", "w_both", "[1, 2, 3]")
     rr.fails(RR_ERROR, r"RobotRaconteur\.WriteOnlyMember", "watch", "w_sink", "--count", "1")
 
+    # memories: get reads the whole memory
+    mem = rr.json_lines("get", "mem_double")
+    check(len(mem) == 1 and isinstance(mem[0], list) and len(mem[0]) > 0, "get mem_double reads the array", str(mem)[:200])
+    md = rr.json_lines("get", "mem_md")
+    check(len(md) == 1 and isinstance(md[0], dict) and len(md[0].get("array", [])) == 
+          (lambda d: d[0] * d[1] if len(d) == 2 else -1)(md[0].get("dims", [])), "get mem_md reads dims and array",
+          str(md)[:200])
+
     # events (fired for every connected client; keep firing until the watch got its values)
     rc, lines, err = watch_while(rr, ["ev_values", "--count", "2"], lambda: rr.run("call", "fire_events", "3"))
     evs = [json.loads(x) for x in lines]
