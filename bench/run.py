@@ -160,6 +160,8 @@ def main(argv=None):
     ap.add_argument("--skip-scale", action="store_true")
     ap.add_argument("--skip-calls", action="store_true", help="only fan-out and scale")
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
+    ap.add_argument("--update-doc", action="store_true",
+                    help="also replace the latest figures in docs/benchmarks.md (between its latest:begin/end markers)")
     args = ap.parse_args(argv)
     if args.quick:
         args.rounds, args.count = 1, 500
@@ -295,6 +297,8 @@ def main(argv=None):
     with open(os.path.join(args.out, "latest.md"), "w") as f:
         f.write(md)
     print(md)
+    if args.update_doc:
+        update_doc(os.path.join(ROOT, "docs", "benchmarks.md"), md)
     log("wrote %s/latest.json and latest.md in %.0f s" % (args.out, result["duration_s"]))
     return 0
 
@@ -366,11 +370,24 @@ def summarize(raw, fanout, scale):
     return {"references": refs, "rows": table, "gateway_hops": hops, "cost_growth": growth, "fanout": fanout, "scale": scale}
 
 
+def update_doc(path, md):
+    begin, end = "<!-- latest:begin -->", "<!-- latest:end -->"
+    with open(path) as f:
+        text = f.read()
+    a, b = text.find(begin), text.find(end)
+    if a < 0 or b < a:
+        log("%s has no %s ... %s markers; not updated" % (path, begin, end))
+        return
+    with open(path, "w") as f:
+        f.write(text[:a + len(begin)] + "\n" + md + text[b:])
+    log("updated " + path)
+
+
 def fmt(v, nd=1):
     if v is None or v == "":
         return ""
     if isinstance(v, float):
-        if abs(v) >= 1000:
+        if abs(v) >= 999.5:
             return "{:,.0f}".format(v)
         return ("{:.%df}" % nd).format(v)
     return "{:,}".format(v) if isinstance(v, int) else str(v)
