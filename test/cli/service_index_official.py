@@ -34,7 +34,8 @@ def main():
     ap.add_argument("--service", required=True)
     args = ap.parse_args()
 
-    svc = subprocess.Popen([args.service, "--port", "0", "--max-lifetime", "120"], stdout=subprocess.PIPE, text=True)
+    svc = subprocess.Popen([args.service, "--port", "0", "--max-lifetime", "120", "--websocket"], stdout=subprocess.PIPE,
+                           text=True)
     try:
         ready = json.loads(svc.stdout.readline())
         port, nodeid = ready["port"], ready["nodeid"].strip("{}")
@@ -65,6 +66,15 @@ def main():
                     RRN.DisconnectService(c2)
             check(len(c.GetRoutedNodes()) == 0, "GetRoutedNodes is empty")
             RRN.DisconnectService(c)
+
+            # Over rr+ws on the same port: the listener's address is reported (the WebSocket stream
+            # does not expose its socket), which reaches the same node.
+            ws_index = ready["ws_url"].replace("service=interop", "service=RobotRaconteurServiceIndex")
+            w = RRN.ConnectService(ws_index)
+            names = {s.Name: dict(s.ConnectionURL) for s in w.GetLocalNodeServices().values()}
+            check(names.get("interop") == {1: f"rr+tcp://127.0.0.1:{port}/?nodeid={nodeid}&service=interop"},
+                  "index over rr+ws reports the TCP listener URL", repr(names))
+            RRN.DisconnectService(w)
             check(re.fullmatch(r"[0-9a-f-]{36}", nodeid) is not None, "nodeid form", nodeid)
         finally:
             RRN.Shutdown()
