@@ -273,6 +273,11 @@ def interop_checks(rr, service_url):
              url=f"rr+tcp://127.0.0.1:{closed_port()}/?service=interop")
     rr.fails(CONNECT, r"RobotRaconteur\.ServiceNotFound", "get", "p_int32",
              url=re.sub(r"service=[^&]*", "service=nosuch", service_url))
+    t0 = time.time()
+    rr.fails(CONNECT, r"RobotRaconteur\.\w+", "get", "p_int32", "--timeout", "1",
+             url="rr+tcp://10.255.255.1:4/?service=interop")  # unroutable: refused or timed out
+    check(time.time() - t0 < 10, "--timeout bounds the connect", f"{time.time() - t0:.1f} s")
+    check(rr.json_lines("get", "p_int64", "--disable-message4") == ["-9223372036854775808"], "message format v2")
     rr.fails(USAGE, r"names no service", "get", "p_int32", url=without_service(service_url))
     rr.fails(USAGE, r"InvalidArgument", "get", "p_int32", url="bogus://x")
     rr.ok("call", "reset")
