@@ -1,6 +1,10 @@
 #include "server/gateway/json_socket.hpp"
 
+#include <atomic>
+
+#include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
 
 #include "core/session/elements.hpp"
 #include "core/value/timespec.hpp"
@@ -32,8 +36,12 @@ ApiError bad_request(std::string message) { return api_error(400, MessageErrorTy
 class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession> {
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
-                      boost::asio::any_io_executor executor, const JsonSocketOptions& options)
-        : api_(std::move(api)), socket_(std::move(socket)), options_(options), timer_(executor) {}
+                      boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options)
+        : api_(std::move(api)),
+          socket_(std::move(socket)),
+          options_(options),
+          timer_(executor),
+          convert_strand_(std::move(convert_strand)) {}
 
     void on_message(std::string text) {
         if (text.size() > options_.max_message_bytes) {
@@ -505,10 +513,30 @@ private:
         send_text(msg);
     }
 
+    // Runs on the device's strand, which must not wait for a packet's JSON (a camera frame is about
+    // 1 MB of text; seconds under ASan): the device's replies to everyone arrive on it. The JSON is made
+    // on the server's conversion strand; while `max_pipe_conversions` of this socket wait there, newer
+    // packets are dropped and counted.
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
         MemberTarget t;
         std::uint64_t dropped = 0;
         if (!take_push(sid, t, dropped)) return;
+        if (pipe_converting_.fetch_add(1) >= options_.max_pipe_conversions) {
+            pipe_converting_.fetch_sub(1);
+            std::lock_guard lock(mutex_);
+            if (auto it = subs_.find(sid); it != subs_.end()) it->second.dropped += dropped + 1;
+            ++push_drops_;
+            return;
+        }
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped] {
+            self->convert_pipe_packet(sid, packet, t, dropped);
+            self->pipe_converting_.fetch_sub(1);
+        });
+    }
+
+    // On the conversion strand (packets of one socket stay in order).
+    void convert_pipe_packet(std::uint64_t sid, const MessageElement& packet, const MemberTarget& t, std::uint64_t dropped) {
+        if (!push_allowed(sid)) return;
         nlohmann::json msg{{"subscription", sid}, {"kind", "pipe"}};
         auto j = api_->element_json(packet, t.member->type, t);
         if (j)
@@ -516,7 +544,19 @@ private:
         else
             msg["error"] = error_object(*j.error);
         if (dropped) msg["dropped"] = dropped;
-        send_text(msg);
+        auto text = json_text(msg);
+        // Under the lock: never after the subscription's "closed" push or its unsubscribe reply.
+        std::lock_guard lock(mutex_);
+        if (push_allowed_locked(sid)) socket_->send(std::move(text));
+    }
+
+    bool push_allowed(std::uint64_t sid) const {
+        std::lock_guard lock(mutex_);
+        return push_allowed_locked(sid);
+    }
+    bool push_allowed_locked(std::uint64_t sid) const {
+        auto it = subs_.find(sid);
+        return !closed_ && it != subs_.end() && it->second.active;
     }
 
     void on_pipe_ack(std::uint64_t sid, std::uint32_t number) {
@@ -653,13 +693,15 @@ private:
     std::uint64_t next_sid_ = 1;
     std::size_t in_flight_ = 0;
     std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
+    ConvertStrand convert_strand_;                  // shared by the server's sockets
+    std::atomic<std::size_t> pipe_converting_{0};  // this socket's packets posted there, not yet sent
 };
 
 // --- server ---------------------------------------------------------------------------------------
 
 JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor,
                                    JsonSocketOptions options)
-    : api_(std::move(api)), executor_(std::move(executor)), options_(options) {}
+    : api_(std::move(api)), executor_(executor), convert_strand_(boost::asio::make_strand(executor)), options_(options) {}
 
 std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
                                                            boost::asio::any_io_executor executor,
@@ -695,7 +737,7 @@ http::JsonSocketHandler JsonSocketServer::handler() {
 }
 
 void JsonSocketServer::on_open(const std::shared_ptr<http::JsonSocket>& socket) {
-    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, options_);
+    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_);
     std::lock_guard lock(mutex_);
     sessions_[socket.get()] = std::move(session);
 }

@@ -12,6 +12,10 @@
 //     messages are queued, and replaces an older waiting one;
 //   * events and pipe packets are dropped (counted, and reported as "dropped" in the next push of that
 //     subscription) while `push_queue_limit` messages or `push_bytes_limit` bytes are queued;
+//   * pipe packets become JSON on one strand shared by all sockets, never on the device connection's
+//     strand: a slow conversion (a camera frame) delays neither the device's replies nor other
+//     traffic, and takes at most one worker thread; a socket's packets are dropped (counted) while
+//     `max_pipe_conversions` of its own wait there;
 //   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
 //     answered at once, and messages over `max_message_bytes` are refused.
 // Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
@@ -23,6 +27,7 @@
 #include <vector>
 
 #include <boost/asio/any_io_executor.hpp>
+#include <boost/asio/strand.hpp>
 
 #include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
@@ -31,10 +36,14 @@ namespace rr::server::gateway {
 
 inline constexpr std::string_view kJsonSubprotocol = "rr-gateway.json.v1";
 
+/// Where pipe packets become JSON (see above).
+using ConvertStrand = boost::asio::strand<boost::asio::any_io_executor>;
+
 struct JsonSocketOptions {
     std::size_t push_queue_limit = 768;             ///< messages queued: events / pipe packets dropped from here
     std::size_t push_bytes_limit = 8u << 20;        ///< bytes queued: pushes dropped / wire values wait from here
     std::size_t wire_queue_threshold = 8;           ///< messages queued: wire values wait (coalesced) from here
+    std::size_t max_pipe_conversions = 2;           ///< a socket's pipe packets waiting for their JSON: newer dropped
     std::chrono::milliseconds wire_retry{10};       ///< how often waiting wire values retry
     std::size_t max_in_flight = 64;                 ///< requests per socket being answered at once
     std::size_t max_subscriptions = 256;            ///< per socket
@@ -56,7 +65,8 @@ class JsonSocketSession;
 /// Serves the subprotocol: one JsonSocketSession per socket.
 class JsonSocketServer : public std::enable_shared_from_this<JsonSocketServer> {
 public:
-    /// `executor` runs the wire retry timers (the gateway node's io_context).
+    /// `executor` runs the wire retry timers and the pipe packets' JSON conversion (the gateway
+    /// node's io_context).
     static std::shared_ptr<JsonSocketServer> create(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor,
                                                     JsonSocketOptions options = {});
     ~JsonSocketServer();
@@ -76,6 +86,7 @@ private:
 
     std::shared_ptr<JsonApi> api_;
     boost::asio::any_io_executor executor_;
+    ConvertStrand convert_strand_;
     JsonSocketOptions options_;
     std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
     mutable std::mutex mutex_;
