@@ -43,7 +43,7 @@ struct JsonSocketOptions {
     std::size_t push_queue_limit = 768;             ///< messages queued: events / pipe packets dropped from here
     std::size_t push_bytes_limit = 8u << 20;        ///< bytes queued: pushes dropped / wire values wait from here
     std::size_t wire_queue_threshold = 8;           ///< messages queued: wire values wait (coalesced) from here
-    std::size_t max_pipe_conversions = 2;           ///< a socket's pipe packets waiting for their JSON: newer dropped
+    std::size_t max_pipe_conversions = 16;          ///< a socket's pipe packets waiting for their JSON: newer dropped (a burst of small packets must fit)
     std::chrono::milliseconds wire_retry{10};       ///< how often waiting wire values retry
     std::size_t max_in_flight = 64;                 ///< requests per socket being answered at once
     std::size_t max_subscriptions = 256;            ///< per socket
