@@ -1,11 +1,11 @@
 #include "server/client/client.hpp"
 
 #include <map>
-#include <random>
 
 #include <boost/asio/ip/tcp.hpp>
 
 #include "server/client/tcp_connector.hpp"
+#include "server/node/random_ids.hpp"
 
 namespace rr::client {
 
@@ -17,25 +17,6 @@ using server::mono_now;
 using server::StreamPump;
 
 namespace {
-
-std::uint32_t random_u32() {
-    static thread_local std::mt19937 rng{std::random_device{}()};
-    std::uint32_t v;
-    do v = rng();
-    while (v == 0);
-    return v;
-}
-
-NodeID random_node_id() {
-    NodeID::Bytes b{};
-    for (std::size_t i = 0; i < 16; i += 4) {
-        auto v = random_u32();
-        for (std::size_t k = 0; k < 4; ++k) b[i + k] = static_cast<std::byte>((v >> (8 * k)) & 0xFF);
-    }
-    b[6] = static_cast<std::byte>((static_cast<unsigned>(b[6]) & 0x0F) | 0x40);
-    b[8] = static_cast<std::byte>((static_cast<unsigned>(b[8]) & 0x3F) | 0x80);
-    return NodeID(b);
-}
 
 // rr+tcp: resolve, connect (TCP_NODELAY), then a StreamPump over the socket.
 void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
@@ -128,7 +109,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
         return done(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
 
     ClientContextConfig cfg;
-    cfg.session.stream.local_node_id = options.local_node_id.is_any() ? random_node_id() : options.local_node_id;
+    cfg.session.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
     cfg.session.stream.local_node_name = options.local_node_name;
     cfg.session.stream.target_node_id = url->node_id;
     cfg.session.stream.target_node_name = url->node_name;
@@ -141,7 +122,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     cfg.session.username = options.username;
     cfg.session.password = options.password;
     cfg.session.request_timeout = options.request_timeout;
-    cfg.session.local_endpoint = random_u32();
+    cfg.session.local_endpoint = server::random_endpoint_id();
     cfg.memory_max_transfer_size = options.memory_max_transfer_size;
 
     std::shared_ptr<Client> client(new Client());

@@ -1,38 +1,14 @@
 #include "server/client/raw_client.hpp"
 
-#include <random>
-
 #include <boost/asio/ip/tcp.hpp>
 
 #include "server/client/tcp_connector.hpp"
+#include "server/node/random_ids.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
-
-namespace {
-
-std::uint32_t random_u32() {
-    static thread_local std::mt19937 rng{std::random_device{}()};
-    std::uint32_t v;
-    do v = rng();
-    while (v == 0);
-    return v;
-}
-
-NodeID random_node_id() {
-    NodeID::Bytes b{};
-    for (std::size_t i = 0; i < 16; i += 4) {
-        auto v = random_u32();
-        for (std::size_t k = 0; k < 4; ++k) b[i + k] = static_cast<std::byte>((v >> (8 * k)) & 0xFF);
-    }
-    b[6] = static_cast<std::byte>((static_cast<unsigned>(b[6]) & 0x0F) | 0x40);
-    b[8] = static_cast<std::byte>((static_cast<unsigned>(b[8]) & 0x3F) | 0x80);
-    return NodeID(b);
-}
-
-}  // namespace
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
@@ -140,7 +116,7 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
                         return;
                     }
                     ClientSessionConfig cfg;
-                    cfg.stream.local_node_id = options.local_node_id.is_any() ? random_node_id() : options.local_node_id;
+                    cfg.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
                     cfg.stream.local_node_name = options.local_node_name;
                     cfg.stream.target_node_id = url.node_id;
                     cfg.stream.target_node_name = url.node_name;
@@ -151,7 +127,7 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
                     cfg.username = options.username;
                     cfg.password = options.password;
                     cfg.request_timeout = options.request_timeout;
-                    cfg.local_endpoint = random_u32();
+                    cfg.local_endpoint = server::random_endpoint_id();
 
                     std::shared_ptr<RawClient> client(new RawClient());
                     auto logic = std::make_shared<Logic>(std::move(cfg), mono_now());

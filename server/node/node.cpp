@@ -3,6 +3,7 @@
 #include <boost/asio/write.hpp>
 
 #include "robdef/builtin/service_index.hpp"
+#include "server/node/random_ids.hpp"
 #include "server/node/service_index.hpp"
 #include "server/transport/tcp_listener.hpp"
 
@@ -10,19 +11,6 @@ namespace rr::server {
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
-
-namespace {
-
-NodeID random_node_id(std::mt19937& rng) {
-    NodeID::Bytes b{};
-    for (auto& x : b) x = static_cast<std::byte>(rng() & 0xFF);
-    // RFC 4122 version 4, variant 1.
-    b[6] = static_cast<std::byte>((static_cast<unsigned>(b[6]) & 0x0F) | 0x40);
-    b[8] = static_cast<std::byte>((static_cast<unsigned>(b[8]) & 0x3F) | 0x80);
-    return NodeID(b);
-}
-
-}  // namespace
 
 std::string tcp_base_url(const tcp::endpoint& local) {
     std::string host = local.address().to_string();
@@ -39,8 +27,8 @@ std::shared_ptr<Node> Node::create(NodeOptions options) {
     return node;
 }
 
-Node::Node(NodeOptions options) : options_(std::move(options)), rng_(std::random_device{}()) {
-    if (options_.node_id.is_any()) options_.node_id = random_node_id(rng_);
+Node::Node(NodeOptions options) : options_(std::move(options)) {
+    if (options_.node_id.is_any()) options_.node_id = random_node_id();
     if (options_.threads == 0) options_.threads = std::max(2u, std::thread::hardware_concurrency());
     work_ = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(io_.get_executor());
 }
@@ -179,8 +167,8 @@ std::string Node::listen_base_url() const {
 std::uint32_t Node::new_endpoint_id() {
     std::lock_guard lock(mutex_);
     for (;;) {
-        std::uint32_t id = rng_();
-        if (id != 0 && endpoints_.insert(id).second) return id;
+        std::uint32_t id = random_endpoint_id();
+        if (endpoints_.insert(id).second) return id;
     }
 }
 

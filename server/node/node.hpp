@@ -7,7 +7,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <set>
 #include <string>
 #include <thread>
@@ -101,7 +100,6 @@ private:
     std::shared_ptr<Service> service_index_;  // set once in create()
     std::vector<boost::asio::ip::tcp::endpoint> listen_endpoints_;
     std::set<std::uint32_t> endpoints_;
-    std::mt19937 rng_;
     std::shared_ptr<std::atomic<std::size_t>> connections_ = std::make_shared<std::atomic<std::size_t>>(0);
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
     std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
