@@ -721,6 +721,8 @@ bool Parser::parse_enum(const lex::LogicalLine& opener) {
             while (k < piece.size() && is_word(piece[k])) ++k;
             std::string_view vname = piece.substr(0, k);
             if (vname.empty() || !is_alpha(vname[0])) return fail(l.line, DiagnosticKind::enumeration, "Enum parse error");
+            // `end` would end the block once the value stands on its own line (canonical text).
+            if (vname == "end") return fail(l.line, DiagnosticKind::enumeration, "Enum parse error");
             std::string_view rhs = trim(piece.substr(k));
             EnumValue v;
             v.name = std::string(vname);

@@ -170,6 +170,7 @@ TEST_CASE("invalid definitions fail to parse with the official message at the ri
          "Enum names or values not unique", 4},
         {"enum value overflow", h10 + "enum E\n    a = 2147483648\nend\n", K::enumeration, "Enum parse error", 4},
         {"enum hex overflow", h10 + "enum E\n    a = 0xFFFFFFFF\nend\n", K::enumeration, "Enum parse error", 4},
+        {"enum value named end", h10 + "enum E\n    a = 0,\tend\nend\n", K::enumeration, "Enum parse error", 4},
         {"enum empty piece", h10 + "enum E\n    a = 1,, b\nend\n", K::enumeration, "Enum parse error", 4},
         {"enum leading zero", h10 + "enum E\n    a = 03\nend\n", K::enumeration, "Enum parse error", 4},
         // --- constants (robdef.md §7)
