@@ -77,6 +77,14 @@ std::string constant_to_string(const ConstantDefinition& c) {
     return "constant " + c.type.to_string() + " " + c.name + " " + c.value;
 }
 
+// An option's text is free; one ending in `\` (left by a continuation onto a blank line) would continue
+// onto the next line when read back, so it gets one more `\` continued onto a blank line (robdef.md
+// §1.2: that backslash becomes a space, which the parser trims).
+std::string option_line(std::string_view indent, const std::string& text) {
+    std::string line = std::string(indent) + "option " + text;
+    return line + (!text.empty() && text.back() == '\\' ? "\\\n\n" : "\n");
+}
+
 std::string entry_to_string(const ServiceEntryDefinition& e, const ServiceDefinition& def) {
     std::string s;
     switch (e.kind) {
@@ -87,7 +95,7 @@ std::string entry_to_string(const ServiceEntryDefinition& e, const ServiceDefini
     }
     s += e.name + "\n";
     for (const auto& i : e.implements) s += "    implements " + unqualify(i, def) + "\n";
-    for (const auto& o : e.options) s += "    option " + o + "\n";
+    for (const auto& o : e.options) s += option_line("    ", o);
     for (const auto& c : e.constants) s += "    " + constant_to_string(c) + "\n";
     for (const auto& m : e.members) s += "    " + member_to_string(m, def, e.kind == EntryKind::object) + "\n";
     return s + "end\n";
@@ -125,7 +133,7 @@ std::string to_string(const ServiceDefinition& def) {
         o += "using " + u.qualified_name + (last == u.unqualified_name ? "" : " as " + u.unqualified_name) + "\n";
     }
     if (!def.usings.empty()) o += "\n";
-    for (const auto& opt : def.options) o += "option " + opt + "\n";
+    for (const auto& opt : def.options) o += option_line("", opt);
     if (!def.options.empty()) o += "\n";
     for (const auto& c : def.constants) o += constant_to_string(c) + "\n";
     if (!def.constants.empty()) o += "\n";

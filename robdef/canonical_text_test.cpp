@@ -133,3 +133,18 @@ TEST_CASE("canonical text: empty enum and member_to_string") {
     CHECK(member_to_string(m, r->definition, false) == "field double{list} x");
     CHECK(member_to_string(m, r->definition, true) == "property double{list} x");
 }
+
+TEST_CASE("canonical text: an option ending in a backslash reads back the same") {
+    // `x\\` continued onto a blank line leaves the option text `x\` (robdef.md §1.2).
+    const std::string text = "service a.b\noption x\\\\\n\nstruct S\n    option y\\\\\n\n    field int32 f\nend\n";
+    auto r = parse_service_definition(text, "t.robdef");
+    REQUIRE(r);
+    REQUIRE(r->definition.options == std::vector<std::string>{"x\\"});
+    REQUIRE(r->definition.structures.at(0).options == std::vector<std::string>{"y\\"});
+    const std::string once = to_string(r->definition);
+    auto again = parse_service_definition(once, "canonical.robdef");
+    REQUIRE(again);
+    CHECK(again->definition.options == r->definition.options);
+    CHECK(again->definition.structures.at(0).options == r->definition.structures.at(0).options);
+    CHECK(to_string(again->definition) == once);
+}

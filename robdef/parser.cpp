@@ -528,6 +528,10 @@ ParseReport Parser::run() {
 bool Parser::finish_versions() {
     bool version_found = stdver_found_;
     if (stdver_found_) def_.stdver = stdver_;
+    // An option line above `stdver` passed the in-flight check; the rule holds for the whole file.
+    if (stdver_found_ && stdver_ >= kVersion0_9_2 && !def_.options.empty())
+        return fail(def_.option_lines.empty() ? 0 : def_.option_lines.front(), DiagnosticKind::version,
+                    "option keyword is not support in stdver 0.9.2 or greater");
     for (std::size_t i = 0; i < def_.options.size(); ++i) {
         std::string_view o = trim_left(def_.options[i]);
         int line = i < def_.option_lines.size() ? def_.option_lines[i] : 0;

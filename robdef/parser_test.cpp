@@ -66,6 +66,8 @@ TEST_CASE("invalid definitions fail to parse with the official message at the ri
          "Service definition standard version 0.9 or greater required for \"stdver\" keyword", 2},
         {"option with stdver 0.10", h10 + "option foo\n", K::version,
          "option keyword is not support in stdver 0.9.2 or greater", 3},
+        {"option above stdver 0.10", "service a.b\noption foo\nstdver 0.10\n", K::version,
+         "option keyword is not support in stdver 0.9.2 or greater", 2},
         {"option inside an object with stdver 0.9.2", "service a.b\nstdver 0.9.2\nobject O\n    option x\nend\n",
          K::version, "option keyword is not support in stdver 0.9.2 or greater", 4},
         {"import after struct", h + "struct S\nend\nimport c.d\n", K::ordering, "import must be before all but options",
