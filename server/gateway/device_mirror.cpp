@@ -261,7 +261,7 @@ void DeviceMirror::request(MessageEntry entry, std::function<void(Result<Message
 }
 
 std::uint64_t DeviceMirror::subscribe(std::string path, std::string member, bool is_wire,
-                                      std::function<void(const MessageEntry&)> on_entry,
+                                      std::function<void(const SharedEntryPtr&)> on_entry,
                                       std::function<void(Result<void>)> done) {
     return service_->add_internal_subscriber(std::move(path), std::move(member), is_wire, std::move(on_entry),
                                              std::move(done));

@@ -25,6 +25,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
+#include "server/gateway/shared_entry.hpp"
 #include "server/service/service.hpp"
 
 namespace rr::server {
@@ -92,9 +93,10 @@ public:
     /// path uses the gateway's name for the device; the reply's is rewritten back the same way.
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     /// Subscribes the gateway itself to a wire or event (JSON API): `on_entry` gets upstream WirePacket /
-    /// EventReq entries for that member (paths in gateway naming). Returns an id for unsubscribe().
+    /// EventReq entries for that member (paths in gateway naming), one SharedEntry per value shared by
+    /// every subscriber. Returns an id for unsubscribe().
     std::uint64_t subscribe(std::string path, std::string member, bool is_wire,
-                            std::function<void(const MessageEntry&)> on_entry,
+                            std::function<void(const SharedEntryPtr&)> on_entry,
                             std::function<void(Result<void>)> done);
     void unsubscribe(std::uint64_t id);
 

@@ -107,7 +107,7 @@ private:
         bool mirror_known = false;
         bool active = false;  // subscribe answered: pushes may go
         bool failed = false;  // subscribe failed before mirror_id was known
-        std::optional<MessageEntry> pending_wire;
+        SharedEntryPtr pending_wire;  // newest value not yet sent
         std::uint64_t dropped = 0;  // pushes dropped since the last one sent
     };
 
@@ -306,7 +306,7 @@ private:
         const bool is_wire = kind == SubKind::wire;
         const std::uint64_t mid = t.device->subscribe(
             t.path, t.member->name, is_wire,
-            [weak, sid, is_wire](const MessageEntry& e) {
+            [weak, sid, is_wire](const SharedEntryPtr& e) {
                 auto s = weak.lock();
                 if (!s) return;
                 if (is_wire)
@@ -358,7 +358,7 @@ private:
                 // Under the lock: the reply is queued before any push of this subscription.
                 send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(it->second.kind)}}));
                 it->second.active = true;
-                flush = it->second.pending_wire.has_value();
+                flush = it->second.pending_wire != nullptr;
             }
         }
         if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
@@ -488,29 +488,51 @@ private:
         return true;
     }
 
-    void on_event(std::uint64_t sid, const MessageEntry& e) {
+    void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
         MemberTarget t;
         std::uint64_t dropped = 0;
         if (!take_push(sid, t, dropped)) return;
-        nlohmann::json msg{{"subscription", sid}, {"kind", "event"}};
+        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_body(entry, t)); });
+        socket_->send(push_text(sid, "event", dropped, body));
+    }
+
+    // {"args": {…}} or {"error": …}: the part of an event push every subscriber shares.
+    nlohmann::json event_body(const MessageEntry& e, const MemberTarget& t) const {
         auto args = nlohmann::json::object();
         for (const auto& p : t.member->parameters) {
             const auto* el = e.find(p.name);
-            if (!el) {
-                msg["error"] = error_object(api_error(502, MessageErrorType::MessageElementNotFound,
-                                                      "event from the device has no \"" + p.name + "\" element"));
-                break;
-            }
+            if (!el)
+                return {{"error", error_object(api_error(502, MessageErrorType::MessageElementNotFound,
+                                                         "event from the device has no \"" + p.name + "\" element"))}};
             auto j = api_->element_json(*el, p, t);
-            if (!j) {
-                msg["error"] = error_object(*j.error);
-                break;
-            }
+            if (!j) return {{"error", error_object(*j.error)}};
             args[p.name] = std::move(j.value);
         }
-        if (!msg.contains("error")) msg["args"] = std::move(args);
-        if (dropped) msg["dropped"] = dropped;
-        send_text(msg);
+        return {{"args", std::move(args)}};
+    }
+
+    // {"subscription": sid, "kind": kind[, "dropped": n], …the members of `body`}; `body` is a JSON
+    // object's text, rendered once per value for all subscribers.
+    static std::string push_text(std::uint64_t sid, std::string_view kind, std::uint64_t dropped,
+                                 const std::string& body) {
+        std::string out;
+        out.reserve(body.size() + 64);
+        out += "{\"subscription\":";
+        out += std::to_string(sid);
+        out += ",\"kind\":\"";
+        out += kind;
+        out += '"';
+        if (dropped) {
+            out += ",\"dropped\":";
+            out += std::to_string(dropped);
+        }
+        if (body.size() > 2) {
+            out += ',';
+            out.append(body, 1, std::string::npos);  // the members and the closing brace
+        } else {
+            out += '}';
+        }
+        return out;
     }
 
     // Runs on the device's strand, which must not wait for a packet's JSON (a camera frame is about
@@ -576,8 +598,8 @@ private:
             send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
     }
 
-    void on_wire(std::uint64_t sid, const MessageEntry& e) {
-        if (e.entry_type == MessageEntryType::WireClosed) {
+    void on_wire(std::uint64_t sid, const SharedEntryPtr& e) {
+        if (e->entry().entry_type == MessageEntryType::WireClosed) {
             on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));
             return;
         }
@@ -605,7 +627,7 @@ private:
         }
         struct Item {
             std::uint64_t sid;
-            MessageEntry entry;
+            SharedEntryPtr entry;
             MemberTarget target;
         };
         std::vector<Item> batch;
@@ -619,7 +641,7 @@ private:
                     return;
                 }
                 bool waiting = false;
-                for (auto& [sid, sub] : subs_) waiting |= sub.active && sub.pending_wire.has_value();
+                for (auto& [sid, sub] : subs_) waiting |= sub.active && sub.pending_wire;
                 if (!waiting) {
                     flushing_ = false;
                     return;
@@ -631,11 +653,15 @@ private:
                 }
                 for (auto& [sid, sub] : subs_) {
                     if (!sub.active || !sub.pending_wire) continue;
-                    batch.push_back(Item{sid, std::move(*sub.pending_wire), sub.target});
-                    sub.pending_wire.reset();
+                    batch.push_back(Item{sid, std::move(sub.pending_wire), sub.target});
+                    sub.pending_wire = nullptr;
                 }
             }
-            for (auto& item : batch) send_text(wire_message(item.sid, item.entry, item.target));
+            for (auto& item : batch) {
+                const std::string& body = item.entry->rendered(
+                    [&](const MessageEntry& e) { return json_text(wire_body(e, item.target)); });
+                socket_->send(push_text(item.sid, "wire", 0, body));
+            }
             std::lock_guard lock(mutex_);
             if (!flush_again_) {
                 flushing_ = false;
@@ -644,8 +670,9 @@ private:
         }
     }
 
-    nlohmann::json wire_message(std::uint64_t sid, const MessageEntry& e, const MemberTarget& t) const {
-        nlohmann::json msg{{"subscription", sid}, {"kind", "wire"}};
+    // {"value": …, "time": …} or {"error": …}: the part of a wire push every subscriber shares.
+    nlohmann::json wire_body(const MessageEntry& e, const MemberTarget& t) const {
+        nlohmann::json msg = nlohmann::json::object();
         const auto* p = e.find("packet");
         const auto* ts = e.find("packettime");
         if (!p || !ts) {

@@ -191,6 +191,43 @@ TEST_CASE("json socket: subscribe to wires; events; pipes; unsubscribe") {
     CHECK(gw.sockets().stats().at(0).subscriptions == 5);  // values, empty, echo, both, sink
 }
 
+TEST_CASE("json socket: subscribers of one wire and one event each get every value under their own id") {
+    // The gateway renders a value's JSON once and shares it: every push must still carry its own
+    // subscription id and the whole value.
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    WsClient a(gw.port());
+    WsClient b(gw.port());
+    const auto wire_a = subscribe(a, "w_state", "wire");
+    const auto wire_b1 = subscribe(b, "w_state", "wire");
+    const auto wire_b2 = subscribe(b, "w_state", "wire");
+    const auto ev_a = subscribe(a, "ev_values", "event");
+    const auto ev_b = subscribe(b, "ev_values", "event");
+    CHECK(wire_b1 != wire_b2);
+
+    CHECK(a.request(member("call", "update_state", {{"args", {515151}}}))["result"] == json{{"return", nullptr}});
+    const json expected{{"id", 515151}, {"label", "demand"}, {"values", {128787.75}}};
+    for (auto [ws, sid] : {std::pair{&a, wire_a}, std::pair{&b, wire_b1}, std::pair{&b, wire_b2}}) {
+        auto push = ws->wait_push([&](const json& j) { return push_of(sid, "wire")(j) && j["value"]["id"] == 515151; });
+        REQUIRE(push);
+        CHECK((*push)["value"] == expected);
+        CHECK((*push)["time"]["seconds"].get<std::int64_t>() > 1600000000);
+        CHECK(push->size() == 4);  // subscription, kind, value, time
+    }
+
+    CHECK(b.request(member("call", "fire_events", {{"args", {2}}}))["result"] == json{{"return", nullptr}});
+    for (int seq = 0; seq < 2; ++seq) {
+        for (auto [ws, sid] : {std::pair{&a, ev_a}, std::pair{&b, ev_b}}) {
+            auto ev = ws->wait_push([&](const json& j) { return push_of(sid, "event")(j) && j["args"]["seq"] == seq; });
+            REQUIRE(ev);
+            CHECK((*ev)["args"]["text"] == "event " + std::to_string(seq) + " \u2713");
+            CHECK((*ev)["args"]["data"] == json{{"id", seq}, {"label", "event"}, {"values", {seq * 1.5}}});
+            CHECK(ev->size() == 3);  // subscription, kind, args
+        }
+    }
+}
+
 TEST_CASE("json socket: subscriptions end with the socket; device state is pushed") {
     if (!interop_service_built()) return;
     auto device = std::make_unique<InteropProcess>();

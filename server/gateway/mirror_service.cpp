@@ -9,6 +9,35 @@
 namespace rr::server::gateway {
 namespace {
 
+// The copy-on-write lists of internal subscribers (MirrorService::InternalSubs).
+template <class Subs>
+bool no_subscribers(const Subs& subs) {
+    return !subs || subs->empty();
+}
+
+template <class Sub>
+std::shared_ptr<const std::vector<Sub>> with_subscriber(const std::shared_ptr<const std::vector<Sub>>& subs, Sub sub) {
+    auto next = subs ? std::make_shared<std::vector<Sub>>(*subs) : std::make_shared<std::vector<Sub>>();
+    next->push_back(std::move(sub));
+    return next;
+}
+
+template <class Sub>
+std::shared_ptr<const std::vector<Sub>> without_subscriber(const std::shared_ptr<const std::vector<Sub>>& subs,
+                                                           std::uint64_t id) {
+    if (!subs || std::none_of(subs->begin(), subs->end(), [&](const Sub& s) { return s.id == id; })) return subs;
+    auto next = std::make_shared<std::vector<Sub>>();
+    for (const auto& s : *subs)
+        if (s.id != id) next->push_back(s);
+    return next;
+}
+
+template <class Subs>
+void deliver(const Subs& subs, const SharedEntryPtr& entry) {
+    if (subs)
+        for (const auto& s : *subs) s.on_entry(entry);
+}
+
 RRError not_connected(const std::string& device) {
     return make_error(MessageErrorType::ConnectionError, "device \"" + device + "\" is not connected");
 }
@@ -232,7 +261,7 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
 
 void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     MemberKey key{entry.service_path, entry.member_name};
-    std::optional<MessageEntry> last;
+    SharedEntryPtr last;
     bool ready = false;
     {
         std::lock_guard lock(mutex_);
@@ -254,7 +283,7 @@ void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry
     }
     if (ready) {
         responder.respond(MessageEntry{});
-        if (last) (void)session.send_wire_packet(std::move(*last));  // the newest value, at once
+        if (last) (void)session.send_wire_packet(last->entry());  // the newest value, at once
         return;
     }
     ensure_upstream_wire(key);
@@ -298,7 +327,7 @@ void MirrorService::ensure_upstream_wire(const MemberKey& key) {
             if (!outcome.ok()) {
                 // Nobody gets a connection that does not exist upstream.
                 it->second.sessions.clear();
-                if (it->second.internal.empty()) self->wires_.erase(it);
+                if (no_subscribers(it->second.internal)) self->wires_.erase(it);
             }
         }
         for (auto& w : waiting)
@@ -314,7 +343,7 @@ void MirrorService::wire_disconnect(const SessionRef& session, MessageEntry&& en
         auto it = wires_.find(key);
         if (it != wires_.end()) {
             std::erase(it->second.sessions, session);
-            last = it->second.sessions.empty() && it->second.internal.empty() && it->second.upstream_connected;
+            last = it->second.sessions.empty() && no_subscribers(it->second.internal) && it->second.upstream_connected;
             if (last) wires_.erase(it);
         }
     }
@@ -456,9 +485,9 @@ void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
 
 // --- upstream traffic ----------------------------------------------------------------------------
 
-void MirrorService::fan_out(const MessageEntry& entry) {
+void MirrorService::fan_out(MessageEntry&& entry) {
     std::vector<SessionRef> sessions;
-    std::vector<InternalSub> internal;
+    InternalSubs internal;
     {
         std::lock_guard lock(mutex_);
         sessions = sessions_;
@@ -468,7 +497,7 @@ void MirrorService::fan_out(const MessageEntry& entry) {
     auto m = mirror_.lock();
     for (const auto& s : sessions)
         if (!s.send(entry) && m) m->counters_.event_drops.fetch_add(1);
-    for (const auto& i : internal) i.on_entry(entry);
+    if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
 }
 
 void MirrorService::callback_from_device(MessageEntry&& entry) {
@@ -520,31 +549,33 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
         case MessageEntryType::ServicePathReleasedReq:
             if (m) m->counters_.events.fetch_add(1);
             entry.service_path = to_downstream(entry.service_path);
-            fan_out(entry);
+            fan_out(std::move(entry));
             return;
         case MessageEntryType::WirePacket: {
             if (m) m->counters_.wire_packets_in.fetch_add(1);
             entry.service_path = to_downstream(entry.service_path);
+            // One shared copy: the newest value for late subscribers and what internal subscribers get.
+            auto shared = std::make_shared<const SharedEntry>(std::move(entry));
             std::vector<SessionRef> sessions;
-            std::vector<InternalSub> internal;
+            InternalSubs internal;
             {
                 std::lock_guard lock(mutex_);
-                auto it = wires_.find({entry.service_path, entry.member_name});
+                auto it = wires_.find({shared->entry().service_path, shared->entry().member_name});
                 if (it == wires_.end()) return;
-                it->second.last_packet = entry;
+                it->second.last_packet = shared;
                 sessions = it->second.sessions;
                 internal = it->second.internal;
             }
             for (const auto& s : sessions) {
-                if (s.send_wire_packet(entry) && m) m->counters_.wire_packets_out.fetch_add(1);
+                if (s.send_wire_packet(shared->entry()) && m) m->counters_.wire_packets_out.fetch_add(1);
             }
-            for (const auto& i : internal) i.on_entry(entry);
+            deliver(internal, shared);
             return;
         }
         case MessageEntryType::WireClosed: {
             entry.service_path = to_downstream(entry.service_path);
             std::vector<SessionRef> sessions;
-            std::vector<InternalSub> internal;
+            InternalSubs internal;
             {
                 std::lock_guard lock(mutex_);
                 auto it = wires_.find({entry.service_path, entry.member_name});
@@ -554,7 +585,8 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
                 wires_.erase(it);
             }
             for (const auto& s : sessions) (void)s.send(entry);
-            for (const auto& i : internal) i.on_entry(entry);  // internal subscribers see the WireClosed too
+            // Internal subscribers see the WireClosed too.
+            if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
             return;
         }
         case MessageEntryType::PipePacket:
@@ -603,7 +635,7 @@ void MirrorService::on_upstream_connected(const std::shared_ptr<RawClient>&) {
         for (auto& [key, sub] : wires_) {
             sub.upstream_connected = false;
             sub.connecting = false;
-            if (!sub.sessions.empty() || !sub.internal.empty()) resubscribe.push_back(key);
+            if (!sub.sessions.empty() || !no_subscribers(sub.internal)) resubscribe.push_back(key);
         }
     }
     for (const auto& key : resubscribe) ensure_upstream_wire(key);
@@ -648,21 +680,22 @@ void MirrorService::on_upstream_lost(const RRError& error) {
 }
 
 std::uint64_t MirrorService::add_internal_subscriber(std::string path, std::string member, bool is_wire,
-                                                     std::function<void(const MessageEntry&)> on_entry,
+                                                     std::function<void(const SharedEntryPtr&)> on_entry,
                                                      std::function<void(Result<void>)> done) {
     std::uint64_t id;
     MemberKey key{std::move(path), std::move(member)};
-    std::optional<MessageEntry> last;
+    SharedEntryPtr last;
     bool ready = false;
     {
         std::lock_guard lock(mutex_);
         id = next_internal_id_++;
         if (!is_wire) {
-            event_subscribers_[key].push_back(InternalSub{id, std::move(on_entry)});
+            auto& subs = event_subscribers_[key];
+            subs = with_subscriber(subs, InternalSub{id, std::move(on_entry)});
             ready = true;
         } else {
             auto& sub = wires_[key];
-            sub.internal.push_back(InternalSub{id, on_entry});
+            sub.internal = with_subscriber(sub.internal, InternalSub{id, on_entry});
             ready = sub.upstream_connected;
             if (ready) {
                 last = sub.last_packet;
@@ -672,7 +705,7 @@ std::uint64_t MirrorService::add_internal_subscriber(std::string path, std::stri
         }
     }
     if (ready) {
-        if (last && is_wire) on_entry(*last);
+        if (last && is_wire) on_entry(last);
         if (done) done({});
         return id;
     }
@@ -684,10 +717,10 @@ void MirrorService::remove_internal_subscriber(std::uint64_t id) {
     std::vector<MemberKey> disconnect;
     {
         std::lock_guard lock(mutex_);
-        for (auto& [key, subs] : event_subscribers_) std::erase_if(subs, [&](const InternalSub& s) { return s.id == id; });
+        for (auto& [key, subs] : event_subscribers_) subs = without_subscriber(subs, id);
         for (auto it = wires_.begin(); it != wires_.end();) {
-            std::erase_if(it->second.internal, [&](const InternalSub& s) { return s.id == id; });
-            const bool unused = it->second.internal.empty() && it->second.sessions.empty();
+            it->second.internal = without_subscriber(it->second.internal, id);
+            const bool unused = no_subscribers(it->second.internal) && it->second.sessions.empty();
             if (unused && it->second.upstream_connected) {
                 disconnect.push_back(it->first);
                 it = wires_.erase(it);

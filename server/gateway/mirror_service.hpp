@@ -38,7 +38,7 @@ public:
     /// Gateway-internal subscribers (JSON API), keyed by id. A wire subscriber's `on_entry` gets the
     /// WirePackets and, when the device closes the wire, its WireClosed (the subscription is gone then).
     std::uint64_t add_internal_subscriber(std::string path, std::string member, bool is_wire,
-                                          std::function<void(const MessageEntry&)> on_entry,
+                                          std::function<void(const SharedEntryPtr&)> on_entry,
                                           std::function<void(Result<void>)> done);
     void remove_internal_subscriber(std::uint64_t id);
 
@@ -70,15 +70,17 @@ private:
     using MemberKey = std::pair<std::string, std::string>;  // downstream service path, member
     struct InternalSub {
         std::uint64_t id;
-        std::function<void(const MessageEntry&)> on_entry;
+        std::function<void(const SharedEntryPtr&)> on_entry;
     };
+    // Copied on write: a value fanned out takes a reference to the list, not a copy of every handler.
+    using InternalSubs = std::shared_ptr<const std::vector<InternalSub>>;
     struct WireSubscription {
         std::vector<SessionRef> sessions;
-        std::vector<InternalSub> internal;
+        InternalSubs internal;
         bool upstream_connected = false;
         bool connecting = false;
         std::vector<std::function<void(Result<void>)>> waiting;  // connect requests waiting for upstream
-        std::optional<MessageEntry> last_packet;                 // newest value, for late subscribers
+        SharedEntryPtr last_packet;                              // newest value, for late subscribers
     };
     struct PipeLink {
         SessionRef session;
@@ -97,7 +99,7 @@ private:
     void pipe_packets_from_client(const SessionRef& session, MessageEntry&& entry);
     void pipe_packets_from_device(MessageEntry&& entry);
     void callback_from_device(MessageEntry&& entry);
-    void fan_out(const MessageEntry& entry);
+    void fan_out(MessageEntry&& entry);
     void drop_session_state(std::uint32_t endpoint);
 
     std::weak_ptr<DeviceMirror> mirror_;
@@ -108,7 +110,7 @@ private:
     std::vector<SessionRef> sessions_;
     std::uint32_t last_caller_ = 0;  // endpoint of the client that most recently called into the device
     std::map<MemberKey, WireSubscription> wires_;
-    std::map<MemberKey, std::vector<InternalSub>> event_subscribers_;
+    std::map<MemberKey, InternalSubs> event_subscribers_;
     std::map<std::tuple<std::string, std::string, std::int32_t>, PipeLink> pipes_by_upstream_;
     std::map<std::tuple<std::uint32_t, std::string, std::string, std::int32_t>, std::int32_t> pipes_by_downstream_;
     std::set<std::pair<std::uint32_t, std::int32_t>> generators_;  // (endpoint, generator index)
