@@ -20,7 +20,6 @@
 #include <sstream>
 
 #include "bench/bench_common.hpp"
-#include "bench/ws_client_transport.hpp"
 #include "server/client/client.hpp"
 
 using namespace rr;
@@ -254,7 +253,6 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    rr::bench::register_ws_client_transport();
     client::IoThreads io(1);
     client::ClientOptions options;
     options.memory_max_transfer_size = 102400;

@@ -5,6 +5,7 @@
 #include <boost/asio/ip/tcp.hpp>
 
 #include "server/client/tcp_connector.hpp"
+#include "server/client/ws_transport.hpp"
 #include "server/node/random_ids.hpp"
 
 namespace rr::client {
@@ -32,7 +33,8 @@ void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOp
 
 struct TransportRegistry {
     std::mutex mutex;
-    std::map<std::string, ClientTransport, std::less<>> transports{{"rr+tcp", tcp_transport}, {"tcp", tcp_transport}};
+    std::map<std::string, ClientTransport, std::less<>> transports{
+        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}};
 };
 
 TransportRegistry& registry() {

@@ -10,7 +10,7 @@
 //     return InvalidOperation there.
 //
 // Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`)
-// are built in.
+// and `rr+ws` (server/client/ws_transport.hpp) are built in.
 //
 // Thread-safety: every public function may be called from any thread. Handlers must not block.
 // Lifetime: handlers that capture a Client or ObjectProxy keep the connection alive until close().

@@ -7,6 +7,7 @@
 #include <future>
 
 #include "server/client/client.hpp"
+#include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
 
@@ -183,6 +184,38 @@ TEST_CASE("client: transports are pluggable by URL scheme") {
     CHECK(host == "example");
     CHECK(Client::connect(f.io.executor(), "rr+bluetooth://example:5/?service=svc", {}).error().type ==
           MessageErrorType::ConnectionError);
+}
+
+TEST_CASE("client: rr+ws is built in; a peer that never answers the upgrade times out") {
+    Fixture f;
+    auto http_server = std::make_shared<server::http::HttpServer>(f.node, server::http::HttpOptions{});
+    f.node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial) {
+        http_server->handle(std::move(socket), std::move(initial));
+    });
+    const std::string ws_url = "rr+ws://127.0.0.1:" + std::to_string(f.port) + "/?service=svc";
+    auto c = Client::connect(f.io.executor(), ws_url, {});
+    INFO((c ? std::string() : c.error().message));
+    REQUIRE(c);
+    auto sum = (*c)->root().call("add", {Value::scalar(std::int32_t{20}), Value::scalar(std::int32_t{22})});
+    REQUIRE(sum);
+    CHECK(*sum == Value::scalar(std::int32_t{42}));
+    auto x = (*c)->root().get("x");
+    REQUIRE(x);
+    CHECK(*x == Value::scalar(42.5));
+    REQUIRE((*c)->close_wait());
+
+    // A TCP listener that accepts and then says nothing.
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::acceptor silent(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
+    rr::client::ClientOptions o;
+    o.connect_timeout = 300ms;
+    const auto start = std::chrono::steady_clock::now();
+    auto r = Client::connect(f.io.executor(), "rr+ws://127.0.0.1:" + std::to_string(silent.local_endpoint().port()) +
+                                                  "/?service=svc", o);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::ConnectionError);
+    CHECK(r.error().message.find("WebSocket handshake") != std::string::npos);
+    CHECK(std::chrono::steady_clock::now() - start < 10s);
 }
 
 TEST_CASE("client: the service sees the session close") {

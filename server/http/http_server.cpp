@@ -85,6 +85,7 @@ public:
 
     void start() {
         ws_.text(true);
+        ws_.auto_fragment(false);  // one frame per message, not Beast's 4 KiB fragments (one write each)
         if (handler_->on_open) handler_->on_open(shared_from_this());
         read();
     }

@@ -1,6 +1,8 @@
 // Presents a Beast WebSocket as a byte stream, so RR messages travel over it exactly as over TCP
 // (wire.md §8): binary frames only, frame boundaries carry no meaning, at most 65 536 payload bytes per
 // frame written (as CORE). A text frame from the peer is an error. Used by StreamPump.
+// Beast's defaults would split every frame into 4 KiB fragments (auto_fragment) and mask a client's
+// frames through a 4 KiB buffer: one write per 4 KiB. Here a frame goes out in one gathered write.
 #pragma once
 
 #include <algorithm>
@@ -21,7 +23,11 @@ public:
     using executor_type = typename websocket_type::executor_type;
     static constexpr std::size_t kMaxFramePayload = 65536;
 
-    explicit WebSocketByteStream(websocket_type ws) : ws_(std::move(ws)) { ws_.binary(true); }
+    explicit WebSocketByteStream(websocket_type ws) : ws_(std::move(ws)) {
+        ws_.binary(true);
+        ws_.auto_fragment(false);
+        ws_.write_buffer_bytes(kMaxFramePayload);  // client role: the masking buffer
+    }
 
     executor_type get_executor() noexcept { return ws_.get_executor(); }
 
