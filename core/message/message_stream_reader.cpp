@@ -31,8 +31,13 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
             preamble_fill_ = 0;
         }
         const std::size_t n = std::min(bytes.size(), expected_ - body_.size());
-        if (body_.size() + n > body_.capacity())  // grow with what arrived: doubling, capped at MessageSize
-            body_.reserve(std::min(expected_, std::max(body_.size() + n, 2 * body_.capacity())));
+        if (body_.size() + n > body_.capacity()) {
+            // Grow with what arrived: doubling, and the whole MessageSize once a quarter of it is here
+            // (fewer re-copies of a large message; still at most 4 × the bytes received).
+            const std::size_t arrived = body_.size() + n;
+            const std::size_t grown = 4 * arrived >= expected_ ? expected_ : std::max(arrived, 2 * body_.capacity());
+            body_.reserve(std::min(expected_, grown));
+        }
         body_.insert(body_.end(), bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
         bytes = bytes.subspan(n);
         if (body_.size() == expected_) {

@@ -9,8 +9,8 @@
 // Limits: the magic is checked as soon as its bytes arrive; MessageSize is checked against
 // kMinMessageSize and Limits::max_message_size right after the preamble, before any buffer for the
 // message is allocated. The buffer then grows with the bytes that actually arrive (first up to
-// 64 KiB, then doubling, never past MessageSize), so a peer cannot make the reader allocate much more
-// than it has sent.
+// 64 KiB, then doubling, and to MessageSize once a quarter of it has arrived), so a peer cannot make
+// the reader allocate more than 4 × what it has sent.
 // Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
 // below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
 // over the limit, or a decode limit). After the first error every call fails with that error and no

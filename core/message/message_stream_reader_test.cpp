@@ -177,6 +177,19 @@ TEST_CASE("message: the stream reader's buffer grows with the bytes received, no
         CHECK(reader.partial_capacity() <= 2 * reader.partial_bytes());
     }
     CHECK(reader.ready_count() == 0);
+    // Once a quarter of the message is here, the buffer takes the whole MessageSize at once.
+    std::vector<std::byte> mib = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                  std::byte{0x00}, std::byte{0x00}, std::byte{0x10}, std::byte{0x00}};  // 1 MiB
+    MessageStreamReader r1;
+    REQUIRE(r1.feed(mib));
+    std::vector<std::byte> piece(64 * 1024, std::byte{0});
+    for (int i = 0; i < 3; ++i) {
+        REQUIRE(r1.feed(piece));
+        CHECK(r1.partial_capacity() <= 2 * r1.partial_bytes());
+    }
+    REQUIRE(r1.feed(piece));  // 256 KiB + 8 bytes: over a quarter
+    CHECK(r1.partial_capacity() == 1024 * 1024);
+    CHECK(r1.partial_capacity() <= 4 * r1.partial_bytes());
     // Small messages get buffers of their own size.
     std::vector<std::byte> small = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
                                     std::byte{20},  std::byte{0},   std::byte{0},   std::byte{0}};
