@@ -272,38 +272,13 @@ void CreateDevice::call_play(const SessionRef& target, std::int32_t distance, st
 }
 
 void CreateDevice::start(asio::io_context& io) {
-    strand_ = std::make_unique<asio::strand<asio::io_context::executor_type>>(asio::make_strand(io));
-    timer_ = std::make_unique<asio::steady_timer>(*strand_);
-    asio::post(*strand_, [weak = weak_from_this()] {
-        auto self = weak.lock();
-        if (!self || self->stopped_) return;
-        self->last_tick_ = std::chrono::steady_clock::now();
-        self->schedule();
-    });
-}
-
-void CreateDevice::schedule() {
-    timer_->expires_after(options_.step_period);
-    timer_->async_wait([weak = weak_from_this()](boost::system::error_code ec) {
-        if (ec) return;
-        auto self = weak.lock();
-        if (!self || self->stopped_) return;
-        const auto now = std::chrono::steady_clock::now();
-        const auto dt = now - self->last_tick_;
-        self->last_tick_ = now;
-        self->advance(std::chrono::duration_cast<std::chrono::nanoseconds>(dt));
-        self->schedule();
+    driver_ = PeriodicTask::start(io, options_.step_period, [weak = weak_from_this()](std::chrono::nanoseconds dt) {
+        if (auto self = weak.lock()) self->advance(dt);
     });
 }
 
 void CreateDevice::stop() {
-    if (!strand_) return;
-    asio::post(*strand_, [weak = weak_from_this()] {
-        auto self = weak.lock();
-        if (!self) return;
-        self->stopped_ = true;
-        if (self->timer_) self->timer_->cancel();
-    });
+    if (driver_) driver_->stop();
 }
 
 }  // namespace rr::server::demo

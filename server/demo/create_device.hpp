@@ -43,7 +43,7 @@
 //   35     u8    first byte of the last play_callback reply (0 = none)
 //
 // Time: advance(dt) moves the simulation in fixed steps of step_period (50 Hz) and does the streaming
-// work; start() drives it from a steady_timer on an io_context in real time; tests call advance()
+// work; start() drives it in real time (PeriodicTask on an io_context); tests call advance()
 // with simulated time instead.
 //
 // Threads: every public function is thread-safe (one mutex guards the state; events, wire values and
@@ -58,10 +58,9 @@
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
-#include <boost/asio/strand.hpp>
 
 #include "server/demo/create_sim.hpp"
+#include "server/demo/periodic_task.hpp"
 #include "server/service/callback_member.hpp"
 #include "server/service/service_object.hpp"
 #include "server/service/wire_member.hpp"
@@ -123,7 +122,7 @@ public:
     /// sends what is due: Bump events, a packet, a play_callback call.
     void advance(std::chrono::nanoseconds dt);
 
-    /// Advances in real time from a steady_timer on `io` (every step_period). Call once.
+    /// Advances in real time on `io` (every step_period, PeriodicTask). Call once.
     void start(boost::asio::io_context& io);
     /// Stops the timer (pending work is cancelled). Idempotent.
     void stop();
@@ -133,7 +132,6 @@ private:
     Result<void> attach_handlers();
     Value make_packet_locked(std::uint16_t sequence) const;
     void call_play(const SessionRef& target, std::int32_t distance, std::int32_t angle);
-    void schedule();
 
     const CreateDeviceOptions options_;
     std::shared_ptr<ServiceObject> object_;
@@ -149,11 +147,7 @@ private:
     bool play_outstanding_ = false;
     bool bump_play_pending_ = false;  // a bump came while a call was outstanding
 
-    // Real-time driver (start()); touched only on strand_.
-    std::unique_ptr<boost::asio::strand<boost::asio::io_context::executor_type>> strand_;
-    std::unique_ptr<boost::asio::steady_timer> timer_;
-    std::chrono::steady_clock::time_point last_tick_;
-    bool stopped_ = false;
+    std::shared_ptr<PeriodicTask> driver_;  // real time (start())
 };
 
 }  // namespace rr::server::demo

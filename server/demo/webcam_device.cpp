@@ -173,39 +173,13 @@ void WebcamHostDevice::tick() {
 }
 
 void WebcamHostDevice::start(asio::io_context& io) {
-    strand_ = std::make_unique<asio::strand<asio::io_context::executor_type>>(asio::make_strand(io));
-    timer_ = std::make_unique<asio::steady_timer>(*strand_);
-    asio::post(*strand_, [weak = weak_from_this()] {
-        auto self = weak.lock();
-        if (!self || self->stopped_) return;
-        self->next_ = std::chrono::steady_clock::now();
-        self->schedule();
-    });
-}
-
-void WebcamHostDevice::schedule() {
-    // A fixed cadence (next_ += period), re-based when more than a period late: no burst of catch-up frames.
-    const auto now = std::chrono::steady_clock::now();
-    next_ += options_.frame_period;
-    if (next_ < now) next_ = now;
-    timer_->expires_at(next_);
-    timer_->async_wait([weak = weak_from_this()](boost::system::error_code ec) {
-        if (ec) return;
-        auto self = weak.lock();
-        if (!self || self->stopped_) return;
-        self->tick();
-        self->schedule();
+    driver_ = PeriodicTask::start(io, options_.frame_period, [weak = weak_from_this()](std::chrono::nanoseconds) {
+        if (auto self = weak.lock()) self->tick();
     });
 }
 
 void WebcamHostDevice::stop() {
-    if (!strand_) return;
-    asio::post(*strand_, [weak = weak_from_this()] {
-        auto self = weak.lock();
-        if (!self) return;
-        self->stopped_ = true;
-        if (self->timer_) self->timer_->cancel();
-    });
+    if (driver_) driver_->stop();
 }
 
 }  // namespace rr::server::demo

@@ -34,9 +34,8 @@
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
-#include <boost/asio/strand.hpp>
 
+#include "server/demo/periodic_task.hpp"
 #include "server/demo/webcam_image.hpp"
 #include "server/service/memory_member.hpp"
 #include "server/service/pipe_member.hpp"
@@ -107,22 +106,18 @@ public:
 
     /// Every camera's next_frame().
     void tick();
-    /// Ticks in real time from a steady_timer on `io` (every frame_period). Call once.
+    /// Ticks in real time on `io` (every frame_period, PeriodicTask). Call once.
     void start(boost::asio::io_context& io);
     /// Stops the timer. Idempotent.
     void stop();
 
 private:
     explicit WebcamHostDevice(WebcamOptions options) : options_(std::move(options)) {}
-    void schedule();
 
     const WebcamOptions options_;
     std::shared_ptr<ServiceObject> object_;
     std::vector<std::shared_ptr<WebcamDevice>> cameras_;
-    std::unique_ptr<boost::asio::strand<boost::asio::io_context::executor_type>> strand_;
-    std::unique_ptr<boost::asio::steady_timer> timer_;
-    std::chrono::steady_clock::time_point next_;
-    bool stopped_ = false;
+    std::shared_ptr<PeriodicTask> driver_;  // real time (start())
 };
 
 }  // namespace rr::server::demo
