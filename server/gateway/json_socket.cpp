@@ -117,9 +117,9 @@ private:
 
     void send_reply(const nlohmann::json& id, const ApiResult& r) {
         if (r.error) {
-            send_text(nlohmann::json{{"id", id}, {"error", error_object(*r.error)}});
+            socket_->send_urgent(json_text(nlohmann::json{{"id", id}, {"error", error_object(*r.error)}}));
         } else {
-            send_text(nlohmann::json{{"id", id}, {"result", r.value}});
+            socket_->send_urgent(json_text(nlohmann::json{{"id", id}, {"result", r.value}}));
         }
     }
 

@@ -1,6 +1,7 @@
 #include "server/http/http_server.hpp"
 
 #include <atomic>
+#include <algorithm>
 #include <deque>
 #include <fstream>
 #include <sstream>
@@ -90,26 +91,8 @@ public:
         read();
     }
 
-    void send(std::string text) override {
-        auto self = shared_from_this();
-        queued_count_.fetch_add(1);
-        queued_bytes_.fetch_add(text.size());
-        asio::post(ws_.get_executor(), [self, text = std::move(text)]() mutable {
-            if (self->closed_) {
-                self->unqueue(text);
-                return;
-            }
-            // Slow reader: the oldest message not being written is dropped, and counted.
-            if (self->queue_.size() >= self->limit_ && self->queue_.size() > (self->writing_ ? 1u : 0u)) {
-                auto victim = self->writing_ ? std::next(self->queue_.begin()) : self->queue_.begin();
-                self->unqueue(*victim);
-                self->queue_.erase(victim);
-                self->dropped_.fetch_add(1);
-            }
-            self->queue_.push_back(std::move(text));
-            self->write();
-        });
-    }
+    void send(std::string text) override { enqueue(std::move(text), false); }
+    void send_urgent(std::string text) override { enqueue(std::move(text), true); }
 
     std::size_t queued() const override { return queued_count_.load(); }
     std::size_t queued_bytes() const override { return queued_bytes_.load(); }
@@ -127,6 +110,42 @@ public:
     std::string peer() const override { return peer_; }
 
 private:
+    struct Outgoing {
+        std::string text;
+        bool urgent = false;
+    };
+
+    void enqueue(std::string text, bool urgent) {
+        auto self = shared_from_this();
+        queued_count_.fetch_add(1);
+        queued_bytes_.fetch_add(text.size());
+        asio::post(ws_.get_executor(), [self, text = std::move(text), urgent]() mutable {
+            if (self->closed_) {
+                self->unqueue(text);
+                return;
+            }
+            auto& q = self->queue_;
+            // Not yet being written: the messages after the one in flight. Urgent ones lead them.
+            const auto waiting = q.begin() + (self->writing_ ? 1 : 0);
+            const auto pushes = std::find_if(waiting, q.end(), [](const Outgoing& o) { return !o.urgent; });
+            // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
+            if (q.size() >= self->limit_ && waiting != q.end()) {
+                const auto victim = pushes != q.end() ? pushes : waiting;
+                self->unqueue(victim->text);
+                q.erase(victim);
+                self->dropped_.fetch_add(1);
+            }
+            if (urgent) {
+                const auto first_push = std::find_if(q.begin() + (self->writing_ ? 1 : 0), q.end(),
+                                                     [](const Outgoing& o) { return !o.urgent; });
+                q.insert(first_push, Outgoing{std::move(text), true});
+            } else {
+                q.push_back(Outgoing{std::move(text), false});
+            }
+            self->write();
+        });
+    }
+
     void read() {
         auto self = shared_from_this();
         ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
@@ -145,17 +164,17 @@ private:
         if (writing_ || queue_.empty() || closed_) return;
         writing_ = true;
         auto self = shared_from_this();
-        ws_.async_write(asio::buffer(queue_.front()), [self](beast::error_code ec, std::size_t) {
+        ws_.async_write(asio::buffer(queue_.front().text), [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
             if (ec) {
                 self->finish();
                 while (!self->queue_.empty()) {  // the message whose write just ended, if finish() kept it
-                    self->unqueue(self->queue_.front());
+                    self->unqueue(self->queue_.front().text);
                     self->queue_.pop_front();
                 }
                 return;
             }
-            self->unqueue(self->queue_.front());
+            self->unqueue(self->queue_.front().text);
             self->queue_.pop_front();
             self->write();
         });
@@ -172,7 +191,7 @@ private:
         closed_ = true;
         // A write in flight still reads the front message: it is released when that write completes.
         while (queue_.size() > (writing_ ? 1u : 0u)) {
-            unqueue(queue_.back());
+            unqueue(queue_.back().text);
             queue_.pop_back();
         }
         if (handler_->on_close) handler_->on_close(shared_from_this());
@@ -183,7 +202,7 @@ private:
     std::size_t limit_;
     std::string peer_;
     beast::flat_buffer buffer_;
-    std::deque<std::string> queue_;
+    std::deque<Outgoing> queue_;  // front: being written while writing_
     std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
     std::atomic<std::uint64_t> dropped_{0};
     bool writing_ = false;

@@ -38,6 +38,10 @@ class JsonSocket {
 public:
     virtual ~JsonSocket() = default;
     virtual void send(std::string text) = 0;
+    /// Queues `text` ahead of the messages sent with send() that are still waiting (after the one being
+    /// written and after earlier send_urgent() messages, which keep their order): answers to the
+    /// client's requests do not wait behind a backlog of pushes. Thread-safe.
+    virtual void send_urgent(std::string text) { send(std::move(text)); }
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
@@ -63,7 +67,8 @@ struct HttpOptions {
     std::size_t max_body_bytes = 1u << 20;
     /// Time allowed for reading one request, ms.
     std::chrono::milliseconds read_timeout{30000};
-    /// Text messages queued for one JSON WebSocket beyond this are dropped oldest-first and counted.
+    /// Text messages queued for one JSON WebSocket beyond this are dropped oldest-first (send() messages
+    /// before send_urgent() ones) and counted.
     std::size_t json_socket_queue_limit = 1024;
 };
 

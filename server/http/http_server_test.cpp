@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -67,6 +68,15 @@ struct Fixture {
                                                         s->send("echo:" + text);
                                                     },
                                                     {}});
+        // "flood": 200 pushes of 64 KiB, then one urgent reply.
+        server->add_subprotocol("test.flood.v1", http::JsonSocketHandler{
+                                                     {},
+                                                     [](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                         for (int i = 0; i < 200; ++i)
+                                                             s->send("push " + std::to_string(i) + std::string(64 * 1024, ' '));
+                                                         s->send_urgent("reply");
+                                                     },
+                                                     {}});
         node->set_http_handler([s = server](tcp::socket sock, std::vector<std::byte> initial) {
             s->handle(std::move(sock), std::move(initial));
         });
@@ -150,6 +160,41 @@ TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {
     beast::flat_buffer b;
     ws.read(b);
     CHECK(beast::buffers_to_string(b.data()) == "echo:hi");
+}
+
+TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still waiting") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    ws.set_option(websocket::stream_base::decorator(
+        [](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, "test.flood.v1"); }));
+    websocket::response_type res;
+    ws.handshake(res, "localhost", "/");
+    ws.text(true);
+    ws.write(boost::asio::buffer(std::string("flood")));
+    std::this_thread::sleep_for(300ms);  // the 13 MB backlog builds up while we do not read
+    int reply_at = -1, pushes = 0, last_push = -1;
+    bool in_order = true;
+    for (int i = 0; i < 201; ++i) {
+        beast::flat_buffer b;
+        ws.read(b);
+        const std::string text = beast::buffers_to_string(b.data());
+        if (text == "reply") {
+            reply_at = i;
+            continue;
+        }
+        REQUIRE(text.rfind("push ", 0) == 0);
+        const int n = std::stoi(text.substr(5));
+        in_order = in_order && n == last_push + 1;
+        last_push = n;
+        ++pushes;
+    }
+    CHECK(pushes == 200);  // nothing dropped: below the queue limit
+    CHECK(in_order);
+    // Only what was already written (socket buffers) comes first; without priority it would be last.
+    REQUIRE(reply_at >= 0);
+    CHECK(reply_at < 100);
 }
 
 TEST_CASE("an unknown subprotocol is refused with 426") {
