@@ -81,8 +81,8 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             flag = a.substr(0, eq);
             value = a.substr(eq + 1);
         } else {
-            static const char* kWithValue[] = {"--timeout", "--username", "--password",
-                                               "--object",  "--count",    "--seconds"};
+            static const char* kWithValue[] = {"--timeout", "--username", "--password", "--object",
+                                               "--count",   "--seconds",  "--tls-ca",   "--http-login"};
             bool known = false;
             for (const char* k : kWithValue) known = known || flag == k;
             if (!known) return usage("unknown option " + flag);
@@ -107,6 +107,11 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.username = value;
         } else if (flag == "--password") {
             cl.password = value;
+        } else if (flag == "--tls-ca") {
+            cl.tls_ca_file = value;
+        } else if (flag == "--http-login") {
+            if (value.find(':') == std::string::npos) return usage("--http-login needs USER:PASSWORD");
+            cl.http_login = value;
         } else if (flag == "--object") {
             object_path = value;
         } else {
@@ -182,7 +187,7 @@ std::string help_text(std::string_view topic) {
         "  call  URL FUNCTION [JSON...] call a function; a generator prints each item\n"
         "  watch URL MEMBER             stream a wire's values, an event or a pipe's packets\n"
         "\n"
-        "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rr+ws://...).\n"
+        "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rr+ws://, rr+wss://).\n"
         "MEMBER: name, or a path through objrefs: child.leaf.x, child_by_int[7].value.\n"
         "Values are JSON as in docs/json-mapping.md; output is one JSON value per line.\n"
         "\n"
@@ -192,6 +197,8 @@ std::string help_text(std::string_view topic) {
         "  --count N            watch: stop after N values\n"
         "  --seconds S          watch: stop after S seconds\n"
         "  --username U --password P   credentials for services that require a login\n"
+        "  --tls-ca FILE        rr+wss: PEM certificates to trust (default: the system's)\n"
+        "  --http-login U:P     rr+ws/rr+wss: login for a reverse proxy (HTTP basic auth)\n"
         "  --disable-message4   use message format v2 only\n"
         "  -h, --help           this text; rr COMMAND --help for one command\n"
         "\n"

@@ -47,6 +47,8 @@ struct CommandLine {
     std::optional<std::uint64_t> count;  ///< watch: stop after this many values
     std::optional<double> seconds;       ///< watch: stop after this long
     std::string username, password;
+    std::string tls_ca_file;           ///< rr+wss: PEM certificates to trust ("" = the system's)
+    std::string http_login;            ///< rr+ws/rr+wss: USER:PASSWORD for a reverse proxy's basic auth
     bool disable_message4 = false;
 };
 

@@ -47,6 +47,11 @@ TEST_CASE("cli: commands and their arguments") {
     CHECK(o->objects[0] == PathSegment{"child_by_int", "7"});
     CHECK(o->member->name == "value");
 
+    auto t = parse({"info", "rr+wss://h:443/?service=s", "--tls-ca", "ca.pem", "--http-login=alice:won:der"});
+    REQUIRE(t);
+    CHECK(t->tls_ca_file == "ca.pem");
+    CHECK(t->http_login == "alice:won:der");  // the password may hold colons
+
     auto w = parse({"watch", "u", "w_state", "--count", "3", "--seconds", "1.5"});
     REQUIRE(w);
     CHECK(w->count == 3u);
@@ -80,6 +85,7 @@ TEST_CASE("cli: usage errors") {
         {"watch", "u", "m", "--count", "x"},
         {"get", "u", "m", "--bogus", "1"},
         {"get", "u", "m[1]"},
+        {"info", "u", "--http-login", "alice"},
     };
     for (const auto& a : bad) {
         std::string joined;

@@ -34,7 +34,7 @@ void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOp
 struct TransportRegistry {
     std::mutex mutex;
     std::map<std::string, ClientTransport, std::less<>> transports{
-        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}};
+        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}, {"rr+wss", wss_transport}};
 };
 
 TransportRegistry& registry() {

@@ -10,7 +10,7 @@
 //     return InvalidOperation there.
 //
 // Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`)
-// and `rr+ws` (server/client/ws_transport.hpp) are built in.
+// and `rr+ws` / `rr+wss` (server/client/ws_transport.hpp) are built in.
 //
 // Thread-safety: every public function may be called from any thread. Handlers must not block.
 // Lifetime: handlers that capture a Client or ObjectProxy keep the connection alive until close().
@@ -56,6 +56,12 @@ struct ClientOptions {
     std::chrono::milliseconds heartbeat_period{10000};    ///< ConnectionTest when idle (wire.md §6.3)
     std::chrono::milliseconds receive_timeout{15000};     ///< close when nothing arrives for this long
     std::uint32_t memory_max_transfer_size = 102400;      ///< bytes per memory transfer
+    /// rr+wss: PEM file of the certificates to trust ("" = the system's); the server's certificate must
+    /// also name the URL's host.
+    std::string tls_ca_file;
+    /// rr+ws/rr+wss: the WebSocket handshake's Authorization header ("" = none), for a reverse proxy's
+    /// login (see basic_authorization() in server/client/ws_transport.hpp). Not the RR login above.
+    std::string http_authorization;
     Limits limits;
 };
 

@@ -7,6 +7,7 @@
 #include <future>
 
 #include "server/client/client.hpp"
+#include "server/client/ws_transport.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
@@ -227,4 +228,27 @@ TEST_CASE("client: the service sees the session close") {
     }
     for (int i = 0; i < 200 && f.service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
     CHECK(f.service->closed == 1);
+}
+
+TEST_CASE("client: basic_authorization encodes USER:PASSWORD (RFC 7617)") {
+    CHECK(rr::client::basic_authorization("Aladdin", "open sesame") == "Basic QWxhZGRpbjpvcGVuIHNlc2FtZQ==");
+    CHECK(rr::client::basic_authorization("a", "") == "Basic YTo=");
+}
+
+TEST_CASE("client: rr+wss refuses a server whose certificate it cannot verify") {
+    // A TLS-less listener: the TLS handshake fails, and says so.
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::acceptor plain(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
+    rr::client::IoThreads threads(1);
+    rr::client::ClientOptions o;
+    o.connect_timeout = 500ms;
+    const std::string url = "rr+wss://127.0.0.1:" + std::to_string(plain.local_endpoint().port()) + "/?service=svc";
+    auto r = Client::connect(threads.executor(), url, o);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::ConnectionError);
+    CHECK(r.error().message.find("TLS handshake") != std::string::npos);
+    o.tls_ca_file = "/nonexistent/ca.pem";
+    r = Client::connect(threads.executor(), url, o);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().message.find("/nonexistent/ca.pem") != std::string::npos);
 }

@@ -1,13 +1,20 @@
 #include "server/client/ws_transport.hpp"
 
+#include <openssl/evp.h>
+#include <openssl/ssl.h>
+
+#include <boost/asio/ssl.hpp>
 #include <boost/beast/core/tcp_stream.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 
 #include "server/client/tcp_connector.hpp"
 #include "server/http/websocket_byte_stream.hpp"
 
 namespace rr::client {
 
+namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
 
@@ -15,31 +22,89 @@ namespace {
 
 constexpr const char* kRRSubprotocol = "robotraconteur.robotraconteur.com";
 
+using Done = std::function<void(Result<std::shared_ptr<PumpHandle>>)>;
+
+// The WebSocket handshake on `ws` (its lowest layer connected, TLS done if any), then the pump.
+template <class NextLayer>
+void websocket_handshake(std::shared_ptr<websocket::stream<NextLayer>> ws, ClientStrand strand, std::string host,
+                         std::string target, std::string authorization, std::shared_ptr<ConnectionLogic> logic,
+                         Done done) {
+    ws->set_option(websocket::stream_base::decorator([authorization](websocket::request_type& req) {
+        req.set(beast::http::field::sec_websocket_protocol, kRRSubprotocol);
+        if (!authorization.empty()) req.set(beast::http::field::authorization, authorization);
+    }));
+    ws->async_handshake(host, target, [ws, strand, logic, done](beast::error_code ec) mutable {
+        if (ec) return done(fail(MessageErrorType::ConnectionError, "WebSocket handshake: " + ec.message()));
+        beast::get_lowest_layer(*ws).expires_never();  // from here the RR heartbeat and receive timeout apply
+        using Stream = server::WebSocketByteStream<NextLayer>;
+        auto pump = std::make_shared<server::StreamPump<Stream>>(Stream(std::move(*ws)), strand, logic);
+        done(std::shared_ptr<PumpHandle>(pump));
+        pump->start();
+    });
+}
+
+std::string host_header(const ConnectionUrl& url) { return url.host + ":" + std::to_string(url.port); }
+std::string handshake_target(const ConnectionUrl& url) { return url.path.empty() ? std::string("/") : url.path; }
+
 }  // namespace
 
+std::string basic_authorization(std::string_view user, std::string_view password) {
+    const std::string plain = std::string(user) + ":" + std::string(password);
+    std::string encoded(4 * ((plain.size() + 2) / 3) + 1, '\0');
+    const int n = EVP_EncodeBlock(reinterpret_cast<unsigned char*>(encoded.data()),
+                                  reinterpret_cast<const unsigned char*>(plain.data()), static_cast<int>(plain.size()));
+    encoded.resize(static_cast<std::size_t>(n));
+    return "Basic " + encoded;
+}
+
 void ws_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
-                  std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done) {
-    const std::string host = url.host + ":" + std::to_string(url.port);
-    const std::string target = url.path.empty() ? std::string("/") : url.path;
-    const auto handshake_timeout = options.connect_timeout;
+                  std::shared_ptr<ConnectionLogic> logic, Done done) {
+    server::connect_tcp(strand, url.host, url.port, options.connect_timeout,
+                        [strand, host = host_header(url), target = handshake_target(url), options,
+                         logic = std::move(logic), done = std::move(done)](Result<asio::ip::tcp::socket> socket) mutable {
+                            if (!socket) return done(socket.take_error());
+                            auto ws = std::make_shared<websocket::stream<beast::tcp_stream>>(
+                                beast::tcp_stream(std::move(*socket)));
+                            ws->next_layer().expires_after(options.connect_timeout);  // a peer that never answers
+                            websocket_handshake(std::move(ws), strand, host, target, options.http_authorization,
+                                                std::move(logic), std::move(done));
+                        });
+}
+
+void wss_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
+                   std::shared_ptr<ConnectionLogic> logic, Done done) {
+    // One context per connection: the trust settings come with the options. OpenSSL reference-counts
+    // it, so the TLS stream keeps what it needs after this function's copy is gone.
+    auto tls = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_client);
+    boost::system::error_code ec;
+    if (options.tls_ca_file.empty())
+        tls->set_default_verify_paths(ec);
+    else
+        tls->load_verify_file(options.tls_ca_file, ec);
+    if (ec)
+        return done(fail(MessageErrorType::ConnectionError,
+                         "TLS: cannot load the trusted certificates" +
+                             (options.tls_ca_file.empty() ? std::string() : " from " + options.tls_ca_file) + ": " +
+                             ec.message()));
+    tls->set_verify_mode(asio::ssl::verify_peer);
     server::connect_tcp(
         strand, url.host, url.port, options.connect_timeout,
-        [strand, host, target, handshake_timeout, logic = std::move(logic), done = std::move(done)](Result<boost::asio::ip::tcp::socket> socket) mutable {
+        [strand, tls, url, options, logic = std::move(logic), done = std::move(done)](Result<asio::ip::tcp::socket> socket) mutable {
             if (!socket) return done(socket.take_error());
-            auto ws = std::make_shared<websocket::stream<beast::tcp_stream>>(beast::tcp_stream(std::move(*socket)));
-            ws->set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
-                req.set(beast::http::field::sec_websocket_protocol, kRRSubprotocol);
-            }));
-            ws->next_layer().expires_after(handshake_timeout);  // a peer that never answers the upgrade
-            ws->async_handshake(host, target, [ws, strand, logic, done](beast::error_code ec) mutable {
-                if (ec) return done(fail(MessageErrorType::ConnectionError, "WebSocket handshake: " + ec.message()));
-                ws->next_layer().expires_never();  // from here the RR heartbeat and receive timeout apply
-                ws->binary(true);
-                using Stream = server::WebSocketByteStream<beast::tcp_stream>;
-                auto pump = std::make_shared<server::StreamPump<Stream>>(Stream(std::move(*ws)), strand, logic);
-                done(std::shared_ptr<server::PumpHandle>(pump));
-                pump->start();
-            });
+            using TlsStream = beast::ssl_stream<beast::tcp_stream>;
+            auto ws = std::make_shared<websocket::stream<TlsStream>>(beast::tcp_stream(std::move(*socket)), *tls);
+            beast::get_lowest_layer(*ws).expires_after(options.connect_timeout);
+            auto& tls_stream = ws->next_layer();
+            if (!SSL_set_tlsext_host_name(tls_stream.native_handle(), url.host.c_str()))  // SNI
+                return done(fail(MessageErrorType::ConnectionError, "TLS: bad host name " + url.host));
+            tls_stream.set_verify_callback(asio::ssl::host_name_verification(url.host));
+            tls_stream.async_handshake(
+                asio::ssl::stream_base::client,
+                [ws, tls, strand, url, options, logic, done](beast::error_code ec) mutable {
+                    if (ec) return done(fail(MessageErrorType::ConnectionError, "TLS handshake: " + ec.message()));
+                    websocket_handshake(std::move(ws), strand, host_header(url), handshake_target(url),
+                                        options.http_authorization, std::move(logic), std::move(done));
+                });
         });
 }
 

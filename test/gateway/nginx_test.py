@@ -7,9 +7,10 @@ the openssl CLI) and the htpasswd file (`openssl passwd -apr1`). Then, through n
 `nginx -t` passes; a request without login gets 401 and /livez needs none; the JSON API answers with
 a login; a foreign Origin gets 403 from nginx; a JSON WebSocket (wss, with login and the site's Origin)
 subscribes to the demo Create's `packets` wire and receives values; an RR WebSocket upgrade is
-accepted; plain HTTP redirects to HTTPS.
+accepted; plain HTTP redirects to HTTPS. With --rr, the `rr` CLI reads a device over rr+wss with the
+proxy login and the self-signed certificate as its trust, and fails cleanly without either.
 
-Usage: nginx_test.py --gateway PATH [--conf gateway-config/nginx-rr-gateway.conf]
+Usage: nginx_test.py --gateway PATH [--rr PATH] [--conf gateway-config/nginx-rr-gateway.conf]
 Exit status: 0 all passed, 1 a check failed, 77 nginx or openssl missing (skip).
 """
 import argparse
@@ -53,6 +54,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--conf", default="gateway-config/nginx-rr-gateway.conf")
+    ap.add_argument("--rr", help="the rr CLI: also check it over rr+wss")
     a = ap.parse_args()
     nginx = shutil.which("nginx") or ("/usr/sbin/nginx" if os.path.exists("/usr/sbin/nginx") else None)
     if not nginx or not shutil.which("openssl"):
@@ -171,6 +173,31 @@ def main():
             ws.close()
 
         checks.run("wss RR WebSocket upgrade accepted (subprotocol robotraconteur.robotraconteur.com)", rr_ws)
+
+        if a.rr:
+            # The certificate names localhost, which the client verifies against the URL's host.
+            url = "rr+wss://localhost:%d/?service=create" % https_port
+
+            def rr(*extra):
+                return subprocess.run([a.rr, "info", url, "--timeout", "10"] + list(extra), capture_output=True,
+                                      text=True, timeout=60)
+
+            def rr_wss():
+                p = rr("--tls-ca", cert, "--http-login", "%s:%s" % (USER, PASSWORD))
+                expect(p.returncode == 0, "exit %d: %s" % (p.returncode, p.stderr))
+                expect("service experimental.create" in p.stdout, "no definition in %r" % p.stdout[:300])
+
+            def rr_wss_no_login():
+                p = rr("--tls-ca", cert)
+                expect(p.returncode == 3 and "WebSocket handshake" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
+
+            def rr_wss_untrusted():
+                p = rr("--http-login", "%s:%s" % (USER, PASSWORD))
+                expect(p.returncode == 3 and "TLS handshake" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
+
+            checks.run("rr info over rr+wss through nginx (CA file, proxy login)", rr_wss)
+            checks.run("rr over rr+wss without the proxy login: connect failure (3)", rr_wss_no_login)
+            checks.run("rr over rr+wss not trusting the certificate: connect failure (3)", rr_wss_untrusted)
 
         def redirect():
             c = http.client.HTTPConnection("127.0.0.1", http_port, timeout=5)
