@@ -145,17 +145,27 @@ TEST_CASE("origin matching follows the allowlist forms") {
     CHECK_FALSE(http::same_origin("http://127.0.0.1:80801", "127.0.0.1:8080"));
 }
 
+namespace {
+
+// A client WebSocket to the fixture's port asking for `subprotocol`; the handshake's response in `res`.
+void open_text_socket(websocket::stream<beast::tcp_stream>& ws, std::uint16_t port, const char* subprotocol,
+                      websocket::response_type& res) {
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+    ws.set_option(websocket::stream_base::decorator(
+        [subprotocol](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, subprotocol); }));
+    ws.handshake(res, "localhost", "/");
+    ws.text(true);
+}
+
+}  // namespace
+
 TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {
     Fixture f;
     boost::asio::io_context io;
     websocket::stream<beast::tcp_stream> ws(io);
-    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
-    ws.set_option(websocket::stream_base::decorator(
-        [](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, "test.echo.v1"); }));
     websocket::response_type res;
-    ws.handshake(res, "localhost", "/");
+    open_text_socket(ws, f.port, "test.echo.v1", res);
     CHECK(res[bhttp::field::sec_websocket_protocol] == "test.echo.v1");
-    ws.text(true);
     ws.write(boost::asio::buffer(std::string("hi")));
     beast::flat_buffer b;
     ws.read(b);
@@ -166,12 +176,8 @@ TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still wait
     Fixture f;
     boost::asio::io_context io;
     websocket::stream<beast::tcp_stream> ws(io);
-    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
-    ws.set_option(websocket::stream_base::decorator(
-        [](websocket::request_type& req) { req.set(bhttp::field::sec_websocket_protocol, "test.flood.v1"); }));
     websocket::response_type res;
-    ws.handshake(res, "localhost", "/");
-    ws.text(true);
+    open_text_socket(ws, f.port, "test.flood.v1", res);
     ws.write(boost::asio::buffer(std::string("flood")));
     std::this_thread::sleep_for(300ms);  // the 13 MB backlog builds up while we do not read
     int reply_at = -1, pushes = 0, last_push = -1;
