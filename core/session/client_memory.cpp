@@ -289,28 +289,32 @@ void ClientContext::memory_caps(std::string_view path, std::string_view member, 
                  });
 }
 
+namespace {
+
+// memory_param's answer for a uint64 parameter (Length, DimCount) as that number.
+auto uint64_param(std::string name, Completion<std::uint64_t> done) {
+    return [name = std::move(name), done = std::move(done)](Result<MessageElement> r) {
+        if (!r) return done(r.take_error());
+        std::uint64_t v = 0;
+        if (!read_scalar(*r, v)) return done(fail(MessageErrorType::DataTypeMismatch, name + " is not a uint64"));
+        done(v);
+    };
+}
+
+}  // namespace
+
 void ClientContext::memory_length(std::string_view path, std::string_view member, MonoTime now,
                                   Completion<std::uint64_t> done) {
     auto m = find_member(path, member, MemberKind::memory);
     if (!m) return done(m.take_error());
-    memory_param(path, member, "Length", now, [done = std::move(done)](Result<MessageElement> r) {
-        if (!r) return done(r.take_error());
-        std::uint64_t v = 0;
-        if (!read_scalar(*r, v)) return done(fail(MessageErrorType::DataTypeMismatch, "Length is not a uint64"));
-        done(v);
-    });
+    memory_param(path, member, "Length", now, uint64_param("Length", std::move(done)));
 }
 
 void ClientContext::memory_dim_count(std::string_view path, std::string_view member, MonoTime now,
                                      Completion<std::uint64_t> done) {
     auto m = find_member(path, member, MemberKind::memory);
     if (!m) return done(m.take_error());
-    memory_param(path, member, "DimCount", now, [done = std::move(done)](Result<MessageElement> r) {
-        if (!r) return done(r.take_error());
-        std::uint64_t v = 0;
-        if (!read_scalar(*r, v)) return done(fail(MessageErrorType::DataTypeMismatch, "DimCount is not a uint64"));
-        done(v);
-    });
+    memory_param(path, member, "DimCount", now, uint64_param("DimCount", std::move(done)));
 }
 
 void ClientContext::memory_dimensions(std::string_view path, std::string_view member, MonoTime now,

@@ -243,6 +243,23 @@ void async_op(Client& c, Completion<T> done, Start start) {
     });
 }
 
+// is_closed()/wait_closed() of a pipe endpoint's or wire connection's shared state (mutex, cv, closed).
+template <class State>
+bool state_closed(const std::shared_ptr<State>& st) {
+    if (!st) return true;
+    std::lock_guard lock(st->mutex);
+    return st->closed;
+}
+
+template <class State>
+Result<void> wait_state_closed(const std::shared_ptr<State>& st, std::chrono::milliseconds timeout, const char* what) {
+    if (!st) return {};
+    std::unique_lock lock(st->mutex);
+    if (!st->cv.wait_for(lock, timeout, [&] { return st->closed; }))
+        return fail(MessageErrorType::OperationTimeout, std::string(what) + " not closed in time");
+    return {};
+}
+
 }  // namespace
 
 // --- Generator -------------------------------------------------------------------------------------
@@ -372,18 +389,10 @@ Result<void> PipeEndpoint::wait_acks(std::size_t n, std::chrono::milliseconds ti
     return {};
 }
 
-bool PipeEndpoint::is_closed() const {
-    if (!state_) return true;
-    std::lock_guard lock(state_->mutex);
-    return state_->closed;
-}
+bool PipeEndpoint::is_closed() const { return state_closed(state_); }
 
 Result<void> PipeEndpoint::wait_closed(std::chrono::milliseconds timeout) const {
-    if (!state_) return {};
-    std::unique_lock lock(state_->mutex);
-    if (!state_->cv.wait_for(lock, timeout, [&] { return state_->closed; }))
-        return fail(MessageErrorType::OperationTimeout, "pipe endpoint not closed in time");
-    return {};
+    return wait_state_closed(state_, timeout, "pipe endpoint");
 }
 
 void PipeEndpoint::set_packet_handler(std::function<void(Value&&)> handler) {
@@ -497,18 +506,10 @@ void WireConnection::set_closed_handler(std::function<void(const RRError&)> hand
     });
 }
 
-bool WireConnection::is_closed() const {
-    if (!state_) return true;
-    std::lock_guard lock(state_->mutex);
-    return state_->closed;
-}
+bool WireConnection::is_closed() const { return state_closed(state_); }
 
 Result<void> WireConnection::wait_closed(std::chrono::milliseconds timeout) const {
-    if (!state_) return {};
-    std::unique_lock lock(state_->mutex);
-    if (!state_->cv.wait_for(lock, timeout, [&] { return state_->closed; }))
-        return fail(MessageErrorType::OperationTimeout, "wire connection not closed in time");
-    return {};
+    return wait_state_closed(state_, timeout, "wire connection");
 }
 
 Result<void> WireConnection::close() {
