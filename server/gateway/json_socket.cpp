@@ -41,7 +41,8 @@ public:
           socket_(std::move(socket)),
           options_(options),
           timer_(executor),
-          convert_strand_(std::move(convert_strand)) {}
+          convert_strand_(std::move(convert_strand)),
+          pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {}
 
     void on_message(std::string text) {
         if (text.size() > options_.max_message_bytes) {
@@ -537,22 +538,22 @@ private:
 
     // Runs on the device's strand, which must not wait for a packet's JSON (a camera frame is about
     // 1 MB of text; seconds under ASan): the device's replies to everyone arrive on it. The JSON is made
-    // on the server's conversion strand; while `max_pipe_conversions` of this socket wait there, newer
-    // packets are dropped and counted.
+    // on the server's conversion strand; while this socket's packets waiting there fill its budget
+    // (max_pipe_conversions, max_pipe_conversion_bytes), newer packets are dropped and counted.
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
         MemberTarget t;
         std::uint64_t dropped = 0;
         if (!take_push(sid, t, dropped)) return;
-        if (pipe_converting_.fetch_add(1) >= options_.max_pipe_conversions) {
-            pipe_converting_.fetch_sub(1);
+        const std::size_t bytes = payload_bytes(packet);
+        if (!pipe_budget_.try_acquire(bytes)) {
             std::lock_guard lock(mutex_);
             if (auto it = subs_.find(sid); it != subs_.end()) it->second.dropped += dropped + 1;
             ++push_drops_;
             return;
         }
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped] {
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped, bytes] {
             self->convert_pipe_packet(sid, packet, t, dropped);
-            self->pipe_converting_.fetch_sub(1);
+            self->pipe_budget_.release(bytes);
         });
     }
 
@@ -721,7 +722,7 @@ private:
     std::size_t in_flight_ = 0;
     std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
     ConvertStrand convert_strand_;                  // shared by the server's sockets
-    std::atomic<std::size_t> pipe_converting_{0};  // this socket's packets posted there, not yet sent
+    ConversionBudget pipe_budget_;                  // this socket's packets posted there, not yet sent
 };
 
 // --- server ---------------------------------------------------------------------------------------

@@ -15,7 +15,7 @@
 //   * pipe packets become JSON on one strand shared by all sockets, never on the device connection's
 //     strand: a slow conversion (a camera frame) delays neither the device's replies nor other
 //     traffic, and takes at most one worker thread; a socket's packets are dropped (counted) while
-//     `max_pipe_conversions` of its own wait there;
+//     `max_pipe_conversions` of its own, or `max_pipe_conversion_bytes` of their payload, wait there;
 //   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
 //     answered at once, and messages over `max_message_bytes` are refused.
 // Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
@@ -29,6 +29,7 @@
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/strand.hpp>
 
+#include "server/gateway/conversion_budget.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
 
@@ -44,6 +45,7 @@ struct JsonSocketOptions {
     std::size_t push_bytes_limit = 8u << 20;        ///< bytes queued: pushes dropped / wire values wait from here
     std::size_t wire_queue_threshold = 8;           ///< messages queued: wire values wait (coalesced) from here
     std::size_t max_pipe_conversions = 16;          ///< a socket's pipe packets waiting for their JSON: newer dropped (a burst of small packets must fit)
+    std::size_t max_pipe_conversion_bytes = 4u << 20;  ///< and their payload bytes (one larger packet alone still goes)
     std::chrono::milliseconds wire_retry{10};       ///< how often waiting wire values retry
     std::size_t max_in_flight = 64;                 ///< requests per socket being answered at once
     std::size_t max_subscriptions = 256;            ///< per socket
