@@ -20,12 +20,13 @@ import argparse
 import json
 import os
 import re
-import signal
 import subprocess
 import sys
 import time
 import urllib.error
 import urllib.request
+
+from child_procs import stop
 
 try:
     import websocket  # websocket-client
@@ -236,17 +237,6 @@ def start_gateway(path):
         if "port" in obj:
             return proc, obj["port"]
     raise RuntimeError("rr-gateway printed no port")
-
-
-def stop(proc):
-    if proc is None or proc.poll() is not None:
-        return
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
 
 
 def main():

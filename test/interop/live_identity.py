@@ -25,12 +25,9 @@ Usage: live_identity.py [--checker PATH] [--modes v4,v4st,v2] [--keep DIR] [--ve
 """
 
 import argparse
-import ctypes
 import json
 import os
-import selectors
 import shutil
-import signal
 import struct
 import subprocess
 import sys
@@ -40,6 +37,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import capture_summary  # noqa: E402
+from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail  # noqa: E402
 
 MODES = {
     "v4": {"service": [], "client": [], "version": 4, "string_table": False},
@@ -67,78 +65,6 @@ PROXY_START_S = 10
 CLIENT_S = 60
 CHECKER_S = 60
 STOP_S = 10
-
-
-class StepFailed(Exception):
-    pass
-
-
-def _die_with_parent():
-    # Linux: the child gets SIGTERM if this orchestrator dies, so nothing is ever left running.
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
-
-
-def start(cmd, stderr_path):
-    errf = open(stderr_path, "wb")
-    try:
-        return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL,
-                                preexec_fn=_die_with_parent)
-    finally:
-        errf.close()
-
-
-def read_json_line(proc, timeout, what):
-    """Reads the first stdout line of `proc` as JSON, within `timeout` seconds."""
-    sel = selectors.DefaultSelector()
-    sel.register(proc.stdout, selectors.EVENT_READ)
-    buf = b""
-    deadline = time.monotonic() + timeout
-    try:
-        while b"\n" not in buf:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                raise StepFailed("%s: no ready line within %.0f s" % (what, timeout))
-            if not sel.select(left):
-                continue
-            chunk = os.read(proc.stdout.fileno(), 4096)
-            if not chunk:
-                raise StepFailed("%s exited early (status %s)" % (what, proc.poll()))
-            buf += chunk
-    finally:
-        sel.close()
-    try:
-        return json.loads(buf.split(b"\n", 1)[0])
-    except ValueError as e:
-        raise StepFailed("%s: bad ready line %r: %s" % (what, buf[:200], e))
-
-
-def stop(proc):
-    """SIGTERM, wait, then SIGKILL. Returns the exit status."""
-    if proc is None:
-        return None
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(STOP_S)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
-    if proc.stdout:
-        proc.stdout.close()
-    return proc.returncode
-
-
-def tail(path, n=20):
-    try:
-        with open(path, "rb") as fh:
-            lines = fh.read().decode("utf-8", "replace").splitlines()
-        return "\n".join(lines[-n:])
-    except OSError:
-        return ""
 
 
 def check_capture(summary, mode):
@@ -203,7 +129,7 @@ def run_mode(mode, args, workdir, python):
                 cp = subprocess.run([python, os.path.join(HERE, "official_client.py"), url, "--heartbeat", HEARTBEAT_S,
                                      "--idle", IDLE_S, "--timeout", str(CLIENT_S - 5)] + m["client"],
                                     stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL,
-                                    timeout=CLIENT_S, preexec_fn=_die_with_parent)
+                                    timeout=CLIENT_S, preexec_fn=die_with_parent)
             except subprocess.TimeoutExpired:
                 raise StepFailed("official_client.py timed out after %d s\n%s" % (CLIENT_S, tail(client_err)))
         try:
@@ -218,8 +144,8 @@ def run_mode(mode, args, workdir, python):
         result["error"] = str(e)
         return result
     finally:
-        result["proxy_status"] = stop(proxy)
-        result["service_status"] = stop(svc)
+        result["proxy_status"] = stop(proxy, STOP_S)
+        result["service_status"] = stop(svc, STOP_S)
         result["session_s"] = round(time.monotonic() - t0, 1)
 
     if result["service_status"] != 0:
@@ -247,7 +173,7 @@ def run_mode(mode, args, workdir, python):
     if args.checker:
         try:
             ck = subprocess.run([args.checker, capture], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL, timeout=CHECKER_S, preexec_fn=_die_with_parent)
+                                stdin=subprocess.DEVNULL, timeout=CHECKER_S, preexec_fn=die_with_parent)
         except subprocess.TimeoutExpired:
             result["error"] = "checker timed out after %d s" % CHECKER_S
             return result
@@ -295,7 +221,7 @@ def checker_selftest(checker, capture, workdir):
                 fh.write(struct.pack("<BII", ord(kind), conn, len(data)) + data)
         try:
             ck = subprocess.run([checker, path, "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL, timeout=CHECKER_S, preexec_fn=_die_with_parent)
+                                stdin=subprocess.DEVNULL, timeout=CHECKER_S, preexec_fn=die_with_parent)
         except subprocess.TimeoutExpired:
             problems.append("self-test %s: checker timed out" % name)
             continue

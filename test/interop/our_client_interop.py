@@ -27,7 +27,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from reynard_interop import StepFailed, read_json_line, start, stop, tail, _die_with_parent  # noqa: E402
+from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail  # noqa: E402
 
 SERVICE_START_S = 40
 CLIENT_S = 150
@@ -37,7 +37,7 @@ def run_client(cmd, stderr_path, on_line, timeout):
     """Runs the client, handing each stdout line to on_line; returns (exit status, last JSON line)."""
     with open(stderr_path, "wb") as errf:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL,
-                                preexec_fn=_die_with_parent)
+                                preexec_fn=die_with_parent)
     sel = selectors.DefaultSelector()
     sel.register(proc.stdout, selectors.EVENT_READ)
     buf = b""
@@ -140,7 +140,7 @@ def main(argv=None):
                 sio.eio.disconnect(abort=True)  # a graceful disconnect waits for the long poll
             except Exception:
                 pass
-        status = stop(service)
+        status = stop(service, 15)
         result["service_status"] = status
         if service is not None and status not in (0, None):
             print("[our_client_interop] service/harness exited with %s:\n%s" % (

@@ -44,7 +44,6 @@ Usage:
 """
 
 import argparse
-import ctypes
 import json
 import os
 import re
@@ -54,6 +53,9 @@ import sys
 import threading
 import time
 import urllib.request
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from child_procs import die_with_parent  # noqa: E402
 
 RR_NODENAME = "experimental.reynard_the_robot"
 RR_SERVICE = "reynard"
@@ -74,15 +76,6 @@ FAILURE_RE = re.compile(r"^(Traceback \(most recent call last\)|Exception in thr
 
 def log(*args):
     print("[reynard_harness]", *args, file=sys.stderr, flush=True)
-
-
-def _die_with_parent():
-    # Linux: the child gets SIGTERM when this harness dies, however it dies.
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
 
 
 def listening_ports(pid):
@@ -123,7 +116,7 @@ class Reynard:
         self.cond = threading.Condition()
         self.eof = False
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                     stdin=subprocess.DEVNULL, preexec_fn=_die_with_parent,
+                                     stdin=subprocess.DEVNULL, preexec_fn=die_with_parent,
                                      env=dict(os.environ, PYTHONUNBUFFERED="1"))
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()

@@ -20,10 +20,8 @@ Usage: reynard_interop.py [--instances 2] [--capture] [--checker PATH] [--keep D
 """
 
 import argparse
-import ctypes
 import json
 import os
-import selectors
 import shutil
 import signal
 import subprocess
@@ -35,6 +33,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import capture_summary  # noqa: E402
+from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail  # noqa: E402
 
 HARNESS_START_S = 40
 PROXY_START_S = 10
@@ -50,62 +49,6 @@ REQUIRED_ENTRY_TYPES = [1, 2, 109, 110, 121, 122, 1111, 1112, 1113, 1114, 1121, 
                         1131, 1161, 1163, 1164, 1165, 1166, 1181, 1182]
 
 
-class StepFailed(Exception):
-    pass
-
-
-def _die_with_parent():
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
-
-
-def start(cmd, stderr_path):
-    with open(stderr_path, "wb") as errf:
-        return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL,
-                                preexec_fn=_die_with_parent)
-
-
-def read_json_line(proc, timeout, what):
-    sel = selectors.DefaultSelector()
-    sel.register(proc.stdout, selectors.EVENT_READ)
-    buf = b""
-    deadline = time.monotonic() + timeout
-    try:
-        while b"\n" not in buf:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                raise StepFailed("%s: no ready line within %.0f s" % (what, timeout))
-            if not sel.select(left):
-                continue
-            chunk = os.read(proc.stdout.fileno(), 4096)
-            if not chunk:
-                raise StepFailed("%s exited early (status %s)" % (what, proc.wait(5)))
-            buf += chunk
-    finally:
-        sel.close()
-    try:
-        return json.loads(buf.split(b"\n", 1)[0])
-    except ValueError as e:
-        raise StepFailed("%s: bad ready line %r: %s" % (what, buf[:200], e))
-
-
-def stop(proc):
-    """SIGTERM, wait, then SIGKILL, by PID. Returns the exit status."""
-    if proc is None:
-        return None
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(STOP_S)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
-    if proc.stdout:
-        proc.stdout.close()
-    return proc.returncode
 
 
 def pid_alive(pid):
@@ -114,14 +57,6 @@ def pid_alive(pid):
             return fh.read().split(")")[-1].split()[0] != "Z"
     except OSError:
         return False
-
-
-def tail(path, n=25):
-    try:
-        with open(path, "rb") as fh:
-            return "\n".join(fh.read().decode("utf-8", "replace").splitlines()[-n:])
-    except OSError:
-        return ""
 
 
 def run_instance(i, args, workdir, result):
@@ -150,7 +85,7 @@ def run_instance(i, args, workdir, result):
                 cp = subprocess.run([python, os.path.join(HERE, "reynard_official_client.py"), url,
                                      "--http-url", ready["http_url"], "--timeout", str(CLIENT_S - 5), "--verbose"],
                                     stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL,
-                                    timeout=CLIENT_S, preexec_fn=_die_with_parent)
+                                    timeout=CLIENT_S, preexec_fn=die_with_parent)
             except subprocess.TimeoutExpired:
                 raise StepFailed("reynard_official_client.py timed out after %d s\n%s" % (CLIENT_S, tail(cerr)))
         try:
@@ -163,8 +98,8 @@ def run_instance(i, args, workdir, result):
     except StepFailed as e:
         result["error"] = str(e)
     finally:
-        result["proxy_status"] = stop(proxy)
-        result["harness_status"] = stop(harness)
+        result["proxy_status"] = stop(proxy, STOP_S)
+        result["harness_status"] = stop(harness, STOP_S)
         result["session_s"] = round(time.monotonic() - t0, 1)
         if ready and pid_alive(ready["pid"]):
             result.setdefault("error", "reynard pid %d still running after its harness stopped" % ready["pid"])
@@ -200,7 +135,7 @@ def run_instance(i, args, workdir, result):
             try:
                 ck = subprocess.run([args.checker, result["capture"], "--quiet"], stdout=subprocess.PIPE,
                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, timeout=CHECKER_S,
-                                    preexec_fn=_die_with_parent)
+                                    preexec_fn=die_with_parent)
             except (subprocess.TimeoutExpired, OSError) as e:
                 result["error"] = "checker could not run: %s" % e
                 return

@@ -18,11 +18,12 @@ import argparse
 import json
 import os
 import shlex
-import signal
 import subprocess
 import sys
 import time
 import urllib.request
+
+from child_procs import stop
 
 
 def read_json_line(proc, key, timeout):
@@ -41,17 +42,6 @@ def read_json_line(proc, key, timeout):
         if key in obj:
             return obj
     raise RuntimeError("no JSON line with %r within %ss" % (key, timeout))
-
-
-def stop(proc):
-    if proc is None or proc.poll() is not None:
-        return
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
 
 
 def main():
