@@ -78,7 +78,7 @@ public:
             timer_.cancel();
         }
         for (auto& [sid, s] : subs)
-            if (s.mirror_known) unsubscribe_upstream(s.kind, s.target, s.mirror_id);
+            if (s.mirror_known) unsubscribe_upstream(s.kind, *s.target, s.mirror_id);
     }
 
     void push_device_state(const DeviceStatus& status) {
@@ -103,7 +103,7 @@ public:
 private:
     struct Subscription {
         SubKind kind = SubKind::event;
-        MemberTarget target;
+        std::shared_ptr<const MemberTarget> target;  // shared: every push takes it, copying no strings
         std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, or internal pipe id
         bool mirror_known = false;
         bool active = false;  // subscribe answered: pushes may go
@@ -274,7 +274,7 @@ private:
             sid = next_sid_++;
             Subscription s;
             s.kind = kind;
-            s.target = t;
+            s.target = std::make_shared<const MemberTarget>(t);
             subs_.emplace(sid, std::move(s));
         }
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
@@ -349,7 +349,7 @@ private:
             }
             if (error) {
                 if (it->second.mirror_known) {
-                    unsubscribe.emplace(it->second.target, it->second.mirror_id);
+                    unsubscribe.emplace(*it->second.target, it->second.mirror_id);
                     subs_.erase(it);
                 } else {
                     it->second.failed = true;
@@ -407,7 +407,7 @@ private:
             }
         }
         if (!sub) return send_reply(id, ApiResult::failed(bad_request("no subscription " + std::to_string(sid))));
-        if (sub->mirror_known) unsubscribe_upstream(sub->kind, sub->target, sub->mirror_id);
+        if (sub->mirror_known) unsubscribe_upstream(sub->kind, *sub->target, sub->mirror_id);
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
 
@@ -419,7 +419,7 @@ private:
         if (it->second.kind != kind)
             return bad_request("subscription " + std::to_string(sid) + " is a " + std::string(kind_name(it->second.kind)) +
                                " subscription, not a " + std::string(kind_name(kind)));
-        t = it->second.target;
+        t = *it->second.target;
         mirror_id = it->second.mirror_id;
         return std::nullopt;
     }
@@ -475,7 +475,7 @@ private:
     }
 
     // Takes a push slot for subscription `sid`: false (and counted) when the client is too far behind.
-    bool take_push(std::uint64_t sid, MemberTarget& t, std::uint64_t& dropped) {
+    bool take_push(std::uint64_t sid, std::shared_ptr<const MemberTarget>& t, std::uint64_t& dropped) {
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
         if (it == subs_.end() || !it->second.active || closed_) return false;
@@ -490,10 +490,10 @@ private:
     }
 
     void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
-        MemberTarget t;
+        std::shared_ptr<const MemberTarget> t;
         std::uint64_t dropped = 0;
         if (!take_push(sid, t, dropped)) return;
-        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_body(entry, t)); });
+        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_body(entry, *t)); });
         socket_->send(push_text(sid, "event", dropped, body));
     }
 
@@ -541,7 +541,7 @@ private:
     // on the server's conversion strand; while this socket's packets waiting there fill its budget
     // (max_pipe_conversions, max_pipe_conversion_bytes), newer packets are dropped and counted.
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
-        MemberTarget t;
+        std::shared_ptr<const MemberTarget> t;
         std::uint64_t dropped = 0;
         if (!take_push(sid, t, dropped)) return;
         const std::size_t bytes = payload_bytes(packet);
@@ -552,7 +552,7 @@ private:
             return;
         }
         boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped, bytes] {
-            self->convert_pipe_packet(sid, packet, t, dropped);
+            self->convert_pipe_packet(sid, packet, *t, dropped);
             self->pipe_budget_.release(bytes);
         });
     }
@@ -629,7 +629,7 @@ private:
         struct Item {
             std::uint64_t sid;
             SharedEntryPtr entry;
-            MemberTarget target;
+            std::shared_ptr<const MemberTarget> target;
         };
         std::vector<Item> batch;
         for (;;) {
@@ -660,7 +660,7 @@ private:
             }
             for (auto& item : batch) {
                 const std::string& body = item.entry->rendered(
-                    [&](const MessageEntry& e) { return json_text(wire_body(e, item.target)); });
+                    [&](const MessageEntry& e) { return json_text(wire_body(e, *item.target)); });
                 socket_->send(push_text(item.sid, "wire", 0, body));
             }
             std::lock_guard lock(mutex_);

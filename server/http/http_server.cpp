@@ -125,25 +125,25 @@ private:
                 return;
             }
             auto& q = self->queue_;
-            // Not yet being written: the messages after the one in flight. Urgent ones lead them.
-            const auto waiting = q.begin() + (self->writing_ ? 1 : 0);
-            const auto pushes = std::find_if(waiting, q.end(), [](const Outgoing& o) { return !o.urgent; });
             // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
-            if (q.size() >= self->limit_ && waiting != q.end()) {
-                const auto victim = pushes != q.end() ? pushes : waiting;
+            if (q.size() >= self->limit_ && q.size() > (self->writing_ ? 1u : 0u)) {
+                auto victim = self->first_waiting_push();
+                if (victim == q.end()) victim = q.begin() + (self->writing_ ? 1 : 0);
                 self->unqueue(victim->text);
                 q.erase(victim);
                 self->dropped_.fetch_add(1);
             }
-            if (urgent) {
-                const auto first_push = std::find_if(q.begin() + (self->writing_ ? 1 : 0), q.end(),
-                                                     [](const Outgoing& o) { return !o.urgent; });
-                q.insert(first_push, Outgoing{std::move(text), true});
-            } else {
+            if (urgent)
+                q.insert(self->first_waiting_push(), Outgoing{std::move(text), true});
+            else
                 q.push_back(Outgoing{std::move(text), false});
-            }
             self->write();
         });
+    }
+
+    // The first push not being written: urgent messages go before it, behind earlier urgent ones.
+    std::deque<Outgoing>::iterator first_waiting_push() {
+        return std::find_if(queue_.begin() + (writing_ ? 1 : 0), queue_.end(), [](const Outgoing& o) { return !o.urgent; });
     }
 
     void read() {
