@@ -25,6 +25,14 @@ namespace asio = boost::asio;
 
 namespace {
 
+// `size` zero bytes behind a 4-byte magic and a little-endian MessageSize of `size` (< 256).
+std::vector<std::byte> framed(const char* magic, std::uint8_t size) {
+    std::vector<std::byte> bytes(size, std::byte{0});
+    for (int i = 0; i < 4; ++i) bytes[i] = static_cast<std::byte>(magic[i]);
+    bytes[4] = std::byte{size};
+    return bytes;
+}
+
 std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> service, std::uint16_t& port) {
     options.node_name = "limits.node";
     options.threads = 2;
@@ -225,20 +233,14 @@ TEST_CASE("limits: wrong magic or a truncated message inside an established stre
 
     SECTION("wrong magic") {
         RawStream s(port, {});
-        std::vector<std::byte> bad(64, std::byte{0});
-        const char* magic = "RRAX";
-        for (int i = 0; i < 4; ++i) bad[i] = static_cast<std::byte>(magic[i]);
-        bad[4] = std::byte{64};
+        std::vector<std::byte> bad = framed("RRAX", 64);
         s.write_raw(bad);
         CHECK(is_closed_event(s.next_event(5s)));
     }
     SECTION("truncated: MessageSize covers the bytes, the entries inside do not fit") {
         RawStream s(port, {});
         // A v2 header: RRAC, size 60, version 2, header size 52, then zeros, entry count 3 with no entries.
-        std::vector<std::byte> bad(60, std::byte{0});
-        const char* magic = "RRAC";
-        for (int i = 0; i < 4; ++i) bad[i] = static_cast<std::byte>(magic[i]);
-        bad[4] = std::byte{60};
+        std::vector<std::byte> bad = framed("RRAC", 60);
         bad[8] = std::byte{2};
         bad[10] = std::byte{52};
         bad[56] = std::byte{3};

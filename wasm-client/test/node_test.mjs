@@ -78,6 +78,15 @@ async function gatewayReady(port, timeoutMs = 30000) {
   }
 }
 
+// rr-gateway with the service at `deviceUrl` as device "interop"; the rr+ws URL clients use.
+async function behindGateway(deviceUrl) {
+  const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
+    "--device", `interop=${deviceUrl}`]);
+  const { port } = await readyLine(gw, "port");
+  await gatewayReady(port);
+  return `rr+ws://127.0.0.1:${port}/?service=interop`;
+}
+
 const targets = {
   async ours() {
     const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--max-lifetime", "300"]);
@@ -85,22 +94,12 @@ const targets = {
   },
   async gateway() {
     const svc = start(arg("--interop-service"), ["--port", "0", "--max-lifetime", "300"]);
-    const dev = await readyLine(svc, "url");
-    const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
-      "--device", `interop=${dev.url}`]);
-    const { port } = await readyLine(gw, "port");
-    await gatewayReady(port);
-    return `rr+ws://127.0.0.1:${port}/?service=interop`;
+    return behindGateway((await readyLine(svc, "url")).url);
   },
   async "gateway-official"() {
     const py = arg("--python", join(root, ".venv", "bin", "python"));
     const svc = start(py, [join(root, "test", "interop", "official_service.py"), "--port", "0", "--max-lifetime", "300"]);
-    const dev = await readyLine(svc, "url");
-    const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
-      "--device", `interop=${dev.url}`]);
-    const { port } = await readyLine(gw, "port");
-    await gatewayReady(port);
-    return `rr+ws://127.0.0.1:${port}/?service=interop`;
+    return behindGateway((await readyLine(svc, "url")).url);
   },
   async official() {
     const py = arg("--python", join(root, ".venv", "bin", "python"));
