@@ -7,6 +7,7 @@
 #include "server/client/tcp_connector.hpp"
 #include "server/client/ws_transport.hpp"
 #include "server/node/random_ids.hpp"
+#include "server/transport/local/local_client_transport.hpp"
 
 namespace rr::client {
 
@@ -34,7 +35,8 @@ void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOp
 struct TransportRegistry {
     std::mutex mutex;
     std::map<std::string, ClientTransport, std::less<>> transports{
-        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}, {"rr+wss", wss_transport}};
+        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}, {"rr+wss", wss_transport},
+        {"rr+local", server::local::local_client_transport}};
 };
 
 TransportRegistry& registry() {

@@ -9,8 +9,8 @@
 //     return Result<T>. They must not be called from the strand (a handler), which would deadlock; they
 //     return InvalidOperation there.
 //
-// Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`)
-// and `rr+ws` / `rr+wss` (server/client/ws_transport.hpp) are built in.
+// Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`),
+// `rr+ws` / `rr+wss` (server/client/ws_transport.hpp) and `rr+local` (server/transport/local/) are built in.
 //
 // Thread-safety: every public function may be called from any thread. Handlers must not block.
 // Lifetime: handlers that capture a Client or ObjectProxy keep the connection alive until close().

@@ -1,4 +1,4 @@
-// A native client session at the level of message entries: connects by URL (rr+tcp), runs core's
+// A native client session at the level of message entries: connects by URL (rr+tcp, rr+local), runs core's
 // ClientSession on a strand, and hands out replies and unsolicited entries. The gateway uses it to
 // forward entries to devices without decoding them; the typed client is built the same way.
 //
@@ -38,7 +38,8 @@ public:
     using IncomingHandler = std::function<void(MessageEntry&&)>;
     using ClosedHandler = std::function<void(const RRError&)>;
 
-    /// Connects to `url` (rr+tcp; the URL must name a service) and establishes the client session.
+    /// Connects to `url` (rr+tcp, or rr+local through server/transport/local/local_connector.hpp; the URL
+    /// must name a service) and establishes the client session.
     /// `incoming` receives entries the service sends unasked; `closed` is called once when the session
     /// ends after a successful connect. Both are set before any traffic flows.
     static void connect(boost::asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,

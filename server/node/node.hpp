@@ -67,6 +67,10 @@ public:
     /// `initial` are bytes already read from it.
     template <class Stream>
     void serve_stream(Stream stream, std::vector<std::byte> initial = {});
+    /// Like serve_stream(), with the base URL the service index reports for connections that came in
+    /// this way (wire.md §11.2), e.g. "rr+local:///" for a Unix socket; "" = listen_base_url().
+    template <class Stream>
+    void serve_stream_as(Stream stream, std::string local_url, std::vector<std::byte> initial = {});
 
     /// Stops listening, closes every connection and joins the worker threads. Idempotent.
     void shutdown();

@@ -6,10 +6,14 @@
 // Usage:
 //   rr_interop_service [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
 //                      [--heartbeat S] [--listen-all] [--max-lifetime S] [--robdef PATH]
+//                      [--local-name NAME | --local]
 // When ready it prints one JSON line, like official_service.py:
 //   {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
 // (with "ws_url": "rr+ws://127.0.0.1:PORT/?service=interop" under --websocket: RR over WebSocket on the
-// same port, server/http).
+// same port, server/http). With --local-name NAME the node takes that NodeName (and the NodeID the
+// NodeID cache gives it) and also serves rr+local (server/transport/local), adding "local_url"
+// (by NodeName) and "local_id_url" (by NodeID) to the ready line; --local serves rr+local by NodeID
+// only. A NodeName in use (or any other rr+local error) exits with status 3 and the message on stderr.
 // and runs until SIGTERM / SIGINT (or --max-lifetime), then shuts the node down.
 #include <condition_variable>
 #include <csignal>
@@ -27,6 +31,7 @@
 
 #include "core/value/pack_value.hpp"
 #include "server/http/http_server.hpp"
+#include "server/transport/local/local_listener.hpp"
 #include "server/node/node.hpp"
 #include "server/service/callback_member.hpp"
 #include "server/service/memory_member.hpp"
@@ -932,7 +937,7 @@ volatile std::sig_atomic_t g_stop = 0;
 [[noreturn]] void usage(const char* argv0) {
     std::cerr << "usage: " << argv0
               << " [--port N] [--websocket] [--disable-message4] [--enable-stringtable] [--heartbeat S]"
-                 " [--listen-all] [--max-lifetime S] [--robdef PATH]\n";
+                 " [--listen-all] [--max-lifetime S] [--robdef PATH] [--local-name NAME | --local]\n";
     std::exit(2);
 }
 
@@ -944,6 +949,8 @@ int main(int argc, char** argv) {
     std::optional<double> heartbeat;
     double max_lifetime = 0;
     std::string robdef_path = RR_INTEROP_ROBDEF;
+    std::optional<std::string> local_name;
+    bool local_by_id = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -958,6 +965,8 @@ int main(int argc, char** argv) {
         else if (a == "--listen-all") listen_all = true;
         else if (a == "--max-lifetime") max_lifetime = std::stod(value());
         else if (a == "--robdef") robdef_path = value();
+        else if (a == "--local-name") local_name = value();
+        else if (a == "--local") local_by_id = true;
         else usage(argv[0]);
     }
 
@@ -979,6 +988,19 @@ int main(int argc, char** argv) {
 
     NodeOptions options;
     options.node_name = "interop_service";
+    std::optional<server::local::NodeNameReservation> reservation;
+    if (local_name) {
+        auto r = server::local::reserve_node_name(server::local::default_node_directories(), *local_name);
+        if (!r) {
+            std::cerr << "[interop_service] rr+local: " << r.error().message << std::endl;
+            return 3;
+        }
+        options.node_name = *local_name;
+        options.node_id = r->node_id;
+        reservation = std::move(*r);
+    } else if (local_by_id) {
+        options.node_name.clear();
+    }
     options.server.stream.enable_message4 = !disable_message4;
     options.server.stream.enable_string_table = enable_stringtable;
     if (heartbeat) options.server.stream.heartbeat_period = std::chrono::milliseconds(static_cast<long>(*heartbeat * 1000));
@@ -1001,6 +1023,16 @@ int main(int argc, char** argv) {
         });
     }
     const std::uint16_t bound = must(node->listen_tcp(listen_all ? "0.0.0.0" : "127.0.0.1", port), "listen");
+    std::shared_ptr<server::local::LocalListener> local_listener;
+    if (local_name || local_by_id) {
+        auto l = server::local::listen_local(node, {}, std::move(reservation));
+        if (!l) {
+            std::cerr << "[interop_service] rr+local: " << l.error().message << std::endl;
+            node->shutdown();
+            return 3;
+        }
+        local_listener = *l;
+    }
 
     std::mutex tick_mutex;
     std::condition_variable tick_cv;
@@ -1016,9 +1048,14 @@ int main(int argc, char** argv) {
 
     std::cout << "{\"url\": " << json_string("rr+tcp://127.0.0.1:" + std::to_string(bound) + "/?service=interop")
               << ", \"port\": " << bound << ", \"nodeid\": " << json_string(node->node_id().to_braced_string())
-              << ", \"nodename\": \"interop_service\", \"message4\": " << (disable_message4 ? "false" : "true")
+              << ", \"nodename\": " << json_string(node->node_name()) << ", \"message4\": " << (disable_message4 ? "false" : "true")
               << ", \"stringtable\": " << (enable_stringtable ? "true" : "false");
     if (websocket) std::cout << ", \"ws_url\": " << json_string("rr+ws://127.0.0.1:" + std::to_string(bound) + "/?service=interop");
+    if (local_listener) {
+        if (local_name) std::cout << ", \"local_url\": " << json_string("rr+local:///?nodename=" + *local_name + "&service=interop");
+        std::cout << ", \"local_id_url\": " << json_string("rr+local:///?nodeid=" + node->node_id().to_string() + "&service=interop")
+                  << ", \"local_socket\": " << json_string(local_listener->socket_path());
+    }
     std::cout << "}" << std::endl;
 
     const auto started = std::chrono::steady_clock::now();
@@ -1037,8 +1074,10 @@ int main(int argc, char** argv) {
     }
     tick_cv.notify_all();
     ticker.join();
+    if (local_listener) local_listener->close();
     node->shutdown();
     interop->service->shutdown();
+    local_listener.reset();
     node.reset();
     interop.reset();
     return 0;

@@ -576,6 +576,11 @@ def main(argv=None):
     if args.heartbeat is not None:
         t._SetDefaultHeartbeatPeriod(int(args.heartbeat * 1000))  # the property setter passes a float
     RRN.RegisterTransport(t)
+    if args.url.startswith("rr+local:"):
+        lt = RR.LocalTransport()
+        lt.DisableMessage4 = args.disable_message4
+        lt.DisableStringTable = args.disable_stringtable
+        RRN.RegisterTransport(lt)
 
     summary = {"ok": False, "url": args.url, "sections": sections}
     rc = 2

@@ -8,7 +8,14 @@ yield known sequences, memories are readable and writable, reset() restores the 
 
 Usage:
     official_service.py [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
-                        [--heartbeat SECONDS] [--max-lifetime SECONDS]
+                        [--heartbeat SECONDS] [--max-lifetime SECONDS] [--node-setup NAME]
+
+--node-setup NAME starts the node with the library's default server setup,
+RobotRaconteur.ServerNodeSetup(NAME, port): NodeName NAME with the NodeID of its NodeID cache, the
+local transport (rr+local) serving NAME, TCP on the port (loopback and every other interface), and the
+setup's own defaults for message formats; the transport options above are then ignored. The ready line
+adds "local_url" (by NodeName) and "local_id_url" (by NodeID). A NodeName already in use exits with
+status 3 and the library's message on stderr.
 
 When ready it prints exactly one JSON line on stdout, e.g.
     {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
@@ -491,6 +498,8 @@ def main(argv=None):
     ap.add_argument("--heartbeat", type=float, default=None, help="TCP heartbeat period in seconds")
     ap.add_argument("--listen-all", action="store_true", help="listen on all interfaces, not only loopback")
     ap.add_argument("--max-lifetime", type=float, default=0, help="exit after this many seconds (0 = never)")
+    ap.add_argument("--node-setup", default=None, metavar="NAME",
+                    help="use RobotRaconteur.ServerNodeSetup(NAME, port) (rr+local + TCP, library defaults)")
     args = ap.parse_args(argv)
 
     stop = threading.Event()
@@ -498,16 +507,25 @@ def main(argv=None):
     signal.signal(signal.SIGINT, lambda *a: stop.set())
 
     RRN.SetLogLevelFromEnvVariable()
-    RRN.SetNodeName("interop_service")
-    t = RR.TcpTransport()
-    t.DisableMessage4 = args.disable_message4
-    t.DisableStringTable = not args.enable_stringtable
-    t.AcceptWebSockets = args.websocket
-    if args.heartbeat is not None:
-        t._SetDefaultHeartbeatPeriod(int(args.heartbeat * 1000))  # the property setter passes a float
-    t.StartServer(args.port, not args.listen_all)
-    RRN.RegisterTransport(t)
-    port = t.GetListenPort()
+    setup = None
+    if args.node_setup:
+        try:
+            setup = RR.ServerNodeSetup(args.node_setup, args.port)
+        except Exception as e:
+            log("ServerNodeSetup(%r) failed: %s: %s" % (args.node_setup, type(e).__name__, e))
+            return 3
+        port = setup.tcp_transport.GetListenPort()
+    else:
+        RRN.SetNodeName("interop_service")
+        t = RR.TcpTransport()
+        t.DisableMessage4 = args.disable_message4
+        t.DisableStringTable = not args.enable_stringtable
+        t.AcceptWebSockets = args.websocket
+        if args.heartbeat is not None:
+            t._SetDefaultHeartbeatPeriod(int(args.heartbeat * 1000))  # the property setter passes a float
+        t.StartServer(args.port, not args.listen_all)
+        RRN.RegisterTransport(t)
+        port = t.GetListenPort()
 
     RRN.RegisterServiceTypeFromFile(ROBDEF)
     install_properties()
@@ -532,12 +550,15 @@ def main(argv=None):
         "url": "rr+tcp://127.0.0.1:%d/?service=%s" % (port, iv.SERVICE_NAME),
         "port": port,
         "nodeid": str(RRN.NodeID),
-        "nodename": "interop_service",
+        "nodename": RRN.NodeName,
         "message4": not args.disable_message4,
         "stringtable": bool(args.enable_stringtable),
     }
     if args.websocket:
         ready["ws_url"] = "rr+ws://127.0.0.1:%d/?service=%s" % (port, iv.SERVICE_NAME)
+    if setup is not None:
+        ready["local_url"] = "rr+local:///?nodename=%s&service=%s" % (args.node_setup, iv.SERVICE_NAME)
+        ready["local_id_url"] = "rr+local:///?nodeid=%s&service=%s" % (str(RRN.NodeID).strip("{}"), iv.SERVICE_NAME)
     print(json.dumps(ready), flush=True)
 
     deadline = time.monotonic() + args.max_lifetime if args.max_lifetime > 0 else None

@@ -1,0 +1,262 @@
+// The hostile-peer cases the TCP port survives (server/service/peer_limits_test.cpp), over rr+local:
+// a message over 512 KiB before the client session exists, wrong magic and a truncated message inside an
+// established stream, an unknown special request, max_connections, a peer that never speaks and one
+// that speaks something else than RR. Other clients stay unaffected.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <future>
+#include <thread>
+
+#include <boost/asio/local/stream_protocol.hpp>
+#include <boost/asio/write.hpp>
+
+#include "core/session/elements.hpp"
+#include "core/session/stream_connection.hpp"
+#include "server/client/client.hpp"
+#include "server/node/node.hpp"
+#include "server/service/test_raw_service.hpp"
+#include "server/transport/local/local_client_transport.hpp"
+#include "server/transport/local/local_listener.hpp"
+#include "server/transport/local/local_test_support.hpp"
+#include "server/transport/local/node_identity.hpp"
+
+using namespace rr;
+using namespace rr::server;
+using namespace rr::server::local;
+using namespace std::chrono_literals;
+namespace asio = boost::asio;
+using unix_socket = asio::local::stream_protocol;
+
+namespace {
+
+std::vector<std::byte> framed(const char* magic, std::uint8_t size) {
+    std::vector<std::byte> bytes(size, std::byte{0});
+    for (int i = 0; i < 4; ++i) bytes[i] = static_cast<std::byte>(magic[i]);
+    bytes[4] = std::byte{size};
+    return bytes;
+}
+
+struct LocalNode {
+    local::testing::TempNodeDirs tmp;
+    std::shared_ptr<Node> node;
+    std::shared_ptr<LocalListener> listener;
+
+    explicit LocalNode(NodeOptions options) {
+        options.node_name = local::testing::unique_node_name("limits.local");
+        options.threads = 2;
+        auto r = reserve_node_name(tmp.dirs, options.node_name);
+        REQUIRE(r);
+        options.node_id = r->node_id;
+        node = Node::create(options);
+        REQUIRE(node->register_service(std::make_shared<server::testing::RawTestService>()));
+        LocalListenOptions lo;
+        lo.dirs = tmp.dirs;
+        auto l = listen_local(node, lo, std::move(*r));
+        REQUIRE(l);
+        listener = *l;
+    }
+    ~LocalNode() {
+        listener->close();
+        node->shutdown();
+    }
+    std::string url() const { return "rr+local:///?nodename=" + node->node_name() + "&service=svc"; }
+};
+
+// A client-role StreamConnection over a blocking Unix socket: CreateConnection only, no client session.
+struct RawStream {
+    asio::io_context io;
+    unix_socket::socket socket{io};
+    StreamConnection conn;
+    NodeID remote;
+
+    RawStream(const std::string& path, StreamConfig config, bool handshake = true)
+        : conn(StreamRole::client, with_id(std::move(config)), std::chrono::steady_clock::now()) {
+        socket.connect(unix_socket::endpoint(path));
+        socket.non_blocking(true);
+        if (!handshake) return;
+        auto e = next_event(5s);
+        REQUIRE(e);
+        auto* c = std::get_if<StreamConnected>(&*e);
+        REQUIRE(c);
+        remote = c->remote_node_id;
+    }
+
+    static StreamConfig with_id(StreamConfig c) {
+        c.local_node_id = *NodeID::parse("12345678-2222-3333-4444-555555555555");
+        return c;
+    }
+
+    void write_raw(const std::vector<std::byte>& bytes) {
+        socket.non_blocking(false);
+        boost::system::error_code ec;
+        asio::write(socket, asio::buffer(bytes), ec);
+        socket.non_blocking(true);
+    }
+
+    void flush() {
+        auto out = conn.pending_output();
+        if (out.empty()) return;
+        socket.non_blocking(false);
+        boost::system::error_code ec;
+        asio::write(socket, asio::buffer(out.data(), out.size()), ec);
+        conn.consume_output(out.size());
+        socket.non_blocking(true);
+    }
+
+    std::optional<StreamEvent> next_event(std::chrono::milliseconds timeout) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        std::array<std::byte, 65536> buf;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (auto e = conn.poll_event()) return e;
+            flush();
+            boost::system::error_code ec;
+            auto n = socket.read_some(asio::buffer(buf), ec);
+            if (ec == asio::error::would_block) {
+                std::this_thread::sleep_for(5ms);
+                continue;
+            }
+            if (ec) return StreamEvent{StreamClosed{make_error(MessageErrorType::ConnectionError, ec.message())}};
+            (void)conn.feed(std::span<const std::byte>(buf.data(), n), std::chrono::steady_clock::now());
+        }
+        return std::nullopt;
+    }
+
+    // True once the node closed the socket (EOF / reset) within `timeout`; bytes it sends are dropped.
+    bool closed_by_peer(std::chrono::milliseconds timeout) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        std::array<std::byte, 4096> buf;
+        while (std::chrono::steady_clock::now() < deadline) {
+            boost::system::error_code ec;
+            socket.read_some(asio::buffer(buf), ec);
+            if (ec == asio::error::would_block) {
+                std::this_thread::sleep_for(5ms);
+                continue;
+            }
+            if (ec) return true;
+        }
+        return false;
+    }
+
+    void send_special(MessageEntryType type, std::string path, std::size_t padding) {
+        Message m;
+        m.header.sender_node_id = with_id({}).local_node_id;
+        m.header.receiver_node_id = remote;
+        MessageEntry e;
+        e.entry_type = type;
+        e.service_path = std::move(path);
+        std::vector<std::uint8_t> pad(padding, 0x5a);
+        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
+        m.entries.push_back(std::move(e));
+        REQUIRE(conn.send(m, std::chrono::steady_clock::now()));
+    }
+};
+
+bool is_closed_event(const std::optional<StreamEvent>& e) { return e && std::holds_alternative<StreamClosed>(*e); }
+
+const MessageEntry* reply_entry(const std::optional<StreamEvent>& e) {
+    if (!e) return nullptr;
+    auto* m = std::get_if<StreamMessage>(&*e);
+    return m && !m->message.entries.empty() ? &m->message.entries.front() : nullptr;
+}
+
+// A well-behaved typed client through the node's rr+local entries.
+void check_others_unaffected(LocalNode& n) {
+    client::register_client_transport("rr+local", make_local_client_transport([d = n.tmp.dirs] { return d; }));
+    client::IoThreads io{1};
+    auto c = client::Client::connect(io.executor(), n.url());
+    client::register_client_transport("rr+local", local_client_transport);
+    REQUIRE(c);
+    auto x = (*c)->root().get("x");
+    REQUIRE(x);
+    CHECK(*x == Value::scalar(42.5));
+    CHECK((*c)->close_wait().ok());
+}
+
+}  // namespace
+
+TEST_CASE("local limits: a message over 512 KiB before the client session exists closes the connection") {
+    LocalNode n({});
+    StreamConfig big;
+    big.limits.max_pre_session_message_size = 4u << 20;
+    RawStream under(n.listener->socket_path(), big);
+    under.send_special(MessageEntryType::GetServiceDesc, "svc", 400u * 1024u);
+    auto r = under.next_event(5s);
+    const MessageEntry* reply = reply_entry(r);
+    REQUIRE(reply);
+    CHECK(reply->entry_type == MessageEntryType::GetServiceDescRet);
+    CHECK(reply->error == MessageErrorType::None);
+
+    RawStream over(n.listener->socket_path(), big);
+    over.send_special(MessageEntryType::GetServiceDesc, "svc", 600u * 1024u);
+    CHECK(is_closed_event(over.next_event(5s)));
+    check_others_unaffected(n);
+}
+
+TEST_CASE("local limits: wrong magic, a truncated message, an unknown special request") {
+    LocalNode n({});
+    SECTION("wrong magic") {
+        RawStream s(n.listener->socket_path(), {});
+        s.write_raw(framed("RRAX", 64));
+        CHECK(is_closed_event(s.next_event(5s)));
+    }
+    SECTION("truncated: MessageSize covers the bytes, the entries inside do not fit") {
+        RawStream s(n.listener->socket_path(), {});
+        std::vector<std::byte> bad = framed("RRAC", 60);
+        bad[8] = std::byte{2};
+        bad[10] = std::byte{52};
+        bad[56] = std::byte{3};
+        s.write_raw(bad);
+        CHECK(is_closed_event(s.next_event(5s)));
+    }
+    SECTION("unknown special request: answered with ProtocolError, the stream stays up") {
+        RawStream s(n.listener->socket_path(), {});
+        s.send_special(static_cast<MessageEntryType>(151), "svc", 0);
+        auto r = s.next_event(5s);
+        const MessageEntry* reply = reply_entry(r);
+        REQUIRE(reply);
+        CHECK(reply->error == MessageErrorType::ProtocolError);
+        s.send_special(MessageEntryType::GetServiceDesc, "svc", 0);
+        auto next = s.next_event(5s);
+        const MessageEntry* desc = reply_entry(next);
+        REQUIRE(desc);
+        CHECK(desc->entry_type == MessageEntryType::GetServiceDescRet);
+    }
+    check_others_unaffected(n);
+}
+
+TEST_CASE("local limits: a silent peer and a peer speaking something else are dropped") {
+    NodeOptions o;
+    o.first_bytes_timeout = 300ms;
+    LocalNode n(o);
+    SECTION("silent") {
+        RawStream s(n.listener->socket_path(), {}, false);
+        auto t0 = std::chrono::steady_clock::now();
+        CHECK(s.closed_by_peer(5s));
+        CHECK(std::chrono::steady_clock::now() - t0 >= 250ms);
+    }
+    SECTION("HTTP on the local socket") {
+        RawStream s(n.listener->socket_path(), {}, false);
+        const std::string get = "GET / HTTP/1.1\r\n\r\n";
+        std::vector<std::byte> bytes(get.size());
+        std::memcpy(bytes.data(), get.data(), get.size());
+        s.write_raw(bytes);
+        CHECK(s.closed_by_peer(2s));
+    }
+    check_others_unaffected(n);
+}
+
+TEST_CASE("local limits: max_connections refuses further connections until one closes") {
+    NodeOptions o;
+    o.max_connections = 2;
+    LocalNode n(o);
+    auto a = std::make_unique<RawStream>(n.listener->socket_path(), StreamConfig{});
+    auto b = std::make_unique<RawStream>(n.listener->socket_path(), StreamConfig{});
+    for (int i = 0; i < 200 && n.node->connection_count() < 2; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(n.node->connection_count() == 2);
+    RawStream third(n.listener->socket_path(), {}, false);
+    CHECK(third.closed_by_peer(2s));
+    a.reset();
+    for (int i = 0; i < 200 && n.node->connection_count() >= 2; ++i) std::this_thread::sleep_for(10ms);
+    check_others_unaffected(n);
+}
