@@ -50,7 +50,8 @@ Result<std::string> prepare_public_dir(const NodeDirectories& dirs, const std::s
 
 class LocalListener::Impl : public std::enable_shared_from_this<LocalListener::Impl> {
 public:
-    explicit Impl(const std::shared_ptr<Node>& node) : node_(node), node_id_(node->node_id()), acceptor_(node->io_context()) {}
+    explicit Impl(const std::shared_ptr<Node>& node)
+        : node_(node), node_id_(node->node_id()), acceptor_(node->io_context()), retry_(node->io_context()) {}
     ~Impl() { close(); }
 
     Result<void> start(const Node& node, LocalListenOptions options, std::optional<NodeNameReservation> reservation);
@@ -72,6 +73,7 @@ public:
     std::weak_ptr<Node> node_;
     NodeID node_id_;
     unix_socket::acceptor acceptor_;
+    asio::steady_timer retry_;
     mutable std::mutex mutex_;
     bool closed_ = false;
     std::string socket_path_;
@@ -195,12 +197,23 @@ void LocalListener::Impl::accept() {
     acceptor_.async_accept(asio::make_strand(acceptor_.get_executor()),
                            [self = std::move(self_ref)](boost::system::error_code ec, unix_socket::socket socket) {
                                if (ec == asio::error::operation_aborted) return;
+                               if (ec) {
+                                   // Out of descriptors and the like: try again shortly instead of spinning.
+                                   std::lock_guard lock(self->mutex_);
+                                   if (self->closed_) return;
+                                   self->retry_.expires_after(std::chrono::milliseconds(100));
+                                   self->retry_.async_wait([self](boost::system::error_code wait_ec) {
+                                       std::lock_guard lock2(self->mutex_);
+                                       if (!wait_ec && !self->closed_) self->accept();
+                                   });
+                                   return;
+                               }
                                {
                                    std::lock_guard lock(self->mutex_);
                                    if (self->closed_) return;
                                    self->accept();
                                }
-                               if (!ec) self->detect(std::move(socket));
+                               self->detect(std::move(socket));
                            });
 }
 
@@ -259,6 +272,7 @@ void LocalListener::Impl::close() {
     closed_ = true;
     boost::system::error_code ignored;
     acceptor_.close(ignored);
+    retry_.cancel();
     if (!socket_path_.empty()) ::unlink(socket_path_.c_str());
     // Entries go while their locks are still held, so a node starting meanwhile cannot lock a file
     // that is about to disappear (LockedFile::open_locked also re-checks the path after locking).
