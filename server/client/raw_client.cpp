@@ -1,14 +1,12 @@
 #include "server/client/raw_client.hpp"
 
-#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/strand.hpp>
 
-#include "server/client/tcp_connector.hpp"
 #include "server/node/random_ids.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
-using tcp = asio::ip::tcp;
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
@@ -99,50 +97,51 @@ private:
 
 void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
                         IncomingHandler incoming, ClosedHandler closed, ConnectHandler done) {
-    if (url.scheme != "rr+tcp" && url.scheme != "tcp") {
-        done(fail(MessageErrorType::ConnectionError, "unsupported transport \"" + url.scheme + "\" for this client"));
+    const TransportRegistry& transports = options.transports ? *options.transports : default_transports();
+    if (!transports.find(url.scheme)) {
+        done(fail(MessageErrorType::ConnectionError, "no transport for \"" + url.scheme + "\" URLs"));
         return;
     }
     if (url.service.empty()) {
         done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + url.to_string()));
         return;
     }
-    asio::any_io_executor strand = asio::make_strand(executor);
-    connect_tcp(strand, url.host, url.port, options.connect_timeout,
-                [strand, url, options, incoming = std::move(incoming), closed = std::move(closed),
-                 done = std::move(done)](Result<tcp::socket> socket) mutable {
-                    if (!socket) {
-                        done(socket.take_error());
-                        return;
-                    }
-                    ClientSessionConfig cfg;
-                    cfg.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
-                    cfg.stream.local_node_name = options.local_node_name;
-                    cfg.stream.target_node_id = url.node_id;
-                    cfg.stream.target_node_name = url.node_name;
-                    cfg.stream.enable_message4 = options.enable_message4;
-                    cfg.stream.enable_string_table = options.enable_string_table;
-                    cfg.stream.limits = options.limits;
-                    cfg.service_name = url.service;
-                    cfg.username = options.username;
-                    cfg.password = options.password;
-                    cfg.request_timeout = options.request_timeout;
-                    cfg.local_endpoint = server::random_endpoint_id();
+    ClientSessionConfig cfg;
+    cfg.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
+    cfg.stream.local_node_name = options.local_node_name;
+    cfg.stream.target_node_id = url.node_id;
+    cfg.stream.target_node_name = url.node_name;
+    cfg.stream.enable_message4 = options.enable_message4;
+    cfg.stream.enable_string_table = options.enable_string_table;
+    cfg.stream.limits = options.limits;
+    cfg.service_name = url.service;
+    cfg.username = options.username;
+    cfg.password = options.password;
+    cfg.request_timeout = options.request_timeout;
+    cfg.local_endpoint = server::random_endpoint_id();
 
-                    std::shared_ptr<RawClient> client(new RawClient());
-                    auto logic = std::make_shared<Logic>(std::move(cfg), mono_now());
-                    logic->client_ = client;
-                    logic->connecting_ = client;
-                    logic->on_connect_ = std::move(done);
-                    logic->on_incoming_ = std::move(incoming);
-                    logic->on_closed_ = std::move(closed);
-                    logic->request_timeout_ = options.request_timeout;
-                    client->logic_ = logic;
-                    typename StreamPump<tcp::socket>::Strand pump_strand(strand);
-                    auto pump = std::make_shared<StreamPump<tcp::socket>>(std::move(*socket), pump_strand, logic);
-                    client->pump_ = pump;
-                    pump->start();
-                });
+    std::shared_ptr<RawClient> client(new RawClient());
+    auto logic = std::make_shared<Logic>(std::move(cfg), mono_now());
+    logic->client_ = client;
+    logic->connecting_ = client;
+    logic->on_connect_ = std::move(done);
+    logic->on_incoming_ = std::move(incoming);
+    logic->on_closed_ = std::move(closed);
+    logic->request_timeout_ = options.request_timeout;
+    client->logic_ = logic;
+    ConnectOptions connect;
+    connect.connect_timeout = options.connect_timeout;
+    connect.tls_ca_file = options.tls_ca_file;
+    connect.http_authorization = options.http_authorization;
+    asio::any_io_executor strand = asio::make_strand(executor);
+    transports.connect(strand, url, connect, logic, [logic](Result<std::shared_ptr<PumpHandle>> pump) {
+        if (!pump) {
+            // Never connected: the session reports the error to the connect handler (and drops it).
+            logic->on_transport_closed(pump.error());
+            return;
+        }
+        if (auto c = logic->client_.lock()) c->pump_ = *pump;
+    });
 }
 
 void RawClient::request(MessageEntry entry, ReplyHandler done) {
