@@ -7,8 +7,10 @@
 #include <thread>
 
 #include "server/app/gateway.hpp"
-#include "server/app/gateway_extensions.hpp"
 #include "server/app/log.hpp"
+#include "server/app/web_root.hpp"
+#include "server/demo/demo_devices.hpp"
+#include "server/gateway/json_api_installer.hpp"
 
 using namespace rr;
 using namespace rr::server::app;
@@ -49,7 +51,10 @@ int main(int argc, char** argv) {
     }
     set_log_level(log_level_from_string(config.log_level));
 
-    auto gateway = Gateway::start(config, demo_starter(), api_installer());
+    DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port) {
+        return rr::server::demo::start_demo_devices_for_gateway(*node, port);
+    };
+    auto gateway = Gateway::start(config, demo, rr::server::gateway::install_json_api);
     if (!gateway) {
         std::cerr << "rr-gateway: " << gateway.error().message << "\n";
         return 1;

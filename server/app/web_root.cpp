@@ -1,6 +1,6 @@
 #include <filesystem>
 
-#include "server/app/gateway_extensions.hpp"
+#include "server/app/web_root.hpp"
 
 namespace rr::server::app {
 

@@ -5,7 +5,7 @@
 
 #include "core/json/value_json.hpp"
 #include "core/names/connection_url.hpp"
-#include "server/client/ws_transport.hpp"
+#include "server/transport/websocket_connector.hpp"
 
 namespace rr::cli {
 
@@ -59,7 +59,7 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
     options.password = cl.password;
     options.tls_ca_file = cl.tls_ca_file;
     if (auto colon = cl.http_login.find(':'); colon != std::string::npos)
-        options.http_authorization = client::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
+        options.http_authorization = server::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
     options.enable_message4 = !cl.disable_message4;
     target.io = std::make_unique<client::IoThreads>(1);
     auto c = Client::connect(target.io->executor(), url, options);

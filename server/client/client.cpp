@@ -4,59 +4,22 @@
 
 #include <boost/asio/ip/tcp.hpp>
 
-#include "server/client/tcp_connector.hpp"
-#include "server/client/ws_transport.hpp"
-#include "server/node/random_ids.hpp"
-#include "server/transport/local/local_client_transport.hpp"
+#include "server/common/random_ids.hpp"
 
 namespace rr::client {
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
 using namespace std::chrono_literals;
-using server::connect_tcp;
 using server::mono_now;
 using server::StreamPump;
 
-namespace {
-
-// rr+tcp: resolve, connect (TCP_NODELAY), then a StreamPump over the socket.
-void tcp_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
-                   std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done) {
-    connect_tcp(strand, url.host, url.port, options.connect_timeout,
-                [strand, logic = std::move(logic), done = std::move(done)](Result<tcp::socket> socket) mutable {
-                    if (!socket) return done(socket.take_error());
-                    auto pump = std::make_shared<StreamPump<tcp::socket>>(std::move(*socket), strand, logic);
-                    done(std::shared_ptr<PumpHandle>(pump));
-                    pump->start();
-                });
-}
-
-struct TransportRegistry {
-    std::mutex mutex;
-    std::map<std::string, ClientTransport, std::less<>> transports{
-        {"rr+tcp", tcp_transport}, {"tcp", tcp_transport}, {"rr+ws", ws_transport}, {"rr+wss", wss_transport},
-        {"rr+local", server::local::local_client_transport}};
-};
-
-TransportRegistry& registry() {
-    static TransportRegistry r;
-    return r;
-}
-
-ClientTransport find_transport(std::string_view scheme) {
-    auto& r = registry();
-    std::lock_guard lock(r.mutex);
-    auto it = r.transports.find(scheme);
-    return it == r.transports.end() ? ClientTransport{} : it->second;
-}
-
-}  // namespace
-
-void register_client_transport(std::string scheme, ClientTransport transport) {
-    auto& r = registry();
-    std::lock_guard lock(r.mutex);
-    r.transports[std::move(scheme)] = std::move(transport);
+server::ConnectOptions connect_options(const ClientOptions& options) {
+    server::ConnectOptions o;
+    o.connect_timeout = options.connect_timeout;
+    o.tls_ca_file = options.tls_ca_file;
+    o.http_authorization = options.http_authorization;
+    return o;
 }
 
 TimeSpec wall_clock_now() {
@@ -108,8 +71,8 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     if (!url) return done(url.take_error());
     if (url->service.empty())
         return done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + std::string(url_text)));
-    auto transport = find_transport(url->scheme);
-    if (!transport)
+    const server::TransportRegistry& transports = options.transports ? *options.transports : server::default_transports();
+    if (!transports.find(url->scheme))
         return done(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
 
     ClientContextConfig cfg;
@@ -154,7 +117,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
         }
         if (h) h(e);
     });
-    transport(*client->strand_, *url, options, logic,
+    transports.connect(*client->strand_, *url, connect_options(options), logic,
               [client, logic](Result<std::shared_ptr<PumpHandle>> pump) mutable {
                   if (!pump) {
                       auto h = std::move(client);

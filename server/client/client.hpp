@@ -9,8 +9,9 @@
 //     return Result<T>. They must not be called from the strand (a handler), which would deadlock; they
 //     return InvalidOperation there.
 //
-// Transports are pluggable by URL scheme (register_client_transport); `rr+tcp` (and the legacy `tcp`),
-// `rr+ws` / `rr+wss` (server/client/ws_transport.hpp) and `rr+local` (server/transport/local/) are built in.
+// Transports are pluggable by URL scheme (ClientOptions::transports, server/transport/transport_registry.hpp);
+// `rr+tcp` (and the legacy `tcp`)
+// and `rr+ws` / `rr+wss` (server/transport/websocket_connector.hpp) are built in.
 //
 // Thread-safety: every public function may be called from any thread. Handlers must not block.
 // Lifetime: handlers that capture a Client or ObjectProxy keep the connection alive until close().
@@ -37,8 +38,9 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/session/client_context.hpp"
-#include "server/node/connection_logic.hpp"
+#include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"
+#include "server/transport/transport_registry.hpp"
 
 namespace rr::client {
 
@@ -60,19 +62,17 @@ struct ClientOptions {
     /// also name the URL's host.
     std::string tls_ca_file;
     /// rr+ws/rr+wss: the WebSocket handshake's Authorization header ("" = none), for a reverse proxy's
-    /// login (see basic_authorization() in server/client/ws_transport.hpp). Not the RR login above.
+    /// login (see server::basic_authorization() in server/transport/websocket_connector.hpp). Not the RR login above.
     std::string http_authorization;
     Limits limits;
+    /// Connectors by URL scheme (nullptr: server::default_transports(), the built-in ones).
+    const server::TransportRegistry* transports = nullptr;
 };
 
 using ClientStrand = boost::asio::strand<boost::asio::any_io_executor>;
-/// Opens the byte stream for `url` and creates a pump that drives `logic` on `strand`. Calls `done`
-/// (on the strand) with the pump before starting it, or with the error (ConnectionError).
-using ClientTransport =
-    std::function<void(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
-                       std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done)>;
-/// Registers (or replaces) the transport for a URL scheme, e.g. "rr+ws".
-void register_client_transport(std::string scheme, ClientTransport transport);
+
+/// The transport options of `options` (server/transport/transport.hpp).
+server::ConnectOptions connect_options(const ClientOptions& options);
 
 /// An io_context with worker threads, for programs that have no executor of their own.
 class IoThreads {

@@ -7,7 +7,8 @@
 #include <future>
 
 #include "server/client/client.hpp"
-#include "server/client/ws_transport.hpp"
+#include "server/transport/websocket_connector.hpp"
+#include "server/transport/transport_registry.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
@@ -167,24 +168,32 @@ TEST_CASE("client: connect errors") {
 
 TEST_CASE("client: transports are pluggable by URL scheme") {
     Fixture f;
-    // A scheme the URL parser knows but no transport serves yet; unregistered again at the end.
-    std::atomic<int> used{0};
-    std::string host;
-    rr::client::register_client_transport(
-        "rr+bluetooth", [&](rr::client::ClientStrand, const ConnectionUrl& url, const rr::client::ClientOptions&,
-                            std::shared_ptr<server::ConnectionLogic>, std::function<void(Result<std::shared_ptr<server::PumpHandle>>)> done) {
+    // A scheme the URL parser knows but no built-in transport serves, in a registry of this test's own.
+    struct FakeConnector : server::Connector {
+        std::atomic<int> used{0};
+        std::string host;
+        void connect(boost::asio::any_io_executor, const ConnectionUrl& url, const server::ConnectOptions&,
+                     std::shared_ptr<server::ConnectionLogic>, server::ConnectHandler done) override {
             ++used;
             host = url.host;
             done(fail(MessageErrorType::ConnectionError, "no such network"));
-        });
-    auto r = Client::connect(f.io.executor(), "rr+bluetooth://example:5/?service=svc", {});
-    rr::client::register_client_transport("rr+bluetooth", nullptr);
+        }
+    };
+    auto fake = std::make_shared<FakeConnector>();
+    server::TransportRegistry registry;
+    registry.add("rr+bluetooth", fake);
+    rr::client::ClientOptions options;
+    options.transports = &registry;
+    auto r = Client::connect(f.io.executor(), "rr+bluetooth://example:5/?service=svc", options);
     REQUIRE_FALSE(r);
     CHECK(r.error().message == "no such network");
-    CHECK(used == 1);
-    CHECK(host == "example");
-    CHECK(Client::connect(f.io.executor(), "rr+bluetooth://example:5/?service=svc", {}).error().type ==
-          MessageErrorType::ConnectionError);
+    CHECK(fake->used == 1);
+    CHECK(fake->host == "example");
+    // The default registry has no such transport.
+    auto none = Client::connect(f.io.executor(), "rr+bluetooth://example:5/?service=svc", {});
+    REQUIRE_FALSE(none);
+    CHECK(none.error().type == MessageErrorType::ConnectionError);
+    CHECK(none.error().message.find("rr+bluetooth") != std::string::npos);
 }
 
 TEST_CASE("client: rr+ws is built in; a peer that never answers the upgrade times out") {
@@ -231,8 +240,8 @@ TEST_CASE("client: the service sees the session close") {
 }
 
 TEST_CASE("client: basic_authorization encodes USER:PASSWORD (RFC 7617)") {
-    CHECK(rr::client::basic_authorization("Aladdin", "open sesame") == "Basic QWxhZGRpbjpvcGVuIHNlc2FtZQ==");
-    CHECK(rr::client::basic_authorization("a", "") == "Basic YTo=");
+    CHECK(rr::server::basic_authorization("Aladdin", "open sesame") == "Basic QWxhZGRpbjpvcGVuIHNlc2FtZQ==");
+    CHECK(rr::server::basic_authorization("a", "") == "Basic YTo=");
 }
 
 TEST_CASE("client: rr+wss refuses a server whose certificate it cannot verify") {

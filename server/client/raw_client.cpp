@@ -1,16 +1,12 @@
 #include "server/client/raw_client.hpp"
 
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/post.hpp>
+#include <boost/asio/strand.hpp>
 
-#include "server/client/tcp_connector.hpp"
-#include "server/node/random_ids.hpp"
-#include "server/transport/local/local_connector.hpp"
+#include "server/common/random_ids.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
-using tcp = asio::ip::tcp;
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
@@ -99,68 +95,17 @@ private:
     std::map<std::uint32_t, ReplyHandler> replies_;
 };
 
-namespace {
-
-// Makes a RawClient and, once its pump exists, attaches logic and pump to it (RawClient's private
-// parts; built inside RawClient::connect).
-struct RawClientFactory {
-    std::function<std::shared_ptr<RawClient>()> make;
-    std::function<void(RawClient&, std::shared_ptr<RawClient::Logic>, std::weak_ptr<PumpHandle>)> attach;
-};
-
-// Starts the client session over a connected socket (any Asio stream).
-template <class Socket>
-void start_raw_session(asio::any_io_executor strand, const ConnectionUrl& url, const RawClientOptions& options,
-                       RawClient::IncomingHandler incoming, RawClient::ClosedHandler closed,
-                       RawClient::ConnectHandler done, Socket socket, RawClientFactory factory);
-
-}  // namespace
-
 void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
                         IncomingHandler incoming, ClosedHandler closed, ConnectHandler done) {
-    if (url.scheme != "rr+tcp" && url.scheme != "tcp" && url.scheme != "rr+local") {
-        done(fail(MessageErrorType::ConnectionError, "unsupported transport \"" + url.scheme + "\" for this client"));
+    const TransportRegistry& transports = options.transports ? *options.transports : default_transports();
+    if (!transports.find(url.scheme)) {
+        done(fail(MessageErrorType::ConnectionError, "no transport for \"" + url.scheme + "\" URLs"));
         return;
     }
     if (url.service.empty()) {
         done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + url.to_string()));
         return;
     }
-    asio::any_io_executor strand = asio::make_strand(executor);
-    RawClientFactory attach{[] { return std::shared_ptr<RawClient>(new RawClient()); },
-                            [](RawClient& client, std::shared_ptr<Logic> logic, std::weak_ptr<PumpHandle> pump) {
-                                client.logic_ = std::move(logic);
-                                client.pump_ = std::move(pump);
-                            }};
-    if (url.scheme == "rr+local") {
-        // rr+local (server/transport/local): the lookup reads a few small files, on the strand.
-        asio::post(strand, [strand, url, options, incoming = std::move(incoming), closed = std::move(closed),
-                            done = std::move(done), attach]() mutable {
-            auto socket = local::connect_local_socket(strand, url, local::default_node_directories());
-            if (!socket) return done(socket.take_error());
-            start_raw_session(strand, url, options, std::move(incoming), std::move(closed), std::move(done),
-                              std::move(*socket), attach);
-        });
-        return;
-    }
-    connect_tcp(strand, url.host, url.port, options.connect_timeout,
-                [strand, url, options, incoming = std::move(incoming), closed = std::move(closed),
-                 done = std::move(done), attach](Result<tcp::socket> socket) mutable {
-                    if (!socket) {
-                        done(socket.take_error());
-                        return;
-                    }
-                    start_raw_session(strand, url, options, std::move(incoming), std::move(closed), std::move(done),
-                                      std::move(*socket), attach);
-                });
-}
-
-namespace {
-
-template <class Socket>
-void start_raw_session(asio::any_io_executor strand, const ConnectionUrl& url, const RawClientOptions& options,
-                       RawClient::IncomingHandler incoming, RawClient::ClosedHandler closed,
-                       RawClient::ConnectHandler done, Socket socket, RawClientFactory factory) {
     ClientSessionConfig cfg;
     cfg.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
     cfg.stream.local_node_name = options.local_node_name;
@@ -175,21 +120,29 @@ void start_raw_session(asio::any_io_executor strand, const ConnectionUrl& url, c
     cfg.request_timeout = options.request_timeout;
     cfg.local_endpoint = server::random_endpoint_id();
 
-    std::shared_ptr<RawClient> client = factory.make();
-    auto logic = std::make_shared<RawClient::Logic>(std::move(cfg), mono_now());
+    std::shared_ptr<RawClient> client(new RawClient());
+    auto logic = std::make_shared<Logic>(std::move(cfg), mono_now());
     logic->client_ = client;
     logic->connecting_ = client;
     logic->on_connect_ = std::move(done);
     logic->on_incoming_ = std::move(incoming);
     logic->on_closed_ = std::move(closed);
     logic->request_timeout_ = options.request_timeout;
-    typename StreamPump<Socket>::Strand pump_strand(strand);
-    auto pump = std::make_shared<StreamPump<Socket>>(std::move(socket), pump_strand, logic);
-    factory.attach(*client, logic, pump);
-    pump->start();
+    client->logic_ = logic;
+    ConnectOptions connect;
+    connect.connect_timeout = options.connect_timeout;
+    connect.tls_ca_file = options.tls_ca_file;
+    connect.http_authorization = options.http_authorization;
+    asio::any_io_executor strand = asio::make_strand(executor);
+    transports.connect(strand, url, connect, logic, [logic](Result<std::shared_ptr<PumpHandle>> pump) {
+        if (!pump) {
+            // Never connected: the session reports the error to the connect handler (and drops it).
+            logic->on_transport_closed(pump.error());
+            return;
+        }
+        if (auto c = logic->client_.lock()) c->pump_ = *pump;
+    });
 }
-
-}  // namespace
 
 void RawClient::request(MessageEntry entry, ReplyHandler done) {
     request(std::move(entry), std::chrono::milliseconds(-1), std::move(done));

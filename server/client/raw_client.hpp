@@ -1,5 +1,6 @@
-// A native client session at the level of message entries: connects by URL (rr+tcp, rr+local), runs core's
-// ClientSession on a strand, and hands out replies and unsolicited entries. The gateway uses it to
+// A native client session at the level of message entries: connects by URL (any transport of its
+// TransportRegistry: rr+tcp, rr+ws, rr+wss, rr+local, …), runs
+// core's ClientSession on a strand, and hands out replies and unsolicited entries. The gateway uses it to
 // forward entries to devices without decoding them; the typed client is built the same way.
 //
 // Thread-safety: every public function may be called from any thread. Handlers run on the
@@ -15,8 +16,9 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/session/client_session.hpp"
-#include "server/node/connection_logic.hpp"
+#include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"
+#include "server/transport/transport_registry.hpp"
 
 namespace rr::server {
 
@@ -28,7 +30,13 @@ struct RawClientOptions {
     bool enable_string_table = true;
     std::chrono::milliseconds connect_timeout{5000};
     std::chrono::milliseconds request_timeout{15000};
+    /// rr+wss: PEM file of the certificates to trust ("" = the system's).
+    std::string tls_ca_file;
+    /// WebSocket handshakes: Authorization header ("" = none).
+    std::string http_authorization;
     Limits limits;
+    /// Connectors by URL scheme (nullptr: default_transports()); the gateway passes its node's.
+    const TransportRegistry* transports = nullptr;
 };
 
 class RawClient : public std::enable_shared_from_this<RawClient> {
@@ -38,8 +46,7 @@ public:
     using IncomingHandler = std::function<void(MessageEntry&&)>;
     using ClosedHandler = std::function<void(const RRError&)>;
 
-    /// Connects to `url` (rr+tcp, or rr+local through server/transport/local/local_connector.hpp; the URL
-    /// must name a service) and establishes the client session.
+    /// Connects to `url` (the URL must name a service) and establishes the client session.
     /// `incoming` receives entries the service sends unasked; `closed` is called once when the session
     /// ends after a successful connect. Both are set before any traffic flows.
     static void connect(boost::asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,

@@ -62,4 +62,10 @@ std::vector<gateway::DeviceConfig> demo_device_configs(std::uint16_t port, const
     return out;
 }
 
+Result<std::vector<gateway::DeviceConfig>> start_demo_devices_for_gateway(Node& node, std::uint16_t port) {
+    auto devices = start_demo_devices(node);
+    if (!devices) return devices.take_error();
+    return demo_device_configs(port);
+}
+
 }  // namespace rr::server::demo

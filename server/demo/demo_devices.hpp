@@ -44,4 +44,8 @@ Result<DemoDevices> start_demo_devices(Node& node, const DemoOptions& options = 
 /// {create, rr+tcp://127.0.0.1:PORT/?service=create}, {webcam, rr+tcp://127.0.0.1:PORT/?service=webcam}.
 std::vector<gateway::DeviceConfig> demo_device_configs(std::uint16_t port, const DemoOptions& options = {});
 
+/// start_demo_devices on `node` (listening on 127.0.0.1:`port`), then demo_device_configs: what the
+/// gateway's demo starter does. Errors: those of start_demo_devices.
+Result<std::vector<gateway::DeviceConfig>> start_demo_devices_for_gateway(Node& node, std::uint16_t port);
+
 }  // namespace rr::server::demo

@@ -13,7 +13,6 @@
 #include "core/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
-#include "server/app/gateway_extensions.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/demo/demo_devices.hpp"
 
@@ -166,9 +165,7 @@ struct NodeFixture {
 
 TEST_CASE("demo starter: registers create and webcam on the demo node and returns their loopback URLs") {
     NodeFixture f;
-    auto starter = app::demo_starter();
-    REQUIRE(starter);
-    auto configs = starter(f.node, f.port);
+    auto configs = start_demo_devices_for_gateway(*f.node, f.port);
     REQUIRE(configs);
     REQUIRE(configs->size() == 2);
     const std::string base = "rr+tcp://127.0.0.1:" + std::to_string(f.port) + "/?service=";
@@ -181,7 +178,7 @@ TEST_CASE("demo starter: registers create and webcam on the demo node and return
     CHECK(std::find(names.begin(), names.end(), "webcam") != names.end());
 
     // A second start on the same node fails (names taken) and leaves the first one working.
-    CHECK_FALSE(starter(f.node, f.port));
+    CHECK_FALSE(start_demo_devices_for_gateway(*f.node, f.port));
 
     auto c = connect(f.node->io_context().get_executor(), f.port, "create");
     auto dist = c.ok(req(MessageEntryType::PropertyGetReq, "create", "DistanceTraveled"));

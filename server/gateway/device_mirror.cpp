@@ -34,9 +34,12 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
     if (!url) return fail(MessageErrorType::InvalidConfiguration, "device \"" + config.name + "\": " + url.error().message);
     if (url->service.empty())
         return fail(MessageErrorType::InvalidConfiguration, "device \"" + config.name + "\": URL names no service (?service=…)");
-    if (url->scheme != "rr+tcp" && url->scheme != "tcp")
-        return fail(MessageErrorType::InvalidConfiguration,
-                    "device \"" + config.name + "\": transport \"" + url->scheme + "\" is not supported for devices");
+    if (!node->transports().find(url->scheme)) {
+        std::string known;
+        for (const auto& s : node->transports().schemes()) known += (known.empty() ? "" : ", ") + s;
+        return fail(MessageErrorType::InvalidConfiguration, "device \"" + config.name + "\": no transport for \"" +
+                                                                url->scheme + "\" URLs (known: " + known + ")");
+    }
     std::shared_ptr<DeviceMirror> m(new DeviceMirror(std::move(node), std::move(config), std::move(*url)));
     m->service_ = std::make_shared<MirrorService>(m, m->config_.name, m->url_.service);
     return m;
@@ -83,6 +86,7 @@ void DeviceMirror::connect() {
     options.local_node_name = node->node_name().empty() ? std::string() : node->node_name();
     options.username = config_.username;
     options.password = config_.password;
+    options.transports = &node->transports();
     std::weak_ptr<DeviceMirror> weak = weak_from_this();
     RawClient::connect(
         node->io_context().get_executor(), url_, options,

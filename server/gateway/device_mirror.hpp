@@ -26,7 +26,7 @@
 #include "core/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/gateway/shared_entry.hpp"
-#include "server/service/service.hpp"
+#include "server/node/service.hpp"
 
 namespace rr::server {
 class Node;

@@ -23,7 +23,8 @@
 #include <nlohmann/json.hpp>
 
 #include "server/app/gateway.hpp"
-#include "server/app/gateway_extensions.hpp"
+#include "server/app/gateway.hpp"
+#include "server/gateway/json_api_installer.hpp"
 #include "server/gateway/json_rest.hpp"
 #include "server/gateway/json_socket.hpp"
 

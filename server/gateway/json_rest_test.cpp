@@ -350,7 +350,7 @@ TEST_CASE("json api: the installer of rr-gateway serves the same API") {
     d.name = "interop";
     d.url = device.url();
     cfg.devices.push_back(d);
-    auto g = app::Gateway::start(cfg, {}, app::api_installer());
+    auto g = app::Gateway::start(cfg, {}, install_json_api);
     REQUIRE(g);
     for (int i = 0; i < 2000 && !(*g)->ready(); ++i) std::this_thread::sleep_for(10ms);
     REQUIRE((*g)->ready());

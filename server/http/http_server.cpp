@@ -11,7 +11,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
-#include "server/http/websocket_byte_stream.hpp"
+#include "server/transport/websocket_byte_stream.hpp"
 #include "server/node/node.hpp"
 
 namespace rr::server::http {
@@ -331,6 +331,11 @@ private:
                 return;
             }
         }
+        // Addresses before the stream moves into the WebSocket.
+        auto peer = remote();
+        beast::error_code lec;
+        auto local = beast::get_lowest_layer(stream_).socket().local_endpoint(lec);
+        AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer};
         stream_.expires_never();
         websocket::stream<beast::tcp_stream> ws(std::move(stream_));
         ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
@@ -338,9 +343,8 @@ private:
         }));
         ws.read_message_max(64u * 1024u * 1024u);
         auto server = server_;
-        auto peer = remote();
         auto holder = std::make_shared<websocket::stream<beast::tcp_stream>>(std::move(ws));
-        holder->async_accept(req, [holder, server, json, peer](beast::error_code ec) {
+        holder->async_accept(req, [holder, server, json, peer, info](beast::error_code ec) {
             if (ec) return;
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession>(std::move(*holder), json,
@@ -351,7 +355,7 @@ private:
             auto node = server->node();
             if (!node) return;
             holder->binary(true);
-            node->serve_stream(WebSocketByteStream<beast::tcp_stream>(std::move(*holder)));
+            serve_stream(*node, WebSocketByteStream<beast::tcp_stream>(std::move(*holder)), info);
         });
     }
 

@@ -1,28 +1,21 @@
 #include "server/node/node.hpp"
 
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/write.hpp>
 
 #include "robdef/builtin/service_index.hpp"
-#include "server/node/random_ids.hpp"
+#include "server/common/random_ids.hpp"
 #include "server/node/service_index.hpp"
-#include "server/transport/tcp_listener.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
 
-std::string tcp_base_url(const tcp::endpoint& local) {
-    std::string host = local.address().to_string();
-    if (local.address().is_v6()) host = "[" + host.substr(0, host.find('%')) + "]";
-    return "rr+tcp://" + host + ":" + std::to_string(local.port()) + "/";
-}
-
 std::shared_ptr<Node> Node::create(NodeOptions options) {
     std::shared_ptr<Node> node(new Node(std::move(options)));
-    // Built from the built-in definition: cannot fail short of a broken build, and then the node
-    // simply has no index (find_service answers ServiceNotFound as before).
-    if (auto index = make_service_index(node)) node->service_index_ = std::move(*index);
+    node->service_index_ = make_service_index(node);
+    node->services_->set_fallback(std::string(robdef::kServiceIndexServiceName), node->service_index_);
     node->start_threads();
     return node;
 }
@@ -30,6 +23,8 @@ std::shared_ptr<Node> Node::create(NodeOptions options) {
 Node::Node(NodeOptions options) : options_(std::move(options)) {
     if (options_.node_id.is_any()) options_.node_id = random_node_id();
     if (options_.threads == 0) options_.threads = std::max(2u, std::thread::hardware_concurrency());
+    options_.server.stream.local_node_id = options_.node_id;
+    options_.server.stream.local_node_name = options_.node_name;
     work_ = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(io_.get_executor());
 }
 
@@ -41,14 +36,14 @@ void Node::start_threads() {
 
 void Node::shutdown() {
     if (stopped_.exchange(true)) return;
-    std::vector<std::shared_ptr<TcpListener>> listeners;
+    std::vector<std::shared_ptr<Listener>> listeners;
     std::vector<std::weak_ptr<PumpHandle>> pumps;
     {
         std::lock_guard lock(mutex_);
         listeners.swap(listeners_);
         pumps.swap(pumps_);
     }
-    for (auto& l : listeners) asio::post(io_, [l] { l->stop(); });
+    for (auto& l : listeners) l->stop();
     for (auto& w : pumps)
         if (auto p = w.lock()) p->close();
     work_.reset();
@@ -62,27 +57,40 @@ void Node::shutdown() {
 }
 
 Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t port) {
-    boost::system::error_code ec;
-    auto addr = asio::ip::make_address(address, ec);
-    if (ec) return fail(MessageErrorType::InvalidArgument, "bad listen address \"" + address + "\": " + ec.message());
-    tcp::acceptor acceptor(io_);
-    tcp::endpoint ep(addr, port);
-    acceptor.open(ep.protocol(), ec);
-    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-    if (!ec) acceptor.bind(ep, ec);
-    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-    if (ec)
-        return fail(MessageErrorType::IOError,
-                    "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message());
-    auto listener = std::make_shared<TcpListener>(weak_from_this(), std::move(acceptor));
-    const std::uint16_t bound = listener->port();
-    {
-        std::lock_guard lock(mutex_);
-        listeners_.push_back(listener);
-        listen_endpoints_.emplace_back(addr, bound);
-    }
-    listener->start();
-    return bound;
+    TcpListenerOptions opts;
+    opts.first_bytes_timeout = options_.first_bytes_timeout;
+    std::weak_ptr<Node> weak = weak_from_this();
+    opts.http = [weak](tcp::socket socket, std::vector<std::byte> initial) {
+        if (auto node = weak.lock()) node->dispatch_http(std::move(socket), std::move(initial));
+    };
+    auto listener = TcpListener::open(io_.get_executor(), address, port, weak, std::move(opts));
+    if (!listener) return listener.take_error();
+    add_listener(*listener);
+    (*listener)->start();
+    return (*listener)->port();
+}
+
+void Node::add_listener(std::shared_ptr<Listener> listener) {
+    std::lock_guard lock(mutex_);
+    listeners_.push_back(std::move(listener));
+}
+
+std::vector<std::string> Node::listen_urls() const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& l : listeners_)
+        for (auto& u : l->urls()) out.push_back(std::move(u));
+    return out;
+}
+
+std::string Node::listen_base_url() const {
+    std::lock_guard lock(mutex_);
+    for (const auto& l : listeners_)
+        if (l->scheme() == "rr+tcp") {
+            auto urls = l->urls();
+            if (!urls.empty()) return urls.front();
+        }
+    return "rr+tcp://127.0.0.1:0/";
 }
 
 void Node::set_http_handler(HttpHandler handler) {
@@ -108,6 +116,15 @@ void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial) {
     });
 }
 
+std::shared_ptr<ConnectionLogic> Node::open_connection(const AcceptedStream& stream) {
+    if (stopped_.load() || !can_accept()) return nullptr;
+    return std::make_shared<ServerConnection>(services_, stats_, options_.server, stream.local_url, mono_now());
+}
+
+bool Node::can_accept() const {
+    return !options_.max_connections || connection_count() < options_.max_connections;
+}
+
 void Node::track(const std::shared_ptr<PumpHandle>& pump) {
     std::lock_guard lock(mutex_);
     if (pumps_.size() > 64 && pumps_.size() % 64 == 0)
@@ -116,65 +133,27 @@ void Node::track(const std::shared_ptr<PumpHandle>& pump) {
 }
 
 Result<void> Node::register_service(std::shared_ptr<Service> service) {
-    const std::string& name = service->name();
-    bool valid = !name.empty() && ((name[0] >= 'a' && name[0] <= 'z') || (name[0] >= 'A' && name[0] <= 'Z'));
-    for (char c : name)
-        valid = valid && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_');
-    if (!valid) return fail(MessageErrorType::InvalidArgument, "invalid service name \"" + name + "\"");
-    {
-        std::lock_guard lock(mutex_);
-        if (services_.count(name)) return fail(MessageErrorType::InvalidArgument, "service \"" + name + "\" already registered");
-        services_.emplace(name, std::move(service));
-    }
-    local_node_services_changed(service_index_);
+    if (auto r = services_->add(std::move(service)); !r) return r;
+    services_changed();
     return {};
 }
 
 void Node::unregister_service(const std::string& name) {
-    bool erased = false;
+    if (services_->remove(name)) services_changed();
+}
+
+void Node::services_changed() {
+    local_node_services_changed(service_index_);
+    std::vector<std::shared_ptr<Listener>> listeners;
     {
         std::lock_guard lock(mutex_);
-        erased = services_.erase(name) != 0;
+        listeners = listeners_;
     }
-    if (erased) local_node_services_changed(service_index_);
+    for (const auto& l : listeners) l->services_changed();
 }
 
-std::vector<std::string> Node::service_names() const {
-    std::lock_guard lock(mutex_);
-    std::vector<std::string> out;
-    for (const auto& [n, s] : services_) out.push_back(n);
-    return out;
-}
+std::vector<std::string> Node::service_names() const { return services_->names(); }
 
-std::shared_ptr<Service> Node::find_service(std::string_view name) const {
-    std::lock_guard lock(mutex_);
-    auto it = services_.find(name);
-    if (it != services_.end()) return it->second;
-    return name == robdef::kServiceIndexServiceName ? service_index_ : nullptr;
-}
-
-std::string Node::listen_base_url() const {
-    std::lock_guard lock(mutex_);
-    if (listen_endpoints_.empty()) return "rr+tcp://127.0.0.1:0/";
-    auto ep = listen_endpoints_.front();
-    // A wildcard listener has no one address; loopback is the one every client of this host can use.
-    if (ep.address().is_unspecified())
-        ep.address(ep.address().is_v6() ? asio::ip::address(asio::ip::address_v6::loopback())
-                                         : asio::ip::address(asio::ip::address_v4::loopback()));
-    return tcp_base_url(ep);
-}
-
-std::uint32_t Node::new_endpoint_id() {
-    std::lock_guard lock(mutex_);
-    for (;;) {
-        std::uint32_t id = random_endpoint_id();
-        if (endpoints_.insert(id).second) return id;
-    }
-}
-
-void Node::release_endpoint_id(std::uint32_t id) {
-    std::lock_guard lock(mutex_);
-    endpoints_.erase(id);
-}
+std::shared_ptr<Service> Node::find_service(std::string_view name) const { return services_->find(name); }
 
 }  // namespace rr::server

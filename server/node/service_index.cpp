@@ -1,11 +1,14 @@
 #include "server/node/service_index.hpp"
 
 #include <algorithm>
+#include <mutex>
+#include <vector>
 
+#include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
 #include "robdef/builtin/service_index.hpp"
+#include "robdef/service_definition_set.hpp"
 #include "server/node/node.hpp"
-#include "server/service/object_service.hpp"
 
 namespace rr::server {
 
@@ -22,8 +25,7 @@ MapString index_attributes(const Service& service) {
     const MapString* map = all ? all->get_if<MapString>() : nullptr;
     if (!map) return out;
     for (const auto& [key, value] : map->entries) {
-        if (value.kind() == ValueKind::string || value.kind() == ValueKind::numeric)
-            out.entries.emplace_back(key, value);
+        if (value.kind() == ValueKind::string || value.kind() == ValueKind::numeric) out.entries.emplace_back(key, value);
     }
     return out;
 }
@@ -44,22 +46,83 @@ Value service_info(const Service& service, const std::string& name, const std::s
     return Value(std::move(s));
 }
 
-}  // namespace
+class ServiceIndexService : public Service {
+public:
+    explicit ServiceIndexService(std::weak_ptr<Node> node) : node_(std::move(node)) {
+        for (const auto* def : types_.definitions())
+            if (def->name == robdef::kServiceIndexServiceName)
+                for (const auto& o : def->objects)
+                    if (qualified(o.name) == robdef::kServiceIndexObjectType) root_ = &o;
+    }
 
-Result<std::shared_ptr<Service>> make_service_index(std::weak_ptr<Node> weak_node) {
-    auto types = ServiceTypes::create({std::string(robdef::service_index_robdef())});
-    if (!types) return types.take_error();
-    auto root = ServiceObject::create(*types, robdef::kServiceIndexObjectType);
-    if (!root) return root.take_error();
-    auto self_name = std::string(robdef::kServiceIndexServiceName);
-    auto r = (*root)->set_function("GetLocalNodeServices", [weak_node, self_name](const SessionRef& session,
-                                                                                 std::vector<Value>) -> Result<Value> {
-        auto node = weak_node.lock();
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override { return {std::string(robdef::service_index_robdef())}; }
+    std::optional<std::string> service_definition(std::string_view type) const override {
+        if (type != robdef::kServiceIndexServiceName) return std::nullopt;
+        return std::string(robdef::service_index_robdef());
+    }
+    ObjectTypeInfo root_type() const override { return {std::string(robdef::kServiceIndexObjectType), {}}; }
+
+    void object_type(const SessionRef&, const std::string& path, std::function<void(Result<ObjectTypeInfo>)> done) override {
+        if (path != name_) return done(fail(MessageErrorType::ObjectNotFound, "Object not found: " + path));
+        done(root_type());
+    }
+
+    void on_session_open(const SessionRef& session) override {
+        std::lock_guard lock(mutex_);
+        sessions_.push_back(session);
+    }
+    void on_session_close(const SessionRef& session) override {
+        std::lock_guard lock(mutex_);
+        std::erase(sessions_, session);
+    }
+
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override {
+        if (entry.entry_type == MessageEntryType::PipePacket || entry.entry_type == MessageEntryType::PipePacketRet ||
+            entry.entry_type == MessageEntryType::WirePacket)
+            return;  // no pipes or wires here
+        if (entry.service_path != name_)
+            return responder.fail(make_error(MessageErrorType::ObjectNotFound, "Object not found: " + entry.service_path));
+        const robdef::MemberDefinition* member = root_ ? root_->find_member(entry.member_name) : nullptr;
+        if (!member)
+            return responder.fail(make_error(MessageErrorType::MemberNotFound, "Member not found: " + entry.member_name));
+        if (entry.entry_type != MessageEntryType::FunctionCallReq || member->kind != robdef::MemberKind::function)
+            return responder.fail(make_error(MessageErrorType::MemberFormatMismatch,
+                                             "Invalid operation on member " + entry.member_name));
+        Value result{MapInt32{}};
+        if (entry.member_name == "GetLocalNodeServices") {
+            auto nodes = local_node_services(session);
+            if (!nodes) return responder.fail(nodes.error());
+            result = std::move(*nodes);
+        }
+        auto packed = pack_value(result, member->type, "return", types_, robdef::kServiceIndexServiceName);
+        if (!packed) return responder.fail(packed.error());
+        MessageEntry reply;
+        reply.elements.push_back(std::move(*packed));
+        responder.respond(std::move(reply));
+    }
+
+    void services_changed() {
+        std::vector<SessionRef> sessions;
+        {
+            std::lock_guard lock(mutex_);
+            sessions = sessions_;
+        }
+        MessageEntry event;
+        event.entry_type = MessageEntryType::EventReq;
+        event.service_path = name_;
+        event.member_name = "LocalNodeServicesChanged";
+        for (const auto& s : sessions) (void)s.send(event);  // a client whose queue is full misses it, as any event
+    }
+
+private:
+    Result<Value> local_node_services(const SessionRef& session) const {
+        auto node = node_.lock();
         if (!node) return fail(MessageErrorType::ServiceNotFound, "node is shutting down");
         std::string base = session.local_url();
         if (base.empty()) base = node->listen_base_url();
         auto names = node->service_names();
-        if (std::find(names.begin(), names.end(), self_name) == names.end()) names.push_back(self_name);
+        if (std::find(names.begin(), names.end(), name_) == names.end()) names.push_back(name_);
         std::sort(names.begin(), names.end());
         MapInt32 out;
         std::int32_t key = 0;
@@ -70,20 +133,24 @@ Result<std::shared_ptr<Service>> make_service_index(std::weak_ptr<Node> weak_nod
             out.entries.emplace_back(key++, service_info(*service, name, url));
         }
         return Value(std::move(out));
-    });
-    if (!r) return r.take_error();
-    for (const char* f : {"GetRoutedNodes", "GetDetectedNodes"}) {
-        r = (*root)->set_function(f, [](const SessionRef&, std::vector<Value>) -> Result<Value> { return Value(MapInt32{}); });
-        if (!r) return r.take_error();
     }
-    auto service = ObjectService::create(self_name, *root);
-    if (!service) return service.take_error();
-    return std::shared_ptr<Service>(*service);
+
+    const std::string name_{robdef::kServiceIndexServiceName};
+    std::weak_ptr<Node> node_;
+    robdef::ServiceDefinitionSet types_;  // holds the built-in definition
+    const robdef::ServiceEntryDefinition* root_ = nullptr;
+    std::mutex mutex_;
+    std::vector<SessionRef> sessions_;
+};
+
+}  // namespace
+
+std::shared_ptr<Service> make_service_index(std::weak_ptr<Node> node) {
+    return std::make_shared<ServiceIndexService>(std::move(node));
 }
 
 void local_node_services_changed(const std::shared_ptr<Service>& index) {
-    // Clients that cannot take it (full queue) miss it, as any event.
-    if (auto s = std::dynamic_pointer_cast<ObjectService>(index)) (void)s->root()->fire_event("LocalNodeServicesChanged", {});
+    if (auto s = std::dynamic_pointer_cast<ServiceIndexService>(index)) s->services_changed();
 }
 
 }  // namespace rr::server

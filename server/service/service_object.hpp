@@ -48,7 +48,7 @@
 #include "core/message/message.hpp"
 #include "core/value/value.hpp"
 #include "server/service/generator.hpp"
-#include "server/service/service.hpp"
+#include "server/node/service.hpp"
 #include "server/service/service_types.hpp"
 
 namespace rr::server {

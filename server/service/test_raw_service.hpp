@@ -10,7 +10,7 @@
 
 #include "core/session/elements.hpp"
 #include "core/value/timespec.hpp"
-#include "server/service/service.hpp"
+#include "server/node/service.hpp"
 
 namespace rr::server::testing {
 

@@ -15,7 +15,7 @@
 #include <boost/asio/strand.hpp>
 #include <boost/asio/write.hpp>
 
-#include "server/node/connection_logic.hpp"
+#include "server/transport/connection_logic.hpp"
 
 namespace rr::server {
 

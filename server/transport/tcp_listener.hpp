@@ -1,29 +1,61 @@
-// Accepts TCP connections and tells raw RR from HTTP by the first four bytes, as CORE's TcpTransport
-// does (wire.md §6.1: `RRAC` → RR stream; `GET ` / `GET\t` → HTTP / WebSocket; anything else → 404 or
-// close). Sockets get TCP_NODELAY.
+// rr+tcp, service side: accepts TCP connections and tells raw RR from HTTP by the first four bytes, as
+// CORE's TcpTransport does (wire.md §6.1: `RRAC` → an RR stream for the ConnectionSink; anything else
+// → the HttpHandler, which serves plain HTTP and WebSocket upgrades; without one: 404 and close).
+// Sockets get TCP_NODELAY. A socket that sends nothing within first_bytes_timeout is dropped.
 #pragma once
 
+#include <chrono>
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
 
+#include "server/transport/transport.hpp"
+
 namespace rr::server {
 
-class Node;
+/// Takes a socket whose first bytes (`initial`) were not `RRAC`: HTTP requests, WebSocket upgrades.
+using HttpHandler = std::function<void(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial)>;
 
-class TcpListener : public std::enable_shared_from_this<TcpListener> {
+/// `rr+tcp://<address>:<port>/` for a local TCP endpoint (IPv6 in brackets, without scope): the base
+/// of the URLs the service index reports (wire.md §11.2).
+std::string tcp_base_url(const boost::asio::ip::tcp::endpoint& local);
+
+struct TcpListenerOptions {
+    /// How long an accepted socket may take to send its first 4 bytes (wire.md §6.1: 5 s).
+    std::chrono::milliseconds first_bytes_timeout{5000};
+    /// Where non-RR sockets go (empty: answer 404 and close).
+    HttpHandler http;
+};
+
+class TcpListener : public Listener, public std::enable_shared_from_this<TcpListener> {
 public:
-    TcpListener(std::weak_ptr<Node> node, boost::asio::ip::tcp::acceptor acceptor);
+    /// Binds and listens on `address:port` (port 0 = ephemeral). Errors: InvalidArgument for a bad
+    /// address, IOError with the system message (port in use, …).
+    static Result<std::shared_ptr<TcpListener>> open(boost::asio::any_io_executor executor, const std::string& address,
+                                                     std::uint16_t port, std::weak_ptr<ConnectionSink> sink,
+                                                     TcpListenerOptions options);
+    /// Starts accepting.
     void start();
-    void stop();
+
+    std::string scheme() const override { return "rr+tcp"; }
+    /// The bound address's URL; a wildcard address is reported as loopback (the one address every
+    /// client on this host can use).
+    std::vector<std::string> urls() const override;
+    void stop() override;
     std::uint16_t port() const;
+    boost::asio::ip::tcp::endpoint local_endpoint() const;
 
 private:
+    TcpListener(boost::asio::ip::tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink, TcpListenerOptions options);
     void accept();
     void detect(boost::asio::ip::tcp::socket socket);
 
-    std::weak_ptr<Node> node_;
     boost::asio::ip::tcp::acceptor acceptor_;
+    std::weak_ptr<ConnectionSink> sink_;
+    TcpListenerOptions options_;
+    boost::asio::ip::tcp::endpoint bound_;
 };
 
 }  // namespace rr::server

@@ -7,6 +7,8 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <boost/asio/post.hpp>
+
 #include "server/transport/local/local_entries.hpp"
 
 namespace rr::server::local {
@@ -151,6 +153,16 @@ Result<unix_socket::socket> connect_local_socket(const asio::any_io_executor& ex
     std::string what = !target->node_name.empty() ? "named \"" + target->node_name + "\"" : "with NodeID " + target->node_id.to_string();
     if (!target->node_name.empty() && !target->node_id.is_any()) what += " and NodeID " + target->node_id.to_string();
     return fail(MessageErrorType::ConnectionError, "no local node " + what + " (searched " + searched + ")");
+}
+
+void LocalConnector::connect(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions&,
+                             std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) {
+    // The lookup reads a few small files: done on the strand, as the TCP connect completes there.
+    asio::post(strand, [strand, url, dirs = dirs_, logic = std::move(logic), done = std::move(done)]() mutable {
+        auto socket = connect_local_socket(strand, url, dirs());
+        if (!socket) return done(socket.take_error());
+        start_client_stream(std::move(*socket), strand, std::move(logic), done);
+    });
 }
 
 }  // namespace rr::server::local

@@ -29,6 +29,7 @@
 #include "core/names/connection_url.hpp"
 #include "server/transport/local/local_layout.hpp"
 #include "server/transport/local/node_directories.hpp"
+#include "server/transport/transport.hpp"
 
 namespace rr::server::local {
 
@@ -46,5 +47,19 @@ Result<boost::asio::local::stream_protocol::socket> connect_local_socket(const b
                                                                          const ConnectionUrl& url,
                                                                          const NodeDirectories& dirs,
                                                                          FoundNode* found = nullptr);
+
+/// The rr+local Connector (transport.hpp): finds the node with connect_local_socket() in the directories
+/// `dirs()` returns at each connect (default: this process's, so environment overrides set before
+/// connecting apply) and runs a StreamPump over the Unix socket.
+class LocalConnector : public Connector {
+public:
+    LocalConnector() : dirs_(default_node_directories) {}
+    explicit LocalConnector(std::function<NodeDirectories()> dirs) : dirs_(std::move(dirs)) {}
+    void connect(boost::asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions& options,
+                 std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) override;
+
+private:
+    std::function<NodeDirectories()> dirs_;
+};
 
 }  // namespace rr::server::local

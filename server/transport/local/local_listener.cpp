@@ -10,8 +10,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "server/node/node.hpp"
-#include "server/node/random_ids.hpp"
+#include "server/common/random_ids.hpp"
 #include "server/transport/local/local_layout.hpp"
 
 namespace rr::server::local {
@@ -50,11 +49,13 @@ Result<std::string> prepare_public_dir(const NodeDirectories& dirs, const std::s
 
 class LocalListener::Impl : public std::enable_shared_from_this<LocalListener::Impl> {
 public:
-    explicit Impl(const std::shared_ptr<Node>& node)
-        : node_(node), node_id_(node->node_id()), acceptor_(node->io_context()), retry_(node->io_context()) {}
+    Impl(asio::any_io_executor executor, std::weak_ptr<ConnectionSink> sink, NodeID node_id, std::string node_name,
+         std::chrono::milliseconds first_bytes_timeout)
+        : sink_(std::move(sink)), node_id_(node_id), node_name_(std::move(node_name)),
+          first_bytes_timeout_(first_bytes_timeout), acceptor_(executor), retry_(executor) {}
     ~Impl() { close(); }
 
-    Result<void> start(const Node& node, LocalListenOptions options, std::optional<NodeNameReservation> reservation);
+    Result<void> start(LocalListenOptions options, std::optional<NodeNameReservation> reservation);
     void accept();
     void detect(unix_socket::socket socket);
     void refresh();
@@ -68,10 +69,11 @@ public:
     }
 
     // Weak: pending accepts hold the Impl, and the Impl must never be what keeps the node (and its
-    // threads) alive, or the node could be destroyed on one of its own threads. LocalListener holds
-    // the node instead.
-    std::weak_ptr<Node> node_;
+    // threads) alive, or the node could be destroyed on one of its own threads.
+    std::weak_ptr<ConnectionSink> sink_;
     NodeID node_id_;
+    std::string node_name_;
+    std::chrono::milliseconds first_bytes_timeout_;
     unix_socket::acceptor acceptor_;
     asio::steady_timer retry_;
     mutable std::mutex mutex_;
@@ -84,11 +86,10 @@ public:
     LockedFile pid_id_, info_id_, pid_name_, info_name_;
 };
 
-Result<void> LocalListener::Impl::start(const Node& node, LocalListenOptions options,
-                                        std::optional<NodeNameReservation> reservation) {
+Result<void> LocalListener::Impl::start(LocalListenOptions options, std::optional<NodeNameReservation> reservation) {
     const NodeDirectories dirs = options.dirs ? *options.dirs : default_node_directories();
-    const NodeID node_id = node.node_id();
-    const std::string& name = node.node_name();
+    const NodeID node_id = node_id_;
+    const std::string& name = node_name_;
 
     // 1. The NodeName (and the NodeID its cache gives it).
     if (!name.empty()) {
@@ -218,11 +219,9 @@ void LocalListener::Impl::accept() {
 }
 
 void LocalListener::Impl::detect(unix_socket::socket socket) {
-    std::weak_ptr<Node> weak_node = node_;
-    auto node = node_.lock();
-    if (!node) return;
-    const auto& opts = node->options();
-    if (opts.max_connections && node->connection_count() >= opts.max_connections) {
+    std::weak_ptr<ConnectionSink> weak_sink = sink_;
+    auto sink = sink_.lock();
+    if (!sink || !sink->can_accept()) {
         boost::system::error_code ignored;
         socket.close(ignored);  // over the connection limit: refuse without reading
         return;
@@ -234,17 +233,17 @@ void LocalListener::Impl::detect(unix_socket::socket socket) {
     };
     auto ex = socket.get_executor();
     auto d = std::make_shared<Detect>(Detect{std::move(socket), asio::steady_timer(ex), {}});
-    d->timer.expires_after(opts.first_bytes_timeout);
+    d->timer.expires_after(first_bytes_timeout_);
     d->timer.async_wait([d](boost::system::error_code ec) {
         if (!ec) {
             boost::system::error_code ignored;
             d->socket.close(ignored);  // silent for too long: drop
         }
     });
-    asio::async_read(d->socket, asio::buffer(d->head), [d, weak_node](boost::system::error_code ec, std::size_t) {
+    asio::async_read(d->socket, asio::buffer(d->head), [d, weak_sink](boost::system::error_code ec, std::size_t) {
         d->timer.cancel();
-        auto node = weak_node.lock();
-        if (ec || !node) return;
+        auto sink = weak_sink.lock();
+        if (ec || !sink) return;
         static constexpr char kMagic[4] = {'R', 'R', 'A', 'C'};
         for (int i = 0; i < 4; ++i)
             if (d->head[i] != static_cast<std::byte>(kMagic[i])) {
@@ -252,8 +251,8 @@ void LocalListener::Impl::detect(unix_socket::socket socket) {
                 d->socket.close(ignored);  // not the RR stream protocol
                 return;
             }
-        node->serve_stream_as(std::move(d->socket), std::string(kLocalBaseUrl),
-                              std::vector<std::byte>(d->head.begin(), d->head.end()));
+        serve_stream(*sink, std::move(d->socket), AcceptedStream{std::string(kLocalBaseUrl), "local"},
+                     std::vector<std::byte>(d->head.begin(), d->head.end()));
     });
 }
 
@@ -286,8 +285,7 @@ void LocalListener::Impl::close() {
 
 // --- LocalListener ---------------------------------------------------------------------------------
 
-LocalListener::LocalListener(std::shared_ptr<Impl> impl, std::shared_ptr<Node> node)
-    : impl_(std::move(impl)), node_(std::move(node)) {
+LocalListener::LocalListener(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {
     socket_path_ = impl_->socket_path_;
     entry_dir_ = impl_->entry_dir_;
 }
@@ -295,14 +293,14 @@ LocalListener::LocalListener(std::shared_ptr<Impl> impl, std::shared_ptr<Node> n
 LocalListener::~LocalListener() {
     close();
     impl_.reset();  // a pending accept may still hold it; it never holds the node
-    node_.reset();  // may be the node's last owner: destroyed here, on this thread
 }
 
-Result<std::shared_ptr<LocalListener>> LocalListener::start(std::shared_ptr<Node> node, LocalListenOptions options,
+Result<std::shared_ptr<LocalListener>> LocalListener::start(asio::any_io_executor executor,
+                                                             std::weak_ptr<ConnectionSink> sink, const NodeID& node_id,
+                                                             const std::string& node_name, LocalListenOptions options,
                                                              std::optional<NodeNameReservation> reservation) {
-    if (!node) return fail(MessageErrorType::InvalidArgument, "no node");
-    auto impl = std::make_shared<Impl>(node);
-    if (auto r = impl->start(*node, std::move(options), std::move(reservation)); !r) {
+    auto impl = std::make_shared<Impl>(std::move(executor), std::move(sink), node_id, node_name, options.first_bytes_timeout);
+    if (auto r = impl->start(std::move(options), std::move(reservation)); !r) {
         impl->close();
         return r.take_error();
     }
@@ -310,7 +308,7 @@ Result<std::shared_ptr<LocalListener>> LocalListener::start(std::shared_ptr<Node
         std::lock_guard lock(impl->mutex_);
         impl->accept();
     }
-    return std::shared_ptr<LocalListener>(new LocalListener(std::move(impl), std::move(node)));
+    return std::shared_ptr<LocalListener>(new LocalListener(std::move(impl)));
 }
 
 std::string LocalListener::url() const { return local_listen_url(impl_->node_id_); }

@@ -16,14 +16,13 @@
 // its `.info`/`.pid` behind, unlocked; we remove ours while still holding their locks), and releases
 // the name. A process that dies leaves unlocked entries and a dead socket: clients report them stale.
 //
-// Accepted connections are served by the node (Node::serve_stream_as) with the base URL
-// "rr+local:///", so its service index reports `rr+local:///?nodeid=<id>&service=<name>` as CORE does.
-// Like the TCP listener, a connection must send its first 4 bytes (`RRAC`) within the node's
-// first_bytes_timeout and counts against NodeOptions::max_connections.
+// Accepted connections go to the ConnectionSink (the node; server/transport/transport.hpp) with the
+// base URL "rr+local:///", so its service index reports `rr+local:///?nodeid=<id>&service=<name>` as
+// CORE does. Like the TCP listener, a connection must send its first 4 bytes (`RRAC`) within
+// first_bytes_timeout and is refused while the sink is at its connection limit.
 //
-// Lifetime: the listener keeps the node alive; close it before (or when) the node shuts down: after
-// Node::shutdown() nobody accepts any more, and clients that still find the socket would wait.
-// Thread-safety: every member may be called from any thread.
+// Lifetime: listen_local() adds the listener to its node, which stops it (close()) at shutdown; the
+// listener holds the sink weakly. Thread-safety: every member may be called from any thread.
 #pragma once
 
 #include <memory>
@@ -31,13 +30,13 @@
 #include <optional>
 #include <string>
 
+#include <boost/asio/any_io_executor.hpp>
+
 #include "core/error/rr_error.hpp"
+#include "core/names/node_id.hpp"
 #include "server/transport/local/node_directories.hpp"
 #include "server/transport/local/node_identity.hpp"
-
-namespace rr::server {
-class Node;
-}
+#include "server/transport/transport.hpp"
 
 namespace rr::server::local {
 
@@ -48,21 +47,26 @@ struct LocalListenOptions {
     /// owns that directory may connect) instead of the private `<user run>/transport/local/`. The
     /// directory must have been created by an administrator: else SystemResourceError.
     bool public_server = false;
+    /// How long an accepted socket may take to send its first 4 bytes (as TCP, wire.md §6.1).
+    std::chrono::milliseconds first_bytes_timeout{5000};
 };
 
-class LocalListener : public std::enable_shared_from_this<LocalListener> {
+class LocalListener : public Listener, public std::enable_shared_from_this<LocalListener> {
 public:
-    /// Starts listening for `node`. `reservation`: the node's NodeName as reserved by
+    /// Starts listening on `executor` for the node `node_id` / `node_name` (empty: published by NodeID
+    /// only), handing connections to `sink`. `reservation`: the node's NodeName as reserved by
     /// reserve_node_name() (how the node got its NodeID); when absent and the node has a NodeName it
     /// is reserved here and must give the node's NodeID. Errors: those of reserve_node_name();
     /// InvalidArgument when the NodeID cache gives the name another NodeID than the node's;
     /// InvalidOperation when the NodeID or NodeName is in use (this process or another);
     /// SystemResourceError / SystemResourcePermissionDenied / IOError for the directories, the
     /// socket (incl. a socket path over 107 bytes) and the entry files.
-    static Result<std::shared_ptr<LocalListener>> start(std::shared_ptr<Node> node, LocalListenOptions options = {},
+    static Result<std::shared_ptr<LocalListener>> start(boost::asio::any_io_executor executor,
+                                                         std::weak_ptr<ConnectionSink> sink, const NodeID& node_id,
+                                                         const std::string& node_name, LocalListenOptions options = {},
                                                          std::optional<NodeNameReservation> reservation = std::nullopt);
 
-    ~LocalListener();
+    ~LocalListener() override;
     LocalListener(const LocalListener&) = delete;
     LocalListener& operator=(const LocalListener&) = delete;
 
@@ -83,20 +87,35 @@ public:
     /// Connections already accepted stay with the node. Idempotent.
     void close();
 
+    // Listener
+    std::string scheme() const override { return "rr+local"; }
+    std::vector<std::string> urls() const override { return {url()}; }
+    void stop() override { close(); }
+    void services_changed() override { refresh_service_state(); }
+
     class Impl;
 
 private:
-    LocalListener(std::shared_ptr<Impl> impl, std::shared_ptr<Node> node);
+    explicit LocalListener(std::shared_ptr<Impl> impl);
     std::shared_ptr<Impl> impl_;
-    std::shared_ptr<Node> node_;
     std::string socket_path_;
     std::string entry_dir_;
 };
 
-/// Shorthand for LocalListener::start().
-inline Result<std::shared_ptr<LocalListener>> listen_local(std::shared_ptr<Node> node, LocalListenOptions options = {},
-                                                           std::optional<NodeNameReservation> reservation = std::nullopt) {
-    return LocalListener::start(std::move(node), std::move(options), std::move(reservation));
+/// Opens an rr+local listener for `node` and adds it to the node (which stops it at shutdown and tells
+/// it when services change). `NodeT`: server::Node, or anything with io_context(), node_id(),
+/// node_name(), options().first_bytes_timeout, add_listener() and weak_from_this() as a ConnectionSink.
+/// Errors: those of LocalListener::start().
+template <class NodeT>
+Result<std::shared_ptr<LocalListener>> listen_local(const std::shared_ptr<NodeT>& node, LocalListenOptions options = {},
+                                                    std::optional<NodeNameReservation> reservation = std::nullopt) {
+    if (!node) return fail(MessageErrorType::InvalidArgument, "no node");
+    options.first_bytes_timeout = node->options().first_bytes_timeout;
+    std::weak_ptr<ConnectionSink> sink = node;
+    auto l = LocalListener::start(node->io_context().get_executor(), sink, node->node_id(), node->node_name(),
+                                  std::move(options), std::move(reservation));
+    if (l) node->add_listener(*l);
+    return l;
 }
 
 }  // namespace rr::server::local

@@ -16,7 +16,7 @@
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
-#include "server/transport/local/local_client_transport.hpp"
+#include "server/transport/local/local_connector.hpp"
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"
 #include "server/transport/local/node_identity.hpp"
@@ -162,10 +162,10 @@ const MessageEntry* reply_entry(const std::optional<StreamEvent>& e) {
 
 // A well-behaved typed client through the node's rr+local entries.
 void check_others_unaffected(LocalNode& n) {
-    client::register_client_transport("rr+local", make_local_client_transport([d = n.tmp.dirs] { return d; }));
+    default_transports().add("rr+local", std::make_shared<LocalConnector>([d = n.tmp.dirs] { return d; }));
     client::IoThreads io{1};
     auto c = client::Client::connect(io.executor(), n.url());
-    client::register_client_transport("rr+local", local_client_transport);
+    default_transports().add("rr+local", std::make_shared<LocalConnector>());
     REQUIRE(c);
     auto x = (*c)->root().get("x");
     REQUIRE(x);

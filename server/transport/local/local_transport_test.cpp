@@ -22,7 +22,6 @@
 #include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
-#include "server/transport/local/local_client_transport.hpp"
 #include "server/transport/local/local_connector.hpp"
 #include "server/transport/local/local_entries.hpp"
 #include "server/transport/local/local_layout.hpp"
@@ -45,9 +44,9 @@ namespace {
 // Routes the typed client's rr+local to `dirs` for the scope; back to the process's dirs after.
 struct LocalTransportFor {
     explicit LocalTransportFor(const NodeDirectories& dirs) {
-        client::register_client_transport("rr+local", make_local_client_transport([dirs] { return dirs; }));
+        default_transports().add("rr+local", std::make_shared<LocalConnector>([dirs] { return dirs; }));
     }
-    ~LocalTransportFor() { client::register_client_transport("rr+local", local_client_transport); }
+    ~LocalTransportFor() { default_transports().add("rr+local", std::make_shared<LocalConnector>()); }
 };
 
 struct NamedNode {

@@ -7,7 +7,7 @@
 
 #include <unistd.h>
 
-#include "server/node/random_ids.hpp"
+#include "server/common/random_ids.hpp"
 #include "server/transport/local/local_layout.hpp"
 
 namespace rr::server::local {

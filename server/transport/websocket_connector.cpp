@@ -1,4 +1,4 @@
-#include "server/client/ws_transport.hpp"
+#include "server/transport/websocket_connector.hpp"
 
 #include <openssl/evp.h>
 #include <openssl/ssl.h>
@@ -9,10 +9,10 @@
 #include <boost/beast/websocket.hpp>
 #include <boost/beast/websocket/ssl.hpp>
 
-#include "server/client/tcp_connector.hpp"
-#include "server/http/websocket_byte_stream.hpp"
+#include "server/transport/tcp_connector.hpp"
+#include "server/transport/websocket_byte_stream.hpp"
 
-namespace rr::client {
+namespace rr::server {
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
@@ -22,13 +22,12 @@ namespace {
 
 constexpr const char* kRRSubprotocol = "robotraconteur.robotraconteur.com";
 
-using Done = std::function<void(Result<std::shared_ptr<PumpHandle>>)>;
 
 // The WebSocket handshake on `ws` (its lowest layer connected, TLS done if any), then the pump.
 template <class NextLayer>
-void websocket_handshake(std::shared_ptr<websocket::stream<NextLayer>> ws, ClientStrand strand, std::string host,
+void websocket_handshake(std::shared_ptr<websocket::stream<NextLayer>> ws, asio::any_io_executor strand, std::string host,
                          std::string target, std::string authorization, std::shared_ptr<ConnectionLogic> logic,
-                         Done done) {
+                         ConnectHandler done) {
     ws->set_option(websocket::stream_base::decorator([authorization](websocket::request_type& req) {
         req.set(beast::http::field::sec_websocket_protocol, kRRSubprotocol);
         if (!authorization.empty()) req.set(beast::http::field::authorization, authorization);
@@ -36,10 +35,7 @@ void websocket_handshake(std::shared_ptr<websocket::stream<NextLayer>> ws, Clien
     ws->async_handshake(host, target, [ws, strand, logic, done](beast::error_code ec) mutable {
         if (ec) return done(fail(MessageErrorType::ConnectionError, "WebSocket handshake: " + ec.message()));
         beast::get_lowest_layer(*ws).expires_never();  // from here the RR heartbeat and receive timeout apply
-        using Stream = server::WebSocketByteStream<NextLayer>;
-        auto pump = std::make_shared<server::StreamPump<Stream>>(Stream(std::move(*ws)), strand, logic);
-        done(std::shared_ptr<PumpHandle>(pump));
-        pump->start();
+        start_client_stream(WebSocketByteStream<NextLayer>(std::move(*ws)), strand, std::move(logic), done);
     });
 }
 
@@ -57,9 +53,9 @@ std::string basic_authorization(std::string_view user, std::string_view password
     return "Basic " + encoded;
 }
 
-void ws_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
-                  std::shared_ptr<ConnectionLogic> logic, Done done) {
-    server::connect_tcp(strand, url.host, url.port, options.connect_timeout,
+static void connect_ws(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions& options,
+                std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) {
+    connect_tcp(strand, url.host, url.port, options.connect_timeout,
                         [strand, host = host_header(url), target = handshake_target(url), options,
                          logic = std::move(logic), done = std::move(done)](Result<asio::ip::tcp::socket> socket) mutable {
                             if (!socket) return done(socket.take_error());
@@ -71,8 +67,8 @@ void ws_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOpt
                         });
 }
 
-void wss_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOptions& options,
-                   std::shared_ptr<ConnectionLogic> logic, Done done) {
+static void connect_wss(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions& options,
+                 std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) {
     // One context per connection: the trust settings come with the options. OpenSSL reference-counts
     // it, so the TLS stream keeps what it needs after this function's copy is gone.
     auto tls = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_client);
@@ -87,7 +83,7 @@ void wss_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOp
                              (options.tls_ca_file.empty() ? std::string() : " from " + options.tls_ca_file) + ": " +
                              ec.message()));
     tls->set_verify_mode(asio::ssl::verify_peer);
-    server::connect_tcp(
+    connect_tcp(
         strand, url.host, url.port, options.connect_timeout,
         [strand, tls, url, options, logic = std::move(logic), done = std::move(done)](Result<asio::ip::tcp::socket> socket) mutable {
             if (!socket) return done(socket.take_error());
@@ -108,4 +104,12 @@ void wss_transport(ClientStrand strand, const ConnectionUrl& url, const ClientOp
         });
 }
 
-}  // namespace rr::client
+void WebSocketConnector::connect(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions& options,
+                                 std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) {
+    if (tls_)
+        connect_wss(std::move(strand), url, options, std::move(logic), std::move(done));
+    else
+        connect_ws(std::move(strand), url, options, std::move(logic), std::move(done));
+}
+
+}  // namespace rr::server

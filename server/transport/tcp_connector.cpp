@@ -1,4 +1,4 @@
-#include "server/client/tcp_connector.hpp"
+#include "server/transport/tcp_connector.hpp"
 
 #include <memory>
 
@@ -53,6 +53,19 @@ void connect_tcp(asio::any_io_executor executor, const std::string& host, std::u
             op->finish(std::move(op->socket));
         });
     });
+}
+
+}  // namespace rr::server
+
+namespace rr::server {
+
+void TcpConnector::connect(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions& options,
+                           std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) {
+    connect_tcp(strand, url.host, url.port, options.connect_timeout,
+                [strand, logic = std::move(logic), done = std::move(done)](Result<tcp::socket> socket) mutable {
+                    if (!socket) return done(socket.take_error());
+                    start_client_stream(std::move(*socket), strand, std::move(logic), done);
+                });
 }
 
 }  // namespace rr::server

@@ -1,6 +1,7 @@
 // A service registered on a node, as the node's connections see it: what is needed to answer the
-// special requests (GetServiceDesc, ObjectTypeName, ConnectClient(Combined), GetServiceAttributes;
-// wire.md §6.4) and to dispatch member requests (wire.md §6.7).
+// special requests (HostedService, core/session/service_host.hpp; wire.md §6.4) and to dispatch member
+// requests (wire.md §6.7), plus the handles it gets for its clients (SessionRef) and their requests
+// (Responder).
 //
 // Two implementations: ObjectService (a tree of C++ ServiceObjects typed by robdef) and, in the
 // gateway, a mirror that forwards entries to a device.
@@ -16,6 +17,7 @@
 
 #include "core/error/rr_error.hpp"
 #include "core/message/message.hpp"
+#include "core/session/service_host.hpp"
 
 namespace rr::server {
 
@@ -82,36 +84,14 @@ private:
     MessageEntry request_;  // fields only, no elements
 };
 
-/// Root and implemented types of an object, answering ObjectTypeName.
-struct ObjectTypeInfo {
-    std::string object_type;                  ///< qualified, e.g. "experimental.create.Create"
-    std::vector<std::string> implements;      ///< qualified
-};
-
-class Service {
+/// A service a node hosts: what the session protocol needs (HostedService: definitions, root type,
+/// attributes, login) plus its objects' behaviour.
+class Service : public HostedService {
 public:
-    virtual ~Service() = default;
-
-    virtual const std::string& name() const = 0;
-    /// Definition texts: the root object's service definition first, then every definition it imports,
-    /// transitively (what ConnectClientCombined returns as `servicedefs`).
-    virtual std::vector<std::string> service_definitions() const = 0;
-    /// Definition text of one service definition by name (GetServiceDesc with ServiceType).
-    virtual std::optional<std::string> service_definition(std::string_view service_type) const = 0;
-    virtual ObjectTypeInfo root_type() const = 0;
-    /// `attributes`: a map{string} element of varvalues (may be an empty map).
-    virtual MessageElement attributes() const;
-
     /// Type of the object at `path` (the root or a path reached through objrefs), for ObjectTypeName.
     /// `done` may be called from any thread. Errors: ObjectNotFound.
     virtual void object_type(const SessionRef& session, const std::string& path,
                              std::function<void(Result<ObjectTypeInfo>)> done) = 0;
-
-    /// Whether a session must authenticate, and the check itself (username + credentials element).
-    virtual bool requires_authentication() const { return false; }
-    virtual Result<void> authenticate(const std::string& username, const MessageElement* credentials) {
-        return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
-    }
 
     virtual void on_session_open(const SessionRef& session) {}
     virtual void on_session_close(const SessionRef& session) {}

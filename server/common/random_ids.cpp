@@ -1,4 +1,4 @@
-#include "server/node/random_ids.hpp"
+#include "server/common/random_ids.hpp"
 
 #include <random>
 

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -16,9 +17,13 @@ namespace rr::server {
 /// The monotonic clock of the server: the only place core's MonoTime is read.
 inline MonoTime mono_now() noexcept { return std::chrono::steady_clock::now(); }
 
+class PumpHandle;
+
 class ConnectionLogic {
 public:
     virtual ~ConnectionLogic() = default;
+    /// The pump that drives this logic, before any byte flows (for work posted from other threads).
+    virtual void attach(std::weak_ptr<PumpHandle> pump) {}
     /// Bytes arrived. Protocol errors are handled inside (they make wants_close() true).
     virtual void on_bytes(std::span<const std::byte> bytes, MonoTime now) = 0;
     /// True when bytes are waiting to be written.

@@ -1,0 +1,490 @@
+#include "core/session/service_session.hpp"
+
+#include "core/names/service_path.hpp"
+#include "core/session/elements.hpp"
+
+namespace rr {
+namespace {
+
+// ObjectTypeName queries a client may have waiting for the service at once; more are refused, so a
+// client cannot grow the table by asking faster than the service answers.
+constexpr std::size_t kMaxPendingObjectTypes = 256;
+
+MessageElement make_string_list(std::string name, const std::vector<std::string>& items) {
+    MessageElement list;
+    list.name = std::move(name);
+    list.type = DataTypes::list_t;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        MessageElement item = make_string_element("", items[i]);
+        item.number = static_cast<std::int32_t>(i);
+        list.elements.push_back(std::move(item));
+    }
+    return list;
+}
+
+MessageEntry reply_to(const MessageEntry& request) {
+    MessageEntry r;
+    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request.entry_type) + 1);
+    r.service_path = request.service_path;
+    r.member_name = request.member_name;
+    r.request_id = request.request_id;
+    return r;
+}
+
+MessageEntry error_reply(const MessageEntry& request, const RRError& error) {
+    MessageEntry r = reply_to(request);
+    set_entry_error(r, error);
+    return r;
+}
+
+RRError service_not_found(std::string_view name) {
+    // CORE's special-request path uses this non-canonical name (wire.md §5.1).
+    RRError e = make_error(MessageErrorType::ServiceNotFound, "Service \"" + std::string(name) + "\" not found");
+    e.name = "RobotRaconteur.ServiceNotFoundException";
+    return e;
+}
+
+}  // namespace
+
+MessageElement HostedService::attributes() const {
+    MessageElement e;
+    e.name = "attributes";
+    e.type = DataTypes::dictionary_t;
+    return e;
+}
+
+ServiceSession::ServiceSession(ServiceHost& host, ServiceSessionConfig config, MonoTime now)
+    : host_(host), config_(std::move(config)), stream_(StreamRole::server, config_.stream, now) {}
+
+ServiceSession::~ServiceSession() {
+    if (service_) host_.release_endpoint(endpoint_);
+}
+
+void ServiceSession::feed(std::span<const std::byte> bytes, MonoTime now) {
+    (void)stream_.feed(bytes, now);  // errors close the stream; its Closed event follows
+    drain_stream(now);
+}
+
+void ServiceSession::on_transport_closed(RRError error) {
+    stream_.on_transport_closed(std::move(error));
+    drain_stream(MonoTime{});
+}
+
+void ServiceSession::close(RRError error) {
+    if (stream_.is_closed()) return;
+    stream_.on_transport_closed(std::move(error));
+    drain_stream(MonoTime{});
+}
+
+void ServiceSession::drain_stream(MonoTime now) {
+    while (auto ev = stream_.poll_event()) {
+        if (auto* m = std::get_if<StreamMessage>(&*ev)) {
+            on_message(std::move(m->message), now);
+        } else if (auto* c = std::get_if<StreamClosed>(&*ev)) {
+            close_session();
+            if (!closed_reported_) {
+                closed_reported_ = true;
+                events_.emplace_back(ServiceConnectionClosed{std::move(c->error)});
+            }
+        }
+    }
+}
+
+void ServiceSession::take_output(std::vector<std::byte>& out) {
+    stream_.take_output(out);
+    // Held wire values go out once the backlog has been handed to the transport.
+    if (!held_wires_.empty()) flush_held_wires(MonoTime{});
+}
+
+std::optional<MonoTime> ServiceSession::next_deadline() const {
+    auto d = stream_.next_deadline();
+    for (const auto& [id, deadline] : pending_callbacks_) d = d ? std::min(*d, deadline) : deadline;
+    return d;
+}
+
+void ServiceSession::on_timer(MonoTime now) {
+    stream_.on_timer(now);
+    for (auto it = pending_callbacks_.begin(); it != pending_callbacks_.end();) {
+        if (now >= it->second) {
+            events_.emplace_back(ServiceCallbackResponse{it->first, fail(MessageErrorType::RequestTimeout, "callback timed out")});
+            it = pending_callbacks_.erase(it);
+        } else {
+            ++it;
+        }
+    }
+    drain_stream(now);
+}
+
+std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
+    if (events_.empty()) return std::nullopt;
+    ServiceSessionEvent ev = std::move(events_.front());
+    events_.pop_front();
+    return ev;
+}
+
+void ServiceSession::close_session() {
+    for (auto& [id, deadline] : pending_callbacks_)
+        events_.emplace_back(ServiceCallbackResponse{id, fail(MessageErrorType::ConnectionError, "client disconnected")});
+    pending_callbacks_.clear();
+    pending_object_types_.clear();
+    held_wires_.clear();
+    if (!service_) return;
+    auto service = std::move(service_);
+    service_.reset();
+    host_.release_endpoint(endpoint_);
+    events_.emplace_back(ServiceSessionClosed{std::move(service), endpoint_});
+    endpoint_ = 0;
+    client_endpoint_ = 0;
+    authenticated_ = false;
+    username_.clear();
+}
+
+Message ServiceSession::session_message(MessageEntry entry) {
+    ++messages_out_;
+    Message m;
+    m.version = 2;
+    m.header.sender_node_id = config_.stream.local_node_id;
+    m.header.receiver_node_id = stream_.negotiated().remote_node_id;
+    m.header.sender_endpoint = endpoint_;
+    m.header.receiver_endpoint = client_endpoint_;
+    m.header.message_id = ++message_id_;
+    if (entry.metadata == "unreliable\n") m.header.metadata = entry.metadata;
+    m.entries.push_back(std::move(entry));
+    return m;
+}
+
+void ServiceSession::reply(MessageEntry entry, MonoTime now) {
+    if (!service_ || stream_.is_closed()) return;
+    MessageEntry header;
+    header.entry_type = entry.entry_type;
+    header.service_path = entry.service_path;
+    header.member_name = entry.member_name;
+    header.request_id = entry.request_id;
+    if (auto r = stream_.send(session_message(std::move(entry)), now); !r) {
+        // A reply must not vanish: answer with the error instead (e.g. over the size limit).
+        set_entry_error(header, r.error());
+        (void)stream_.send(session_message(std::move(header)), now);
+    }
+}
+
+Result<void> ServiceSession::send(MessageEntry entry, MonoTime now) {
+    if (!service_ || stream_.is_closed()) return fail(MessageErrorType::InvalidState, "client session closed");
+    return stream_.send(session_message(std::move(entry)), now);
+}
+
+void ServiceSession::send_wire_packet(MessageEntry entry, MonoTime now) {
+    if (!service_ || stream_.is_closed()) return;
+    if (stream_.pending_output_size() > config_.wire_hold_bytes) {
+        WireKey key(entry.service_path, entry.member_name);
+        held_wires_.insert_or_assign(std::move(key), std::move(entry));  // newest kept until the output drains
+        return;
+    }
+    (void)stream_.send(session_message(std::move(entry)), now);
+}
+
+void ServiceSession::flush_held_wires(MonoTime now) {
+    if (!service_) return;
+    auto held = std::move(held_wires_);
+    held_wires_.clear();
+    for (auto& [key, entry] : held) (void)stream_.send(session_message(std::move(entry)), now);
+}
+
+Result<std::uint32_t> ServiceSession::request(MessageEntry entry, MonoTime now) {
+    if (!service_ || stream_.is_closed()) return fail(MessageErrorType::ConnectionError, "client session closed");
+    if (++callback_request_counter_ == 0) ++callback_request_counter_;
+    const std::uint32_t id = callback_request_counter_;
+    entry.request_id = id;
+    if (auto r = stream_.send(session_message(std::move(entry)), now); !r) return r.take_error();
+    pending_callbacks_[id] = now + config_.callback_timeout;
+    return id;
+}
+
+void ServiceSession::answer_object_type(std::uint64_t token, Result<ObjectTypeInfo> info, MonoTime now) {
+    auto it = pending_object_types_.find(token);
+    if (it == pending_object_types_.end()) return;
+    PendingObjectType p = std::move(it->second);
+    pending_object_types_.erase(it);
+    if (stream_.is_closed()) return;
+    if (!info) {
+        set_entry_error(p.reply, info.error());
+    } else {
+        p.reply.elements.push_back(make_string_element("objecttype", info->object_type));
+        if (!info->implements.empty()) p.reply.elements.push_back(make_string_list("objectimplements", info->implements));
+    }
+    reply_special(p.header, std::move(p.reply), now);
+}
+
+void ServiceSession::reply_special(const MessageHeader& request_header, MessageEntry reply, MonoTime now) {
+    Message m;
+    m.version = 2;
+    m.header.sender_node_id = config_.stream.local_node_id;
+    m.header.sender_node_name = config_.stream.local_node_name;
+    m.header.receiver_node_id = request_header.sender_node_id;
+    m.header.receiver_node_name = request_header.sender_node_name;
+    m.header.sender_endpoint = endpoint_;
+    m.header.receiver_endpoint = request_header.sender_endpoint;
+    m.header.message_id = ++message_id_;
+    ++messages_out_;
+    m.entries.push_back(std::move(reply));
+    (void)stream_.send(m, now);
+}
+
+void ServiceSession::on_message(Message&& m, MonoTime now) {
+    ++messages_in_;
+    for (auto& e : m.entries) {
+        if (stream_.is_closed()) return;
+        const auto type = e.entry_type;
+        const bool special = is_special_request(type) &&
+                             !(type == MessageEntryType::ObjectTypeName && m.header.receiver_endpoint != 0);
+        if (special)
+            handle_special(m.header, std::move(e), now);
+        else
+            handle_session_entry(m.header, std::move(e), now);
+    }
+}
+
+void ServiceSession::handle_special(const MessageHeader& h, MessageEntry&& e, MonoTime now) {
+    if (!is_request(e.entry_type)) return;  // special replies carry nothing for a service
+    if (!h.receiver_node_id.is_any() && h.receiver_node_id != config_.stream.local_node_id) {
+        reply_special(h, error_reply(e, make_error(MessageErrorType::NodeNotFound, "Could not find route to remote node")),
+                      now);
+        return;
+    }
+    switch (e.entry_type) {
+        case MessageEntryType::GetServiceDesc: get_service_desc(h, std::move(e), now); return;
+        case MessageEntryType::ObjectTypeName: object_type_name(h, std::move(e), now); return;
+        case MessageEntryType::ConnectClient: connect_client(h, std::move(e), false, now); return;
+        case MessageEntryType::ConnectClientCombined: connect_client(h, std::move(e), true, now); return;
+        case MessageEntryType::DisconnectClient: {
+            MessageEntry r = reply_to(e);
+            close_session();
+            reply_special(h, std::move(r), now);
+            return;
+        }
+        case MessageEntryType::GetNodeInfo: reply_special(h, reply_to(e), now); return;
+        case MessageEntryType::NodeCheckCapability: {
+            MessageEntry r = reply_to(e);
+            r.elements.push_back(make_scalar_element<std::uint32_t>("return", 0));
+            reply_special(h, std::move(r), now);
+            return;
+        }
+        case MessageEntryType::GetServiceAttributes: {
+            auto service = host_.hosted_service(e.service_path);
+            if (!service) {
+                reply_special(h, error_reply(e, make_error(MessageErrorType::ServiceError, "Service not found")), now);
+                return;
+            }
+            MessageEntry r = reply_to(e);
+            MessageElement attrs = service->attributes();
+            attrs.name = "return";
+            r.elements.push_back(std::move(attrs));
+            reply_special(h, std::move(r), now);
+            return;
+        }
+        default:
+            reply_special(h, error_reply(e, make_error(MessageErrorType::ProtocolError, "Invalid Special Operation")), now);
+            return;
+    }
+}
+
+void ServiceSession::get_service_desc(const MessageHeader& h, MessageEntry&& e, MonoTime now) {
+    auto service = host_.hosted_service(e.service_path);
+    if (!service) {
+        reply_special(h, error_reply(e, service_not_found(e.service_path)), now);
+        return;
+    }
+    const MessageElement* type = e.find("ServiceType");
+    if (!type) type = e.find("servicetype");
+    MessageEntry r = reply_to(e);
+    if (type) {
+        auto def = service->service_definition(read_string(*type));
+        if (!def) {
+            reply_special(h,
+                          error_reply(e, make_error(MessageErrorType::ServiceNotFound, "Service definition \"" +
+                                                                                         std::string(read_string(*type)) +
+                                                                                         "\" not found")),
+                          now);
+            return;
+        }
+        r.elements.push_back(make_string_element("servicedef", *def));
+    } else {
+        auto defs = service->service_definitions();
+        r.elements.push_back(make_string_element("servicedef", defs.empty() ? std::string() : defs.front()));
+        MessageElement attrs = service->attributes();
+        attrs.name = "attributes";
+        r.elements.push_back(std::move(attrs));
+    }
+    reply_special(h, std::move(r), now);
+}
+
+void ServiceSession::object_type_name(const MessageHeader& h, MessageEntry&& e, MonoTime now) {
+    const std::string_view name = service_name_of(e.service_path);
+    auto service = host_.hosted_service(name);
+    if (!service) {
+        reply_special(h, error_reply(e, service_not_found(name)), now);
+        return;
+    }
+    if (pending_object_types_.size() >= kMaxPendingObjectTypes) {
+        reply_special(h, error_reply(e, make_error(MessageErrorType::BufferLimitViolation, "too many ObjectTypeName requests waiting")),
+                      now);
+        return;
+    }
+    const std::uint64_t token = ++object_type_counter_;
+    pending_object_types_.emplace(token, PendingObjectType{h, reply_to(e)});
+    events_.emplace_back(ServiceObjectTypeQuery{token, std::move(service), std::move(e.service_path)});
+}
+
+void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bool combined, MonoTime now) {
+    if (service_) {
+        reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidOperation, "Already connected")), now);
+        return;
+    }
+    auto service = host_.hosted_service(e.service_path);
+    if (!service) {
+        reply_special(h, error_reply(e, service_not_found(e.service_path)), now);
+        return;
+    }
+    std::string username;
+    bool authenticated = false;
+    if (combined) {
+        const MessageElement* user = e.find("username");
+        const MessageElement* creds = e.find("credentials");
+        if (service->requires_authentication() || user || creds) {
+            if (!user || !creds || !service->requires_authentication()) {
+                reply_special(h, error_reply(e, make_error(MessageErrorType::AuthenticationError, "Authentication Failed")), now);
+                return;
+            }
+            username = std::string(read_string(*user));
+            if (auto ok = service->authenticate(username, creds); !ok) {
+                reply_special(h, error_reply(e, ok.error()), now);
+                return;
+            }
+            authenticated = true;
+        }
+    }
+    if (h.sender_endpoint == 0) {
+        reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidEndpoint, "client endpoint 0")), now);
+        return;
+    }
+    service_ = service;
+    endpoint_ = host_.allocate_endpoint();
+    client_endpoint_ = h.sender_endpoint;
+    username_ = username;
+    authenticated_ = authenticated;
+    stream_.set_session_established(endpoint_, client_endpoint_);
+
+    MessageEntry r = reply_to(e);
+    if (combined) {
+        auto type = service->root_type();
+        r.elements.push_back(make_string_element("objecttype", type.object_type));
+        if (!type.implements.empty()) r.elements.push_back(make_string_list("objectimplements", type.implements));
+        const MessageElement* ret = e.find("returnservicedefs");
+        std::string_view want = ret ? read_string(*ret) : std::string_view("true");
+        if (want != "false" && want != "0") r.elements.push_back(make_string_list("servicedefs", service->service_definitions()));
+        MessageElement attrs = service->attributes();
+        attrs.name = "attributes";
+        r.elements.push_back(std::move(attrs));
+    }
+    reply_special(h, std::move(r), now);
+    events_.emplace_back(ServiceSessionOpened{std::move(service), endpoint_, client_endpoint_, std::move(username)});
+}
+
+void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&& e, MonoTime now) {
+    const bool request = is_request(e.entry_type);
+    if (!service_ || h.receiver_endpoint != endpoint_) {
+        if (request && e.entry_type != MessageEntryType::PipePacket && e.entry_type != MessageEntryType::WirePacket)
+            reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidEndpoint, "Invalid destination endpoint")), now);
+        return;
+    }
+    switch (e.entry_type) {
+        case MessageEntryType::EndpointCheckCapability:
+        case MessageEntryType::ServiceCheckCapabilityReq: {
+            MessageEntry r = reply_to(e);
+            r.elements.push_back(make_scalar_element<std::uint32_t>("return", 0));
+            reply(std::move(r), now);
+            return;
+        }
+        case MessageEntryType::ClientKeepAliveReq: reply(reply_to(e), now); return;
+        case MessageEntryType::ClientSessionOpReq: handle_session_op(std::move(e), now); return;
+        case MessageEntryType::ObjectTypeName: handle_special(h, std::move(e), now); return;
+        case MessageEntryType::CallbackCallRet: {
+            auto it = pending_callbacks_.find(e.request_id);
+            if (it == pending_callbacks_.end()) return;
+            pending_callbacks_.erase(it);
+            const std::uint32_t id = e.request_id;
+            events_.emplace_back(ServiceCallbackResponse{id, std::move(e)});
+            return;
+        }
+        case MessageEntryType::PipePacket:
+        case MessageEntryType::PipePacketRet:
+        case MessageEntryType::WirePacket: events_.emplace_back(ServiceRequest{std::move(e), false}); return;
+        default: break;
+    }
+    if (!request) return;
+    if (service_name_of(e.service_path) != service_->name()) {
+        reply(error_reply(e, make_error(MessageErrorType::ServiceNotFound,
+                                        "Service \"" + std::string(service_name_of(e.service_path)) +
+                                            "\" is not this session's service")),
+              now);
+        return;
+    }
+    if (service_->requires_authentication() && !authenticated_) {
+        // CORE (ServerContext::ProcessMessageEntry, requirevaliduser): PermissionDenied until the user logs in.
+        reply(error_reply(e, make_error(MessageErrorType::PermissionDenied, "User must authenticate before accessing this service")),
+              now);
+        return;
+    }
+    events_.emplace_back(ServiceRequest{std::move(e), true});
+}
+
+void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
+    MessageEntry r = reply_to(e);
+    const std::string& op = e.member_name;
+    if (op == "AuthenticateUser") {
+        const MessageElement* user = e.find("username");
+        const MessageElement* creds = e.find("credentials");
+        if (!user || !creds || !service_->requires_authentication()) {
+            reply(error_reply(e, make_error(MessageErrorType::AuthenticationError, "Authentication Failed")), now);
+            return;
+        }
+        std::string name(read_string(*user));
+        if (auto ok = service_->authenticate(name, creds); !ok) {
+            reply(error_reply(e, ok.error()), now);
+            return;
+        }
+        authenticated_ = true;
+        username_ = name;
+        events_.emplace_back(ServiceSessionUser{std::move(name)});
+        r.elements.push_back(make_string_element("return", "OK"));
+        reply(std::move(r), now);
+        return;
+    }
+    if (op == "LogoutUser") {
+        authenticated_ = false;
+        username_.clear();
+        events_.emplace_back(ServiceSessionUser{});
+        r.elements.push_back(make_string_element("return", "OK"));
+        reply(std::move(r), now);
+        return;
+    }
+    if (op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit") {
+        // Monitor locks serialise access per object; with per-call handlers there is nothing to hold,
+        // so entering always succeeds at once.
+        r.elements.push_back(make_string_element("return", "OK"));
+        reply(std::move(r), now);
+        return;
+    }
+    if (op == "RequestObjectLock" || op == "ReleaseObjectLock" || op == "RequestClientObjectLock" ||
+        op == "ReleaseClientObjectLock") {
+        if (!service_->requires_authentication()) {
+            reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Object locks require an authenticated service")),
+                  now);
+            return;
+        }
+        events_.emplace_back(ServiceRequest{std::move(e), true});  // locks go to the service, which owns the objects
+        return;
+    }
+    reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Unknown session operation \"" + op + "\"")), now);
+}
+
+}  // namespace rr

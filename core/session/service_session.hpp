@@ -1,0 +1,174 @@
+// The service side of one transport connection, sans-IO (wire.md §6.2–§6.6): the basic stream
+// protocol (StreamConnection, server role), the node's special requests (GetServiceDesc,
+// ObjectTypeName, ConnectClient, ConnectClientCombined, DisconnectClient, GetNodeInfo,
+// NodeCheckCapability, GetServiceAttributes), the at most one client session the connection carries
+// (endpoints, login state), the session operations (keep-alive, capability checks, AuthenticateUser,
+// LogoutUser, monitor and object locks) and output policy (a reply over the size limit becomes an
+// error reply; wire packets held back, newest kept, while output is backed up).
+//
+// What needs the service's own objects is handed to the host as an event: member requests and
+// client-sent packets, ObjectTypeName for paths below the root, object lock operations, and the
+// opening and closing of the client session. The host answers with reply(), answer_object_type(),
+// and sends unsolicited entries with send(), send_wire_packet() and request() (callbacks).
+//
+// Bytes in: feed(). Bytes out: take_output(). Events out: poll_event(). Time: next_deadline() /
+// on_timer(). Never reads a clock; not thread-safe (one owner drives it, e.g. a strand).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "core/session/service_host.hpp"
+#include "core/session/stream_connection.hpp"
+
+namespace rr {
+
+struct ServiceSessionConfig {
+    /// Stream settings; local_node_id and local_node_name are this node's.
+    StreamConfig stream;
+    /// Callback requests (request()) not answered in this time fail with RequestTimeout.
+    std::chrono::milliseconds callback_timeout{15000};
+    /// Wire packets are held back (newest per member kept) while more output than this waits.
+    std::size_t wire_hold_bytes = 256u * 1024u;
+};
+
+/// The client session exists: `service` is the one the client connected to.
+struct ServiceSessionOpened {
+    std::shared_ptr<HostedService> service;
+    std::uint32_t endpoint = 0;         ///< this node's endpoint for the session
+    std::uint32_t client_endpoint = 0;  ///< the client's
+    std::string username;               ///< set when the client logged in with the connect
+};
+/// The logged-in user changed (AuthenticateUser, LogoutUser): empty when none.
+struct ServiceSessionUser {
+    std::string username;
+};
+/// A member request (answer with reply()), a client-sent packet that needs no answer (PipePacket,
+/// PipePacketRet, WirePacket: `needs_reply` false), or a lock operation (ClientSessionOpReq with
+/// MemberName RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, answer with reply()).
+struct ServiceRequest {
+    MessageEntry entry;
+    bool needs_reply = true;
+};
+/// ObjectTypeName for `path` in the session's service: answer with answer_object_type(token, …).
+struct ServiceObjectTypeQuery {
+    std::uint64_t token = 0;
+    std::shared_ptr<HostedService> service;
+    std::string path;
+};
+/// The client's answer to request() (CallbackCallRet), or RequestTimeout / ConnectionError.
+struct ServiceCallbackResponse {
+    std::uint32_t request_id = 0;
+    Result<MessageEntry> entry;
+};
+/// The client session ended (DisconnectClient or the connection closed). No further session events.
+struct ServiceSessionClosed {
+    std::shared_ptr<HostedService> service;
+    std::uint32_t endpoint = 0;
+};
+/// The connection is closed: no further events.
+struct ServiceConnectionClosed {
+    RRError error;
+};
+
+using ServiceSessionEvent = std::variant<ServiceSessionOpened, ServiceSessionUser, ServiceRequest, ServiceObjectTypeQuery,
+                                         ServiceCallbackResponse, ServiceSessionClosed, ServiceConnectionClosed>;
+
+class ServiceSession {
+public:
+    /// `host` must outlive the session (the node owns its connections' hosts).
+    ServiceSession(ServiceHost& host, ServiceSessionConfig config, MonoTime now);
+    ~ServiceSession();
+    ServiceSession(const ServiceSession&) = delete;
+    ServiceSession& operator=(const ServiceSession&) = delete;
+
+    // --- I/O (see StreamConnection) ---
+    /// Consumes all of `bytes`; a protocol error closes the connection (ServiceConnectionClosed).
+    void feed(std::span<const std::byte> bytes, MonoTime now);
+    void on_transport_closed(RRError error);
+    void take_output(std::vector<std::byte>& out);
+    std::size_t pending_output_size() const noexcept { return stream_.pending_output_size(); }
+    std::optional<MonoTime> next_deadline() const;
+    void on_timer(MonoTime now);
+    std::optional<ServiceSessionEvent> poll_event();
+    bool is_closed() const noexcept { return stream_.is_closed(); }
+    /// Messages received and queued for sending so far (for the host's counters).
+    std::uint64_t messages_in() const noexcept { return messages_in_; }
+    std::uint64_t messages_out() const noexcept { return messages_out_; }
+
+    // --- the session ---
+    bool has_session() const noexcept { return service_ != nullptr; }
+    std::uint32_t endpoint() const noexcept { return endpoint_; }
+    std::uint32_t client_endpoint() const noexcept { return client_endpoint_; }
+    const std::string& username() const noexcept { return username_; }
+    const StreamConnection& stream() const noexcept { return stream_; }
+
+    /// Answers a ServiceRequest: ServicePath, MemberName and RequestID must be the request's (the
+    /// host's Responder sets them). A reply that cannot be sent (over the size limit) is replaced by
+    /// an error reply with the same RequestID. Ignored without a session.
+    void reply(MessageEntry entry, MonoTime now);
+    /// Sends an entry the client did not ask for (EventReq, PipePacket, PipeClosed, WireClosed, …).
+    /// Errors: InvalidState without a session or after close; BufferLimitViolation over the size limit.
+    Result<void> send(MessageEntry entry, MonoTime now);
+    /// Sends a WirePacket now, or holds it (replacing an older held packet of the same service path
+    /// and member: wires keep only the newest value) while more than wire_hold_bytes of output wait.
+    void send_wire_packet(MessageEntry entry, MonoTime now);
+    /// Sends a request to the client (CallbackCallReq); the RequestID is assigned here and returned.
+    /// The answer arrives as ServiceCallbackResponse. Errors: as send().
+    Result<std::uint32_t> request(MessageEntry entry, MonoTime now);
+    /// Completes a ServiceObjectTypeQuery. Unknown tokens are ignored.
+    void answer_object_type(std::uint64_t token, Result<ObjectTypeInfo> info, MonoTime now);
+    /// Ends the connection after the pending output (the host's close()).
+    void close(RRError error);
+
+private:
+    using WireKey = std::pair<std::string, std::string>;
+    struct PendingObjectType {
+        MessageHeader header;
+        MessageEntry reply;
+    };
+
+    void drain_stream(MonoTime now);
+    void on_message(Message&& m, MonoTime now);
+    void handle_special(const MessageHeader& h, MessageEntry&& e, MonoTime now);
+    void handle_session_entry(const MessageHeader& h, MessageEntry&& e, MonoTime now);
+    void handle_session_op(MessageEntry&& e, MonoTime now);
+    void connect_client(const MessageHeader& h, MessageEntry&& e, bool combined, MonoTime now);
+    void get_service_desc(const MessageHeader& h, MessageEntry&& e, MonoTime now);
+    void object_type_name(const MessageHeader& h, MessageEntry&& e, MonoTime now);
+    void close_session();
+    void reply_special(const MessageHeader& request_header, MessageEntry reply, MonoTime now);
+    Message session_message(MessageEntry entry);
+    void flush_held_wires(MonoTime now);
+
+    ServiceHost& host_;
+    ServiceSessionConfig config_;
+    StreamConnection stream_;
+    std::deque<ServiceSessionEvent> events_;
+    bool closed_reported_ = false;
+
+    std::shared_ptr<HostedService> service_;
+    std::uint32_t endpoint_ = 0;
+    std::uint32_t client_endpoint_ = 0;
+    std::string username_;
+    bool authenticated_ = false;
+
+    std::uint16_t message_id_ = 0;
+    std::uint64_t messages_in_ = 0, messages_out_ = 0;
+    std::uint32_t callback_request_counter_ = 0;
+    std::map<std::uint32_t, MonoTime> pending_callbacks_;  // RequestID → deadline
+    std::uint64_t object_type_counter_ = 0;
+    std::map<std::uint64_t, PendingObjectType> pending_object_types_;
+    std::map<WireKey, MessageEntry> held_wires_;
+};
+
+}  // namespace rr

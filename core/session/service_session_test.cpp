@@ -1,0 +1,451 @@
+// ServiceSession fed by core's own ClientSession in memory: bytes are moved by hand and time is moved
+// by hand, no sockets and no clocks.
+#include <catch2/catch.hpp>
+
+#include <set>
+
+#include "core/session/client_session.hpp"
+#include "core/session/elements.hpp"
+#include "core/session/service_session.hpp"
+
+using namespace rr;
+using namespace std::chrono_literals;
+
+namespace {
+
+const NodeID kClientId = *NodeID::parse("11111111-2222-3333-4444-555555555555");
+const NodeID kServiceNodeId = *NodeID::parse("aaaaaaaa-bbbb-cccc-dddd-eeeeeeeeeeee");
+
+struct FakeService : HostedService {
+    std::string name_ = "svc";
+    bool auth = false;
+    const std::string& name() const override { return name_; }
+    std::vector<std::string> service_definitions() const override {
+        return {"service example.svc\nimport example.base\nobject Obj\nend\n", "service example.base\n"};
+    }
+    std::optional<std::string> service_definition(std::string_view type) const override {
+        if (type == "example.base") return std::string("service example.base\n");
+        return std::nullopt;
+    }
+    ObjectTypeInfo root_type() const override { return {"example.svc.Obj", {"example.base.Thing"}}; }
+    bool requires_authentication() const override { return auth; }
+    Result<void> authenticate(const std::string& user, const MessageElement* creds) override {
+        const MessageElement* pw = creds ? creds->find("password") : nullptr;
+        if (user == "alice" && pw && read_string(*pw) == "secret") return {};
+        return fail(MessageErrorType::AuthenticationError, "Invalid username or password");
+    }
+};
+
+struct FakeHost : ServiceHost {
+    std::shared_ptr<FakeService> service = std::make_shared<FakeService>();
+    std::uint32_t next = 100;
+    std::set<std::uint32_t> live;
+    std::shared_ptr<HostedService> hosted_service(std::string_view name) const override {
+        return name == "svc" ? service : nullptr;
+    }
+    std::uint32_t allocate_endpoint() override {
+        live.insert(next);
+        return next++;
+    }
+    void release_endpoint(std::uint32_t e) override { live.erase(e); }
+};
+
+struct Pair {
+    MonoTime now{};
+    FakeHost host;
+    ServiceSession service;
+    ClientSession client;
+    std::vector<ServiceSessionEvent> service_events;
+    std::vector<ClientSessionEvent> client_events;
+
+    static ServiceSessionConfig service_config() {
+        ServiceSessionConfig c;
+        c.stream.local_node_id = kServiceNodeId;
+        c.stream.local_node_name = "example.node";
+        c.callback_timeout = 2s;
+        c.wire_hold_bytes = 1024;
+        return c;
+    }
+    static ClientSessionConfig client_config(std::string service, std::string user = {}, std::string password = {}) {
+        ClientSessionConfig c;
+        c.stream.local_node_id = kClientId;
+        c.service_name = std::move(service);
+        c.username = std::move(user);
+        c.password = std::move(password);
+        c.local_endpoint = 42;
+        return c;
+    }
+
+    explicit Pair(std::string service_name = "svc", bool auth = false, std::string user = {}, std::string password = {})
+        : service(host, service_config(), now), client(client_config(std::move(service_name), std::move(user), std::move(password)), now) {
+        host.service->auth = auth;
+    }
+
+    // Moves bytes both ways until nothing is left, collecting events.
+    void pump() {
+        std::vector<std::byte> buf;
+        for (int i = 0; i < 100; ++i) {
+            bool moved = false;
+            if (client.pending_output_size()) {
+                client.take_output(buf);
+                service.feed(buf, now);
+                moved = true;
+            }
+            if (service.pending_output_size()) {
+                service.take_output(buf);
+                (void)client.feed(buf, now);
+                moved = true;
+            }
+            while (auto e = service.poll_event()) service_events.push_back(std::move(*e));
+            while (auto e = client.poll_event()) client_events.push_back(std::move(*e));
+            if (!moved) return;
+        }
+        FAIL("pump did not settle");
+    }
+
+    template <class T>
+    std::vector<T> take(std::vector<ServiceSessionEvent>& from) {
+        std::vector<T> out;
+        for (auto it = from.begin(); it != from.end();) {
+            if (auto* t = std::get_if<T>(&*it)) {
+                out.push_back(std::move(*t));
+                it = from.erase(it);
+            } else {
+                ++it;
+            }
+        }
+        return out;
+    }
+    template <class T>
+    std::vector<T> take_client() {
+        std::vector<T> out;
+        for (auto it = client_events.begin(); it != client_events.end();) {
+            if (auto* t = std::get_if<T>(&*it)) {
+                out.push_back(std::move(*t));
+                it = client_events.erase(it);
+            } else {
+                ++it;
+            }
+        }
+        return out;
+    }
+
+    void connect() {
+        pump();
+        REQUIRE(take_client<ClientSessionConnected>().size() == 1);
+        REQUIRE(take<ServiceSessionOpened>(service_events).size() == 1);
+    }
+};
+
+MessageEntry member_request(std::string member, MessageEntryType type = MessageEntryType::PropertyGetReq) {
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = "svc";
+    e.member_name = std::move(member);
+    return e;
+}
+
+MessageEntry reply_for(const MessageEntry& request) {
+    MessageEntry r;
+    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request.entry_type) + 1);
+    r.service_path = request.service_path;
+    r.member_name = request.member_name;
+    r.request_id = request.request_id;
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("service session: a client connects, the session opens with the service's types and definitions") {
+    Pair p;
+    p.pump();
+    auto connected = p.take_client<ClientSessionConnected>();
+    REQUIRE(connected.size() == 1);
+    CHECK(connected[0].info.object_type == "example.svc.Obj");
+    CHECK(connected[0].info.object_implements == std::vector<std::string>{"example.base.Thing"});
+    CHECK(connected[0].info.service_definitions.size() == 2);
+    auto opened = p.take<ServiceSessionOpened>(p.service_events);
+    REQUIRE(opened.size() == 1);
+    CHECK(opened[0].service == p.host.service);
+    CHECK(opened[0].client_endpoint == 42);
+    CHECK(p.service.endpoint() == opened[0].endpoint);
+    CHECK(p.host.live.count(opened[0].endpoint) == 1);
+    CHECK(p.client.remote_endpoint() == opened[0].endpoint);
+}
+
+TEST_CASE("service session: member requests go to the host in order and the replies reach the client") {
+    Pair p;
+    p.connect();
+    auto id1 = p.client.request(member_request("a"), p.now);
+    auto id2 = p.client.request(member_request("b", MessageEntryType::FunctionCallReq), p.now);
+    REQUIRE(id1);
+    REQUIRE(id2);
+    p.pump();
+    auto requests = p.take<ServiceRequest>(p.service_events);
+    REQUIRE(requests.size() == 2);
+    CHECK(requests[0].entry.member_name == "a");
+    CHECK(requests[1].entry.member_name == "b");
+    CHECK(requests[0].needs_reply);
+    // Answer the second first: each reply finds its request by RequestID.
+    MessageEntry r2 = reply_for(requests[1].entry);
+    r2.elements.push_back(make_scalar_element<std::int32_t>("return", 7));
+    p.service.reply(std::move(r2), p.now);
+    p.service.reply(reply_for(requests[0].entry), p.now);
+    p.pump();
+    auto responses = p.take_client<ClientResponse>();
+    REQUIRE(responses.size() == 2);
+    CHECK(responses[0].request_id == *id2);
+    REQUIRE(responses[0].entry);
+    std::int32_t v = 0;
+    REQUIRE(responses[0].entry->find("return"));
+    CHECK(read_scalar(*responses[0].entry->find("return"), v));
+    CHECK(v == 7);
+    CHECK(responses[1].request_id == *id1);
+}
+
+TEST_CASE("service session: a reply over the size limit becomes an error reply with the same RequestID") {
+    Pair p;
+    p.connect();
+    auto id = p.client.request(member_request("big"), p.now);
+    REQUIRE(id);
+    p.pump();
+    auto requests = p.take<ServiceRequest>(p.service_events);
+    REQUIRE(requests.size() == 1);
+    MessageEntry r = reply_for(requests[0].entry);
+    std::vector<std::uint8_t> huge(13u * 1024u * 1024u);
+    r.elements.push_back(make_array_element<std::uint8_t>("return", huge));
+    p.service.reply(std::move(r), p.now);
+    p.pump();
+    auto responses = p.take_client<ClientResponse>();
+    REQUIRE(responses.size() == 1);
+    CHECK(responses[0].request_id == *id);
+    REQUIRE(responses[0].entry);
+    CHECK(responses[0].entry->error == MessageErrorType::BufferLimitViolation);
+}
+
+TEST_CASE("service session: an unknown service is refused with a ServiceNotFound naming it") {
+    Pair p("nosuch");
+    p.pump();
+    auto closed = p.take_client<ClientSessionClosed>();
+    REQUIRE(closed.size() == 1);
+    CHECK(closed[0].error.type == MessageErrorType::ServiceNotFound);
+    CHECK(closed[0].error.message.find("nosuch") != std::string::npos);
+    CHECK(p.take<ServiceSessionOpened>(p.service_events).empty());
+    CHECK(p.host.live.empty());
+}
+
+TEST_CASE("service session: login with the connect, wrong password refused, logout blocks member requests") {
+    SECTION("wrong password") {
+        Pair p("svc", true, "alice", "nope");
+        p.pump();
+        auto closed = p.take_client<ClientSessionClosed>();
+        REQUIRE(closed.size() == 1);
+        CHECK(closed[0].error.type == MessageErrorType::AuthenticationError);
+        CHECK(p.take<ServiceSessionOpened>(p.service_events).empty());
+    }
+    SECTION("right password, then logout") {
+        Pair p("svc", true, "alice", "secret");
+        p.pump();
+        REQUIRE(p.take_client<ClientSessionConnected>().size() == 1);
+        auto opened = p.take<ServiceSessionOpened>(p.service_events);
+        REQUIRE(opened.size() == 1);
+        CHECK(opened[0].username == "alice");
+        CHECK(p.service.username() == "alice");
+
+        MessageEntry logout;
+        logout.entry_type = MessageEntryType::ClientSessionOpReq;
+        logout.member_name = "LogoutUser";
+        logout.elements.push_back(make_string_element("username", "alice"));
+        REQUIRE(p.client.request(std::move(logout), p.now));
+        p.pump();
+        auto users = p.take<ServiceSessionUser>(p.service_events);
+        REQUIRE(users.size() == 1);
+        CHECK(users[0].username.empty());
+
+        auto id = p.client.request(member_request("a"), p.now);
+        REQUIRE(id);
+        p.pump();
+        CHECK(p.take<ServiceRequest>(p.service_events).empty());  // never reaches the service
+        auto responses = p.take_client<ClientResponse>();
+        REQUIRE(responses.size() == 2);  // logout OK, then the refused request
+        REQUIRE(responses[1].entry);
+        CHECK(responses[1].entry->error == MessageErrorType::PermissionDenied);
+    }
+}
+
+TEST_CASE("service session: ObjectTypeName is asked of the host and answered later") {
+    Pair p;
+    p.connect();
+    MessageEntry q;
+    q.entry_type = MessageEntryType::ObjectTypeName;
+    q.service_path = "svc.child";
+    auto id = p.client.request(std::move(q), p.now);
+    REQUIRE(id);
+    p.pump();
+    auto queries = p.take<ServiceObjectTypeQuery>(p.service_events);
+    REQUIRE(queries.size() == 1);
+    CHECK(queries[0].path == "svc.child");
+    CHECK(p.take_client<ClientResponse>().empty());
+    p.service.answer_object_type(queries[0].token, ObjectTypeInfo{"example.svc.Child", {}}, p.now);
+    p.service.answer_object_type(queries[0].token, ObjectTypeInfo{"twice", {}}, p.now);  // ignored
+    p.pump();
+    auto responses = p.take_client<ClientResponse>();
+    REQUIRE(responses.size() == 1);
+    REQUIRE(responses[0].entry);
+    REQUIRE(responses[0].entry->find("objecttype"));
+    CHECK(read_string(*responses[0].entry->find("objecttype")) == "example.svc.Child");
+}
+
+TEST_CASE("service session: callbacks to the client are answered, time out, or fail on disconnect") {
+    Pair p;
+    p.connect();
+    MessageEntry cb = member_request("cb", MessageEntryType::CallbackCallReq);
+    auto id = p.service.request(cb, p.now);
+    REQUIRE(id);
+    p.pump();
+    auto incoming = p.take_client<ClientIncoming>();
+    REQUIRE(incoming.size() == 1);
+    CHECK(incoming[0].entry.entry_type == MessageEntryType::CallbackCallReq);
+    MessageEntry answer = reply_for(incoming[0].entry);
+    answer.elements.push_back(make_scalar_element<double>("return", 2.5));
+    REQUIRE(p.client.reply(std::move(answer), p.now));
+    p.pump();
+    auto responses = p.take<ServiceCallbackResponse>(p.service_events);
+    REQUIRE(responses.size() == 1);
+    CHECK(responses[0].request_id == *id);
+    REQUIRE(responses[0].entry);
+
+    // Unanswered: RequestTimeout once the deadline passes.
+    auto id2 = p.service.request(cb, p.now);
+    REQUIRE(id2);
+    p.pump();
+    REQUIRE(p.service.next_deadline());
+    p.now += 3s;
+    p.service.on_timer(p.now);
+    while (auto e = p.service.poll_event()) p.service_events.push_back(std::move(*e));
+    responses = p.take<ServiceCallbackResponse>(p.service_events);
+    REQUIRE(responses.size() == 1);
+    CHECK(responses[0].request_id == *id2);
+    REQUIRE_FALSE(responses[0].entry);
+    CHECK(responses[0].entry.error().type == MessageErrorType::RequestTimeout);
+
+    // Pending when the transport goes: ConnectionError, then the session and the connection close.
+    auto id3 = p.service.request(cb, p.now);
+    REQUIRE(id3);
+    p.service.on_transport_closed(make_error(MessageErrorType::ConnectionError, "gone"));
+    while (auto e = p.service.poll_event()) p.service_events.push_back(std::move(*e));
+    responses = p.take<ServiceCallbackResponse>(p.service_events);
+    REQUIRE(responses.size() == 1);
+    CHECK(responses[0].entry.error().type == MessageErrorType::ConnectionError);
+    CHECK(p.take<ServiceSessionClosed>(p.service_events).size() == 1);
+    CHECK(p.take<ServiceConnectionClosed>(p.service_events).size() == 1);
+    CHECK(p.host.live.empty());
+    CHECK(p.service.is_closed());
+}
+
+TEST_CASE("service session: wire packets wait while output is backed up, only the newest per member") {
+    Pair p;
+    p.connect();
+    // Back the output up past wire_hold_bytes (1024) without handing it to the transport.
+    MessageEntry ev = member_request("ev", MessageEntryType::EventReq);
+    std::vector<std::uint8_t> payload(4096);
+    ev.elements.push_back(make_array_element<std::uint8_t>("p", payload));
+    REQUIRE(p.service.send(ev, p.now));
+    for (int i = 1; i <= 3; ++i) {
+        MessageEntry w = member_request("w", MessageEntryType::WirePacket);
+        w.elements.push_back(make_scalar_element<std::int32_t>("value", i));
+        p.service.send_wire_packet(std::move(w), p.now);
+    }
+    MessageEntry other = member_request("w2", MessageEntryType::WirePacket);
+    other.elements.push_back(make_scalar_element<std::int32_t>("value", 9));
+    p.service.send_wire_packet(std::move(other), p.now);
+    p.pump();
+    auto incoming = p.take_client<ClientIncoming>();
+    REQUIRE(incoming.size() == 3);  // the event, then the newest value of each wire
+    CHECK(incoming[0].entry.entry_type == MessageEntryType::EventReq);
+    std::vector<std::pair<std::string, std::int32_t>> wires;
+    for (std::size_t i = 1; i < incoming.size(); ++i) {
+        std::int32_t v = 0;
+        REQUIRE(read_scalar(*incoming[i].entry.find("value"), v));
+        wires.emplace_back(incoming[i].entry.member_name, v);
+    }
+    std::sort(wires.begin(), wires.end());
+    CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 3}, {"w2", 9}});
+}
+
+TEST_CASE("service session: DisconnectClient ends the session and frees its endpoint; sends then fail") {
+    Pair p;
+    p.connect();
+    const auto endpoint = p.service.endpoint();
+    p.client.disconnect(p.now);
+    p.pump();
+    auto closed = p.take<ServiceSessionClosed>(p.service_events);
+    REQUIRE(closed.size() == 1);
+    CHECK(closed[0].endpoint == endpoint);
+    CHECK(p.host.live.empty());
+    CHECK_FALSE(p.service.has_session());
+    auto r = p.service.send(member_request("ev", MessageEntryType::EventReq), p.now);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::InvalidState);
+}
+
+TEST_CASE("service session: requests for another endpoint or before a session get InvalidEndpoint") {
+    Pair p;
+    p.pump();  // stream + session up
+    REQUIRE(p.take_client<ClientSessionConnected>().size() == 1);
+    // A hand-made message to a wrong endpoint, straight into the service side.
+    StreamConnection raw(StreamRole::client, [] {
+        StreamConfig c;
+        c.local_node_id = kClientId;
+        return c;
+    }(), p.now);
+    ServiceSession fresh(p.host, Pair::service_config(), p.now);
+    std::vector<std::byte> buf;
+    raw.take_output(buf);
+    fresh.feed(buf, p.now);
+    fresh.take_output(buf);
+    REQUIRE(raw.feed(buf, p.now));
+    Message m;
+    m.header.sender_node_id = kClientId;
+    m.header.receiver_node_id = kServiceNodeId;
+    m.header.sender_endpoint = 5;
+    m.header.receiver_endpoint = 12345;
+    MessageEntry e = member_request("a");
+    e.request_id = 1;
+    m.entries.push_back(e);
+    REQUIRE(raw.send(m, p.now));
+    raw.take_output(buf);
+    fresh.feed(buf, p.now);
+    CHECK_FALSE(fresh.poll_event());  // nothing for the host
+    fresh.take_output(buf);
+    REQUIRE(raw.feed(buf, p.now));
+    bool got = false;
+    while (auto ev = raw.poll_event()) {
+        if (auto* sm = std::get_if<StreamMessage>(&*ev)) {
+            REQUIRE(sm->message.entries.size() == 1);
+            CHECK(sm->message.entries[0].error == MessageErrorType::InvalidEndpoint);
+            got = true;
+        }
+    }
+    CHECK(got);
+}
+
+TEST_CASE("service session: ObjectTypeName queries a client may have waiting are bounded") {
+    Pair p;
+    p.connect();
+    for (int i = 0; i < 300; ++i) {
+        MessageEntry q;
+        q.entry_type = MessageEntryType::ObjectTypeName;
+        q.service_path = "svc.o" + std::to_string(i);
+        REQUIRE(p.client.request(std::move(q), p.now));
+    }
+    p.pump();
+    auto queries = p.take<ServiceObjectTypeQuery>(p.service_events);
+    CHECK(queries.size() == 256);
+    auto responses = p.take_client<ClientResponse>();
+    REQUIRE(responses.size() == 44);
+    for (const auto& r : responses) {
+        REQUIRE(r.entry);
+        CHECK(r.entry->error == MessageErrorType::BufferLimitViolation);
+    }
+}

@@ -1,0 +1,15 @@
+// The JSON API of docs/json-api.md on an HTTP server: REST routes under /api/devices and the
+// `rr-gateway.json.v1` WebSocket, over the gateway's devices.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "server/gateway/device_mirror.hpp"
+#include "server/http/http_server.hpp"
+
+namespace rr::server::gateway {
+
+void install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices);
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,339 @@
+#include "server/node/server_connection.hpp"
+
+#include "core/session/elements.hpp"
+
+namespace rr::server {
+namespace {
+
+std::size_t estimate_size(const MessageElement& e) {
+    std::size_t n = 16 + e.name.size() + e.type_name.size() + e.data.size();
+    for (const auto& c : e.elements) n += estimate_size(c);
+    return n;
+}
+
+std::size_t estimate_size(const MessageEntry& e) {
+    std::size_t n = 64 + e.service_path.size() + e.member_name.size();
+    for (const auto& c : e.elements) n += estimate_size(c);
+    return n;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// SessionRef / Responder
+
+SessionRef::SessionRef(std::weak_ptr<ServerSession> s) : session_(std::move(s)) {
+    if (auto p = session_.lock()) endpoint_ = p->endpoint();
+}
+
+std::string SessionRef::username() const {
+    auto p = session_.lock();
+    return p ? p->username() : std::string();
+}
+
+bool SessionRef::alive() const {
+    auto p = session_.lock();
+    return p && p->alive();
+}
+
+Result<void> SessionRef::send(MessageEntry entry) const {
+    auto p = session_.lock();
+    if (!p) return fail(MessageErrorType::ConnectionError, "client session closed");
+    return p->send(std::move(entry));
+}
+
+Result<void> SessionRef::send_wire_packet(MessageEntry entry) const {
+    auto p = session_.lock();
+    if (!p) return fail(MessageErrorType::ConnectionError, "client session closed");
+    return p->send_wire_packet(std::move(entry));
+}
+
+void SessionRef::request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) const {
+    auto p = session_.lock();
+    if (!p) {
+        done(fail(MessageErrorType::ConnectionError, "client session closed"));
+        return;
+    }
+    p->request(std::move(entry), std::move(done));
+}
+
+std::size_t SessionRef::queued_bytes() const {
+    auto p = session_.lock();
+    return p ? p->queued_bytes() : 0;
+}
+
+std::string SessionRef::local_url() const {
+    auto p = session_.lock();
+    return p ? p->local_url() : std::string();
+}
+
+Responder::Responder(std::function<void(MessageEntry)> send, MessageEntry request_header)
+    : send_(std::move(send)), request_(std::move(request_header)) {
+    request_.elements.clear();
+}
+
+Responder::~Responder() {
+    if (send_) fail(make_error(MessageErrorType::InternalError, "request was not answered"));
+}
+
+void Responder::respond(MessageEntry reply) {
+    if (!send_) return;
+    if (reply.entry_type == MessageEntryType::Null)
+        reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_.entry_type) + 1);
+    reply.service_path = request_.service_path;
+    reply.member_name = request_.member_name;
+    reply.request_id = request_.request_id;
+    auto send = std::move(send_);
+    send_ = nullptr;
+    send(std::move(reply));
+}
+
+void Responder::fail(RRError error) {
+    if (!send_) return;
+    MessageEntry r;
+    set_entry_error(r, error);
+    respond(std::move(r));
+}
+
+// ---------------------------------------------------------------------------------------------
+// ServerSession
+
+ServerSession::ServerSession(std::uint32_t endpoint, std::uint32_t client_endpoint, std::shared_ptr<Service> service,
+                             std::weak_ptr<PumpHandle> pump, std::weak_ptr<ServerConnection> connection,
+                             std::size_t max_queue)
+    : endpoint_(endpoint), client_endpoint_(client_endpoint), service_(std::move(service)), pump_(std::move(pump)),
+      connection_(std::move(connection)), max_queue_(max_queue) {}
+
+std::string ServerSession::username() const {
+    std::lock_guard lock(mutex_);
+    return username_;
+}
+
+void ServerSession::set_username(std::string name) {
+    std::lock_guard lock(mutex_);
+    username_ = std::move(name);
+}
+
+std::string ServerSession::local_url() const {
+    auto c = connection_.lock();
+    return c ? c->local_url() : std::string();
+}
+
+Result<void> ServerSession::send(MessageEntry entry) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
+    const std::size_t size = estimate_size(entry);
+    if (queued_.load() + size > max_queue_) return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
+    queued_.fetch_add(size);
+    // dispatch: on the session's own strand (a handler sending an event or ServicePathReleased before
+    // answering) the entry is queued at once, so it reaches the client before the reply.
+    pump->dispatch([conn = connection_, entry = std::move(entry)]() mutable {
+        if (auto c = conn.lock()) c->send_session_entry(std::move(entry));
+    });
+    return {};
+}
+
+Result<void> ServerSession::send_wire_packet(MessageEntry entry) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
+    auto key = std::make_pair(entry.service_path, entry.member_name);
+    bool post = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto [it, inserted] = wire_pending_.insert_or_assign(key, std::move(entry));
+        post = inserted;  // an older packet not yet sent is replaced: wires keep only the newest value
+    }
+    if (post) {
+        // dispatch, as send(): from the session's own strand the packet goes out before the reply.
+        pump->dispatch([conn = connection_, key] {
+            if (auto c = conn.lock()) c->send_wire_entry(key);
+        });
+    }
+    return {};
+}
+
+std::optional<MessageEntry> ServerSession::take_wire_packet(const std::pair<std::string, std::string>& key) {
+    std::lock_guard lock(mutex_);
+    auto it = wire_pending_.find(key);
+    if (it == wire_pending_.end()) return std::nullopt;
+    MessageEntry e = std::move(it->second);
+    wire_pending_.erase(it);
+    return e;
+}
+
+void ServerSession::request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) {
+        done(fail(MessageErrorType::ConnectionError, "client session closed"));
+        return;
+    }
+    pump->post([conn = connection_, entry = std::move(entry), done = std::move(done)]() mutable {
+        if (auto c = conn.lock())
+            c->send_session_request(std::move(entry), std::move(done));
+        else
+            done(fail(MessageErrorType::ConnectionError, "client session closed"));
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// ServerConnection
+
+ServerConnection::ServerConnection(std::shared_ptr<ServiceRegistry> services, std::shared_ptr<NodeStats> stats,
+                                   ServerConnectionConfig config, std::string local_url, MonoTime now)
+    : services_(std::move(services)), stats_(std::move(stats)), config_(std::move(config)), local_url_(std::move(local_url)),
+      session_(*services_, ServiceSessionConfig{config_.stream, config_.callback_timeout, config_.wire_hold_bytes}, now) {
+    stats_->connections_open.fetch_add(1);
+    stats_->connections_total.fetch_add(1, std::memory_order_relaxed);
+}
+
+ServerConnection::~ServerConnection() {
+    if (current_) current_->mark_closed();
+    stats_->connections_open.fetch_sub(1);
+}
+
+void ServerConnection::on_bytes(std::span<const std::byte> bytes, MonoTime now) {
+    stats_->bytes_in.fetch_add(bytes.size(), std::memory_order_relaxed);
+    session_.feed(bytes, now);
+    drain_events();
+}
+
+void ServerConnection::take_output(std::vector<std::byte>& out) {
+    session_.take_output(out);
+    stats_->bytes_out.fetch_add(out.size(), std::memory_order_relaxed);
+    update_queue_estimate();
+}
+
+void ServerConnection::on_timer(MonoTime now) {
+    session_.on_timer(now);
+    drain_events();
+}
+
+void ServerConnection::on_transport_closed(RRError error) {
+    session_.on_transport_closed(std::move(error));
+    drain_events();
+}
+
+void ServerConnection::update_queue_estimate() {
+    if (current_) current_->set_queued_bytes(session_.pending_output_size());
+}
+
+void ServerConnection::drain_events() {
+    // Handlers may send (SessionRef::send runs inline on the strand) and so come back here: only the
+    // outermost call takes events, so requests are handed to the service in the order they arrived.
+    if (draining_) return;
+    draining_ = true;
+    struct Done {
+        bool& flag;
+        ~Done() { flag = false; }
+    } done_draining{draining_};
+    while (auto ev = session_.poll_event()) {
+        if (auto* opened = std::get_if<ServiceSessionOpened>(&*ev)) {
+            auto service = std::static_pointer_cast<Service>(opened->service);
+            current_ = std::make_shared<ServerSession>(opened->endpoint, opened->client_endpoint, service, pump_,
+                                                       weak_from_this(), config_.max_send_queue_bytes);
+            current_->set_username(opened->username);
+            service->on_session_open(SessionRef(current_));
+        } else if (auto* user = std::get_if<ServiceSessionUser>(&*ev)) {
+            if (current_) current_->set_username(std::move(user->username));
+        } else if (auto* request = std::get_if<ServiceRequest>(&*ev)) {
+            on_request(std::move(*request));
+        } else if (auto* query = std::get_if<ServiceObjectTypeQuery>(&*ev)) {
+            on_object_type_query(std::move(*query));
+        } else if (auto* response = std::get_if<ServiceCallbackResponse>(&*ev)) {
+            auto it = callbacks_.find(response->request_id);
+            if (it == callbacks_.end()) continue;
+            auto done = std::move(it->second);
+            callbacks_.erase(it);
+            done(std::move(response->entry));
+        } else if (std::holds_alternative<ServiceSessionClosed>(*ev)) {
+            if (!current_) continue;
+            auto s = std::move(current_);
+            current_.reset();
+            s->mark_closed();
+            s->service()->on_session_close(SessionRef(s));
+        }
+        // ServiceConnectionClosed: the pump closes the transport (wants_close()).
+    }
+    const auto in = session_.messages_in(), out = session_.messages_out();
+    stats_->messages_in.fetch_add(in - messages_in_seen_, std::memory_order_relaxed);
+    stats_->messages_out.fetch_add(out - messages_out_seen_, std::memory_order_relaxed);
+    messages_in_seen_ = in;
+    messages_out_seen_ = out;
+    update_queue_estimate();
+}
+
+void ServerConnection::on_request(ServiceRequest&& request) {
+    if (!current_) return;
+    auto service = current_->service();
+    if (!request.needs_reply) {
+        service->handle_entry(SessionRef(current_), std::move(request.entry), Responder());
+        return;
+    }
+    Responder responder = make_responder(request.entry);
+    service->handle_entry(SessionRef(current_), std::move(request.entry), std::move(responder));
+}
+
+void ServerConnection::on_object_type_query(ServiceObjectTypeQuery&& query) {
+    auto service = std::static_pointer_cast<Service>(query.service);
+    std::weak_ptr<ServerConnection> weak = weak_from_this();
+    std::weak_ptr<PumpHandle> pump = pump_;
+    service->object_type(SessionRef(current_), query.path, [weak, pump, token = query.token](Result<ObjectTypeInfo> info) mutable {
+        auto p = pump.lock();
+        if (!p) return;
+        p->post([weak, token, info = std::move(info)]() mutable {
+            if (auto c = weak.lock()) {
+                c->session_.answer_object_type(token, std::move(info), mono_now());
+                c->drain_events();
+            }
+        });
+    });
+}
+
+Responder ServerConnection::make_responder(const MessageEntry& request) {
+    std::weak_ptr<ServerConnection> weak = weak_from_this();
+    std::weak_ptr<PumpHandle> pump = pump_;
+    return Responder(
+        [weak, pump](MessageEntry reply) {
+            // The responder may complete on any thread; on the strand itself the reply goes out at once.
+            auto p = pump.lock();
+            if (!p) return;
+            p->dispatch([weak, reply = std::move(reply)]() mutable {
+                if (auto c = weak.lock()) c->reply(std::move(reply));
+            });
+        },
+        request);
+}
+
+void ServerConnection::reply(MessageEntry entry) {
+    session_.reply(std::move(entry), mono_now());
+    drain_events();
+}
+
+void ServerConnection::send_session_entry(MessageEntry entry) {
+    // A reply sent through SessionRef::send keeps the reply rules (never lost: an error reply instead).
+    if (!is_request(entry.entry_type) && entry.request_id != 0)
+        session_.reply(std::move(entry), mono_now());
+    else
+        (void)session_.send(std::move(entry), mono_now());
+    drain_events();
+}
+
+void ServerConnection::send_wire_entry(const std::pair<std::string, std::string>& key) {
+    if (!current_) return;
+    auto entry = current_->take_wire_packet(key);
+    if (!entry) return;
+    session_.send_wire_packet(std::move(*entry), mono_now());
+    drain_events();
+}
+
+void ServerConnection::send_session_request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {
+    auto id = session_.request(std::move(entry), mono_now());
+    if (!id) {
+        done(id.take_error());
+        return;
+    }
+    callbacks_.emplace(*id, std::move(done));
+    drain_events();
+}
+
+}  // namespace rr::server
