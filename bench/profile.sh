@@ -85,7 +85,7 @@ annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[
 dev=$!
 for _ in $(seq 1 100); do [ -s "$tmp/dev" ] && break; sleep 0.1; done
 durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/dev")
-valgrind --tool=callgrind --callgrind-out-file="$tmp/gw.out" "$BUILD/server/app/rr-gateway" --no-demo --port 0 \
+valgrind --tool=callgrind --callgrind-out-file="$tmp/gw.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local --port 0 \
   --log-level warning --device "bench=$durl" > "$tmp/gw" 2>> "$tmp/valgrind.log" &
 gw=$!
 for _ in $(seq 1 600); do [ -s "$tmp/gw" ] && break; sleep 0.1; done

@@ -185,7 +185,7 @@ def main(argv=None):
         procs.append(ours)
         official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket"], "official_service")
         procs.append(official)
-        gw = Proc([exe["rr-gateway"], "--no-demo", "--port", "0", "--log-level", "warning",
+        gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
                    "--device", "bench=" + ours.ready["url"]], "rr-gateway")
         procs.append(gw)
         gw_url = "rr+tcp://127.0.0.1:%d/?service=bench" % gw.ready["port"]
@@ -234,14 +234,14 @@ def main(argv=None):
         if not args.skip_fanout or not args.skip_scale:
             dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
             procs.append(dev)
-            gw = Proc([exe["rr-gateway"], "--no-demo", "--port", "0", "--log-level", "warning",
+            gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
                        "--device", "bench=" + dev.ready["url"]], "rr-gateway")
             procs.append(gw)
             time.sleep(1.0)
             gpid = gw.p.pid
             if not args.skip_scale:
                 # a fresh gateway: its RSS is not yet inflated by the fan-out's traffic (the allocator keeps it)
-                sg = Proc([exe["rr-gateway"], "--no-demo", "--port", "0", "--log-level", "warning",
+                sg = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
                            "--device", "bench=" + dev.ready["url"]], "rr-gateway (scale)")
                 procs.append(sg)
                 for n in ([1000] if args.quick else [1000, 10000]):

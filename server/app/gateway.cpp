@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "server/app/log.hpp"
+#include "server/transport/local/local_listener.hpp"
 
 namespace rr::server::app {
 
@@ -23,6 +24,29 @@ std::string escape_label(std::string_view v) {
     return out;
 }
 
+// The NodeName of a node that will serve rr+local, held for this process, and its NodeID from the
+// NodeID cache (docs/local-transport.md). Errors name the fix.
+Result<std::optional<local::NodeNameReservation>> reserve_local_name(bool local, const std::string& name) {
+    if (!local || name.empty()) return std::optional<local::NodeNameReservation>();
+    auto r = local::reserve_node_name(local::default_node_directories(), name);
+    if (!r)
+        return fail(r.error().type, "rr+local: " + r.error().message +
+                                        (r.error().type == MessageErrorType::InvalidOperation
+                                             ? " (another gateway or node with NodeName \"" + name +
+                                                   "\" runs on this computer: give this gateway another gateway.node_name "
+                                                   "(--robotraconteur-nodename) or turn rr+local off (gateway.local: false, --no-local))"
+                                             : std::string()));
+    return std::optional<local::NodeNameReservation>(std::move(*r));
+}
+
+Result<void> serve_local(const std::shared_ptr<Node>& node, std::optional<local::NodeNameReservation> reservation) {
+    auto l = local::listen_local(node, {}, std::move(reservation));
+    if (!l) return fail(l.error().type, "rr+local: " + l.error().message + " (turn rr+local off with gateway.local: false, --no-local)");
+    log(LogLevel::info, "rr+local: " + (*l)->url() +
+                            (node->node_name().empty() ? std::string() : " (rr+local:///?nodename=" + node->node_name() + ")"));
+    return {};
+}
+
 }  // namespace
 
 Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarter demo, ApiInstaller api) {
@@ -36,6 +60,9 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     opts.threads = c.threads;
     opts.server.stream.limits.max_message_size = c.max_message_size;
     opts.server.stream.heartbeat_period = std::chrono::milliseconds(12000);  // a server's period (wire.md §6.3)
+    auto reservation = reserve_local_name(c.local, c.node_name);
+    if (!reservation) return reservation.take_error();
+    if (*reservation && c.node_id.empty()) opts.node_id = (*reservation)->node_id;
     g->node_ = Node::create(opts);
 
     std::vector<gateway::DeviceConfig> devices = c.devices;
@@ -44,9 +71,15 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         NodeOptions dopts;
         dopts.node_name = c.node_name + ".demo";
         dopts.threads = 2;
+        auto demo_reservation = reserve_local_name(c.local, dopts.node_name);
+        if (!demo_reservation) return demo_reservation.take_error();
+        if (*demo_reservation) dopts.node_id = (*demo_reservation)->node_id;
         g->demo_node_ = Node::create(dopts);
         auto port = g->demo_node_->listen_tcp("127.0.0.1", c.demo_port);
         if (!port) return port.take_error();
+        if (c.local) {
+            if (auto r = serve_local(g->demo_node_, std::move(*demo_reservation)); !r) return r.take_error();
+        }
         auto demo_devices = demo(g->demo_node_, *port);
         if (!demo_devices) return demo_devices.take_error();
         for (auto& d : *demo_devices) {
@@ -108,6 +141,9 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     auto port = g->node_->listen_tcp(c.listen, c.port);
     if (!port) return port.take_error();
     g->port_ = *port;
+    if (c.local) {
+        if (auto r = serve_local(g->node_, std::move(*reservation)); !r) return r.take_error();
+    }
     return g;
 }
 

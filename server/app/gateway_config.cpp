@@ -1,5 +1,6 @@
 #include "server/app/gateway_config.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <fstream>
 #include <set>
@@ -74,7 +75,18 @@ private:
 
 const std::set<std::string> kLogLevels{"trace", "debug", "info", "warning", "error", "fatal", "disable"};
 
+// NodeName syntax of the official library's NodeID cache (wire.md §13): also what rr+local accepts.
+bool valid_node_name(const std::string& name) {
+    if (name.empty()) return true;
+    if (!std::isalpha(static_cast<unsigned char>(name[0]))) return false;
+    for (char ch : name)
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '.' && ch != '-') return false;
+    return true;
+}
+
 void validate(const GatewayConfig& c, const std::function<void(const std::string&, const std::string&)>& error) {
+    if (!valid_node_name(c.node_name))
+        error("gateway.node_name", "not a NodeName (letters, digits, _ . -, starting with a letter): \"" + c.node_name + "\"");
     if (!c.node_id.empty() && !NodeID::parse(c.node_id)) error("gateway.node_id", "not a NodeID (UUID)");
     if (!kLogLevels.count(c.log_level)) error("gateway.log_level", "unknown level \"" + c.log_level + "\"");
     if (c.max_message_size < 16 * 1024 || c.max_message_size > 100u * 1024u * 1024u)
@@ -92,10 +104,14 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins",
-                      "max_message_size", "log_level"});
+                      "max_message_size", "log_level", "local"});
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
-        if (auto n = g["node_name"]) c.node_name = r.string(n, "gateway.node_name");
+        if (auto n = g["node_name"]) {
+            c.node_name = r.string(n, "gateway.node_name");
+            if (!valid_node_name(c.node_name))
+                r.error(n, "gateway.node_name", "not a NodeName (letters, digits, _ . -, starting with a letter)");
+        }
         if (auto n = g["node_id"]) {
             c.node_id = r.string(n, "gateway.node_id");
             if (!NodeID::parse(c.node_id)) r.error(n, "gateway.node_id", "not a NodeID (UUID)");
@@ -107,6 +123,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             c.max_message_size = r.unsigned_int(n, "gateway.max_message_size", 100u * 1024u * 1024u);
             if (c.max_message_size < 16 * 1024) r.error(n, "gateway.max_message_size", "must be at least 16384");
         }
+        if (auto n = g["local"]) c.local = r.boolean(n, "gateway.local");
         if (auto n = g["log_level"]) {
             c.log_level = r.string(n, "gateway.log_level");
             if (!kLogLevels.count(c.log_level)) r.error(n, "gateway.log_level", "unknown level \"" + c.log_level + "\"");
@@ -173,7 +190,7 @@ const std::set<std::string> kValueFlags{"--config",      "--port",       "--list
                                         "--allow-origin", "--device",     "--demo-port", "--threads",
                                         "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--check", "--help", "-h"};
+const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--check", "--help", "-h"};
 
 }  // namespace
 
@@ -246,6 +263,8 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.allowed_origins.push_back(v);
         } else if (flag == "--no-demo") {
             c.demo = false;
+        } else if (flag == "--no-local") {
+            c.local = false;
         } else if (flag == "--robotraconteur-nodename") {
             c.node_name = v;
         } else if (flag == "--robotraconteur-nodeid") {
@@ -292,7 +311,9 @@ Options (override the configuration file):
   --web-root DIR             dashboard files to serve
   --allow-origin ORIGIN      allow a browser Origin (repeatable)
   --device NAME=URL          add a device, e.g. reynard=rr+tcp://localhost:29200/?service=reynard
+                             or cam=rr+local:///?nodename=camera.driver&service=cam
   --no-demo                  do not start the demo devices
+  --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
   --demo-port N              RR port of the demo devices' node (default: ephemeral)
   --threads N                worker threads (default: cores)
   --log-level LEVEL          trace, debug, info, warning, error

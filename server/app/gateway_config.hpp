@@ -25,6 +25,9 @@ struct GatewayConfig {
     std::vector<std::string> allowed_origins;
     std::size_t max_message_size = 12u * 1024u * 1024u;
     std::string log_level = "info";
+    /// Serve rr+local under node_name (and the demo node's under node_name + ".demo"), so clients on
+    /// this computer reach the gateway by NodeName without TCP (docs/local-transport.md).
+    bool local = true;
     // demo:
     bool demo = true;
     std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)
@@ -50,7 +53,7 @@ struct CommandLine {
 
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
-/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --check,
+/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local, --check,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
 Result<CommandLine> parse_command_line(int argc, const char* const* argv);

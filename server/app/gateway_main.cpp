@@ -62,9 +62,12 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     log(LogLevel::info, "rr-gateway listening on port " + std::to_string((*gateway)->port()) +
-                            " (RR rr+tcp and rr+ws, HTTP; dashboard http://localhost:" +
+                            " (RR rr+tcp and rr+ws" + std::string(config.local ? ", rr+local" : "") +
+                            ", HTTP; dashboard http://localhost:" +
                             std::to_string((*gateway)->port()) + "/)");
-    std::cout << "{\"port\": " << (*gateway)->port() << "}" << std::endl;
+    // The ready line, for scripts: the port, and the node's identity (rr+local:///?nodename=… / ?nodeid=…).
+    std::cout << "{\"port\": " << (*gateway)->port() << ", \"nodeid\": \"" << (*gateway)->node()->node_id().to_string()
+              << "\", \"nodename\": \"" << (*gateway)->node()->node_name() << "\"}" << std::endl;
     while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
     log(LogLevel::info, "shutting down");
     (*gateway)->stop();

@@ -6,8 +6,13 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 
+#include <cstdlib>
+
 #include "server/app/gateway.hpp"
+#include "server/client/client.hpp"
+#include "server/demo/demo_devices.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/local/local_test_support.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -42,6 +47,7 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     probe->shutdown();
 
     GatewayConfig cfg;
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = 0;
     cfg.listen = "127.0.0.1";
     cfg.demo = false;
@@ -78,6 +84,7 @@ TEST_CASE("a gateway that cannot listen fails to start and says why") {
     auto holder = Node::create(NodeOptions{NodeID(), "holder", 1, {}, 0, 5000ms});
     const auto port = *holder->listen_tcp("127.0.0.1", 0);
     GatewayConfig cfg;
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = port;
     cfg.listen = "127.0.0.1";
     cfg.demo = false;
@@ -85,4 +92,70 @@ TEST_CASE("a gateway that cannot listen fails to start and says why") {
     REQUIRE_FALSE(gw);
     CHECK(gw.error().type == MessageErrorType::IOError);
     CHECK_THAT(gw.error().message, Catch::Contains(std::to_string(port)));
+}
+
+TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under NAME.demo); a second gateway with that name is refused") {
+    // This process's node directories in a temporary tree (root uses the system dirs, others the user dirs).
+    local::testing::TempNodeDirs tmp;
+    for (const auto& [var, dir] : {std::pair{"ROBOTRACONTEUR_SYSTEM_RUN_DIR", tmp.dirs.system_run_dir},
+                                   {"ROBOTRACONTEUR_SYSTEM_STATE_DIR", tmp.dirs.system_state_dir},
+                                   {"ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", tmp.dirs.system_config_dir},
+                                   {"ROBOTRACONTEUR_USER_RUN_DIR", tmp.dirs.user_run_dir},
+                                   {"ROBOTRACONTEUR_USER_CONFIG_DIR", tmp.dirs.user_config_dir}})
+        REQUIRE(::setenv(var, dir.c_str(), 1) == 0);
+
+    auto device = Node::create(NodeOptions{NodeID(), "dev.node", 2, {}, 0, 5000ms});
+    REQUIRE(device->register_service(std::make_shared<testing::RawTestService>()));
+    const auto port = *device->listen_tcp("127.0.0.1", 0);
+
+    const std::string name = local::testing::unique_node_name("gwtest");
+    GatewayConfig cfg;
+    cfg.local = true;
+    cfg.node_name = name;
+    cfg.port = 0;
+    cfg.listen = "127.0.0.1";
+    cfg.demo = true;
+    gateway::DeviceConfig d;
+    d.name = "dev";
+    d.url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
+    cfg.devices.push_back(d);
+    DemoStarter demo = [](const std::shared_ptr<Node>& node, std::uint16_t demo_port) {
+        return demo::start_demo_devices_for_gateway(*node, demo_port);
+    };
+    auto gw = Gateway::start(cfg, demo);
+    REQUIRE(gw);
+    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*gw)->ready());
+
+    client::IoThreads io(1);
+    for (const std::string url : {"rr+local:///?nodename=" + name + "&service=dev",
+                                  "rr+local:///?nodeid=" + (*gw)->node()->node_id().to_string() + "&service=dev"}) {
+        INFO(url);
+        auto c = client::Client::connect(io.executor(), url);
+        INFO((c ? std::string() : c.error().message));
+        REQUIRE(c);
+        auto x = (*c)->root().get("x");
+        REQUIRE(x);
+        CHECK(*x == Value::scalar(42.5));
+        CHECK((*c)->close_wait().ok());
+    }
+
+    // The demo devices' own node, by its NodeName.
+    auto demo_client = client::Client::connect(io.executor(), "rr+local:///?nodename=" + name + ".demo&service=create");
+    INFO((demo_client ? std::string() : demo_client.error().message));
+    REQUIRE(demo_client);
+    CHECK((*demo_client)->root().type() == "experimental.create.Create");
+    CHECK((*demo_client)->close_wait().ok());
+
+    auto second = Gateway::start(cfg, demo);
+    REQUIRE_FALSE(second);
+    CHECK_THAT(second.error().message, Catch::Contains(name) && Catch::Contains("--no-local"));
+
+    (*gw)->stop();
+    // The names are free again once the first gateway is gone.
+    cfg.devices.clear();
+    auto third = Gateway::start(cfg, demo);
+    INFO((third ? std::string() : third.error().message));
+    CHECK(third);
+    device->shutdown();
 }

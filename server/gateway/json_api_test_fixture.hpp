@@ -122,6 +122,7 @@ class TestGateway {
 public:
     explicit TestGateway(const std::string& url, bool wait = true, JsonSocketOptions ws_options = {}) {
         app::GatewayConfig cfg;
+        cfg.local = false;  // tests run side by side: no shared NodeName on this computer
         cfg.port = 0;
         cfg.listen = "127.0.0.1";
         cfg.demo = false;

@@ -343,6 +343,7 @@ TEST_CASE("json api: the installer of rr-gateway serves the same API") {
     if (!interop_service_built()) return;
     InteropProcess device;
     app::GatewayConfig cfg;
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = 0;
     cfg.listen = "127.0.0.1";
     cfg.demo = false;

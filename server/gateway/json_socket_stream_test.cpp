@@ -25,6 +25,7 @@ json webcam(std::string op, std::string m, json more = json::object()) {
 
 TEST_CASE("json socket: requests to a device are answered while its pipe streams camera frames") {
     app::GatewayConfig cfg;
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = 0;
     cfg.listen = "127.0.0.1";
     cfg.demo = true;

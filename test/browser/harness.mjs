@@ -87,7 +87,7 @@ export async function startReynard(s, rrPort = 0) {
  * and `extraArgs` (e.g. ["--allow-origin", ORIGIN]).
  */
 export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = []) {
-  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning",
+  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning", "--no-local",
     ...extraArgs];
   for (const [name, url] of Object.entries(devices)) args.push("--device", `${name}=${url}`);
   const child = new Child("rr-gateway", s.gateway, args);

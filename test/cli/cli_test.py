@@ -298,8 +298,28 @@ def usage_checks(exe):
 
 def node_index_checks(rr, service_url, name, root_type):
     out = rr.ok("info", url=without_service(service_url))
-    check(re.search(rf"(?m)^{re.escape(name)}  {re.escape(root_type)}  rr\+tcp://\S+service={re.escape(name)}$", out),
+    scheme = "local" if service_url.startswith("rr+local:") else "tcp"
+    check(re.search(rf"(?m)^{re.escape(name)}  {re.escape(root_type)}  rr\+{scheme}://\S+service={re.escape(name)}$", out),
           f"info without service= lists {name} from the node's service index", out[:600])
+
+
+def local_error_checks(exe, node_name):
+    """rr+local errors: each a clear message and a non-zero exit, nothing hangs."""
+    missing = f"rr+local:///?nodename=no.such.{node_name}&service=interop"
+    p = subprocess.run([exe, "get", missing, "p_int32"], capture_output=True, text=True, timeout=30)
+    check(p.returncode == CONNECT and "no local node named" in p.stderr, "rr+local: an unknown NodeName is a connect error",
+          f"rc={p.returncode} stderr={p.stderr.strip()}")
+    p = subprocess.run([exe, "get", "rr+local://somehost/?nodename=x&service=interop", "p_int32"], capture_output=True,
+                       text=True, timeout=30)
+    check(p.returncode != OK and "host must be empty" in p.stderr, "rr+local: a host other than localhost is refused",
+          f"rc={p.returncode} stderr={p.stderr.strip()}")
+
+
+def stale_checks(exe, url):
+    """After an official node stopped (it leaves its entries behind), its entry is reported stale."""
+    p = subprocess.run([exe, "get", url, "p_int32"], capture_output=True, text=True, timeout=30)
+    check(p.returncode == CONNECT and "stale" in p.stderr, "rr+local: a stopped official node's entry is reported stale",
+          f"rc={p.returncode} stderr={p.stderr.strip()}")
 
 
 def main():
@@ -309,19 +329,25 @@ def main():
     ap.add_argument("--url", help="service URL (--target url)")
     ap.add_argument("--service", help="rr_interop_service executable (--target ours)")
     ap.add_argument("--no-node-index", action="store_true", help="skip `rr info` without service=")
+    ap.add_argument("--local", action="store_true",
+                    help="--target ours/official: the service serves rr+local under a NodeName of this run; rr uses it")
     args = ap.parse_args()
+    local_name = f"cli.t{os.getpid()}"
 
     usage_checks(args.rr)
     if args.target == "url":
         proc, ready = None, {"url": args.url}
     elif args.target == "ours":
-        proc, ready = start([args.service, "--port", "0", "--max-lifetime", "280"])
+        proc, ready = start([args.service, "--port", "0", "--max-lifetime", "280"] +
+                            (["--local-name", local_name] if args.local else []))
     elif args.target == "official":
         proc, ready = start([sys.executable, os.path.join(INTEROP, "official_service.py"), "--port", "0",
-                             "--max-lifetime", "280"])
+                             "--max-lifetime", "280"] + (["--node-setup", local_name] if args.local else []))
     else:
         proc, ready = start([sys.executable, os.path.join(INTEROP, "reynard_harness.py"), "--max-lifetime", "200"],
                             timeout=90)
+    if args.local:
+        ready["url"] = ready["local_url"]
     try:
         rr = Rr(args.rr, ready["url"])
         if args.target == "reynard":
@@ -337,9 +363,17 @@ def main():
             interop_checks(rr, ready["url"])
             if not args.no_node_index:
                 node_index_checks(rr, ready["url"], "interop", "experimental.interop_test.Root")
+        if args.local:
+            local_error_checks(args.rr, local_name)
     finally:
         if proc is not None:
             stop(proc)
+    if args.local and args.target == "official":
+        stale_checks(args.rr, ready["url"])
+    if args.local:
+        sys.path.insert(0, INTEROP)
+        from through_gateway import forget_node_names  # noqa: E402
+        forget_node_names([local_name], [ready.get("nodeid", "")])
     if args.target == "ours":
         check(proc.returncode == 0, "service exits cleanly", f"rc={proc.returncode}")
     print(json.dumps({"target": args.target, "checks": checks_run[0], "failures": len(failures)}))

@@ -76,7 +76,7 @@ def gateway_env():
 
 
 def start_gateway(exe, args, timeout=30.0):
-    return Proc([exe, "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning"] + list(args),
+    return Proc([exe, "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning", "--no-local"] + list(args),
                 env=gateway_env(), timeout=timeout)
 
 

@@ -82,7 +82,7 @@ def run_config(exe, text, extra=()):
         path = f.name
     try:
         t0 = time.monotonic()
-        r = subprocess.run([exe, "--config", path, "--port", "0", "--listen", "127.0.0.1"] + list(extra),
+        r = subprocess.run([exe, "--config", path, "--port", "0", "--listen", "127.0.0.1", "--no-local"] + list(extra),
                            capture_output=True, text=True, timeout=30, env=gwproc.gateway_env())
         return r, path, time.monotonic() - t0
     finally:

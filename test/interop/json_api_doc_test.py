@@ -223,7 +223,7 @@ def wait_ready(base, timeout=30):
 
 
 def start_gateway(path):
-    proc = subprocess.Popen([path, "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning"],
+    proc = subprocess.Popen([path, "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning", "--no-local"],
                             stdout=subprocess.PIPE, text=True)
     deadline = time.time() + 30
     while time.time() < deadline:
