@@ -2,10 +2,11 @@
 // ObjectService. Handlers do no work, so a client measures transport, codec and dispatch.
 //
 // Usage:
-//   rr_bench_service [--port N] [--websocket] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]
+//   rr_bench_service [--port N] [--websocket] [--local] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]
 //     --tick-hz H   send on the Ticks wire at H Hz from start-up until exit (fan-out benchmarks)
+//     --local       also serve rr+local, by NodeID (no NodeName)
 // Prints one JSON line when ready: {"url": "rr+tcp://127.0.0.1:PORT/?service=bench", "port": PORT,
-// "ws_url": … (with --websocket), "pid": PID}, then runs until SIGTERM / SIGINT.
+// "ws_url": … (with --websocket), "local_url": … (with --local), "pid": PID}, then runs until SIGTERM / SIGINT.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -26,6 +27,7 @@
 #include "server/service/object_service.hpp"
 #include "server/service/pipe_member.hpp"
 #include "server/service/wire_member.hpp"
+#include "server/transport/local/local_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -68,6 +70,7 @@ void send_ticks(WireMember& wire, double rate_hz, std::int64_t count, std::size_
 int main(int argc, char** argv) {
     std::uint16_t port = 0;
     bool websocket = false;
+    bool local = false;
     unsigned threads = 0;
     double memory_mib = 10, tick_hz = 0;
     int tick_size = 2;
@@ -82,13 +85,14 @@ int main(int argc, char** argv) {
         };
         if (a == "--port") port = static_cast<std::uint16_t>(std::stoi(value()));
         else if (a == "--websocket") websocket = true;
+        else if (a == "--local") local = true;
         else if (a == "--threads") threads = static_cast<unsigned>(std::stoi(value()));
         else if (a == "--memory-mib") memory_mib = std::stod(value());
         else if (a == "--tick-hz") tick_hz = std::stod(value());
         else if (a == "--tick-size") tick_size = std::stoi(value());
         else {
             std::cerr << "usage: " << argv[0]
-                      << " [--port N] [--websocket] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]\n";
+                      << " [--port N] [--websocket] [--local] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]\n";
             return 2;
         }
     }
@@ -138,7 +142,7 @@ int main(int argc, char** argv) {
 
     auto service = must(ObjectService::create("bench", root), "service");
     NodeOptions options;
-    options.node_name = "bench_service";
+    options.node_name = local ? std::string() : "bench_service";  // rr+local by NodeID: no NodeName to hold
     options.threads = threads;
     auto node = Node::create(options);
     must(node->register_service(service), "register");
@@ -149,6 +153,7 @@ int main(int argc, char** argv) {
         });
     }
     const std::uint16_t bound = must(node->listen_tcp("127.0.0.1", port), "listen");
+    if (local) must(local::listen_local(node), "rr+local");
 
     if (tick_hz > 0) {
         std::lock_guard lock(senders_mutex);
@@ -159,6 +164,7 @@ int main(int argc, char** argv) {
                             {"port", bound},
                             {"pid", static_cast<int>(getpid())}};
     if (websocket) ready["ws_url"] = "rr+ws://127.0.0.1:" + std::to_string(bound) + "/?service=bench";
+    if (local) ready["local_url"] = "rr+local:///?nodeid=" + node->node_id().to_string() + "&service=bench";
     std::cout << ready.dump() << std::endl;
 
     while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(50));

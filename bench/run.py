@@ -181,9 +181,9 @@ def main(argv=None):
         log("two nice-19 busy loops run for the duration (busy latency regime, ../shared/BENCHMARKING.md)")
     procs = []
     try:
-        ours = Proc([exe["rr_bench_service"], "--websocket"], "bench_service")
+        ours = Proc([exe["rr_bench_service"], "--websocket", "--local"], "bench_service")
         procs.append(ours)
-        official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket"], "official_service")
+        official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket", "--local"], "official_service")
         procs.append(official)
         gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
                    "--device", "bench=" + ours.ready["url"]], "rr-gateway")
@@ -203,6 +203,8 @@ def main(argv=None):
             ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp")),
             ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws")),
             ("official->official rr+ws", lambda: pyc(official.ready["ws_url"], "official->official rr+ws")),
+            ("ours->ours rr+local", lambda: cpp(ours.ready["local_url"], "ours->ours rr+local")),
+            ("official->official rr+local", lambda: pyc(official.ready["local_url"], "official->official rr+local")),
             ("official->ours rr+tcp", lambda: pyc(ours.ready["url"], "official->ours rr+tcp")),
             ("ours->official rr+tcp", lambda: cpp(official.ready["url"], "ours->official rr+tcp", ops)),
             ("ours->gateway->ours rr+tcp", lambda: cpp(gw_url, "ours->gateway->ours rr+tcp")),
@@ -306,8 +308,8 @@ def main(argv=None):
 LATENCY_OPS = ("nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set", "peek", "wire")
 OP_ORDER = ["tcp_64", "unix_64", "tcp_bulk", "nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set",
             "peek", "wire", "wire_rate", "pipe", "memory_read", "memory_write"]
-PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "official->official rr+tcp", "official->official rr+ws",
-              "official->ours rr+tcp",
+PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "ours->ours rr+local", "official->official rr+tcp",
+              "official->official rr+ws", "official->official rr+local", "official->ours rr+tcp",
               "ours->official rr+tcp", "ours->gateway->ours rr+tcp", "official->gateway->ours rr+tcp"]
 
 
@@ -330,6 +332,8 @@ def summarize(raw, fanout, scale):
         e = {"path": label, "op": op, **{k: v for k, v in row.items() if k not in ("label", "op", "round")}}
         if label != "floor" and op in LATENCY_OPS and floor and row.get("p50_us"):
             e["x_tcp_floor"] = row["p50_us"] / floor  # target: rr+tcp Nop <= 1.5
+            if label.endswith("rr+local") and refs["unix_floor_p50_us"]:
+                e["x_unix_floor"] = row["p50_us"] / refs["unix_floor_p50_us"]
         if bulk and row.get("mb_s") and (op == "echo100000" or op.startswith("memory")):
             e["pct_tcp_bulk"] = 100 * row["mb_s"] / bulk  # target: >= 50 %
         if label.startswith("ours->") and "gateway" not in label and "official" not in label:
@@ -405,7 +409,7 @@ def markdown(res):
            "References measured in this run: TCP floor p50 **%s µs** (64 B ping-pong, TCP_NODELAY), Unix socket floor "
            "p50 %s µs, TCP bulk round trip (800,000 B each way) **%s MB/s**." % (
                fmt(refs.get("tcp_floor_p50_us"), 2), fmt(refs.get("unix_floor_p50_us"), 2), fmt(refs.get("tcp_bulk_mb_s"))), "",
-           "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
+           "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor (× Unix floor for rr+local) | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in res["rows"]:
         off = fmt(e.get("official_p50_us")) if "official_p50_us" in e else (
@@ -414,7 +418,8 @@ def markdown(res):
             off += "*"
         out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             e["op"], e["path"], fmt(e.get("p50_us")), fmt(e.get("p99_us")), fmt(e.get("max_us")), fmt(e.get("ops_per_s"), 0),
-            fmt(e.get("mb_s")), fmt(e.get("x_tcp_floor"), 2), fmt(e.get("pct_tcp_bulk")), off,
+            fmt(e.get("mb_s")), fmt(e.get("x_tcp_floor"), 2) + (" (%s)" % fmt(e["x_unix_floor"], 2) if "x_unix_floor" in e else ""),
+            fmt(e.get("pct_tcp_bulk")), off,
             (fmt(e["speedup_vs_official"], 2) + "×") if "speedup_vs_official" in e else ""))
     out += ["", "\\* the official library over rr+tcp (it ran the streaming rows on rr+tcp only)."]
     if res["gateway_hops"]:

@@ -84,18 +84,44 @@ class BenchImpl:
             ep.ReceivePacket()
 
 
+def forget_local_name(name, nodeid):
+    """Removes the NodeID cache and entry files a named node leaves in the node directories."""
+    import glob
+    d = RRN.GetNodeDirectories()
+    run, config, state = d.user_run_dir.string(), d.user_config_dir.string(), d.user_state_dir.string()
+    paths = glob.glob(os.path.join(run, "transport", "local", "by-nodename", name + ".*"))
+    paths += glob.glob(os.path.join(run, "transport", "local", "by-nodeid", nodeid.strip("{}") + ".*"))
+    paths += [os.path.join(run, "nodeids", name + ".pid"), os.path.join(config, "nodeids", name),
+              os.path.join(state, "nodeids", name)]
+    for p in paths:
+        try:
+            os.unlink(p)
+        except OSError:
+            pass
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--port", type=int, default=0)
     ap.add_argument("--websocket", action="store_true")
     ap.add_argument("--memory-mib", type=float, default=10)
+    ap.add_argument("--local", action="store_true",
+                    help="also serve rr+local under a NodeName of this process (what it leaves in the node "
+                         "directories is removed at exit)")
     args = ap.parse_args(argv)
 
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *a: stop.set())
     signal.signal(signal.SIGINT, lambda *a: stop.set())
 
-    RRN.SetNodeName("bench_official_service")
+    local_name = "bench.official.%d" % os.getpid()
+    if args.local:
+        # StartServerAsNodeID fails in the official library ("open: Already open"); by NodeName it works.
+        lt = RR.LocalTransport()
+        lt.StartServerAsNodeName(local_name)
+        RRN.RegisterTransport(lt)
+    else:
+        RRN.SetNodeName("bench_official_service")
     t = RR.TcpTransport()
     t.AcceptWebSockets = args.websocket
     t.StartServer(args.port, True)
@@ -108,10 +134,14 @@ def main(argv=None):
     ready = {"url": "rr+tcp://127.0.0.1:%d/?service=bench" % port, "port": port, "pid": os.getpid()}
     if args.websocket:
         ready["ws_url"] = "rr+ws://127.0.0.1:%d/?service=bench" % port
+    if args.local:
+        ready["local_url"] = "rr+local:///?nodename=%s&service=bench" % local_name
     print(json.dumps(ready), flush=True)
     while not stop.wait(0.2):
         pass
     impl._stop.set()
+    if args.local:
+        forget_local_name(local_name, str(RRN.NodeID))
     watchdog = threading.Timer(10.0, lambda: os._exit(3))
     watchdog.daemon = True
     watchdog.start()
