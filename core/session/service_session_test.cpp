@@ -373,7 +373,7 @@ TEST_CASE("service session: wire packets wait while output is backed up, only th
     CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 3}, {"w2", 9}});
 }
 
-TEST_CASE("service session: DisconnectClient ends the session and frees its endpoint; sends then fail") {
+TEST_CASE("service session: DisconnectClient ends the session and frees its endpoint, sends then fail") {
     Pair p;
     p.connect();
     const auto endpoint = p.service.endpoint();

@@ -94,7 +94,7 @@ TEST_CASE("a gateway that cannot listen fails to start and says why") {
     CHECK_THAT(gw.error().message, Catch::Contains(std::to_string(port)));
 }
 
-TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under NAME.demo); a second gateway with that name is refused") {
+TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under NAME.demo), a second gateway with that name is refused") {
     // This process's node directories in a temporary tree (root uses the system dirs, others the user dirs).
     local::testing::TempNodeDirs tmp;
     for (const auto& [var, dir] : {std::pair{"ROBOTRACONTEUR_SYSTEM_RUN_DIR", tmp.dirs.system_run_dir},

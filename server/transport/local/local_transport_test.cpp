@@ -128,7 +128,7 @@ void as_nobody(Fn fn) {
 
 }  // namespace
 
-TEST_CASE("local: a named node is found by NodeName, NodeID and both; its entries are CORE's") {
+TEST_CASE("local: a named node is found by NodeName, NodeID and both, its entries are CORE's") {
     TempNodeDirs tmp;
     LocalTransportFor route(tmp.dirs);
     const std::string name = unique_node_name("local.basic");
