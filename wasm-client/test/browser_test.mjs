@@ -70,7 +70,7 @@ let code = 2;
 try {
   const svc = start(arg("--interop-service"), ["--port", "0", "--max-lifetime", "300"]);
   const dev = await readyLine(svc, "url");
-  const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
+  const gw = start(arg("--gateway"), ["--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
     "--web-root", pkgRoot, "--device", `interop=${dev.url}`]);
   const { port } = await readyLine(gw, "port");
   for (let i = 0; ; i++) {

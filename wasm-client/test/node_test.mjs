@@ -80,7 +80,7 @@ async function gatewayReady(port, timeoutMs = 30000) {
 
 // rr-gateway with the service at `deviceUrl` as device "interop"; the rr+ws URL clients use.
 async function behindGateway(deviceUrl) {
-  const gw = start(arg("--gateway"), ["--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
+  const gw = start(arg("--gateway"), ["--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
     "--device", `interop=${deviceUrl}`]);
   const { port } = await readyLine(gw, "port");
   await gatewayReady(port);
