@@ -61,12 +61,23 @@ void NodeTable::schedule_update(NodeEntry& e, MonoTime now, milliseconds delay) 
 
 void NodeTable::evict_oldest() {
     auto victim = nodes_.end();
-    for (auto it = nodes_.begin(); it != nodes_.end(); ++it)
-        if (victim == nodes_.end() || it->second.last_seen < victim->second.last_seen) victim = it;
+    for (int pass = 0; pass < 2 && victim == nodes_.end(); ++pass) {
+        for (auto it = nodes_.begin(); it != nodes_.end(); ++it) {
+            if (pass == 0 && it->second.services) continue;  // first: only nodes that never answered
+            if (victim == nodes_.end() || it->second.last_seen < victim->second.last_seen) victim = it;
+        }
+    }
     if (victim != nodes_.end()) {
+        if (evicted_.size() < limits_.max_nodes) evicted_.push_back(std::move(victim->second));
         nodes_.erase(victim);
         ++counters_.evictions;
     }
+}
+
+std::vector<NodeEntry> NodeTable::take_evicted() {
+    std::vector<NodeEntry> out;
+    out.swap(evicted_);
+    return out;
 }
 
 DetectResult NodeTable::node_detected(const NodeAnnouncement& a, MonoTime now, std::uint32_t random) {

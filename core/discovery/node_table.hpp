@@ -3,9 +3,11 @@
 //
 //   * every URL of a node expires 60 s after its last announcement; a node without URLs is lost;
 //   * the table holds at most `max_nodes` nodes and `max_urls_per_node` URLs per node: a new node
-//     beyond the cap evicts the node heard from least recently, a new URL the oldest URL (CORE instead
-//     drops newcomers at 4096 nodes; evicting keeps a live network's nodes when a flood of forged NodeIDs
-//     ages out). Evictions are counted.
+//     beyond the cap evicts the node heard from least recently among those whose service index never
+//     answered (else the least recent of all), a new URL the oldest URL. CORE instead drops newcomers
+//     at 4096 nodes; evicting lets a live network recover once a flood of forged NodeIDs stops, and
+//     preferring unverified nodes keeps the real ones (a forged NodeID never answers). Evictions are
+//     counted and the evicted entries handed out (take_evicted) so that users treat them as lost.
 //   * ServiceInfo2 (services of a node) is fetched by the caller when `want_services` is set: a node is
 //     due 100–600 ms after it is first seen or announces a ServiceStateNonce not seen recently (CORE
 //     keeps the last 16), and again after a failure with CORE's progressive back-off. A node announcing
@@ -106,6 +108,8 @@ public:
     DetectResult node_detected(const NodeAnnouncement& a, MonoTime now, std::uint32_t random = 0);
     /// Removes URLs older than the expiry and nodes left without URLs; returns the lost nodes.
     std::vector<NodeEntry> expire(MonoTime now);
+    /// Nodes evicted by the cap since the last call.
+    std::vector<NodeEntry> take_evicted();
     /// Removes a node at once (its source says it is gone, e.g. an rr+local socket vanished).
     std::optional<NodeEntry> remove(const NodeID& id);
 
@@ -142,6 +146,7 @@ private:
 
     NodeTableLimits limits_;
     std::map<NodeID, NodeEntry> nodes_;
+    std::vector<NodeEntry> evicted_;
     NodeTableCounters counters_;
     bool want_services_ = false;
 };

@@ -87,6 +87,8 @@ TEST_CASE("discovery table: a flood of distinct NodeIDs stays within the cap, ol
     CHECK(t.find(keeper));            // heard from recently, never the oldest
     CHECK_FALSE(t.find(make_id(1)));  // the oldest went first
     CHECK(t.find(make_id(10000)));
+    CHECK(t.take_evicted().size() == 64);  // handed out (at most max_nodes kept between calls)
+    CHECK(t.take_evicted().empty());
 
     // Many URLs for one node: at most 4 kept, the oldest replaced.
     auto id = make_id(20000);
@@ -198,4 +200,22 @@ TEST_CASE("discovery table: ServiceInfo2 from a GetLocalNodeServices value") {
     ServiceInfoLimits small;
     small.max_services = 0;
     CHECK(service_infos_from_value(Value(ret), id, "n", small).error().type == MessageErrorType::OutOfRange);
+}
+
+TEST_CASE("discovery table: nodes whose service index answered outlive a flood") {
+    NodeTableLimits limits;
+    limits.max_nodes = 16;
+    NodeTable t(limits);
+    t.set_want_services(true, t0);
+    auto real = make_id(0);
+    t.node_detected(ann(real, url_for(real), "real", "N"), t0);
+    REQUIRE(t.take_due_updates(t0 + 1s).size() == 1);
+    REQUIRE(t.services_updated(real, "N", {}, t0 + 1s));
+    for (unsigned i = 1; i <= 500; ++i) {
+        auto id = make_id(i);
+        t.node_detected(ann(id, url_for(id)), t0 + 2s + std::chrono::milliseconds(i));
+    }
+    CHECK(t.size() == 16);
+    CHECK(t.find(real));  // the oldest, but verified
+    CHECK(t.counters().evictions == 500 - 15);
 }
