@@ -278,6 +278,14 @@ std::optional<MonoTime> NodeTable::next_deadline() const {
     return t;
 }
 
+std::optional<MonoTime> NodeTable::oldest_announce() const {
+    std::optional<MonoTime> t;
+    for (const auto& [id, e] : nodes_)
+        for (const auto& u : e.urls)
+            if (!t || u.last_announce < *t) t = u.last_announce;
+    return t;
+}
+
 const NodeEntry* NodeTable::find(const NodeID& id) const {
     auto it = nodes_.find(id);
     return it == nodes_.end() ? nullptr : &it->second;

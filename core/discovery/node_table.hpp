@@ -126,6 +126,8 @@ public:
     /// The interrogation failed: retried after CORE's back-off (100–600 ms, growing to 25–35 s).
     void services_failed(const NodeID& id, std::string error, MonoTime now, std::uint32_t random = 0);
 
+    /// The oldest announce time of any URL in the table (the next to expire), or nullopt when empty.
+    std::optional<MonoTime> oldest_announce() const;
     /// Earliest time expire() or take_due_updates() has work, or nullopt.
     std::optional<MonoTime> next_deadline() const;
 

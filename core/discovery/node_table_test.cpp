@@ -44,6 +44,7 @@ TEST_CASE("discovery table: nodes appear, refresh and expire 60 s after their la
     CHECK(t.find(id)->urls.size() == 2);
     CHECK(t.find_by_name("a").size() == 1);
     CHECK(t.next_deadline() == t0 + 90s);
+    CHECK(t.oldest_announce() == t0 + 30s);
 
     CHECK(t.expire(t0 + 89s).empty());
     CHECK(t.find(id)->urls.size() == 2);

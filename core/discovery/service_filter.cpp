@@ -121,10 +121,19 @@ std::optional<FilterMatch> match_service(const ServiceFilter& filter, const Serv
     FilterMatch out;
     const auto& types = filter.service_types;
     if (!types.empty() && std::find(types.begin(), types.end(), info.root_object_type) == types.end()) {
-        auto it = std::find_if(info.root_object_implements.begin(), info.root_object_implements.end(),
-                               [&](const std::string& t) { return std::find(types.begin(), types.end(), t) != types.end(); });
-        if (it == info.root_object_implements.end()) return std::nullopt;
-        out.client_service_type = *it;
+        // CORE reports a type implemented from the root's own service unqualified ("Base" for
+        // "svc.Base"), as the robdef wrote it; such a name is also taken as of the root's service.
+        const auto dot = info.root_object_type.rfind('.');
+        const std::string service = dot == std::string::npos ? std::string() : info.root_object_type.substr(0, dot + 1);
+        std::string found;
+        for (const auto& t : info.root_object_implements) {
+            const std::string qualified = t.find('.') == std::string::npos ? service + t : t;
+            for (const auto& want : types)
+                if (want == t || want == qualified) found = want;
+            if (!found.empty()) break;
+        }
+        if (found.empty()) return std::nullopt;
+        out.client_service_type = found;
     } else {
         out.client_service_type = info.root_object_type;
     }

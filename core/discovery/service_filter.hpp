@@ -1,7 +1,9 @@
 // Selecting discovered services, as the official ServiceSubscriptionFilter does (CORE Subscription.cpp
 // ServiceSubscription_FilterService and ServiceSubscriptionFilterAttributeGroup):
 //
-//   service types   the root object type or one of the types it implements is in the list (empty = any)
+//   service types   the root object type or one of the types it implements is in the list (empty = any);
+//                   an unqualified implemented type (CORE reports `implements Base` of the root's own
+//                   service as "Base") also counts as qualified with the root's service name
 //   nodes           any entry matches: NodeID and/or NodeName (an entry with neither matches everything)
 //   service names   the service's name is in the list (empty = any)
 //   transports      URL schemes; the service's URLs are narrowed to them; when none is left the node's

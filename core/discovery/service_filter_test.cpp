@@ -47,6 +47,16 @@ TEST_CASE("discovery filter: service type matches the root type or an implemente
     CHECK(m->client_service_type == "experimental.robot.Base");
     f.service_types = {"other.Type"};
     CHECK_FALSE(match_service(f, reynard()));
+    // CORE lists a type of the root's own service unqualified.
+    auto s = reynard();
+    s.root_object_implements = {"Arm"};
+    f.service_types = {"experimental.reynard_the_robot.Arm"};
+    REQUIRE(match_service(f, s));
+    CHECK(match_service(f, s)->client_service_type == "experimental.reynard_the_robot.Arm");
+    f.service_types = {"Arm"};
+    CHECK(match_service(f, s));
+    f.service_types = {"other.Arm"};
+    CHECK_FALSE(match_service(f, s));
 }
 
 TEST_CASE("discovery filter: nodes by NodeID and/or NodeName") {

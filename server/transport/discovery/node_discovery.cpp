@@ -143,6 +143,8 @@ void NodeDiscovery::open_sockets() {
         if (!ec) s->socket.bind(udp::endpoint(asio::ip::address_v6::any(), options_.port), ec);
         if (!ec) {
             s->socket.set_option(asio::ip::multicast::enable_loopback(true), ec);
+            s->socket.set_option(udp::socket::receive_buffer_size(1 << 18), ec);  // bursts of announces
+            ec.clear();
             v6 = s;
             sockets_.push_back(s);
             receive(s);
@@ -236,6 +238,7 @@ void NodeDiscovery::arm_timer() {
             if (t && (!next || *t < *next)) next = t;
         };
         consider(table_.next_deadline());
+        consider(refresh_deadline());
         consider(announce_.next_deadline());
         consider(requests_.next_deadline());
         consider(next_rescan_);
@@ -263,6 +266,10 @@ void NodeDiscovery::on_timer() {
                 for (const auto& u : e.urls)
                     if (auto p = parse_connection_url(u.url)) hosts.insert(p->host);
             for (auto it = zones_.begin(); it != zones_.end();) it = hosts.count(it->first) ? std::next(it) : zones_.erase(it);
+        }
+        if (auto r = refresh_deadline(); r && *r <= t) {
+            requests_.trigger(t, random32());
+            last_refresh_ = t;
         }
         announce = announce_.due(t);
         request = requests_.due(t, random32());
@@ -432,6 +439,14 @@ void NodeDiscovery::remove_node(const NodeID& id) {
         if (auto e = table_.remove(id)) events.push_back({DiscoveryEvent::Kind::node_lost, std::move(*e)});
     }
     emit(std::move(events));
+}
+
+std::optional<core::MonoTime> NodeDiscovery::refresh_deadline() const {
+    if (!options_.listen) return std::nullopt;
+    auto oldest = table_.oldest_announce();
+    if (!oldest) return std::nullopt;
+    const auto expiry = options_.limits.url_expiry;
+    return std::max(*oldest + expiry * 3 / 4, last_refresh_ + expiry / 4);
 }
 
 std::vector<LocalAddress> NodeDiscovery::addresses() const {

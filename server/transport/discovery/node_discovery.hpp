@@ -8,6 +8,10 @@
 //   announcing   sends our announce (NodeID, NodeName, one rr+tcp URL per listening address: IPv6
 //                link-local and loopback addresses on their own interface, IPv4 ones by broadcast) every
 //                55 s, within 500 ms of a request from another node or of services_changed().
+//   refreshing   when a URL in the table reaches 3/4 of its expiry, a request round asks live nodes to
+//                announce again (at most one round per 1/4 of the expiry): a lost announce does not
+//                drop a live node, and a short expiry works with the official 55 s period. (CORE relies
+//                on the periodic announces alone.)
 //   services     when wanted (want_services()), interrogates each node's RobotRaconteurServiceIndex with
 //                GetLocalNodeServices() (5 s timeout, at most 4 at once) and keeps the ServiceInfo2
 //                records in the table.
@@ -155,6 +159,8 @@ private:
     std::vector<std::shared_ptr<Socket>> sockets_;
     std::vector<unsigned> joined_scopes_;
     rr::discovery::MonoTime next_rescan_{};
+    rr::discovery::MonoTime last_refresh_{};
+    std::optional<rr::discovery::MonoTime> refresh_deadline() const;  // under mutex_
     std::map<std::uint64_t, Listener> listeners_;
     std::uint64_t next_listener_ = 1;
     int want_services_ = 0;

@@ -105,11 +105,13 @@ TEST_CASE("discovery: a flood of distinct NodeIDs keeps the table within its cap
         auto text = std::string(discovery::kAnnounceMagic) + "\n" + id.to_braced_string() + "\nrr+tcp://[::1]:1/?nodeid=" +
                     id.to_string() + "&service=RobotRaconteurServiceIndex\n";
         s.send_to(asio::buffer(text), to);
-        if (i % 200 == 0) std::this_thread::sleep_for(5ms);  // let the receiver keep up (UDP drops otherwise)
+        if (i % 50 == 49) std::this_thread::sleep_for(3ms);  // let the receiver keep up (UDP drops otherwise)
     }
-    REQUIRE(wait_for([&] { return d->counters().announces >= 500; }));
-    CHECK(d->size() <= 32);
-    CHECK(d->counters().evictions >= d->counters().announces - 32);
+    // UDP may drop some under load; enough arrive to overflow the table many times.
+    REQUIRE(wait_for([&] { return d->counters().announces >= 300; }));
+    std::this_thread::sleep_for(200ms);
+    CHECK(d->size() == 32);
+    CHECK(d->counters().evictions == d->counters().announces - 32);
     d->stop();
 }
 
