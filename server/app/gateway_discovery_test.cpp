@@ -101,7 +101,8 @@ TEST_CASE("gateway discovery: device names from the template are RR service name
     auto s = service("reynard", "x.Y");
     CHECK(discovered_device_name("{service}", s) == "reynard");
     CHECK(discovered_device_name("{service}@{nodename}", s) == "reynard_lab_robot_1");
-    CHECK(discovered_device_name("{nodeid}", s) == "d_d835c41d_339c_47a8_84db_f00a8fefd2fa");
+    CHECK(discovered_device_name("{nodeid}", s) == "d835c41d_339c_47a8_84db_f00a8fefd2fa");
+    CHECK(discovered_device_name("9{service}", s) == "d_9reynard");
     CHECK(discovered_device_name("dev_{service}_{unknown}", s) == "dev_reynard__unknown_");
     CHECK(discovered_device_name("", s) == "d_");
 }
