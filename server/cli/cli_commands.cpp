@@ -279,6 +279,7 @@ ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err
             case CommandKind::set: f = run_set(cl, t, json.at(0)); break;
             case CommandKind::call: f = run_call(cl, t, json, out); break;
             case CommandKind::watch: f = run_watch(cl, t, out, stop); break;
+            case CommandKind::discover:  // handled above
             case CommandKind::help: break;
         }
     }

@@ -163,7 +163,7 @@ def main():
         # --- the gateway in A, before the official node exists -------------------------------------
         cfg = os.path.join(tmp, "gateway.yaml")
         with open(cfg, "w") as f:
-            f.write("gateway: {listen: '::', port: 0, node_name: %s, log_level: warning}\n"
+            f.write("gateway: {listen: '::', port: 0, node_name: %s, log_level: warning, local: false}\n"
                     "demo: {enabled: true}\n"
                     "discovery: {enabled: true, node_expiry_ms: 15000, max_nodes: 64}\n"
                     "discover:\n"
