@@ -328,8 +328,7 @@ const std::set<std::string> kValueFlags{"--config",      "--port",       "--list
                                         "--allow-origin", "--device",     "--demo-port", "--threads",
                                         "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--check", "--help", "-h"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--discovery", "--check", "--help", "-h"};
+const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h"};
 
 }  // namespace
 

@@ -77,8 +77,8 @@ struct CommandLine {
 
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
-/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local, --check,
-/// --device NAME=URL (repeat), --discovery, --no-demo, --demo-port N, --threads N, --log-level LEVEL, --check,
+/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local,
+/// --discovery, --check,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
 Result<CommandLine> parse_command_line(int argc, const char* const* argv);
