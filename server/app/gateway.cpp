@@ -214,7 +214,7 @@ std::vector<std::shared_ptr<gateway::DeviceMirror>> Gateway::discovered_devices(
 
 void Gateway::stop() {
     if (discovered_) discovered_->stop();
-    if (discovery_) discovery_->stop();
+    if (discovery_) discovery_->stop(std::chrono::milliseconds(6000));  // before the node's threads stop
     for (auto& d : devices_) d->stop();
     if (node_) node_->shutdown();
     if (demo_node_) demo_node_->shutdown();

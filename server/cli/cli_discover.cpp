@@ -58,7 +58,7 @@ ExitCode run_discover(const CommandLine& cl, std::ostream& out, std::ostream& er
         if (all) break;
     }
     auto nodes = d->nodes();
-    d->stop();
+    d->stop(std::chrono::milliseconds(6000));
 
     std::size_t shown = 0;
     for (const auto& n : nodes) {
@@ -126,7 +126,7 @@ Result<std::vector<std::string>> resolve_through_discovery(const ConnectionUrl& 
             parsed->service = url.service.empty() ? std::string(rr::discovery::kServiceIndexName) : url.service;
             for (auto& c : d->connectable_urls(parsed->to_string())) out.push_back(std::move(c));
         }
-    d->stop();
+    d->stop(std::chrono::milliseconds(6000));
     if (out.empty()) {
         std::string what = !url.node_name.empty() ? "NodeName \"" + url.node_name + "\"" : "NodeID " + url.node_id.to_string();
         return fail(MessageErrorType::NodeNotFound,

@@ -291,7 +291,8 @@ def main():
             p = os.path.join(tmp, name)
             if os.path.exists(p):
                 with open(p, errors="replace") as f:
-                    log("--- %s (tail) ---\n%s" % (name, f.read()[-4000:]))
+                    text = f.read()
+                log("--- %s (head and tail) ---\n%s\n...\n%s" % (name, text[:3000], text[-3000:]))
         return 1
     finally:
         for p in procs:

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <set>
+#include <thread>
 
 #include <boost/asio/bind_executor.hpp>
 #include <boost/asio/ip/multicast.hpp>
@@ -110,15 +111,31 @@ Result<void> NodeDiscovery::start() {
     return {};
 }
 
-void NodeDiscovery::stop() {
+void NodeDiscovery::stop(std::chrono::milliseconds wait) {
+    stop_now();
+    const auto until = std::chrono::steady_clock::now() + wait;
+    while (std::chrono::steady_clock::now() < until) {
+        {
+            std::lock_guard lock(mutex_);
+            if (running_interrogations_ == 0) return;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+}
+
+void NodeDiscovery::stop_now() {
     std::vector<std::shared_ptr<Socket>> sockets;
+    std::map<std::uint64_t, std::shared_ptr<void>> clients;
     {
         std::lock_guard lock(mutex_);
         if (stopped_) return;
         stopped_ = true;
         sockets.swap(sockets_);
         listeners_.clear();
+        clients.swap(interrogation_clients_);
     }
+    for (auto& [k, c] : clients) std::static_pointer_cast<client::Client>(c)->close();
+    clients.clear();
     asio::post(strand_, [self = shared_from_this(), sockets] {
         boost::system::error_code ec;
         for (auto& s : sockets) s->socket.close(ec);
@@ -599,14 +616,26 @@ void NodeDiscovery::interrogate(NodeID id, std::vector<std::string> urls, std::s
                                 }
                                 auto client = *c;
                                 std::string name;
+                                std::uint64_t key = 0;
                                 {
                                     std::lock_guard lock(self->mutex_);
+                                    if (self->stopped_) {
+                                        client->close();
+                                        return;
+                                    }
                                     if (const auto* e = self->table_.find(id)) name = e->node_name;
+                                    key = self->next_interrogation_++;
+                                    self->interrogation_clients_[key] = client;
                                 }
+                                std::weak_ptr<client::Client> weak_client = client;
                                 client->root().async_call(
                                     "GetLocalNodeServices", {},
-                                    [self, client, id, name, finish](Result<Value> v) {
-                                        client->close();
+                                    [self, weak_client, key, id, name, finish](Result<Value> v) {
+                                        {
+                                            std::lock_guard lock(self->mutex_);
+                                            self->interrogation_clients_.erase(key);
+                                        }
+                                        if (auto cl = weak_client.lock()) cl->close();
                                         if (!v) return finish(v.take_error());
                                         finish(core::service_infos_from_value(*v, id, name, self->options_.limits.services));
                                     });

@@ -88,8 +88,11 @@ public:
 
     /// Opens the sockets and starts the timers. Errors: IOError when no socket could be opened.
     Result<void> start();
-    /// Closes the sockets and cancels everything. Idempotent.
-    void stop();
+    /// Closes the sockets and cancels everything, then waits (at most `wait`) until the interrogations
+    /// in flight have ended (a connect to a silent address ends at its 5 s timeout): stopping the
+    /// executor under a pending client connect would leave it unfinished. Idempotent. Not on the
+    /// executor's threads when `wait` > 0.
+    void stop(std::chrono::milliseconds wait = std::chrono::milliseconds(0));
 
     /// Starts a round of 3 discovery requests (ignored when a round is running).
     void send_requests_now();
@@ -128,6 +131,7 @@ public:
 
 private:
     NodeDiscovery(boost::asio::any_io_executor executor, DiscoveryOptions options);
+    void stop_now();
     struct Socket;
     void open_sockets();
     std::vector<LocalAddress> addresses() const;
@@ -166,6 +170,10 @@ private:
     int want_services_ = 0;
     std::size_t running_interrogations_ = 0;
     std::vector<NodeID> waiting_interrogations_;
+    // Clients of the interrogations in flight: held here (their completions hold only weak references),
+    // closed and dropped by stop(), so that a call cut short by shutdown leaves no cycle behind.
+    std::map<std::uint64_t, std::shared_ptr<void>> interrogation_clients_;
+    std::uint64_t next_interrogation_ = 1;
     std::mt19937 rng_;
     bool started_ = false;
     bool stopped_ = false;
