@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "server/app/gateway_discovery.hpp"
 #include "server/app/log.hpp"
 #include "server/transport/local/local_listener.hpp"
 
@@ -124,7 +125,62 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     g->http_->add_route(bhttp::verb::get, "/metrics", [self](const http::Request& req, http::Responder respond) {
         respond(http::make_response(req, bhttp::status::ok, self->metrics_text(), "text/plain; version=0.0.4; charset=utf-8"));
     });
-    if (api) api(*g->http_, g->devices_);
+    std::shared_ptr<gateway::JsonApi> json_api;
+    if (api) json_api = api(*g->http_, g->devices_);
+
+    // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the
+    // services that `discover:` filters select into devices.
+    if (c.discovery.enabled) {
+        discovery::DiscoveryOptions dopts;
+        dopts.node_id = g->node_->node_id();
+        dopts.node_name = g->node_->node_name();
+        dopts.listen = true;
+        dopts.announce = c.discovery.announce;
+        dopts.flags = rr::discovery::kLinkLocal | (c.discovery.ipv4_broadcast ? rr::discovery::kIpv4Broadcast : 0u);
+        dopts.interfaces = c.discovery.interfaces;
+        dopts.limits.max_nodes = c.discovery.max_nodes;
+        dopts.limits.url_expiry = c.discovery.node_expiry;
+        std::weak_ptr<Node> weak_node = g->node_;
+        dopts.listen_endpoints = [weak_node] {
+            auto n = weak_node.lock();
+            return n ? n->listen_endpoints() : std::vector<boost::asio::ip::tcp::endpoint>{};
+        };
+        g->discovery_ = discovery::NodeDiscovery::create(g->node_->io_context().get_executor(), dopts);
+        std::weak_ptr<discovery::NodeDiscovery> weak_discovery = g->discovery_;
+        g->node_->on_services_changed([weak_discovery] {
+            if (auto d = weak_discovery.lock()) d->services_changed();
+        });
+        g->discovered_ = DiscoveredDevices::create(g->node_, g->discovery_, c.discover,
+                                                   [self](const std::string& name) { return self->device(name) != nullptr; });
+        g->discovered_->set_api(json_api);
+        if (json_api) {
+            std::weak_ptr<DiscoveredDevices> weak = g->discovered_;
+            gateway::JsonApi::DiscoveryHooks hooks;
+            hooks.list = [weak] {
+                auto d = weak.lock();
+                return d ? d->list() : nlohmann::json{{"nodes", nlohmann::json::array()}};
+            };
+            hooks.add = [weak](const nlohmann::json& body, gateway::JsonApi::Done done) {
+                auto d = weak.lock();
+                if (!d) return done(gateway::ApiResult::failed(gateway::api_error(503, MessageErrorType::InvalidState, "gateway stopping")));
+                if (!body.is_object() || !body.contains("nodeid") || !body["nodeid"].is_string() || !body.contains("service") ||
+                    !body["service"].is_string() || (body.contains("name") && !body["name"].is_string()))
+                    return done(gateway::ApiResult::failed(gateway::api_error(
+                        400, MessageErrorType::InvalidArgument, "the body must be {\"nodeid\": …, \"service\": …, \"name\"?: …}")));
+                auto id = NodeID::parse(body["nodeid"].get<std::string>());
+                if (!id) return done(gateway::ApiResult::failed(gateway::api_error(400, MessageErrorType::InvalidArgument, "not a NodeID")));
+                auto r = d->add(*id, body["service"].get<std::string>(), body.value("name", std::string()));
+                if (!r) {
+                    const auto t = r.error().type;
+                    const unsigned status = (t == MessageErrorType::NodeNotFound || t == MessageErrorType::ServiceNotFound) ? 404 : 400;
+                    return done(gateway::ApiResult::failed(gateway::api_error(status, t, r.error().message)));
+                }
+                done(gateway::ApiResult::ok(gateway::JsonApi::status_json((*r)->status())));
+            };
+            json_api->set_discovery_hooks(std::move(hooks));
+        }
+        g->discovered_->start();
+    }
     g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial) {
         h->handle(std::move(s), std::move(initial));
     });
@@ -144,12 +200,21 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     if (c.local) {
         if (auto r = serve_local(g->node_, std::move(*reservation)); !r) return r.take_error();
     }
+    if (g->discovery_) {
+        if (auto r = g->discovery_->start(); !r) return r.take_error();
+    }
     return g;
 }
 
 Gateway::~Gateway() { stop(); }
 
+std::vector<std::shared_ptr<gateway::DeviceMirror>> Gateway::discovered_devices() const {
+    return discovered_ ? discovered_->devices() : std::vector<std::shared_ptr<gateway::DeviceMirror>>{};
+}
+
 void Gateway::stop() {
+    if (discovered_) discovered_->stop();
+    if (discovery_) discovery_->stop(std::chrono::milliseconds(6000));  // before the node's threads stop
     for (auto& d : devices_) d->stop();
     if (node_) node_->shutdown();
     if (demo_node_) demo_node_->shutdown();
@@ -172,6 +237,8 @@ bool Gateway::ready() const {
 std::string Gateway::metrics_text() const {
     std::ostringstream o;
     auto stats = node_->stats();
+    auto all = devices_;  // configured devices, then discovered ones
+    for (auto& d : discovered_devices()) all.push_back(d);
     o << "# HELP rr_gateway_connections Open RR connections (TCP and WebSocket) to the gateway.\n"
          "# TYPE rr_gateway_connections gauge\n"
       << "rr_gateway_connections " << node_->connection_count() << "\n"
@@ -188,7 +255,7 @@ std::string Gateway::metrics_text() const {
       << "rr_gateway_bytes_total{direction=\"out\"} " << stats->bytes_out.load() << "\n";
 
     o << "# HELP rr_gateway_device_up Device state: 1 when connected.\n# TYPE rr_gateway_device_up gauge\n";
-    for (const auto& d : devices_) {
+    for (const auto& d : all) {
         auto s = d->status();
         o << "rr_gateway_device_up{device=\"" << escape_label(s.name) << "\",state=\""
           << gateway::device_state_name(s.state) << "\"} " << (s.state == gateway::DeviceState::connected ? 1 : 0)
@@ -196,7 +263,7 @@ std::string Gateway::metrics_text() const {
     }
     auto counter = [&](const char* name, const char* help, auto field) {
         o << "# HELP " << name << " " << help << "\n# TYPE " << name << " counter\n";
-        for (const auto& d : devices_)
+        for (const auto& d : all)
             o << name << "{device=\"" << escape_label(d->config().name) << "\"} " << field(d->counters()) << "\n";
     };
     counter("rr_gateway_device_requests_total", "Requests forwarded to the device.",
@@ -216,7 +283,7 @@ std::string Gateway::metrics_text() const {
 
     o << "# HELP rr_gateway_request_duration_seconds Device request round trip through the gateway.\n"
          "# TYPE rr_gateway_request_duration_seconds histogram\n";
-    for (const auto& d : devices_) {
+    for (const auto& d : all) {
         const auto& c = d->counters();
         const std::string label = "device=\"" + escape_label(d->config().name) + "\"";
         std::uint64_t cumulative = 0;
@@ -229,6 +296,33 @@ std::string Gateway::metrics_text() const {
         o << "rr_gateway_request_duration_seconds_bucket{" << label << ",le=\"+Inf\"} " << cumulative << "\n";
         o << "rr_gateway_request_duration_seconds_sum{" << label << "} " << (c.latency_sum_us.load() / 1e6) << "\n";
         o << "rr_gateway_request_duration_seconds_count{" << label << "} " << cumulative << "\n";
+    }
+    if (discovery_) {
+        const auto dc = discovery_->counters();
+        o << "# HELP rr_gateway_discovery_nodes Nodes in the discovery table.\n# TYPE rr_gateway_discovery_nodes gauge\n"
+          << "rr_gateway_discovery_nodes " << discovery_->size() << "\n"
+          << "# HELP rr_gateway_discovery_announces_total Node announcements accepted.\n"
+             "# TYPE rr_gateway_discovery_announces_total counter\n"
+          << "rr_gateway_discovery_announces_total " << dc.announces << "\n"
+          << "# HELP rr_gateway_discovery_evictions_total Nodes evicted from the full discovery table (oldest first).\n"
+             "# TYPE rr_gateway_discovery_evictions_total counter\n"
+          << "rr_gateway_discovery_evictions_total " << dc.evictions << "\n"
+          << "# HELP rr_gateway_discovery_url_evictions_total URLs evicted by the per-node cap.\n"
+             "# TYPE rr_gateway_discovery_url_evictions_total counter\n"
+          << "rr_gateway_discovery_url_evictions_total " << dc.url_evictions << "\n"
+          << "# HELP rr_gateway_discovery_expired_total Nodes lost after 60 s without an announce.\n"
+             "# TYPE rr_gateway_discovery_expired_total counter\n"
+          << "rr_gateway_discovery_expired_total " << dc.expired << "\n"
+          << "# HELP rr_gateway_discovery_packets_rejected_total Discovery datagrams rejected, by reason (own packets not counted).\n"
+             "# TYPE rr_gateway_discovery_packets_rejected_total counter\n";
+        for (int r = 0; r <= static_cast<int>(rr::discovery::Reject::own_packet); ++r) {
+            const auto reason = static_cast<rr::discovery::Reject>(r);
+            if (reason == rr::discovery::Reject::own_packet) continue;
+            o << "rr_gateway_discovery_packets_rejected_total{reason=\"" << rr::discovery::reject_name(reason) << "\"} "
+              << dc.rejected[r] << "\n";
+        }
+        o << "# HELP rr_gateway_discovered_devices Devices added by discovery.\n# TYPE rr_gateway_discovered_devices gauge\n"
+          << "rr_gateway_discovered_devices " << discovered_devices().size() << "\n";
     }
     return o.str();
 }

@@ -9,16 +9,23 @@
 
 #include "server/app/gateway_config.hpp"
 #include "server/gateway/device_mirror.hpp"
+#include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
+#include "server/transport/discovery/node_discovery.hpp"
 
 namespace rr::server::app {
 
 /// Starts demo devices on `demo_node` (already listening on `port`) and returns how to reach them.
 using DemoStarter = std::function<Result<std::vector<gateway::DeviceConfig>>(const std::shared_ptr<Node>& demo_node,
                                                                              std::uint16_t port)>;
-/// Adds routes and subprotocols (the JSON API) once the devices exist.
-using ApiInstaller = std::function<void(http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices)>;
+/// Adds routes and subprotocols (the JSON API) once the devices exist, and returns the JsonApi it
+/// installed (or nullptr), so that discovered devices and the discovery routes reach it
+/// (gateway::install_json_api is one).
+using ApiInstaller = std::function<std::shared_ptr<gateway::JsonApi>(
+    http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices)>;
+
+class DiscoveredDevices;
 
 class Gateway {
 public:
@@ -33,6 +40,10 @@ public:
     const std::shared_ptr<Node>& demo_node() const noexcept { return demo_node_; }
     const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices() const noexcept { return devices_; }
     std::shared_ptr<gateway::DeviceMirror> device(std::string_view name) const;
+    /// Node discovery (docs/discovery.md), nullptr when `discovery.enabled` is off.
+    const std::shared_ptr<discovery::NodeDiscovery>& discovery() const noexcept { return discovery_; }
+    /// Devices found by `discover:` filters or added from the JSON API, now.
+    std::vector<std::shared_ptr<gateway::DeviceMirror>> discovered_devices() const;
 
     /// Ready when every required device is connected (/readyz).
     bool ready() const;
@@ -47,6 +58,8 @@ private:
     std::shared_ptr<http::HttpServer> http_;
     std::vector<std::shared_ptr<gateway::DeviceMirror>> devices_;
     std::uint16_t port_ = 0;
+    std::shared_ptr<discovery::NodeDiscovery> discovery_;
+    std::shared_ptr<DiscoveredDevices> discovered_;
 };
 
 }  // namespace rr::server::app

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -97,10 +98,146 @@ void validate(const GatewayConfig& c, const std::function<void(const std::string
     }
 }
 
+// An attribute filter: "value", [values] (any of), or {any: [..], all: [..], none: [..], regex: ".." | [..]}.
+rr::discovery::FilterAttributeGroup attribute_group(const YAML::Node& n, const Reader& r, const std::string& key) {
+    using rr::discovery::FilterAttribute;
+    using rr::discovery::FilterAttributeGroup;
+    using rr::discovery::FilterOperation;
+    auto exact = [](std::string v) { return FilterAttribute{"", std::move(v), {}, ""}; };
+    FilterAttributeGroup g;
+    g.operation = FilterOperation::op_or;
+    if (n.IsScalar()) {
+        g.attributes.push_back(exact(r.string(n, key)));
+        return g;
+    }
+    if (n.IsSequence()) {
+        for (auto& v : r.string_list(n, key)) g.attributes.push_back(exact(std::move(v)));
+        return g;
+    }
+    r.check_keys(n, key, {"any", "all", "none", "regex"});
+    g.operation = FilterOperation::op_and;
+    auto sub = [&](const char* k, FilterOperation op) {
+        if (auto l = n[k]) {
+            FilterAttributeGroup s;
+            s.operation = op;
+            for (auto& v : r.string_list(l, key + "." + k)) s.attributes.push_back(exact(std::move(v)));
+            g.groups.push_back(std::move(s));
+        }
+    };
+    sub("any", FilterOperation::op_or);
+    sub("all", FilterOperation::op_and);
+    sub("none", FilterOperation::op_nor);
+    if (auto re = n["regex"]) {
+        FilterAttributeGroup s;
+        s.operation = FilterOperation::op_or;
+        std::vector<std::string> patterns = re.IsSequence() ? r.string_list(re, key + ".regex")
+                                                            : std::vector<std::string>{r.string(re, key + ".regex")};
+        for (auto& p : patterns) {
+            std::shared_ptr<std::regex> compiled;
+            try {
+                compiled = std::make_shared<std::regex>(p, std::regex::ECMAScript);
+            } catch (const std::regex_error& e) {
+                r.error(re, key + ".regex", "bad regular expression \"" + p + "\": " + e.what());
+            }
+            s.attributes.push_back(FilterAttribute{
+                "", "", [compiled](std::string_view v) { return std::regex_match(v.begin(), v.end(), *compiled); }, p});
+        }
+        g.groups.push_back(std::move(s));
+    }
+    return g;
+}
+
+void parse_discovery(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
+    if (auto d = root["discovery"]) {
+        r.check_keys(d, "discovery", {"enabled", "announce", "ipv4_broadcast", "interfaces", "max_nodes", "node_expiry_ms"});
+        if (auto n = d["node_expiry_ms"]) {
+            c.discovery.node_expiry = std::chrono::milliseconds(r.unsigned_int(n, "discovery.node_expiry_ms", 3600000));
+            if (c.discovery.node_expiry.count() < 1000) r.error(n, "discovery.node_expiry_ms", "must be at least 1000");
+        }
+        if (auto n = d["enabled"]) c.discovery.enabled = r.boolean(n, "discovery.enabled");
+        if (auto n = d["announce"]) c.discovery.announce = r.boolean(n, "discovery.announce");
+        if (auto n = d["ipv4_broadcast"]) c.discovery.ipv4_broadcast = r.boolean(n, "discovery.ipv4_broadcast");
+        if (auto n = d["interfaces"]) c.discovery.interfaces = r.string_list(n, "discovery.interfaces");
+        if (auto n = d["max_nodes"]) {
+            c.discovery.max_nodes = r.unsigned_int(n, "discovery.max_nodes", 65536);
+            if (c.discovery.max_nodes == 0) r.error(n, "discovery.max_nodes", "must be at least 1");
+        }
+    }
+    auto list = root["discover"];
+    if (!list) return;
+    if (!list.IsSequence()) r.error(list, "discover", "expected a list of filters");
+    std::size_t i = 0;
+    for (const auto& d : list) {
+        const std::string key = "discover[" + std::to_string(i++) + "]";
+        r.check_keys(d, key,
+                     {"type", "types", "name", "nodename", "nodeid", "nodes", "service", "services", "transports",
+                      "attributes", "attributes_operation", "max", "username", "password", "backoff_max_ms"});
+        DiscoverRule rule;
+        auto& f = rule.filter;
+        if (auto n = d["type"]) f.service_types.push_back(r.string(n, key + ".type"));
+        if (auto n = d["types"])
+            for (auto& t : r.string_list(n, key + ".types")) f.service_types.push_back(std::move(t));
+        if (auto n = d["name"]) {
+            rule.name_template = r.string(n, key + ".name");
+            if (rule.name_template.empty()) r.error(n, key + ".name", "must not be empty");
+        }
+        rr::discovery::FilterNode node;
+        if (auto n = d["nodename"]) node.node_name = r.string(n, key + ".nodename");
+        if (auto n = d["nodeid"]) {
+            auto id = NodeID::parse(r.string(n, key + ".nodeid"));
+            if (!id) r.error(n, key + ".nodeid", "not a NodeID (UUID)");
+            node.node_id = *id;
+        }
+        if (!node.node_name.empty() || !node.node_id.is_any()) f.nodes.push_back(node);
+        if (auto n = d["nodes"]) {
+            if (!n.IsSequence()) r.error(n, key + ".nodes", "expected a list of {nodename, nodeid}");
+            for (const auto& e : n) {
+                r.check_keys(e, key + ".nodes[]", {"nodename", "nodeid"});
+                rr::discovery::FilterNode fn;
+                if (auto x = e["nodename"]) fn.node_name = r.string(x, key + ".nodes[].nodename");
+                if (auto x = e["nodeid"]) {
+                    auto id = NodeID::parse(r.string(x, key + ".nodes[].nodeid"));
+                    if (!id) r.error(x, key + ".nodes[].nodeid", "not a NodeID (UUID)");
+                    fn.node_id = *id;
+                }
+                f.nodes.push_back(fn);
+            }
+        }
+        if (auto n = d["service"]) f.service_names.push_back(r.string(n, key + ".service"));
+        if (auto n = d["services"])
+            for (auto& s : r.string_list(n, key + ".services")) f.service_names.push_back(std::move(s));
+        if (auto n = d["transports"]) {
+            f.transport_schemes = r.string_list(n, key + ".transports");
+            for (const auto& t : f.transport_schemes)
+                if (t != "rr+tcp" && t != "rr+local" && t != "rr+ws" && t != "rr+wss" && t != "rrs+tcp" && t != "rr+usb")
+                    r.error(n, key + ".transports", "unknown transport scheme \"" + t + "\"");
+        }
+        if (auto n = d["attributes"]) {
+            if (!n.IsMap()) r.error(n, key + ".attributes", "expected a mapping of attribute name to filter");
+            for (const auto& kv : n) {
+                auto name = kv.first.as<std::string>();
+                f.attributes[name] = attribute_group(kv.second, r, key + ".attributes." + name);
+            }
+        }
+        if (auto n = d["attributes_operation"]) {
+            auto op = rr::discovery::parse_filter_operation(r.string(n, key + ".attributes_operation"));
+            if (!op) r.error(n, key + ".attributes_operation", "expected and, or, nor or nand");
+            f.attributes_operation = *op;
+        }
+        if (auto n = d["max"]) f.max_count = static_cast<std::uint32_t>(r.unsigned_int(n, key + ".max", 100000));
+        if (auto n = d["username"]) rule.username = r.string(n, key + ".username");
+        if (auto n = d["password"]) rule.password = r.string(n, key + ".password");
+        if (auto n = d["backoff_max_ms"])
+            rule.backoff_max = std::chrono::milliseconds(r.unsigned_int(n, key + ".backoff_max_ms", 3600000));
+        c.discover.push_back(std::move(rule));
+    }
+    if (!c.discover.empty()) c.discovery.enabled = true;
+}
+
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover"});
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins",
@@ -157,6 +294,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             c.devices.push_back(std::move(dc));
         }
     }
+    parse_discovery(root, r, c);
     return c;
 }
 
@@ -190,7 +328,7 @@ const std::set<std::string> kValueFlags{"--config",      "--port",       "--list
                                         "--allow-origin", "--device",     "--demo-port", "--threads",
                                         "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--check", "--help", "-h"};
+const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h"};
 
 }  // namespace
 
@@ -265,6 +403,8 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.demo = false;
         } else if (flag == "--no-local") {
             c.local = false;
+        } else if (flag == "--discovery") {
+            c.discovery.enabled = true;
         } else if (flag == "--robotraconteur-nodename") {
             c.node_name = v;
         } else if (flag == "--robotraconteur-nodeid") {
@@ -314,6 +454,7 @@ Options (override the configuration file):
                              or cam=rr+local:///?nodename=camera.driver&service=cam
   --no-demo                  do not start the demo devices
   --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
+  --discovery                node discovery: announce the gateway, list nodes (docs/discovery.md)
   --demo-port N              RR port of the demo devices' node (default: ephemeral)
   --threads N                worker threads (default: cores)
   --log-level LEVEL          trace, debug, info, warning, error

@@ -9,10 +9,31 @@
 #include <string>
 #include <vector>
 
+#include "core/discovery/service_filter.hpp"
 #include "core/error/rr_error.hpp"
 #include "server/gateway/device_mirror.hpp"
 
 namespace rr::server::app {
+
+/// `discovery:` (docs/gateway-config.md, docs/discovery.md): node discovery on the network.
+struct DiscoverySettings {
+    bool enabled = false;          ///< listen (and announce); also on when `discover:` has entries
+    bool announce = true;          ///< announce the gateway (when enabled)
+    bool ipv4_broadcast = false;   ///< also IPv4 broadcast (the official IPV4_BROADCAST flag)
+    std::vector<std::string> interfaces;  ///< interface names; empty = all
+    std::size_t max_nodes = 1024;  ///< node table cap (oldest evicted)
+    std::chrono::milliseconds node_expiry{60000};  ///< a node's URL lives this long after its last announce
+};
+
+/// One `discover:` entry: services selected by filter become gateway devices while their node is seen.
+struct DiscoverRule {
+    rr::discovery::ServiceFilter filter;
+    /// Device name; {service}, {nodename}, {nodeid} are replaced, then every character outside
+    /// [A-Za-z0-9_] becomes '_' (RR service names).
+    std::string name_template = "{service}";
+    std::string username, password;
+    std::chrono::milliseconds backoff_max{30000};
+};
 
 struct GatewayConfig {
     // gateway:
@@ -33,6 +54,9 @@ struct GatewayConfig {
     std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)
     // devices:
     std::vector<gateway::DeviceConfig> devices;
+    // discovery: / discover:
+    DiscoverySettings discovery;
+    std::vector<DiscoverRule> discover;
 };
 
 /// Parses YAML text. `source` names the file in error messages. Errors: InvalidConfiguration with
@@ -53,7 +77,8 @@ struct CommandLine {
 
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
-/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local, --check,
+/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local,
+/// --discovery, --check,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
 Result<CommandLine> parse_command_line(int argc, const char* const* argv);

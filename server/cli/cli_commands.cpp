@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "robdef/builtin/service_index.hpp"
+#include "server/cli/cli_discover.hpp"
 #include "server/cli/cli_target.hpp"
 #include "server/cli/cli_watch.hpp"
 
@@ -225,6 +226,7 @@ void print_error(std::ostream& err, const RRError& e) {
 }  // namespace
 
 ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err, const std::atomic<bool>& stop) {
+    if (cl.kind == CommandKind::discover) return run_discover(cl, out, err);
     // Command-line JSON first: a typo must not need a connection to be reported.
     std::vector<nlohmann::json> json;
     for (std::size_t i = 0; i < cl.values.size(); ++i) {
@@ -246,14 +248,30 @@ ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err
         print_error(err, make_error(MessageErrorType::InvalidArgument, "the URL names no service (add ?service=NAME)"));
         return ExitCode::usage_error;
     }
-    auto url = url_with_service(cl.url, node_index ? std::string(robdef::kServiceIndexServiceName) : "");
-    if (!url) {
-        print_error(err, url.error());
-        return ExitCode::usage_error;
+    // rr+tcp:///?nodename=NAME (no host): the node's URLs from discovery, tried in turn (docs/discovery.md).
+    std::vector<std::string> candidates{cl.url};
+    if (needs_discovery(*parsed)) {
+        auto found = resolve_through_discovery(*parsed, std::min(cl.timeout_s, 10.0), cl.interfaces);
+        if (!found) {
+            print_error(err, found.error());
+            return ExitCode::connect_failure;
+        }
+        candidates = std::move(*found);
     }
 
-    Target t;
-    std::optional<Failure> f = connect_target(cl, *url, t);
+    auto target = std::make_unique<Target>();
+    std::optional<Failure> f;
+    for (const auto& candidate : candidates) {
+        auto url = url_with_service(candidate, node_index ? std::string(robdef::kServiceIndexServiceName) : "");
+        if (!url) {
+            print_error(err, url.error());
+            return ExitCode::usage_error;
+        }
+        target = std::make_unique<Target>();
+        f = connect_target(cl, *url, *target);
+        if (!f || f->code != ExitCode::connect_failure) break;
+    }
+    Target& t = *target;
     if (!f) {
         switch (cl.kind) {
             case CommandKind::info: f = run_info(t, node_index, out); break;
@@ -261,6 +279,7 @@ ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err
             case CommandKind::set: f = run_set(cl, t, json.at(0)); break;
             case CommandKind::call: f = run_call(cl, t, json, out); break;
             case CommandKind::watch: f = run_watch(cl, t, out, stop); break;
+            case CommandKind::discover:  // handled above
             case CommandKind::help: break;
         }
     }

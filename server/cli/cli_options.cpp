@@ -12,7 +12,7 @@ Unexpected usage(std::string message) { return fail(MessageErrorType::InvalidArg
 
 const std::map<std::string, CommandKind, std::less<>> kCommands = {
     {"info", CommandKind::info}, {"get", CommandKind::get},     {"set", CommandKind::set},
-    {"call", CommandKind::call}, {"watch", CommandKind::watch},
+    {"call", CommandKind::call}, {"watch", CommandKind::watch}, {"discover", CommandKind::discover},
 };
 
 Result<double> parse_seconds(std::string_view flag, std::string_view text) {
@@ -57,6 +57,7 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
     std::optional<std::string> object_path;
     bool want_help = false;
     bool flags_done = false;
+    bool timeout_given = false;
     for (std::size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         // Single-dash tokens other than -h are values (negative numbers in JSON arguments).
@@ -76,13 +77,18 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.disable_message4 = true;
             continue;
         }
+        if (a == "--json") {
+            cl.json = true;
+            continue;
+        }
         std::string flag = a, value;
         if (auto eq = a.find('='); eq != std::string::npos) {
             flag = a.substr(0, eq);
             value = a.substr(eq + 1);
         } else {
             static const char* kWithValue[] = {"--timeout", "--username", "--password", "--object",
-                                               "--count",   "--seconds",  "--tls-ca",   "--http-login"};
+                                               "--count",   "--seconds",  "--tls-ca",   "--http-login",
+                                               "--type",    "--interface"};
             bool known = false;
             for (const char* k : kWithValue) known = known || flag == k;
             if (!known) return usage("unknown option " + flag);
@@ -93,6 +99,13 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             auto v = parse_seconds(flag, value);
             if (!v) return v.take_error();
             cl.timeout_s = *v;
+            timeout_given = true;
+        } else if (flag == "--type") {
+            if (value.empty()) return usage("--type needs a service type");
+            cl.types.push_back(value);
+        } else if (flag == "--interface") {
+            if (value.empty()) return usage("--interface needs an interface name");
+            cl.interfaces.push_back(value);
         } else if (flag == "--seconds") {
             auto v = parse_seconds(flag, value);
             if (!v) return v.take_error();
@@ -138,6 +151,14 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
     }
     cl.kind = it->second;
     const std::string& name = positional[0];
+    if (cl.kind != CommandKind::discover && (!cl.types.empty() || cl.json))
+        return usage("--type and --json apply to discover only");
+    if (cl.kind == CommandKind::discover) {
+        if (positional.size() != 1) return usage("discover takes no arguments (try rr discover --help)");
+        if (!timeout_given) cl.timeout_s = 5;
+        if (cl.count || cl.seconds || object_path) return usage("--count, --seconds and --object do not apply to discover");
+        return cl;
+    }
     auto need = [&](std::size_t min, std::size_t max) -> Result<void> {
         std::size_t n = positional.size() - 1;
         if (n < min || n > max) return usage("wrong number of arguments for \"" + name + "\" (try rr " + name + " --help)");
@@ -150,6 +171,7 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
         case CommandKind::set: shape = need(3, 3); break;
         case CommandKind::call: shape = need(2, SIZE_MAX); break;
         case CommandKind::watch: shape = need(2, 2); break;
+        case CommandKind::discover:
         case CommandKind::help: break;
     }
     if (!shape) return shape.take_error();
@@ -186,9 +208,11 @@ std::string help_text(std::string_view topic) {
         "  set   URL MEMBER JSON        write a property (or poke a wire's OutValue)\n"
         "  call  URL FUNCTION [JSON...] call a function; a generator prints each item\n"
         "  watch URL MEMBER             stream a wire's values, an event or a pipe's packets\n"
+        "  discover [--type T] [--json] nodes and services found on the network (docs/discovery.md)\n"
         "\n"
         "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rr+ws://, rr+wss://;\n"
-        "     rr+local:///?nodename=NAME&service=S on this computer).\n"
+        "     rr+local:///?nodename=NAME&service=S on this computer;\n"
+        "     rr+tcp:///?nodename=NAME&service=S finds the node by discovery).\n"
         "MEMBER: name, or a path through objrefs: child.leaf.x, child_by_int[7].value.\n"
         "Values are JSON as in docs/json-mapping.md; output is one JSON value per line.\n"
         "\n"
@@ -211,6 +235,12 @@ std::string help_text(std::string_view topic) {
                "Prints the service definitions the service sent, then the root object's (or the object at\n"
                "PATH's) type and members, one per line: KIND NAME TYPE [MODIFIERS].\n"
                "Without service= in the URL, lists the node's services (RobotRaconteurServiceIndex).\n";
+    if (topic == "discover")
+        return "usage: rr discover [--type TYPE]... [--timeout S] [--json] [--interface IF]...\n"
+               "Listens for node announces (UDP 48653, IPv6 FF02::BA86) and sends discovery requests for\n"
+               "S seconds (default 5), asks each node found for its services (RobotRaconteurServiceIndex),\n"
+               "and prints every node with its URLs and services. --type keeps only services whose root\n"
+               "object type is TYPE or implements it. --json prints one JSON object per node.\n";
     if (topic == "get")
         return "usage: rr get URL MEMBER [--object PATH]\n"
                "Prints the value of property MEMBER as one JSON line. For a wire, prints its InValue\n"

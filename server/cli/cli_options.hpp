@@ -25,7 +25,7 @@ enum class ExitCode : int {
     connect_failure = 3,  ///< no client session: unreachable, ServiceNotFound, authentication, …
 };
 
-enum class CommandKind { help, info, get, set, call, watch };
+enum class CommandKind { help, info, get, set, call, watch, discover };
 
 /// One segment of a member path: an objref (or, last, the member) name and an optional index key.
 struct PathSegment {
@@ -50,6 +50,10 @@ struct CommandLine {
     std::string tls_ca_file;           ///< rr+wss: PEM certificates to trust ("" = the system's)
     std::string http_login;            ///< rr+ws/rr+wss: USER:PASSWORD for a reverse proxy's basic auth
     bool disable_message4 = false;
+    // discover (docs/discovery.md)
+    std::vector<std::string> types;       ///< --type: only services of these types (root or implemented)
+    bool json = false;                    ///< --json: one JSON object per node
+    std::vector<std::string> interfaces;  ///< --interface: network interfaces to use (default: all)
 };
 
 /// Parses a member path (`a.b[3].c`). Errors: InvalidArgument (empty segment, unterminated `[`, text

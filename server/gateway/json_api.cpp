@@ -1,5 +1,8 @@
 #include "server/gateway/json_api.hpp"
 
+#include <algorithm>
+
+
 #include "core/json/value_json.hpp"
 #include "core/message/error_entry.hpp"
 #include "core/names/service_path.hpp"
@@ -100,9 +103,67 @@ JsonApi::JsonApi(std::vector<std::shared_ptr<DeviceMirror>> devices, JsonApiOpti
     : devices_(std::move(devices)), options_(std::move(options)) {}
 
 std::shared_ptr<DeviceMirror> JsonApi::find_device(std::string_view name) const {
+    std::lock_guard lock(mutex_);
     for (const auto& d : devices_)
         if (d->config().name == name) return d;
     return nullptr;
+}
+
+std::vector<std::shared_ptr<DeviceMirror>> JsonApi::devices() const {
+    std::lock_guard lock(mutex_);
+    return devices_;
+}
+
+Result<void> JsonApi::add_device(std::shared_ptr<DeviceMirror> device) {
+    std::vector<DevicesListener> listeners;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& d : devices_)
+            if (d->config().name == device->config().name)
+                return fail(MessageErrorType::InvalidArgument, "device name \"" + d->config().name + "\" is taken");
+        devices_.push_back(device);
+        for (const auto& [id, l] : devices_listeners_) listeners.push_back(l);
+    }
+    for (const auto& l : listeners) l(device, true);
+    return {};
+}
+
+std::shared_ptr<DeviceMirror> JsonApi::remove_device(std::string_view name) {
+    std::shared_ptr<DeviceMirror> removed;
+    std::vector<DevicesListener> listeners;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = std::find_if(devices_.begin(), devices_.end(), [&](const auto& d) { return d->config().name == name; });
+        if (it == devices_.end()) return nullptr;
+        removed = *it;
+        devices_.erase(it);
+        types_.erase(removed.get());
+        for (const auto& [id, l] : devices_listeners_) listeners.push_back(l);
+    }
+    for (const auto& l : listeners) l(removed, false);
+    return removed;
+}
+
+std::uint64_t JsonApi::add_devices_listener(DevicesListener listener) {
+    std::lock_guard lock(mutex_);
+    const auto id = next_devices_listener_++;
+    devices_listeners_.emplace(id, std::move(listener));
+    return id;
+}
+
+void JsonApi::remove_devices_listener(std::uint64_t id) {
+    std::lock_guard lock(mutex_);
+    devices_listeners_.erase(id);
+}
+
+void JsonApi::set_discovery_hooks(DiscoveryHooks hooks) {
+    std::lock_guard lock(mutex_);
+    discovery_hooks_ = std::move(hooks);
+}
+
+JsonApi::DiscoveryHooks JsonApi::discovery_hooks() const {
+    std::lock_guard lock(mutex_);
+    return discovery_hooks_;
 }
 
 nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
@@ -119,7 +180,7 @@ nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
 
 nlohmann::json JsonApi::device_list() const {
     auto list = nlohmann::json::array();
-    for (const auto& d : devices_) list.push_back(status_json(d->status()));
+    for (const auto& d : devices()) list.push_back(status_json(d->status()));
     return list;
 }
 

@@ -71,9 +71,30 @@ public:
 
     explicit JsonApi(std::vector<std::shared_ptr<DeviceMirror>> devices, JsonApiOptions options = {});
 
-    const std::vector<std::shared_ptr<DeviceMirror>>& devices() const noexcept { return devices_; }
+    /// The devices now (configured ones first, then those added while running), a snapshot.
+    std::vector<std::shared_ptr<DeviceMirror>> devices() const;
     const JsonApiOptions& options() const noexcept { return options_; }
     std::shared_ptr<DeviceMirror> find_device(std::string_view name) const;
+
+    /// A device added while running (discovery, the "add" action): listed and reachable from now on.
+    /// Errors: InvalidArgument when the name is taken.
+    Result<void> add_device(std::shared_ptr<DeviceMirror> device);
+    /// Removes a device added while running; returns it (nullptr when unknown). The caller stops it.
+    std::shared_ptr<DeviceMirror> remove_device(std::string_view name);
+    /// Told (without locks held) after add_device (`added` true) and remove_device (false).
+    using DevicesListener = std::function<void(const std::shared_ptr<DeviceMirror>& device, bool added)>;
+    std::uint64_t add_devices_listener(DevicesListener listener);
+    void remove_devices_listener(std::uint64_t id);
+
+    /// What discovery offers the API (docs/json-api.md "Discovery"): the list of discovered nodes and
+    /// services, and turning a discovered service into a device. Unset: those routes answer 404.
+    struct DiscoveryHooks {
+        std::function<nlohmann::json()> list;
+        /// Body `{"nodeid", "service", "name"?}`; `done` gets the new device's status_json or an error.
+        std::function<void(const nlohmann::json& body, Done done)> add;
+    };
+    void set_discovery_hooks(DiscoveryHooks hooks);
+    DiscoveryHooks discovery_hooks() const;
 
     /// `{"name", "url", "state", "reason", "object_type", "required", "clients"}` of one device.
     static nlohmann::json status_json(const DeviceStatus& status);
@@ -117,9 +138,12 @@ private:
                         std::string path, std::string object_type, std::string member,
                         const std::function<void(Resolved)>& done) const;
 
-    std::vector<std::shared_ptr<DeviceMirror>> devices_;
+    std::vector<std::shared_ptr<DeviceMirror>> devices_;  // guarded by mutex_
     JsonApiOptions options_;
     mutable std::mutex mutex_;
+    std::map<std::uint64_t, DevicesListener> devices_listeners_;
+    std::uint64_t next_devices_listener_ = 1;
+    DiscoveryHooks discovery_hooks_;
     mutable std::map<const DeviceMirror*, std::shared_ptr<const DeviceTypes>> types_;
 };
 

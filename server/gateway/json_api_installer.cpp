@@ -6,10 +6,11 @@
 
 namespace rr::server::gateway {
 
-void install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices) {
+std::shared_ptr<JsonApi> install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices) {
     auto api = std::make_shared<JsonApi>(devices);
     install_json_rest(http, api);
     install_json_socket(http, api);
+    return api;
 }
 
 }  // namespace rr::server::gateway

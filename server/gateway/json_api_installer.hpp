@@ -10,6 +10,9 @@
 
 namespace rr::server::gateway {
 
-void install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices);
+class JsonApi;
+
+/// Installs the JSON API and returns it (the gateway adds discovered devices to it).
+std::shared_ptr<JsonApi> install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices);
 
 }  // namespace rr::server::gateway

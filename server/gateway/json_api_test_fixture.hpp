@@ -138,6 +138,7 @@ public:
             api_ = std::make_shared<JsonApi>(devices);
             install_json_rest(http, api_);
             sockets_ = install_json_socket(http, api_, ws_options);
+            return api_;
         };
         auto g = app::Gateway::start(cfg, {}, installer);
         REQUIRE(g);

@@ -98,6 +98,7 @@ std::optional<ApiError> read_max_items(const nlohmann::json& j, std::size_t& out
 class RestRouter {
 public:
     explicit RestRouter(std::shared_ptr<JsonApi> api) : api_(std::move(api)) {}
+    const std::shared_ptr<JsonApi>& api() const noexcept { return api_; }
 
     void handle(const http::Request& req, http::Responder respond) {
         try {
@@ -232,6 +233,27 @@ void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
     auto handler = [router](const http::Request& req, http::Responder respond) { router->handle(req, std::move(respond)); };
     for (auto verb : {bhttp::verb::get, bhttp::verb::put, bhttp::verb::post, bhttp::verb::options})
         http.add_route(verb, "/api/devices", handler, /*prefix=*/true);
+
+    // Discovery (docs/json-api.md "Discovery"): the nodes and services found, and "add".
+    auto no_discovery = [](const http::Request& req) {
+        return error_response(req, api_error(404, MessageErrorType::ResourceNotFound, "discovery is not enabled"));
+    };
+    http.add_route(bhttp::verb::get, "/api/discovered",
+                   [router, no_discovery](const http::Request& req, http::Responder respond) {
+                       auto hooks = router->api()->discovery_hooks();
+                       if (!hooks.list) return respond(no_discovery(req));
+                       respond(json_response(req, 200, hooks.list()));
+                   });
+    http.add_route(bhttp::verb::post, "/api/discovered/add",
+                   [router, no_discovery](const http::Request& req, http::Responder respond) {
+                       auto hooks = router->api()->discovery_hooks();
+                       if (!hooks.add) return respond(no_discovery(req));
+                       auto body = parse_request_json(req.body());
+                       if (!body)
+                           return respond(error_response(req, api_error(400, MessageErrorType::InvalidArgument, body.error().message)));
+                       auto head = std::make_shared<http::Request>(req.base(), std::string());
+                       hooks.add(*body, [head, respond](ApiResult r) { respond(result_response(*head, r)); });
+                   });
 }
 
 }  // namespace rr::server::gateway

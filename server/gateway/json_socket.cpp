@@ -82,9 +82,13 @@ public:
     }
 
     void push_device_state(const DeviceStatus& status) {
+        push_json(nlohmann::json{{"kind", "device_state"}, {"device", JsonApi::status_json(status)}});
+    }
+
+    void push_json(const nlohmann::json& message) {
         std::lock_guard lock(mutex_);
         if (closed_) return;
-        send_text(nlohmann::json{{"kind", "device_state"}, {"device", JsonApi::status_json(status)}});
+        send_text(message);
     }
 
     JsonSocketStats stats() const {
@@ -742,10 +746,51 @@ std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonA
         });
         s->listeners_.emplace_back(d, id);
     }
+    // Devices added and removed while running (discovery): state pushes for new ones, device_removed.
+    s->devices_listener_ = s->api_->add_devices_listener([weak](const std::shared_ptr<DeviceMirror>& d, bool added) {
+        if (auto self = weak.lock()) self->on_devices_changed(d, added);
+    });
     return s;
 }
 
+void JsonSocketServer::on_devices_changed(const std::shared_ptr<DeviceMirror>& device, bool added) {
+    std::weak_ptr<JsonSocketServer> weak = weak_from_this();
+    if (added) {
+        const auto id = device->add_state_listener([weak](const DeviceStatus& status) {
+            if (auto self = weak.lock()) self->on_device_state(status);
+        });
+        {
+            std::lock_guard lock(mutex_);
+            listeners_.emplace_back(device, id);
+        }
+        on_device_state(device->status());
+        return;
+    }
+    {
+        std::lock_guard lock(mutex_);
+        for (auto it = listeners_.begin(); it != listeners_.end();) {
+            if (it->first == device) {
+                device->remove_state_listener(it->second);
+                it = listeners_.erase(it);
+            } else {
+                ++it;
+            }
+        }
+    }
+    push_text(nlohmann::json{{"kind", "device_removed"}, {"device", JsonApi::status_json(device->status())}});
+}
+
+void JsonSocketServer::push_text(const nlohmann::json& message) {
+    std::vector<std::shared_ptr<JsonSocketSession>> sessions;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [k, s] : sessions_) sessions.push_back(s);
+    }
+    for (const auto& s : sessions) s->push_json(message);
+}
+
 JsonSocketServer::~JsonSocketServer() {
+    api_->remove_devices_listener(devices_listener_);
     for (auto& [d, id] : listeners_) d->remove_state_listener(id);
     std::map<const http::JsonSocket*, std::shared_ptr<JsonSocketSession>> sessions;
     {

@@ -85,6 +85,8 @@ private:
     void on_message(const std::shared_ptr<http::JsonSocket>& socket, std::string text);
     void on_close(const std::shared_ptr<http::JsonSocket>& socket);
     void on_device_state(const DeviceStatus& status);
+    void on_devices_changed(const std::shared_ptr<DeviceMirror>& device, bool added);
+    void push_text(const nlohmann::json& message);
 
     std::shared_ptr<JsonApi> api_;
     boost::asio::any_io_executor executor_;
@@ -93,6 +95,7 @@ private:
     std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
     mutable std::mutex mutex_;
     std::map<const http::JsonSocket*, std::shared_ptr<JsonSocketSession>> sessions_;
+    std::uint64_t devices_listener_ = 0;
 };
 
 /// Registers the subprotocol on `http`; returns the server (kept alive by the registered handler too).

@@ -145,11 +145,27 @@ void Node::unregister_service(const std::string& name) {
 void Node::services_changed() {
     local_node_services_changed(service_index_);
     std::vector<std::shared_ptr<Listener>> listeners;
+    std::vector<std::function<void()>> callbacks;
     {
         std::lock_guard lock(mutex_);
         listeners = listeners_;
+        callbacks = services_changed_callbacks_;
     }
     for (const auto& l : listeners) l->services_changed();
+    for (const auto& c : callbacks) c();
+}
+
+std::vector<tcp::endpoint> Node::listen_endpoints() const {
+    std::lock_guard lock(mutex_);
+    std::vector<tcp::endpoint> out;
+    for (const auto& l : listeners_)
+        if (auto t = std::dynamic_pointer_cast<TcpListener>(l)) out.push_back(t->local_endpoint());
+    return out;
+}
+
+void Node::on_services_changed(std::function<void()> callback) {
+    std::lock_guard lock(mutex_);
+    services_changed_callbacks_.push_back(std::move(callback));
 }
 
 std::vector<std::string> Node::service_names() const { return services_->names(); }

@@ -64,6 +64,11 @@ public:
     std::vector<std::string> listen_urls() const;
     /// Base URL for connections whose transport gave none: the first TCP listener's.
     std::string listen_base_url() const;
+    /// TCP endpoints the node listens on, as bound (wildcards not expanded): what discovery announces.
+    std::vector<boost::asio::ip::tcp::endpoint> listen_endpoints() const;
+    /// Adds a callback run after every register_service / unregister_service (on that thread, no lock
+    /// held): discovery renews its ServiceStateNonce there (wire.md §11.1).
+    void on_services_changed(std::function<void()> callback);
     /// Where TCP sockets starting with anything but `RRAC` go (HTTP; default: answer 404 and close).
     void set_http_handler(HttpHandler handler);
 
@@ -106,6 +111,7 @@ private:
     HttpHandler http_handler_;
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
     std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
+    std::vector<std::function<void()>> services_changed_callbacks_;
     std::atomic<bool> stopped_{false};
 };
 

@@ -1,0 +1,305 @@
+#!/usr/bin/env python3
+"""Node discovery over real IPv6 link-local multicast between two network namespaces (docs/discovery.md).
+
+The test makes namespaces A and B joined by a veth pair (link-local addresses, DAD off) and runs:
+
+  A: rr-gateway (discovery on, a `discover:` filter for experimental.discovery_test.Base, demo devices,
+     node expiry 15 s, table cap 64), then our `rr discover` and `rr info rr+tcp:///?nodename=…`
+  B: the official library: a ServerNodeSetup node serving "thing" (started after the gateway), an
+     official client (ClientNodeSetup; FindServiceByType, FindNodeByName), and a sender of hostile
+     datagrams (truncated, oversized, bad UUID, lying URLs, a flood of distinct NodeIDs)
+
+and checks: rr discover lists the official node, its service, type and attributes, and the gateway;
+rr info reaches a service by NodeName; the gateway adds the official service as a device (reachable
+through the JSON API), the "add" action adds another; the official client finds the gateway by
+NodeName and its devices by type; hostile datagrams are counted in /metrics and the table stays within
+its cap; when the official node stops, the gateway removes its devices after the expiry.
+
+Needs root (ip netns); without it, or without `ip`, it exits 77 (skipped) with the reason.
+
+    discovery_netns.py --rr PATH --gateway PATH --python PATH
+"""
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import child_procs  # noqa: E402
+
+SKIP = 77
+OFFICIAL_NAME = "disc_official"
+GATEWAY_NAME = "disc.gateway"
+THING_TYPE = "experimental.discovery_test.Thing"
+BASE_TYPE = "experimental.discovery_test.Base"
+
+
+class Failed(Exception):
+    pass
+
+
+def log(*a):
+    print("[discovery_netns]", *a, flush=True)
+
+
+def run(cmd, timeout=30, check=True):
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=timeout,
+                       stdin=subprocess.DEVNULL)
+    if check and r.returncode != 0:
+        raise Failed("%s: exit %s: %s" % (" ".join(cmd), r.returncode, r.stderr.strip()[-2000:]))
+    return r
+
+
+class Net:
+    def __init__(self):
+        tag = str(os.getpid() % 100000)
+        self.a, self.b = "rrdA" + tag, "rrdB" + tag
+        self.va, self.vb = "rrvA" + tag, "rrvB" + tag
+        self.made = []
+
+    def setup(self):
+        for ns in (self.a, self.b):
+            r = run(["ip", "netns", "add", ns], check=False)
+            if r.returncode != 0:
+                raise PermissionError("ip netns add failed: " + r.stderr.strip())
+            self.made.append(ns)
+        run(["ip", "link", "add", self.va, "type", "veth", "peer", "name", self.vb])
+        run(["ip", "link", "set", self.va, "netns", self.a])
+        run(["ip", "link", "set", self.vb, "netns", self.b])
+        for ns, dev in ((self.a, self.va), (self.b, self.vb)):
+            run(["ip", "netns", "exec", ns, "sysctl", "-qw", "net.ipv6.conf.%s.accept_dad=0" % dev])
+            run(["ip", "-n", ns, "link", "set", "lo", "up"])
+            run(["ip", "-n", ns, "link", "set", dev, "up"])
+        deadline = time.monotonic() + 10
+        for ns, dev in ((self.a, self.va), (self.b, self.vb)):
+            while True:
+                out = run(["ip", "-n", ns, "-6", "addr", "show", "dev", dev, "scope", "link"]).stdout
+                if "inet6 fe80" in out and "tentative" not in out:
+                    break
+                if time.monotonic() > deadline:
+                    raise Failed("no link-local address on %s in %s: %s" % (dev, ns, out))
+                time.sleep(0.1)
+
+    def teardown(self):
+        for ns in self.made:
+            run(["ip", "netns", "del", ns], check=False)
+
+    def cmd(self, ns, argv):
+        return ["ip", "netns", "exec", ns] + list(argv)
+
+
+def http(net, python, url, method="GET", body=None):
+    """An HTTP request from inside namespace A (the gateway's loopback is there)."""
+    code = ("import json,sys,urllib.request,urllib.error\n"
+            "req=urllib.request.Request(sys.argv[1],method=sys.argv[2],data=(sys.argv[3].encode() if sys.argv[3] else None),"
+            "headers={'Content-Type':'application/json'})\n"
+            "try:\n r=urllib.request.urlopen(req,timeout=10); print(json.dumps({'status':r.status,'body':r.read().decode()}))\n"
+            "except urllib.error.HTTPError as e:\n print(json.dumps({'status':e.code,'body':e.read().decode()}))\n")
+    r = run(net.cmd(net.a, [python, "-c", code, url, method, json.dumps(body) if body is not None else ""]), timeout=20)
+    return json.loads(r.stdout)
+
+
+def wait_until(what, fn, timeout):
+    deadline = time.monotonic() + timeout
+    last = None
+    while time.monotonic() < deadline:
+        last = fn()
+        if last:
+            return last
+        time.sleep(0.3)
+    raise Failed("timed out waiting for " + what)
+
+
+def devices(net, python, port):
+    r = http(net, python, "http://[::1]:%d/api/devices" % port)
+    return {d["name"]: d for d in json.loads(r["body"])}
+
+
+def metric(text, name):
+    total = 0.0
+    found = False
+    for line in text.splitlines():
+        if line.startswith(name + " ") or line.startswith(name + "{"):
+            total += float(line.rsplit(" ", 1)[1])
+            found = True
+    if not found:
+        raise Failed("metric %s missing" % name)
+    return total
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rr", required=True)
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--python", required=True)
+    args = ap.parse_args()
+    if os.geteuid() != 0:
+        print("SKIP: network namespaces need root (ip netns add)")
+        return SKIP
+    if not shutil.which("ip"):
+        print("SKIP: the ip tool (iproute2) is not installed")
+        return SKIP
+    if not os.path.exists(args.python):
+        print("SKIP: %s missing (run ./scripts/setup.sh)" % args.python)
+        return SKIP
+    tmp = tempfile.mkdtemp(prefix="rr_discovery_")
+    net = Net()
+    procs = []
+    try:
+        try:
+            net.setup()
+        except PermissionError as e:
+            print("SKIP: " + str(e))
+            return SKIP
+        official_py = os.path.join(HERE, "discovery_official.py")
+
+        # --- the gateway in A, before the official node exists -------------------------------------
+        cfg = os.path.join(tmp, "gateway.yaml")
+        with open(cfg, "w") as f:
+            f.write("gateway: {listen: '::', port: 0, node_name: %s, log_level: warning, local: false}\n"
+                    "demo: {enabled: true}\n"
+                    "discovery: {enabled: true, node_expiry_ms: 15000, max_nodes: 64}\n"
+                    "discover:\n"
+                    "  - type: %s\n"
+                    "    name: '{service}_{nodename}'\n"
+                    "    transports: [rr+tcp]\n"
+                    "    attributes: {tags: fox}\n" % (GATEWAY_NAME, BASE_TYPE))
+        gw = child_procs.start(net.cmd(net.a, [args.gateway, "--config", cfg]), os.path.join(tmp, "gateway.err"))
+        procs.append(gw)
+        port = child_procs.read_json_line(gw, 60, "rr-gateway")["port"]
+        log("gateway on port", port)
+
+        # --- the official node in B --------------------------------------------------------------
+        official = child_procs.start(net.cmd(net.b, [args.python, official_py, "serve", "--name", OFFICIAL_NAME]),
+                                     os.path.join(tmp, "official.err"))
+        procs.append(official)
+        official_id = child_procs.read_json_line(official, 60, "official node")["nodeid"].strip("{}")
+        log("official node", official_id)
+
+        # --- our rr discover in A finds it, its service, and the gateway --------------------------
+        r = run(net.cmd(net.a, [args.rr, "discover", "--json", "--timeout", "5"]), timeout=30)
+        nodes = [json.loads(line) for line in r.stdout.splitlines() if line.strip()]
+        by_name = {n["nodename"]: n for n in nodes}
+        if OFFICIAL_NAME not in by_name:
+            raise Failed("rr discover did not list the official node: %s / %s" % (r.stdout, r.stderr))
+        node = by_name[OFFICIAL_NAME]
+        if node["nodeid"] != official_id:
+            raise Failed("NodeID %s, expected %s" % (node["nodeid"], official_id))
+        things = [s for s in (node["services"] or []) if s["name"] == "thing"]
+        if not things or things[0]["root_object_type"] != THING_TYPE or "Base" not in things[0]["implements"]:  # CORE reports it unqualified
+            raise Failed("rr discover: service thing missing or wrong: %s" % node)
+        if things[0]["attributes"].get("tags", {}).get("value") != "fox,arm":
+            raise Failed("rr discover: attributes %s" % things[0]["attributes"])
+        if not any(u.startswith("rr+tcp://[fe80:") for u in node["urls"]):
+            raise Failed("rr discover: no link-local URL in %s" % node["urls"])
+        if GATEWAY_NAME not in by_name:
+            raise Failed("rr discover did not list the gateway: %s" % sorted(by_name))
+        log("rr discover: ok (%d nodes)" % len(nodes))
+
+        r = run(net.cmd(net.a, [args.rr, "discover", "--type", BASE_TYPE, "--timeout", "4"]), timeout=30)
+        if "service  thing  " + THING_TYPE not in r.stdout or "create" in r.stdout:
+            raise Failed("rr discover --type: %s" % r.stdout)
+        r = run(net.cmd(net.a, [args.rr, "info", "rr+tcp:///?nodename=%s&service=thing" % OFFICIAL_NAME,
+                                "--timeout", "8"]), timeout=30)
+        if "== object thing: " + THING_TYPE not in r.stdout:
+            raise Failed("rr info by NodeName: %s" % r.stdout)
+        r = run(net.cmd(net.a, [args.rr, "get", "rr+tcp:///?nodename=%s&service=thing" % OFFICIAL_NAME, "label"]),
+                timeout=30)
+        if r.stdout.strip() != '"official thing"':
+            raise Failed("rr get by NodeName: %r" % r.stdout)
+        log("rr info / get by NodeName: ok")
+
+        # --- the gateway picked up the official service ------------------------------------------
+        device = "thing_" + OFFICIAL_NAME
+        wait_until("the gateway device " + device,
+                   lambda: devices(net, args.python, port).get(device, {}).get("state") == "connected", 30)
+        r = http(net, args.python, "http://[::1]:%d/api/devices/%s/properties/label" % (port, device))
+        if r["status"] != 200 or json.loads(r["body"]) != {"value": "official thing"}:
+            raise Failed("label through the gateway: %s" % r)
+        listing = json.loads(http(net, args.python, "http://[::1]:%d/api/discovered" % port)["body"])
+        found = [n for n in listing["nodes"] if n["nodeid"] == official_id]
+        if not found or not any(s.get("device") == device for s in found[0]["services"] or []):
+            raise Failed("/api/discovered: %s" % listing)
+        r = http(net, args.python, "http://[::1]:%d/api/discovered/add" % port, "POST",
+                 {"nodeid": official_id, "service": "RobotRaconteurServiceIndex", "name": "official_index"})
+        if r["status"] != 200 or json.loads(r["body"])["name"] != "official_index":
+            raise Failed("add action: %s" % r)
+        r = http(net, args.python, "http://[::1]:%d/api/discovered/add" % port, "POST",
+                 {"nodeid": official_id, "service": "nope"})
+        if r["status"] != 404:
+            raise Failed("add of an unknown service: %s" % r)
+        wait_until("official_index connected",
+                   lambda: devices(net, args.python, port).get("official_index", {}).get("state") == "connected", 20)
+        log("gateway discover: entry and add action: ok")
+
+        # --- the official client in B finds the gateway by NodeName and its devices by type ---------
+        r = run(net.cmd(net.b, [args.python, official_py, "find", "--type", "experimental.create.Create",
+                                "--name", GATEWAY_NAME, "--wait", "4"]), timeout=60)
+        res = json.loads(r.stdout.strip().splitlines()[-1])
+        if not any(n["nodename"] == GATEWAY_NAME and n["urls"] for n in res["nodes"]):
+            raise Failed("official FindNodeByName did not find the gateway: %s" % res)
+        if not any(s["name"] == "create" and s["nodename"] == GATEWAY_NAME for s in res["services"]):
+            raise Failed("official FindServiceByType did not find the gateway's create device: %s" % res)
+        # (CORE compares implemented types as reported, and reports `implements Base` unqualified, so
+        # the official client searches by the root type.)
+        r = run(net.cmd(net.b, [args.python, official_py, "find", "--type", THING_TYPE, "--name", OFFICIAL_NAME,
+                                "--wait", "4"]), timeout=60)
+        res = json.loads(r.stdout.strip().splitlines()[-1])
+        names = {(s["nodename"], s["name"]) for s in res["services"]}
+        if (GATEWAY_NAME, device) not in names or (OFFICIAL_NAME, "thing") not in names:
+            raise Failed("official FindServiceByType(%s): %s" % (THING_TYPE, sorted(names)))
+        log("official client finds the gateway and its devices: ok")
+
+        # --- hostile datagrams from B: counted, the table stays within its cap --------------------
+        run(net.cmd(net.b, [args.python, official_py, "hostile", "--iface", net.vb, "--flood", "600"]), timeout=60)
+        time.sleep(1.0)
+        text = http(net, args.python, "http://[::1]:%d/metrics" % port)["body"]
+        for reason in ("truncated", "oversized", "bad_node_id", "node_id_mismatch", "not_link_local", "not_ip_literal"):
+            if metric(text, 'rr_gateway_discovery_packets_rejected_total{reason="%s"}' % reason) < 1:
+                raise Failed("rejected %s not counted:\n%s" % (reason, text))
+        if metric(text, "rr_gateway_discovery_nodes") > 64:
+            raise Failed("table over its cap:\n" + text)
+        accepted = metric(text, "rr_gateway_discovery_announces_total")
+        if accepted < 100 or metric(text, "rr_gateway_discovery_evictions_total") < accepted - 64 - 20:
+            raise Failed("flood not received or not evicted:\n" + text)
+        if devices(net, args.python, port).get(device, {}).get("state") != "connected":
+            raise Failed("the flood cost the real device")
+        log("hostile datagrams: ok")
+
+        # --- the official node stops: its devices go away after the expiry -------------------------
+        child_procs.stop(official)
+        wait_until("devices removed after expiry",
+                   lambda: device not in devices(net, args.python, port) and
+                   "official_index" not in devices(net, args.python, port), 40)
+        log("devices removed after the node expired: ok")
+
+        status = child_procs.stop(gw, 20)
+        if status != 0:
+            raise Failed("rr-gateway exited with %s" % status)
+        log("PASS")
+        return 0
+    except (Failed, child_procs.StepFailed, subprocess.TimeoutExpired) as e:
+        log("FAIL:", e)
+        for name in ("gateway.err", "official.err"):
+            p = os.path.join(tmp, name)
+            if os.path.exists(p):
+                with open(p, errors="replace") as f:
+                    text = f.read()
+                log("--- %s (head and tail) ---\n%s\n...\n%s" % (name, text[:3000], text[-3000:]))
+        return 1
+    finally:
+        for p in procs:
+            child_procs.stop(p, 5)
+        net.teardown()
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""The official Robot Raconteur library's side of the discovery tests (discovery_netns.py).
+
+    discovery_official.py serve --name NODENAME --port N
+        ServerNodeSetup(NODENAME, N) (official defaults: TCP server, IPv6 link-local announce and listen)
+        serving "thing" (experimental.discovery_test.Thing, implements Base, attribute tags="fox,arm").
+        Prints {"port": N, "nodeid": "..."} when ready; runs until SIGTERM.
+    discovery_official.py find --type T --name NODENAME --wait S
+        ClientNodeSetup(), waits S seconds for announces, then RRN.FindServiceByType(T, ["rr+tcp"]) and
+        RRN.FindNodeByName(NODENAME, ["rr+tcp"]); prints {"services": [...], "nodes": [...]}.
+    discovery_official.py hostile --iface IF --flood N
+        Sends hostile datagrams to FF02::BA86%IF port 48653: truncated, oversized, a bad UUID, a lying
+        URL, a global address, then N announces of distinct NodeIDs. Prints {"sent": count}.
+"""
+
+import argparse
+import json
+import signal
+import socket
+import sys
+import threading
+import time
+import uuid
+
+ROBDEF = """service experimental.discovery_test
+
+object Base
+    property int32 x
+end
+
+object Thing
+    implements Base
+    property int32 x
+    property string label
+end
+"""
+
+
+class Thing:
+    def __init__(self):
+        self.x = 7
+        self.label = "official thing"
+
+
+def serve(args):
+    import RobotRaconteur as RR
+    RRN = RR.RobotRaconteurNode.s
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *a: stop.set())
+    signal.signal(signal.SIGINT, lambda *a: stop.set())
+    with RR.ServerNodeSetup(args.name, args.port):
+        RRN.RegisterServiceType(ROBDEF)
+        ctx = RRN.RegisterService("thing", "experimental.discovery_test.Thing", Thing())
+        ctx.SetServiceAttributes({"tags": RR.VarValue("fox,arm", "string")})
+        print(json.dumps({"port": args.port, "nodeid": str(RRN.NodeID)}), flush=True)
+        while not stop.wait(0.2):
+            pass
+
+
+def find(args):
+    import RobotRaconteur as RR
+    RRN = RR.RobotRaconteurNode.s
+    with RR.ClientNodeSetup():
+        time.sleep(args.wait)
+        services = []
+        for s in RRN.FindServiceByType(args.type, ["rr+tcp"]):
+            services.append({"name": s.Name, "nodename": s.NodeName, "nodeid": str(s.NodeID),
+                             "root_object_type": s.RootObjectType,
+                             "implements": list(s.RootObjectImplements), "urls": list(s.ConnectionURL)})
+        nodes = []
+        for n in RRN.FindNodeByName(args.name, ["rr+tcp"]):
+            nodes.append({"nodename": n.NodeName, "nodeid": str(n.NodeID), "urls": list(n.ConnectionURL)})
+        print(json.dumps({"services": services, "nodes": nodes}), flush=True)
+
+
+def hostile(args):
+    s = socket.socket(socket.AF_INET6, socket.SOCK_DGRAM)
+    ifindex = socket.if_nametoindex(args.iface)
+    s.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_MULTICAST_IF, ifindex)
+    dest = ("ff02::ba86", 48653, 0, ifindex)
+    magic = "Robot Raconteur Node Discovery Packet\n"
+    nid = str(uuid.uuid4())
+    url = "rr+tcp://[fe80::99]:1/?nodeid=%s&service=RobotRaconteurServiceIndex" % nid
+    packets = [
+        magic + "{%s}" % nid,                                                   # truncated
+        magic + "{%s}\n" % nid + url + "\n" + "X" * 9000,                       # oversized
+        magic + "{not-a-uuid}\n" + url + "\n",                                   # bad UUID
+        magic + "{%s}\n" % uuid.uuid4() + url + "\n",                            # lying URL (another NodeID)
+        magic + "{%s}\n" % nid + url.replace("fe80::99", "2001:db8::1") + "\n",  # global address
+        magic + "{%s}\n" % nid + url.replace("[fe80::99]", "evil.example.org") + "\n",  # not an IP
+    ]
+    sent = 0
+    for p in packets:
+        s.sendto(p.encode(), dest)
+        sent += 1
+    for i in range(args.flood):
+        n = str(uuid.uuid4())
+        p = magic + "{%s},flood%d\nrr+tcp://[fe80::99]:1/?nodeid=%s&service=RobotRaconteurServiceIndex\n" % (n, i, n)
+        s.sendto(p.encode(), dest)
+        sent += 1
+        if i % 100 == 99:
+            time.sleep(0.01)  # let the receiver keep up; UDP would drop the rest
+    print(json.dumps({"sent": sent}), flush=True)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    a = sub.add_parser("serve")
+    a.add_argument("--name", required=True)
+    a.add_argument("--port", type=int, default=29321)
+    a = sub.add_parser("find")
+    a.add_argument("--type", required=True)
+    a.add_argument("--name", required=True)
+    a.add_argument("--wait", type=float, default=5)
+    a = sub.add_parser("hostile")
+    a.add_argument("--iface", required=True)
+    a.add_argument("--flood", type=int, default=2000)
+    args = ap.parse_args()
+    {"serve": serve, "find": find, "hostile": hostile}[args.cmd](args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
