@@ -93,6 +93,8 @@ public:
     /// Bytes to send on `id` (kept valid by the caller until drained). Errors as set_pending.
     Result<void> send(std::int32_t id, std::span<const std::byte> bytes) { return out_.set_pending(id, bytes); }
     std::size_t pending(std::int32_t id) const noexcept { return out_.pending(id); }
+    /// Forgets the pending write on `id` (its owner aborted it); returns the bytes dropped.
+    std::size_t drop_pending(std::int32_t id) noexcept { return out_.drop_pending(id); }
     /// The device ends `id`: "socket closed" goes to the host after the pending bytes. False if unknown.
     bool close_stream(std::int32_t id) noexcept { return out_.close_after_drain(id); }
     /// Ask the host to pause (or resume) sending on `id`. Errors: InvalidArgument (not open),
