@@ -6,8 +6,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
 #include <future>
 #include <thread>
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <boost/asio/io_context.hpp>
 
 #include "core/codec/endian.hpp"
 #include "core/usb/usb_protocol.hpp"
@@ -418,4 +425,84 @@ TEST_CASE("usb emulated: malformed and stray sub-packets from the device", "[mal
     auto again = connect(*w, "usbtest");
     CHECK(again->root().call("nop"));
     REQUIRE(again->close_wait());
+}
+
+namespace {
+
+// Enumerates with a fresh UsbHost (hotplug off) and checks that the device at `path` is listed with a
+// permission error that names the udev rule, and that connecting to it says the same. Returns "" when
+// so, else what was wrong.
+std::string check_permission_report(const std::string& path) {
+    boost::asio::io_context io;
+    auto work = boost::asio::make_work_guard(io);
+    std::thread t([&] { io.run(); });
+    std::string problem;
+    {
+        server::usb::UsbHostOptions o;
+        o.hotplug = false;
+        o.poll_interval = 0ms;
+        auto host = server::usb::UsbHost::create(io.get_executor(), o);
+        if (!host) {
+            problem = "host: " + host.error().message;
+        } else {
+            auto devices = (*host)->enumerate_wait(10s);
+            const UsbDeviceInfo* found = nullptr;
+            if (devices)
+                for (const auto& d : *devices)
+                    if (d.device_path == path) found = &d;
+            if (!found) problem = "the device is not listed";
+            else if (!found->error) problem = "no error reported";
+            else if (found->error->type != MessageErrorType::SystemResourcePermissionDenied) problem = "wrong type: " + found->error->message;
+            else if (found->error->message.find("99-robotraconteur-usb.rules") == std::string::npos) problem = "no hint: " + found->error->message;
+            if (problem.empty()) {  // connecting names the cause too
+                std::promise<Result<server::usb::UsbByteStream>> p;
+                (*host)->open_stream(parse_connection_url(std::string("rr+usb:///?nodename=") + kDeviceNodeName + "&service=x").value(),
+                                     io.get_executor(), [&](Result<server::usb::UsbByteStream> r) { p.set_value(std::move(r)); });
+                auto r = p.get_future().get();
+                if (r) problem = "connect succeeded";
+                else if (r.error().type != MessageErrorType::SystemResourcePermissionDenied) problem = "connect: " + r.error().message;
+            }
+            (*host)->shutdown();
+        }
+    }
+    work.reset();
+    t.join();
+    return problem;
+}
+
+}  // namespace
+
+TEST_CASE("usb emulated: a device the process may not open is reported with the udev rule to install", "[permission]") {
+    auto w = world(no_demo());
+    auto o = UsbWorld::device_options();
+    o.node_mode = 0600;  // root's only
+    auto* dev = plug(*w, o);
+    if (::geteuid() != 0) {
+        // Not root: a mode the owner cannot use does it in-process.
+        auto other = UsbWorld::device_options(3);
+        other.node_mode = 0;
+        auto* d2 = plug(*w, other);
+        CHECK(check_permission_report(d2->device_path()).empty());
+        return;
+    }
+    // Root may open anything: a child process that drops to "nobody" checks what an unprivileged
+    // gateway sees. umockdev's testbed is root's: the child must reach its sysfs and sockets (and bind
+    // its own netlink emulation socket there); the device node stays root's.
+    namespace fs = std::filesystem;
+    const fs::path root = w->emulator->root_dir();
+    REQUIRE(::chmod(root.c_str(), 01777) == 0);
+    for (const auto& e : fs::recursive_directory_iterator(root))
+        if (e.is_directory() || e.is_socket()) fs::permissions(e.path(), fs::perms::all, fs::perm_options::replace);
+    const pid_t pid = ::fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) {
+        if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+        const auto problem = check_permission_report(dev->device_path());
+        if (!problem.empty()) std::fprintf(stderr, "permission check: %s\n", problem.c_str());
+        ::_exit(problem.empty() ? 0 : 1);
+    }
+    int status = 0;
+    REQUIRE(::waitpid(pid, &status, 0) == pid);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
 }
