@@ -324,7 +324,7 @@ TEST_CASE("usb emulated: pause and resume in both directions", "[pause]") {
     auto* dev = plug(*w);
     start(*w);
     auto c = connect(*w, "usbtest");
-    const auto big = bytes_value(400000, 9);
+    const auto big = bytes_value(100000, 9);
     auto r = c->root().call("echo", {big});
     REQUIRE(r);
     CHECK(*r == big);
