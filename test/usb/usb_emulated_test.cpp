@@ -506,3 +506,21 @@ TEST_CASE("usb emulated: a device the process may not open is reported with the 
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 0);
 }
+
+TEST_CASE("usb emulated: the device table follows plug and unplug by hotplug, and by polling without it", "[detect]") {
+    for (const bool hotplug : {true, false}) {
+        INFO("hotplug " << hotplug);
+        WorldOptions o = no_demo();
+        o.host.hotplug = hotplug;
+        o.host.poll_interval = 100ms;
+        auto w = world(o);
+        start(*w);
+        CHECK(w->host->uses_hotplug() == hotplug);
+        CHECK(w->host->devices().empty());
+        auto* dev = plug(*w);  // no enumerate or connect: the table updates by itself
+        CHECK(eventually([&] { return w->host->devices().size() == 1; }, 3s));
+        w->emulator->unplug(dev);
+        CHECK(eventually([&] { return w->host->devices().empty(); }, 3s));
+        if (!hotplug) CHECK(w->host->stats().hotplug_events == 0);
+    }
+}
