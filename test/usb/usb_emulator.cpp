@@ -23,6 +23,7 @@
 
 #include <boost/asio/strand.hpp>
 
+#include "server/transport/transport.hpp"
 #include "server/transport/usb/usb_stream.hpp"
 
 namespace rr::test::usb {
@@ -391,7 +392,8 @@ private:
                     streams_.try_emplace(o->stream_id);
                     stats_.streams_opened.fetch_add(1);
                     after.push_back([self = shared_from_this(), id = o->stream_id] {
-                        self->node_->serve_stream(UsbByteStream(asio::make_strand(self->node_->io_context()), self, id));
+                        server::serve_stream(*self->node_, UsbByteStream(asio::make_strand(self->node_->io_context()), self, id),
+                                             server::AcceptedStream{"rr+usb:///", self->devpath_ + " stream " + std::to_string(id)});
                     });
                     break;
                 }

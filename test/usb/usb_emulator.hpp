@@ -3,7 +3,7 @@
 // routes the usbdevfs ioctls libusb issues on /dev/bus/usb/BBB/DDD to a handler here. The handler is
 // driven by core's DeviceFunction (core/usb/usb_device_function.hpp) and DescriptorTable, exactly as
 // firmware would use them, and serves an ordinary node's services (server/node) over the RR streams:
-// every stream the host opens becomes Node::serve_stream(UsbByteStream).
+// every stream the host opens is served by the node (server::serve_stream over a UsbByteStream).
 //
 // ioctls answered: GET_CAPABILITIES, CLAIM/RELEASEINTERFACE, DISCONNECT_CLAIM, SETINTERFACE,
 // SETCONFIGURATION, CLEAR_HALT, RESET(EP), GETDRIVER (none), GET_SPEED, CONNECTINFO, SUBMITURB

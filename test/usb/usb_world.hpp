@@ -118,7 +118,7 @@ public:
         auto h = server::usb::UsbHost::create(io.executor(), options_.host);
         if (!h) return h.take_error();
         host = *h;
-        server::usb::register_usb_client_transport(host);
+        server::usb::register_usb_transport(server::default_transports(), host);
         return {};
     }
 

@@ -12,7 +12,7 @@
 #include <boost/asio/post.hpp>
 
 #include "core/usb/usb_descriptors.hpp"
-#include "server/client/client.hpp"
+#include "server/transport/transport_registry.hpp"
 
 namespace rr::server::usb {
 
@@ -580,22 +580,36 @@ void UsbHost::connect_to(Entry& e, asio::any_io_executor stream_executor, std::f
 
 // --- client transport --------------------------------------------------------------------------------------------
 
-void register_usb_client_transport(std::shared_ptr<UsbHost> host_ptr) {
-    std::weak_ptr<UsbHost> weak = host_ptr;
-    client::register_client_transport(
-        "rr+usb", [weak](client::ClientStrand strand, const ConnectionUrl& url, const client::ClientOptions&,
-                         std::shared_ptr<ConnectionLogic> logic, std::function<void(Result<std::shared_ptr<PumpHandle>>)> done) {
-            auto host = weak.lock();
-            if (!host) return done(fail(MessageErrorType::ConnectionError, "the rr+usb transport is shut down"));
-            host->open_stream(url, strand, [strand, logic = std::move(logic), done = std::move(done)](Result<UsbByteStream> s) mutable {
-                asio::dispatch(strand, [strand, logic = std::move(logic), done = std::move(done), s = std::move(s)]() mutable {
-                    if (!s) return done(s.take_error());
-                    auto pump = std::make_shared<StreamPump<UsbByteStream>>(std::move(*s), strand, logic);
-                    done(std::shared_ptr<PumpHandle>(pump));
-                    pump->start();
-                });
+namespace {
+
+/// rr+usb for TransportRegistry: the stream from UsbHost::open_stream, run in a StreamPump.
+class UsbConnector final : public Connector {
+public:
+    explicit UsbConnector(std::weak_ptr<UsbHost> host) : host_(std::move(host)) {}
+    void connect(asio::any_io_executor strand, const ConnectionUrl& url, const ConnectOptions&,
+                 std::shared_ptr<ConnectionLogic> logic, ConnectHandler done) override {
+        auto host = host_.lock();
+        if (!host) return done(fail(MessageErrorType::ConnectionError, "the rr+usb transport is shut down"));
+        host->open_stream(url, strand, [strand, logic = std::move(logic), done = std::move(done)](Result<UsbByteStream> s) mutable {
+            asio::dispatch(strand, [strand, logic = std::move(logic), done = std::move(done), s = std::move(s)]() mutable {
+                if (!s) return done(s.take_error());
+                start_client_stream(std::move(*s), strand, std::move(logic), done);
             });
         });
+    }
+
+private:
+    std::weak_ptr<UsbHost> host_;
+};
+
+}  // namespace
+
+std::shared_ptr<Connector> make_usb_connector(std::shared_ptr<UsbHost> host) {
+    return std::make_shared<UsbConnector>(std::move(host));
+}
+
+void register_usb_transport(TransportRegistry& registry, std::shared_ptr<UsbHost> host) {
+    registry.add("rr+usb", make_usb_connector(std::move(host)));
 }
 
 }  // namespace rr::server::usb

@@ -1,5 +1,5 @@
 // The rr+usb host transport (wire.md §10, docs/usb.md): finds RR USB devices with libusb, reads
-// their NodeID and NodeName, and opens RR streams on them for rr::client (URL
+// their NodeID and NodeName, and opens RR streams on them for the transport registry (URL
 // `rr+usb:///?nodename=NAME&service=S` or `?nodeid=ID…`).
 //
 // Detection (as CORE HardwareTransport_libusb.cpp): a device is an RR device when its BOS holds the
@@ -36,6 +36,8 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/names/node_id.hpp"
+#include "server/transport/transport.hpp"
+#include "server/transport/transport_registry.hpp"
 #include "server/transport/usb/usb_host_link.hpp"
 
 namespace rr::server::usb {
@@ -156,9 +158,11 @@ private:
     UsbHostStats stats_;
 };
 
-/// Registers the "rr+usb" scheme with rr::client (server/client/client.hpp) so Client::connect
-/// reaches devices through `host`. Replaces an earlier registration. The registry keeps only a weak
-/// reference: once `host` is gone, rr+usb connects fail with ConnectionError.
-void register_usb_client_transport(std::shared_ptr<UsbHost> host);
+/// The rr+usb Connector (server/transport/transport.hpp) over `host`. It keeps only a weak reference:
+/// once `host` is gone, connects fail with ConnectionError.
+std::shared_ptr<Connector> make_usb_connector(std::shared_ptr<UsbHost> host);
+/// Adds that connector to `registry` as "rr+usb": a node's transports() (the gateway's devices), or
+/// default_transports() for clients without a node (rr::client::Client, the rr CLI).
+void register_usb_transport(TransportRegistry& registry, std::shared_ptr<UsbHost> host);
 
 }  // namespace rr::server::usb

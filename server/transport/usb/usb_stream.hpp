@@ -1,7 +1,7 @@
 // One RR stream of an rr+usb link as an Asio byte stream (async_read_some, async_write_some,
 // get_executor, close), so StreamPump carries RR messages over it exactly as over TCP (wire.md §6).
 // Used on both ends: the host's link (usb_host_link.hpp) and a device emulator serving the stream
-// with Node::serve_stream.
+// with server::serve_stream (transport.hpp).
 //
 // The stream is a handle (stream id + the channel that owns the link); the channel runs the
 // operations on its own serialisation (a strand or a mutex) and completes them by invoking the
