@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
 
     {
         auto usb = must(world->connect("bench"), "rr+usb connect");
-        run_rows("ours->ours rr+usb (emulated, " + std::to_string(packet) + " B packets)", usb, count);
+        run_rows(packet == 512 ? std::string("ours->ours rr+usb") : "ours->ours rr+usb " + std::to_string(packet) + " B", usb, count);
         std::cerr << "[bench_usb] bulk transfers: " << device->stats().bulk_out << " out, " << device->stats().bulk_in
                   << " in; control requests " << device->stats().control_requests << std::endl;
         (void)usb->close_wait();
@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     {
         auto tcp = must(client::Client::connect(world->io.executor(), "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=bench"),
                         "rr+tcp connect");
-        run_rows("ours->ours rr+tcp (same process)", tcp, count);
+        run_rows("ours->ours rr+tcp in-process", tcp, count);
         (void)tcp->close_wait();
     }
     service->shutdown();
