@@ -2,6 +2,8 @@
 // (test/usb/usb_emulator.hpp), next to the same calls over rr+tcp loopback to the same node in the same
 // process, so that the difference is the USB transport's own cost (sub-packet framing, libusb, usbdevfs
 // ioctls – here answered by umockdev over a Unix socket, a cost real hardware replaces with the bus).
+// Row `floor`/`usb_control`: one bare control transfer through libusb and umockdev (no RR), the
+// emulated path's floor. Labels: "ours->ours rr+usb", "ours->ours rr+tcp in-process".
 // Prints one JSON line per row (bench_common.hpp: latency_row); figures only, nothing is asserted.
 //
 // Usage: rr_bench_usb [--count N] [--packet BYTES]
@@ -14,6 +16,8 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+
+#include <libusb.h>
 
 #include "bench/bench_common.hpp"
 #include "test/usb/usb_world.hpp"
@@ -114,6 +118,20 @@ int main(int argc, char** argv) {
     auto* device = must(world->plug(dev), "plug");
     must(world->start_host(), "USB host");
 
+    {
+        // The floor of the emulated path: one synchronous control transfer (GET_DESCRIPTOR) through
+        // libusb and umockdev, no RR. A Nop over rr+usb takes one bulk OUT and one bulk IN transfer.
+        libusb_context* ctx = nullptr;
+        if (libusb_init(&ctx) != 0) die("libusb_init");
+        libusb_device_handle* h = libusb_open_device_with_vid_pid(ctx, dev.layout.vendor_id, dev.layout.product_id);
+        if (!h) die("libusb_open_device_with_vid_pid");
+        unsigned char desc[18];
+        timed("floor", "usb_control", count, 0, [&] {
+            if (libusb_get_descriptor(h, LIBUSB_DT_DEVICE, 0, desc, sizeof desc) != 18) die("GET_DESCRIPTOR");
+        });
+        libusb_close(h);
+        libusb_exit(ctx);
+    }
     {
         auto usb = must(world->connect("bench"), "rr+usb connect");
         run_rows(packet == 512 ? std::string("ours->ours rr+usb") : "ours->ours rr+usb " + std::to_string(packet) + " B", usb, count);

@@ -1,6 +1,6 @@
 #include "test/usb/usb_emulator.hpp"
 
-#include <fcntl.h>
+#include <fcntl.h>  // F_SETPIPE_SZ (_GNU_SOURCE, which g++ defines)
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -72,8 +72,6 @@ public:
     }
     ~DeviceCore() override {
         if (fifo_fd_ >= 0) ::close(fifo_fd_);
-        for (auto& p : pending_in_) release(p);
-        for (auto* u : reapable_) umockdev_ioctl_data_unref(u);
         if (handler_) g_object_unref(handler_);
     }
 
@@ -92,6 +90,7 @@ public:
             return fail(MessageErrorType::IOError, "cannot make the FIFO " + node_path + ": " + std::strerror(errno));
         fifo_fd_ = ::open(node_path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
         if (fifo_fd_ < 0) return fail(MessageErrorType::IOError, "cannot open the FIFO " + node_path);
+        (void)::fcntl(fifo_fd_, F_SETPIPE_SZ, 4096);  // one page: one write fills it, one read drains it
         fill_fifo();
 
         std::string s = "P: " + syspath_.substr(4) + "\n" +
@@ -117,12 +116,10 @@ public:
             std::lock_guard lock(m_);
             if (gone_) return;
             gone_ = true;
-            for (auto& p : pending_in_) {
-                auto* urb = reinterpret_cast<usbdevfs_urb*>(p.urb->data);
+            for (auto* urb : pending_in_) {
                 urb->status = -ESHUTDOWN;
                 urb->actual_length = 0;
-                if (p.buf) umockdev_ioctl_data_unref(p.buf);
-                reapable_.push_back(p.urb);
+                reapable_.push_back(urb);
             }
             pending_in_.clear();
             for (auto& [id, s] : streams_) s.buf.end(asio::error::eof, asio::error::broken_pipe);
@@ -205,10 +202,6 @@ public:
     }
 
 private:
-    struct PendingIn {
-        UMockdevIoctlData* urb = nullptr;
-        UMockdevIoctlData* buf = nullptr;
-    };
     struct Stream {
         UsbStreamBuffers buf;
         bool paused_rx = false;
@@ -230,9 +223,12 @@ private:
         g_free(r);
         return s;
     }
-    static void release(PendingIn& p) {
-        if (p.buf) umockdev_ioctl_data_unref(p.buf);
-        if (p.urb) umockdev_ioctl_data_unref(p.urb);
+    // The ioctl argument as the client passed it (a pointer into the client, which is this process:
+    // the preload library and the handler share the address space, as libusb's own umockdev test notes).
+    static void* arg_pointer(UMockdevIoctlData* arg) {
+        void* p = nullptr;
+        std::memcpy(&p, arg->data, std::min<std::size_t>(sizeof p, static_cast<std::size_t>(arg->data_len)));
+        return p;
     }
 
     // FIFO readiness (under m_).
@@ -271,11 +267,9 @@ private:
             } else {
                 switch (request) {
                     case USBDEVFS_GET_CAPABILITIES: {
-                        UMockdevIoctlData* d = umockdev_ioctl_data_resolve(arg, 0, sizeof(guint32), nullptr);
                         const guint32 caps = USBDEVFS_CAP_BULK_CONTINUATION | USBDEVFS_CAP_NO_PACKET_SIZE_LIM |
                                              USBDEVFS_CAP_REAP_AFTER_DISCONNECT | USBDEVFS_CAP_ZERO_PACKET;
-                        std::memcpy(d->data, &caps, sizeof caps);
-                        umockdev_ioctl_data_unref(d);
+                        std::memcpy(arg_pointer(arg), &caps, sizeof caps);
                         break;
                     }
                     case USBDEVFS_CLAIMINTERFACE:
@@ -296,12 +290,10 @@ private:
                         res = 3;  // USB_SPEED_HIGH
                         break;
                     case USBDEVFS_CONNECTINFO: {
-                        UMockdevIoctlData* d = umockdev_ioctl_data_resolve(arg, 0, sizeof(usbdevfs_connectinfo), nullptr);
                         usbdevfs_connectinfo ci{};
                         ci.devnum = opt_.address;
                         ci.slow = 0;
-                        std::memcpy(d->data, &ci, sizeof ci);
-                        umockdev_ioctl_data_unref(d);
+                        std::memcpy(arg_pointer(arg), &ci, sizeof ci);
                         break;
                     }
                     case USBDEVFS_SUBMITURB:
@@ -326,20 +318,20 @@ private:
         return TRUE;
     }
 
+    // URBs are used in place (umockdev_ioctl_data_resolve would copy each one and its buffer through
+    // umockdev's socket, several round trips per transfer): libusb does not touch a submitted URB until
+    // it is reaped.
     void submit(UMockdevIoctlData* arg, std::vector<std::function<void()>>& after) {
-        UMockdevIoctlData* ud = umockdev_ioctl_data_resolve(arg, 0, sizeof(usbdevfs_urb), nullptr);
-        auto* urb = reinterpret_cast<usbdevfs_urb*>(ud->data);
-        UMockdevIoctlData* bd = nullptr;
-        if (urb->buffer_length > 0)
-            bd = umockdev_ioctl_data_resolve(ud, offsetof(usbdevfs_urb, buffer), static_cast<gsize>(urb->buffer_length), nullptr);
+        auto* urb = static_cast<usbdevfs_urb*>(arg_pointer(arg));
         std::span<std::byte> data;
-        if (bd) data = std::span<std::byte>(reinterpret_cast<std::byte*>(bd->data), static_cast<std::size_t>(urb->buffer_length));
+        if (urb->buffer_length > 0)
+            data = std::span<std::byte>(static_cast<std::byte*>(urb->buffer), static_cast<std::size_t>(urb->buffer_length));
         urb->status = 0;
         urb->actual_length = 0;
         if (urb->type == USBDEVFS_URB_TYPE_CONTROL) {
             control(urb, data, after);
         } else if (urb->type == USBDEVFS_URB_TYPE_BULK && urb->endpoint == opt_.layout.in_endpoint) {
-            pending_in_.push_back(PendingIn{ud, bd});
+            pending_in_.push_back(urb);
             pump_in();
             return;
         } else if (urb->type == USBDEVFS_URB_TYPE_BULK && urb->endpoint == opt_.layout.out_endpoint) {
@@ -348,8 +340,7 @@ private:
         } else {
             urb->status = -EPIPE;
         }
-        if (bd) umockdev_ioctl_data_unref(bd);
-        reapable_.push_back(ud);
+        reapable_.push_back(urb);
         signal_ready();
     }
 
@@ -458,10 +449,10 @@ private:
 
     void pump_in() {
         while (!pending_in_.empty() && !hold_in_ && !gone_) {
-            PendingIn& p = pending_in_.front();
-            auto* urb = reinterpret_cast<usbdevfs_urb*>(p.urb->data);
+            usbdevfs_urb* urb = pending_in_.front();
             std::span<std::byte> out;
-            if (p.buf) out = std::span<std::byte>(reinterpret_cast<std::byte*>(p.buf->data), static_cast<std::size_t>(urb->buffer_length));
+            if (urb->buffer_length > 0)
+                out = std::span<std::byte>(static_cast<std::byte*>(urb->buffer), static_cast<std::size_t>(urb->buffer_length));
             std::size_t n = 0;
             if (!injected_.empty()) {
                 auto& b = injected_.front();
@@ -482,8 +473,7 @@ private:
             stats_.bulk_in.fetch_add(1);
             stats_.bulk_in_bytes.fetch_add(n);
             bump_max(stats_.max_bulk_in_size, n);
-            if (p.buf) umockdev_ioctl_data_unref(p.buf);
-            reapable_.push_back(p.urb);
+            reapable_.push_back(urb);
             pending_in_.pop_front();
         }
         signal_ready();
@@ -494,30 +484,22 @@ private:
             unsignal();
             return false;
         }
-        UMockdevIoctlData* ud = reapable_.front();
+        usbdevfs_urb* urb = reapable_.front();
         reapable_.pop_front();
-        UMockdevIoctlData* ptr = umockdev_ioctl_data_resolve(arg, 0, sizeof(gpointer), nullptr);
-        umockdev_ioctl_data_set_ptr(ptr, 0, ud);
-        umockdev_ioctl_data_unref(ptr);
-        umockdev_ioctl_data_unref(ud);
+        *static_cast<void**>(arg_pointer(arg)) = urb;
         return true;
     }
 
     bool discard(UMockdevIoctlData* arg) {
-        gulong addr = 0;
-        std::memcpy(&addr, arg->data, std::min<std::size_t>(sizeof addr, static_cast<std::size_t>(arg->data_len)));
-        for (auto it = pending_in_.begin(); it != pending_in_.end(); ++it) {
-            if (it->urb->client_addr != addr) continue;
-            auto* urb = reinterpret_cast<usbdevfs_urb*>(it->urb->data);
-            urb->status = -ENOENT;
-            urb->actual_length = 0;
-            if (it->buf) umockdev_ioctl_data_unref(it->buf);
-            reapable_.push_back(it->urb);
-            pending_in_.erase(it);
-            signal_ready();
-            return true;
-        }
-        return false;
+        auto* target = static_cast<usbdevfs_urb*>(arg_pointer(arg));
+        auto it = std::find(pending_in_.begin(), pending_in_.end(), target);
+        if (it == pending_in_.end()) return false;
+        target->status = -ENOENT;
+        target->actual_length = 0;
+        reapable_.push_back(target);
+        pending_in_.erase(it);
+        signal_ready();
+        return true;
     }
 
     EmulatedDeviceOptions opt_;
@@ -530,8 +512,8 @@ private:
     std::string devpath_, syspath_;
     int fifo_fd_ = -1;
     bool signaled_ = false;
-    std::deque<PendingIn> pending_in_;
-    std::deque<UMockdevIoctlData*> reapable_;
+    std::deque<usbdevfs_urb*> pending_in_;
+    std::deque<usbdevfs_urb*> reapable_;
     std::deque<std::vector<std::byte>> injected_;
     bool hold_in_ = false;
     bool gone_ = false;
