@@ -146,7 +146,7 @@ TEST_CASE("usb emulated: detection by BOS capability (sysfs and over the wire) a
     CHECK(find(*again, "hidden"));
 }
 
-TEST_CASE("usb emulated: the RR descriptor set is read and parsed; a malformed one is reported, not used", "[detect]") {
+TEST_CASE("usb emulated: the RR descriptor set is read and parsed, a malformed one is reported, not used", "[detect]") {
     auto w = world(no_demo());
     plug(*w);
     auto bad = UsbWorld::device_options(3);
@@ -353,7 +353,7 @@ TEST_CASE("usb emulated: pause and resume in both directions", "[pause]") {
     REQUIRE(c->close_wait());
 }
 
-TEST_CASE("usb emulated: unplug during a request fails it with a clear error; re-plug reconnects", "[unplug]") {
+TEST_CASE("usb emulated: unplug during a request fails it with a clear error, re-plug reconnects", "[unplug]") {
     auto w = world(no_demo());
     auto* dev = plug(*w);
     start(*w);
