@@ -210,6 +210,9 @@ def main(argv=None):
             ("ours->gateway->ours rr+tcp", lambda: cpp(gw_url, "ours->gateway->ours rr+tcp")),
             ("official->gateway->ours rr+tcp", lambda: pyc(gw_url, "official->gateway->ours rr+tcp")),
         ]
+        usb = os.path.join(b, "bench", "rr_bench_usb")
+        if os.path.exists(usb):  # rr+usb against the umockdev-emulated device, and in-process rr+tcp (bench_usb.cpp)
+            plan.append(("ours->ours rr+usb", lambda: run_rows([usb, "--count", str(max(args.count // 5, 100))])))
         raw = []
         if args.skip_calls:
             plan, args.rounds = [], 0
@@ -310,7 +313,8 @@ OP_ORDER = ["tcp_64", "unix_64", "tcp_bulk", "nop", "nop_async", "echo10", "echo
             "peek", "wire", "wire_rate", "pipe", "memory_read", "memory_write"]
 PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "ours->ours rr+local", "official->official rr+tcp",
               "official->official rr+ws", "official->official rr+local", "official->ours rr+tcp",
-              "ours->official rr+tcp", "ours->gateway->ours rr+tcp", "official->gateway->ours rr+tcp"]
+              "ours->official rr+tcp", "ours->gateway->ours rr+tcp", "official->gateway->ours rr+tcp",
+              "ours->ours rr+usb", "ours->ours rr+tcp in-process"]
 
 
 def order(path, op):

@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 APT_PACKAGES=(
   cmake ninja-build g++ pkg-config ccache
   libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev catch2 libyaml-cpp-dev
+  umockdev libumockdev-dev
   clang-14 libclang-rt-14-dev
   python3-venv
   chromium fonts-liberation
