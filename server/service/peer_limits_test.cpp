@@ -17,6 +17,7 @@
 #include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/test_raw_stream.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -24,14 +25,6 @@ using namespace std::chrono_literals;
 namespace asio = boost::asio;
 
 namespace {
-
-// `size` zero bytes behind a 4-byte magic and a little-endian MessageSize of `size` (< 256).
-std::vector<std::byte> framed(const char* magic, std::uint8_t size) {
-    std::vector<std::byte> bytes(size, std::byte{0});
-    for (int i = 0; i < 4; ++i) bytes[i] = static_cast<std::byte>(magic[i]);
-    bytes[4] = std::byte{size};
-    return bytes;
-}
 
 std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> service, std::uint16_t& port) {
     options.node_name = "limits.node";
@@ -44,89 +37,14 @@ std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> se
     return node;
 }
 
-// A client-role StreamConnection driven over a blocking socket: CreateConnection only, no client
-// session, so special requests and raw bytes can be sent at will.
-struct RawStream {
-    asio::io_context io;
-    asio::ip::tcp::socket socket{io};
-    StreamConnection conn;
-    NodeID remote;
-
+// A raw client-role stream to the node's TCP port.
+struct RawStream : testing::RawStream<asio::ip::tcp> {
     RawStream(std::uint16_t port, StreamConfig config)
-        : conn(StreamRole::client, with_id(std::move(config)), std::chrono::steady_clock::now()) {
-        socket.connect({asio::ip::make_address("127.0.0.1"), port});
-        socket.non_blocking(true);
-        auto e = next_event(5s);
-        REQUIRE(e);
-        auto* c = std::get_if<StreamConnected>(&*e);
-        REQUIRE(c);
-        remote = c->remote_node_id;
-    }
-
-    static StreamConfig with_id(StreamConfig c) {
-        c.local_node_id = *NodeID::parse("12345678-2222-3333-4444-555555555555");
-        return c;
-    }
-
-    void flush() {
-        socket.non_blocking(false);
-        auto out = conn.pending_output();
-        if (!out.empty()) {
-            boost::system::error_code ec;
-            asio::write(socket, asio::buffer(out.data(), out.size()), ec);
-            conn.consume_output(out.size());
-        }
-        socket.non_blocking(true);
-    }
-
-    void write_raw(const std::vector<std::byte>& bytes) {
-        socket.non_blocking(false);
-        boost::system::error_code ec;
-        asio::write(socket, asio::buffer(bytes), ec);
-        socket.non_blocking(true);
-    }
-
-    // The next event, a StreamClosed when the server closed the socket, or nullopt after `timeout`.
-    std::optional<StreamEvent> next_event(std::chrono::milliseconds timeout) {
-        const auto deadline = std::chrono::steady_clock::now() + timeout;
-        std::array<std::byte, 65536> buf;
-        while (std::chrono::steady_clock::now() < deadline) {
-            if (auto e = conn.poll_event()) return e;
-            flush();
-            boost::system::error_code ec;
-            auto n = socket.read_some(asio::buffer(buf), ec);
-            if (ec == asio::error::would_block) {
-                std::this_thread::sleep_for(5ms);
-                continue;
-            }
-            if (ec) return StreamEvent{StreamClosed{make_error(MessageErrorType::ConnectionError, ec.message())}};
-            (void)conn.feed(std::span<const std::byte>(buf.data(), n), std::chrono::steady_clock::now());
-        }
-        return std::nullopt;
-    }
-
-    // Sends a special request (no client session) whose entry carries `padding` extra bytes.
-    void send_special(MessageEntryType type, std::string path, std::size_t padding) {
-        Message m;
-        m.header.sender_node_id = RawStream::with_id({}).local_node_id;
-        m.header.receiver_node_id = remote;
-        MessageEntry e;
-        e.entry_type = type;
-        e.service_path = std::move(path);
-        std::vector<std::uint8_t> pad(padding, 0x5a);
-        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
-        m.entries.push_back(std::move(e));
-        REQUIRE(conn.send(m, std::chrono::steady_clock::now()));
-    }
+        : testing::RawStream<asio::ip::tcp>({asio::ip::make_address("127.0.0.1"), port}, std::move(config)) {}
 };
-
-bool is_closed_event(const std::optional<StreamEvent>& e) { return e && std::holds_alternative<StreamClosed>(*e); }
-
-const MessageEntry* reply_entry(const std::optional<StreamEvent>& e) {
-    if (!e) return nullptr;
-    auto* m = std::get_if<StreamMessage>(&*e);
-    return m && !m->message.entries.empty() ? &m->message.entries.front() : nullptr;
-}
+using testing::framed;
+using testing::is_closed_event;
+using testing::reply_entry;
 
 Result<MessageEntry> call(RawClient& c, MessageEntry e) {
     std::promise<Result<MessageEntry>> p;

@@ -20,6 +20,7 @@
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"
 #include "server/transport/local/node_identity.hpp"
+#include "server/transport/test_raw_stream.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -29,13 +30,6 @@ namespace asio = boost::asio;
 using unix_socket = asio::local::stream_protocol;
 
 namespace {
-
-std::vector<std::byte> framed(const char* magic, std::uint8_t size) {
-    std::vector<std::byte> bytes(size, std::byte{0});
-    for (int i = 0; i < 4; ++i) bytes[i] = static_cast<std::byte>(magic[i]);
-    bytes[4] = std::byte{size};
-    return bytes;
-}
 
 struct LocalNode {
     local::testing::TempNodeDirs tmp;
@@ -63,102 +57,14 @@ struct LocalNode {
     std::string url() const { return "rr+local:///?nodename=" + node->node_name() + "&service=svc"; }
 };
 
-// A client-role StreamConnection over a blocking Unix socket: CreateConnection only, no client session.
-struct RawStream {
-    asio::io_context io;
-    unix_socket::socket socket{io};
-    StreamConnection conn;
-    NodeID remote;
-
+// A raw client-role stream to the node's Unix socket.
+struct RawStream : server::testing::RawStream<unix_socket> {
     RawStream(const std::string& path, StreamConfig config, bool handshake = true)
-        : conn(StreamRole::client, with_id(std::move(config)), std::chrono::steady_clock::now()) {
-        socket.connect(unix_socket::endpoint(path));
-        socket.non_blocking(true);
-        if (!handshake) return;
-        auto e = next_event(5s);
-        REQUIRE(e);
-        auto* c = std::get_if<StreamConnected>(&*e);
-        REQUIRE(c);
-        remote = c->remote_node_id;
-    }
-
-    static StreamConfig with_id(StreamConfig c) {
-        c.local_node_id = *NodeID::parse("12345678-2222-3333-4444-555555555555");
-        return c;
-    }
-
-    void write_raw(const std::vector<std::byte>& bytes) {
-        socket.non_blocking(false);
-        boost::system::error_code ec;
-        asio::write(socket, asio::buffer(bytes), ec);
-        socket.non_blocking(true);
-    }
-
-    void flush() {
-        auto out = conn.pending_output();
-        if (out.empty()) return;
-        socket.non_blocking(false);
-        boost::system::error_code ec;
-        asio::write(socket, asio::buffer(out.data(), out.size()), ec);
-        conn.consume_output(out.size());
-        socket.non_blocking(true);
-    }
-
-    std::optional<StreamEvent> next_event(std::chrono::milliseconds timeout) {
-        const auto deadline = std::chrono::steady_clock::now() + timeout;
-        std::array<std::byte, 65536> buf;
-        while (std::chrono::steady_clock::now() < deadline) {
-            if (auto e = conn.poll_event()) return e;
-            flush();
-            boost::system::error_code ec;
-            auto n = socket.read_some(asio::buffer(buf), ec);
-            if (ec == asio::error::would_block) {
-                std::this_thread::sleep_for(5ms);
-                continue;
-            }
-            if (ec) return StreamEvent{StreamClosed{make_error(MessageErrorType::ConnectionError, ec.message())}};
-            (void)conn.feed(std::span<const std::byte>(buf.data(), n), std::chrono::steady_clock::now());
-        }
-        return std::nullopt;
-    }
-
-    // True once the node closed the socket (EOF / reset) within `timeout`; bytes it sends are dropped.
-    bool closed_by_peer(std::chrono::milliseconds timeout) {
-        const auto deadline = std::chrono::steady_clock::now() + timeout;
-        std::array<std::byte, 4096> buf;
-        while (std::chrono::steady_clock::now() < deadline) {
-            boost::system::error_code ec;
-            socket.read_some(asio::buffer(buf), ec);
-            if (ec == asio::error::would_block) {
-                std::this_thread::sleep_for(5ms);
-                continue;
-            }
-            if (ec) return true;
-        }
-        return false;
-    }
-
-    void send_special(MessageEntryType type, std::string path, std::size_t padding) {
-        Message m;
-        m.header.sender_node_id = with_id({}).local_node_id;
-        m.header.receiver_node_id = remote;
-        MessageEntry e;
-        e.entry_type = type;
-        e.service_path = std::move(path);
-        std::vector<std::uint8_t> pad(padding, 0x5a);
-        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
-        m.entries.push_back(std::move(e));
-        REQUIRE(conn.send(m, std::chrono::steady_clock::now()));
-    }
+        : server::testing::RawStream<unix_socket>(unix_socket::endpoint(path), std::move(config), handshake) {}
 };
-
-bool is_closed_event(const std::optional<StreamEvent>& e) { return e && std::holds_alternative<StreamClosed>(*e); }
-
-const MessageEntry* reply_entry(const std::optional<StreamEvent>& e) {
-    if (!e) return nullptr;
-    auto* m = std::get_if<StreamMessage>(&*e);
-    return m && !m->message.entries.empty() ? &m->message.entries.front() : nullptr;
-}
+using server::testing::framed;
+using server::testing::is_closed_event;
+using server::testing::reply_entry;
 
 // A well-behaved typed client through the node's rr+local entries.
 void check_others_unaffected(LocalNode& n) {
