@@ -29,6 +29,7 @@ OK, RR_ERROR, USAGE, CONNECT = 0, 1, 2, 3
 
 failures = []
 checks_run = [0]
+NODE_NAME = None  # the service's NodeName when its ready line says it (legacy tcp:// URLs by name)
 
 
 def check(cond, what, detail=""):
@@ -299,7 +300,10 @@ def legacy_url_checks(rr, service_url):
     if not check(node, "info prints the node's NodeID", out[:300]):
         return
     want = rr.json_lines("get", "p_int64")
-    for legacy in ["tcp://%s/{%s}/interop" % (m.group(1), node.group(1))]:
+    legacy_urls = ["tcp://%s/{%s}/interop" % (m.group(1), node.group(1))]
+    if NODE_NAME:  # the form of issue 15: tcp://HOST:PORT/interop_service/interop
+        legacy_urls.append("tcp://%s/%s/interop" % (m.group(1), NODE_NAME))
+    for legacy in legacy_urls:
         check(rr.json_lines("get", "p_int64", url=legacy) == want, f"legacy URL {legacy} reads the same service")
     rr.fails(CONNECT, r'ServiceNotFound: service "nosuch" not found', "get", "p_int64",
              url="tcp://%s/{%s}/nosuch" % (m.group(1), node.group(1)))
@@ -421,6 +425,8 @@ def main():
                             timeout=90)
     if args.local:
         ready["url"] = ready["local_url"]
+    global NODE_NAME
+    NODE_NAME = ready.get("nodename")
     try:
         rr = Rr(args.rr, ready["url"])
         if args.target == "reynard":
