@@ -364,6 +364,7 @@ RULES = [
     (r"^cmake --build --preset release$", skip("the test's build tree stands in for a Release build")),
     (r"^sudo cmake --install build/release", do_cmake_install),
     (r"^sudo useradd ", skip("would add a user to this machine (the package's postinst does the same)")),
+    (r"^sudo chgrp rr-gateway ", skip("no rr-gateway group on this machine (see useradd)")),
     (r"certbot|/etc/letsencrypt", skip("needs a public DNS name for this machine and port 80 reachable by Let's Encrypt; "
                                        "the self-signed certificate below stands in")),
     (r"^sudo apt-get install ", skip("would install on this machine; the test needs nginx, apache2-utils and openssl "
