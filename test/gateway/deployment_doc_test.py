@@ -115,7 +115,7 @@ class Scratch:
         self.adapted = []
         self.ca_bundle = None  # made by the page's update-ca-certificates
         # What a Debian 12 machine with nginx and ca-certificates has before the page starts.
-        for d in ["etc/ssl/certs", "etc/ssl/private", "etc/nginx/conf.d", "usr/local/share/ca-certificates",
+        for d in ["etc/ssl/certs", "etc/ssl/private", "etc/nginx/conf.d", "etc/udev/rules.d", "usr/local/share/ca-certificates",
                   "usr/share/ca-certificates", "etc/ca-certificates/update.d", "client", "nginx-run"]:
             os.makedirs(os.path.join(self.root, d), exist_ok=True)
         open(os.path.join(self.root, "etc/ca-certificates.conf"), "w").close()
@@ -296,10 +296,22 @@ def do_start_gateway(s, cmd, checks):
     unit = open(s.path("/lib/systemd/system/rr-gateway.service")).read()
     exec_start = shlex.split(re.search(r"(?m)^ExecStart=(.*)$", unit).group(1))
     argv = [s.root + a if a.startswith("/") else a for a in exec_start]
-    s.gateway = gwproc.Proc(argv, env=s.env())
+    # The unit's Environment= (rr+local's folders), with systemd's %t and %S below the scratch root.
+    env = s.env()
+    env["HOME"] = "/nonexistent"
+    for k in [k for k in env if k.startswith("XDG_")]:
+        del env[k]
+    for m in re.finditer(r"(?m)^Environment=(.*)$", unit):
+        for item in shlex.split(m.group(1)):
+            k, _, v = item.partition("=")
+            v = v.replace("%t", s.path("/run")).replace("%S", s.path("/var/lib"))
+            os.makedirs(v, exist_ok=True)
+            env[k] = v
+    s.gateway = gwproc.Proc(argv, env=env)
     gwproc.wait_ready(s.gateway.port)
     expect(s.gateway.port == s.ports["gw"], "the gateway listens on %d, not %d" % (s.gateway.port, s.ports["gw"]))
-    s.note("ADAPTED", cmd, "no systemd here: the unit's ExecStart (%s) runs as a child process" % " ".join(exec_start))
+    s.note("ADAPTED", cmd, "no systemd here: the unit's ExecStart (%s) runs as a child process, with the unit's "
+           "Environment= (%%t, %%S below the scratch root) and no home" % " ".join(exec_start))
 
 
 def do_nginx_test(s, cmd, checks):
@@ -378,6 +390,7 @@ RULES = [
     (r"^sudo update-ca-certificates$", do_update_ca),
     (r"^sudo chgrp www-data " if os.geteuid() != 0 else r"^$^", skip("not root: the file stays readable by all")),
     (r"^sudo cp robots\.example\.com\.pem ", do_copy_cert_to_client),
+    (r"^sudo udevadm ", skip("no udev and no USB bus on this machine (test/usb covers rr+usb with an emulated device)")),
     (r"^\./docker/build\.sh|^podman ", skip("a container image build takes about 10 minutes and needs podman "
                                              "(docker/build.sh --smoke runs the image)")),
 ]

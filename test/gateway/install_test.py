@@ -32,7 +32,8 @@ import gwproc
 from gwproc import expect
 
 BINARIES = ["rr-gateway", "rr", "rr-robdef", "rr-demo-devices"]
-EXAMPLES = ["demo.yaml", "lab.yaml", "reynard.yaml", "nginx-rr-gateway.conf", "nginx-rr-gateway-lan.conf"]
+EXAMPLES = ["demo.yaml", "lab.yaml", "reynard.yaml", "nginx-rr-gateway.conf", "nginx-rr-gateway-lan.conf",
+            "99-robotraconteur-usb.rules"]
 HARDENING = ["NoNewPrivileges=yes", "ProtectSystem=strict", "ProtectHome=yes", "PrivateTmp=yes", "PrivateDevices=yes",
              "CapabilityBoundingSet=", "RestrictAddressFamilies=AF_UNIX AF_INET AF_INET6", "SystemCallFilter=@system-service",
              "MemoryDenyWriteExecute=yes", "User=rr-gateway"]
@@ -139,6 +140,28 @@ def verify_unit(dest, prefix, checks):
     checks.run("prefix %s: systemd-analyze verify accepts the unit" % prefix, verify)
 
 
+def service_environment(unit_text, dest):
+    """The unit's Environment= with %t (/run) and %S (/var/lib) below `dest`, and the folders its
+    RuntimeDirectory= and StateDirectory= name, made there. Returns (variables, folders made)."""
+    spec = {"%t": dest + "/run", "%S": dest + "/var/lib"}
+    made = []
+    for key, base in [("RuntimeDirectory", spec["%t"]), ("StateDirectory", spec["%S"])]:
+        for m in re.finditer(r"(?m)^%s=(.*)$" % key, unit_text):
+            for name in m.group(1).split():
+                d = os.path.join(base, name)
+                os.makedirs(d, exist_ok=True)
+                os.chmod(base, 0o755)
+                made.append(d)
+    variables = {}
+    for m in re.finditer(r"(?m)^Environment=(.*)$", unit_text):
+        for item in shlex.split(m.group(1)):
+            k, _, v = item.partition("=")
+            for sp, path in spec.items():
+                v = v.replace(sp, path)
+            variables[k] = v
+    return variables, made
+
+
 def run_installed(src, dest, prefix, checks):
     _, units = layout(prefix)
     argv = unit_exec_start(open(dest + units + "/rr-gateway.service").read())
@@ -154,15 +177,36 @@ def run_installed(src, dest, prefix, checks):
     expected_index = open(os.path.join(web, "index.html"), "rb").read()
     bindir = os.path.dirname(dest + exe)
     env = dict(gwproc.gateway_env(), PATH=bindir + os.pathsep + os.environ.get("PATH", ""))
+    tools_env = dict(env)
+    # The unit's environment as systemd gives it: a user without home, no XDG_* variables, the
+    # unit's Environment= (its directories made as RuntimeDirectory=/StateDirectory= would).
+    service_env = {k: v for k, v in env.items() if not k.startswith("XDG_")}
+    service_env["HOME"] = "/nonexistent"
+    unit_env, made = service_environment(open(dest + units + "/rr-gateway.service").read(), dest)
+    service_env.update(unit_env)
     # As the unit does, but found on PATH (argv[0] "rr-gateway") and from / : the binary must find its
-    # files from where it is installed, not from the source tree or the working directory.
+    # files from where it is installed, not from the source tree or the working directory. As root,
+    # the test runs it as an unprivileged user whose group may read the configuration (0640), as the
+    # package's user rr-gateway.
+    run_as = []
+    if os.geteuid() == 0 and shutil.which("setpriv"):
+        import grp
+        import pwd
+        uid, gid = pwd.getpwnam("nobody").pw_uid, grp.getgrnam("nogroup").gr_gid
+        os.chmod(dest, 0o755)
+        for d in made:
+            os.chown(d, uid, gid)
+        os.chown(rest[rest.index("--config") + 1], 0, gid)
+        run_as = ["setpriv", "--reuid=%d" % uid, "--regid=%d" % gid, "--clear-groups"]
     gw = None
     cwd = os.getcwd()
     try:
         os.chdir("/")
-        gw = gwproc.Proc([os.path.basename(exe)] + rest + ["--port", "0", "--log-level", "warning"], env=env)
+        gw = gwproc.Proc(run_as + [os.path.basename(exe)] + rest + ["--port", "0", "--log-level", "warning"],
+                         env=service_env)
     finally:
         os.chdir(cwd)
+    env = tools_env
     try:
         base = "http://127.0.0.1:%d" % gw.port
         checks.run("prefix %s: the installed gateway gets ready (demo devices)" % prefix, lambda: gwproc.wait_ready(gw.port))
