@@ -474,3 +474,11 @@ TEST_CASE("constant value checks") {
     CHECK((*f)[1].name == "c");
     CHECK((*f)[1].constant_name == "d");
 }
+
+TEST_CASE("robdef: member kinds read with their article in messages") {
+    using rr::robdef::MemberKind;
+    CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::event)) == "an event");
+    CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::objref)) == "an objref");
+    CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::wire)) == "a wire");
+    CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::property)) == "a property");
+}

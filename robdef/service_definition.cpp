@@ -55,6 +55,11 @@ std::string_view member_kind_keyword(MemberKind kind) noexcept {
     return "";
 }
 
+std::string with_article(std::string_view word) {
+    const bool vowel = !word.empty() && std::string_view("aeiouAEIOU").find(word.front()) != std::string_view::npos;
+    return (vowel ? "an " : "a ") + std::string(word);
+}
+
 bool MemberDefinition::has_modifier(std::string_view m) const noexcept {
     return std::find(modifiers.begin(), modifiers.end(), m) != modifiers.end();
 }

@@ -68,6 +68,9 @@ enum class MemberKind : std::uint8_t { field, property, function, event, objref,
 /// robdef keyword for a member kind (`property`, `function`, …).
 std::string_view member_kind_keyword(MemberKind kind) noexcept;
 
+/// `word` with its indefinite article, for messages: "a wire", "an event", "an objref".
+std::string with_article(std::string_view word);
+
 /// Direction from modifiers: readonly wins over writeonly (robdef.md §5.2).
 enum class MemberDirection : std::uint8_t { both, readonly, writeonly };
 

@@ -72,6 +72,11 @@ std::string ConnectionUrl::to_string() const {
     else
         s += host;
     if (port) s += ":" + std::to_string(port);
+    if (scheme == "tcp") {
+        // The legacy form keeps node and service in the path (CORE's ParseConnectionURL reads nothing else).
+        s += "/" + (node_id.is_any() ? node_name : node_id.to_braced_string()) + "/" + service;
+        return s;
+    }
     s += path.empty() ? "/" : path;
     char sep = '?';
     auto add = [&](std::string_view k, const std::string& v) {
@@ -147,11 +152,17 @@ Result<ConnectionUrl> parse_connection_url(std::string_view url) {
         auto slash = p.find('/');
         if (slash == std::string_view::npos) return bad(url, "legacy tcp:// URL needs /{node}/service");
         auto node = p.substr(0, slash);
-        out.service = std::string(p.substr(slash + 1));
-        if (auto id = NodeID::parse(node))
+        auto service = p.substr(slash + 1);
+        service = service.substr(0, service.find('/'));  // CORE uses the second segment only
+        if (service.empty()) return bad(url, "legacy tcp:// URL needs /{node}/service");
+        out.service = std::string(service);
+        if (node.find('{') != std::string_view::npos) {  // as CORE: braces mean a NodeID, else a NodeName
+            auto id = NodeID::parse(node);
+            if (!id) return bad(url, "bad nodeid \"" + std::string(node) + "\"");
             out.node_id = *id;
-        else
+        } else {
             out.node_name = std::string(node);
+        }
         out.path = "/";
     }
 

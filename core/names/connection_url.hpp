@@ -1,4 +1,4 @@
-// Robot Raconteur connection URLs (wire.md §13 "URLs"; standards draft/tcp_transport.md):
+// Robot Raconteur connection URLs (standards draft/tcp_transport.md; CORE Transport.cpp ParseConnectionURL):
 //   scheme://host[:port]/[path]?nodeid=…&nodename=…&service=…
 // Schemes: rr+tcp, rrs+tcp (default port 48653), rr+ws, rrs+ws (80), rr+wss, rrs+wss (443),
 // rr+local (no host/port; optional `user@localhost`), rr+usb, rr+pci, rr+bluetooth, and the legacy
@@ -28,7 +28,8 @@ struct ConnectionUrl {
     bool is_websocket() const noexcept;  ///< rr+ws, rr+wss, rrs+ws, rrs+wss
     bool is_secure_websocket() const noexcept { return scheme.ends_with("wss"); }
 
-    /// Canonical text: `scheme://host:port/?nodeid=…&nodename=…&service=…` (only present parts).
+    /// Canonical text: `scheme://host:port/?nodeid=…&nodename=…&service=…` (only present parts); a
+    /// legacy `tcp` URL keeps its own form `tcp://host:port/{node}/service`, so it parses back.
     std::string to_string() const;
 };
 

@@ -43,6 +43,35 @@ TEST_CASE("legacy tcp:// form names node and service in the path") {
     CHECK(n->node_name == "MyNode");
 }
 
+TEST_CASE("legacy tcp:// URLs print in their own form and parse back to the same target") {
+    // to_string() of a legacy URL must stay legacy: rr re-parses it after replacing service= (issue 15).
+    for (const char* text : {"tcp://127.0.0.1:52222/interop_service/interop",
+                             "tcp://127.0.0.1:52222/{d835c41d-339c-47a8-84db-f00a8fefd2fa}/Create"}) {
+        auto u = parse_connection_url(text);
+        REQUIRE(u);
+        CHECK(u->to_string() == text);
+        auto again = parse_connection_url(u->to_string());
+        REQUIRE(again);
+        CHECK(again->service == u->service);
+        CHECK(again->node_name == u->node_name);
+        CHECK(again->node_id == u->node_id);
+        CHECK(again->port == 52222);
+    }
+    auto renamed = parse_connection_url("tcp://h:1/node/svc");
+    REQUIRE(renamed);
+    renamed->service = "other";
+    CHECK(renamed->to_string() == "tcp://h:1/node/other");
+    // CORE reads the second path segment as the service; a NodeID needs its braces.
+    CHECK(parse_connection_url("tcp://h:1/node/svc/extra")->service == "svc");
+    CHECK(parse_connection_url("tcp://h:1/d835c41d339c47a884dbf00a8fefd2fa/svc")->node_name ==
+          "d835c41d339c47a884dbf00a8fefd2fa");
+    for (const char* bad : {"tcp://h:1/", "tcp://h:1/node", "tcp://h:1/node/", "tcp://h:1/{zz}/svc"}) {
+        auto u = parse_connection_url(bad);
+        CHECK_FALSE(u);
+        if (!u) CHECK(u.error().type == MessageErrorType::InvalidArgument);
+    }
+}
+
 TEST_CASE("malformed URLs are rejected with a reason") {
     for (const char* bad : {"localhost:1234", "http://h/", "rr+tcp://h:99999/", "rr+tcp://h:x/",
                             "rr+tcp://[::1/", "rr+tcp://h/?service", "rr+tcp://h/?nodeid=zz"}) {

@@ -51,6 +51,12 @@ std::string NodeID::to_string() const {
     return s;
 }
 
-std::string NodeID::to_braced_string() const { return "{" + to_string() + "}"; }
+std::string NodeID::to_braced_string() const {
+    // Appended, not "{" + s + "}": GCC 12 at -O2 warns (-Wrestrict) on the latter (a false positive).
+    std::string s(1, '{');
+    s += to_string();
+    s += '}';
+    return s;
+}
 
 }  // namespace rr

@@ -18,7 +18,7 @@ public:
     NodeID() = default;  ///< the all-zero NodeID: "any node / unknown"
     explicit NodeID(const Bytes& bytes) : bytes_(bytes) {}
 
-    /// Parses "{8-4-4-4-12}", "8-4-4-4-12" or 32 hex digits (upper or lower case); wire.md §13 URLs.
+    /// Parses "{8-4-4-4-12}", "8-4-4-4-12" or 32 hex digits (upper or lower case), as in connection URLs.
     /// Errors: InvalidArgument.
     static Result<NodeID> parse(std::string_view text);
 

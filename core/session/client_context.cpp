@@ -233,8 +233,8 @@ Result<const robdef::MemberDefinition*> ClientContext::find_member(std::string_v
                     "object type " + (*o)->ref.type + " has no member \"" + std::string(member) + "\"");
     if (m->kind != kind)
         return fail(MessageErrorType::InvalidOperation, "member \"" + std::string(member) + "\" of " + (*o)->ref.type +
-                                                            " is a " + std::string(kind_text(m->kind)) + ", not a " +
-                                                            std::string(kind_text(kind)));
+                                                            " is " + robdef::with_article(kind_text(m->kind)) + ", not " +
+                                                            robdef::with_article(kind_text(kind)));
     if (obj) *obj = *o;
     return m;
 }

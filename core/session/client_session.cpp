@@ -71,9 +71,32 @@ std::vector<std::string> read_string_list(const MessageElement& e) {
 
 }  // namespace
 
+std::string seconds_text(std::chrono::milliseconds d) {
+    const auto ms = d.count();
+    std::string s = std::to_string(ms / 1000);
+    if (auto frac = ms % 1000; frac != 0) {
+        std::string f = std::to_string(1000 + frac).substr(1);  // three digits
+        while (f.back() == '0') f.pop_back();
+        s += "." + f;
+    }
+    return s + " s";
+}
+
+RRError service_not_found_error(std::string_view service, std::string_view remote_message) {
+    const std::string quoted = "\"" + std::string(service) + "\"";
+    std::string message = "service " + quoted + " not found";
+    // Keep what the node said when it adds something (CORE says only "Service not found").
+    if (!remote_message.empty() && remote_message.find(quoted) == std::string_view::npos &&
+        remote_message != "Service not found")
+        message += " (" + std::string(remote_message) + ")";
+    return make_error(MessageErrorType::ServiceNotFound, std::move(message));
+}
+
 ClientSession::ClientSession(ClientSessionConfig config, MonoTime now)
     : config_(std::move(config)), stream_(StreamRole::client, config_.stream, now), last_send_(now),
-      connect_deadline_(now + config_.request_timeout), disconnect_deadline_(now) {}
+      connect_deadline_(now + config_.request_timeout), disconnect_deadline_(now) {
+    if (config_.connect_timeout.count() > 0) connect_limit_ = now + config_.connect_timeout;
+}
 
 std::uint32_t ClientSession::next_request_id() {
     // Per-client counter from 1, wrapping through 0 as CORE does (wire.md §6.4); 0 itself is skipped.
@@ -186,7 +209,13 @@ void ClientSession::request_missing_definitions(MonoTime now) {
 
 void ClientSession::on_connect_reply(MessageEntry&& e, const MessageHeader& h, MonoTime now) {
     if (e.error != MessageErrorType::None) {
-        fail_connect(*entry_error(e));
+        RRError error = *entry_error(e);
+        // The service itself is unknown (not one of its imported definitions): name it, under the
+        // standard name. CORE sends "RobotRaconteur.ServiceNotFoundException" / "Service not found".
+        if (error.type == MessageErrorType::ServiceNotFound &&
+            (state_ != State::legacy_servicedesc || info_.service_definitions.empty()))
+            error = service_not_found_error(config_.service_name, error.message);
+        fail_connect(std::move(error));
         return;
     }
     switch (state_) {
@@ -337,6 +366,7 @@ std::optional<MonoTime> ClientSession::next_deadline() const {
     if (state_ == State::closed) return std::nullopt;
     std::optional<MonoTime> d = stream_.next_deadline();
     auto take = [&](MonoTime t) { d = d ? std::min(*d, t) : t; };
+    if (connect_limit_ && state_ != State::connected && state_ != State::disconnecting) take(*connect_limit_);
     switch (state_) {
         case State::connected:
             take(last_send_ + config_.keepalive_period);
@@ -351,6 +381,15 @@ std::optional<MonoTime> ClientSession::next_deadline() const {
 }
 
 void ClientSession::on_timer(MonoTime now) {
+    if (connect_limit_ && now >= *connect_limit_ && state_ != State::connected && state_ != State::disconnecting &&
+        state_ != State::closed) {
+        fail_connect(make_error(MessageErrorType::ConnectionError,
+                                "connect timed out after " + seconds_text(config_.connect_timeout) +
+                                    (state_ == State::stream_connecting
+                                         ? ": the peer did not answer CreateConnection"
+                                         : ": the service did not answer the connect request")));
+        return;
+    }
     stream_.on_timer(now);
     while (auto ev = stream_.poll_event()) on_stream_event(std::move(*ev), now);
     switch (state_) {

@@ -30,6 +30,12 @@ struct ClientSessionConfig {
     std::string password;
     /// Per-request timeout (wire.md §13: 15 s).
     std::chrono::milliseconds request_timeout{15000};
+    /// Bound on the whole connect, counted from construction: CreateConnection and the service connect
+    /// exchange (ConnectClientCombined, or the legacy sequence) must be done by then, else the session
+    /// closes with ConnectionError "connect timed out after S s: …". The host starts its transport
+    /// (TCP connect, handshakes) after constructing the session, so one value bounds it all.
+    /// 0 = no overall bound (only StreamConfig::connect_timeout and request_timeout per step).
+    std::chrono::milliseconds connect_timeout{0};
     /// Send ClientKeepAliveReq after this long without sending (60 s).
     std::chrono::milliseconds keepalive_period{60000};
     /// The endpoint id of this client (random, non-zero); chosen by the host (core has no RNG).
@@ -65,6 +71,16 @@ struct ClientSessionClosed {
 };
 
 using ClientSessionEvent = std::variant<ClientSessionConnected, ClientResponse, ClientIncoming, ClientSessionClosed>;
+
+/// "2 s", "1.5 s", "0.25 s": a duration for messages.
+std::string seconds_text(std::chrono::milliseconds d);
+
+/// The error a client reports when the node has no service `service`: ServiceNotFound under its
+/// standard name `RobotRaconteur.ServiceNotFound` (CORE puts the non-canonical
+/// `RobotRaconteur.ServiceNotFoundException` on the wire, wire.md §5.1), with a message naming the
+/// service; `remote_message` is kept in parentheses unless it is CORE's bare "Service not found" or
+/// names the service already.
+RRError service_not_found_error(std::string_view service, std::string_view remote_message);
 
 class ClientSession {
 public:
@@ -145,6 +161,7 @@ private:
     std::deque<ClientSessionEvent> events_;
     MonoTime last_send_;
     MonoTime connect_deadline_;
+    std::optional<MonoTime> connect_limit_;  // construction + config_.connect_timeout, when set
     MonoTime disconnect_deadline_;
 };
 

@@ -17,6 +17,8 @@ struct ScriptedServer {
     StreamConnection stream;
     bool combined;
     std::vector<MessageEntry> received;
+    std::optional<RRError> refuse_connect;  // answer the connect with this error
+    bool silent = false;                    // answer no entry at all (CreateConnection still is)
 
     ScriptedServer(MonoTime t0, bool allow_combined)
         : stream(StreamRole::server, [] {
@@ -43,6 +45,7 @@ struct ScriptedServer {
             if (!sm) continue;
             for (auto& e : sm->message.entries) {
                 received.push_back(e);
+                if (silent) continue;
                 MessageEntry r;
                 r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(e.entry_type) + 1);
                 r.service_path = e.service_path;
@@ -50,6 +53,10 @@ struct ScriptedServer {
                 r.request_id = e.request_id;
                 switch (e.entry_type) {
                     case MessageEntryType::ConnectClientCombined:
+                        if (refuse_connect) {
+                            set_entry_error(r, *refuse_connect);
+                            break;
+                        }
                         if (!combined) {
                             set_entry_error(r, make_error(MessageErrorType::ProtocolError, "Invalid Special Operation"));
                             break;
@@ -155,6 +162,71 @@ TEST_CASE("client session fails cleanly when the combined connect is refused") {
     REQUIRE(closed);
     CHECK(closed->error.type == MessageErrorType::ProtocolError);
     CHECK(c.is_closed());
+}
+
+TEST_CASE("an unknown service is reported by name under the standard error name") {
+    MonoTime t0{};
+    ClientSession c(config(), t0);
+    ScriptedServer s(t0, true);
+    // What CORE answers (RobotRaconteurNode.cpp, ConnectClient): a non-canonical name, no service name.
+    RRError core_answer = make_error(MessageErrorType::ServiceNotFound, "Service not found");
+    core_answer.name = "RobotRaconteur.ServiceNotFoundException";
+    s.refuse_connect = core_answer;
+    pump(c, s, t0);
+    auto closed = next_event<ClientSessionClosed>(c);
+    REQUIRE(closed);
+    CHECK(closed->error.type == MessageErrorType::ServiceNotFound);
+    CHECK(closed->error.name == "RobotRaconteur.ServiceNotFound");
+    CHECK(closed->error.message == "service \"svc\" not found");
+    // Another node's own wording is kept when it adds something.
+    CHECK(service_not_found_error("svc", "node is shutting down").message ==
+          "service \"svc\" not found (node is shutting down)");
+    CHECK(service_not_found_error("svc", "Service \"svc\" not found").message == "service \"svc\" not found");
+}
+
+TEST_CASE("connect_timeout bounds the whole connect, from construction") {
+    auto cfg = config();
+    cfg.connect_timeout = 2500ms;
+    cfg.request_timeout = 15s;  // longer than the bound: the bound must win
+
+    SECTION("a peer that accepted the connection and never answers CreateConnection") {
+        MonoTime t0{};
+        ClientSession c(cfg, t0);
+        CHECK(c.next_deadline() == t0 + 2500ms);
+        c.on_timer(t0 + 2499ms);
+        CHECK_FALSE(c.is_closed());
+        c.on_timer(t0 + 2500ms);
+        REQUIRE(c.is_closed());
+        auto closed = next_event<ClientSessionClosed>(c);
+        REQUIRE(closed);
+        CHECK(closed->error.type == MessageErrorType::ConnectionError);
+        CHECK(closed->error.message == "connect timed out after 2.5 s: the peer did not answer CreateConnection");
+    }
+    SECTION("a node that negotiates the stream but never answers the service connect") {
+        MonoTime t0{};
+        ClientSession c(cfg, t0);
+        ScriptedServer s(t0, true);
+        s.silent = true;
+        pump(c, s, t0 + 1s);  // CreateConnection answered at 1 s; ConnectClientCombined never
+        REQUIRE_FALSE(c.is_closed());
+        CHECK(c.next_deadline() == t0 + 2500ms);
+        c.on_timer(t0 + 2500ms);
+        auto closed = next_event<ClientSessionClosed>(c);
+        REQUIRE(closed);
+        CHECK(closed->error.type == MessageErrorType::ConnectionError);
+        CHECK(closed->error.message == "connect timed out after 2.5 s: the service did not answer the connect request");
+    }
+    SECTION("no effect once connected") {
+        MonoTime t0{};
+        ClientSession c(cfg, t0);
+        ScriptedServer s(t0, true);
+        pump(c, s, t0);
+        REQUIRE(c.is_connected());
+        c.on_timer(t0 + 3s);
+        CHECK(c.is_connected());
+    }
+    CHECK(seconds_text(2000ms) == "2 s");
+    CHECK(seconds_text(250ms) == "0.25 s");
 }
 
 TEST_CASE("requests are matched by RequestID and time out after 15 s") {

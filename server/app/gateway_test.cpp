@@ -36,6 +36,21 @@ bhttp::response<bhttp::string_body> http_get(std::uint16_t port, const std::stri
     return res;
 }
 
+// HEAD: the parser must not wait for the body the Content-Length announces.
+bhttp::response<bhttp::string_body> http_head(std::uint16_t port, const std::string& target) {
+    boost::asio::io_context io;
+    beast::tcp_stream s(io);
+    s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+    bhttp::request<bhttp::string_body> req{bhttp::verb::head, target, 11};
+    req.set(bhttp::field::host, "localhost");
+    bhttp::write(s, req);
+    beast::flat_buffer b;
+    bhttp::response_parser<bhttp::string_body> parser;
+    parser.skip(true);
+    bhttp::read(s, b, parser);
+    return parser.release();
+}
+
 }  // namespace
 
 TEST_CASE("gateway health endpoints follow the required devices") {
@@ -73,6 +88,13 @@ TEST_CASE("gateway health endpoints follow the required devices") {
 
     auto metrics = http_get(gport, "/metrics");
     CHECK(metrics.result() == bhttp::status::ok);
+    // The Prometheus text format's content type, also for HEAD (which had 404 text/plain, issue 15).
+    CHECK(metrics[bhttp::field::content_type] == "text/plain; version=0.0.4; charset=utf-8");
+    auto head = http_head(gport, "/metrics");
+    CHECK(head.result() == bhttp::status::ok);
+    CHECK(head[bhttp::field::content_type] == "text/plain; version=0.0.4; charset=utf-8");
+    CHECK(head.body().empty());
+    CHECK(std::stoul(std::string(head[bhttp::field::content_length])) > 0);
     CHECK_THAT(metrics.body(), Catch::Contains("rr_gateway_device_up{device=\"dev\",state=\"connected\"} 1"));
     CHECK_THAT(metrics.body(), Catch::Contains("rr_gateway_request_duration_seconds_bucket{device=\"dev\",le=\"+Inf\"}"));
     CHECK_THAT(metrics.body(), Catch::Contains("rr_gateway_connections "));

@@ -140,7 +140,7 @@ std::optional<Failure> run_get(const CommandLine& cl, Target& t, std::ostream& o
         }
         default:
             return rr_failure(MessageErrorType::InvalidOperation,
-                              name + " is a " + std::string(robdef::member_kind_keyword(m->def.kind)) +
+                              name + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
                                   "; rr get reads properties, wires (InValue) and memories");
     }
     if (!v) return rr_failure(v.error());
@@ -156,7 +156,7 @@ std::optional<Failure> run_set(const CommandLine& cl, Target& t, const nlohmann:
     if (!m) return rr_failure(m.error());
     if (m->def.kind != MemberKind::property && m->def.kind != MemberKind::wire)
         return rr_failure(MessageErrorType::InvalidOperation,
-                          name + " is a " + std::string(robdef::member_kind_keyword(m->def.kind)) +
+                          name + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
                               "; rr set writes properties and wires (OutValue)");
     auto v = from_json(*t.client, json, m->def.type, m->service);
     if (!v) return rr_failure(v.error());
@@ -173,7 +173,7 @@ std::optional<Failure> run_call(const CommandLine& cl, Target& t, const std::vec
     if (!m) return rr_failure(m.error());
     if (m->def.kind != MemberKind::function)
         return rr_failure(MessageErrorType::InvalidOperation,
-                          name + " is a " + std::string(robdef::member_kind_keyword(m->def.kind)) + ", not a function");
+                          name + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) + ", not a function");
     const auto& params = m->def.parameters;
     const bool gen_param = !params.empty() && params.back().container == robdef::ContainerKind::generator;
     if (gen_param)

@@ -51,9 +51,12 @@ Result<ObjRefIndex> objref_index(const MemberInfo& m, const PathSegment& seg) {
 }  // namespace
 
 std::optional<Failure> connect_target(const CommandLine& cl, const std::string& url, Target& target) {
+    // A URL that does not parse is the user's typo (status 2), never a connect failure.
+    if (auto parsed = parse_connection_url(url); !parsed) return Failure{ExitCode::usage_error, parsed.error()};
     client::ClientOptions options;
     const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(cl.timeout_s * 1000)));
     options.connect_timeout = timeout;
+    options.total_connect_timeout = timeout;  // --timeout bounds the whole connect, not each step
     options.request_timeout = timeout;
     options.username = cl.username;
     options.password = cl.password;
@@ -71,8 +74,8 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
         if (!m) return Failure{ExitCode::rr_error, m.error()};
         if (m->def.kind != robdef::MemberKind::objref)
             return Failure{ExitCode::rr_error, make_error(MessageErrorType::InvalidArgument,
-                                                          seg.name + " is a " +
-                                                              std::string(robdef::member_kind_keyword(m->def.kind)) +
+                                                          seg.name + " is " +
+                                                              robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
                                                               ", not an objref")};
         auto index = objref_index(*m, seg);
         if (!index) return Failure{ExitCode::rr_error, index.error()};

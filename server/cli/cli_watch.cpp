@@ -162,7 +162,7 @@ std::optional<Failure> run_watch(const CommandLine& cl, Target& t, std::ostream&
         case MemberKind::event: return watch_event(t, *m, out, rule);
         default:
             return rr_failure(make_error(MessageErrorType::InvalidOperation,
-                                         cl.member->name + " is a " + std::string(robdef::member_kind_keyword(m->def.kind)) +
+                                         cl.member->name + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
                                              "; rr watch streams wires, events and pipes"));
     }
 }

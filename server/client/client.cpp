@@ -89,6 +89,11 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     cfg.session.username = options.username;
     cfg.session.password = options.password;
     cfg.session.request_timeout = options.request_timeout;
+    // One bound for the whole connect when asked for: the session counts it from here, before the
+    // transport starts (its message then wins over the stream's own CreateConnection timeout).
+    cfg.session.connect_timeout = options.total_connect_timeout;
+    if (options.total_connect_timeout.count() > 0)
+        cfg.session.stream.connect_timeout = std::max(cfg.session.stream.connect_timeout, options.total_connect_timeout);
     cfg.session.local_endpoint = server::random_endpoint_id();
     cfg.memory_max_transfer_size = options.memory_max_transfer_size;
 

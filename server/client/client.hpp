@@ -53,7 +53,11 @@ struct ClientOptions {
     std::string username, password;
     bool enable_message4 = true;
     bool enable_string_table = true;
-    std::chrono::milliseconds connect_timeout{5000};      ///< TCP connect (wire.md §13)
+    std::chrono::milliseconds connect_timeout{5000};      ///< TCP connect, with TLS/WebSocket handshakes (wire.md §13)
+    /// Bound on the whole connect: transport (connect_timeout applies too), CreateConnection and the
+    /// service connect exchange; ConnectionError "connect timed out after S s: …" beyond it.
+    /// 0 = only the per-step timeouts (connect_timeout, 10 s for CreateConnection, request_timeout).
+    std::chrono::milliseconds total_connect_timeout{0};
     std::chrono::milliseconds request_timeout{15000};     ///< per request, and the client session connect
     std::chrono::milliseconds heartbeat_period{10000};    ///< ConnectionTest when idle (wire.md §6.3)
     std::chrono::milliseconds receive_timeout{15000};     ///< close when nothing arrives for this long

@@ -5,6 +5,8 @@
 
 #include <atomic>
 #include <future>
+#include <thread>
+#include <vector>
 
 #include "server/client/client.hpp"
 #include "server/transport/websocket_connector.hpp"
@@ -158,7 +160,11 @@ TEST_CASE("client: connect errors") {
     CHECK(Client::connect(f.io.executor(), "rr+tcp://127.0.0.1:1/", {}).error().type == MessageErrorType::InvalidArgument);
     auto unknown = Client::connect(f.io.executor(), "rr+usb://device/?service=svc", {});
     CHECK(unknown.error().type == MessageErrorType::ConnectionError);
-    CHECK(Client::connect(f.io.executor(), f.url("nosuch"), {}).error().type == MessageErrorType::ServiceNotFound);
+    auto nosuch = Client::connect(f.io.executor(), f.url("nosuch"), {});
+    REQUIRE_FALSE(nosuch);
+    CHECK(nosuch.error().type == MessageErrorType::ServiceNotFound);
+    CHECK(nosuch.error().name == "RobotRaconteur.ServiceNotFound");  // one name for users (issue 15)
+    CHECK(nosuch.error().message == "service \"nosuch\" not found");
     // A closed port: the transport's error.
     rr::client::ClientOptions o;
     o.connect_timeout = 2000ms;
@@ -260,4 +266,44 @@ TEST_CASE("client: rr+wss refuses a server whose certificate it cannot verify") 
     r = Client::connect(threads.executor(), url, o);
     REQUIRE_FALSE(r);
     CHECK(r.error().message.find("/nonexistent/ca.pem") != std::string::npos);
+}
+
+TEST_CASE("client: total_connect_timeout bounds a peer that accepts and never answers (rr+tcp, rr+ws)") {
+    // A listener that accepts every connection and never writes a byte (issue 15: `rr --timeout 1`
+    // took 7 s). The whole connect (TCP, WebSocket handshake, CreateConnection, service connect) must
+    // end within the bound with one message.
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
+    const auto port = acceptor.local_endpoint().port();
+    std::vector<boost::asio::ip::tcp::socket> held;
+    std::function<void()> accept = [&] {
+        acceptor.async_accept([&](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
+            if (ec) return;
+            held.push_back(std::move(s));
+            accept();
+        });
+    };
+    accept();
+    std::thread t([&] { io.run(); });
+    rr::client::IoThreads threads{1};
+    rr::client::ClientOptions o;
+    o.connect_timeout = 1000ms;
+    o.total_connect_timeout = 1000ms;
+    o.request_timeout = 1000ms;
+    for (std::string scheme : {"rr+tcp", "rr+ws"}) {
+        INFO(scheme);
+        const auto t0 = std::chrono::steady_clock::now();
+        auto c = Client::connect(threads.executor(), scheme + "://127.0.0.1:" + std::to_string(port) + "/?service=svc", o);
+        const auto elapsed = std::chrono::steady_clock::now() - t0;
+        REQUIRE_FALSE(c);
+        CHECK(c.error().type == MessageErrorType::ConnectionError);
+        CHECK_THAT(c.error().message, Catch::Contains("timed out after 1 s"));
+        CHECK(elapsed >= 900ms);
+        CHECK(elapsed < 2500ms);  // the bound plus scheduling slack; was 7 s before
+    }
+    boost::asio::post(io, [&] {
+        acceptor.close();
+        held.clear();
+    });
+    t.join();
 }

@@ -339,8 +339,8 @@ namespace {
 std::optional<ApiError> expect_kind(const MemberTarget& t, robdef::MemberKind kind) {
     if (t.member->kind == kind) return std::nullopt;
     return api_error(404, MessageErrorType::MemberNotFound,
-                     "member \"" + t.member->name + "\" of " + t.object_type + " is a " +
-                         std::string(kind_word(t.member->kind)) + ", not a " + std::string(kind_word(kind)));
+                     "member \"" + t.member->name + "\" of " + t.object_type + " is " +
+                         robdef::with_article(kind_word(t.member->kind)) + ", not " + robdef::with_article(kind_word(kind)));
 }
 
 MessageEntry member_request(MessageEntryType type, const MemberTarget& t) {

@@ -113,8 +113,8 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
         const auto& m = *t.member;
         if (m.kind != robdef::MemberKind::function)
             return done(ApiResult::failed(api_error(404, MessageErrorType::MemberNotFound,
-                                                    "member \"" + m.name + "\" of " + t.object_type + " is a " +
-                                                        std::string(robdef::member_kind_keyword(m.kind)) +
+                                                    "member \"" + m.name + "\" of " + t.object_type + " is " +
+                                                        robdef::with_article(robdef::member_kind_keyword(m.kind)) +
                                                         ", not a function")));
         const bool param_generator =
             !m.parameters.empty() && m.parameters.back().container == robdef::ContainerKind::generator;

@@ -56,13 +56,17 @@ std::variant<Target, ApiError> parse_target(std::string_view target) {
     const auto q = target.find('?');
     std::string_view path = target.substr(0, q);
     constexpr std::string_view prefix = "/api/devices";
-    if (path.rfind(prefix, 0) != 0)
-        return api_error(404, MessageErrorType::ResourceNotFound, "no such resource");
+    auto no_route = [&] {
+        return api_error(404, MessageErrorType::ResourceNotFound,
+                         "no such resource: " + std::string(path) +
+                             " (the JSON API's routes are under /api/devices and /api/discovered)");
+    };
+    if (path.rfind(prefix, 0) != 0) return no_route();
     path.remove_prefix(prefix.size());
     if (!path.empty() && path.back() == '/') path.remove_suffix(1);
     Target t;
     if (!path.empty()) {
-        if (path.front() != '/') return api_error(404, MessageErrorType::ResourceNotFound, "no such resource");
+        if (path.front() != '/') return no_route();
         for (auto seg : split(path.substr(1), '/')) {
             auto d = url_decode(seg, false);
             if (!d) return api_error(400, MessageErrorType::InvalidArgument, d.error().message);
@@ -111,20 +115,10 @@ public:
 
 private:
     void dispatch(const http::Request& req, const http::Responder& respond) {
-        auto parsed = parse_target(std::string_view(req.target().data(), req.target().size()));
-        if (auto* e = std::get_if<ApiError>(&parsed)) return respond(error_response(req, *e));
-        auto& t = std::get<Target>(parsed);
-        const auto& seg = t.segments;
-        const auto method = req.method();
-
-        if (method == bhttp::verb::options) {
-            auto r = json_response(req, 204, nullptr);
-            r.body().clear();
-            r.set(bhttp::field::access_control_allow_methods, "GET, PUT, POST");
-            r.set(bhttp::field::access_control_allow_headers, "Content-Type");
-            r.set(bhttp::field::access_control_max_age, "600");
-            return respond(std::move(r));
-        }
+        const std::string_view target(req.target().data(), req.target().size());
+        const std::string_view path = target.substr(0, target.find('?'));
+        // HEAD is GET without the body (the HttpServer drops it when writing).
+        const auto method = req.method() == bhttp::verb::head ? bhttp::verb::get : req.method();
 
         auto not_allowed = [&](std::string_view allow) {
             auto r = error_response(req, api_error(405, MessageErrorType::InvalidOperation,
@@ -133,6 +127,28 @@ private:
             r.set(bhttp::field::allow, allow);
             respond(std::move(r));
         };
+        auto preflight = [&] {
+            auto r = json_response(req, 204, nullptr);
+            r.body().clear();
+            r.set(bhttp::field::access_control_allow_methods, "GET, PUT, POST");
+            r.set(bhttp::field::access_control_allow_headers, "Content-Type");
+            r.set(bhttp::field::access_control_max_age, "600");
+            respond(std::move(r));
+        };
+
+        // The discovery routes have their own handlers for their methods (install_json_rest); other
+        // methods end up here.
+        if (path == "/api/discovered" || path == "/api/discovered/add") {
+            if (method == bhttp::verb::options) return preflight();
+            return not_allowed(path == "/api/discovered" ? "GET" : "POST");
+        }
+
+        auto parsed = parse_target(target);
+        if (auto* e = std::get_if<ApiError>(&parsed)) return respond(error_response(req, *e));
+        auto& t = std::get<Target>(parsed);
+        const auto& seg = t.segments;
+
+        if (method == bhttp::verb::options) return preflight();
 
         if (seg.empty()) {
             if (method != bhttp::verb::get) return not_allowed("GET");
@@ -148,7 +164,9 @@ private:
             return respond(result_response(req, api_->definitions(device)));
         }
         if (seg.size() != 3 || (seg[1] != "properties" && seg[1] != "functions" && seg[1] != "wires"))
-            return respond(error_response(req, api_error(404, MessageErrorType::ResourceNotFound, "no such resource")));
+            return respond(error_response(req, api_error(404, MessageErrorType::ResourceNotFound,
+                                                         "no such resource (routes of a device: /definitions, "
+                                                         "/properties/NAME, /functions/NAME, /wires/NAME)")));
 
         MemberAddress address{device, {}, seg[2]};
         if (auto it = t.query.find("object"); it != t.query.end()) address.object = it->second;
@@ -231,9 +249,6 @@ Result<std::string> url_decode(std::string_view text, bool plus_is_space) {
 void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
     auto router = std::make_shared<RestRouter>(std::move(api));
     auto handler = [router](const http::Request& req, http::Responder respond) { router->handle(req, std::move(respond)); };
-    for (auto verb : {bhttp::verb::get, bhttp::verb::put, bhttp::verb::post, bhttp::verb::options})
-        http.add_route(verb, "/api/devices", handler, /*prefix=*/true);
-
     // Discovery (docs/json-api.md "Discovery"): the nodes and services found, and "add".
     auto no_discovery = [](const http::Request& req) {
         return error_response(req, api_error(404, MessageErrorType::ResourceNotFound, "discovery is not enabled"));
@@ -254,6 +269,12 @@ void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
                        auto head = std::make_shared<http::Request>(req.base(), std::string());
                        hooks.add(*body, [head, respond](ApiResult r) { respond(result_response(*head, r)); });
                    });
+
+    // Every other method and path under /api (the HttpServer tries routes of a method first): the router
+    // answers 405 (with Allow) for a method a route does not take and 404 for a path that is no route,
+    // both as JSON (docs/json-api.md).
+    http.add_route_any_method("/api", handler);
+    http.add_route_any_method("/api/", handler, /*prefix=*/true);
 }
 
 }  // namespace rr::server::gateway

@@ -117,6 +117,44 @@ TEST_CASE("json api: devices; definitions; the member summary") {
     auto method = http_request(gw.port(), bhttp::verb::post, "/api/devices");
     CHECK(method.status == 405);
     CHECK(method.raw[bhttp::field::allow] == "GET");
+
+    // Issue 15: methods no route takes and paths under /api that are no route answer in JSON too.
+    auto is_json_error = [](const HttpReply& r, const char* name) {
+        INFO(r.raw.body());
+        CHECK(r.raw[bhttp::field::content_type] == "application/json");
+        REQUIRE(r.body.is_object());
+        CHECK(error_name_of(r) == name);
+        CHECK(r.body["error"]["message"].is_string());
+    };
+    struct MethodCase {
+        bhttp::verb verb;
+        std::string target;
+        const char* allow;
+    };
+    for (const auto& c : {MethodCase{bhttp::verb::delete_, "/api/devices/interop/properties/p_int32", "GET, PUT"},
+                          MethodCase{bhttp::verb::patch, "/api/devices/interop", "GET"},
+                          MethodCase{bhttp::verb::delete_, "/api/devices", "GET"},
+                          MethodCase{bhttp::verb::patch, "/api/devices/interop/functions/add", "POST"},
+                          MethodCase{bhttp::verb::put, "/api/devices/interop/wires/w_state", "GET"},
+                          MethodCase{bhttp::verb::delete_, "/api/discovered", "GET"},
+                          MethodCase{bhttp::verb::get, "/api/discovered/add", "POST"}}) {
+        INFO(c.target);
+        auto r = http_request(gw.port(), c.verb, c.target);
+        CHECK(r.status == 405);
+        CHECK(r.raw[bhttp::field::allow] == c.allow);
+        is_json_error(r, "RobotRaconteur.InvalidOperation");
+    }
+    for (const char* target : {"/api", "/api/", "/api/nothing", "/api/v2/devices", "/api/devicesX"}) {
+        INFO(target);
+        auto r = http_get(gw.port(), target);
+        CHECK(r.status == 404);
+        is_json_error(r, "RobotRaconteur.ResourceNotFound");
+        CHECK(http_request(gw.port(), bhttp::verb::delete_, target).status == 404);
+    }
+    // Outside /api the server's own answers stay as they were (pages, probes).
+    auto page = http_get(gw.port(), "/no-such-page");
+    CHECK(page.status == 404);
+    CHECK(page.raw[bhttp::field::content_type] != "application/json");
 }
 
 TEST_CASE("json api: every read/write property round-trips through JSON unchanged") {

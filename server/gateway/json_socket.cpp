@@ -256,8 +256,8 @@ private:
             case robdef::MemberKind::pipe: kind = SubKind::pipe; break;
             default:
                 send_reply(id, ApiResult::failed(api_error(404, MessageErrorType::MemberNotFound,
-                                                           "member \"" + t.member->name + "\" is a " +
-                                                               std::string(robdef::member_kind_keyword(t.member->kind)) +
+                                                           "member \"" + t.member->name + "\" is " +
+                                                               robdef::with_article(robdef::member_kind_keyword(t.member->kind)) +
                                                                "; subscribe takes a wire, an event or a pipe")));
                 return end_request();
         }
@@ -421,8 +421,8 @@ private:
         auto it = subs_.find(sid);
         if (it == subs_.end() || !it->second.active) return bad_request("no subscription " + std::to_string(sid));
         if (it->second.kind != kind)
-            return bad_request("subscription " + std::to_string(sid) + " is a " + std::string(kind_name(it->second.kind)) +
-                               " subscription, not a " + std::string(kind_name(kind)));
+            return bad_request("subscription " + std::to_string(sid) + " is " + robdef::with_article(kind_name(it->second.kind)) +
+                               " subscription, not " + robdef::with_article(kind_name(kind)));
         t = *it->second.target;
         mirror_id = it->second.mirror_id;
         return std::nullopt;

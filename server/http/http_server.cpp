@@ -253,6 +253,7 @@ private:
     }
 
     void on_request(Request req) {
+        head_ = req.method() == bhttp::verb::head;
         const auto origin = req[bhttp::field::origin];
         if (!origin.empty() && !same_origin(origin, req[bhttp::field::host]) &&
             !origin_allowed(server_->options().allowed_origins, origin)) {
@@ -267,7 +268,11 @@ private:
         }
         std::string_view target(req.target().data(), req.target().size());
         auto path = target.substr(0, target.find('?'));
-        if (const RouteHandler* route = server_->find_route(req.method(), path)) {
+        // A route of this method, for HEAD one of GET (its headers, no body), then a route for any method.
+        const RouteHandler* route = server_->find_route(req.method(), path, false);
+        if (!route && head_) route = server_->find_route(bhttp::verb::get, path, false);
+        if (!route) route = server_->find_route(req.method(), path);
+        if (route) {
             auto self = shared_from_this();
             auto keep = std::make_shared<Request>(std::move(req));
             auto ex = stream_.get_executor();
@@ -298,8 +303,7 @@ private:
         }
         std::ostringstream body;
         body << f.rdbuf();
-        auto r = make_response(req, bhttp::status::ok, req.method() == bhttp::verb::head ? std::string() : body.str(),
-                               mime_type(*path));
+        auto r = make_response(req, bhttp::status::ok, body.str(), mime_type(*path));  // write() drops it for HEAD
         r.set(bhttp::field::cache_control, "no-cache");
         write(std::move(r));
     }
@@ -323,7 +327,10 @@ private:
                 }
             }
             if (chosen.empty()) {
-                auto r = make_response(req, bhttp::status::upgrade_required, "Unsupported WebSocket subprotocol\n");
+                std::string served = server_->subprotocol_names();
+                served += (served.empty() ? "" : ", ") + std::string(kRRSubprotocol);
+                auto r = make_response(req, bhttp::status::upgrade_required,
+                                       "Unsupported WebSocket subprotocol; this server speaks: " + served + "\n");
                 r.set(bhttp::field::sec_websocket_protocol, kRRSubprotocol);
                 r.set(bhttp::field::sec_websocket_version, "13");
                 r.keep_alive(false);
@@ -344,7 +351,8 @@ private:
         ws.read_message_max(64u * 1024u * 1024u);
         auto server = server_;
         auto holder = std::make_shared<websocket::stream<beast::tcp_stream>>(std::move(ws));
-        holder->async_accept(req, [holder, server, json, peer, info](beast::error_code ec) {
+        const bool unnamed = protocols.empty();
+        holder->async_accept(req, [holder, server, json, peer, info, unnamed](beast::error_code ec) {
             if (ec) return;
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession>(std::move(*holder), json,
@@ -352,10 +360,49 @@ private:
                 s->start();
                 return;
             }
+            if (unnamed) return sniff_unnamed(holder, server, info);
             auto node = server->node();
             if (!node) return;
             holder->binary(true);
             serve_stream(*node, WebSocketByteStream<beast::tcp_stream>(std::move(*holder)), info);
+        });
+    }
+
+    // No subprotocol asked for: raw RR, as CORE accepts, whose first message (CreateConnection) comes
+    // in binary frames. A text frame first is a JSON client that forgot its subprotocol: it gets an
+    // error naming the subprotocols instead of a silent drop. The bytes read go to the node first.
+    static void sniff_unnamed(std::shared_ptr<websocket::stream<beast::tcp_stream>> ws, std::shared_ptr<HttpServer> server,
+                              AcceptedStream info) {
+        auto buf = std::make_shared<std::vector<std::byte>>(4096);
+        beast::get_lowest_layer(*ws).expires_after(server->options().read_timeout);
+        ws->async_read_some(asio::buffer(buf->data(), buf->size()), [ws, buf, server, info](beast::error_code ec, std::size_t n) {
+            if (ec) return;  // closed or timed out before a byte: nothing to serve
+            beast::get_lowest_layer(*ws).expires_never();
+            if (ws->got_text()) return refuse_text(ws, server->subprotocol_names());
+            auto node = server->node();
+            if (!node) return;
+            buf->resize(n);
+            ws->binary(true);
+            serve_stream(*node, WebSocketByteStream<beast::tcp_stream>(std::move(*ws)), info, std::move(*buf));
+        });
+    }
+
+    static void refuse_text(std::shared_ptr<websocket::stream<beast::tcp_stream>> ws, const std::string& json_protocols) {
+        // Subprotocol names are HTTP tokens (no quotes or backslashes): safe inside a JSON string.
+        const std::string hint = json_protocols.empty()
+                                     ? std::string("this WebSocket speaks Robot Raconteur (binary frames) only")
+                                     : "open the WebSocket with the subprotocol " + json_protocols + " for the JSON API";
+        auto text = std::make_shared<std::string>(
+            "{\"error\": {\"name\": \"RobotRaconteur.ProtocolError\", \"message\": \"no WebSocket subprotocol was "
+            "asked for, so this connection speaks raw Robot Raconteur (subprotocol " +
+            std::string(kRRSubprotocol) + "); " + hint + "\"}}");
+        ws->text(true);
+        beast::get_lowest_layer(*ws).expires_after(std::chrono::seconds(5));  // the write and the close handshake
+        ws->async_write(asio::buffer(*text), [ws, text, hint](beast::error_code ec, std::size_t) {
+            if (ec) return;
+            // A close frame's reason has at most 123 bytes.
+            websocket::close_reason reason(websocket::close_code::policy_error, beast::string_view(hint).substr(0, 123));
+            ws->async_close(reason, [ws](beast::error_code) {});
         });
     }
 
@@ -369,6 +416,10 @@ private:
         auto self = shared_from_this();
         auto res = std::make_shared<Response>(std::move(r));
         res->prepare_payload();
+        if (head_) {  // the answer to HEAD: GET's Content-Length, no body
+            res->body().clear();
+            head_ = false;
+        }
         bhttp::async_write(stream_, *res, [self, res](beast::error_code ec, std::size_t) {
             if (ec || !res->keep_alive()) {
                 self->shutdown();
@@ -388,6 +439,7 @@ private:
     beast::tcp_stream stream_;
     beast::flat_buffer buffer_;
     std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+    bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)
 };
 
 }  // namespace
@@ -445,15 +497,27 @@ void HttpServer::add_route(bhttp::verb method, std::string path, RouteHandler ha
     routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
 }
 
+void HttpServer::add_route_any_method(std::string path, RouteHandler handler, bool prefix) {
+    routes_.push_back(Route{std::nullopt, std::move(path), prefix, std::move(handler)});
+}
+
+std::string HttpServer::subprotocol_names() const {
+    std::string out;
+    for (const auto& [name, handler] : subprotocols_) out += (out.empty() ? "" : ", ") + name;
+    return out;
+}
+
 void HttpServer::add_subprotocol(std::string name, JsonSocketHandler handler) {
     subprotocols_.emplace(std::move(name), std::move(handler));
 }
 
-const RouteHandler* HttpServer::find_route(bhttp::verb method, std::string_view path) const {
-    for (const auto& r : routes_) {
-        if (r.method != method) continue;
-        if (r.prefix ? path.rfind(r.path, 0) == 0 : path == r.path) return &r.handler;
-    }
+const RouteHandler* HttpServer::find_route(bhttp::verb method, std::string_view path, bool any_method) const {
+    auto matches = [&](const Route& r) { return r.prefix ? path.rfind(r.path, 0) == 0 : path == r.path; };
+    for (const auto& r : routes_)
+        if (r.method && *r.method == method && matches(r)) return &r.handler;
+    if (any_method)
+        for (const auto& r : routes_)
+            if (!r.method && matches(r)) return &r.handler;
     return nullptr;
 }
 

@@ -3,7 +3,11 @@
 // WebSocket upgrades:
 //   * subprotocol `robotraconteur.robotraconteur.com` (or none): raw RR over binary frames, served by the
 //     node exactly like a TCP connection (wire.md §8) — what `rr+ws://host:port/?service=…` clients use;
-//   * other registered subprotocols (the JSON WebSocket API): handed to their handler.
+//     without a subprotocol, a first message in a text frame (a JSON client that forgot its subprotocol)
+//     gets one text message {"error": {"name": "RobotRaconteur.ProtocolError", "message": …}} naming
+//     the registered subprotocols, then a close (1008, policy) with the same hint as its reason;
+//   * other registered subprotocols (the JSON WebSocket API): handed to their handler;
+//   * any other subprotocol list: 426 naming the subprotocols served.
 // Origins: a request carrying an Origin header must be same-origin (its Host) or match the allowlist
 // (403 otherwise); requests without Origin (non-browser clients) are allowed. Matching follows CORE (wire.md §8): exact, or
 // `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
@@ -13,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,21 +91,27 @@ public:
 
     /// Exact-path route for a method (GET, POST, PUT…); `prefix` routes match a path prefix.
     void add_route(boost::beast::http::verb method, std::string path, RouteHandler handler, bool prefix = false);
+    /// A route for every method, also ones Beast does not know (the handler answers 405 itself).
+    void add_route_any_method(std::string path, RouteHandler handler, bool prefix = false);
     /// WebSocket subprotocol served by a JSON handler.
     void add_subprotocol(std::string name, JsonSocketHandler handler);
 
     const HttpOptions& options() const noexcept { return options_; }
 
     // Used by sessions.
-    const RouteHandler* find_route(boost::beast::http::verb method, std::string_view path) const;
+    /// The route for `method` and `path`: routes of that method first, then (with `any_method`) routes
+    /// for any method, each in the order added.
+    const RouteHandler* find_route(boost::beast::http::verb method, std::string_view path, bool any_method = true) const;
     const JsonSocketHandler* find_subprotocol(std::string_view name) const;
+    /// The registered JSON subprotocols, comma-separated (for error messages).
+    std::string subprotocol_names() const;
     std::shared_ptr<Node> node() const { return node_.lock(); }
 
 private:
     std::weak_ptr<Node> node_;
     HttpOptions options_;
     struct Route {
-        boost::beast::http::verb method;
+        std::optional<boost::beast::http::verb> method;  ///< none: any method
         std::string path;
         bool prefix;
         RouteHandler handler;

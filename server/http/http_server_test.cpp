@@ -215,19 +215,77 @@ TEST_CASE("an unknown subprotocol is refused with 426") {
     ws.handshake(res, "localhost", "/", ec);
     CHECK(ec);
     CHECK(res.result() == bhttp::status::upgrade_required);
+    // The answer says what this server speaks.
+    CHECK_THAT(res.body(), Catch::Contains("test.echo.v1") && Catch::Contains("robotraconteur.robotraconteur.com"));
 }
 
-TEST_CASE("RR messages travel over a WebSocket with the RR subprotocol") {
+TEST_CASE("a WebSocket without subprotocol whose first message is text gets a JSON error, then a close") {
+    // A JSON API client that forgot `Sec-WebSocket-Protocol`: before, the node read its text as RR
+    // and dropped it silently (issue 15).
     Fixture f;
     boost::asio::io_context io;
     websocket::stream<beast::tcp_stream> ws(io);
     beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
-    ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
-        req.set(bhttp::field::sec_websocket_protocol, "robotraconteur.robotraconteur.com");
-    }));
     websocket::response_type res;
     ws.handshake(res, "localhost", "/");
-    CHECK(res[bhttp::field::sec_websocket_protocol] == "robotraconteur.robotraconteur.com");
+    CHECK(res[bhttp::field::sec_websocket_protocol].empty());
+    ws.text(true);
+    ws.write(boost::asio::buffer(std::string(R"({"id": 1, "op": "devices"})")));
+    beast::flat_buffer b;
+    ws.read(b);
+    CHECK(ws.got_text());
+    const std::string text = beast::buffers_to_string(b.data());
+    CHECK_THAT(text, Catch::StartsWith(R"({"error": {"name": "RobotRaconteur.ProtocolError", "message": ")"));
+    CHECK_THAT(text, Catch::Contains("open the WebSocket with the subprotocol test.echo.v1, test.flood.v1"));
+    beast::error_code ec;
+    b.clear();
+    ws.read(b, ec);
+    CHECK(ec == websocket::error::closed);
+    CHECK(ws.reason().code == websocket::close_code::policy_error);
+    CHECK_THAT(std::string(ws.reason().reason.c_str()), Catch::Contains("subprotocol test.echo.v1"));
+}
+
+TEST_CASE("a route for any method sees methods Beast does not know") {
+    Fixture f;
+    f.server->add_route_any_method("/any", [](const http::Request& req, http::Responder respond) {
+        respond(http::make_response(req, bhttp::status::ok, std::string(req.method_string())));
+    });
+    // A route of the method wins over the any-method route, whichever was added first.
+    f.server->add_route(bhttp::verb::put, "/any", [](const http::Request& req, http::Responder respond) {
+        respond(http::make_response(req, bhttp::status::ok, "put route"));
+    });
+    for (const char* method : {"GET", "DELETE", "PATCH", "BREW", "PUT"}) {
+        boost::asio::io_context io;
+        beast::tcp_stream s(io);
+        s.connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+        bhttp::request<bhttp::string_body> req;
+        req.method_string(method);
+        req.target("/any");
+        req.version(11);
+        req.set(bhttp::field::host, "localhost");
+        bhttp::write(s, req);
+        beast::flat_buffer b;
+        bhttp::response<bhttp::string_body> r;
+        bhttp::read(s, b, r);
+        CHECK(r.result() == bhttp::status::ok);
+        CHECK(r.body() == (std::string(method) == "PUT" ? std::string("put route") : std::string(method)));
+    }
+}
+
+TEST_CASE("RR messages travel over a WebSocket with the RR subprotocol, or none") {
+    Fixture f;
+    const bool named = GENERATE(true, false);
+    INFO((named ? "subprotocol robotraconteur.robotraconteur.com" : "no subprotocol"));
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    if (named)
+        ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
+            req.set(bhttp::field::sec_websocket_protocol, "robotraconteur.robotraconteur.com");
+        }));
+    websocket::response_type res;
+    ws.handshake(res, "localhost", "/");
+    CHECK(res[bhttp::field::sec_websocket_protocol] == (named ? "robotraconteur.robotraconteur.com" : ""));
     ws.binary(true);
 
     ClientSessionConfig cfg;

@@ -156,6 +156,11 @@ TEST_CASE("connecting to an unknown service fails with ServiceNotFound") {
     auto r = p.get_future().get();
     REQUIRE_FALSE(r);
     CHECK(r.error().type == MessageErrorType::ServiceNotFound);
+    // The client reports it under the standard name with the service named (the wire keeps CORE's
+    // name "RobotRaconteur.ServiceNotFoundException": test/cli/service_index_official.py checks the
+    // official client's view).
+    CHECK(r.error().name == "RobotRaconteur.ServiceNotFound");
+    CHECK_THAT(r.error().message, Catch::Contains("\"nosuch\""));
 }
 
 namespace {

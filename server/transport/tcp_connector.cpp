@@ -5,6 +5,8 @@
 #include <boost/asio/connect.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "core/session/client_session.hpp"
+
 namespace rr::server {
 
 namespace asio = boost::asio;
@@ -19,6 +21,7 @@ void connect_tcp(asio::any_io_executor executor, const std::string& host, std::u
         std::function<void(Result<tcp::socket>)> done;
         bool finished = false;
         std::string where;
+        std::string limit;
         void finish(Result<tcp::socket> r) {
             if (finished) return;
             finished = true;
@@ -27,14 +30,14 @@ void connect_tcp(asio::any_io_executor executor, const std::string& host, std::u
         }
     };
     auto op = std::make_shared<Op>(Op{tcp::resolver(executor), tcp::socket(executor), asio::steady_timer(executor),
-                                      std::move(done), false, host + ":" + std::to_string(port)});
+                                      std::move(done), false, host + ":" + std::to_string(port), seconds_text(timeout)});
     op->timer.expires_after(timeout);
     op->timer.async_wait([op](boost::system::error_code ec) {
         if (ec || op->finished) return;
         boost::system::error_code ignored;
         op->resolver.cancel();
         op->socket.close(ignored);
-        op->finish(fail(MessageErrorType::ConnectionError, "connect to " + op->where + " timed out"));
+        op->finish(fail(MessageErrorType::ConnectionError, "connect to " + op->where + " timed out after " + op->limit));
     });
     op->resolver.async_resolve(host, std::to_string(port), [op](boost::system::error_code ec, tcp::resolver::results_type results) {
         if (op->finished) return;

@@ -14,7 +14,7 @@
 namespace rr::server {
 
 /// Calls `done` once with the connected socket or an error (ConnectionError naming host:port and
-/// the system message, or ConnectionError "connect to host:port timed out").
+/// the system message, or ConnectionError "connect to host:port timed out after S s").
 void connect_tcp(boost::asio::any_io_executor executor, const std::string& host, std::uint16_t port,
                  std::chrono::milliseconds timeout,
                  std::function<void(Result<boost::asio::ip::tcp::socket>)> done);

@@ -5,7 +5,8 @@
 // behind a reverse proxy at a sub-path is reachable), then the same StreamPump as rr+tcp over
 // WebSocketByteStream (binary frames, boundaries carry no meaning). ConnectOptions::http_authorization,
 // when set, is sent as the handshake's Authorization header (a proxy's login, e.g. nginx basic auth).
-// The TLS and WebSocket handshakes together are bounded by ConnectOptions::connect_timeout.
+// The TCP connect and the TLS and WebSocket handshakes together are bounded by
+// ConnectOptions::connect_timeout (ConnectionError "connect to HOST:PORT timed out after S s (step)").
 #pragma once
 
 #include <string>
@@ -17,7 +18,9 @@ namespace rr::server {
 
 /// "rr+ws", or "rr+wss" with `tls`. Errors reach the client as ConnectionError naming the failed step
 /// (TCP connect, the TLS handshake: "certificate verify failed", an unreadable tls_ca_file, or the
-/// WebSocket handshake with Beast's message, e.g. "bad status" for a 401 from a proxy).
+/// WebSocket handshake with Beast's message). An upgrade answered with an HTTP status instead of 101
+/// says the status: "HTTP 401: a login is needed (…)" (or "…: the login was refused" when
+/// http_authorization was sent), "HTTP 403: forbidden (…)", "HTTP N REASON: the server declined …".
 class WebSocketConnector : public Connector {
 public:
     explicit WebSocketConnector(bool tls) : tls_(tls) {}

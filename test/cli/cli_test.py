@@ -29,6 +29,7 @@ OK, RR_ERROR, USAGE, CONNECT = 0, 1, 2, 3
 
 failures = []
 checks_run = [0]
+NODE_NAME = None  # the service's NodeName when its ready line says it (legacy tcp:// URLs by name)
 
 
 def check(cond, what, detail=""):
@@ -271,7 +272,9 @@ def interop_checks(rr, service_url):
     # connection-level failures
     rr.fails(CONNECT, r"RobotRaconteur\.ConnectionError", "get", "p_int32",
              url=f"rr+tcp://127.0.0.1:{closed_port()}/?service=interop")
-    rr.fails(CONNECT, r"RobotRaconteur\.ServiceNotFound", "get", "p_int32",
+    # One name for an unknown service, whatever the node sends (CORE: "...ServiceNotFoundException",
+    # "Service not found"), and the service named (issue 15).
+    rr.fails(CONNECT, r'^rr: RobotRaconteur\.ServiceNotFound: service "nosuch" not found\n$', "get", "p_int32",
              url=re.sub(r"service=[^&]*", "service=nosuch", service_url))
     t0 = time.time()
     rr.fails(CONNECT, r"RobotRaconteur\.\w+", "get", "p_int32", "--timeout", "1",
@@ -280,7 +283,79 @@ def interop_checks(rr, service_url):
     check(rr.json_lines("get", "p_int64", "--disable-message4") == ["-9223372036854775808"], "message format v2")
     rr.fails(USAGE, r"names no service", "get", "p_int32", url=without_service(service_url))
     rr.fails(USAGE, r"InvalidArgument", "get", "p_int32", url="bogus://x")
+    rr.fails(USAGE, r"InvalidArgument: invalid connection URL .*has no '='", "get", "p_int32", url=service_url + "&junk")
+    rr.fails(USAGE, r"legacy tcp:// URL needs /\{node\}/service", "get", "p_int32", url="tcp://127.0.0.1:1/node")
+    rr.fails(RR_ERROR, r"InvalidOperation: ev_values is an event; rr get reads", "get", "ev_values")
+    legacy_url_checks(rr, service_url)
     rr.ok("call", "reset")
+
+
+def legacy_url_checks(rr, service_url):
+    """The legacy form tcp://HOST:PORT/NODE/SERVICE (docs/cli.md) reaches the same service."""
+    m = re.match(r"rr\+tcp://([^/?]+)/", service_url)
+    if not m:
+        return  # rr+ws: the legacy form is TCP only
+    out = rr.ok("info", url=without_service(service_url))
+    node = re.search(r"(?m)^== services of node ([0-9a-f-]{36}) ==$", out)
+    if not check(node, "info prints the node's NodeID", out[:300]):
+        return
+    want = rr.json_lines("get", "p_int64")
+    legacy_urls = ["tcp://%s/{%s}/interop" % (m.group(1), node.group(1))]
+    if NODE_NAME:  # the form of issue 15: tcp://HOST:PORT/interop_service/interop
+        legacy_urls.append("tcp://%s/%s/interop" % (m.group(1), NODE_NAME))
+    for legacy in legacy_urls:
+        check(rr.json_lines("get", "p_int64", url=legacy) == want, f"legacy URL {legacy} reads the same service")
+    rr.fails(CONNECT, r'ServiceNotFound: service "nosuch" not found', "get", "p_int64",
+             url="tcp://%s/{%s}/nosuch" % (m.group(1), node.group(1)))
+
+
+class SilentPeer:
+    """A TCP listener that accepts every connection and never sends a byte."""
+
+    def __init__(self):
+        import threading
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(16)
+        self.port = self.sock.getsockname()[1]
+        self.held = []
+        self.stopped = False
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self):
+        while not self.stopped:
+            try:
+                c, _ = self.sock.accept()
+            except OSError:
+                return
+            self.held.append(c)
+
+    def close(self):
+        self.stopped = True
+        self.sock.close()
+        for c in self.held:
+            c.close()
+
+
+def timeout_checks(exe):
+    """--timeout S bounds the whole connect to a peer that accepts and never answers (was 7-10 s)."""
+    peer = SilentPeer()
+    try:
+        for scheme, seconds in [("rr+tcp", 1), ("rr+tcp", 3), ("rr+ws", 2), ("tcp", 1)]:
+            url = (f"tcp://127.0.0.1:{peer.port}/node/interop" if scheme == "tcp"
+                   else f"{scheme}://127.0.0.1:{peer.port}/?service=interop")
+            t0 = time.time()
+            p = subprocess.run([exe, "get", url, "p_int32", "--timeout", str(seconds)], capture_output=True, text=True,
+                               timeout=60)
+            took = time.time() - t0
+            check(p.returncode == CONNECT and f"timed out after {seconds} s" in p.stderr,
+                  f"--timeout {seconds} against a silent {scheme} peer: status 3, 'timed out after {seconds} s'",
+                  f"rc={p.returncode} stderr={p.stderr.strip()!r}")
+            # Slack for the process's start-up on a loaded machine; it was 7-10 s before.
+            check(seconds - 0.2 <= took <= seconds + 3.0, f"--timeout {seconds} ({scheme}) ends after about {seconds} s",
+                  f"{took:.2f} s")
+    finally:
+        peer.close()
 
 
 def usage_checks(exe):
@@ -335,6 +410,8 @@ def main():
     local_name = f"cli.t{os.getpid()}"
 
     usage_checks(args.rr)
+    if args.target in ("ours", "official"):
+        timeout_checks(args.rr)
     if args.target == "url":
         proc, ready = None, {"url": args.url}
     elif args.target == "ours":
@@ -348,6 +425,8 @@ def main():
                             timeout=90)
     if args.local:
         ready["url"] = ready["local_url"]
+    global NODE_NAME
+    NODE_NAME = ready.get("nodename")
     try:
         rr = Rr(args.rr, ready["url"])
         if args.target == "reynard":

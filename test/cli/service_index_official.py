@@ -76,6 +76,16 @@ def main():
                   "index over rr+ws reports the TCP listener URL", repr(names))
             RRN.DisconnectService(w)
             check(re.fullmatch(r"[0-9a-f-]{36}", nodeid) is not None, "nodeid form", nodeid)
+
+            # An unknown service: the official client gets its ServiceNotFoundException (our node sends
+            # CORE's wire name) and the message names the service (issue 15).
+            try:
+                RRN.ConnectService(f"rr+tcp://127.0.0.1:{port}/?nodeid={nodeid}&service=nosuch")
+                check(False, "connecting to an unknown service fails")
+            except RR.ServiceNotFoundException as e:
+                check('"nosuch"' in str(e), "ServiceNotFoundException names the service", str(e))
+            except Exception as e:  # noqa: BLE001 (any other type is the failure to report)
+                check(False, "unknown service: ServiceNotFoundException", f"{type(e).__name__}: {e}")
         finally:
             RRN.Shutdown()
     finally:

@@ -189,14 +189,20 @@ def main():
 
             def rr_wss_no_login():
                 p = rr("--tls-ca", cert)
-                expect(p.returncode == 3 and "WebSocket handshake" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
+                expect(p.returncode == 3 and "HTTP 401: a login is needed" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
+
+            def rr_wss_wrong_login():
+                p = rr("--tls-ca", cert, "--http-login", "%s:nope" % USER)
+                expect(p.returncode == 3 and "HTTP 401: the login was refused" in p.stderr,
+                       "exit %d: %s" % (p.returncode, p.stderr))
 
             def rr_wss_untrusted():
                 p = rr("--http-login", "%s:%s" % (USER, PASSWORD))
                 expect(p.returncode == 3 and "TLS handshake" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
 
             checks.run("rr info over rr+wss through nginx (CA file, proxy login)", rr_wss)
-            checks.run("rr over rr+wss without the proxy login: connect failure (3)", rr_wss_no_login)
+            checks.run("rr over rr+wss without the proxy login: connect failure (3), HTTP 401 named", rr_wss_no_login)
+            checks.run("rr over rr+wss with a wrong proxy login: connect failure (3), HTTP 401 named", rr_wss_wrong_login)
             checks.run("rr over rr+wss not trusting the certificate: connect failure (3)", rr_wss_untrusted)
 
         def redirect():
