@@ -97,7 +97,7 @@ TEST_CASE("canonical text: sections, regrouping, using abbreviation, modifiers, 
     CHECK(canon(expected) == expected);
 }
 
-TEST_CASE("canonical text: legacy option version stays an option; old stdver becomes option version") {
+TEST_CASE("canonical text: legacy option version stays an option, old stdver becomes option version") {
     const std::string legacy =
         "service experimental.old\n"
         "option version 0.8\n"
