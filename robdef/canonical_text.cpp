@@ -123,6 +123,14 @@ std::string member_to_string(const MemberDefinition& m, const ServiceDefinition&
 
 std::string to_string(const ServiceDefinition& def) {
     std::string o = "service " + def.name + "\n\n";
+    // Top-level options are legal above `stdver` >= 0.9.2 but not below it (robdef.md §2.2). The
+    // official ToString writes them below and cannot read its own text back; ours go above then.
+    const bool options_first =
+        def.stdver && !def.version_from_option && *def.stdver >= Version{0, 9, 2, 0} && !def.options.empty();
+    if (options_first) {
+        for (const auto& opt : def.options) o += option_line("", opt);
+        o += "\n";
+    }
     if (def.stdver && !def.version_from_option) {
         o += (*def.stdver < Version{0, 9, 0, 0} ? "option version " : "stdver ") + def.stdver->to_string() + "\n\n";
     }
@@ -133,8 +141,10 @@ std::string to_string(const ServiceDefinition& def) {
         o += "using " + u.qualified_name + (last == u.unqualified_name ? "" : " as " + u.unqualified_name) + "\n";
     }
     if (!def.usings.empty()) o += "\n";
-    for (const auto& opt : def.options) o += option_line("", opt);
-    if (!def.options.empty()) o += "\n";
+    if (!options_first) {
+        for (const auto& opt : def.options) o += option_line("", opt);
+        if (!def.options.empty()) o += "\n";
+    }
     for (const auto& c : def.constants) o += constant_to_string(c) + "\n";
     if (!def.constants.empty()) o += "\n";
     for (const auto& e : def.enums) o += enum_to_string(e) + "\n";

@@ -2,6 +2,11 @@
 // and what dynamic clients re-serialise received definitions into. Comments, docstrings and
 // `end <kind>` forms are dropped; entries are regrouped by kind (structs, pods, namedarrays,
 // objects) in source order; bodies use 4-space indentation; LF line endings.
+//
+// One deliberate difference from the official ToString: top-level `option` lines of a definition
+// with `stdver` >= 0.9.2 (legal only above the stdver line, robdef.md §2.2) are written between the
+// `service` and `stdver` lines. The official ToString writes them after the usings, where its own
+// parser rejects them; we never emit text the official parser rejects.
 #pragma once
 
 #include <string>

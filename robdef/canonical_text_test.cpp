@@ -97,7 +97,7 @@ TEST_CASE("canonical text: sections, regrouping, using abbreviation, modifiers, 
     CHECK(canon(expected) == expected);
 }
 
-TEST_CASE("canonical text: legacy option version stays an option; old stdver becomes option version") {
+TEST_CASE("canonical text: legacy option version stays an option, old stdver becomes option version") {
     const std::string legacy =
         "service experimental.old\n"
         "option version 0.8\n"
@@ -147,4 +147,16 @@ TEST_CASE("canonical text: an option ending in a backslash reads back the same")
     CHECK(again->definition.options == r->definition.options);
     CHECK(again->definition.structures.at(0).options == r->definition.structures.at(0).options);
     CHECK(to_string(again->definition) == once);
+}
+
+TEST_CASE("canonical text: options of a stdver >= 0.9.2 definition go above the stdver line") {
+    // Legal only there (robdef.md §2.2); the official ToString writes them below, where its own parser
+    // rejects them. Below 0.9.2, and with `option version`, the official order is kept.
+    const std::string once = canon("service a.b\noption foo\noption bar\nstdver 0.10\nimport c.d\nusing c.d.T\n");
+    CHECK(once == "service a.b\n\noption foo\noption bar\n\nstdver 0.10\n\nimport c.d\n\nusing c.d.T\n\n");
+    CHECK(canon(once) == once);
+    CHECK(canon("service a.b\nstdver 0.9\nimport c.d\noption foo\n") ==
+          "service a.b\n\nstdver 0.9\n\nimport c.d\n\noption foo\n\n");
+    CHECK(canon("service a.b\noption version 0.8\noption foo\n") ==
+          "service a.b\n\noption version 0.8\noption foo\n\n");
 }

@@ -214,6 +214,9 @@ bool scalar_ok(DataTypes type, std::string_view lit) {
     lit = trim(lit);
     if (type == DataTypes::double_t || type == DataTypes::single_t)
         return lex::is_float_literal(lit) && float_in_range(type, lit);
+    // The official parser converts 8-bit integers as characters: exactly one digit passes
+    // (robdef.md §7). A wider value would break every official peer that parses the definition.
+    if (type == DataTypes::int8_t || type == DataTypes::uint8_t) return lit.size() == 1 && is_digit(lit[0]);
     return (lex::is_int_literal(lit) || lex::is_hex_literal(lit)) && integer_in_range(type, lit);
 }
 
@@ -245,10 +248,10 @@ bool string_constant_ok(std::string_view v) {
 
 bool is_valid_constant_value(const TypeDefinition& t, std::string_view value) {
     if (t.array == ArrayKind::multidimarray) return false;
-    if (t.container != ContainerKind::none) return false;
     if (is_numeric(t.base)) {
         if (t.base == DataTypes::cdouble_t || t.base == DataTypes::csingle_t || t.base == DataTypes::bool_t)
             return false;
+        if (t.container != ContainerKind::none) return false;
         if (t.array == ArrayKind::none) return scalar_ok(t.base, value);
         auto v = trim(value);
         if (v.size() < 2 || v.front() != '{' || v.back() != '}') return false;
@@ -258,6 +261,7 @@ bool is_valid_constant_value(const TypeDefinition& t, std::string_view value) {
             if (!scalar_ok(t.base, e)) return false;
         return true;
     }
+    // A container on a string or struct constant is not checked, as in the official parser.
     if (t.array != ArrayKind::none) return false;
     if (t.base == DataTypes::string_t) return string_constant_ok(value);
     if (t.base == DataTypes::namedtype_t) return parse_struct_constant_fields(value).has_value();
@@ -528,10 +532,8 @@ ParseReport Parser::run() {
 bool Parser::finish_versions() {
     bool version_found = stdver_found_;
     if (stdver_found_) def_.stdver = stdver_;
-    // An option line above `stdver` passed the in-flight check; the rule holds for the whole file.
-    if (stdver_found_ && stdver_ >= kVersion0_9_2 && !def_.options.empty())
-        return fail(def_.option_lines.empty() ? 0 : def_.option_lines.front(), DiagnosticKind::version,
-                    "option keyword is not support in stdver 0.9.2 or greater");
+    // An option line above `stdver` passed the in-flight check and stays legal, as in the official
+    // parser (robdef.md §2.2); canonical_text writes such options above the stdver line.
     for (std::size_t i = 0; i < def_.options.size(); ++i) {
         std::string_view o = trim_left(def_.options[i]);
         int line = i < def_.option_lines.size() ? def_.option_lines[i] : 0;
@@ -836,9 +838,14 @@ bool Parser::parse_member(const lex::LogicalLine& ll, std::string_view kw, Servi
         if (m.kind == MemberKind::objref) {
             const auto& t = m.type;
             bool ok = (t.base == DataTypes::namedtype_t || t.base == DataTypes::varobject_t);
-            if (t.array == ArrayKind::array)
-                ok = ok && t.array_var_length && t.array_length.empty() && t.container == ContainerKind::none;
-            else if (t.array == ArrayKind::multidimarray)
+            if (t.array == ArrayKind::array) {
+                // `[]` or `[0-]` only (`[0]` is a fixed length here, though it behaves as `[]`
+                // elsewhere). With an array, any container passes: the official parser checks the
+                // wrong variable (robdef.md §4.1) and official clients accept such definitions.
+                auto open = p.type->find('[');
+                auto inner = p.type->substr(open + 1, p.type->find(']', open) - open - 1);
+                ok = ok && t.array_var_length && t.array_length.empty() && (inner.empty() || inner.back() == '-');
+            } else if (t.array == ArrayKind::multidimarray)
                 ok = false;
             else
                 ok = ok && (t.container == ContainerKind::none || t.container == ContainerKind::map_int32 ||

@@ -9,9 +9,6 @@
 // Deliberate differences from the official parser (robdef.md §20 lists the quirks):
 //  - line numbers are physical lines (no drift after continuations, robdef.md §1.2; enum errors at
 //    the offending value, not at `end`; member and type errors at the member line, not 0/-1);
-//  - 8-bit integer constants take their full range (the official single-digit quirk is a bug);
-//  - `objref T[]{int32}` is rejected (the official parser accepts it and then cannot print it);
-//  - constants with a container (`string{list}`) are rejected for every base type;
 //  - array sizes above 2^31-1 give `Could not parse type "…"` (the official text leaks
 //    `Parse error: bad lexical cast: …`);
 //  - modifier arguments may have blanks before any comma (`f(1 ,2 ,3)`);
@@ -51,7 +48,8 @@ ParseReport parse_service_definition_report(std::string_view text, std::string_v
 Result<TypeDefinition> parse_type(std::string_view text);
 
 /// True when `value` is a valid constant value for `type` (robdef.md §7). Integer ranges are the
-/// type's full range (the official 8-bit quirk is not copied); unsigned types also take negative
+/// type's full range except for int8/uint8, which take exactly one digit `0`-`9` per value as in the
+/// official parser (it converts them as characters; robdef.md §7); unsigned types also take negative
 /// decimal values, as the official parser does.
 bool is_valid_constant_value(const TypeDefinition& type, std::string_view value);
 

@@ -66,8 +66,8 @@ TEST_CASE("invalid definitions fail to parse with the official message at the ri
          "Service definition standard version 0.9 or greater required for \"stdver\" keyword", 2},
         {"option with stdver 0.10", h10 + "option foo\n", K::version,
          "option keyword is not support in stdver 0.9.2 or greater", 3},
-        {"option above stdver 0.10", "service a.b\noption foo\nstdver 0.10\n", K::version,
-         "option keyword is not support in stdver 0.9.2 or greater", 2},
+        {"option between two stdver lines", "service a.b\nstdver 0.10\noption foo\nstdver 0.9\n", K::version,
+         "option keyword is not support in stdver 0.9.2 or greater", 3},
         {"option inside an object with stdver 0.9.2", "service a.b\nstdver 0.9.2\nobject O\n    option x\nend\n",
          K::version, "option keyword is not support in stdver 0.9.2 or greater", 4},
         {"import after struct", h + "struct S\nend\nimport c.d\n", K::ordering, "import must be before all but options",
@@ -158,8 +158,10 @@ TEST_CASE("invalid definitions fail to parse with the official message at the ri
          "Invalid objref definition \"objref P[3] o\"", 3},
         {"objref list", h + "object O\n    objref P{list} o\nend\n", K::syntax,
          "Invalid objref definition \"objref P{list} o\"", 3},
-        {"objref array and map", h + "object O\n    objref P[]{int32} o\nend\n", K::syntax,
-         "Invalid objref definition \"objref P[]{int32} o\"", 3},
+        {"objref fixed array of length 0", h + "object O\n    objref P[0] o\nend\n", K::syntax,
+         "Invalid objref definition \"objref P[0] o\"", 3},
+        {"objref bounded array and map", h + "object O\n    objref P[2-]{int32} o\nend\n", K::syntax,
+         "Invalid objref definition \"objref P[2-]{int32} o\"", 3},
         // --- enums (robdef.md §3.2)
         {"enum first value implicit", h10 + "enum E\n    a,\n    b\nend\n", K::enumeration,
          "Enum first value must be specified", 4},
@@ -201,6 +203,12 @@ TEST_CASE("invalid definitions fail to parse with the official message at the ri
         {"struct constant without colon", h10 + "constant struct C {a b}\n", K::constant,
          "Invalid constant definition", 3},
         {"uint8 constant above 255", h10 + "constant uint8 C 256\n", K::constant, "Invalid constant definition", 3},
+        {"int8 constant of two digits", h10 + "constant int8 C 10\n", K::constant, "Invalid constant definition", 3},
+        {"negative int8 constant", h10 + "constant int8 C -1\n", K::constant, "Invalid constant definition", 3},
+        {"uint8 array constant with 20", h10 + "constant uint8[] C {1, 20}\n", K::constant,
+         "Invalid constant definition", 3},
+        {"int8 constant in an object", h10 + "object O\n    constant int8 C 0x1\nend\n", K::constant,
+         "Invalid constant definition", 4},
     };
     for (const auto& c : cases) {
         INFO(c.what << "\n" << c.text);
@@ -425,7 +433,7 @@ TEST_CASE("empty entries, struct constants, generators, empty file") {
         "constant int32 A 1\n"
         "constant double[] B {1.5, -.5, 1., 2e3}\n"
         "constant uint32 WRAP -1\n"
-        "constant int8 I8 -128\n"
+        "constant int8 I8 7\n"
         "constant uint64[] H {0xFFFFFFFFFFFFFFFF, +0x10}\n"
         "constant struct S1 {a: A, b: B}\n"
         "constant struct S2 {}\n"
@@ -452,10 +460,22 @@ TEST_CASE("empty entries, struct constants, generators, empty file") {
 
 TEST_CASE("constant value checks") {
     auto t = [](std::string_view s) { return parse_type(s).value(); };
-    CHECK(is_valid_constant_value(t("int8"), "127"));  // the official 8-bit single-digit quirk is not copied
-    CHECK(is_valid_constant_value(t("int8"), "-128"));
-    CHECK_FALSE(is_valid_constant_value(t("int8"), "128"));
-    CHECK(is_valid_constant_value(t("uint8[]"), "{1, 20, 255}"));
+    // 8-bit integers: one digit per value, as the official parser (which reads them as characters).
+    CHECK(is_valid_constant_value(t("int8"), "0"));
+    CHECK(is_valid_constant_value(t("uint8"), " 9 "));
+    CHECK_FALSE(is_valid_constant_value(t("int8"), "10"));
+    CHECK_FALSE(is_valid_constant_value(t("int8"), "-1"));
+    CHECK_FALSE(is_valid_constant_value(t("int8"), "+1"));
+    CHECK_FALSE(is_valid_constant_value(t("int8"), "-0"));
+    CHECK_FALSE(is_valid_constant_value(t("uint8"), "0x1"));
+    CHECK_FALSE(is_valid_constant_value(t("uint8"), "a"));
+    CHECK(is_valid_constant_value(t("uint8[]"), "{1, 2, 3}"));
+    CHECK(is_valid_constant_value(t("int8[2]"), "{ }"));
+    CHECK_FALSE(is_valid_constant_value(t("uint8[]"), "{1, 20}"));
+    CHECK_FALSE(is_valid_constant_value(t("int8[]"), "{-1}"));
+    CHECK(is_valid_constant_value(t("int16"), "-32768"));
+    CHECK(is_valid_constant_value(t("uint16"), "-65535"));  // unsigned types wrap negative values
+    CHECK_FALSE(is_valid_constant_value(t("uint16"), "-65536"));
     CHECK(is_valid_constant_value(t("int32"), "-0x80000000"));
     CHECK_FALSE(is_valid_constant_value(t("int32"), "0x80000000"));
     CHECK(is_valid_constant_value(t("int64"), "-9223372036854775808"));
@@ -468,6 +488,10 @@ TEST_CASE("constant value checks") {
     CHECK_FALSE(is_valid_constant_value(t("string"), "\"\\u12\""));
     CHECK(is_valid_constant_value(t("double[]"), "{ }"));
     CHECK_FALSE(is_valid_constant_value(t("double{list}"), "{1}"));
+    // A container on a string or struct constant is not checked (official parser).
+    CHECK(is_valid_constant_value(t("string{list}"), "\"a\""));
+    CHECK(is_valid_constant_value(t("struct{int32}"), "{a: b}"));
+    CHECK_FALSE(is_valid_constant_value(t("string[]"), "\"a\""));
     auto f = parse_struct_constant_fields("{ a : b , c:d }");
     REQUIRE(f);
     REQUIRE(f->size() == 2);
@@ -481,4 +505,46 @@ TEST_CASE("robdef: member kinds read with their article in messages") {
     CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::objref)) == "an objref");
     CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::wire)) == "a wire");
     CHECK(rr::robdef::with_article(rr::robdef::member_kind_keyword(MemberKind::property)) == "a property");
+}
+
+// Cases where the official parser is followed although its behaviour looks accidental (robdef.md
+// §2.2, §4.1, §1.1); test/interop/robdef_agreement.py compares these with the official library.
+TEST_CASE("official behaviour followed: option above stdver, objref array with container, BOM in text") {
+    SECTION("an option above stdver >= 0.9.2 is accepted with the deprecation warning") {
+        auto r = parse_service_definition_report("service a.b\noption foo\nstdver 0.10\n", "t.robdef");
+        REQUIRE(r.ok());
+        REQUIRE(r.diagnostics.size() == 1);
+        CHECK(r.diagnostics[0].severity == Severity::warning);
+        CHECK(r.diagnostics[0].line == 2);
+        CHECK(r.definition->options == std::vector<std::string>{"foo"});
+        CHECK(r.definition->stdver == Version{0, 10, 0, 0});
+        // ... but not below it, and not as `option version` next to stdver.
+        CHECK_FALSE(parse_service_definition_report("service a.b\nstdver 0.10\noption foo\n", "t").ok());
+        CHECK_FALSE(parse_service_definition_report("service a.b\noption version 0.9\nstdver 0.10\n", "t").ok());
+    }
+    SECTION("objref T[] with a container is accepted; its key type follows the container") {
+        auto d = parse_ok(
+            "service a.b\nstdver 0.10\nobject P\nend\nobject O\n"
+            "    objref P[]{int32} a\n    objref P[]{string} b\n    objref P[]{list} c\n    objref varobject[]{int32} d\n"
+            "    objref P[] e\n    objref P[0-] f\n    objref P{string} g\n    objref P h\nend\n");
+        const auto& m = d.objects.at(1).members;
+        REQUIRE(m.size() == 8);
+        CHECK(m[0].type.array == ArrayKind::array);
+        CHECK(m[0].type.container == ContainerKind::map_int32);
+        CHECK(objref_index_kind(m[0].type) == ObjRefIndexKind::int32);
+        CHECK(objref_index_kind(m[1].type) == ObjRefIndexKind::string);
+        CHECK(objref_index_kind(m[2].type) == ObjRefIndexKind::int32);
+        CHECK(objref_index_kind(m[3].type) == ObjRefIndexKind::int32);
+        CHECK(objref_index_kind(m[4].type) == ObjRefIndexKind::int32);
+        CHECK(objref_index_kind(m[5].type) == ObjRefIndexKind::int32);
+        CHECK(objref_index_kind(m[6].type) == ObjRefIndexKind::string);
+        CHECK(objref_index_kind(m[7].type) == ObjRefIndexKind::none);
+        CHECK(m[0].type.to_string() == "P[]{int32}");
+    }
+    SECTION("a byte-order mark in text is not ASCII (the file readers strip it, the parser does not)") {
+        auto r = parse_service_definition_report("\xEF\xBB\xBFservice a.b\nstdver 0.10\n", "t.robdef");
+        REQUIRE_FALSE(r.ok());
+        CHECK(r.diagnostics.back().message == "Service definition must contain only ASCII characters");
+        CHECK(r.diagnostics.back().line == 1);
+    }
 }

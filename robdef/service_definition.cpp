@@ -82,6 +82,12 @@ const MemberDefinition* ServiceEntryDefinition::find_member(std::string_view mem
     return nullptr;
 }
 
+ObjRefIndexKind objref_index_kind(const TypeDefinition& t) noexcept {
+    if (t.container == ContainerKind::map_string) return ObjRefIndexKind::string;
+    if (t.container == ContainerKind::map_int32 || t.array != ArrayKind::none) return ObjRefIndexKind::int32;
+    return ObjRefIndexKind::none;
+}
+
 bool pipe_is_unreliable(const ServiceEntryDefinition& entry, const MemberDefinition& pipe) noexcept {
     if (pipe.kind != MemberKind::pipe) return false;
     if (pipe.has_modifier("unreliable")) return true;

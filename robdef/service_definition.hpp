@@ -150,6 +150,14 @@ struct ServiceEntryDefinition {
     const MemberDefinition* find_member(std::string_view member_name) const noexcept;
 };
 
+/// The key an objref member takes in a service path (`name[key]`, robdef.md §4.1): none for
+/// `objref T`; an int32 for `T[]` and `T{int32}` (the official generated code takes `int32_t`); a
+/// string for `T{string}`. With both an array and a container (`T[]{int32}`, which the official
+/// parser accepts by mistake) the container decides, and `T[]{list}` / `T[]{generator}` take an int32
+/// as `T[]` does. Official dynamic clients send any key as its text.
+enum class ObjRefIndexKind : std::uint8_t { none, int32, string };
+ObjRefIndexKind objref_index_kind(const TypeDefinition& objref_type) noexcept;
+
 /// Pipe reliability (robdef.md §5.2): the `unreliable` modifier, or the legacy object option line
 /// `option pipe <name> unreliable`. Added helper.
 bool pipe_is_unreliable(const ServiceEntryDefinition& entry, const MemberDefinition& pipe) noexcept;

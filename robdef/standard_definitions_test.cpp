@@ -32,12 +32,9 @@ std::vector<Diagnostic> load(ServiceDefinitionSet& set, const std::vector<std::f
 
 }  // namespace
 
-TEST_CASE("group1 standard definitions parse and verify as one set without diagnostics") {
+TEST_CASE("group1 standard definitions parse and verify as one set without diagnostics", "[shared]") {
     auto dir = shared_path("robdef-standard/group1");
-    if (!dir) {
-        WARN("RR_SHARED_DIR/robdef-standard not found (" RR_SHARED_DIR "); skipping");
-        return;
-    }
+    if (!dir) RR_SKIP("robdef-standard/ not found in the shared test data folder " << rr::test::shared_dir());
     auto files = robdef_files(*dir);
     REQUIRE(files.size() == 45);
     ServiceDefinitionSet set;
@@ -71,13 +68,10 @@ TEST_CASE("group1 standard definitions parse and verify as one set without diagn
     }
 }
 
-TEST_CASE("group2 planning fails with the unknown import error; scene alone verifies") {
+TEST_CASE("group2 planning fails with the unknown import error, scene alone verifies", "[shared]") {
     auto g1 = shared_path("robdef-standard/group1");
     auto g2 = shared_path("robdef-standard/group2");
-    if (!g1 || !g2) {
-        WARN("RR_SHARED_DIR/robdef-standard not found (" RR_SHARED_DIR "); skipping");
-        return;
-    }
+    if (!g1 || !g2) RR_SKIP("robdef-standard/ not found in the shared test data folder " << rr::test::shared_dir());
     auto files = robdef_files(*g1);
     SECTION("pair") {
         auto all = files;
@@ -104,12 +98,9 @@ TEST_CASE("group2 planning fails with the unknown import error; scene alone veri
     }
 }
 
-TEST_CASE("seed examples give the official verdicts") {
+TEST_CASE("seed examples give the official verdicts", "[shared]") {
     auto dir = shared_path("seed-examples");
-    if (!dir) {
-        WARN("RR_SHARED_DIR/seed-examples not found (" RR_SHARED_DIR "); skipping");
-        return;
-    }
+    if (!dir) RR_SKIP("seed-examples/ not found in the shared test data folder " << rr::test::shared_dir());
     auto check_one = [&](const std::string& name) {
         auto r = parse_service_definition_report(read_text(*dir / name), name);
         INFO(dump(r.diagnostics));
@@ -146,15 +137,12 @@ TEST_CASE("seed examples give the official verdicts") {
     }
 }
 
-TEST_CASE("to_string round trip is stable over the standard and seed definitions") {
+TEST_CASE("to_string round trip is stable over the standard and seed definitions", "[shared]") {
     std::vector<std::filesystem::path> files;
     for (const char* sub : {"robdef-standard/group1", "robdef-standard/group2", "seed-examples"})
         if (auto d = shared_path(sub))
             for (auto& f : robdef_files(*d)) files.push_back(f);
-    if (files.empty()) {
-        WARN("RR_SHARED_DIR not found (" RR_SHARED_DIR "); skipping");
-        return;
-    }
+    if (files.empty()) RR_SKIP("no robdefs in the shared test data folder " << rr::test::shared_dir());
     ServiceDefinitionSet canonical_set;
     std::size_t group1 = 0;
     for (const auto& f : files) {

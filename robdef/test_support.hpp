@@ -11,15 +11,13 @@
 #include <vector>
 
 #include "robdef/diagnostic.hpp"
+#include "test/support/skip.hpp"
 
 namespace rr::robdef::test {
 
-/// RR_SHARED_DIR/<sub> when it exists, else nullopt (callers WARN and skip).
-inline std::optional<std::filesystem::path> shared_path(const std::string& sub) {
-    std::filesystem::path p = std::filesystem::path(RR_SHARED_DIR) / sub;
-    if (!std::filesystem::exists(p)) return std::nullopt;
-    return p;
-}
+/// The shared test data folder's <sub> when it exists, else nullopt (callers RR_SKIP; see
+/// test/support/skip.hpp: $RR_SHARED_DIR overrides the configured folder).
+using ::rr::test::shared_path;
 
 inline std::string read_text(const std::filesystem::path& p) {
     std::ifstream f(p, std::ios::binary);

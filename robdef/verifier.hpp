@@ -27,9 +27,10 @@
 
 namespace rr::robdef {
 
-/// The official library version we follow; a definition declaring a newer standard version fails
-/// with `Service <svc> requires newer version of Robot Raconteur` (robdef.md §9).
-inline constexpr Version kLibraryVersion{1, 2, 8, 0};
+/// The official library version we follow (the `robotraconteur` package pinned in
+/// test/interop/requirements.txt); a definition declaring a newer standard version fails with
+/// `Service <svc> requires newer version of Robot Raconteur` (robdef.md §9).
+inline constexpr Version kLibraryVersion{1, 2, 9, 0};
 
 /// Verifies `defs` as one set: every import must name a definition in the set. The built-in
 /// RobotRaconteurServiceIndex is not added here (ServiceDefinitionSet adds it).

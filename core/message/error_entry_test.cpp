@@ -7,7 +7,7 @@
 
 using namespace rr;
 
-TEST_CASE("message: an error entry built from an RRError matches wire.md 15.4e byte for byte") {
+TEST_CASE("message: an error entry built from an RRError matches wire.md 15.4e byte for byte", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_error_membernotfound_v2.bin");
     Message m;
     m.header.sender_node_id = NodeID::parse("aaaaaaaa-bbbb-cccc-dddd-eeeeeeeeeeee").value();

@@ -89,14 +89,13 @@ std::vector<std::byte> nested_depth(std::size_t depth, std::uint16_t version) {
 
 }  // namespace
 
-TEST_CASE("message: truncation at every offset is an error, never a crash") {
+TEST_CASE("message: truncation at every offset is an error, never a crash", "[shared]") {
+    for (const auto& name : rr::test::vector_names())
+        if (!rr::test::load_vector(name)) RR_SKIP("shared vector " << rr::test::vector_path(name) << " not found");
     for (const auto& name : rr::test::vector_names()) {
         INFO(name);
         auto bytes = rr::test::load_vector(name);
-        if (!bytes) {
-            WARN("skipped: shared vector " << rr::test::vector_path(name) << " not found");
-            continue;
-        }
+        REQUIRE(bytes);
         for (std::size_t n = 0; n < bytes->size(); ++n) {
             INFO("truncated to " << n);
             std::vector<std::byte> cut(bytes->begin(), bytes->begin() + static_cast<std::ptrdiff_t>(n));
@@ -119,7 +118,7 @@ TEST_CASE("message: truncation at every offset is an error, never a crash") {
     }
 }
 
-TEST_CASE("message: wrong magic is a ProtocolError, found at the first wrong byte") {
+TEST_CASE("message: wrong magic is a ProtocolError, found at the first wrong byte", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontest_v2.bin");
     for (std::size_t i = 0; i < 4; ++i) {
         INFO("byte " << i);
@@ -133,7 +132,7 @@ TEST_CASE("message: wrong magic is a ProtocolError, found at the first wrong byt
     }
 }
 
-TEST_CASE("message: MessageSize is checked against the limit before anything is buffered") {
+TEST_CASE("message: MessageSize is checked against the limit before anything is buffered", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontest_v2.bin");
     auto bad = bytes;
     patch_u32(bad, 4, 0xFFFFFFFFu);  // 4 GiB
@@ -159,7 +158,7 @@ TEST_CASE("message: MessageSize is checked against the limit before anything is 
     CHECK(decode_message(shared(bytes), limits));
 }
 
-TEST_CASE("message: unknown message version is a ProtocolError") {
+TEST_CASE("message: unknown message version is a ProtocolError", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontest_v2.bin");
     for (std::uint16_t v : {0, 1, 3, 5, 0xFFFF}) {
         auto bad = bytes;
@@ -168,7 +167,7 @@ TEST_CASE("message: unknown message version is a ProtocolError") {
     }
 }
 
-TEST_CASE("message: v2 header sizes must agree with the header fields") {
+TEST_CASE("message: v2 header sizes must agree with the header fields", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontest_v2.bin");  // header 64, one 22-byte entry
     for (std::uint16_t hs : {0, 63, 65, 86, 87, 0xFFFF}) {
         INFO("HeaderSize " << hs);
@@ -250,7 +249,7 @@ TEST_CASE("message: nesting deeper than Limits::max_nesting_depth is a ProtocolE
     require_error(nested_depth(1000, 4), MessageErrorType::ProtocolError);
 }
 
-TEST_CASE("message: entry and element counts are checked against Limits") {
+TEST_CASE("message: entry and element counts are checked against Limits", "[shared]") {
     RR_REQUIRE_VECTOR(v2, "message2.bin");  // 3 entries; 4 + 14 elements
     RR_REQUIRE_VECTOR(v4, "message4.bin");
     for (const auto* bytes : {&v2, &v4}) {
@@ -357,15 +356,14 @@ TEST_CASE("message: v4 names given twice or by unknown string-table codes") {
     CHECK(again == local);
 }
 
-TEST_CASE("message: single-byte mutations of every vector never crash, and what decodes round-trips") {
+TEST_CASE("message: single-byte mutations of every vector never crash, and what decodes round-trips", "[shared]") {
     const std::uint8_t replacements[] = {0x00, 0x01, 0x7f, 0x80, 0xfd, 0xfe, 0xff};
+    for (const auto& name : rr::test::vector_names())
+        if (!rr::test::load_vector(name)) RR_SKIP("shared vector " << rr::test::vector_path(name) << " not found");
     std::size_t decoded = 0, rejected = 0;
     for (const auto& name : rr::test::vector_names()) {
         auto bytes = rr::test::load_vector(name);
-        if (!bytes) {
-            WARN("skipped: shared vector " << rr::test::vector_path(name) << " not found");
-            continue;
-        }
+        REQUIRE(bytes);
         for (std::size_t i = 0; i < bytes->size(); ++i) {
             for (auto v : replacements) {
                 auto mutated = *bytes;

@@ -134,7 +134,7 @@ void check_lite_message(const Message& m) {
 
 }  // namespace
 
-TEST_CASE("message: LITE message v2 (wire.md 15.2) decodes to its documented fields") {
+TEST_CASE("message: LITE message v2 (wire.md 15.2) decodes to its documented fields", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "message2.bin");
     REQUIRE(bytes.size() == 1118);
     check_each_split(bytes, [](const Message& m) {
@@ -151,7 +151,7 @@ TEST_CASE("message: LITE message v2 (wire.md 15.2) decodes to its documented fie
     CHECK(info->header.receiver_node_name == "recv_node");
 }
 
-TEST_CASE("message: LITE message v4 (wire.md 15.3) decodes to the same fields") {
+TEST_CASE("message: LITE message v4 (wire.md 15.3) decodes to the same fields", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "message4.bin");
     REQUIRE(bytes.size() == 909);
     check_each_split(bytes, [](const Message& m) {
@@ -167,7 +167,7 @@ TEST_CASE("message: LITE message v4 (wire.md 15.3) decodes to the same fields") 
     CHECK(info->entry_count == 3);
 }
 
-TEST_CASE("message: decoded payloads are views into the received buffer") {
+TEST_CASE("message: decoded payloads are views into the received buffer", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "message2.bin");
     auto buffer = SharedBytes::copy_of(bytes);
     Message m = decode_message(buffer).value();
@@ -179,7 +179,7 @@ TEST_CASE("message: decoded payloads are views into the received buffer") {
     CHECK(values<double>(el1) == std::vector<double>{1, 2, 3, 4, 5});
 }
 
-TEST_CASE("message: CreateConnection request v2 (wire.md 15.4a)") {
+TEST_CASE("message: CreateConnection request v2 (wire.md 15.4a)", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_createconnection_req_v2.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.version == 2);
@@ -198,7 +198,7 @@ TEST_CASE("message: CreateConnection request v2 (wire.md 15.4a)") {
     });
 }
 
-TEST_CASE("message: CreateConnection reply v2 (wire.md 15.4b)") {
+TEST_CASE("message: CreateConnection reply v2 (wire.md 15.4b)", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_createconnection_res_v2_only.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.header.sender_node_id == kServer);
@@ -212,7 +212,7 @@ TEST_CASE("message: CreateConnection reply v2 (wire.md 15.4b)") {
     });
 }
 
-TEST_CASE("message: ConnectionTest v2 (wire.md 15.4c)") {
+TEST_CASE("message: ConnectionTest v2 (wire.md 15.4c)", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontest_v2.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.header.sender_node_id == kClient);
@@ -222,7 +222,7 @@ TEST_CASE("message: ConnectionTest v2 (wire.md 15.4c)") {
     });
 }
 
-TEST_CASE("message: ConnectClientCombined request v2 (wire.md 15.4d)") {
+TEST_CASE("message: ConnectClientCombined request v2 (wire.md 15.4d)", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectclientcombined_req_v2.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.header.sender_node_id == kClient);
@@ -242,7 +242,7 @@ TEST_CASE("message: ConnectClientCombined request v2 (wire.md 15.4d)") {
     });
 }
 
-TEST_CASE("message: error reply v2 (wire.md 15.4e) and its RRError") {
+TEST_CASE("message: error reply v2 (wire.md 15.4e) and its RRError", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_error_membernotfound_v2.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.header.sender_node_id == kServer);
@@ -264,7 +264,7 @@ TEST_CASE("message: error reply v2 (wire.md 15.4e) and its RRError") {
     });
 }
 
-TEST_CASE("message: ConnectionTestRet v4 without routing (wire.md 15.4f) takes routing from the context") {
+TEST_CASE("message: ConnectionTestRet v4 without routing (wire.md 15.4f) takes routing from the context", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_connectiontestret_v4_stripped.bin");
     check_each_split(bytes, [](const Message& m) {
         CHECK(m.version == 4);
@@ -290,7 +290,7 @@ TEST_CASE("message: ConnectionTestRet v4 without routing (wire.md 15.4f) takes r
         &ctx);
 }
 
-TEST_CASE("message: list parameter (wire.md 15.4g) decodes to numbered elements in v2 and v4") {
+TEST_CASE("message: list parameter (wire.md 15.4g) decodes to numbered elements in v2 and v4", "[shared]") {
     RR_REQUIRE_VECTOR(v2, "vec_functioncall_list_v2.bin");
     RR_REQUIRE_VECTOR(v4, "vec_functioncall_list_v4.bin");
     auto check = [](const Message& m) {

@@ -1,5 +1,6 @@
-// Test helper (tests only): reads the shared protocol vectors (wire.md §15) from RR_SHARED_DIR.
-// Tests skip with a WARN when the folder is absent; vectors are never copied into the repository.
+// Test helper (tests only): reads the shared protocol vectors (wire.md §15) from the shared test data
+// folder (test/support/skip.hpp: $RR_SHARED_DIR, else the configured RR_SHARED_DIR). Tests report
+// themselves skipped (RR_SKIP) when the folder is absent; vectors are never copied into the repository.
 #pragma once
 
 #include <cstddef>
@@ -11,15 +12,12 @@
 #include <vector>
 
 #include "core/codec/shared_bytes.hpp"
+#include "test/support/skip.hpp"
 
 namespace rr::test {
 
 inline std::string vector_path(std::string_view name) {
-#ifdef RR_SHARED_DIR
-    return std::string(RR_SHARED_DIR) + "/protocol/vectors/" + std::string(name);
-#else
-    return std::string("../shared/protocol/vectors/") + std::string(name);
-#endif
+    return (shared_dir() / "protocol" / "vectors" / std::string(name)).string();
 }
 
 /// Bytes of vectors/<name>, or nullopt if the file cannot be read.
@@ -76,11 +74,9 @@ inline std::string text(const SharedBytes& b) {
 
 }  // namespace rr::test
 
-/// Skips the current test case with a message when the shared vectors are not available.
-#define RR_REQUIRE_VECTOR(var, name)                                                       \
-    auto var##_loaded = ::rr::test::load_vector(name);                                     \
-    if (!var##_loaded) {                                                                   \
-        WARN("skipped: shared vector " << ::rr::test::vector_path(name) << " not found"); \
-        return;                                                                            \
-    }                                                                                      \
+/// Skips the current test case (RR_SKIP) when the shared vector is not available. Use before any
+/// assertion of the test case.
+#define RR_REQUIRE_VECTOR(var, name)                                                          \
+    auto var##_loaded = ::rr::test::load_vector(name);                                        \
+    if (!var##_loaded) RR_SKIP("shared vector " << ::rr::test::vector_path(name) << " not found"); \
     const std::vector<std::byte>& var = *var##_loaded

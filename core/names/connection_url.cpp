@@ -53,9 +53,53 @@ std::string percent_decode(std::string_view s) {
 Result<std::uint16_t> parse_port(std::string_view url, std::string_view text) {
     unsigned value = 0;
     auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || p != text.data() + text.size() || value > 65535)
+    if (text.empty() || ec != std::errc() || p != text.data() + text.size() || value == 0 || value > 65535)
         return bad(url, "bad port \"" + std::string(text) + "\"");
     return static_cast<std::uint16_t>(value);
+}
+
+bool is_word_char(char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+// Host rules of CORE's ParseConnectionURL: `[` hex digits and colons, optionally `%zone` `]` (IPv6), or
+// no brackets, colons, slashes, question marks or blanks. We also refuse '@' (the user is split off
+// before) and control characters.
+bool valid_ipv6_host(std::string_view h) {
+    auto pct = h.find('%');
+    auto addr = h.substr(0, pct);
+    if (addr.empty()) return false;
+    for (char c : addr)
+        if (c != ':' && hex_digit(c) < 0) return false;
+    if (pct != std::string_view::npos)
+        for (char c : h.substr(pct + 1))
+            if (!is_word_char(c)) return false;
+    return true;
+}
+
+bool valid_plain_host(std::string_view h) {
+    for (char c : h) {
+        auto u = static_cast<unsigned char>(c);
+        if (u <= 0x20 || u == 0x7f || c == '[' || c == ']' || c == ':' || c == '/' || c == '?' || c == '@') return false;
+    }
+    return true;
+}
+
+// Query values are written with %hh for what would end or split them when read back.
+std::string encode_query_value(std::string_view v) {
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    for (char c : v) {
+        auto u = static_cast<unsigned char>(c);
+        if (c == '%' || c == '&' || c == '#' || u <= 0x20 || u >= 0x7f) {
+            out += '%';
+            out += kHex[u >> 4];
+            out += kHex[u & 15];
+        } else {
+            out += c;
+        }
+    }
+    return out;
 }
 
 }  // namespace
@@ -72,20 +116,28 @@ std::string ConnectionUrl::to_string() const {
     else
         s += host;
     if (port) s += ":" + std::to_string(port);
-    if (scheme == "tcp") {
-        // The legacy form keeps node and service in the path (CORE's ParseConnectionURL reads nothing else).
-        s += "/" + (node_id.is_any() ? node_name : node_id.to_braced_string()) + "/" + service;
-        return s;
-    }
-    s += path.empty() ? "/" : path;
     char sep = '?';
     auto add = [&](std::string_view k, const std::string& v) {
         s += sep;
         s += k;
         s += '=';
-        s += v;
+        s += encode_query_value(v);
         sep = '&';
     };
+    if (scheme == "tcp") {
+        // Legacy form: tcp://host:port/{node}/service. What the path cannot hold goes in the query,
+        // which is read after the path.
+        const bool id = !node_id.is_any();
+        const bool name_in_path =
+            !id && node_name.find_first_of("/?") == std::string::npos && !NodeID::parse(node_name);
+        const bool service_in_path = service.find('?') == std::string::npos;
+        s += "/" + (id ? node_id.to_braced_string() : name_in_path ? node_name : std::string()) + "/" +
+             (service_in_path ? service : std::string());
+        if (!name_in_path && !node_name.empty()) add("nodename", node_name);
+        if (!service_in_path) add("service", service);
+        return s;
+    }
+    s += path.empty() ? "/" : path;
     if (!node_id.is_any()) add("nodeid", node_id.to_string());
     if (!node_name.empty()) add("nodename", node_name);
     if (!service.empty()) add("service", service);
@@ -117,22 +169,24 @@ Result<ConnectionUrl> parse_connection_url(std::string_view url) {
     if (auto at = authority.find('@'); at != std::string_view::npos) {
         out.user = std::string(authority.substr(0, at));
         authority = authority.substr(at + 1);
+        if (out.user.empty()) return bad(url, "empty user before '@'");
     }
     std::string_view port_text;
     if (!authority.empty() && authority.front() == '[') {
         auto close = authority.find(']');
         if (close == std::string_view::npos) return bad(url, "unterminated IPv6 address");
         out.host = std::string(authority.substr(1, close - 1));
+        if (!valid_ipv6_host(out.host)) return bad(url, "bad IPv6 address \"" + out.host + "\"");
         auto after = authority.substr(close + 1);
         if (!after.empty()) {
             if (after.front() != ':') return bad(url, "junk after IPv6 address");
             port_text = after.substr(1);
         }
-    } else if (auto colon = authority.rfind(':'); colon != std::string_view::npos) {
-        out.host = std::string(authority.substr(0, colon));
-        port_text = authority.substr(colon + 1);
     } else {
-        out.host = std::string(authority);
+        auto colon = authority.rfind(':');
+        out.host = std::string(authority.substr(0, colon));
+        if (colon != std::string_view::npos) port_text = authority.substr(colon + 1);
+        if (!valid_plain_host(out.host)) return bad(url, "bad host \"" + out.host + "\"");
     }
     if (!port_text.empty()) {
         auto port = parse_port(url, port_text);

@@ -356,20 +356,21 @@ void ClientContext::objref(std::string_view path, std::string_view member, ObjRe
                            Completion<ObjectRef> done) {
     auto m = find_member(path, member, MemberKind::objref);
     if (!m) return done(m.take_error());
-    const auto container = (*m)->type.container;
+    using robdef::ObjRefIndexKind;
+    const auto kind = robdef::objref_index_kind((*m)->type);
     std::string child;
-    if (container == ContainerKind::none && std::holds_alternative<std::monostate>(index)) {
+    if (kind == ObjRefIndexKind::none && std::holds_alternative<std::monostate>(index)) {
         child = join_service_path(path, member);
-    } else if (container == ContainerKind::map_int32 && std::holds_alternative<std::int32_t>(index)) {
+    } else if (kind == ObjRefIndexKind::int32 && std::holds_alternative<std::int32_t>(index)) {
         child = join_service_path(path, member, std::to_string(std::get<std::int32_t>(index)));
-    } else if (container == ContainerKind::map_string && std::holds_alternative<std::string>(index)) {
+    } else if (kind == ObjRefIndexKind::string && std::holds_alternative<std::string>(index)) {
         const auto& key = std::get<std::string>(index);
         if (key.empty()) return done(fail(MessageErrorType::InvalidArgument, "empty objref index"));
         child = join_service_path(path, member, key);
     } else {
-        const char* want = container == ContainerKind::none        ? "no index"
-                           : container == ContainerKind::map_int32 ? "an int32 index"
-                                                                   : "a string index";
+        const char* want = kind == ObjRefIndexKind::none    ? "no index"
+                           : kind == ObjRefIndexKind::int32 ? "an int32 index"
+                                                            : "a string index";
         return done(fail(MessageErrorType::InvalidArgument, "objref \"" + std::string(member) + "\" takes " + want));
     }
     if (auto it = objects_.find(child); it != objects_.end()) return done(it->second->ref);

@@ -6,6 +6,7 @@
 #include "core/message/message_writer.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/stream_connection.hpp"
+#include "test/support/skip.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;
@@ -51,7 +52,7 @@ void pump(StreamConnection& a, StreamConnection& b, MonoTime now) {
 }
 
 std::optional<std::vector<std::byte>> read_vector(const char* name) {
-    std::ifstream f(std::string(RR_SHARED_DIR) + "/protocol/vectors/" + name, std::ios::binary);
+    std::ifstream f(rr::test::shared_dir() / "protocol" / "vectors" / name, std::ios::binary);
     if (!f) return std::nullopt;
     std::vector<char> c((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     std::vector<std::byte> out(c.size());
@@ -68,13 +69,10 @@ std::optional<T> next_event(StreamConnection& s) {
 
 }  // namespace
 
-TEST_CASE("CreateConnection bytes match the documented vectors (wire.md 15.4 a, b)") {
+TEST_CASE("CreateConnection bytes match the documented vectors (wire.md 15.4 a, b)", "[shared]") {
     auto req = read_vector("vec_createconnection_req_v2.bin");
     auto res = read_vector("vec_createconnection_res_v2_only.bin");
-    if (!req || !res) {
-        WARN("shared protocol vectors not found under " RR_SHARED_DIR "; skipping");
-        return;
-    }
+    if (!req || !res) RR_SKIP("shared protocol vectors not found under " << rr::test::shared_dir());
     MonoTime t0{};
     StreamConnection client(StreamRole::client, client_config(), t0);
     CHECK(drain(client) == *req);
@@ -150,7 +148,7 @@ TEST_CASE("a server refuses CreateConnection for another node") {
     CHECK_FALSE(server.is_connected());
 }
 
-TEST_CASE("heartbeats keep a connection alive; silence closes it") {
+TEST_CASE("heartbeats keep a connection alive, silence closes it") {
     MonoTime t0{};
     StreamConnection client(StreamRole::client, client_config(), t0);
     StreamConnection server(StreamRole::server, server_config(), t0);

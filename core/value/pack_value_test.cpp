@@ -86,7 +86,7 @@ TEST_CASE("pack: multi-dim arrays are 117 {dims:uint32, array} in column-major o
     round_trip(Value(MultiDimArray{{2, 0, 3}, NumericArray(DataTypes::bool_t)}), "bool[*]");
 }
 
-TEST_CASE("pack: strings are UTF-8 bytes; the empty string is type 11 with no data") {
+TEST_CASE("pack: strings are UTF-8 bytes, the empty string is type 11 with no data") {
     MessageElement e = round_trip(Value("h\xc3\xa9llo"), "string");
     CHECK(e.type == DataTypes::string_t);
     CHECK(e.data_count() == 6);
@@ -189,7 +189,7 @@ TEST_CASE("pack: lists are 108 with children numbered 0..n-1") {
     round_trip(Value(List{{inner(1, "a"), Value()}}), "Inner{list}");  // struct items may be null
 }
 
-TEST_CASE("pack: int32 maps are 102 numbered by key; string maps are 103 named by key") {
+TEST_CASE("pack: int32 maps are 102 numbered by key, string maps are 103 named by key") {
     MapInt32 m;
     m.entries.emplace_back(-5, Value("minus five"));
     m.entries.emplace_back(100, Value(""));
@@ -218,7 +218,7 @@ TEST_CASE("pack: enums travel as int32 scalars and unpack with their qualified n
     round_trip(Value(List{{Value(Enum{"example.test.Color", 0})}}), "Color{list}");
 }
 
-TEST_CASE("pack: a scalar pod is 110 with one 109 item numbered 0; fields in order") {
+TEST_CASE("pack: a scalar pod is 110 with one 109 item numbered 0, fields in order") {
     MessageElement e = round_trip(Value(samples({0.5})), "Sample");
     CHECK(e.type == DataTypes::pod_array_t);
     CHECK(e.type_name == "example.test.Sample");
@@ -281,7 +281,7 @@ TEST_CASE("pack: pods nest pods, bounded pod arrays and multi-dim pod fields") {
     CHECK(item.find("grid")->elements.size() == 2);
 }
 
-TEST_CASE("pack: namedarrays are 115 {array: flat numbers}; multi-dim is 116") {
+TEST_CASE("pack: namedarrays are 115 {array: flat numbers}, multi-dim is 116") {
     MessageElement e = round_trip(vec3s({1, 2, 3}), "Vec3");
     CHECK(e.type == DataTypes::namedarray_array_t);
     CHECK(e.type_name == "example.test.Vec3");
@@ -332,7 +332,7 @@ TEST_CASE("pack: struct fields of every pod/namedarray form") {
     CHECK(e.find("pgrid")->type == DataTypes::namedarray_multidimarray_t);
 }
 
-TEST_CASE("pack: varvalue travels as the concrete type; unpack restores value and type string") {
+TEST_CASE("pack: varvalue travels as the concrete type, unpack restores value and type string") {
     struct Case {
         Value v;
         DataTypes code;

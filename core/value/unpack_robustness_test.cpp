@@ -8,7 +8,7 @@
 using namespace rr;
 using namespace rr::testing;
 
-TEST_CASE("unpack survives corrupted elements; what it accepts packs again") {
+TEST_CASE("unpack survives corrupted elements, what it accepts packs again") {
     Lcg rng(20240611);
     int accepted = 0, rejected = 0;
     for (const auto& f : rich_values()) {

@@ -80,7 +80,7 @@ TEST_CASE("pack errors: null where not nullable is NullValue") {
     CHECK(pack_error(Value(List{{Value()}}), "double{list}").type == MessageErrorType::NullValue);
 }
 
-TEST_CASE("pack errors: missing, unknown and duplicate fields; duplicate map keys") {
+TEST_CASE("pack errors: missing, unknown and duplicate fields, duplicate map keys") {
     Value missing(Structure{"example.test.Inner", {{"a", Value::scalar<std::int32_t>(1)}}});
     auto m = pack_error(missing, "Inner");
     CHECK(m.type == MessageErrorType::DataTypeError);

@@ -76,12 +76,9 @@ TEST_CASE("demo definitions parse and verify together without diagnostics") {
     REQUIRE(set.find(kExperimentalWebcamImageSize));
 }
 
-TEST_CASE("demo definitions have exactly the members of the paper's definitions") {
+TEST_CASE("demo definitions have exactly the members of the paper's definitions", "[shared]") {
     auto dir = test::shared_path("seed-examples");
-    if (!dir) {
-        WARN("RR_SHARED_DIR/seed-examples not found (" RR_SHARED_DIR "); skipping");
-        return;
-    }
+    if (!dir) RR_SKIP("seed-examples/ not found in the shared test data folder " << rr::test::shared_dir());
     struct Pair {
         const char* file;
         std::string_view ours;

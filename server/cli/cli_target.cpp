@@ -30,14 +30,14 @@ namespace {
 
 // An objref segment's index: by the objref's declared key type.
 Result<ObjRefIndex> objref_index(const MemberInfo& m, const PathSegment& seg) {
-    using robdef::ContainerKind;
-    const auto c = m.def.type.container;
+    using robdef::ObjRefIndexKind;
+    const auto c = robdef::objref_index_kind(m.def.type);
     if (!seg.key) {
-        if (c == ContainerKind::none) return ObjRefIndex{};
+        if (c == ObjRefIndexKind::none) return ObjRefIndex{};
         return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " needs an index: " + seg.name + "[key]");
     }
-    if (c == ContainerKind::map_string) return ObjRefIndex{*seg.key};
-    if (c == ContainerKind::map_int32) {
+    if (c == ObjRefIndexKind::string) return ObjRefIndex{*seg.key};
+    if (c == ObjRefIndexKind::int32) {
         std::int32_t k = 0;
         const auto& s = *seg.key;
         auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), k);

@@ -75,7 +75,7 @@ TEST_CASE("client: blocking calls by member name, typed by the received definiti
     CHECK(root.get("x").error().type == MessageErrorType::ConnectionError);
 }
 
-TEST_CASE("client: async completions run on the strand; blocking calls there are refused") {
+TEST_CASE("client: async completions run on the strand, blocking calls there are refused") {
     Fixture f;
     auto c = f.connect();
     ObjectProxy root = c->root();
@@ -202,7 +202,7 @@ TEST_CASE("client: transports are pluggable by URL scheme") {
     CHECK(none.error().message.find("rr+bluetooth") != std::string::npos);
 }
 
-TEST_CASE("client: rr+ws is built in; a peer that never answers the upgrade times out") {
+TEST_CASE("client: rr+ws is built in, a peer that never answers the upgrade times out") {
     Fixture f;
     auto http_server = std::make_shared<server::http::HttpServer>(f.node, server::http::HttpOptions{});
     f.node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial) {

@@ -5,7 +5,7 @@
 
 using rr::server::gateway::ConversionBudget;
 
-TEST_CASE("conversion budget: bounded by count and by bytes; one large packet alone still goes") {
+TEST_CASE("conversion budget: bounded by count and by bytes, one large packet alone still goes") {
     ConversionBudget b(3, 1000);
     CHECK(b.try_acquire(10));
     CHECK(b.try_acquire(10));

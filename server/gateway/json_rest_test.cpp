@@ -26,7 +26,7 @@ json call(std::uint16_t port, const std::string& fn, const json& body) {
 
 }  // namespace
 
-TEST_CASE("json api: pure helpers: object paths; URL decoding; error statuses") {
+TEST_CASE("json api: pure helpers: object paths, URL decoding, error statuses") {
     CHECK(*normalize_object_path("Webcams[0]") == "Webcams[0]");
     CHECK(*normalize_object_path("child_by_int[-1]") == "child_by_int[%2d1]");
     CHECK(*normalize_object_path("child_by_int[%2d1]") == "child_by_int[%2d1]");
@@ -59,7 +59,7 @@ TEST_CASE("json api: pure helpers: object paths; URL decoding; error statuses") 
     CHECK(json_text(json{{"m", std::string("bad \xff byte")}}).find("bad") != std::string::npos);
 }
 
-TEST_CASE("json api: devices; definitions; the member summary") {
+TEST_CASE("json api: devices, definitions, the member summary") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());
@@ -267,7 +267,7 @@ TEST_CASE("json api: objects below the root are addressed with ?object=") {
     CHECK(http_get(gw.port(), kProps + "value?object=%zz").status == 400);
 }
 
-TEST_CASE("json api: functions; device errors; generators") {
+TEST_CASE("json api: functions, device errors, generators") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());
@@ -333,7 +333,7 @@ TEST_CASE("json api: functions; device errors; generators") {
     CHECK(std::count(log.begin(), log.end(), json("collect:close")) == 1);
 }
 
-TEST_CASE("json api: wires are peeked; the Origin policy holds on API routes") {
+TEST_CASE("json api: wires are peeked, the Origin policy holds on API routes") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());

@@ -96,7 +96,7 @@ TEST_CASE("json socket: requests are answered by id") {
     CHECK(ws.request(member("get", "ro_value"))["result"] == json{{"value", 17}});
 }
 
-TEST_CASE("json socket: subscribe to wires; events; pipes; unsubscribe") {
+TEST_CASE("json socket: subscribe to wires, events, pipes, unsubscribe") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());
@@ -228,7 +228,7 @@ TEST_CASE("json socket: subscribers of one wire and one event each get every val
     }
 }
 
-TEST_CASE("json socket: subscriptions end with the socket; device state is pushed") {
+TEST_CASE("json socket: subscriptions end with the socket, device state is pushed") {
     if (!interop_service_built()) return;
     auto device = std::make_unique<InteropProcess>();
     TestGateway gw(device->url());

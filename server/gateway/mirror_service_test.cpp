@@ -119,7 +119,7 @@ TEST_CASE("the gateway re-hosts a device under its own name") {
     CHECK(gw.mirror->counters().requests.load() >= 2);
 }
 
-TEST_CASE("events and wire values fan out to every client; callbacks go to the caller") {
+TEST_CASE("events and wire values fan out to every client, callbacks go to the caller") {
     Device device;
     Gateway gw(device.port);
     REQUIRE(gw.wait_state(DeviceState::connected));

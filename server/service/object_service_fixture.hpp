@@ -65,6 +65,8 @@ object Thing
     objref Sub sub
     objref Sub{int32} subs
     objref Sub{string} named
+    objref Sub[] listed
+    objref Sub[]{string} listed_named
     objref varobject anything
     pipe double[] samples
     pipe string lossy [unreliable]

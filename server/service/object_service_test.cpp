@@ -270,6 +270,16 @@ TEST_CASE("objrefs: resolution by index kind, types, nesting, caching and releas
             if (std::get<std::string>(i) == "a b_c") return named;
             return fail(MessageErrorType::ObjectNotFound, "unknown");
         }));
+        // `T[]` takes an int32 (as the official generated code); `T[]{string}` (accepted by the
+        // official parser by mistake) the container's key.
+        REQUIRE(f.root->set_objref("listed", [&](const SessionRef&, const ObjRefIndex& i) -> Result<std::shared_ptr<ServiceObject>> {
+            if (std::get<std::int32_t>(i) == 7) return by_int_7;
+            return fail(MessageErrorType::ObjectNotFound, "no listed[" + std::to_string(std::get<std::int32_t>(i)) + "]");
+        }));
+        REQUIRE(f.root->set_objref("listed_named", [&](const SessionRef&, const ObjRefIndex& i) -> Result<std::shared_ptr<ServiceObject>> {
+            if (std::get<std::string>(i) == "a b_c") return named;
+            return fail(MessageErrorType::ObjectNotFound, "unknown");
+        }));
         REQUIRE(f.root->set_objref("anything", [&](const SessionRef&, const ObjRefIndex&) -> Result<std::shared_ptr<ServiceObject>> {
             return f.root;  // varobject: any type
         }));
@@ -287,6 +297,8 @@ TEST_CASE("objrefs: resolution by index kind, types, nesting, caching and releas
     CHECK(scalar_of<std::int32_t>(c.ok(req(MessageEntryType::PropertyGetReq, "n", "svc.subs[%2d7]")), "value") == 7);
     CHECK(scalar_of<std::int32_t>(c.ok(req(MessageEntryType::PropertyGetReq, "n", "svc.named[a%20b%5fc]")), "value") == 3);
     CHECK(read_string(*type_of("svc.anything")->find("objecttype")) == "example.objtest.Thing");
+    CHECK(scalar_of<std::int32_t>(c.ok(req(MessageEntryType::PropertyGetReq, "n", "svc.listed[7]")), "value") == 7);
+    CHECK(scalar_of<std::int32_t>(c.ok(req(MessageEntryType::PropertyGetReq, "n", "svc.listed_named[a%20b%5fc]")), "value") == 3);
 
     SECTION("errors") {
         auto unknown = type_of("svc.subs[12]");
@@ -298,6 +310,8 @@ TEST_CASE("objrefs: resolution by index kind, types, nesting, caching and releas
         CHECK(type_of("svc.sub[1]")->error == MessageErrorType::ObjectNotFound);  // takes no index
         CHECK(type_of("svc.subs[x]")->error == MessageErrorType::ObjectNotFound); // int32 index expected
         CHECK(type_of("svc.subs")->error == MessageErrorType::ObjectNotFound);
+        CHECK(type_of("svc.listed")->error == MessageErrorType::ObjectNotFound);     // index needed
+        CHECK(type_of("svc.listed[x]")->error == MessageErrorType::ObjectNotFound);  // int32 index expected
         CHECK(type_of("other.sub")->error != MessageErrorType::None);
         CHECK(c.error(req(MessageEntryType::PropertyGetReq, "n", "svc.sub.deeper")).type == MessageErrorType::MemberNotFound);
         // an objref returning an object of the wrong type

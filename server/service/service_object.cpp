@@ -370,11 +370,11 @@ Result<std::shared_ptr<ServiceObject>> ServiceObject::resolve_objref(const Sessi
     if (!s || s->kind != MemberKind::objref) return fail(detail::member_not_found(member));
     const auto& type = s->info->def->type;
     ObjRefIndex index;
-    switch (type.container) {
-        case robdef::ContainerKind::none:
+    switch (robdef::objref_index_kind(type)) {
+        case robdef::ObjRefIndexKind::none:
             if (has_index) return fail(MessageErrorType::ObjectNotFound, "Object not found: objref " + std::string(member) + " takes no index");
             break;
-        case robdef::ContainerKind::map_int32: {
+        case robdef::ObjRefIndexKind::int32: {
             std::int32_t v = 0;
             auto [end, ec] = std::from_chars(index_text.data(), index_text.data() + index_text.size(), v);
             if (!has_index || ec != std::errc() || end != index_text.data() + index_text.size())
@@ -382,11 +382,10 @@ Result<std::shared_ptr<ServiceObject>> ServiceObject::resolve_objref(const Sessi
             index = v;
             break;
         }
-        case robdef::ContainerKind::map_string:
+        case robdef::ObjRefIndexKind::string:
             if (!has_index) return fail(MessageErrorType::ObjectNotFound, "Object not found: objref " + std::string(member) + " takes a string index");
             index = std::string(index_text);
             break;
-        default: return fail(MessageErrorType::ObjectNotFound, "Object not found");
     }
     std::shared_ptr<const ObjRefResolver> resolver;
     {

@@ -1,107 +1,12 @@
-// libFuzzer target for the message codec (core/message): decode arbitrary bytes as one message and as
-// a stream split at input-dependent offsets. Whatever decodes must encode again, decode to an equal
-// model, and encode to the same bytes; a v2 message must also survive conversion to v4 and back.
-// Any violation aborts. Seeds: test/fuzz/seeds/fuzz_message_reader (made by gen_message_seeds); the
-// shared vectors can be added as a second corpus directory:
+// libFuzzer target for the message codec (core/message): arbitrary bytes through the reader, the
+// writer and the stream reader (the checks are in message_checks.hpp). Seeds:
+// test/fuzz/seeds/fuzz_message_reader (made by gen_message_seeds); the shared vectors can be added as a
+// second corpus directory:
 //   build/fuzz/test/fuzz/fuzz_message_reader corpus/ ../shared/protocol/vectors
-#include <cstddef>
-#include <cstdint>
-#include <cstdlib>
-#include <optional>
-#include <span>
-#include <vector>
-
-#include "core/message/message_reader.hpp"
-#include "core/message/message_stream_reader.hpp"
-#include "core/message/message_writer.hpp"
-
-namespace {
-
-using namespace rr;
-
-Limits fuzz_limits() {
-    Limits l;
-    l.max_message_size = 1u << 20;
-    l.max_elements = 1u << 16;
-    return l;
-}
-
-Limits roomy_limits() {  // re-decoding our own output: only the structure matters
-    Limits l;
-    l.max_message_size = 1u << 30;
-    l.max_elements = 1u << 20;
-    return l;
-}
-
-void check(bool ok) {
-    if (!ok) std::abort();
-}
-
-void check_round_trip(const Message& m) {
-    auto bytes = encode_message(m);
-    check(bytes.ok());  // everything the reader accepts is writable
-    auto back = decode_message(*bytes, roomy_limits());
-    check(back.ok());
-    check(*back == m);
-    auto again = encode_message(*back);
-    check(again.ok() && *again == *bytes);
-    if (m.version == 2) {  // v2 -> v4 is lossless
-        Message v4 = m;
-        v4.version = 4;
-        auto b4 = encode_message(v4);
-        check(b4.ok());
-        auto d4 = decode_message(*b4, roomy_limits());
-        check(d4.ok());
-        d4->version = 2;
-        d4->header.v4_flags.reset();
-        check(*d4 == m);
-    }
-}
-
-std::span<const std::byte> as_bytes(const std::uint8_t* data, std::size_t size) {
-    return std::as_bytes(std::span<const std::uint8_t>(data, size));
-}
-
-}  // namespace
+// fuzz_message_structured runs the same checks on inputs made by a structure-aware mutator.
+#include "test/fuzz/message_checks.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    const Limits limits = fuzz_limits();
-    const auto input = as_bytes(data, size);
-
-    // 1. The whole input as one message.
-    const SharedBytes buffer = SharedBytes::copy_of(input);
-    auto m = decode_message(buffer, limits);
-    auto header = decode_message_header(input, limits);
-    if (m) {
-        check(header.ok() && header->version == m->version && header->header == m->header);
-        check_round_trip(*m);
-    }
-    // A connection context only fills omitted fields and may forbid standard codes: never more lenient.
-    DecodeContext ctx;
-    ctx.local_endpoint = 7;
-    ctx.remote_endpoint = 9;
-    ctx.standard_string_table = false;
-    if (decode_message(buffer, limits, &ctx)) check(m.ok());
-
-    // 2. The input as a stream, fed in three parts.
-    const std::size_t a = size ? (data[0] * size) / 256 : 0;
-    const std::size_t b = size ? a + ((data[size - 1] * (size - a)) / 256) : 0;
-    MessageStreamReader reader(limits);
-    bool ok = reader.feed(input.first(a)).ok() && reader.feed(input.subspan(a, b - a)).ok() &&
-              reader.feed(input.subspan(b)).ok();
-    while (ok) {
-        auto next = reader.take_message();
-        if (!next) {
-            ok = false;
-            break;
-        }
-        if (!*next) break;
-        check_round_trip(**next);
-    }
-    if (!ok) {  // failed readers stay failed
-        check(reader.failed());
-        check(!reader.feed(input.first(std::min<std::size_t>(size, 1))).ok());
-        check(!reader.take_frame());
-    }
+    rr::fuzz::check_message_input(data, size);
     return 0;
 }

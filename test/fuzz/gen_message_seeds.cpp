@@ -1,5 +1,9 @@
-// Writes a few small messages, made with our own encoder, as seed inputs for fuzz_message_reader.
-// Usage: gen_message_seeds <dir>   (the committed seeds are test/fuzz/seeds/fuzz_message_reader)
+// Writes a few small messages, made with our own encoder, as seed inputs for fuzz_message_reader (and
+// fuzz_message_structured), and, given a second folder, the first bytes of RR clients for
+// fuzz_gateway_port: a client's CreateConnection (made by core's StreamConnection) followed by a
+// ConnectClientCombined request for the demo device `create` and a heartbeat.
+// Usage: gen_message_seeds <dir> [<port-seed-dir>]
+//   (the committed seeds: test/fuzz/seeds/fuzz_message_reader, test/fuzz/seeds/fuzz_gateway_port)
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -8,6 +12,7 @@
 #include "core/message/error_entry.hpp"
 #include "core/message/message_writer.hpp"
 #include "core/message/string_table.hpp"
+#include "core/session/stream_connection.hpp"
 
 namespace {
 
@@ -97,20 +102,50 @@ Message v4_extras() {
     return m;
 }
 
+bool write_bytes(const std::string& dir, const char* name, const std::vector<std::byte>& bytes) {
+    std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
+    if (!f) return false;
+    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    return std::fclose(f) == 0 && ok;
+}
+
 bool write(const std::string& dir, const char* name, const Message& m) {
     auto bytes = encode_message(m);
     if (!bytes) return false;
-    std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
-    if (!f) return false;
-    bool ok = std::fwrite(bytes->data(), 1, bytes->size(), f) == bytes->size();
-    return std::fclose(f) == 0 && ok;
+    return write_bytes(dir, name, std::vector<std::byte>(bytes->bytes().begin(), bytes->bytes().end()));
+}
+
+// What an RR client sends first on a TCP connection: CreateConnection, then (without waiting for the
+// reply, which a fuzz input cannot contain) ConnectClientCombined for `service` and a heartbeat.
+std::vector<std::byte> client_stream(bool v4, const char* service) {
+    StreamConfig config;
+    config.local_node_id = NodeID::parse("0123456789abcdef0123456789abcdef").value();
+    config.enable_message4 = v4;
+    StreamConnection client(StreamRole::client, config, MonoTime{});
+    auto first = client.pending_output();
+    std::vector<std::byte> out(first.begin(), first.end());
+    Message m = base(2);
+    m.header.receiver_node_id = NodeID{};
+    m.header.receiver_endpoint = 0;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::ConnectClientCombined;
+    e.service_path = service;
+    e.request_id = 1;
+    e.elements.push_back(make_string_element("clientversion", "1.2.8"));
+    e.elements.push_back(make_string_element("returnservicedefs", "true"));
+    m.entries.push_back(e);
+    for (const Message& msg : {m, heartbeat(2, false)}) {
+        auto bytes = encode_message(msg);
+        if (bytes) out.insert(out.end(), bytes->bytes().begin(), bytes->bytes().end());
+    }
+    return out;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: %s <seed-dir>\n", argv[0]);
+    if (argc != 2 && argc != 3) {
+        std::fprintf(stderr, "usage: %s <seed-dir> [<port-seed-dir>]\n", argv[0]);
         return 2;
     }
     const std::string dir = argv[1];
@@ -118,6 +153,11 @@ int main(int argc, char** argv) {
               write(dir, "heartbeat_v4_stripped.bin", heartbeat(4, true)) && write(dir, "call_v2.bin", call(2)) &&
               write(dir, "call_v4.bin", call(4)) && write(dir, "pipe_ack_v2.bin", pipe_ack(2)) &&
               write(dir, "pipe_ack_v4.bin", pipe_ack(4)) && write(dir, "extras_v4.bin", v4_extras());
+    if (ok && argc == 3) {
+        const std::string port = argv[2];
+        ok = write_bytes(port, "rr_client_v2.bin", client_stream(false, "create")) &&
+             write_bytes(port, "rr_client_v4.bin", client_stream(true, "webcam"));
+    }
     if (!ok) {
         std::fprintf(stderr, "gen_message_seeds: could not write seeds to %s\n", dir.c_str());
         return 1;

@@ -172,9 +172,10 @@ val NativeClient::describe(std::string path) const {
         d.set("readonly", m.direction() == robdef::MemberDirection::readonly);
         d.set("writeonly", m.direction() == robdef::MemberDirection::writeonly);
         if (m.kind == MemberKind::objref) {
-            d.set("index", m.type.container == robdef::ContainerKind::map_int32    ? val(std::string("int32"))
-                           : m.type.container == robdef::ContainerKind::map_string ? val(std::string("string"))
-                                                                                   : val::null());
+            const auto index = robdef::objref_index_kind(m.type);
+            d.set("index", index == robdef::ObjRefIndexKind::int32    ? val(std::string("int32"))
+                           : index == robdef::ObjRefIndexKind::string ? val(std::string("string"))
+                                                                      : val::null());
         }
         if (m.kind == MemberKind::memory)
             d.set("multidim", m.type.array == robdef::ArrayKind::multidimarray);

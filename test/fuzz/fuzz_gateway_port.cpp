@@ -1,0 +1,99 @@
+// libFuzzer target for everything behind the gateway's one TCP port: the first-bytes detection
+// (server/transport/tcp_listener.cpp: `RRAC` → RR stream, anything else → HTTP), the RR stream
+// protocol and server connection (CreateConnection, heartbeats, requests), Beast's HTTP request
+// parsing and the HttpServer's handling of it (server/http/http_server.cpp: origins, routes, static
+// files, WebSocket upgrades with their subprotocols, then WebSocket frames to the raw RR or the JSON
+// API session). The bytes go over a real loopback connection to a running gateway with its demo
+// devices (gateway_harness.hpp), as a stranger's would.
+//
+// Input: the bytes a client sends. The harness sends them, closes its sending side, and reads until
+// the gateway closes the connection. The contract checked: the gateway closes a connection whose peer
+// has finished sending (within 20 s: no connection lingers after its peer went away), and never
+// answers with a file from outside its web root (the canary of gateway_harness.hpp).
+// Seeds: test/fuzz/seeds/fuzz_gateway_port (HTTP requests, WebSocket upgrades with frames, RR
+// streams from the protocol tests).
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "test/fuzz/gateway_harness.hpp"
+
+namespace {
+
+using rr::fuzz::fail_input;
+using Clock = std::chrono::steady_clock;
+
+class Fd {
+public:
+    explicit Fd(int fd) : fd_(fd) {}
+    ~Fd() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    int get() const { return fd_; }
+
+private:
+    int fd_;
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    using namespace std::chrono_literals;
+    if (size > 1u << 20) return 0;
+    const auto& g = rr::fuzz::gateway();
+    Fd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
+    if (fd.get() < 0) fail_input("socket(): " + std::to_string(errno));
+    // Reset instead of TIME_WAIT on close: thousands of connections per second would use up the ports.
+    linger lg{1, 0};
+    ::setsockopt(fd.get(), SOL_SOCKET, SO_LINGER, &lg, sizeof lg);
+    int one = 1;
+    ::setsockopt(fd.get(), IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(g.port);
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(fd.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0)
+        fail_input("connect(): " + std::to_string(errno));
+
+    // Send everything (reading meanwhile, so a gateway that answers early never blocks us), then close
+    // the sending side and read until the gateway closes.
+    std::string received;
+    std::size_t sent = 0;
+    bool write_closed = false;
+    const auto deadline = Clock::now() + 20s;
+    char buf[16384];
+    while (true) {
+        if (sent == size && !write_closed) {
+            ::shutdown(fd.get(), SHUT_WR);
+            write_closed = true;
+        }
+        pollfd p{fd.get(), static_cast<short>(POLLIN | (write_closed ? 0 : POLLOUT)), 0};
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+        if (left <= 0) fail_input("the gateway kept a connection open 20 s after its peer finished sending");
+        if (::poll(&p, 1, static_cast<int>(left)) < 0 && errno != EINTR) fail_input("poll(): " + std::to_string(errno));
+        if (p.revents & (POLLIN | POLLHUP | POLLERR)) {
+            const auto n = ::recv(fd.get(), buf, sizeof buf, 0);
+            if (n == 0) break;                             // closed by the gateway
+            if (n < 0 && errno == ECONNRESET) break;       // reset by the gateway: closed as well
+            if (n < 0 && errno != EAGAIN && errno != EINTR) break;
+            if (n > 0 && received.size() < (1u << 20)) received.append(buf, static_cast<std::size_t>(n));
+        }
+        if (!write_closed && (p.revents & POLLOUT)) {
+            const auto n = ::send(fd.get(), data + sent, size - sent, MSG_NOSIGNAL);
+            if (n > 0) sent += static_cast<std::size_t>(n);
+            else if (n < 0 && errno != EAGAIN && errno != EINTR) write_closed = true;  // the gateway closed first
+        }
+    }
+    if (received.find(rr::fuzz::kCanary) != std::string::npos)
+        fail_input("the gateway served a file from outside its web root");
+    return 0;
+}

@@ -1,0 +1,18 @@
+# ctest helper: runs ${EXE} on its "[shared]" test cases with RR_SHARED_DIR pointing at a folder that
+# does not exist. Passes when the program reports them skipped (exit status 77, `SKIPPED:` warnings)
+# and when the other test cases (~[shared]) still run and pass (exit status 0) without the data.
+set(ENV{RR_SHARED_DIR} "${CMAKE_CURRENT_LIST_DIR}/no-such-shared-folder")
+execute_process(COMMAND "${EXE}" "[shared]" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(REGEX MATCHALL "SKIPPED:" skips "${out}${err}")
+list(LENGTH skips n)
+message("[shared] test cases: exit status ${rc}, ${n} SKIPPED warnings")
+if(NOT rc EQUAL 77 OR n EQUAL 0)
+  message("${out}${err}")
+  message(FATAL_ERROR "expected exit status 77 and SKIPPED: warnings without the shared test data")
+endif()
+execute_process(COMMAND "${EXE}" "~[shared]" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("other test cases: exit status ${rc}")
+if(NOT rc EQUAL 0)
+  message("${out}${err}")
+  message(FATAL_ERROR "expected the test cases that do not need the shared test data to pass")
+endif()
