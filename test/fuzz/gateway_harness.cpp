@@ -8,9 +8,9 @@
 #include <thread>
 
 #include "server/app/gateway.hpp"
-#include "server/app/gateway_extensions.hpp"
 #include "server/app/log.hpp"
 #include "server/demo/demo_devices.hpp"
+#include "server/gateway/json_api_installer.hpp"
 
 namespace rr::fuzz {
 
@@ -48,6 +48,7 @@ GatewayHarness* start() {
     config.web_root = h->web_root;
     config.demo = true;
     config.demo_port = 0;
+    config.local = false;  // no rr+local node directory entries from a fuzzing process
     // The demo devices of demo_starter(), with 16x12 webcam images: a 320x240 frame as JSON takes
     // tens of milliseconds under the sanitizers, which would make every frame-touching input slow.
     server::demo::DemoOptions demo;
@@ -59,12 +60,12 @@ GatewayHarness* start() {
         if (!devices) return devices.take_error();
         return server::demo::demo_device_configs(port, demo);
     };
-    auto install = server::app::api_installer();
     auto g = server::app::Gateway::start(
         config, starter,
-        [h, install](server::http::HttpServer& http, const std::vector<std::shared_ptr<server::gateway::DeviceMirror>>& d) {
-            install(http, d);
+        [h](server::http::HttpServer& http, const std::vector<std::shared_ptr<server::gateway::DeviceMirror>>& d) {
+            auto api = server::gateway::install_json_api(http, d);
             h->http = &http;
+            return api;
         });
     if (!g) fail_input("the gateway does not start: " + g.error().message);
     h->port = (*g)->port();
