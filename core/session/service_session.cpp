@@ -467,21 +467,24 @@ void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
         reply(std::move(r), now);
         return;
     }
-    if (op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit") {
-        // Monitor locks serialise access per object; with per-call handlers there is nothing to hold,
-        // so entering always succeeds at once.
+    const bool monitor_op = op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit";
+    const bool lock_op = op == "RequestObjectLock" || op == "ReleaseObjectLock" || op == "RequestClientObjectLock" ||
+                         op == "ReleaseClientObjectLock";
+    if ((monitor_op || lock_op) && service_->handles_locks()) {
+        // CORE ServerContext::ClientLockOp: the service owns the objects and their locks.
+        events_.emplace_back(ServiceRequest{std::move(e), true});
+        return;
+    }
+    if (monitor_op) {
+        // A service without locks of its own (the gateway's mirror today): entering succeeds at once
+        // and locks nothing.
         r.elements.push_back(make_string_element("return", "OK"));
         reply(std::move(r), now);
         return;
     }
-    if (op == "RequestObjectLock" || op == "ReleaseObjectLock" || op == "RequestClientObjectLock" ||
-        op == "ReleaseClientObjectLock") {
-        if (!service_->requires_authentication()) {
-            reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Object locks require an authenticated service")),
-                  now);
-            return;
-        }
-        events_.emplace_back(ServiceRequest{std::move(e), true});  // locks go to the service, which owns the objects
+    if (lock_op) {
+        reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Object locks are not supported by this service")),
+              now);
         return;
     }
     reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Unknown session operation \"" + op + "\"")), now);
