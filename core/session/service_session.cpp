@@ -349,11 +349,20 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
     if (combined) {
         const MessageElement* user = e.find("username");
         const MessageElement* creds = e.find("credentials");
-        if (service->requires_authentication() || user || creds) {
-            if (!user || !creds || !service->requires_authentication()) {
-                reply_special(h, error_reply(e, make_error(MessageErrorType::AuthenticationError, "Authentication Failed")), now);
-                return;
-            }
+        // CORE RobotRaconteurNode (ConnectClientCombined): the same errors and messages.
+        const char* refused = nullptr;
+        if (!service->requires_authentication()) {
+            if (user && creds) refused = "Authentication not enabled for service";
+        } else if (!user) {
+            refused = "Username not provided";
+        } else if (!creds) {
+            refused = "Credentials not provided";
+        }
+        if (refused) {
+            reply_special(h, error_reply(e, make_error(MessageErrorType::AuthenticationError, refused)), now);
+            return;
+        }
+        if (service->requires_authentication()) {
             username = std::string(read_string(*user));
             if (auto ok = service->authenticate(username, creds); !ok) {
                 reply_special(h, error_reply(e, ok.error()), now);

@@ -594,9 +594,12 @@ void ObjectService::park_monitor(const std::string& path, std::uint32_t endpoint
     auto parked = std::make_shared<ParkedMonitor>();
     parked->responder = std::move(responder);
     std::shared_ptr<ParkedMonitor> replaced;
+    bool granted_meanwhile = false;
     {
         std::lock_guard lock(mutex_);
-        if (io_ && !shut_down_) {
+        // Handed over between monitor_enter/continue and now (its event found nothing parked).
+        granted_meanwhile = locks_.monitor_holder(path) == endpoint;
+        if (io_ && !shut_down_ && !granted_meanwhile) {
             parked->timer = std::make_unique<boost::asio::steady_timer>(*io_, wait);
             replaced = std::move(parked_[{path, endpoint}]);
             parked_[{path, endpoint}] = parked;
@@ -609,7 +612,7 @@ void ObjectService::park_monitor(const std::string& path, std::uint32_t endpoint
     }
     if (!parked->timer) {  // no io_context: the client asks again at once
         MessageEntry r;
-        r.elements.push_back(make_string_element("return", "Continue"));
+        r.elements.push_back(make_string_element("return", granted_meanwhile ? "OK" : "Continue"));
         parked->responder.respond(std::move(r));
         return;
     }

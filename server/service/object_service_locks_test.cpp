@@ -178,3 +178,60 @@ TEST_CASE("object locks: monitor lock blocks other sessions and is handed over o
     CHECK(scalar_of<double>(a.ok(get_value()), "value") == 1.5);
     CHECK(returned(a.ok(lock_op("MonitorExit"))) == "OK");
 }
+
+TEST_CASE("object locks: members marked [nolock] / [nolockread] pass object locks, not monitor locks") {
+    ServiceFixture f;
+    auto types = ServiceTypes::create({"service example.nolocktest\n\nstdver 0.10\n\nobject Obj\n"
+                                       "    property double plain\n"
+                                       "    property double free [nolock]\n"
+                                       "    property double readable [nolockread]\n"
+                                       "end\n"});
+    REQUIRE(types);
+    auto root = ServiceObject::create(*types, "example.nolocktest.Obj").value();
+    for (const char* p : {"plain", "free", "readable"}) REQUIRE(root->set_property_value(p, Value::scalar(2.0)));
+    auto service = ObjectService::create("lk", root).value();
+    PasswordTable users;
+    users.add_user("alice", "a", {"objectlock"});
+    users.add_user("bob", "b");
+    service->set_users(std::move(users));
+    REQUIRE(f.node->register_service(service));
+    auto connect = [&](const char* user, const char* pw) {
+        TestClient c;
+        std::promise<Result<std::shared_ptr<RawClient>>> p;
+        auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(f.port) + "/?service=lk");
+        REQUIRE(url);
+        RawClient::connect(f.node->io_context().get_executor(), *url, login(user, pw),
+                           [inbox = c.inbox](MessageEntry&& e) { inbox->push(std::move(e)); }, {},
+                           [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+        auto fut = p.get_future();
+        REQUIRE(fut.wait_for(10s) == std::future_status::ready);
+        auto r = fut.get();
+        REQUIRE(r);
+        c.raw = *r;
+        return c;
+    };
+    auto a = connect("alice", "a");
+    auto b = connect("bob", "b");
+    auto get = [](const char* m) { return req(MessageEntryType::PropertyGetReq, m, "lk"); };
+    auto set = [](const char* m) {
+        auto e = req(MessageEntryType::PropertySetReq, m, "lk");
+        e.elements.push_back(make_scalar_element("value", 3.0));
+        return e;
+    };
+    CHECK(returned(a.ok(lock_op("RequestObjectLock", "lk"))) == "OK");
+    CHECK(b.error(get("plain")).type == MessageErrorType::ObjectLockedError);
+    CHECK(scalar_of<double>(b.ok(get("free")), "value") == 2.0);
+    b.ok(set("free"));
+    CHECK(scalar_of<double>(b.ok(get("readable")), "value") == 2.0);
+    CHECK(b.error(set("readable")).type == MessageErrorType::ObjectLockedError);
+    CHECK(returned(a.ok(lock_op("ReleaseObjectLock", "lk"))) == "OK");
+
+    auto enter = lock_op("MonitorEnter", "lk");
+    enter.elements.push_back(make_scalar_element<std::int32_t>("timeout", -1));
+    CHECK(returned(a.ok(enter)) == "OK");
+    CHECK(b.error(get("free")).type == MessageErrorType::InvalidOperation);
+    CHECK(returned(a.ok(lock_op("MonitorExit", "lk"))) == "OK");
+    a.raw->close();
+    b.raw->close();
+    service->shutdown();
+}
