@@ -59,8 +59,13 @@ def connect(url, user, password=None):
     return RRN.ConnectService(url, user, creds(password))
 
 
+def register_transport():
+    RRN.RegisterTransport(RR.TcpTransport())
+
+
 def child_lock(url, user, password):
     """Connects, takes a user lock on the root, says so, then waits to be killed."""
+    register_transport()
     c = connect(url, user, password)
     RRN.RequestObjectLock(c, RR.RobotRaconteurObjectLockFlags_USER_LOCK)
     print("locked", flush=True)
@@ -72,12 +77,16 @@ class Checks:
         self.results = []
 
     def check(self, name, fn):
+        t0 = time.monotonic()
+        print("[locks_logins] %s ..." % name, file=sys.stderr, flush=True)
         try:
             fn()
-            self.results.append({"check": name, "ok": True})
+            self.results.append({"check": name, "ok": True, "seconds": round(time.monotonic() - t0, 2)})
+            print("[locks_logins]   ok", file=sys.stderr, flush=True)
         except Exception as e:  # noqa: BLE001 - every failure is reported
             self.results.append({"check": name, "ok": False, "error": "%s: %s" % (type(e).__name__, e),
                                  "trace": traceback.format_exc(limit=4)})
+            print("[locks_logins]   FAILED: %s" % self.results[-1]["error"], file=sys.stderr, flush=True)
 
 
 def expect(cond, what):
@@ -209,26 +218,36 @@ def run_checks(url, ck):
                       "monitor locked")
         expect(isinstance(a2.base_name, str), "the monitor holder reads")
         done = {}
+        go_exit = threading.Event()
 
-        def enter():
+        def enter_then_exit():
+            # The official client wants MonitorEnter and MonitorExit on the same thread (its stub mutex).
             try:
                 RRN.MonitorEnter(b2, -1)
                 done["t"] = time.monotonic()
+                done["read"] = b2.base_name
+                go_exit.wait(10)
+                RRN.MonitorExit(b2)
+                done["exited"] = True
             except Exception as e:  # noqa: BLE001
                 done["error"] = e
 
-        t = threading.Thread(target=enter, daemon=True)
+        t = threading.Thread(target=enter_then_exit, daemon=True)
         t.start()
         time.sleep(0.7)
         expect(not done, "bob's MonitorEnter returned while alice holds the monitor: %r" % done)
         released = time.monotonic()
         RRN.MonitorExit(a2)
-        t.join(6)
+        deadline = time.monotonic() + 6
+        while "t" not in done and "error" not in done and time.monotonic() < deadline:
+            time.sleep(0.02)
         expect("t" in done, "bob's MonitorEnter did not return after alice's MonitorExit: %r" % done)
         expect(done["t"] - released < 3.0, "hand-over took %.1f s" % (done["t"] - released))
+        expect(isinstance(done.get("read"), str), "bob reads under his monitor: %r" % done)
         expect_raises(RR.InvalidOperationException, lambda: a2.base_name, "alice reads bob's monitor-locked object")
-        expect(isinstance(b2.base_name, str), "bob reads under his monitor")
-        RRN.MonitorExit(b2)
+        go_exit.set()
+        t.join(10)
+        expect(done.get("exited"), "bob's MonitorExit: %r" % done)
         expect(isinstance(a2.base_name, str), "alice reads after bob's MonitorExit")
 
     ck.check("monitor: MonitorEnter blocks other sessions; the waiter gets it on MonitorExit", monitor)
@@ -264,6 +283,7 @@ def main():
     try:
         svc = start([args.service, "--port", "0", "--max-lifetime", str(int(args.timeout) + 30), "--users", users], err)
         ready = read_json_line(svc, 30, "rr_interop_service")
+        register_transport()
         run_checks(ready["url"], ck)
     except StepFailed as e:
         print(json.dumps({"error": str(e), "service_stderr": tail(err)}))
