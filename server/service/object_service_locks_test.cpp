@@ -90,7 +90,9 @@ TEST_CASE("object locks: user lock blocks other users on the object and its chil
     CHECK(scalar_of<double>(b.ok(get_value()), "value") == 1.5);
     CHECK(returned(b.ok(lock_op("ReleaseObjectLock"))) == "OK");  // nothing locked
     CHECK(b.error(lock_op("ReleaseClientObjectLock")).type == MessageErrorType::InvalidOperation);
-    CHECK(b.error(lock_op("RequestObjectLock", std::string(kTestService) + ".nothing")).type == MessageErrorType::ObjectNotFound);
+    // No such object: the resolution error (MemberNotFound here), and nothing is locked.
+    CHECK(b.error(lock_op("RequestObjectLock", std::string(kTestService) + ".nothing")).type == MessageErrorType::MemberNotFound);
+    CHECK_FALSE(lf.f.service->lock_holder(std::string(kTestService) + ".nothing"));
 
     // objectlockoverride releases another user's lock.
     CHECK(returned(b.ok(lock_op("RequestObjectLock"))) == "OK");
