@@ -45,6 +45,11 @@ public:
     virtual Result<void> authenticate(const std::string& username, const MessageElement* credentials) {
         return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
     }
+    /// Whether the service implements object and monitor locks itself: then every lock session
+    /// operation (RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, ReleaseClientObjectLock,
+    /// MonitorEnter, MonitorContinueEnter, MonitorExit) reaches it as a ServiceRequest. Otherwise the
+    /// session answers object locks InvalidOperation and monitor operations "OK" (nothing is locked).
+    virtual bool handles_locks() const { return false; }
 };
 
 /// The node, as its connections see it. Thread-safe.

@@ -349,11 +349,20 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
     if (combined) {
         const MessageElement* user = e.find("username");
         const MessageElement* creds = e.find("credentials");
-        if (service->requires_authentication() || user || creds) {
-            if (!user || !creds || !service->requires_authentication()) {
-                reply_special(h, error_reply(e, make_error(MessageErrorType::AuthenticationError, "Authentication Failed")), now);
-                return;
-            }
+        // CORE RobotRaconteurNode (ConnectClientCombined): the same errors and messages.
+        const char* refused = nullptr;
+        if (!service->requires_authentication()) {
+            if (user && creds) refused = "Authentication not enabled for service";
+        } else if (!user) {
+            refused = "Username not provided";
+        } else if (!creds) {
+            refused = "Credentials not provided";
+        }
+        if (refused) {
+            reply_special(h, error_reply(e, make_error(MessageErrorType::AuthenticationError, refused)), now);
+            return;
+        }
+        if (service->requires_authentication()) {
             username = std::string(read_string(*user));
             if (auto ok = service->authenticate(username, creds); !ok) {
                 reply_special(h, error_reply(e, ok.error()), now);
@@ -467,21 +476,24 @@ void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
         reply(std::move(r), now);
         return;
     }
-    if (op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit") {
-        // Monitor locks serialise access per object; with per-call handlers there is nothing to hold,
-        // so entering always succeeds at once.
+    const bool monitor_op = op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit";
+    const bool lock_op = op == "RequestObjectLock" || op == "ReleaseObjectLock" || op == "RequestClientObjectLock" ||
+                         op == "ReleaseClientObjectLock";
+    if ((monitor_op || lock_op) && service_->handles_locks()) {
+        // CORE ServerContext::ClientLockOp: the service owns the objects and their locks.
+        events_.emplace_back(ServiceRequest{std::move(e), true});
+        return;
+    }
+    if (monitor_op) {
+        // A service without locks of its own (the gateway's mirror today): entering succeeds at once
+        // and locks nothing.
         r.elements.push_back(make_string_element("return", "OK"));
         reply(std::move(r), now);
         return;
     }
-    if (op == "RequestObjectLock" || op == "ReleaseObjectLock" || op == "RequestClientObjectLock" ||
-        op == "ReleaseClientObjectLock") {
-        if (!service_->requires_authentication()) {
-            reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Object locks require an authenticated service")),
-                  now);
-            return;
-        }
-        events_.emplace_back(ServiceRequest{std::move(e), true});  // locks go to the service, which owns the objects
+    if (lock_op) {
+        reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Object locks are not supported by this service")),
+              now);
         return;
     }
     reply(error_reply(e, make_error(MessageErrorType::InvalidOperation, "Unknown session operation \"" + op + "\"")), now);

@@ -53,8 +53,10 @@ struct ServiceSessionUser {
     std::string username;
 };
 /// A member request (answer with reply()), a client-sent packet that needs no answer (PipePacket,
-/// PipePacketRet, WirePacket: `needs_reply` false), or a lock operation (ClientSessionOpReq with
-/// MemberName RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, answer with reply()).
+/// PipePacketRet, WirePacket: `needs_reply` false), or, for services whose handles_locks() is true, a
+/// lock operation (ClientSessionOpReq with MemberName RequestObjectLock, RequestClientObjectLock,
+/// ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit;
+/// answer with reply()).
 struct ServiceRequest {
     MessageEntry entry;
     bool needs_reply = true;

@@ -29,6 +29,8 @@ struct FakeService : HostedService {
     }
     ObjectTypeInfo root_type() const override { return {"example.svc.Obj", {"example.base.Thing"}}; }
     bool requires_authentication() const override { return auth; }
+    bool handles_locks() const override { return locks; }
+    bool locks = false;
     Result<void> authenticate(const std::string& user, const MessageElement* creds) override {
         const MessageElement* pw = creds ? creds->find("password") : nullptr;
         if (user == "alice" && pw && read_string(*pw) == "secret") return {};
@@ -270,6 +272,61 @@ TEST_CASE("service session: login with the connect, wrong password refused, logo
         REQUIRE(responses.size() == 2);  // logout OK, then the refused request
         REQUIRE(responses[1].entry);
         CHECK(responses[1].entry->error == MessageErrorType::PermissionDenied);
+    }
+}
+
+TEST_CASE("service session: lock operations reach a service that handles locks; others answer as before") {
+    auto op = [](const char* name) {
+        MessageEntry e;
+        e.entry_type = MessageEntryType::ClientSessionOpReq;
+        e.service_path = "svc";
+        e.member_name = name;
+        return e;
+    };
+    const char* ops[] = {"RequestObjectLock", "RequestClientObjectLock", "ReleaseObjectLock", "ReleaseClientObjectLock",
+                         "MonitorEnter",      "MonitorContinueEnter",    "MonitorExit"};
+    SECTION("handles_locks: every lock operation is a ServiceRequest") {
+        Pair p;
+        p.host.service->locks = true;
+        p.connect();
+        for (const char* name : ops) REQUIRE(p.client.request(op(name), p.now));
+        p.pump();
+        auto requests = p.take<ServiceRequest>(p.service_events);
+        REQUIRE(requests.size() == std::size(ops));
+        for (std::size_t i = 0; i < std::size(ops); ++i) {
+            CHECK(requests[i].entry.member_name == ops[i]);
+            CHECK(requests[i].needs_reply);
+        }
+        CHECK(p.take_client<ClientResponse>().empty());  // the service answers
+    }
+    SECTION("without: object locks InvalidOperation, monitor operations OK") {
+        Pair p;
+        p.connect();
+        for (const char* name : ops) REQUIRE(p.client.request(op(name), p.now));
+        p.pump();
+        CHECK(p.take<ServiceRequest>(p.service_events).empty());
+        auto responses = p.take_client<ClientResponse>();
+        REQUIRE(responses.size() == std::size(ops));
+        for (std::size_t i = 0; i < 4; ++i) CHECK(responses[i].entry->error == MessageErrorType::InvalidOperation);
+        for (std::size_t i = 4; i < 7; ++i) CHECK(responses[i].entry->error == MessageErrorType::None);
+    }
+}
+
+TEST_CASE("service session: connect-time login errors are CORE's") {
+    SECTION("no username for a service that requires a login") {
+        Pair p("svc", true);
+        p.pump();
+        auto closed = p.take_client<ClientSessionClosed>();
+        REQUIRE(closed.size() == 1);
+        CHECK(closed[0].error.type == MessageErrorType::AuthenticationError);
+        CHECK(closed[0].error.message == "Username not provided");
+    }
+    SECTION("credentials for a service without logins") {
+        Pair p("svc", false, "alice", "secret");
+        p.pump();
+        auto closed = p.take_client<ClientSessionClosed>();
+        REQUIRE(closed.size() == 1);
+        CHECK(closed[0].error.message == "Authentication not enabled for service");
     }
 }
 

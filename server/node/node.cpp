@@ -133,6 +133,7 @@ void Node::track(const std::shared_ptr<PumpHandle>& pump) {
 }
 
 Result<void> Node::register_service(std::shared_ptr<Service> service) {
+    if (service) service->attach(io_);
     if (auto r = services_->add(std::move(service)); !r) return r;
     services_changed();
     return {};

@@ -19,6 +19,10 @@
 #include "core/message/message.hpp"
 #include "core/session/service_host.hpp"
 
+namespace boost::asio {
+class io_context;
+}
+
 namespace rr::server {
 
 class ServerSession;
@@ -92,6 +96,10 @@ public:
     /// `done` may be called from any thread. Errors: ObjectNotFound.
     virtual void object_type(const SessionRef& session, const std::string& path,
                              std::function<void(Result<ObjectTypeInfo>)> done) = 0;
+
+    /// Called by Node::register_service with the node's io_context (for the service's own timers,
+    /// e.g. monitor lock waits); the node outlives its registrations' use of it.
+    virtual void attach(boost::asio::io_context& io) {}
 
     virtual void on_session_open(const SessionRef& session) {}
     virtual void on_session_close(const SessionRef& session) {}

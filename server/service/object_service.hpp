@@ -13,7 +13,15 @@
 //   authentication  optional user table (password_table.hpp): when set, every session must log in
 //                   (ConnectClientCombined `username` + `credentials{password}` or AuthenticateUser)
 //                   before member requests are accepted, and events skip sessions not logged in.
-//   object locks    not supported: RequestObjectLock & co. answer InvalidOperation.
+//   object locks    RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock and MonitorEnter /
+//                   MonitorContinueEnter / MonitorExit with CORE's semantics (object_locks.hpp): object
+//                   locks need a logged-in user with the `objectlock` or `objectlockoverride` privilege
+//                   (PermissionDenied / ObjectLockedError otherwise); every member request (not pipe or
+//                   wire packets) to a locked object from another user or session gets ObjectLockedError
+//                   "Object locked by <user>", to a monitor-locked one InvalidOperation. A MonitorEnter
+//                   that must wait is answered "Continue" after at most 5 s (the client then repeats
+//                   MonitorContinueEnter) or "OK" as soon as the monitor is handed over. Locks go when
+//                   their session (client lock) or their user's last session (user lock) closes.
 //
 // Threads: thread-safe. Requests run on the client's strand (see ServiceObject for handler rules).
 #pragma once
@@ -28,6 +36,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "server/service/object_locks.hpp"
 #include "server/service/password_table.hpp"
 #include "server/service/service_object.hpp"
 
@@ -55,6 +64,10 @@ public:
     /// path; ObjectNotFound when nothing is served at `path`.
     Result<void> release_path(const std::string& path);
 
+    /// The object lock covering `path` (its user, the path it was taken on, its session for a client
+    /// lock), if any.
+    std::optional<ObjectLocks::Holder> lock_holder(const std::string& path) const;
+
     /// Client sessions currently open (logged-in ones only when authentication is on).
     std::vector<SessionRef> sessions() const;
 
@@ -67,6 +80,8 @@ public:
     /// untouched generator is dropped.
     static constexpr std::size_t kMaxGeneratorsPerSession = 1024;
     static constexpr std::chrono::minutes kGeneratorIdleTimeout{10};
+    /// A waiting MonitorEnter / MonitorContinueEnter is answered "Continue" after this (CORE: 5 s).
+    static constexpr std::chrono::seconds kMonitorWait{5};
 
     // --- Service ---
     const std::string& name() const override { return name_; }
@@ -77,6 +92,8 @@ public:
     void object_type(const SessionRef& session, const std::string& path,
                      std::function<void(Result<ObjectTypeInfo>)> done) override;
     bool requires_authentication() const override;
+    bool handles_locks() const override { return true; }
+    void attach(boost::asio::io_context& io) override;
     Result<void> authenticate(const std::string& username, const MessageElement* credentials) override;
     void on_session_open(const SessionRef& session) override;
     void on_session_close(const SessionRef& session) override;
@@ -93,7 +110,19 @@ private:
     /// The object at `path`, resolving objrefs as needed. Errors: ObjectNotFound.
     Result<std::shared_ptr<ServiceObject>> resolve(const SessionRef& session, const std::string& path);
     void handle_generator_next(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void handle_lock_op(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// Object and monitor locks for a member request. Errors: ObjectLockedError, InvalidOperation.
+    /// `obj`: the object at `path` when resolved (for its members' [nolock] / [nolockread]).
+    Result<void> check_locks(const SessionRef& session, const std::string& path, const ServiceObject* obj,
+                             const MessageEntry& entry);
+    /// Keeps a MonitorEnter / MonitorContinueEnter that must wait: answered "Continue" after
+    /// kMonitorWait (or at once without an io_context), "OK" when granted, RequestTimeout.
+    void park_monitor(const std::string& path, std::uint32_t endpoint, Responder responder, std::chrono::milliseconds wait);
+    /// Answers parked monitor requests for `events` (call without mutex_ held).
+    void deliver_monitor_events(std::vector<ObjectLocks::MonitorEvent>& events);
+    bool has_privilege(const std::string& username, std::string_view privilege) const;  // mutex_ held
 
+    struct ParkedMonitor;
     struct GeneratorEntry {
         std::uint32_t session = 0;
         std::string path, member;
@@ -112,6 +141,9 @@ private:
     std::mt19937 rng_;
     MessageElement attributes_;
     PasswordTable users_;
+    ObjectLocks locks_;
+    std::map<std::pair<std::string, std::uint32_t>, std::shared_ptr<ParkedMonitor>> parked_;  // (path, endpoint)
+    boost::asio::io_context* io_ = nullptr;
     bool shut_down_ = false;
 };
 

@@ -2,6 +2,9 @@
 
 #include <openssl/evp.h>
 
+#include <fstream>
+#include <sstream>
+
 #include "core/session/elements.hpp"
 
 namespace rr::server {
@@ -97,6 +100,17 @@ Result<PasswordTable> PasswordTable::parse(std::string_view text) {
                         "password file line " + std::to_string(line_no) + ": " + r.error().message);
     }
     return table;
+}
+
+Result<PasswordTable> PasswordTable::load_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return fail(MessageErrorType::IOError, "cannot read password file " + path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (text.str().size() > kMaxFileBytes) return fail(MessageErrorType::InvalidArgument, "password file " + path + " is too large");
+    auto t = parse(text.str());
+    if (!t) return fail(MessageErrorType::InvalidArgument, path + ": " + t.error().message);
+    return t;
 }
 
 Result<void> PasswordTable::check(std::string_view username, const MessageElement* credentials) const {

@@ -35,6 +35,10 @@ public:
     /// Parses CORE's password file format (privileges `_` = none; the NodeID column is ignored; blank
     /// lines and lines starting with `#` are skipped). Errors: InvalidArgument naming the bad line.
     static Result<PasswordTable> parse(std::string_view text);
+    /// parse() on the contents of the file at `path` (at most kMaxFileBytes). Errors: IOError (cannot
+    /// read), InvalidArgument (too large, or parse errors, with the path).
+    static Result<PasswordTable> load_file(const std::string& path);
+    static constexpr std::size_t kMaxFileBytes = 4u * 1024u * 1024u;
 
     bool empty() const noexcept { return users_.empty(); }
     const std::vector<User>& users() const noexcept { return users_; }

@@ -6,7 +6,7 @@
 // Usage:
 //   rr_interop_service [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
 //                      [--heartbeat S] [--listen-all] [--max-lifetime S] [--robdef PATH]
-//                      [--local-name NAME | --local]
+//                      [--local-name NAME | --local] [--users FILE]
 // When ready it prints one JSON line, like official_service.py:
 //   {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
 // (with "ws_url": "rr+ws://127.0.0.1:PORT/?service=interop" under --websocket: RR over WebSocket on the
@@ -14,6 +14,8 @@
 // NodeID cache gives it) and also serves rr+local (server/transport/local), adding "local_url"
 // (by NodeName) and "local_id_url" (by NodeID) to the ready line; --local serves rr+local by NodeID
 // only. A NodeName in use (or any other rr+local error) exits with status 3 and the message on stderr.
+// --users FILE requires a login against that password file (CORE's format: `user md5hex privileges`);
+// users with the `objectlock` privilege may lock objects (test/interop/locks_logins.py).
 // and runs until SIGTERM / SIGINT (or --max-lifetime), then shuts the node down.
 #include <condition_variable>
 #include <csignal>
@@ -937,7 +939,7 @@ volatile std::sig_atomic_t g_stop = 0;
 [[noreturn]] void usage(const char* argv0) {
     std::cerr << "usage: " << argv0
               << " [--port N] [--websocket] [--disable-message4] [--enable-stringtable] [--heartbeat S]"
-                 " [--listen-all] [--max-lifetime S] [--robdef PATH] [--local-name NAME | --local]\n";
+                 " [--listen-all] [--max-lifetime S] [--robdef PATH] [--local-name NAME | --local] [--users FILE]\n";
     std::exit(2);
 }
 
@@ -951,6 +953,7 @@ int main(int argc, char** argv) {
     std::string robdef_path = RR_INTEROP_ROBDEF;
     std::optional<std::string> local_name;
     bool local_by_id = false;
+    std::optional<std::string> users_path;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -967,6 +970,7 @@ int main(int argc, char** argv) {
         else if (a == "--robdef") robdef_path = value();
         else if (a == "--local-name") local_name = value();
         else if (a == "--local") local_by_id = true;
+        else if (a == "--users") users_path = value();
         else usage(argv[0]);
     }
 
@@ -1012,6 +1016,7 @@ int main(int argc, char** argv) {
     attributes.entries.emplace_back("purpose", str("interop test ✓"));
     attributes.entries.emplace_back("version", array<std::int32_t>({1, 0}));
     must(interop->service->set_attributes(std::move(attributes)), "attributes");
+    if (users_path) interop->service->set_users(must(PasswordTable::load_file(*users_path), "--users"));
 
     auto node = Node::create(options);
     must(node->register_service(interop->service), "register");
