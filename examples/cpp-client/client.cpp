@@ -55,13 +55,16 @@ int main(int argc, char** argv) {
     if (wrong) return fail("call Drive(1.5)", rr::make_error(rr::MessageErrorType::OperationFailed, "accepted a bad call"));
     std::printf("Drive(1.5): %s (as expected)\n", wrong.error().name.c_str());
 
-    // A wire: SensorPacket packets [readonly]; peek once, then connect and wait for the next InValue.
+    // A wire: SensorPacket packets [readonly]; peek once, then connect, ask the device to stream and
+    // wait for a new InValue (after = the values received so far: only one that arrives later).
     auto peek = root.peek_in_value("packets");
     if (!peek) return fail("peek packets", peek.error());
     auto wire = root.wire_connect("packets");
     if (!wire) return fail("connect packets", wire.error());
-    auto next = wire->wait_value([](const rr::WireValue&) { return true; }, 5s);
+    if (auto r = root.call("StartStreaming"); !r) return fail("call StartStreaming", r.error());
+    auto next = wire->wait_value([](const rr::WireValue&) { return true; }, 5s, wire->values_received());
     if (!next) return fail("wait for packets", next.error());
+    if (auto r = root.call("StopStreaming"); !r) return fail("call StopStreaming", r.error());
     const Value* id = next->value.field("ID");
     const Value* data = next->value.field("Data");
     if (!id || !data) return fail("read SensorPacket", rr::make_error(rr::MessageErrorType::DataTypeMismatch, "no ID/Data field"));

@@ -83,7 +83,7 @@ const modes = {
       await run(binary, [`rr+tcp://127.0.0.1:${g.port}/?service=nope`], { timeout: 60000 });
       ok(false, "a missing service must fail");
     } catch (e) {
-      ok(e.code === 1 && /connect failed: RobotRaconteur\.ServiceNotFoundException/.test(e.stderr), `missing service: ${e.stderr.trim()}`);
+      ok(e.code === 1 && /connect failed: RobotRaconteur\.ServiceNotFound/.test(e.stderr), `missing service: ${e.stderr.trim()}`);
     }
   },
 
