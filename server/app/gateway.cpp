@@ -105,6 +105,9 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             hopts.allowed_origins.push_back(std::string("http://") + host + ":" + std::to_string(c.port));
     }
     hopts.static_root = c.web_root;
+    for (const auto& p : c.trusted_proxies)
+        if (auto n = http::parse_ip_network(p)) hopts.trusted_proxies.push_back(*n);
+    hopts.on_websocket = [](const std::string& line) { log(LogLevel::info, line); };
     g->http_ = std::make_shared<http::HttpServer>(g->node_, hopts);
     Gateway* self = g.get();
     g->http_->add_route(bhttp::verb::get, "/livez", [](const http::Request& req, http::Responder respond) {

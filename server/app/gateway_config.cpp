@@ -11,6 +11,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/names/node_id.hpp"
+#include "server/http/forwarded.hpp"
 
 namespace rr::server::app {
 namespace {
@@ -240,7 +241,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover"});
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
-                     {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins",
+                     {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
                       "max_message_size", "log_level", "local"});
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
@@ -256,6 +257,12 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         if (auto n = g["threads"]) c.threads = static_cast<unsigned>(r.unsigned_int(n, "gateway.threads", 256));
         if (auto n = g["web_root"]) c.web_root = r.string(n, "gateway.web_root");
         if (auto n = g["allowed_origins"]) c.allowed_origins = r.string_list(n, "gateway.allowed_origins");
+        if (auto n = g["trusted_proxies"]) {
+            c.trusted_proxies = r.string_list(n, "gateway.trusted_proxies");
+            for (const auto& p : c.trusted_proxies)
+                if (!http::parse_ip_network(p))
+                    r.error(n, "gateway.trusted_proxies", "\"" + p + "\" is not an IP address or CIDR range (10.0.0.0/8)");
+        }
         if (auto n = g["max_message_size"]) {
             c.max_message_size = r.unsigned_int(n, "gateway.max_message_size", 100u * 1024u * 1024u);
             if (c.max_message_size < 16 * 1024) r.error(n, "gateway.max_message_size", "must be at least 16384");
@@ -325,7 +332,7 @@ namespace {
 
 // Flags that take a value, with their official RR spellings mapped to ours.
 const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
-                                        "--allow-origin", "--device",     "--demo-port", "--threads",
+                                        "--allow-origin", "--device",     "--demo-port", "--threads", "--trusted-proxy",
                                         "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level"};
 const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h"};
@@ -399,6 +406,10 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.web_root = v;
         } else if (flag == "--allow-origin") {
             c.allowed_origins.push_back(v);
+        } else if (flag == "--trusted-proxy") {
+            if (!http::parse_ip_network(v))
+                return fail(MessageErrorType::InvalidConfiguration, flag + ": \"" + v + "\" is not an IP address or CIDR range");
+            c.trusted_proxies.push_back(v);
         } else if (flag == "--no-demo") {
             c.demo = false;
         } else if (flag == "--no-local") {
@@ -450,6 +461,7 @@ Options (override the configuration file):
   --listen ADDR              listen address (default 0.0.0.0)
   --web-root DIR             dashboard files to serve
   --allow-origin ORIGIN      allow a browser Origin (repeatable)
+  --trusted-proxy ADDR[/N]   believe X-Forwarded-For/-Proto from this proxy (repeatable)
   --device NAME=URL          add a device, e.g. reynard=rr+tcp://localhost:29200/?service=reynard
                              or cam=rr+local:///?nodename=camera.driver&service=cam
   --no-demo                  do not start the demo devices

@@ -44,6 +44,9 @@ struct GatewayConfig {
     unsigned threads = 0;
     std::string web_root;  ///< empty = the built-in default (web/ next to the executable's project)
     std::vector<std::string> allowed_origins;
+    /// Reverse proxies whose X-Forwarded-For/-Proto are believed: addresses or CIDR ranges
+    /// ("127.0.0.1", "10.0.0.0/8", "::1"); validated by the parser. Empty = none (the headers are ignored).
+    std::vector<std::string> trusted_proxies;
     std::size_t max_message_size = 12u * 1024u * 1024u;
     std::string log_level = "info";
     /// Serve rr+local under node_name (and the demo node's under node_name + ".demo"), so clients on
@@ -77,6 +80,7 @@ struct CommandLine {
 
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
+/// --trusted-proxy ADDR[/BITS] (repeat),
 /// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local,
 /// --discovery, --check,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,

@@ -120,3 +120,24 @@ TEST_CASE("every example in gateway-config/ is a valid configuration") {
     REQUIRE_FALSE(missing);
     CHECK_THAT(missing.error().message, Catch::Contains("cannot read"));
 }
+
+TEST_CASE("gateway.trusted_proxies and --trusted-proxy take addresses and CIDR ranges, nothing else") {
+    auto c = parse_gateway_config("gateway:\n  trusted_proxies: [127.0.0.1, 10.0.0.0/8, \"::1\"]\n", "t.yaml");
+    REQUIRE(c);
+    CHECK(c->trusted_proxies == std::vector<std::string>{"127.0.0.1", "10.0.0.0/8", "::1"});
+    auto bad = parse_gateway_config("gateway:\n  trusted_proxies: [proxy.example.org]\n", "t.yaml");
+    REQUIRE_FALSE(bad);
+    CHECK_THAT(bad.error().message, Catch::Contains("t.yaml:2") && Catch::Contains("gateway.trusted_proxies") &&
+                                        Catch::Contains("proxy.example.org"));
+    const char* argv[] = {"rr-gateway", "--trusted-proxy", "192.168.0.0/16", "--trusted-proxy=10.0.0.300"};
+    auto cmd = parse_command_line(3, argv);
+    REQUIRE(cmd);
+    GatewayConfig g;
+    REQUIRE(apply_overrides(g, *cmd));
+    CHECK(g.trusted_proxies == std::vector<std::string>{"192.168.0.0/16"});
+    auto cmd2 = parse_command_line(4, argv);
+    REQUIRE(cmd2);
+    auto applied = apply_overrides(g, *cmd2);
+    REQUIRE_FALSE(applied);
+    CHECK_THAT(applied.error().message, Catch::Contains("--trusted-proxy"));
+}

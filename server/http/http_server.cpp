@@ -254,8 +254,20 @@ private:
 
     void on_request(Request req) {
         head_ = req.method() == bhttp::verb::head;
+        client_ = client();
+        auto forwarded = [&](std::string_view name) {
+            auto v = req[name];
+            return std::string_view(v.data(), v.size());
+        };
+        if (!server_->options().trusted_proxies.empty()) {
+            beast::error_code ec;
+            auto ep = beast::get_lowest_layer(stream_).socket().remote_endpoint(ec);
+            if (!ec)
+                client_ = client_origin(ep.address(), ep.port(), forwarded("X-Forwarded-For"),
+                                        forwarded("X-Forwarded-Proto"), server_->options().trusted_proxies);
+        }
         const auto origin = req[bhttp::field::origin];
-        if (!origin.empty() && !same_origin(origin, req[bhttp::field::host]) &&
+        if (!origin.empty() && !same_origin(origin, req[bhttp::field::host], client_.scheme) &&
             !origin_allowed(server_->options().allowed_origins, origin)) {
             auto r = make_response(req, bhttp::status::forbidden, "Forbidden Origin\n");
             r.keep_alive(false);
@@ -339,7 +351,15 @@ private:
             }
         }
         // Addresses before the stream moves into the WebSocket.
-        auto peer = remote();
+        auto peer = client_.address;
+        if (server_->options().on_websocket) {
+            std::string line = "WebSocket " + (chosen.empty() || chosen == kRRSubprotocol ? std::string("rr") : chosen) +
+                               " from " + peer;
+            if (client_.forwarded)
+                line += " (" + (client_.scheme.empty() ? std::string("scheme unknown") : client_.scheme) + ", via " +
+                        remote() + ")";
+            server_->options().on_websocket(line);
+        }
         beast::error_code lec;
         auto local = beast::get_lowest_layer(stream_).socket().local_endpoint(lec);
         AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer};
@@ -406,6 +426,8 @@ private:
         });
     }
 
+    ClientOrigin client() const { return ClientOrigin{remote(), "", false}; }
+
     std::string remote() const {
         beast::error_code ec;
         auto ep = beast::get_lowest_layer(stream_).socket().remote_endpoint(ec);
@@ -440,13 +462,15 @@ private:
     beast::flat_buffer buffer_;
     std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
     bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)
+    ClientOrigin client_;  // who sent the request being answered (behind a trusted proxy: the proxy's client)
 };
 
 }  // namespace
 
-bool same_origin(std::string_view origin, std::string_view host) {
+bool same_origin(std::string_view origin, std::string_view host, std::string_view only_scheme) {
     if (host.empty()) return false;
     for (std::string_view scheme : {"http://", "https://"}) {
+        if (!only_scheme.empty() && scheme.substr(0, scheme.size() - 3) != only_scheme) continue;
         if (origin.size() == scheme.size() + host.size() && iequals(origin.substr(0, scheme.size()), scheme) &&
             iequals(origin.substr(scheme.size()), host))
             return true;

@@ -9,7 +9,9 @@
 //   * other registered subprotocols (the JSON WebSocket API): handed to their handler;
 //   * any other subprotocol list: 426 naming the subprotocols served.
 // Origins: a request carrying an Origin header must be same-origin (its Host) or match the allowlist
-// (403 otherwise); requests without Origin (non-browser clients) are allowed. Matching follows CORE (wire.md §8): exact, or
+// (403 otherwise); requests without Origin (non-browser clients) are allowed. Behind a trusted proxy
+// (HttpOptions::trusted_proxies) the client's address comes from X-Forwarded-For and the same-origin
+// check uses the X-Forwarded-Proto scheme; from any other peer those headers are ignored. Matching follows CORE (wire.md §8): exact, or
 // `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
 #pragma once
 
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
+#include "server/http/forwarded.hpp"
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 
@@ -75,12 +78,18 @@ struct HttpOptions {
     /// Text messages queued for one JSON WebSocket beyond this are dropped oldest-first (send() messages
     /// before send_urgent() ones) and counted.
     std::size_t json_socket_queue_limit = 1024;
+    /// Peers whose X-Forwarded-For / X-Forwarded-Proto are believed (forwarded.hpp). Empty = none.
+    std::vector<IpNetwork> trusted_proxies;
+    /// Called once per accepted WebSocket with a line for the log: kind, client, and the proxy when the
+    /// client came through a trusted one (`WebSocket rr from 198.51.100.1 (https, via 10.0.0.1:5123)`).
+    std::function<void(const std::string&)> on_websocket;
 };
 
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin);
 /// True when `origin` is "http://" or "https://" followed by the request's Host header: a page served
 /// by this server (also behind a reverse proxy that forwards Host). Always allowed.
-bool same_origin(std::string_view origin, std::string_view host);
+/// With `scheme` ("http"/"https", from a trusted proxy's X-Forwarded-Proto) only that scheme matches.
+bool same_origin(std::string_view origin, std::string_view host, std::string_view scheme = {});
 
 class HttpServer : public std::enable_shared_from_this<HttpServer> {
 public:

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <thread>
 
 #include <boost/beast/core.hpp>
@@ -51,13 +52,22 @@ struct Fixture {
     std::filesystem::path root = std::filesystem::temp_directory_path() / ("rr_http_test_" + std::to_string(::getpid()));
     std::uint16_t port = 0;
 
-    Fixture() {
+    /// Lines of HttpOptions::on_websocket.
+    std::shared_ptr<std::vector<std::string>> ws_log = std::make_shared<std::vector<std::string>>();
+    std::shared_ptr<std::mutex> ws_log_mutex = std::make_shared<std::mutex>();
+
+    explicit Fixture(std::vector<std::string> trusted_proxies = {}) {
         std::filesystem::create_directories(root / "sub");
         std::ofstream(root / "index.html") << "<h1>dash</h1>";
         std::ofstream(root / "sub" / "app.wasm") << "wasm";
         http::HttpOptions opts;
         opts.allowed_origins = {"http://localhost:8080", "http://*.example.org"};
         opts.static_root = root.string();
+        for (const auto& p : trusted_proxies) opts.trusted_proxies.push_back(*http::parse_ip_network(p));
+        opts.on_websocket = [log = ws_log, m = ws_log_mutex](const std::string& line) {
+            std::lock_guard lock(*m);
+            log->push_back(line);
+        };
         server = std::make_shared<http::HttpServer>(node, opts);
         server->add_route(bhttp::verb::get, "/livez", [](const http::Request& req, http::Responder respond) {
             respond(http::make_response(req, bhttp::status::ok, "ok\n"));
@@ -89,13 +99,20 @@ struct Fixture {
         std::filesystem::remove_all(root, ec);
     }
 
-    bhttp::response<bhttp::string_body> get(std::string target, std::string origin = {}) {
+    std::vector<std::string> websocket_log() const {
+        std::lock_guard lock(*ws_log_mutex);
+        return *ws_log;
+    }
+
+    bhttp::response<bhttp::string_body> get(std::string target, std::string origin = {},
+                                            std::vector<std::pair<std::string, std::string>> headers = {}) {
         boost::asio::io_context io;
         beast::tcp_stream s(io);
         s.connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
         bhttp::request<bhttp::string_body> req{bhttp::verb::get, target, 11};
         req.set(bhttp::field::host, "localhost");
         if (!origin.empty()) req.set(bhttp::field::origin, origin);
+        for (const auto& [name, value] : headers) req.set(name, value);
         bhttp::write(s, req);
         beast::flat_buffer b;
         bhttp::response<bhttp::string_body> res;
@@ -170,6 +187,51 @@ TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {
     beast::flat_buffer b;
     ws.read(b);
     CHECK(beast::buffers_to_string(b.data()) == "echo:hi");
+}
+
+namespace {
+
+// The on_websocket line of one JSON WebSocket opened with `headers`.
+std::string websocket_line(Fixture& f, std::vector<std::pair<std::string, std::string>> headers) {
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), f.port));
+    ws.set_option(websocket::stream_base::decorator([headers](websocket::request_type& req) {
+        req.set(bhttp::field::sec_websocket_protocol, "test.echo.v1");
+        for (const auto& [name, value] : headers) req.set(name, value);
+    }));
+    const auto before = f.websocket_log().size();
+    ws.handshake("localhost", "/");  // the line is written before the handshake's answer
+    auto log = f.websocket_log();
+    ws.close(websocket::close_code::normal);
+    return log.size() == before + 1 ? log.back() : std::string("(no line)");
+}
+
+}  // namespace
+
+TEST_CASE("X-Forwarded-For/-Proto are believed from a trusted proxy only") {
+    const std::vector<std::pair<std::string, std::string>> forged{{"X-Forwarded-For", "198.51.100.7"},
+                                                                  {"X-Forwarded-Proto", "https"}};
+    SECTION("no trusted proxy: the headers change nothing") {
+        Fixture f;
+        auto line = websocket_line(f, forged);
+        CHECK_THAT(line, Catch::StartsWith("WebSocket test.echo.v1 from 127.0.0.1:"));
+        CHECK_THAT(line, !Catch::Contains("198.51.100.7"));
+        // same-origin accepts either scheme for the Host
+        CHECK(f.get("/livez", "http://localhost", forged).result() == bhttp::status::ok);
+        CHECK(f.get("/livez", "https://localhost", forged).result() == bhttp::status::ok);
+    }
+    SECTION("the peer is a trusted proxy: the client and its scheme come from the headers") {
+        Fixture f({"127.0.0.0/8"});
+        auto line = websocket_line(f, forged);
+        CHECK_THAT(line, Catch::StartsWith("WebSocket test.echo.v1 from 198.51.100.7 (https, via 127.0.0.1:"));
+        // the page was https: an http Origin for the same Host is another origin (and not in the allowlist)
+        CHECK(f.get("/livez", "https://localhost", forged).result() == bhttp::status::ok);
+        CHECK(f.get("/livez", "http://localhost", forged).result() == bhttp::status::forbidden);
+        // without X-Forwarded-Proto the scheme is unknown: either is same-origin
+        CHECK(f.get("/livez", "http://localhost", {{"X-Forwarded-For", "198.51.100.7"}}).result() == bhttp::status::ok);
+        CHECK_THAT(websocket_line(f, {}), Catch::StartsWith("WebSocket test.echo.v1 from 127.0.0.1:"));
+    }
 }
 
 TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still waiting") {

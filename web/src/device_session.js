@@ -1,4 +1,4 @@
-// One browser RR session to a device through the gateway (rr+ws://<gateway>/?service=<device>), made
+// One browser RR session to a device through the gateway (rr+ws://<gateway>/<page's folder>?service=<device>), made
 // with the client package (vendor/rr/robotraconteur.mjs) and kept up: after a failed connect or a
 // close it connects again with backoff (0.5 s doubling to 5 s).
 //
@@ -19,10 +19,16 @@ export function loadClientPackage() {
   return rrModule;
 }
 
-/** The RR URL of device `name` on the gateway that served this page. */
+/**
+ * The RR URL of device `name` on the gateway that served this page, relative to the page: the page's
+ * folder keeps a reverse proxy's path prefix (a page at https://site/rr/ connects to
+ * rr+wss://site/rr/?service=name), so `location /rr/ { proxy_pass http://gateway/; }` is all a proxy
+ * needs (docs/deployment.md). The hash (#/device) and the page's query are not part of it.
+ */
 export function deviceUrl(name, loc = window.location) {
   const scheme = loc.protocol === "https:" ? "rr+wss" : "rr+ws";
-  return `${scheme}://${loc.host}/?service=${encodeURIComponent(name)}`;
+  const folder = new URL(".", `${loc.protocol}//${loc.host}${loc.pathname}`).pathname;
+  return `${scheme}://${loc.host}${folder}?service=${encodeURIComponent(name)}`;
 }
 
 export class DeviceSession extends EventTarget {

@@ -1,0 +1,103 @@
+// The client package as a user gets it: `npm pack` of wasm-client/dist gives a tarball holding every
+// file package.json lists; `npm install` of that tarball into an empty project works offline; index.d.ts
+// type-checks typecheck/usage.ts (tsc --noEmit, strict) and rejects every line of typecheck/misuse.ts;
+// the compiled usage.ts then runs against rr-gateway's demo devices (every member kind, errors).
+// Usage: node package_test.mjs --gateway PATH. Exit 77 (skipped) when dist/ or typescript is missing.
+import { execFileSync, spawn } from "node:child_process";
+import fs from "node:fs";
+import os from "node:os";
+import path from "node:path";
+import readline from "node:readline";
+import { fileURLToPath } from "node:url";
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const pkgRoot = path.resolve(here, "..");
+const dist = path.join(pkgRoot, "dist");
+const tsc = path.join(pkgRoot, "node_modules/typescript/bin/tsc");
+const arg = (name) => { const i = process.argv.indexOf(name); return i > 0 ? process.argv[i + 1] : undefined; };
+const gatewayBin = arg("--gateway");
+
+function skip(why) { console.log(`SKIP: ${why}`); process.exit(77); }
+if (!fs.existsSync(path.join(dist, "robotraconteur_wasm.wasm"))) skip("wasm-client/dist not built (wasm-client/build.sh)");
+if (!fs.existsSync(tsc)) skip("typescript missing (npm ci in wasm-client/, scripts/setup.sh)");
+if (!gatewayBin) { console.error("usage: package_test.mjs --gateway PATH"); process.exit(2); }
+
+let failures = 0;
+const ok = (cond, what) => { console.log(`${cond ? "ok" : "FAIL"}: ${what}`); if (!cond) failures++; };
+const run = (cmd, args, opts = {}) => execFileSync(cmd, args, { encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], ...opts });
+
+const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "rr-wasm-pack-"));
+let gateway;
+try {
+  // npm pack: a tarball with every file of package.json "files"
+  const packed = JSON.parse(run("npm", ["pack", dist, "--pack-destination", tmp, "--json"], { cwd: tmp }))[0];
+  const listed = new Set(packed.files.map((f) => f.path));
+  const wanted = JSON.parse(fs.readFileSync(path.join(dist, "package.json"), "utf8")).files;
+  ok(wanted.every((f) => listed.has(f)), `npm pack: ${packed.filename} holds ${wanted.join(", ")} (${packed.size} bytes)`);
+
+  // an empty project installs the tarball (offline: nothing comes from a registry)
+  const app = path.join(tmp, "app");
+  fs.mkdirSync(app);
+  fs.writeFileSync(path.join(app, "package.json"), JSON.stringify({ name: "usage-app", private: true, type: "module" }));
+  run("npm", ["install", "--offline", "--no-audit", "--no-fund", "--no-package-lock", path.join(tmp, packed.filename)], { cwd: app });
+  const installed = path.join(app, "node_modules/robotraconteur-wasm");
+  ok(fs.existsSync(path.join(installed, "robotraconteur_wasm.wasm")) && fs.existsSync(path.join(installed, "index.d.ts")),
+    "npm install of the tarball");
+  // ws (the optional peer dependency for node) from this folder's node_modules
+  fs.symlinkSync(path.join(pkgRoot, "node_modules/ws"), path.join(app, "node_modules/ws"), "dir");
+
+  for (const f of ["usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
+  // tsc --noEmit: usage.ts is accepted
+  try {
+    run(process.execPath, [tsc, "--noEmit", "-p", app]);
+    ok(true, "tsc --noEmit (strict): usage.ts type-checks against index.d.ts");
+  } catch (e) {
+    ok(false, `tsc --noEmit usage.ts:\n${e.stdout}${e.stderr}`);
+  }
+  // every MISUSE line of misuse.ts is an error
+  let out = "";
+  try {
+    run(process.execPath, [tsc, "--noEmit", "--strict", "--module", "NodeNext", "--moduleResolution", "NodeNext", "--target", "ES2022",
+      "misuse.ts"], { cwd: app });
+  } catch (e) { out = e.stdout + e.stderr; }
+  const lines = fs.readFileSync(path.join(app, "misuse.ts"), "utf8").split("\n");
+  const misuse = lines.map((l, i) => (l.includes("// MISUSE") ? i + 1 : 0)).filter(Boolean);
+  const reported = misuse.filter((n) => new RegExp(`misuse\\.ts\\(${n},`).test(out));
+  ok(misuse.length === 5 && reported.length === misuse.length,
+    `tsc rejects misuse.ts lines ${misuse.join(", ")} (reported: ${reported.join(", ") || "none"})`);
+
+  // compile usage.ts and run it against the gateway's demo devices
+  run(process.execPath, [tsc, "-p", app]);
+  gateway = spawn(gatewayBin, ["--listen", "127.0.0.1", "--port", "0", "--no-local", "--log-level", "warning"], { stdio: ["ignore", "pipe", "pipe"] });
+  gateway.stderr.on("data", (d) => process.stderr.write(`[rr-gateway] ${d}`));
+  const port = await new Promise((resolve, reject) => {
+    const rl = readline.createInterface({ input: gateway.stdout });
+    rl.on("line", (l) => { try { const j = JSON.parse(l); if (j.port) resolve(j.port); } catch { /* not JSON */ } });
+    gateway.once("exit", () => reject(new Error("rr-gateway exited")));
+    setTimeout(() => reject(new Error("rr-gateway: no port line")), 30000);
+  });
+  // the demo devices connect to the gateway in the background: wait for both
+  for (let i = 0; ; i++) {
+    const devices = await (await fetch(`http://127.0.0.1:${port}/api/devices`)).json();
+    if (devices.filter((d) => d.state === "connected").length >= 2) break;
+    if (i > 200) throw new Error(`devices not connected: ${JSON.stringify(devices)}`);
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  try {
+    const r = run(process.execPath, [path.join(app, "out/usage.js"), `rr+ws://127.0.0.1:${port}/`], { cwd: app, timeout: 120000 });
+    process.stdout.write(`${r.trimEnd().replace(/^/gm, "  | ")}\n`);
+    ok(/usage: all ok/.test(r), "usage.js ran every member kind against the demo devices");
+  } catch (e) {
+    ok(false, `usage.js failed:\n${e.stdout}${e.stderr}`);
+  }
+} catch (e) {
+  ok(false, `${e.message}\n${e.stdout ?? ""}${e.stderr ?? ""}`);
+} finally {
+  if (gateway && gateway.exitCode === null) {
+    gateway.kill("SIGTERM");
+    await new Promise((r) => gateway.once("exit", r));
+  }
+  fs.rmSync(tmp, { recursive: true, force: true });
+}
+console.log(failures ? `${failures} failure(s)` : "all passed");
+process.exit(failures ? 1 : 0);
