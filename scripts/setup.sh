@@ -13,7 +13,7 @@ APT_PACKAGES=(
   python3-venv
   chromium fonts-liberation
   emscripten node-acorn
-  nginx openssl apache2-utils
+  nginx openssl apache2-utils haproxy
 )
 
 missing=()

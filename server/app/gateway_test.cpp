@@ -150,7 +150,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     REQUIRE((*gw)->ready());
 
     client::IoThreads io(1);
-    for (const std::string url : {"rr+local:///?nodename=" + name + "&service=dev",
+    for (const std::string& url : {"rr+local:///?nodename=" + name + "&service=dev",
                                   "rr+local:///?nodeid=" + (*gw)->node()->node_id().to_string() + "&service=dev"}) {
         INFO(url);
         auto c = client::Client::connect(io.executor(), url);
