@@ -129,7 +129,7 @@ std::string ConnectionUrl::to_string() const {
         // which is read after the path.
         const bool id = !node_id.is_any();
         const bool name_in_path =
-            !id && node_name.find_first_of("/?") == std::string::npos && !NodeID::parse(node_name);
+            !id && node_name.find_first_of("/?{") == std::string::npos && !NodeID::parse(node_name);
         const bool service_in_path = service.find('?') == std::string::npos;
         s += "/" + (id ? node_id.to_braced_string() : name_in_path ? node_name : std::string()) + "/" +
              (service_in_path ? service : std::string());
@@ -208,8 +208,7 @@ Result<ConnectionUrl> parse_connection_url(std::string_view url) {
         auto node = p.substr(0, slash);
         auto service = p.substr(slash + 1);
         service = service.substr(0, service.find('/'));  // CORE uses the second segment only
-        if (service.empty()) return bad(url, "legacy tcp:// URL needs /{node}/service");
-        out.service = std::string(service);
+        out.service = std::string(service);  // may come from ?service= instead (checked below)
         if (node.find('{') != std::string_view::npos) {  // as CORE: braces mean a NodeID, else a NodeName
             auto id = NodeID::parse(node);
             if (!id) return bad(url, "bad nodeid \"" + std::string(node) + "\"");
@@ -240,6 +239,7 @@ Result<ConnectionUrl> parse_connection_url(std::string_view url) {
         }
         // Other keys are ignored, as CORE does for unknown query parts it does not use.
     }
+    if (out.scheme == "tcp" && out.service.empty()) return bad(url, "legacy tcp:// URL needs /{node}/service");
     return out;
 }
 
