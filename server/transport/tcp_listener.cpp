@@ -1,6 +1,8 @@
 #include "server/transport/tcp_listener.hpp"
 
 #include <array>
+#include <cctype>
+#include <string_view>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/read.hpp>
@@ -75,6 +77,31 @@ void TcpListener::accept() {
     });
 }
 
+namespace {
+
+// Whether four bytes can begin an HTTP/1.1 request: a method token (RFC 9110 tchar), then the space
+// (or the tab CORE accepts) before the target; CR and LF for the empty lines a server may skip first.
+// Anything else is neither RR nor HTTP: dropped at once rather than left to the HTTP parser, which
+// waits for the end of a header that will never come (until the read timeout).
+bool could_begin_http(const std::array<std::byte, 4>& head) {
+    static constexpr std::string_view kTchar = "!#$%&'*+-.^_`|~";
+    bool token = false;
+    for (auto b : head) {
+        const auto c = static_cast<unsigned char>(b);
+        const bool t = std::isalnum(c) || kTchar.find(static_cast<char>(c)) != std::string_view::npos;
+        if (t) {
+            token = true;
+        } else if ((c == ' ' || c == '\t') && token) {
+            return true;
+        } else if (!((c == '\r' || c == '\n') && !token)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
 void TcpListener::detect(tcp::socket socket) {
     auto sink = sink_.lock();
     if (!sink || !sink->can_accept()) {
@@ -117,6 +144,9 @@ void TcpListener::detect(tcp::socket socket) {
             auto remote = d->socket.remote_endpoint(ec2);
             if (!ec2) info.peer = remote.address().to_string() + ":" + std::to_string(remote.port());
             serve_stream(*sink, std::move(d->socket), info, std::move(initial));
+        } else if (!could_begin_http(h)) {
+            boost::system::error_code ignored2;
+            d->socket.close(ignored2);  // neither RR nor HTTP (wrong magic, binary garbage): drop
         } else if (self->options_.http) {
             // Anything else is HTTP (plain requests and WebSocket upgrades).
             self->options_.http(std::move(d->socket), std::move(initial));
