@@ -214,7 +214,11 @@ def case_flood_then_stall(gw, kind, victims, total=100 << 20, seconds=25.0):
     sent, peak, deadline = 0, rss0, time.monotonic() + seconds
     buf = b""
     dropped = False
+    next_check = time.monotonic() + 2
     while sent < total and time.monotonic() < deadline:
+        if time.monotonic() > next_check:  # the victims are answered during the flood (and stay alive:
+            victims.check("during a %s flood" % kind)  # the node drops a peer silent for 15 s)
+            next_check = time.monotonic() + 2
         if not buf:
             buf = one
         try:

@@ -305,9 +305,12 @@ class JsonEcho:
         return ident, text
 
     def expect_reply(self, ident):
-        op, data = self.ws.recv()
-        expect(op == OP_TEXT, "JSON reply in opcode %d" % op)
-        reply = json.loads(data.decode("utf-8"))
+        while True:
+            op, data = self.ws.recv()
+            expect(op == OP_TEXT, "JSON reply in opcode %d" % op)
+            reply = json.loads(data.decode("utf-8"))
+            if "id" in reply:  # pushes (device_state, subscriptions) carry no id
+                break
         expect(reply.get("id") == ident, "reply to id %r...: %r" % (ident[:20], str(reply)[:200]))
         return reply
 
