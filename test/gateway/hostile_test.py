@@ -373,12 +373,13 @@ def case_connect_close(gw, kind, victims, n=1000):
     fds0 = fd_count(gw.pid)
     for i in range(n):
         try:
+            # 20 s: a loaded CI machine may be slow to answer one handshake among a thousand.
             if kind == "ws":
-                p = Pipe("ws", gw)
+                p = Pipe("ws", gw, timeout=20)
             elif kind == "local":
-                p = Pipe("local", gw)
+                p = Pipe("local", gw, timeout=20)
             else:
-                p = Pipe("tcp", gw)
+                p = Pipe("tcp", gw, timeout=20)
                 if kind == "http":
                     p.sock.sendall(b"GET /livez HTTP/1.1\r\nHost: x\r\n")
         except ConnectionRefusedError:
