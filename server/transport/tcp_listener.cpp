@@ -1,7 +1,6 @@
 #include "server/transport/tcp_listener.hpp"
 
 #include <array>
-#include <cctype>
 #include <string_view>
 
 #include <boost/asio/post.hpp>
@@ -79,25 +78,19 @@ void TcpListener::accept() {
 
 namespace {
 
-// Whether four bytes can begin an HTTP/1.1 request: a method token (RFC 9110 tchar), then the space
-// (or the tab CORE accepts) before the target; CR and LF for the empty lines a server may skip first.
-// Anything else is neither RR nor HTTP: dropped at once rather than left to the HTTP parser, which
-// waits for the end of a header that will never come (until the read timeout).
+// Whether four bytes can begin an HTTP/1.1 request: the start of "METHOD " for a standard method
+// (RFC 9110 §9; "GET\t" as CORE accepts), or CR/LF (the empty lines a server may skip first). Anything
+// else is neither RR nor HTTP (a wrong magic, binary garbage): dropped at once rather than handed to
+// the HTTP parser, which waits for the end of a header that never comes (until the read timeout).
+// Extension methods are not served by the gateway, so nothing is lost by refusing them here.
 bool could_begin_http(const std::array<std::byte, 4>& head) {
-    static constexpr std::string_view kTchar = "!#$%&'*+-.^_`|~";
-    bool token = false;
-    for (auto b : head) {
-        const auto c = static_cast<unsigned char>(b);
-        const bool t = std::isalnum(c) || kTchar.find(static_cast<char>(c)) != std::string_view::npos;
-        if (t) {
-            token = true;
-        } else if ((c == ' ' || c == '\t') && token) {
-            return true;
-        } else if (!((c == '\r' || c == '\n') && !token)) {
-            return false;
-        }
-    }
-    return true;
+    const std::string_view h(reinterpret_cast<const char*>(head.data()), head.size());
+    if (h[0] == '\r' || h[0] == '\n') return true;
+    static constexpr std::string_view kStarts[] = {"GET ", "GET\t", "HEAD", "POST", "PUT ", "DELE", "OPTI",
+                                                   "PATC", "CONN", "TRAC"};
+    for (auto s : kStarts)
+        if (h == s) return true;
+    return false;
 }
 
 }  // namespace
