@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds the debug preset (ASan + UBSan), runs every
-# test (unit, interop against the official library), then builds the libFuzzer targets and runs each
+# test (unit, interop against the official library), the server tests again under ThreadSanitizer
+# (with RR_TSAN=1), then builds the libFuzzer targets and runs each
 # briefly (scripts/fuzz.sh; RR_FUZZ_SECONDS=N for N seconds each, 0 for none). Exits non-zero on any failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,6 +19,18 @@ else
   echo "test: wasm-client/dist missing: the browser tests will be skipped"
 fi
 ctest --preset debug -j "$jobs"
+
+# ThreadSanitizer (issue 16): the threaded server tests (node, client, gateway, transports: the
+# "server: " tests of rr_server_tests) built with -fsanitize=thread in build/tsan (preset tsan builds
+# only rr_server_tests) and run; a data race fails the run (halt_on_error; test/support/tsan.supp holds
+# only explained third-party false positives). RR_TSAN=1 runs it. Off by default until a clean run has
+# been recorded in docs/reliability.md: the build could not be completed on the loaded machine where
+# this step was written, and an unverified race or TSan-slowed timeout must not block every CI run.
+if [ "${RR_TSAN:-0}" != 0 ]; then
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan -j "$jobs"
+  ctest --preset tsan -j "$jobs"
+fi
 
 # RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times (~3.5 min).
 fuzz_seconds=${RR_FUZZ_SECONDS:-}

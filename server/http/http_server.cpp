@@ -155,9 +155,24 @@ private:
             }
             std::string text = beast::buffers_to_string(self->buffer_.data());
             self->buffer_.consume(self->buffer_.size());
+            // Beast 1.81 checks UTF-8 per frame and misses a text message that ends inside a UTF-8
+            // sequence when its last frame is empty (read.hpp calls finish() only after copying bytes).
+            // RFC 6455 §8.1: fail the connection with 1007, as for invalid UTF-8 anywhere else.
+            if (self->ws_.got_text() && !websocket::detail::check_utf8(text.data(), text.size())) {
+                self->fail(websocket::close_code::bad_payload, "invalid UTF-8 in a text message");
+                return;
+            }
             if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
             self->read();
         });
+    }
+
+    // Ends the WebSocket with a close frame carrying `code` (the read side already stopped).
+    void fail(websocket::close_code code, const char* reason) {
+        auto self = shared_from_this();
+        closed_ = true;
+        beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(5));
+        ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) { self->finish(); });
     }
 
     void write() {

@@ -1,6 +1,7 @@
 #include "server/transport/tcp_listener.hpp"
 
 #include <array>
+#include <string_view>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/read.hpp>
@@ -75,6 +76,25 @@ void TcpListener::accept() {
     });
 }
 
+namespace {
+
+// Whether four bytes can begin an HTTP/1.1 request: the start of "METHOD " for a standard method
+// (RFC 9110 §9; "GET\t" as CORE accepts), or CR/LF (the empty lines a server may skip first). Anything
+// else is neither RR nor HTTP (a wrong magic, binary garbage): dropped at once rather than handed to
+// the HTTP parser, which waits for the end of a header that never comes (until the read timeout).
+// Extension methods are not served by the gateway, so nothing is lost by refusing them here.
+bool could_begin_http(const std::array<std::byte, 4>& head) {
+    const std::string_view h(reinterpret_cast<const char*>(head.data()), head.size());
+    if (h[0] == '\r' || h[0] == '\n') return true;
+    static constexpr std::string_view kStarts[] = {"GET ", "GET\t", "HEAD", "POST", "PUT ", "DELE", "OPTI",
+                                                   "PATC", "CONN", "TRAC"};
+    for (auto s : kStarts)
+        if (h == s) return true;
+    return false;
+}
+
+}  // namespace
+
 void TcpListener::detect(tcp::socket socket) {
     auto sink = sink_.lock();
     if (!sink || !sink->can_accept()) {
@@ -117,6 +137,9 @@ void TcpListener::detect(tcp::socket socket) {
             auto remote = d->socket.remote_endpoint(ec2);
             if (!ec2) info.peer = remote.address().to_string() + ":" + std::to_string(remote.port());
             serve_stream(*sink, std::move(d->socket), info, std::move(initial));
+        } else if (!could_begin_http(h)) {
+            boost::system::error_code ignored2;
+            d->socket.close(ignored2);  // neither RR nor HTTP (wrong magic, binary garbage): drop
         } else if (self->options_.http) {
             // Anything else is HTTP (plain requests and WebSocket upgrades).
             self->options_.http(std::move(d->socket), std::move(initial));
