@@ -76,7 +76,9 @@ export class DiscoveredList extends EventTarget {
       this.model = discoveredModel(await r.json());
       this.status.textContent = "";
       this.section.hidden = false;
-      this.render();
+      // Rebuilt only when something changed (a button under the pointer stays the same element).
+      const key = JSON.stringify([this.model, [...this.pending]]);
+      if (key !== this.shown) this.render();
     } catch (e) {
       this.status.textContent = `discovery unavailable: ${errorText(e)}`;
     }
@@ -105,6 +107,7 @@ export class DiscoveredList extends EventTarget {
 
   render() {
     if (!this.model) return;
+    this.shown = JSON.stringify([this.model, [...this.pending]]);
     const items = this.model.nodes.map((n) => h("li", { class: "discovered-node", dataset: { nodeid: n.nodeid, source: n.source } },
       h("div", { class: "discovered-head" },
         h("span", { class: "device-name", text: n.nodename || n.nodeid }),
