@@ -13,9 +13,10 @@
 //
 // Ours, not CORE's: a node counts only while it runs. CORE reports every entry it finds, and the
 // official node leaves its entries behind when it exits, so CORE's discovery keeps reporting nodes that
-// are gone until the URL expires. An entry is live when another process holds its fcntl write lock (the
-// official and our servers hold it while they run), or when it names this process and its socket exists
-// (POSIX locks of our own process are invisible to F_GETLK).
+// are gone until the URL expires. An entry is live when another process holds the fcntl write lock on
+// its sibling `.pid` file (by-nodeid/<id>.pid: the official and our servers hold it while they run; a
+// lock on the `.info` itself counts too), or when it names this process and its socket exists (POSIX
+// locks of our own process are invisible to F_GETLK).
 //
 // LocalNodeWatcher keeps the list current: inotify on the entry directories (CORE's events plus
 // IN_CLOSE_WRITE, which the kernel sends when a server's entry file is closed, also when the process is
