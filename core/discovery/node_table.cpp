@@ -183,6 +183,21 @@ std::optional<NodeEntry> NodeTable::remove(const NodeID& id) {
     return e;
 }
 
+bool NodeTable::remove_urls(const NodeID& id, const std::vector<std::string>& urls, std::optional<NodeEntry>& lost) {
+    lost.reset();
+    auto it = nodes_.find(id);
+    if (it == nodes_.end()) return false;
+    auto& known = it->second.urls;
+    const auto before = known.size();
+    std::erase_if(known, [&](const DetectedUrl& u) { return std::find(urls.begin(), urls.end(), u.url) != urls.end(); });
+    if (known.size() == before) return false;
+    if (known.empty()) {
+        lost = std::move(it->second);
+        nodes_.erase(it);
+    }
+    return true;
+}
+
 void NodeTable::set_want_services(bool want, MonoTime now) {
     if (want == want_services_) return;
     want_services_ = want;

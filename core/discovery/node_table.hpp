@@ -112,6 +112,10 @@ public:
     std::vector<NodeEntry> take_evicted();
     /// Removes a node at once (its source says it is gone, e.g. an rr+local socket vanished).
     std::optional<NodeEntry> remove(const NodeID& id);
+    /// Removes some URLs of a node (one source says they are gone; others may still know the node).
+    /// `lost`: the node when no URL is left (then removed from the table). Returns true when a URL was
+    /// removed.
+    bool remove_urls(const NodeID& id, const std::vector<std::string>& urls, std::optional<NodeEntry>& lost);
 
     /// Whether ServiceInfo2 is wanted (some subscriber needs services): nodes become due for interrogation.
     void set_want_services(bool want, MonoTime now);

@@ -167,6 +167,30 @@ TEST_CASE("discovery table: other sources feed the same table") {
     CHECK(t.size() == 0);
 }
 
+TEST_CASE("discovery table: a source removes only its own URLs of a node") {
+    NodeTable t;
+    auto id = make_id(8);
+    const std::string local = "rr+local:///?nodeid=" + id.to_string() + "&service=RobotRaconteurServiceIndex";
+    NodeAnnouncement a = ann(id, url_for(id));
+    CHECK(t.node_detected(a, t0) == DetectResult::added);
+    NodeAnnouncement l = ann(id, local);
+    l.source = NodeSource::local;
+    CHECK(t.node_detected(l, t0 + 1s) == DetectResult::updated);
+    REQUIRE(t.find(id)->urls.size() == 2);
+    std::optional<NodeEntry> lost;
+    CHECK_FALSE(t.remove_urls(make_id(9), {local}, lost));
+    CHECK_FALSE(t.remove_urls(id, {"rr+local:///?nodeid=other"}, lost));
+    CHECK(t.remove_urls(id, {local}, lost));
+    CHECK_FALSE(lost);
+    REQUIRE(t.find(id));
+    CHECK(t.find(id)->urls.size() == 1);
+    CHECK(t.find(id)->urls[0].url == url_for(id));
+    CHECK(t.remove_urls(id, {url_for(id)}, lost));
+    REQUIRE(lost);
+    CHECK(lost->node_id == id);
+    CHECK(t.size() == 0);
+}
+
 TEST_CASE("discovery table: ServiceInfo2 from a GetLocalNodeServices value") {
     auto id = make_id(3);
     Structure s{"RobotRaconteurServiceIndex.ServiceInfo", {}};

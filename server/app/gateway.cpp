@@ -1,10 +1,17 @@
 #include "server/app/gateway.hpp"
 
+#include <cstdio>
 #include <sstream>
+#include <thread>
 
 #include "server/app/gateway_discovery.hpp"
 #include "server/app/log.hpp"
+#include "server/transport/discovery/discovery_sources.hpp"
 #include "server/transport/local/local_listener.hpp"
+#ifdef RR_HAVE_USB
+#include "server/transport/usb/usb_discovery.hpp"
+#include "server/transport/usb/usb_host.hpp"
+#endif
 
 namespace rr::server::app {
 
@@ -65,6 +72,34 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     if (!reservation) return reservation.take_error();
     if (*reservation && c.node_id.empty()) opts.node_id = (*reservation)->node_id;
     g->node_ = Node::create(opts);
+
+    // rr+usb (docs/usb.md): a USB host on the node's executor when a device or discover: entry names
+    // rr+usb, or usb.enabled is true; the devices reach it through the node's transports.
+    if (usb_wanted(c)) {
+#ifdef RR_HAVE_USB
+        usb::UsbHostOptions uo;
+        for (const auto& a : c.usb.allow) uo.allowed.push_back(usb::UsbDeviceId{a.vendor_id, a.product_id, a.interface_number});
+        uo.hotplug = c.usb.hotplug;
+        uo.poll_interval = c.usb.poll_interval;
+        uo.log = [](std::string_view line) { log(LogLevel::debug, "rr+usb: " + std::string(line)); };
+        auto host = usb::UsbHost::create(g->node_->io_context().get_executor(), uo);
+        if (!host)
+            return fail(host.error().type,
+                        "rr+usb: " + host.error().message +
+                            " (the configuration uses USB; in a container pass the bus in with --device /dev/bus/usb, "
+                            "or turn USB off with usb.enabled: false)");
+        g->usb_host_ = *host;
+        usb::register_usb_transport(g->node_->transports(), g->usb_host_);
+        log(LogLevel::info, std::string("rr+usb: USB host transport on (") +
+                                (g->usb_host_->uses_hotplug() ? std::string("hotplug")
+                                                              : "polling every " + std::to_string(c.usb.poll_interval.count()) + " ms") +
+                                ")");
+#else
+        return fail(MessageErrorType::InvalidConfiguration,
+                    "rr+usb: this rr-gateway was built without libusb-1.0, so the configuration's rr+usb devices cannot be "
+                    "reached (rebuild with libusb-1.0-0-dev, or remove them)");
+#endif
+    }
 
     std::vector<gateway::DeviceConfig> devices = c.devices;
     if (c.demo) {
@@ -143,7 +178,14 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         dopts.interfaces = c.discovery.interfaces;
         dopts.limits.max_nodes = c.discovery.max_nodes;
         dopts.limits.url_expiry = c.discovery.node_expiry;
+        // Services are read over the node's transports (rr+tcp, rr+local, and rr+usb when on).
+        dopts.transports = &g->node_->transports();
         std::weak_ptr<Node> weak_node = g->node_;
+        // One ServiceStateNonce per node: the announces carry the node's, as its rr+local entries do.
+        dopts.service_state_nonce = [weak_node] {
+            auto n = weak_node.lock();
+            return n ? n->service_state_nonce() : std::string();
+        };
         dopts.listen_endpoints = [weak_node] {
             auto n = weak_node.lock();
             return n ? n->listen_endpoints() : std::vector<boost::asio::ip::tcp::endpoint>{};
@@ -159,9 +201,11 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         if (json_api) {
             std::weak_ptr<DiscoveredDevices> weak = g->discovered_;
             gateway::JsonApi::DiscoveryHooks hooks;
-            hooks.list = [weak] {
+            hooks.list = [weak, self] {
                 auto d = weak.lock();
-                return d ? d->list() : nlohmann::json{{"nodes", nlohmann::json::array()}};
+                auto j = d ? d->list() : nlohmann::json{{"nodes", nlohmann::json::array()}};
+                j["usb_problems"] = self->usb_problems();
+                return j;
             };
             hooks.add = [weak](const nlohmann::json& body, gateway::JsonApi::Done done) {
                 auto d = weak.lock();
@@ -205,6 +249,16 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     }
     if (g->discovery_) {
         if (auto r = g->discovery_->start(); !r) return r.take_error();
+        // Other sources of the table: this computer's rr+local nodes and the USB devices.
+        if (c.discovery.local) {
+            discovery::LocalSourceOptions lo;
+            lo.dirs = local::default_node_directories();
+            g->local_source_ = discovery::LocalDiscoverySource::start(g->node_->io_context().get_executor(), g->discovery_, lo);
+        }
+#ifdef RR_HAVE_USB
+        if (g->usb_host_)
+            g->usb_source_ = usb::UsbDiscoverySource::start(g->node_->io_context().get_executor(), g->usb_host_, g->discovery_);
+#endif
     }
     return g;
 }
@@ -215,10 +269,35 @@ std::vector<std::shared_ptr<gateway::DeviceMirror>> Gateway::discovered_devices(
     return discovered_ ? discovered_->devices() : std::vector<std::shared_ptr<gateway::DeviceMirror>>{};
 }
 
+nlohmann::json Gateway::usb_problems() const {
+    auto out = nlohmann::json::array();
+#ifdef RR_HAVE_USB
+    if (!usb_host_) return out;
+    for (const auto& d : usb_host_->devices()) {
+        if (!d.error) continue;
+        char id[16];
+        std::snprintf(id, sizeof id, "%04x:%04x", d.vendor_id, d.product_id);
+        out.push_back({{"device", id}, {"path", d.device_path}, {"error", d.error->message}});
+    }
+#endif
+    return out;
+}
+
 void Gateway::stop() {
     if (discovered_) discovered_->stop();
+    if (local_source_) local_source_->stop();
+#ifdef RR_HAVE_USB
+    if (usb_source_) usb_source_->stop();
+#endif
     if (discovery_) discovery_->stop(std::chrono::milliseconds(6000));  // before the node's threads stop
     for (auto& d : devices_) d->stop();
+#ifdef RR_HAVE_USB
+    if (usb_host_) {
+        // Before the node's threads stop: the host's strand runs on them.
+        usb_host_->shutdown();
+        for (int i = 0; i < 200 && !usb_host_->idle(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+#endif
     if (node_) node_->shutdown();
     if (demo_node_) demo_node_->shutdown();
 }

@@ -1,6 +1,8 @@
 // The assembled gateway: the gateway node (RR + HTTP + WebSocket on one port), one DeviceMirror per
 // configured device, the embedded demo devices on their own node (reached over rr+tcp on loopback, so
-// the default path is the real path), health endpoints and the JSON API.
+// the default path is the real path), health endpoints and the JSON API. Transports for the devices:
+// the node's TransportRegistry, plus rr+usb (a UsbHost) when the configuration needs it (usb_wanted).
+// Discovery (when on) is fed by UDP, by the rr+local node directories and by the USB devices.
 #pragma once
 
 #include <functional>
@@ -26,6 +28,15 @@ using ApiInstaller = std::function<std::shared_ptr<gateway::JsonApi>(
     http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices)>;
 
 class DiscoveredDevices;
+}  // namespace rr::server::app
+namespace rr::server::discovery {
+class LocalDiscoverySource;
+}
+namespace rr::server::usb {
+class UsbHost;
+class UsbDiscoverySource;
+}  // namespace rr::server::usb
+namespace rr::server::app {
 
 class Gateway {
 public:
@@ -44,6 +55,11 @@ public:
     const std::shared_ptr<discovery::NodeDiscovery>& discovery() const noexcept { return discovery_; }
     /// Devices found by `discover:` filters or added from the JSON API, now.
     std::vector<std::shared_ptr<gateway::DeviceMirror>> discovered_devices() const;
+    /// The rr+usb host transport, nullptr unless the configuration needs it (usb_wanted()).
+    const std::shared_ptr<usb::UsbHost>& usb_host() const noexcept { return usb_host_; }
+    /// USB devices found but unusable (no permission: the udev rule to install; malformed descriptors),
+    /// for GET /api/discovered: [{"device": "1209:0001", "path": "/dev/bus/usb/…", "error": "…"}].
+    nlohmann::json usb_problems() const;
 
     /// Ready when every required device is connected (/readyz).
     bool ready() const;
@@ -60,6 +76,9 @@ private:
     std::uint16_t port_ = 0;
     std::shared_ptr<discovery::NodeDiscovery> discovery_;
     std::shared_ptr<DiscoveredDevices> discovered_;
+    std::shared_ptr<usb::UsbHost> usb_host_;
+    std::shared_ptr<discovery::LocalDiscoverySource> local_source_;
+    std::shared_ptr<usb::UsbDiscoverySource> usb_source_;
 };
 
 }  // namespace rr::server::app

@@ -86,7 +86,24 @@ bool valid_node_name(const std::string& name) {
     return true;
 }
 
+bool names_usb(const GatewayConfig& c, std::string* key) {
+    for (const auto& d : c.devices)
+        if (d.url.rfind("rr+usb:", 0) == 0) {
+            if (key) *key = "devices." + d.name + ".url";
+            return true;
+        }
+    for (std::size_t i = 0; i < c.discover.size(); ++i)
+        for (const auto& t : c.discover[i].filter.transport_schemes)
+            if (t == "rr+usb") {
+                if (key) *key = "discover[" + std::to_string(i) + "].transports";
+                return true;
+            }
+    return false;
+}
+
 void validate(const GatewayConfig& c, const std::function<void(const std::string&, const std::string&)>& error) {
+    if (std::string key; c.usb.enabled == UsbSettings::Mode::off && names_usb(c, &key))
+        error(key, "rr+usb is turned off by usb.enabled: false (remove it, or enable USB)");
     if (!valid_node_name(c.node_name))
         error("gateway.node_name", "not a NodeName (letters, digits, _ . -, starting with a letter): \"" + c.node_name + "\"");
     if (!c.node_id.empty() && !NodeID::parse(c.node_id)) error("gateway.node_id", "not a NodeID (UUID)");
@@ -150,7 +167,8 @@ rr::discovery::FilterAttributeGroup attribute_group(const YAML::Node& n, const R
 
 void parse_discovery(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
     if (auto d = root["discovery"]) {
-        r.check_keys(d, "discovery", {"enabled", "announce", "ipv4_broadcast", "interfaces", "max_nodes", "node_expiry_ms"});
+        r.check_keys(d, "discovery", {"enabled", "announce", "ipv4_broadcast", "interfaces", "max_nodes", "node_expiry_ms", "local"});
+        if (auto n = d["local"]) c.discovery.local = r.boolean(n, "discovery.local");
         if (auto n = d["node_expiry_ms"]) {
             c.discovery.node_expiry = std::chrono::milliseconds(r.unsigned_int(n, "discovery.node_expiry_ms", 3600000));
             if (c.discovery.node_expiry.count() < 1000) r.error(n, "discovery.node_expiry_ms", "must be at least 1000");
@@ -235,10 +253,63 @@ void parse_discovery(const YAML::Node& root, const Reader& r, GatewayConfig& c) 
     if (!c.discover.empty()) c.discovery.enabled = true;
 }
 
+// A USB id: an integer, hexadecimal with 0x (0x1209, as lsusb shows 1209) or decimal.
+std::uint64_t usb_id(const YAML::Node& n, const Reader& r, const std::string& key, std::uint64_t max) {
+    if (!n.IsScalar()) r.error(n, key, "expected a number (hexadecimal with 0x, e.g. 0x1209)");
+    const auto& s = n.Scalar();
+    std::uint64_t v = 0;
+    const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+    const char* first = s.data() + (hex ? 2 : 0);
+    auto [p, ec] = std::from_chars(first, s.data() + s.size(), v, hex ? 16 : 10);
+    if (s.empty() || ec != std::errc() || p != s.data() + s.size())
+        r.error(n, key, "expected a number (hexadecimal with 0x, e.g. 0x1209), got \"" + s + "\"");
+    if (v > max) r.error(n, key, "must be at most " + std::to_string(max));
+    return v;
+}
+
+void parse_usb(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
+    auto u = root["usb"];
+    if (!u) return;
+    r.check_keys(u, "usb", {"enabled", "allow", "hotplug", "poll_interval_ms"});
+    if (auto n = u["enabled"]) {
+        if (n.IsScalar() && n.Scalar() == "auto") {
+            c.usb.enabled = UsbSettings::Mode::automatic;
+        } else {
+            bool on = false;
+            if (!n.IsScalar() || !YAML::convert<bool>::decode(n, on)) r.error(n, "usb.enabled", "expected true, false or auto");
+            c.usb.enabled = on ? UsbSettings::Mode::on : UsbSettings::Mode::off;
+        }
+    }
+    if (auto n = u["hotplug"]) c.usb.hotplug = r.boolean(n, "usb.hotplug");
+    if (auto n = u["poll_interval_ms"]) {
+        c.usb.poll_interval = std::chrono::milliseconds(r.unsigned_int(n, "usb.poll_interval_ms", 3600000));
+        if (c.usb.poll_interval.count() < 100) r.error(n, "usb.poll_interval_ms", "must be at least 100");
+    }
+    if (auto list = u["allow"]) {
+        if (!list.IsSequence()) r.error(list, "usb.allow", "expected a list of {vid, pid, interface}");
+        std::size_t i = 0;
+        for (const auto& e : list) {
+            const std::string key = "usb.allow[" + std::to_string(i++) + "]";
+            r.check_keys(e, key, {"vid", "pid", "interface"});
+            if (!e["vid"]) r.error(e, key + ".vid", "missing");
+            if (!e["pid"]) r.error(e, key + ".pid", "missing");
+            UsbAllowEntry a;
+            a.vendor_id = static_cast<std::uint16_t>(usb_id(e["vid"], r, key + ".vid", 0xFFFF));
+            a.product_id = static_cast<std::uint16_t>(usb_id(e["pid"], r, key + ".pid", 0xFFFF));
+            if (auto n = e["interface"]) a.interface_number = static_cast<std::uint8_t>(usb_id(n, r, key + ".interface", 255));
+            c.usb.allow.push_back(a);
+        }
+    }
+    if (c.usb.enabled == UsbSettings::Mode::off) {
+        std::string key;
+        if (names_usb(c, &key)) r.error(u["enabled"], key, "rr+usb is turned off by usb.enabled: false (remove it, or enable USB)");
+    }
+}
+
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb"});
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
@@ -302,10 +373,20 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         }
     }
     parse_discovery(root, r, c);
+    parse_usb(root, r, c);
     return c;
 }
 
 }  // namespace
+
+bool usb_wanted(const GatewayConfig& config) {
+    switch (config.usb.enabled) {
+        case UsbSettings::Mode::on: return true;
+        case UsbSettings::Mode::off: return false;
+        case UsbSettings::Mode::automatic: return names_usb(config, nullptr);
+    }
+    return false;
+}
 
 Result<GatewayConfig> parse_gateway_config(std::string_view yaml_text, std::string_view source) {
     Reader reader(source);

@@ -23,6 +23,26 @@ struct DiscoverySettings {
     std::vector<std::string> interfaces;  ///< interface names; empty = all
     std::size_t max_nodes = 1024;  ///< node table cap (oldest evicted)
     std::chrono::milliseconds node_expiry{60000};  ///< a node's URL lives this long after its last announce
+    /// Also list the rr+local nodes of this computer (their node directories, watched) in the table.
+    bool local = true;
+};
+
+/// One `usb.allow` entry: a device admitted without the RR BOS capability (docs/usb.md).
+struct UsbAllowEntry {
+    std::uint16_t vendor_id = 0;
+    std::uint16_t product_id = 0;
+    std::uint8_t interface_number = 0;
+};
+
+/// `usb:` (docs/gateway-config.md, docs/usb.md): the rr+usb host transport (libusb).
+struct UsbSettings {
+    enum class Mode { automatic, on, off };
+    /// automatic (the default): on when a device URL or a `discover:` entry's `transports` names
+    /// rr+usb; on: always (USB devices then also appear in discovery); off: never (rr+usb URLs refused).
+    Mode enabled = Mode::automatic;
+    std::vector<UsbAllowEntry> allow;        ///< devices without the BOS capability
+    bool hotplug = true;                     ///< libusb hotplug where available, else polling
+    std::chrono::milliseconds poll_interval{2000};  ///< rescan period without hotplug
 };
 
 /// One `discover:` entry: services selected by filter become gateway devices while their node is seen.
@@ -60,7 +80,12 @@ struct GatewayConfig {
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;
+    // usb:
+    UsbSettings usb;
 };
+
+/// Whether the configuration needs the rr+usb host transport (UsbSettings::enabled).
+bool usb_wanted(const GatewayConfig& config);
 
 /// Parses YAML text. `source` names the file in error messages. Errors: InvalidConfiguration with
 /// "<source>:<line>: <key>: <problem>".

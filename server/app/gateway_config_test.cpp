@@ -71,6 +71,81 @@ TEST_CASE("configuration errors name the key and the line") {
     }
 }
 
+TEST_CASE("usb: starts when the configuration names rr+usb, or when enabled; allow-list ids") {
+    auto none = parse_gateway_config("devices:\n  - name: a\n    url: rr+tcp://x:1/?service=s\n", "t.yaml");
+    REQUIRE(none);
+    CHECK(none->usb.enabled == UsbSettings::Mode::automatic);
+    CHECK_FALSE(usb_wanted(*none));
+    auto dev = parse_gateway_config("devices:\n  - name: b\n    url: rr+usb:///?nodename=board&service=s\n", "t.yaml");
+    REQUIRE(dev);
+    CHECK(usb_wanted(*dev));
+    auto disc = parse_gateway_config("discover:\n  - type: a.B\n    transports: [rr+local, rr+usb]\n", "t.yaml");
+    REQUIRE(disc);
+    CHECK(usb_wanted(*disc));
+    CHECK(disc->discovery.enabled);
+    CHECK(disc->discovery.local);
+    auto any = parse_gateway_config("discover:\n  - type: a.B\n", "t.yaml");  // no transports: USB not started
+    REQUIRE(any);
+    CHECK_FALSE(usb_wanted(*any));
+    auto on = parse_gateway_config(R"(
+usb:
+  enabled: true
+  hotplug: false
+  poll_interval_ms: 500
+  allow:
+    - {vid: 0x1209, pid: 0x0001}
+    - {vid: 4617, pid: 0xBEEF, interface: 2}
+discovery:
+  local: false
+)", "t.yaml");
+    REQUIRE(on);
+    CHECK(usb_wanted(*on));
+    CHECK_FALSE(on->usb.hotplug);
+    CHECK(on->usb.poll_interval == std::chrono::milliseconds(500));
+    REQUIRE(on->usb.allow.size() == 2);
+    CHECK(on->usb.allow[0].vendor_id == 0x1209);
+    CHECK(on->usb.allow[0].product_id == 0x0001);
+    CHECK(on->usb.allow[0].interface_number == 0);
+    CHECK(on->usb.allow[1].vendor_id == 0x1209);
+    CHECK(on->usb.allow[1].product_id == 0xBEEF);
+    CHECK(on->usb.allow[1].interface_number == 2);
+    CHECK_FALSE(on->discovery.local);
+    auto autom = parse_gateway_config("usb:\n  enabled: auto\n", "t.yaml");
+    REQUIRE(autom);
+    CHECK_FALSE(usb_wanted(*autom));
+
+    struct Case {
+        const char* yaml;
+        const char* expect;
+    };
+    for (auto [yaml, expect] : {
+             Case{"usb:\n  enabled: maybe\n", "bad.yaml:2: usb.enabled: expected true, false or auto"},
+             Case{"usb:\n  allow:\n    - {vid: 0x1209}\n", "bad.yaml:3: usb.allow[0].pid: missing"},
+             Case{"usb:\n  allow:\n    - {vid: 0x12345, pid: 1}\n", "bad.yaml:3: usb.allow[0].vid: must be at most 65535"},
+             Case{"usb:\n  allow:\n    - {vid: 12ab, pid: 1}\n", "bad.yaml:3: usb.allow[0].vid: expected a number"},
+             Case{"usb:\n  allow:\n    - {vid: 1, pid: 1, interface: 256}\n", "bad.yaml:3: usb.allow[0].interface: must be at most 255"},
+             Case{"usb:\n  allow:\n    - {vid: 1, pid: 1, if: 0}\n", "bad.yaml:3: usb.allow[0].if: unknown key"},
+             Case{"usb:\n  poll_interval_ms: 5\n", "bad.yaml:2: usb.poll_interval_ms: must be at least 100"},
+             Case{"usb:\n  enabled: false\ndevices:\n  - name: b\n    url: rr+usb:///?nodename=x&service=s\n",
+                  "bad.yaml:2: devices.b.url: rr+usb is turned off"},
+             Case{"discovery:\n  local: yes please\n", "bad.yaml:2: discovery.local: expected true or false"},
+         }) {
+        auto c = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(c);
+        CHECK_THAT(c.error().message, Catch::StartsWith(expect));
+    }
+    // A --device flag naming rr+usb with USB turned off is refused too.
+    auto off = parse_gateway_config("usb:\n  enabled: false\n", "t.yaml");
+    REQUIRE(off);
+    const char* argv[] = {"rr-gateway", "--device", "b=rr+usb:///?nodename=x&service=s"};
+    auto cmd = parse_command_line(3, argv);
+    REQUIRE(cmd);
+    auto r = apply_overrides(*off, *cmd);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("rr+usb is turned off"));
+}
+
 TEST_CASE("command-line flags override the file, including the official RR flags") {
     const char* argv[] = {"rr-gateway", "--config", "x.yaml", "--port=9000", "--robotraconteur-nodename=gw2",
                           "--device", "reynard=rr+tcp://localhost:29200/?service=reynard", "--no-demo",
@@ -109,13 +184,13 @@ TEST_CASE("bad flags are refused with the flag's name") {
 
 TEST_CASE("every example in gateway-config/ is a valid configuration") {
     int n = 0;
-    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml"}) {
+    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml"}) {
         auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/" + name);
         INFO(name);
         REQUIRE(c);
         ++n;
     }
-    CHECK(n == 3);
+    CHECK(n == 4);
     auto missing = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/nope.yaml");
     REQUIRE_FALSE(missing);
     CHECK_THAT(missing.error().message, Catch::Contains("cannot read"));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/names/connection_url.hpp"
 #include "server/app/log.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
@@ -70,8 +71,26 @@ void DiscoveredDevices::stop() {
 void DiscoveredDevices::on_event(const discovery::DiscoveryEvent& e) {
     using Kind = discovery::DiscoveryEvent::Kind;
     if (e.kind == Kind::node_lost) return drop_node(e.node.node_id, "node " + e.node.node_id.to_string() + " lost");
-    if (e.kind == Kind::services_updated) sync_node(e.node);
+    // node_updated: URLs came or went (an rr+local entry closed while UDP still knows the node, a USB
+    // device unplugged): devices reached through a vanished URL go, new URLs may select services.
+    if (e.kind == Kind::services_updated || e.kind == Kind::node_updated) sync_node(e.node);
 }
+
+namespace {
+
+// Devices reached over rr+local or rr+usb stay only while the node still has a URL of that transport
+// (those sources take their URLs back when the node goes). Network URLs expire with the node instead.
+bool endpoint_still_known(const core::NodeEntry& node, const std::string& device_url) {
+    auto d = parse_connection_url(device_url);
+    if (!d || (d->scheme != "rr+local" && d->scheme != "rr+usb")) return true;
+    for (const auto& u : node.urls) {
+        auto n = parse_connection_url(u.url);
+        if (n && n->scheme == d->scheme && n->host == d->host && n->user == d->user) return true;
+    }
+    return false;
+}
+
+}  // namespace
 
 void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
     if (!node.services) return;
@@ -90,6 +109,7 @@ void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
             auto s = std::find_if(node.services->begin(), node.services->end(),
                                   [&](const core::ServiceInfo2& x) { return x.name == it->first.second; });
             bool keep = s != node.services->end();
+            keep = keep && endpoint_still_known(node, it->second.url);
             if (keep && it->second.rule >= 0) {
                 auto m = core::match_service(rules_[static_cast<std::size_t>(it->second.rule)].filter, *s, node_urls);
                 keep = m && std::any_of(m->urls.begin(), m->urls.end(), [&](const std::string& u) {

@@ -5,9 +5,11 @@
 
 #include "core/discovery/service_filter.hpp"
 #include "server/cli/cli_target.hpp"
+#include "server/cli/cli_usb.hpp"
 #include "server/client/client.hpp"
 #include "server/transport/discovery/discovery_json.hpp"
 #include "server/transport/discovery/node_discovery.hpp"
+#include "server/transport/local/local_discovery.hpp"
 
 namespace rr::cli {
 
@@ -27,6 +29,26 @@ bool wanted(const rr::discovery::ServiceInfo2& s, const std::vector<std::string>
 
 std::chrono::milliseconds seconds(double s) { return std::chrono::milliseconds(static_cast<long long>(s * 1000)); }
 
+// This computer's rr+local nodes and the USB devices go into the same table as the network's
+// (docs/discovery.md "Other sources"); their services are read over rr+local / rr+usb.
+void add_local_and_usb_nodes(NodeDiscovery& d, double timeout_s, std::ostream& err) {
+    for (const auto& n : server::local::find_local_nodes(server::local::default_node_directories()))
+        d.add_node({n.node_id, n.node_name, n.urls, n.service_state_nonce, rr::discovery::NodeSource::local});
+    auto usb = list_usb_devices(std::min(seconds(timeout_s), std::chrono::milliseconds(10000)));
+    if (!usb) {
+        if (usb.error().type != MessageErrorType::NotImplementedError)
+            err << "rr: note: USB devices not listed: " << usb.error().message << std::endl;
+        return;
+    }
+    for (const auto& u : *usb) {
+        if (u.error) {
+            err << "rr: " << u.description << ": " << u.error->message << std::endl;
+            continue;
+        }
+        d.add_node({u.node_id, u.node_name, {u.url}, {}, rr::discovery::NodeSource::usb});
+    }
+}
+
 }  // namespace
 
 bool needs_discovery(const ConnectionUrl& url) {
@@ -45,6 +67,7 @@ ExitCode run_discover(const CommandLine& cl, std::ostream& out, std::ostream& er
         err << "rr: " << error_name(r.error().type) << ": " << r.error().message << std::endl;
         return ExitCode::connect_failure;
     }
+    add_local_and_usb_nodes(*d, cl.timeout_s, err);
     const auto deadline = std::chrono::steady_clock::now() + seconds(cl.timeout_s);
     // Wait the whole time (later nodes answer later), but stop early once every node found has answered
     // and at least half the time is gone.
@@ -77,7 +100,8 @@ ExitCode run_discover(const CommandLine& cl, std::ostream& out, std::ostream& er
             out << json_line(j) << "\n";
             continue;
         }
-        out << "node " << n.node_id.to_string() << "  " << (n.node_name.empty() ? "-" : n.node_name) << "\n";
+        out << "node " << n.node_id.to_string() << "  " << (n.node_name.empty() ? "-" : n.node_name) << "  ("
+            << rr::discovery::node_source_name(n.source) << ")\n";
         for (const auto& u : n.urls) out << "  url      " << u.url << "\n";
         if (!n.services) {
             out << "  services ? (" << (n.last_error.empty() ? "no answer in time" : n.last_error) << ")\n";

@@ -9,6 +9,7 @@
 
 #include "server/cli/cli_commands.hpp"
 #include "server/cli/cli_options.hpp"
+#include "server/cli/cli_usb.hpp"
 
 namespace {
 
@@ -42,5 +43,9 @@ int main(int argc, char** argv) {
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
     std::signal(SIGPIPE, SIG_IGN);
-    return static_cast<int>(run_command(*cl, std::cout, std::cerr, g_stop));
+    // rr+usb in the client's transports; libusb starts only when an rr+usb URL or discover needs it.
+    auto usb = install_usb_transport();
+    const auto code = run_command(*cl, std::cout, std::cerr, g_stop);
+    usb.reset();
+    return static_cast<int>(code);
 }

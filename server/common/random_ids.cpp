@@ -26,6 +26,17 @@ NodeID random_node_id() {
     return NodeID(b);
 }
 
+std::string random_service_state_nonce(std::string_view previous) {
+    static constexpr std::string_view kChars = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    auto& rng = generator();
+    std::string out;
+    do {
+        out.clear();
+        for (int i = 0; i < 16; ++i) out.push_back(kChars[rng() % kChars.size()]);
+    } while (out == previous);
+    return out;
+}
+
 std::uint32_t random_endpoint_id() {
     auto& rng = generator();
     std::uint32_t v;

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <string_view>
 
 #include "core/names/node_id.hpp"
 
@@ -14,5 +16,9 @@ NodeID random_node_id();
 
 /// A fresh endpoint number, never 0.
 std::uint32_t random_endpoint_id();
+
+/// A fresh ServiceStateNonce: 16 characters of [A-Za-z0-9] (wire.md §11.1; CORE's form), never equal
+/// to `previous`.
+std::string random_service_state_nonce(std::string_view previous = {});
 
 }  // namespace rr::server

@@ -25,6 +25,7 @@ Node::Node(NodeOptions options) : options_(std::move(options)) {
     if (options_.threads == 0) options_.threads = std::max(2u, std::thread::hardware_concurrency());
     options_.server.stream.local_node_id = options_.node_id;
     options_.server.stream.local_node_name = options_.node_name;
+    service_state_nonce_ = random_service_state_nonce();
     work_ = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(io_.get_executor());
 }
 
@@ -147,12 +148,15 @@ void Node::services_changed() {
     local_node_services_changed(service_index_);
     std::vector<std::shared_ptr<Listener>> listeners;
     std::vector<std::function<void()>> callbacks;
+    std::string nonce;
     {
         std::lock_guard lock(mutex_);
+        service_state_nonce_ = random_service_state_nonce(service_state_nonce_);
+        nonce = service_state_nonce_;
         listeners = listeners_;
         callbacks = services_changed_callbacks_;
     }
-    for (const auto& l : listeners) l->services_changed();
+    for (const auto& l : listeners) l->services_changed(nonce);
     for (const auto& c : callbacks) c();
 }
 
@@ -162,6 +166,11 @@ std::vector<tcp::endpoint> Node::listen_endpoints() const {
     for (const auto& l : listeners_)
         if (auto t = std::dynamic_pointer_cast<TcpListener>(l)) out.push_back(t->local_endpoint());
     return out;
+}
+
+std::string Node::service_state_nonce() const {
+    std::lock_guard lock(mutex_);
+    return service_state_nonce_;
 }
 
 void Node::on_services_changed(std::function<void()> callback) {

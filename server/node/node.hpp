@@ -67,8 +67,13 @@ public:
     /// TCP endpoints the node listens on, as bound (wildcards not expanded): what discovery announces.
     std::vector<boost::asio::ip::tcp::endpoint> listen_endpoints() const;
     /// Adds a callback run after every register_service / unregister_service (on that thread, no lock
-    /// held): discovery renews its ServiceStateNonce there (wire.md §11.1).
+    /// held), after the ServiceStateNonce was renewed: discovery announces the new one there.
     void on_services_changed(std::function<void()> callback);
+    /// The node's ServiceStateNonce (wire.md §11.1; CORE RobotRaconteurNode::GetServiceStateNonce): 16
+    /// characters, renewed whenever a service is registered or removed. The node has one: its UDP
+    /// announces and its rr+local entries carry the same value, so clients re-read its services when it
+    /// changes, whichever way they found the node. Thread-safe.
+    std::string service_state_nonce() const;
     /// Where TCP sockets starting with anything but `RRAC` go (HTTP; default: answer 404 and close).
     void set_http_handler(HttpHandler handler);
 
@@ -112,6 +117,7 @@ private:
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
     std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
     std::vector<std::function<void()>> services_changed_callbacks_;
+    std::string service_state_nonce_;  // guarded by mutex_
     std::atomic<bool> stopped_{false};
 };
 

@@ -111,8 +111,9 @@ public:
     virtual std::vector<std::string> urls() const = 0;
     /// Stops accepting (open connections stay). Idempotent; thread-safe.
     virtual void stop() = 0;
-    /// The node's set of services changed (a listener that publishes a service-state nonce renews it).
-    virtual void services_changed() {}
+    /// The node's set of services changed and `service_state_nonce` is the node's new ServiceStateNonce
+    /// (a listener that publishes one, as rr+local's entries do, writes it; Node::service_state_nonce()).
+    virtual void services_changed(const std::string& service_state_nonce) { (void)service_state_nonce; }
 };
 
 }  // namespace rr::server

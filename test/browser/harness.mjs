@@ -28,9 +28,9 @@ export function settings() {
 
 /** A child process whose stdout lines are read for a JSON object holding `key`. */
 class Child {
-  constructor(name, cmd, args) {
+  constructor(name, cmd, args, env = undefined) {
     this.name = name;
-    this.proc = spawn(cmd, args, { stdio: ["ignore", "pipe", "pipe"] });
+    this.proc = spawn(cmd, args, { stdio: ["ignore", "pipe", "pipe"], env });
     this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
     this.lines = readline.createInterface({ input: this.proc.stdout });
     this.stderr = [];
@@ -84,13 +84,14 @@ export async function startReynard(s, rrPort = 0) {
 
 /**
  * Starts rr-gateway on 127.0.0.1 (port 0 = ephemeral), demo devices on, plus `devices` {name: url}
- * and `extraArgs` (e.g. ["--allow-origin", ORIGIN]).
+ * and `extraArgs` (e.g. ["--allow-origin", ORIGIN]). `options.local`: publish the node on rr+local
+ * (default false: --no-local); `options.env`: the process environment (e.g. node directories).
  */
-export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = []) {
-  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning", "--no-local",
-    ...extraArgs];
+export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = [], options = {}) {
+  const args = ["--listen", "127.0.0.1", "--port", String(listenPort), "--web-root", s.webRoot, "--log-level", "warning",
+    ...(options.local ? [] : ["--no-local"]), ...extraArgs];
   for (const [name, url] of Object.entries(devices)) args.push("--device", `${name}=${url}`);
-  const child = new Child("rr-gateway", s.gateway, args);
+  const child = new Child("rr-gateway", s.gateway, args, options.env);
   const { port } = await child.jsonLine("port", 30000);
   return { child, port, base: `http://127.0.0.1:${port}` };
 }

@@ -390,6 +390,30 @@ def local_error_checks(exe, node_name):
           f"rc={p.returncode} stderr={p.stderr.strip()}")
 
 
+def local_discover_checks(exe, node_name, root_type):
+    """`rr discover` lists the running rr+local node (docs/cli.md): source local, its rr+local URL, and its
+    services read over rr+local."""
+    p = subprocess.run([exe, "discover", "--json", "--timeout", "3", "--type", root_type], capture_output=True, text=True,
+                       timeout=60)
+    check(p.returncode == OK, "rr discover exits 0", f"rc={p.returncode} stderr={p.stderr.strip()}")
+    nodes = []
+    for line in p.stdout.splitlines():
+        try:
+            nodes.append(json.loads(line))
+        except ValueError:
+            check(False, "rr discover --json prints JSON lines", repr(line))
+    node = next((n for n in nodes if n.get("nodename") == node_name), None)
+    if not check(node is not None, "rr discover lists the rr+local node", p.stdout[:800] + p.stderr[-400:]):
+        return
+    check(node.get("source") == "local", "rr discover: the node's source is local", str(node))
+    want = f"rr+local:///?nodeid={node['nodeid']}&service=RobotRaconteurServiceIndex"
+    check(want in node.get("urls", []), "rr discover: the node's rr+local URL", str(node.get("urls")))
+    svc = next((x for x in node.get("services") or [] if x.get("name") == "interop"), None)
+    check(svc is not None and svc.get("root_object_type") == root_type and
+          f"rr+local:///?nodeid={node['nodeid']}&service=interop" in svc.get("urls", []),
+          "rr discover: its services read over rr+local", str(node.get("services")) + " " + str(node.get("error")))
+
+
 def stale_checks(exe, url):
     """After an official node stopped (it leaves its entries behind), its entry is reported stale."""
     p = subprocess.run([exe, "get", url, "p_int32"], capture_output=True, text=True, timeout=30)
@@ -444,6 +468,7 @@ def main():
                 node_index_checks(rr, ready["url"], "interop", "experimental.interop_test.Root")
         if args.local:
             local_error_checks(args.rr, local_name)
+            local_discover_checks(args.rr, local_name, "experimental.interop_test.Root")
     finally:
         if proc is not None:
             stop(proc)

@@ -16,8 +16,16 @@
 
 #include <boost/asio/io_context.hpp>
 
+#include <sstream>
+
 #include "core/codec/endian.hpp"
+#include "server/app/gateway.hpp"
+#include "server/cli/cli_commands.hpp"
+#include "server/cli/cli_options.hpp"
+#include "server/cli/cli_usb.hpp"
 #include "core/usb/usb_protocol.hpp"
+#include "server/transport/discovery/node_discovery.hpp"
+#include "server/transport/usb/usb_discovery.hpp"
 #include "test/usb/usb_world.hpp"
 
 using namespace rr;
@@ -470,6 +478,41 @@ std::string check_permission_report(const std::string& path) {
     return problem;
 }
 
+// The same problem as the gateway and rr report it: a configured rr+usb device's state reason, and
+// rr's error and exit status. Returns "" when both name the udev rule.
+std::string check_gateway_and_cli_report() {
+    const std::string url = std::string("rr+usb:///?nodename=") + kDeviceNodeName + "&service=create";
+    auto config = server::app::parse_gateway_config(
+        "gateway: {listen: 127.0.0.1, port: 0, local: false}\ndemo: {enabled: false}\ndevices:\n  - name: board\n    url: \"" +
+            url + "\"\n",
+        "test.yaml");
+    if (!config) return "config: " + config.error().message;
+    if (!server::app::usb_wanted(*config)) return "usb not wanted by an rr+usb device";
+    auto gw = server::app::Gateway::start(*config);
+    if (!gw) return "gateway: " + gw.error().message;
+    if (!(*gw)->usb_host()) return "the gateway started no USB host";
+    std::string problem;
+    auto reason_ok = [&] {
+        auto s = (*gw)->device("board")->status();
+        return s.state != server::gateway::DeviceState::connected && s.reason.find("99-robotraconteur-usb.rules") != std::string::npos;
+    };
+    if (!eventually(reason_ok, 10s)) problem = "device reason: " + (*gw)->device("board")->status().reason;
+    (*gw)->stop();
+    if (!problem.empty()) return problem;
+
+    auto usb = cli::install_usb_transport();
+    auto cl = cli::parse_command_line({"info", url, "--timeout", "5"});
+    if (!cl) return "rr command line";
+    std::ostringstream out, err;
+    std::atomic<bool> stop{false};
+    const auto code = cli::run_command(*cl, out, err, stop);
+    if (code != cli::ExitCode::connect_failure) return "rr exit status " + std::to_string(static_cast<int>(code));
+    if (err.str().find("SystemResourcePermissionDenied") == std::string::npos ||
+        err.str().find("99-robotraconteur-usb.rules") == std::string::npos)
+        return "rr error: " + err.str();
+    return {};
+}
+
 }  // namespace
 
 TEST_CASE("usb emulated: a device the process may not open is reported with the udev rule to install", "[permission]") {
@@ -497,7 +540,8 @@ TEST_CASE("usb emulated: a device the process may not open is reported with the 
     REQUIRE(pid >= 0);
     if (pid == 0) {
         if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
-        const auto problem = check_permission_report(dev->device_path());
+        auto problem = check_permission_report(dev->device_path());
+        if (problem.empty()) problem = check_gateway_and_cli_report();
         if (!problem.empty()) std::fprintf(stderr, "permission check: %s\n", problem.c_str());
         ::_exit(problem.empty() ? 0 : 1);
     }
@@ -523,4 +567,50 @@ TEST_CASE("usb emulated: the device table follows plug and unplug by hotplug, an
         CHECK(eventually([&] { return w->host->devices().empty(); }, 3s));
         if (!hotplug) CHECK(w->host->stats().hotplug_events == 0);
     }
+}
+
+TEST_CASE("usb emulated: USB devices feed the discovery table, their services are read over rr+usb", "[discover]") {
+    auto w = world(no_demo());
+    start(*w);  // rr+usb in default_transports(), which the interrogations use
+    auto d = server::discovery::NodeDiscovery::create(w->io.executor(), [] {
+        server::discovery::DiscoveryOptions o;
+        o.port = 0;
+        o.interfaces = {"lo"};
+        return o;
+    }());
+    REQUIRE(d->start());
+    d->want_services(true);
+    std::atomic<int> lost{0};
+    d->add_listener([&](const server::discovery::DiscoveryEvent& e) {
+        if (e.kind == server::discovery::DiscoveryEvent::Kind::node_lost && e.node.node_id == device_node_id()) ++lost;
+    });
+    auto source = server::usb::UsbDiscoverySource::start(w->io.executor(), w->host, d);
+    CHECK_FALSE(d->node(device_node_id()));
+
+    auto* dev = plug(*w);  // hotplug: the host's table changes, the source adds the node
+    REQUIRE(eventually([&] { return d->node(device_node_id()).has_value(); }, 5s));
+    auto n = d->node(device_node_id());
+    CHECK(n->node_name == kDeviceNodeName);
+    CHECK(n->source == rr::discovery::NodeSource::usb);
+    REQUIRE(n->urls.size() == 1);
+    CHECK(n->urls[0].url == "rr+usb:///?nodeid=" + device_node_id().to_string() + "&service=RobotRaconteurServiceIndex");
+    REQUIRE(eventually([&] {
+        auto x = d->node(device_node_id());
+        return x && x->services.has_value();
+    }, 10s));
+    n = d->node(device_node_id());
+    auto s = std::find_if(n->services->begin(), n->services->end(), [](const auto& x) { return x.name == "usbtest"; });
+    REQUIRE(s != n->services->end());
+    CHECK(s->root_object_type == "example.usbtest.Bench");
+    CHECK(s->connection_urls == std::vector<std::string>{"rr+usb:///?nodeid=" + device_node_id().to_string() + "&service=usbtest"});
+
+    w->emulator->unplug(dev);  // unplugged: lost at once, not after the 60 s expiry
+    CHECK(eventually([&] { return lost.load() == 1; }, 5s));
+    CHECK_FALSE(d->node(device_node_id()));
+    plug(*w, UsbWorld::device_options(5));  // re-plugged at another address: back
+    CHECK(eventually([&] { return d->node(device_node_id()).has_value(); }, 5s));
+
+    source->stop();
+    CHECK_FALSE(d->node(device_node_id()));  // stop() takes its URLs back
+    d->stop(6s);
 }

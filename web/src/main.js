@@ -1,8 +1,10 @@
-// Entry point: the device list on the left, the selected device (#/<name>) on the right.
+// Entry point: the device list (and, with discovery on, the discovered nodes) on the left, the
+// selected device (#/<name>) on the right.
 
 import { h } from "./dom.js";
 import { DeviceList } from "./device_list.js";
 import { DeviceView } from "./device_view.js";
+import { DiscoveredList } from "./discovered_list.js";
 
 const list = new DeviceList(document.getElementById("device-list"), document.getElementById("gateway-status"));
 const main = document.getElementById("device-view");
@@ -27,5 +29,12 @@ list.addEventListener("update", (ev) => {
   if (!location.hash && ev.detail.length) location.replace(`#/${encodeURIComponent(ev.detail[0].name)}`);
 });
 window.addEventListener("hashchange", route);
+const discovered = new DiscoveredList(document.getElementById("device-list"));
+// A service added from the discovered list opens as the selected device.
+discovered.addEventListener("added", (ev) => {
+  list.poll();
+  if (ev.detail?.name) location.hash = `#/${encodeURIComponent(ev.detail.name)}`;
+});
 list.start();
+discovered.start();
 route();

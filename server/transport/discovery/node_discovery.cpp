@@ -351,11 +351,7 @@ void NodeDiscovery::send_announces() {
             targets.emplace(a, ep.port());
         }
     }
-    std::string nonce;
-    {
-        std::lock_guard lock(mutex_);
-        nonce = nonce_;
-    }
+    const std::string nonce = service_state_nonce();
     for (const auto& [addr, port] : targets) {
         if (addr.is_v6()) {
             const auto v6 = addr.to_v6();
@@ -393,13 +389,15 @@ void NodeDiscovery::send_requests_now() {
 void NodeDiscovery::services_changed() {
     {
         std::lock_guard lock(mutex_);
-        std::array<std::uint8_t, 16> r{};
-        std::string n;
-        do {
-            for (auto& b : r) b = static_cast<std::uint8_t>(rng_());
-            n = core::make_service_state_nonce(r);
-        } while (n == nonce_);
-        nonce_ = n;
+        if (!options_.service_state_nonce) {
+            std::array<std::uint8_t, 16> r{};
+            std::string n;
+            do {
+                for (auto& b : r) b = static_cast<std::uint8_t>(rng_());
+                n = core::make_service_state_nonce(r);
+            } while (n == nonce_);
+            nonce_ = n;
+        }
         announce_.announce_soon(now());
         if (stopped_ || !started_) return;
     }
@@ -407,6 +405,7 @@ void NodeDiscovery::services_changed() {
 }
 
 std::string NodeDiscovery::service_state_nonce() const {
+    if (options_.service_state_nonce) return options_.service_state_nonce();
     std::lock_guard lock(mutex_);
     return nonce_;
 }
@@ -454,6 +453,21 @@ void NodeDiscovery::remove_node(const NodeID& id) {
     {
         std::lock_guard lock(mutex_);
         if (auto e = table_.remove(id)) events.push_back({DiscoveryEvent::Kind::node_lost, std::move(*e)});
+    }
+    emit(std::move(events));
+}
+
+void NodeDiscovery::remove_urls(const NodeID& id, const std::vector<std::string>& urls) {
+    std::vector<DiscoveryEvent> events;
+    {
+        std::lock_guard lock(mutex_);
+        std::optional<NodeEntry> lost;
+        if (!table_.remove_urls(id, urls, lost)) return;
+        if (lost) {
+            events.push_back({DiscoveryEvent::Kind::node_lost, std::move(*lost)});
+        } else if (const auto* e = table_.find(id)) {
+            events.push_back({DiscoveryEvent::Kind::node_updated, *e});
+        }
     }
     emit(std::move(events));
 }
@@ -606,6 +620,7 @@ void NodeDiscovery::interrogate(NodeID id, std::vector<std::string> urls, std::s
     opts.connect_timeout = options_.interrogate_timeout;
     opts.request_timeout = options_.interrogate_timeout;
     opts.limits.max_message_size = 1u << 20;  // a service index reply is small (CORE drops > 64 KiB elements)
+    opts.transports = options_.transports;
     std::string url = urls[index];
     client::Client::connect(executor_, url, opts,
                             [self, id, urls, index, nonce, finish](Result<std::shared_ptr<client::Client>> c) mutable {

@@ -19,8 +19,9 @@
 // Link-local URLs are announced without a zone (as CORE does); connectable_urls() adds the interface
 // the node's datagrams came from (`[fe80::1%3]`), or every local link-local interface when unknown.
 //
-// Other sources (rr+local node directories, USB devices) add their nodes with add_node(); they share the
-// table, the events and the interrogation.
+// Other sources (rr+local node directories, USB devices: discovery_sources.hpp) add their nodes with
+// add_node() and take their URLs back with remove_urls(); they share the table, the events and the
+// interrogation (over rr+local and rr+usb too, interrogate_schemes).
 //
 // Thread-safety: every public function may be called from any thread. Listeners run on the discovery's
 // strand without locks held; they must not block.
@@ -46,6 +47,7 @@
 #include "core/discovery/discovery_timing.hpp"
 #include "core/discovery/node_table.hpp"
 #include "server/transport/discovery/local_addresses.hpp"
+#include "server/transport/transport_registry.hpp"
 
 namespace rr::server::discovery {
 
@@ -66,8 +68,15 @@ struct DiscoveryOptions {
     rr::discovery::NodeTableLimits limits;
     /// The node's TCP listening endpoints to announce (wildcards are expanded to the local addresses).
     std::function<std::vector<boost::asio::ip::tcp::endpoint>()> listen_endpoints;
-    /// URL schemes used to interrogate service indexes.
-    std::vector<std::string> interrogate_schemes{"rr+tcp"};
+    /// URL schemes used to interrogate service indexes (a node's URLs of other schemes are not asked).
+    std::vector<std::string> interrogate_schemes{"rr+tcp", "rr+local", "rr+usb"};
+    /// Connectors for the interrogations (nullptr: server::default_transports()); a gateway passes its
+    /// node's, which holds rr+usb when USB is on. Must outlive the discovery.
+    const TransportRegistry* transports = nullptr;
+    /// The node's ServiceStateNonce, announced (wire.md §11.1): the node owns one nonce that its
+    /// announces and its rr+local entries both carry (Node::service_state_nonce()). Unset: the
+    /// discovery keeps its own, renewed by services_changed().
+    std::function<std::string()> service_state_nonce;
     std::chrono::milliseconds interrogate_timeout{5000};
     std::size_t max_parallel_interrogations = 4;
     /// Interface names to use (join, send); empty = every interface.
@@ -96,7 +105,8 @@ public:
 
     /// Starts a round of 3 discovery requests (ignored when a round is running).
     void send_requests_now();
-    /// Our services changed: a new ServiceStateNonce, announced within 500 ms.
+    /// Our services changed: announced within 500 ms with the new ServiceStateNonce (the provider's,
+    /// or a fresh one of our own when options().service_state_nonce is unset).
     void services_changed();
     /// The current ServiceStateNonce.
     std::string service_state_nonce() const;
@@ -110,6 +120,9 @@ public:
     rr::discovery::DetectResult add_node(const NodeAnnouncement& announcement);
     /// Removes a node whose source says it is gone (fires node_lost).
     void remove_node(const NodeID& id);
+    /// Removes the URLs one source knew a node by (an rr+local entry gone, a USB device unplugged):
+    /// node_lost when none is left, node_updated when other sources still know it.
+    void remove_urls(const NodeID& id, const std::vector<std::string>& urls);
 
     std::vector<NodeEntry> nodes() const;
     std::optional<NodeEntry> node(const NodeID& id) const;

@@ -58,7 +58,7 @@ public:
     Result<void> start(LocalListenOptions options, std::optional<NodeNameReservation> reservation);
     void accept();
     void detect(unix_socket::socket socket);
-    void refresh();
+    void refresh(const std::string& nonce);
     void close();
     std::vector<std::string> info_files() const {
         std::lock_guard lock(mutex_);
@@ -163,7 +163,7 @@ Result<void> LocalListener::Impl::start(LocalListenOptions options, std::optiona
     info_["nodename"] = name;
     info_["nodeid"] = node_id.to_braced_string();
     info_["socket"] = socket_path_;
-    info_["ServiceStateNonce"] = random_alnum(16);
+    info_["ServiceStateNonce"] = options.service_state_nonce.empty() ? random_service_state_nonce() : options.service_state_nonce;
     info_["pid"] = std::to_string(::getpid());
     info_["username"] = *user;
     const std::string pid_text = std::to_string(::getpid());
@@ -256,10 +256,10 @@ void LocalListener::Impl::detect(unix_socket::socket socket) {
     });
 }
 
-void LocalListener::Impl::refresh() {
+void LocalListener::Impl::refresh(const std::string& nonce) {
     std::lock_guard lock(mutex_);
     if (closed_) return;
-    info_["ServiceStateNonce"] = random_alnum(16);
+    info_["ServiceStateNonce"] = nonce.empty() ? random_service_state_nonce(info_["ServiceStateNonce"]) : nonce;
     const std::string text = format_info(info_);
     for (auto* f : {&info_id_, &info_name_})
         if (f->is_open()) (void)f->replace(text);
@@ -315,7 +315,13 @@ std::string LocalListener::url() const { return local_listen_url(impl_->node_id_
 
 std::vector<std::string> LocalListener::info_files() const { return impl_->info_files(); }
 
-void LocalListener::refresh_service_state() { impl_->refresh(); }
+void LocalListener::refresh_service_state(const std::string& nonce) { impl_->refresh(nonce); }
+
+std::string LocalListener::service_state_nonce() const {
+    std::lock_guard lock(impl_->mutex_);
+    auto it = impl_->info_.find("ServiceStateNonce");
+    return it == impl_->info_.end() ? std::string() : it->second;
+}
 
 void LocalListener::close() {
     if (impl_) impl_->close();

@@ -49,6 +49,9 @@ struct LocalListenOptions {
     bool public_server = false;
     /// How long an accepted socket may take to send its first 4 bytes (as TCP, wire.md §6.1).
     std::chrono::milliseconds first_bytes_timeout{5000};
+    /// The ServiceStateNonce the entries start with: the node's (Node::service_state_nonce(); set by
+    /// listen_local). Empty: a random one.
+    std::string service_state_nonce;
 };
 
 class LocalListener : public Listener, public std::enable_shared_from_this<LocalListener> {
@@ -79,10 +82,13 @@ public:
     /// The `.info` files this listener holds (by-nodeid first).
     std::vector<std::string> info_files() const;
 
-    /// Picks a new ServiceStateNonce and rewrites the `.info` files (CORE LocalNodeServicesChanged;
-    /// local discovery re-reads a node's service index when the nonce changes). Call when services
-    /// are registered or removed.
-    void refresh_service_state();
+    /// Writes `service_state_nonce` (the node's new one; empty: a fresh random one) into the `.info`
+    /// files (CORE LocalNodeServicesChanged writes the node's GetServiceStateNonce(); local discovery
+    /// re-reads a node's service index when the nonce changes). The node calls it when services are
+    /// registered or removed (Listener::services_changed).
+    void refresh_service_state(const std::string& service_state_nonce = {});
+    /// The ServiceStateNonce the entries carry now.
+    std::string service_state_nonce() const;
     /// Stops accepting, removes the socket file and the entries, releases the NodeName/NodeID.
     /// Connections already accepted stay with the node. Idempotent.
     void close();
@@ -91,7 +97,7 @@ public:
     std::string scheme() const override { return "rr+local"; }
     std::vector<std::string> urls() const override { return {url()}; }
     void stop() override { close(); }
-    void services_changed() override { refresh_service_state(); }
+    void services_changed(const std::string& nonce) override { refresh_service_state(nonce); }
 
     class Impl;
 
@@ -111,6 +117,8 @@ Result<std::shared_ptr<LocalListener>> listen_local(const std::shared_ptr<NodeT>
                                                     std::optional<NodeNameReservation> reservation = std::nullopt) {
     if (!node) return fail(MessageErrorType::InvalidArgument, "no node");
     options.first_bytes_timeout = node->options().first_bytes_timeout;
+    if constexpr (requires(NodeT& n) { n.service_state_nonce(); })
+        if (options.service_state_nonce.empty()) options.service_state_nonce = node->service_state_nonce();
     std::weak_ptr<ConnectionSink> sink = node;
     auto l = LocalListener::start(node->io_context().get_executor(), sink, node->node_id(), node->node_name(),
                                   std::move(options), std::move(reservation));

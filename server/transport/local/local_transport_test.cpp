@@ -173,12 +173,24 @@ TEST_CASE("local: a named node is found by NodeName, NodeID and both, its entrie
         CHECK((*c)->close_wait().ok());
     }
 
-    // A new ServiceStateNonce is written to both entries.
+    // The entries carry the node's one ServiceStateNonce; a change of services renews it in both
+    // entries (CORE LocalNodeServicesChanged writes the node's GetServiceStateNonce()).
     const auto nonce = info["ServiceStateNonce"];
-    listener->refresh_service_state();
+    CHECK(nonce == node->service_state_nonce());
+    CHECK(listener->service_state_nonce() == nonce);
+    node->unregister_service("svc");
     auto after = parse_info(read_file(info_name));
     CHECK(after["ServiceStateNonce"] != nonce);
+    CHECK(after["ServiceStateNonce"] == node->service_state_nonce());
     CHECK(read_file(info_name) == read_file(info_id));
+    REQUIRE(node->register_service(std::make_shared<server::testing::RawTestService>()));
+    CHECK(parse_info(read_file(info_id))["ServiceStateNonce"] == node->service_state_nonce());
+    CHECK(node->service_state_nonce() != after["ServiceStateNonce"]);
+    // Without a node's nonce the listener picks a fresh one.
+    const auto before_refresh = listener->service_state_nonce();
+    listener->refresh_service_state();
+    CHECK(listener->service_state_nonce().size() == 16);
+    CHECK(listener->service_state_nonce() != before_refresh);
 
     // Clean close: socket and entries gone, the NodeName lock file stays (unlocked), as CORE leaves it.
     const std::string socket = listener->socket_path();

@@ -471,12 +471,34 @@ void UsbHost::scan_finished() {
     }
 }
 
+namespace {
+
+bool same_device(const UsbDeviceInfo& a, const UsbDeviceInfo& b) {
+    return a.node_id == b.node_id && a.node_name == b.node_name && a.url == b.url && a.bus == b.bus && a.address == b.address &&
+           a.interface_number == b.interface_number && a.error.has_value() == b.error.has_value() &&
+           (!a.error || a.error->message == b.error->message);
+}
+
+}  // namespace
+
 void UsbHost::publish() {
     std::vector<UsbDeviceInfo> out;
     for (const auto& [key, e] : entries_)
         if (e.state == Entry::State::Ready || e.state == Entry::State::Failed) out.push_back(e.info);
+    std::function<void(const std::vector<UsbDeviceInfo>&)> listener;
+    {
+        std::lock_guard lock(snapshot_mutex_);
+        const bool changed = out.size() != snapshot_.size() ||
+                             !std::equal(out.begin(), out.end(), snapshot_.begin(), same_device);
+        snapshot_ = out;
+        if (changed) listener = devices_listener_;
+    }
+    if (listener && !stopped_) listener(out);
+}
+
+void UsbHost::set_devices_listener(std::function<void(const std::vector<UsbDeviceInfo>&)> listener) {
     std::lock_guard lock(snapshot_mutex_);
-    snapshot_ = std::move(out);
+    devices_listener_ = std::move(listener);
 }
 
 std::vector<UsbDeviceInfo> UsbHost::devices() const {

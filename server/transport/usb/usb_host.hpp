@@ -102,6 +102,10 @@ public:
     Result<std::vector<UsbDeviceInfo>> enumerate_wait(std::chrono::milliseconds timeout = std::chrono::seconds(10));
     /// The table as last scanned (no bus access).
     std::vector<UsbDeviceInfo> devices() const;
+    /// Called with the new table (as devices() returns it) after a scan that changed it: a device
+    /// plugged, unplugged, identified or failing (hotplug or polling). Runs on the host's strand; must
+    /// not block. One listener; set it before the devices matter (the first scan starts at create()).
+    void set_devices_listener(std::function<void(const std::vector<UsbDeviceInfo>&)> listener);
 
     /// Adds a (VID, PID, interface) to the allow-list; takes effect at the next scan.
     void allow_device(UsbDeviceId id);
@@ -154,6 +158,7 @@ private:
     bool stopped_ = false;
     mutable std::mutex snapshot_mutex_;
     std::vector<UsbDeviceInfo> snapshot_;
+    std::function<void(const std::vector<UsbDeviceInfo>&)> devices_listener_;  // guarded by snapshot_mutex_
     std::map<NodeID, std::weak_ptr<UsbHostLink>> links_by_node_;  // guarded by snapshot_mutex_
     UsbHostStats stats_;
 };

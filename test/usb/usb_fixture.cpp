@@ -1,0 +1,129 @@
+// rr_usb_fixture: an emulated RR USB device (usb_emulator.hpp, under umockdev-wrapper) with the
+// programs that use it in the same process, for the tests that run our real gateway and CLI code
+// against it (test/usb/usb_gateway_test.py, usb_discover_test.py). umockdev answers the device's ioctls
+// in the process that created the emulator, so the gateway and rr run here, not as children.
+//
+//   rr_usb_fixture gateway CONFIG.yaml
+//       The device (NodeName usb_demo, the demo services `create` and `webcam` running, and `usbtest`,
+//       example.usbtest.Bench) plugged in, then the gateway started from CONFIG.yaml (server/app
+//       Gateway::start, the JSON API installed, no demo devices of its own). Prints one JSON line
+//       {"port": N, "device_nodeid": "…", "device_nodename": "usb_demo"} and runs until SIGTERM/SIGINT
+//       or stdin closes; exit status 0 after a clean stop.
+//   rr_usb_fixture rr ARGS…
+//       The device plugged in, then the rr command line ARGS run as rr_main runs them (the CLI's
+//       rr+usb connector installed); exits with rr's status.
+//
+// Exits 77 (skipped) when not under umockdev-wrapper.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <thread>
+
+#include <poll.h>
+#include <unistd.h>
+
+#include "server/app/gateway.hpp"
+#include "server/app/log.hpp"
+#include "server/cli/cli_commands.hpp"
+#include "server/cli/cli_options.hpp"
+#include "server/cli/cli_usb.hpp"
+#include "server/demo/demo_devices.hpp"
+#include "server/gateway/json_api_installer.hpp"
+#include "test/usb/usb_world.hpp"
+
+using namespace rr;
+using namespace rr::test::usb;
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop.store(true); }
+
+int usage() {
+    std::fprintf(stderr, "usage: rr_usb_fixture gateway CONFIG.yaml | rr ARGS...\n");
+    return 2;
+}
+
+// The emulated device with running demo devices (play_callback every second, as rr-demo-devices
+// --play-period 1 in the other gateway tests) and the usbtest service.
+Result<std::unique_ptr<UsbWorld>> device() {
+    WorldOptions o;
+    o.demo = false;  // UsbWorld's demo devices are not started; start running ones below
+    auto w = UsbWorld::create(o);
+    if (!w) return w.take_error();
+    server::demo::DemoOptions demo;
+    demo.create.play_period = std::chrono::seconds(1);
+    auto d = server::demo::start_demo_devices(*(*w)->node, demo);
+    if (!d) return d.take_error();
+    (*w)->demo = std::move(*d);
+    auto plugged = (*w)->plug();
+    if (!plugged) return plugged.take_error();
+    return w;
+}
+
+int run_gateway(const std::string& config_path) {
+    auto config = server::app::load_gateway_config(config_path);
+    if (!config) {
+        std::fprintf(stderr, "rr_usb_fixture: %s\n", config.error().message.c_str());
+        return 2;
+    }
+    auto w = device();
+    if (!w) {
+        std::fprintf(stderr, "rr_usb_fixture: device: %s\n", w.error().message.c_str());
+        return 1;
+    }
+    server::app::set_log_level(server::app::log_level_from_string(config->log_level));
+    auto gw = server::app::Gateway::start(*config, {}, server::gateway::install_json_api);
+    if (!gw) {
+        std::fprintf(stderr, "rr_usb_fixture: gateway: %s\n", gw.error().message.c_str());
+        return 1;
+    }
+    std::cout << "{\"port\": " << (*gw)->port() << ", \"device_nodeid\": \"" << device_node_id().to_string()
+              << "\", \"device_nodename\": \"" << kDeviceNodeName << "\"}" << std::endl;
+    while (!g_stop.load()) {
+        pollfd p{0, POLLIN, 0};
+        if (::poll(&p, 1, 100) > 0) {
+            char b[64];
+            if (::read(0, b, sizeof b) <= 0) break;  // stdin closed: the driver is gone
+        }
+    }
+    (*gw)->stop();
+    gw->reset();
+    return 0;
+}
+
+int run_rr(std::vector<std::string> args) {
+    auto w = device();
+    if (!w) {
+        std::fprintf(stderr, "rr_usb_fixture: device: %s\n", w.error().message.c_str());
+        return 1;
+    }
+    auto usb = cli::install_usb_transport();
+    auto cl = cli::parse_command_line(args);
+    if (!cl) {
+        std::cerr << "rr: " << cl.error().message << "\n";
+        return static_cast<int>(cli::ExitCode::usage_error);
+    }
+    const auto code = cli::run_command(*cl, std::cout, std::cerr, g_stop);
+    std::cout.flush();
+    usb.reset();
+    return static_cast<int>(code);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (auto why = emulator_unavailable_reason(); !why.empty()) {
+        std::printf("SKIP: %s\n", why.c_str());
+        return 77;
+    }
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    std::signal(SIGPIPE, SIG_IGN);
+    if (argc < 2) return usage();
+    const std::string mode = argv[1];
+    if (mode == "gateway" && argc == 3) return run_gateway(argv[2]);
+    if (mode == "rr" && argc >= 3) return run_rr(std::vector<std::string>(argv + 2, argv + argc));
+    return usage();
+}
