@@ -14,6 +14,7 @@ APT_PACKAGES=(
   chromium fonts-liberation
   emscripten node-acorn
   nginx openssl apache2-utils haproxy
+  testssl.sh
 )
 
 missing=()

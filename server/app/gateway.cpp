@@ -132,12 +132,20 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         g->devices_.push_back(*m);
     }
 
+    if (c.tls.enabled()) {
+        auto creds = load_tls(c.tls);
+        if (!creds) return creds.take_error();
+        g->tls_ = *creds;
+    }
+
     http::HttpOptions hopts;
     hopts.allowed_origins = c.allowed_origins;
     if (hopts.allowed_origins.empty()) {
         // Default: the gateway's own pages on this machine.
-        for (const char* host : {"localhost", "127.0.0.1", "[::1]"})
+        for (const char* host : {"localhost", "127.0.0.1", "[::1]"}) {
             hopts.allowed_origins.push_back(std::string("http://") + host + ":" + std::to_string(c.port));
+            if (g->tls_) hopts.allowed_origins.push_back(std::string("https://") + host + ":" + std::to_string(c.port));
+        }
     }
     hopts.static_root = c.web_root;
     for (const auto& p : c.trusted_proxies)
@@ -231,6 +239,10 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial) {
         h->handle(std::move(s), std::move(initial));
     });
+    if (g->tls_)
+        g->node_->set_https_handler([h = g->http_](TlsStream s, std::vector<std::byte> initial) {
+            h->handle_tls(std::move(s), std::move(initial));
+        });
 
     for (auto& d : g->devices_) {
         d->set_state_listener([](const gateway::DeviceStatus& s) {
@@ -241,7 +253,14 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         d->start();
     }
 
-    auto port = g->node_->listen_tcp(c.listen, c.port);
+    NodeTlsOptions tls;
+    tls.credentials = g->tls_;
+    tls.required = c.tls.required;
+    tls.on_failure = [failures = g->tls_failures_](const std::string& peer, const std::string& reason) {
+        failures->fetch_add(1);
+        log(LogLevel::debug, "TLS from " + peer + ": " + reason);
+    };
+    auto port = g->node_->listen_tcp(c.listen, c.port, std::move(tls));
     if (!port) return port.take_error();
     g->port_ = *port;
     if (c.local) {
@@ -261,6 +280,19 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
 #endif
     }
     return g;
+}
+
+Result<std::shared_ptr<TlsServerCredentials>> load_tls(const GatewayTlsConfig& t) {
+    auto creds = TlsServerCredentials::load(
+        TlsServerFiles{t.certificate, t.private_key, t.client_ca, t.node_certificate, t.node_private_key});
+    if (!creds) return fail(MessageErrorType::InvalidConfiguration, "gateway.tls: " + creds.error().message);
+    return *creds;
+}
+
+Result<void> Gateway::reload_tls() {
+    if (!tls_) return fail(MessageErrorType::InvalidState, "no TLS configured (gateway.tls)");
+    if (auto r = tls_->reload(); !r) return fail(MessageErrorType::InvalidConfiguration, "gateway.tls: " + r.error().message);
+    return {};
 }
 
 Gateway::~Gateway() { stop(); }
@@ -334,7 +366,10 @@ std::string Gateway::metrics_text() const {
       << "# HELP rr_gateway_bytes_total Bytes to and from clients.\n"
          "# TYPE rr_gateway_bytes_total counter\n"
       << "rr_gateway_bytes_total{direction=\"in\"} " << stats->bytes_in.load() << "\n"
-      << "rr_gateway_bytes_total{direction=\"out\"} " << stats->bytes_out.load() << "\n";
+      << "rr_gateway_bytes_total{direction=\"out\"} " << stats->bytes_out.load() << "\n"
+      << "# HELP rr_gateway_tls_failures_total TLS connections that failed before serving (handshake, certificate, timeout).\n"
+         "# TYPE rr_gateway_tls_failures_total counter\n"
+      << "rr_gateway_tls_failures_total " << tls_failures_->load() << "\n";
 
     o << "# HELP rr_gateway_device_up Device state: 1 when connected.\n# TYPE rr_gateway_device_up gauge\n";
     for (const auto& d : all) {

@@ -5,6 +5,7 @@
 // Discovery (when on) is fed by UDP, by the rr+local node directories and by the USB devices.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -38,6 +39,10 @@ class UsbDiscoverySource;
 }  // namespace rr::server::usb
 namespace rr::server::app {
 
+/// The TLS credentials of gateway.tls, loaded (every file checked). Errors: InvalidConfiguration
+/// "gateway.tls: FILE: problem" (used by --check too).
+Result<std::shared_ptr<TlsServerCredentials>> load_tls(const GatewayTlsConfig& tls);
+
 class Gateway {
 public:
     /// Starts everything or nothing. Errors: InvalidConfiguration, IOError (port in use, …).
@@ -63,6 +68,11 @@ public:
 
     /// Ready when every required device is connected (/readyz).
     bool ready() const;
+    /// TLS in use (gateway.tls), or nullptr.
+    const std::shared_ptr<TlsServerCredentials>& tls() const noexcept { return tls_; }
+    /// Reads the certificate files again (SIGHUP): new connections get the new certificate, open ones
+    /// keep theirs. Errors (the old certificate stays): InvalidState without TLS, else as at start.
+    Result<void> reload_tls();
     /// Prometheus text exposition of the gateway's counters (/metrics).
     std::string metrics_text() const;
 
@@ -73,6 +83,8 @@ private:
     std::shared_ptr<Node> demo_node_;
     std::shared_ptr<http::HttpServer> http_;
     std::vector<std::shared_ptr<gateway::DeviceMirror>> devices_;
+    std::shared_ptr<TlsServerCredentials> tls_;
+    std::shared_ptr<std::atomic<std::uint64_t>> tls_failures_ = std::make_shared<std::atomic<std::uint64_t>>(0);
     std::uint16_t port_ = 0;
     std::shared_ptr<discovery::NodeDiscovery> discovery_;
     std::shared_ptr<DiscoveredDevices> discovered_;

@@ -114,6 +114,13 @@ void validate(const GatewayConfig& c, const std::function<void(const std::string
     for (const auto& d : c.devices) {
         if (!names.insert(d.name).second) error("devices." + d.name, "duplicate device name");
     }
+    const auto& t = c.tls;
+    if (!t.certificate.empty() && t.private_key.empty()) error("gateway.tls.private_key", "missing (the certificate's key)");
+    if (t.certificate.empty() && (!t.private_key.empty() || !t.client_ca.empty() || !t.node_certificate.empty() || t.required))
+        error("gateway.tls.certificate", "missing (TLS needs a certificate and its private key)");
+    if (t.node_certificate.empty() != t.node_private_key.empty())
+        error(t.node_certificate.empty() ? "gateway.tls.node_certificate" : "gateway.tls.node_private_key",
+              "node_certificate and node_private_key go together");
 }
 
 // An attribute filter: "value", [values] (any of), or {any: [..], all: [..], none: [..], regex: ".." | [..]}.
@@ -313,7 +320,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "max_message_size", "log_level", "local"});
+                      "max_message_size", "log_level", "local", "tls"});
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
         if (auto n = g["node_name"]) {
@@ -339,6 +346,20 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             if (c.max_message_size < 16 * 1024) r.error(n, "gateway.max_message_size", "must be at least 16384");
         }
         if (auto n = g["local"]) c.local = r.boolean(n, "gateway.local");
+        if (auto t = g["tls"]) {
+            r.check_keys(t, "gateway.tls",
+                         {"certificate", "private_key", "client_ca", "node_certificate", "node_private_key", "required"});
+            if (auto n = t["required"]) c.tls.required = r.boolean(n, "gateway.tls.required");
+            if (auto n = t["certificate"]) c.tls.certificate = r.string(n, "gateway.tls.certificate");
+            if (auto n = t["private_key"]) c.tls.private_key = r.string(n, "gateway.tls.private_key");
+            if (auto n = t["client_ca"]) c.tls.client_ca = r.string(n, "gateway.tls.client_ca");
+            if (auto n = t["node_certificate"]) c.tls.node_certificate = r.string(n, "gateway.tls.node_certificate");
+            if (auto n = t["node_private_key"]) c.tls.node_private_key = r.string(n, "gateway.tls.node_private_key");
+            if (c.tls.certificate.empty()) r.error(t, "gateway.tls.certificate", "missing (TLS needs a certificate and its private key)");
+            if (c.tls.private_key.empty()) r.error(t, "gateway.tls.private_key", "missing (the certificate's key)");
+            if (c.tls.node_certificate.empty() != c.tls.node_private_key.empty())
+                r.error(t, "gateway.tls", "node_certificate and node_private_key go together");
+        }
         if (auto n = g["log_level"]) {
             c.log_level = r.string(n, "gateway.log_level");
             if (!kLogLevels.count(c.log_level)) r.error(n, "gateway.log_level", "unknown level \"" + c.log_level + "\"");
@@ -353,7 +374,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         if (!devs.IsSequence()) r.error(devs, "devices", "expected a list of devices");
         std::set<std::string> names;
         for (const auto& d : devs) {
-            r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms"});
+            r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms", "tls_ca",
+                                          "tls_certificate", "tls_private_key"});
             gateway::DeviceConfig dc;
             if (!d["name"]) r.error(d, "devices[].name", "missing");
             if (!d["url"]) r.error(d, "devices[].url", "missing");
@@ -366,6 +388,11 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             if (auto n = d["username"]) dc.username = r.string(n, key + ".username");
             if (auto n = d["password"]) dc.password = r.string(n, key + ".password");
             if (auto n = d["required"]) dc.required = r.boolean(n, key + ".required");
+            if (auto n = d["tls_ca"]) dc.tls_ca = r.string(n, key + ".tls_ca");
+            if (auto n = d["tls_certificate"]) dc.tls_certificate = r.string(n, key + ".tls_certificate");
+            if (auto n = d["tls_private_key"]) dc.tls_private_key = r.string(n, key + ".tls_private_key");
+            if (dc.tls_certificate.empty() != dc.tls_private_key.empty())
+                r.error(d, key, "tls_certificate and tls_private_key go together");
             if (auto n = d["backoff_max_ms"])
                 dc.backoff_max = std::chrono::milliseconds(r.unsigned_int(n, key + ".backoff_max_ms", 3600000));
             if (!names.insert(dc.name).second) r.error(d["name"], key, "duplicate device name");
@@ -415,8 +442,9 @@ namespace {
 const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
                                         "--allow-origin", "--device",     "--demo-port", "--threads", "--trusted-proxy",
                                         "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
-                                        "--robotraconteur-nodeid", "--robotraconteur-log-level"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h"};
+                                        "--robotraconteur-nodeid", "--robotraconteur-log-level", "--tls-certificate",
+                                        "--tls-private-key", "--tls-client-ca"};
+const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h", "--tls-required"};
 
 }  // namespace
 
@@ -497,6 +525,14 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.local = false;
         } else if (flag == "--discovery") {
             c.discovery.enabled = true;
+        } else if (flag == "--tls-certificate") {
+            c.tls.certificate = v;
+        } else if (flag == "--tls-private-key") {
+            c.tls.private_key = v;
+        } else if (flag == "--tls-client-ca") {
+            c.tls.client_ca = v;
+        } else if (flag == "--tls-required") {
+            c.tls.required = true;
         } else if (flag == "--robotraconteur-nodename") {
             c.node_name = v;
         } else if (flag == "--robotraconteur-nodeid") {
@@ -548,6 +584,11 @@ Options (override the configuration file):
   --no-demo                  do not start the demo devices
   --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
   --discovery                node discovery: announce the gateway, list nodes (docs/discovery.md)
+  --tls-certificate FILE     serve HTTPS, WSS and rrs+tcp on the same port with this PEM
+                             certificate chain (leaf first) ...
+  --tls-private-key FILE     ... and its private key (docs/security.md)
+  --tls-client-ca FILE       require client certificates issued by these CAs (mTLS)
+  --tls-required             refuse plain RR and plain HTTP on the port (TLS only)
   --demo-port N              RR port of the demo devices' node (default: ephemeral)
   --threads N                worker threads (default: cores)
   --log-level LEVEL          trace, debug, info, warning, error

@@ -55,6 +55,17 @@ struct DiscoverRule {
     std::chrono::milliseconds backoff_max{30000};
 };
 
+/// gateway.tls (docs/security.md): PEM files; TLS is on when `certificate` is set.
+struct GatewayTlsConfig {
+    std::string certificate;  ///< chain, leaf first
+    std::string private_key;
+    std::string client_ca;    ///< "" = no client certificates; else required (mTLS)
+    std::string node_certificate, node_private_key;  ///< rrs+tcp only; "" = the certificate above
+    /// Refuse plain RR and plain HTTP on the port (TLS and STARTTLS only). rr+local is not affected.
+    bool required = false;
+    bool enabled() const noexcept { return !certificate.empty(); }
+};
+
 struct GatewayConfig {
     // gateway:
     std::string listen = "0.0.0.0";
@@ -72,6 +83,8 @@ struct GatewayConfig {
     /// Serve rr+local under node_name (and the demo node's under node_name + ".demo"), so clients on
     /// this computer reach the gateway by NodeName without TCP (docs/local-transport.md).
     bool local = true;
+    /// HTTPS, WSS, RR over TLS and rrs+tcp on the same port.
+    GatewayTlsConfig tls;
     // demo:
     bool demo = true;
     std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)
@@ -107,7 +120,7 @@ struct CommandLine {
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
 /// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local,
-/// --discovery, --check,
+/// --discovery, --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
 Result<CommandLine> parse_command_line(int argc, const char* const* argv);

@@ -216,3 +216,67 @@ TEST_CASE("gateway.trusted_proxies and --trusted-proxy take addresses and CIDR r
     REQUIRE_FALSE(applied);
     CHECK_THAT(applied.error().message, Catch::Contains("--trusted-proxy"));
 }
+
+TEST_CASE("gateway.tls and the devices' TLS keys parse; incomplete TLS settings name the key") {
+    auto c = parse_gateway_config(R"(
+gateway:
+  tls:
+    certificate: /etc/rr-gateway/cert.pem
+    private_key: /etc/rr-gateway/key.pem
+    client_ca: /etc/rr-gateway/ca.pem
+    required: true
+devices:
+  - name: arm
+    url: rrs+tcp://arm.lab:48653/?service=robot
+    tls_ca: /etc/rr-gateway/devices-ca.pem
+    tls_certificate: /etc/rr-gateway/gw-client.pem
+    tls_private_key: /etc/rr-gateway/gw-client.key
+)", "tls.yaml");
+    REQUIRE(c);
+    CHECK(c->tls.enabled());
+    CHECK(c->tls.certificate == "/etc/rr-gateway/cert.pem");
+    CHECK(c->tls.private_key == "/etc/rr-gateway/key.pem");
+    CHECK(c->tls.client_ca == "/etc/rr-gateway/ca.pem");
+    CHECK(c->tls.required);
+    REQUIRE(c->devices.size() == 1);
+    CHECK(c->devices[0].tls_ca == "/etc/rr-gateway/devices-ca.pem");
+    CHECK(c->devices[0].tls_certificate == "/etc/rr-gateway/gw-client.pem");
+    CHECK(c->devices[0].tls_private_key == "/etc/rr-gateway/gw-client.key");
+    CHECK_FALSE(parse_gateway_config("gateway:\n  port: 1\n", "x.yaml")->tls.enabled());
+
+    for (auto [yaml, expect] : {
+             std::pair{"gateway:\n  tls:\n    certificate: c.pem\n", "bad.yaml:3: gateway.tls.private_key: missing"},
+             std::pair{"gateway:\n  tls:\n    private_key: k.pem\n", "bad.yaml:3: gateway.tls.certificate: missing"},
+             std::pair{"gateway:\n  tls:\n    certificate: c.pem\n    private_key: k.pem\n    key: x\n",
+                       "bad.yaml:5: gateway.tls.key: unknown key"},
+             std::pair{"gateway:\n  tls:\n    certificate: c.pem\n    private_key: k.pem\n    node_certificate: n.pem\n",
+                       "bad.yaml:3: gateway.tls: node_certificate and node_private_key go together"},
+             std::pair{"devices:\n  - name: a\n    url: rrs+tcp://x/?service=s\n    tls_certificate: c.pem\n",
+                       "bad.yaml:2: devices.a: tls_certificate and tls_private_key go together"},
+         }) {
+        auto r = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(r);
+        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+    }
+}
+
+TEST_CASE("TLS flags: --tls-certificate, --tls-private-key, --tls-client-ca") {
+    const char* argv[] = {"g", "--tls-certificate", "c.pem", "--tls-private-key=k.pem", "--tls-client-ca", "ca.pem",
+                          "--tls-required"};
+    auto cmd = parse_command_line(7, argv);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK(c.tls.certificate == "c.pem");
+    CHECK(c.tls.private_key == "k.pem");
+    CHECK(c.tls.client_ca == "ca.pem");
+    CHECK(c.tls.required);
+    const char* half[] = {"g", "--tls-certificate", "c.pem"};
+    auto cmd2 = parse_command_line(3, half);
+    REQUIRE(cmd2);
+    GatewayConfig c2;
+    auto r = apply_overrides(c2, *cmd2);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("gateway.tls.private_key"));
+}

@@ -17,7 +17,9 @@ using namespace rr::server::app;
 
 namespace {
 std::atomic<bool> g_stop{false};  // lock-free: safe to set from a signal handler
+std::atomic<bool> g_reload{false};
 void on_signal(int) { g_stop.store(true); }
+void on_hangup(int) { g_reload.store(true); }
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,8 +47,15 @@ int main(int argc, char** argv) {
     }
     if (config.web_root.empty()) config.web_root = default_web_root(argv[0]);
     if (cmd->check_only) {
+        if (config.tls.enabled()) {
+            auto tls = load_tls(config.tls);  // the certificate files, as the start would read them
+            if (!tls) {
+                std::cerr << "rr-gateway: configuration error: " << tls.error().message << "\n";
+                return 2;
+            }
+        }
         std::cout << "configuration ok: " << config.devices.size() << " device(s)" << (config.demo ? " + demo devices" : "")
-                  << ", port " << config.port << "\n";
+                  << ", port " << config.port << (config.tls.enabled() ? " (TLS)" : "") << "\n";
         return 0;
     }
     set_log_level(log_level_from_string(config.log_level));
@@ -56,19 +65,37 @@ int main(int argc, char** argv) {
     };
     auto gateway = Gateway::start(config, demo, rr::server::gateway::install_json_api);
     if (!gateway) {
-        std::cerr << "rr-gateway: " << gateway.error().message << "\n";
-        return 1;
+        const bool config_error = gateway.error().type == MessageErrorType::InvalidConfiguration;
+        std::cerr << "rr-gateway: " << (config_error ? "configuration error: " : "") << gateway.error().message << "\n";
+        return config_error ? 2 : 1;
     }
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    log(LogLevel::info, "rr-gateway listening on port " + std::to_string((*gateway)->port()) +
-                            " (RR rr+tcp and rr+ws" + std::string(config.local ? ", rr+local" : "") +
-                            ", HTTP; dashboard http://localhost:" +
-                            std::to_string((*gateway)->port()) + "/)");
+    std::signal(SIGHUP, on_hangup);
+    const bool tls = (*gateway)->tls() != nullptr;
+    const std::string port_text = std::to_string((*gateway)->port());
+    log(LogLevel::info, "rr-gateway listening on port " + port_text + " (RR rr+tcp and rr+ws" +
+                            std::string(tls ? ", rrs+tcp, rr+wss" : "") + std::string(config.local ? ", rr+local" : "") +
+                            (tls ? ", HTTP and HTTPS; dashboard https://localhost:" : ", HTTP; dashboard http://localhost:") +
+                            port_text + "/)");
+    if (tls) log(LogLevel::info, "TLS certificate: " + (*gateway)->tls()->describe());
     // The ready line, for scripts: the port, and the node's identity (rr+local:///?nodename=… / ?nodeid=…).
     std::cout << "{\"port\": " << (*gateway)->port() << ", \"nodeid\": \"" << (*gateway)->node()->node_id().to_string()
-              << "\", \"nodename\": \"" << (*gateway)->node()->node_name() << "\"}" << std::endl;
-    while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+              << "\", \"nodename\": \"" << (*gateway)->node()->node_name() << "\", \"tls\": " << (tls ? "true" : "false")
+              << "}" << std::endl;
+    while (!g_stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (g_reload.exchange(false)) {
+            // SIGHUP: the certificate again (renewed by certbot & co.); open connections keep theirs.
+            if (!tls) {
+                log(LogLevel::info, "SIGHUP: no TLS configured, nothing to reload");
+            } else if (auto r = (*gateway)->reload_tls(); r) {
+                log(LogLevel::info, "SIGHUP: TLS certificate reloaded: " + (*gateway)->tls()->describe());
+            } else {
+                log(LogLevel::error, "SIGHUP: TLS certificate not reloaded, the previous one stays in use: " + r.error().message);
+            }
+        }
+    }
     log(LogLevel::info, "shutting down");
     (*gateway)->stop();
     return 0;

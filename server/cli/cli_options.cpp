@@ -88,7 +88,7 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
         } else {
             static const char* kWithValue[] = {"--timeout", "--username", "--password", "--object",
                                                "--count",   "--seconds",  "--tls-ca",   "--http-login",
-                                               "--type",    "--interface"};
+                                               "--type",    "--interface", "--tls-cert", "--tls-key"};
             bool known = false;
             for (const char* k : kWithValue) known = known || flag == k;
             if (!known) return usage("unknown option " + flag);
@@ -122,6 +122,10 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.password = value;
         } else if (flag == "--tls-ca") {
             cl.tls_ca_file = value;
+        } else if (flag == "--tls-cert") {
+            cl.tls_certificate_file = value;
+        } else if (flag == "--tls-key") {
+            cl.tls_private_key_file = value;
         } else if (flag == "--http-login") {
             if (value.find(':') == std::string::npos) return usage("--http-login needs USER:PASSWORD");
             cl.http_login = value;
@@ -210,7 +214,7 @@ std::string help_text(std::string_view topic) {
         "  watch URL MEMBER             stream a wire's values, an event or a pipe's packets\n"
         "  discover [--type T] [--json] nodes and services found on the network (docs/discovery.md)\n"
         "\n"
-        "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rr+ws://, rr+wss://;\n"
+        "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rrs+tcp://, rr+ws://, rr+wss://;\n"
         "     rr+local:///?nodename=NAME&service=S on this computer;\n"
         "     rr+tcp:///?nodename=NAME&service=S finds the node by discovery).\n"
         "MEMBER: name, or a path through objrefs: child.leaf.x, child_by_int[7].value.\n"
@@ -222,7 +226,8 @@ std::string help_text(std::string_view topic) {
         "  --count N            watch: stop after N values\n"
         "  --seconds S          watch: stop after S seconds\n"
         "  --username U --password P   credentials for services that require a login\n"
-        "  --tls-ca FILE        rr+wss: PEM certificates to trust (default: the system's)\n"
+        "  --tls-ca FILE        rr+wss, rrs+tcp: PEM certificates to trust (default: the system's)\n"
+        "  --tls-cert FILE --tls-key FILE   TLS: this client's certificate and key (mTLS)\n"
         "  --http-login U:P     rr+ws/rr+wss: login for a reverse proxy (HTTP basic auth)\n"
         "  --disable-message4   use message format v2 only\n"
         "  -h, --help           this text; rr COMMAND --help for one command\n"

@@ -50,6 +50,10 @@ TEST_CASE("cli: commands and their arguments") {
     auto t = parse({"info", "rr+wss://h:443/?service=s", "--tls-ca", "ca.pem", "--http-login=alice:won:der"});
     REQUIRE(t);
     CHECK(t->tls_ca_file == "ca.pem");
+    auto m = parse({"get", "rrs+tcp://h/?service=s", "x", "--tls-cert", "me.pem", "--tls-key=me.key"});
+    REQUIRE(m);
+    CHECK(m->tls_certificate_file == "me.pem");
+    CHECK(m->tls_private_key_file == "me.key");
     CHECK(t->http_login == "alice:won:der");  // the password may hold colons
 
     auto w = parse({"watch", "u", "w_state", "--count", "3", "--seconds", "1.5"});

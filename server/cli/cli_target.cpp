@@ -61,6 +61,8 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
     options.username = cl.username;
     options.password = cl.password;
     options.tls_ca_file = cl.tls_ca_file;
+    options.tls_certificate_file = cl.tls_certificate_file;
+    options.tls_private_key_file = cl.tls_private_key_file;
     if (auto colon = cl.http_login.find(':'); colon != std::string::npos)
         options.http_authorization = server::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
     options.enable_message4 = !cl.disable_message4;

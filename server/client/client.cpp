@@ -18,6 +18,8 @@ server::ConnectOptions connect_options(const ClientOptions& options) {
     server::ConnectOptions o;
     o.connect_timeout = options.connect_timeout;
     o.tls_ca_file = options.tls_ca_file;
+    o.tls_certificate_file = options.tls_certificate_file;
+    o.tls_private_key_file = options.tls_private_key_file;
     o.http_authorization = options.http_authorization;
     return o;
 }

@@ -62,9 +62,11 @@ struct ClientOptions {
     std::chrono::milliseconds heartbeat_period{10000};    ///< ConnectionTest when idle (wire.md §6.3)
     std::chrono::milliseconds receive_timeout{15000};     ///< close when nothing arrives for this long
     std::uint32_t memory_max_transfer_size = 102400;      ///< bytes per memory transfer
-    /// rr+wss: PEM file of the certificates to trust ("" = the system's); the server's certificate must
-    /// also name the URL's host.
+    /// rr+wss, rrs+tcp: PEM file of the certificates to trust ("" = the system's); the server's
+    /// certificate must also name the URL's host (rrs+tcp: or the node, server/transport/tls/rrs_connector.hpp).
     std::string tls_ca_file;
+    /// TLS: own certificate chain and key (PEM) for servers that require client certificates (mTLS).
+    std::string tls_certificate_file, tls_private_key_file;
     /// rr+ws/rr+wss: the WebSocket handshake's Authorization header ("" = none), for a reverse proxy's
     /// login (see server::basic_authorization() in server/transport/websocket_connector.hpp). Not the RR login above.
     std::string http_authorization;

@@ -132,6 +132,8 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
     ConnectOptions connect;
     connect.connect_timeout = options.connect_timeout;
     connect.tls_ca_file = options.tls_ca_file;
+    connect.tls_certificate_file = options.tls_certificate_file;
+    connect.tls_private_key_file = options.tls_private_key_file;
     connect.http_authorization = options.http_authorization;
     asio::any_io_executor strand = asio::make_strand(executor);
     transports.connect(strand, url, connect, logic, [logic](Result<std::shared_ptr<PumpHandle>> pump) {

@@ -30,8 +30,10 @@ struct RawClientOptions {
     bool enable_string_table = true;
     std::chrono::milliseconds connect_timeout{5000};
     std::chrono::milliseconds request_timeout{15000};
-    /// rr+wss: PEM file of the certificates to trust ("" = the system's).
+    /// rr+wss, rrs+tcp: PEM file of the certificates to trust ("" = the system's).
     std::string tls_ca_file;
+    /// TLS: own certificate chain and key (PEM) for servers that require client certificates.
+    std::string tls_certificate_file, tls_private_key_file;
     /// WebSocket handshakes: Authorization header ("" = none).
     std::string http_authorization;
     Limits limits;

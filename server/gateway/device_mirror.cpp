@@ -86,6 +86,9 @@ void DeviceMirror::connect() {
     options.local_node_name = node->node_name().empty() ? std::string() : node->node_name();
     options.username = config_.username;
     options.password = config_.password;
+    options.tls_ca_file = config_.tls_ca;
+    options.tls_certificate_file = config_.tls_certificate;
+    options.tls_private_key_file = config_.tls_private_key;
     options.transports = &node->transports();
     std::weak_ptr<DeviceMirror> weak = weak_from_this();
     RawClient::connect(

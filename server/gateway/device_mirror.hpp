@@ -38,6 +38,9 @@ struct DeviceConfig {
     std::string name;  ///< service name on the gateway (a valid RR service name)
     std::string url;   ///< rr+tcp://host:port/?service=…
     std::string username, password;
+    /// rr+wss, rrs+tcp: PEM certificates to trust ("" = the system's), and the gateway's own
+    /// certificate and key to present when the device requires client certificates ("" = none).
+    std::string tls_ca, tls_certificate, tls_private_key;
     /// /readyz waits for required devices only.
     bool required = true;
     std::chrono::milliseconds backoff_initial{500};

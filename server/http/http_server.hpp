@@ -1,5 +1,5 @@
 // The HTTP side of the gateway's single port (DESIGN: server/http): sockets whose first bytes are not
-// `RRAC` come here. Serves registered routes (JSON API, /livez, /readyz, /metrics), static files, and
+// `RRAC` come here, plain (handle) or after a TLS handshake (handle_tls: HTTPS, WSS). Serves registered routes (JSON API, /livez, /readyz, /metrics), static files, and
 // WebSocket upgrades:
 //   * subprotocol `robotraconteur.robotraconteur.com` (or none): raw RR over binary frames, served by the
 //     node exactly like a TCP connection (wire.md §8) — what `rr+ws://host:port/?service=…` clients use;
@@ -27,6 +27,8 @@
 #include "server/http/forwarded.hpp"
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
+
+#include "server/transport/tls/tls_stream.hpp"
 
 namespace rr::server {
 
@@ -97,6 +99,9 @@ public:
 
     /// Entry point for the node (Node::set_http_handler).
     void handle(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial);
+    /// Entry point for TLS connections (Node::set_https_handler): HTTPS requests and WSS upgrades,
+    /// served exactly as their plain counterparts (http_server_tls.cpp).
+    void handle_tls(TlsStream stream, std::vector<std::byte> initial);
 
     /// Exact-path route for a method (GET, POST, PUT…); `prefix` routes match a path prefix.
     void add_route(boost::beast::http::verb method, std::string path, RouteHandler handler, bool prefix = false);

@@ -6,6 +6,7 @@
 #include "robdef/builtin/service_index.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/node/service_index.hpp"
+#include "server/transport/tls/tls_listener.hpp"
 
 namespace rr::server {
 
@@ -57,13 +58,26 @@ void Node::shutdown() {
     threads_.clear();
 }
 
-Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t port) {
+Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t port, NodeTlsOptions tls) {
     TcpListenerOptions opts;
     opts.first_bytes_timeout = options_.first_bytes_timeout;
     std::weak_ptr<Node> weak = weak_from_this();
     opts.http = [weak](tcp::socket socket, std::vector<std::byte> initial) {
         if (auto node = weak.lock()) node->dispatch_http(std::move(socket), std::move(initial));
     };
+    if (tls.credentials) {
+        auto t = std::make_shared<TlsListenOptions>();
+        t->credentials = std::move(tls.credentials);
+        t->node_id = options_.node_id;
+        t->node_name = options_.node_name;
+        t->timeout = options_.first_bytes_timeout;
+        t->https = [weak](TlsStream stream, std::vector<std::byte> initial) {
+            if (auto node = weak.lock()) node->dispatch_https(std::move(stream), std::move(initial));
+        };
+        t->on_failure = std::move(tls.on_failure);
+        t->required = tls.required;
+        opts.tls = std::move(t);
+    }
     auto listener = TcpListener::open(io_.get_executor(), address, port, weak, std::move(opts));
     if (!listener) return listener.take_error();
     add_listener(*listener);
@@ -97,6 +111,25 @@ std::string Node::listen_base_url() const {
 void Node::set_http_handler(HttpHandler handler) {
     std::lock_guard lock(mutex_);
     http_handler_ = std::move(handler);
+}
+
+void Node::set_https_handler(HttpsHandler handler) {
+    std::lock_guard lock(mutex_);
+    https_handler_ = std::move(handler);
+}
+
+void Node::dispatch_https(TlsStream stream, std::vector<std::byte> initial) {
+    HttpsHandler handler;
+    {
+        std::lock_guard lock(mutex_);
+        handler = https_handler_;
+    }
+    if (handler) {
+        handler(std::move(stream), std::move(initial));
+        return;
+    }
+    boost::system::error_code ignored;
+    stream.lowest_layer().close(ignored);
 }
 
 void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial) {

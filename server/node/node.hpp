@@ -21,6 +21,8 @@
 #include "server/node/service.hpp"
 #include "server/node/service_registry.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "server/transport/tls/tls_context.hpp"
+#include "server/transport/tls/tls_stream.hpp"
 #include "server/transport/transport.hpp"
 #include "server/transport/transport_registry.hpp"
 
@@ -35,6 +37,16 @@ struct NodeOptions {
     std::size_t max_connections = 0;
     /// How long an accepted TCP socket may take to send its first 4 bytes (wire.md §6.1: 5 s).
     std::chrono::milliseconds first_bytes_timeout{5000};
+};
+
+/// TLS on a TCP listener (docs/security.md).
+struct NodeTlsOptions {
+    /// nullptr: no TLS on the port.
+    std::shared_ptr<TlsServerCredentials> credentials;
+    /// Refuse plain RR and plain HTTP on the port (STARTTLS and TLS only).
+    bool required = false;
+    /// Told about each failed TLS accept (peer address, reason), e.g. to log it. Optional.
+    std::function<void(const std::string& peer, const std::string& reason)> on_failure;
 };
 
 class Node : public ConnectionSink, public std::enable_shared_from_this<Node> {
@@ -54,9 +66,10 @@ public:
     TransportRegistry& transports() noexcept { return transports_; }
 
     /// Listens for TCP connections (raw RR, and HTTP when an HttpHandler is set) on `address:port`
-    /// (port 0 = ephemeral). Returns the bound port. Errors: InvalidArgument (bad address), IOError
-    /// with the system message.
-    Result<std::uint16_t> listen_tcp(const std::string& address, std::uint16_t port);
+    /// (port 0 = ephemeral). With TLS credentials the port also serves RR over TLS, rrs+tcp
+    /// (STARTTLS) and, through the HttpsHandler, HTTPS and WSS. Returns the bound port. Errors:
+    /// InvalidArgument (bad address), IOError with the system message.
+    Result<std::uint16_t> listen_tcp(const std::string& address, std::uint16_t port, NodeTlsOptions tls = {});
     /// Adds a listener of another transport (opened on io_context() with this node as its sink): it is
     /// stopped at shutdown and its URLs are reported by listen_urls().
     void add_listener(std::shared_ptr<Listener> listener);
@@ -76,6 +89,9 @@ public:
     std::string service_state_nonce() const;
     /// Where TCP sockets starting with anything but `RRAC` go (HTTP; default: answer 404 and close).
     void set_http_handler(HttpHandler handler);
+    /// Where TLS connections go whose first decrypted bytes are not `RRAC` (HTTPS, WSS; default:
+    /// closed).
+    void set_https_handler(HttpsHandler handler);
 
     /// Registers a service under its name. Errors: InvalidArgument when the name is taken or invalid.
     Result<void> register_service(std::shared_ptr<Service> service);
@@ -102,6 +118,7 @@ private:
     explicit Node(NodeOptions options);
     void start_threads();
     void dispatch_http(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial);
+    void dispatch_https(TlsStream stream, std::vector<std::byte> initial);
     void services_changed();
 
     NodeOptions options_;
@@ -114,6 +131,7 @@ private:
     mutable std::mutex mutex_;
     std::vector<std::shared_ptr<Listener>> listeners_;
     HttpHandler http_handler_;
+    HttpsHandler https_handler_;
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
     std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
     std::vector<std::function<void()>> services_changed_callbacks_;

@@ -1,5 +1,7 @@
 #include "server/transport/tcp_listener.hpp"
 
+#include "server/transport/tls/tls_listener.hpp"
+
 #include <array>
 #include <string_view>
 
@@ -93,7 +95,34 @@ bool could_begin_http(const std::array<std::byte, 4>& head) {
     return false;
 }
 
+AcceptedStream accepted_info(const tcp::socket& socket) {
+    AcceptedStream info;
+    boost::system::error_code ec;
+    auto local = socket.local_endpoint(ec);
+    if (!ec) info.local_url = tcp_base_url(local);
+    auto remote = socket.remote_endpoint(ec);
+    if (!ec) info.peer = remote.address().to_string() + ":" + std::to_string(remote.port());
+    return info;
+}
+
+bool is_rrac(const std::array<std::byte, 4>& h) {
+    static constexpr char kMagic[] = "RRAC";
+    for (int i = 0; i < 4; ++i)
+        if (h[i] != static_cast<std::byte>(kMagic[i])) return false;
+    return true;
+}
+
 }  // namespace
+
+bool serve_plain_rr(ConnectionSink& sink, tcp::socket socket, const AcceptedStream& info, std::vector<std::byte> initial) {
+    return serve_stream(sink, std::move(socket), info, std::move(initial));
+}
+
+struct TcpListener::Detect {
+    tcp::socket socket;
+    asio::steady_timer timer;
+    std::array<std::byte, 4> head{};
+};
 
 void TcpListener::detect(tcp::socket socket) {
     auto sink = sink_.lock();
@@ -105,11 +134,6 @@ void TcpListener::detect(tcp::socket socket) {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
 
-    struct Detect {
-        tcp::socket socket;
-        asio::steady_timer timer;
-        std::array<std::byte, 4> head{};
-    };
     auto d = std::make_shared<Detect>(Detect{std::move(socket), asio::steady_timer(socket.get_executor()), {}});
     d->timer.expires_after(options_.first_bytes_timeout);
     d->timer.async_wait([d](boost::system::error_code ec) {
@@ -118,28 +142,63 @@ void TcpListener::detect(tcp::socket socket) {
             d->socket.close(ignored2);  // silent for too long: drop
         }
     });
+    if (!options_.tls) {
+        read_head(std::move(d));
+        return;
+    }
+    // TLS on this port: a ClientHello starts with 0x16 (handshake record). Peek at the first byte without
+    // consuming it, so that OpenSSL reads the whole record from the socket.
+    auto self = shared_from_this();
+    d->socket.async_wait(tcp::socket::wait_read, [d, self](boost::system::error_code ec) {
+        if (ec) return;
+        std::array<std::byte, 1> first{};
+        boost::system::error_code ec2;
+        const std::size_t n = d->socket.receive(asio::buffer(first), tcp::socket::message_peek, ec2);
+        if (ec2 || n == 0) {
+            d->timer.cancel();
+            d->socket.close(ec2);  // closed before sending anything
+            return;
+        }
+        if (first[0] == std::byte{0x16}) {
+            d->timer.cancel();  // from here the TLS handshake's own timeout applies
+            auto info = accepted_info(d->socket);
+            accept_direct_tls(std::move(d->socket), std::move(info), self->sink_, self->options_.tls);
+            return;
+        }
+        self->read_head(d);
+    });
+}
+
+void TcpListener::read_head(std::shared_ptr<Detect> d) {
     auto self = shared_from_this();
     asio::async_read(d->socket, asio::buffer(d->head), [d, self](boost::system::error_code ec, std::size_t) {
         d->timer.cancel();
         if (ec) return;
         const auto& h = d->head;
         std::vector<std::byte> initial(h.begin(), h.end());
-        static constexpr char kMagic[] = "RRAC";
-        bool rr = true;
-        for (int i = 0; i < 4; ++i) rr = rr && h[i] == static_cast<std::byte>(kMagic[i]);
-        if (rr) {
+        if (is_rrac(h)) {
             auto sink = self->sink_.lock();
             if (!sink) return;
-            boost::system::error_code ec2;
-            AcceptedStream info;
-            auto local = d->socket.local_endpoint(ec2);
-            if (!ec2) info.local_url = tcp_base_url(local);
-            auto remote = d->socket.remote_endpoint(ec2);
-            if (!ec2) info.peer = remote.address().to_string() + ":" + std::to_string(remote.port());
-            serve_stream(*sink, std::move(d->socket), info, std::move(initial));
+            auto info = accepted_info(d->socket);
+            if (self->options_.tls)  // STARTTLS (rrs+tcp) or plain RR: the first message decides
+                accept_rr_or_starttls(std::move(d->socket), std::move(initial), std::move(info), self->sink_,
+                                      self->options_.tls);
+            else
+                serve_stream(*sink, std::move(d->socket), info, std::move(initial));
         } else if (!could_begin_http(h)) {
             boost::system::error_code ignored2;
             d->socket.close(ignored2);  // neither RR nor HTTP (wrong magic, binary garbage): drop
+        } else if (self->options_.tls && self->options_.tls->required) {
+            // Plain HTTP on a port that requires TLS: say so and close.
+            static constexpr char kTlsRequired[] =
+                "HTTP/1.1 403 Forbidden\r\nConnection: close\r\nContent-Type: text/plain; charset=utf-8\r\n"
+                "Content-Length: 50\r\n\r\nTLS required on this port: use https:// or wss://\n";
+            auto sock = std::make_shared<tcp::socket>(std::move(d->socket));
+            asio::async_write(*sock, asio::buffer(kTlsRequired, sizeof(kTlsRequired) - 1), [sock](boost::system::error_code, std::size_t) {
+                boost::system::error_code ignored;
+                sock->shutdown(tcp::socket::shutdown_send, ignored);
+                sock->close(ignored);
+            });
         } else if (self->options_.http) {
             // Anything else is HTTP (plain requests and WebSocket upgrades).
             self->options_.http(std::move(d->socket), std::move(initial));

@@ -1,6 +1,10 @@
 // rr+tcp, service side: accepts TCP connections and tells raw RR from HTTP by the first four bytes, as
 // CORE's TcpTransport does (wire.md §6.1: `RRAC` → an RR stream for the ConnectionSink; anything else
 // → the HttpHandler, which serves plain HTTP and WebSocket upgrades; without one: 404 and close).
+// With TLS options (tls/tls_listener.hpp) the same port also takes TLS: a first byte 0x16 (a TLS
+// ClientHello) → the TLS handshake, then the decrypted stream is classified again (RR over TLS,
+// HTTPS, WSS); and a first RR message StreamOp STARTTLS → rrs+tcp. Without TLS options the plain
+// paths are exactly as before (no extra read, copy or allocation).
 // Sockets get TCP_NODELAY. A socket that sends nothing within first_bytes_timeout is dropped.
 #pragma once
 
@@ -18,6 +22,12 @@ namespace rr::server {
 /// Takes a socket whose first bytes (`initial`) were not `RRAC`: HTTP requests, WebSocket upgrades.
 using HttpHandler = std::function<void(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial)>;
 
+struct TlsListenOptions;
+
+/// Runs a plain RR connection whose first bytes (`initial`, starting with `RRAC`) were already read.
+bool serve_plain_rr(ConnectionSink& sink, boost::asio::ip::tcp::socket socket, const AcceptedStream& info,
+                    std::vector<std::byte> initial);
+
 /// `rr+tcp://<address>:<port>/` for a local TCP endpoint (IPv6 in brackets, without scope): the base
 /// of the URLs the service index reports (wire.md §11.2).
 std::string tcp_base_url(const boost::asio::ip::tcp::endpoint& local);
@@ -27,6 +37,8 @@ struct TcpListenerOptions {
     std::chrono::milliseconds first_bytes_timeout{5000};
     /// Where non-RR sockets go (empty: answer 404 and close).
     HttpHandler http;
+    /// TLS on this port (nullptr: none; a first byte 0x16 then goes to `http` like any non-RR socket).
+    std::shared_ptr<const TlsListenOptions> tls;
 };
 
 class TcpListener : public Listener, public std::enable_shared_from_this<TcpListener> {
@@ -51,6 +63,8 @@ private:
     TcpListener(boost::asio::ip::tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink, TcpListenerOptions options);
     void accept();
     void detect(boost::asio::ip::tcp::socket socket);
+    struct Detect;
+    void read_head(std::shared_ptr<Detect> d);
 
     boost::asio::ip::tcp::acceptor acceptor_;
     std::weak_ptr<ConnectionSink> sink_;

@@ -28,8 +28,12 @@ namespace rr::server {
 struct ConnectOptions {
     /// Opening the byte stream, including TLS and WebSocket handshakes (wire.md §13: 5 s).
     std::chrono::milliseconds connect_timeout{5000};
-    /// TLS (rr+wss): PEM file of the certificates to trust ("" = the system's).
+    /// TLS (rr+wss, rrs+tcp): PEM file of the certificates to trust ("" = the system's).
     std::string tls_ca_file;
+    /// TLS: this client's own certificate chain and private key (PEM), presented when the server asks
+    /// (mTLS; rrs+tcp then also asks for mutual authentication in STARTTLS). "" = none.
+    std::string tls_certificate_file;
+    std::string tls_private_key_file;
     /// WebSocket handshakes: the Authorization header ("" = none), for a reverse proxy's login.
     std::string http_authorization;
 };

@@ -2,6 +2,7 @@
 
 #include "server/transport/local/local_connector.hpp"
 #include "server/transport/tcp_connector.hpp"
+#include "server/transport/tls/rrs_connector.hpp"
 #include "server/transport/websocket_connector.hpp"
 
 namespace rr::server {
@@ -12,6 +13,7 @@ TransportRegistry::TransportRegistry() {
     connectors_.emplace("tcp", tcp);
     connectors_.emplace("rr+ws", std::make_shared<WebSocketConnector>(false));
     connectors_.emplace("rr+wss", std::make_shared<WebSocketConnector>(true));
+    connectors_.emplace("rrs+tcp", std::make_shared<RrsTcpConnector>());
     connectors_.emplace("rr+local", std::make_shared<local::LocalConnector>());
 }
 

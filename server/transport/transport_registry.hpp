@@ -1,6 +1,6 @@
 // Connectors by URL scheme (transport.hpp). A node owns one (Node::transports()); clients without a
 // node use default_transports(). Every registry starts with the built-in transports: rr+tcp (and the
-// legacy tcp), rr+ws, rr+wss, rr+local.
+// legacy tcp), rr+ws, rr+wss, rrs+tcp, rr+local.
 #pragma once
 
 #include <map>

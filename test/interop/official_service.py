@@ -9,6 +9,7 @@ yield known sequences, memories are readable and writable, reset() restores the 
 Usage:
     official_service.py [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
                         [--heartbeat SECONDS] [--max-lifetime SECONDS] [--node-setup NAME]
+                        [--nodeid ID] [--load-tls]
 
 --node-setup NAME starts the node with the library's default server setup,
 RobotRaconteur.ServerNodeSetup(NAME, port): NodeName NAME with the NodeID of its NodeID cache, the
@@ -16,6 +17,11 @@ local transport (rr+local) serving NAME, TCP on the port (loopback and every oth
 setup's own defaults for message formats; the transport options above are then ignored. The ready line
 adds "local_url" (by NodeName) and "local_id_url" (by NodeID). A NodeName already in use exits with
 status 3 and the library's message on stderr.
+
+--nodeid ID fixes the NodeID; --load-tls loads the node's TLS certificate for rrs+tcp as the library
+does (TcpTransport.LoadTlsNodeCertificate: <config dir>/certificates/{NodeID}.p12, the config dir
+from ROBOTRACONTEUR_SYSTEM_CONFIG_DIR when root, else ROBOTRACONTEUR_USER_CONFIG_DIR); the ready line
+then says "tls": true or false.
 
 When ready it prints exactly one JSON line on stdout, e.g.
     {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
@@ -498,6 +504,8 @@ def main(argv=None):
     ap.add_argument("--heartbeat", type=float, default=None, help="TCP heartbeat period in seconds")
     ap.add_argument("--listen-all", action="store_true", help="listen on all interfaces, not only loopback")
     ap.add_argument("--max-lifetime", type=float, default=0, help="exit after this many seconds (0 = never)")
+    ap.add_argument("--nodeid", default=None, help="fix the NodeID (UUID)")
+    ap.add_argument("--load-tls", action="store_true", help="load the node's TLS certificate (rrs+tcp)")
     ap.add_argument("--node-setup", default=None, metavar="NAME",
                     help="use RobotRaconteur.ServerNodeSetup(NAME, port) (rr+local + TCP, library defaults)")
     args = ap.parse_args(argv)
@@ -508,6 +516,7 @@ def main(argv=None):
 
     RRN.SetLogLevelFromEnvVariable()
     setup = None
+    tls_loaded = None
     if args.node_setup:
         try:
             setup = RR.ServerNodeSetup(args.node_setup, args.port)
@@ -516,6 +525,8 @@ def main(argv=None):
             return 3
         port = setup.tcp_transport.GetListenPort()
     else:
+        if args.nodeid:
+            RRN.SetNodeID(RR.NodeID(args.nodeid))
         RRN.SetNodeName("interop_service")
         t = RR.TcpTransport()
         t.DisableMessage4 = args.disable_message4
@@ -524,6 +535,9 @@ def main(argv=None):
         if args.heartbeat is not None:
             t._SetDefaultHeartbeatPeriod(int(args.heartbeat * 1000))  # the property setter passes a float
         t.StartServer(args.port, not args.listen_all)
+        if args.load_tls:
+            t.LoadTlsNodeCertificate()  # logs a warning and leaves TLS off when the file is missing
+            tls_loaded = bool(t.IsTlsNodeCertificateLoaded)
         RRN.RegisterTransport(t)
         port = t.GetListenPort()
 
@@ -554,6 +568,8 @@ def main(argv=None):
         "message4": not args.disable_message4,
         "stringtable": bool(args.enable_stringtable),
     }
+    if args.load_tls:
+        ready["tls"] = tls_loaded
     if args.websocket:
         ready["ws_url"] = "rr+ws://127.0.0.1:%d/?service=%s" % (port, iv.SERVICE_NAME)
     if setup is not None:

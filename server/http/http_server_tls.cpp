@@ -1,0 +1,14 @@
+// HTTPS and WSS: the sessions of http_session.hpp over TlsStream. Kept apart from http_server.cpp so
+// that the Beast-over-OpenSSL instantiations cost one translation unit (docs/development.md).
+#include <boost/beast/websocket/ssl.hpp>
+
+#include "server/http/http_session.hpp"
+
+namespace rr::server::http {
+
+void HttpServer::handle_tls(TlsStream stream, std::vector<std::byte> initial) {
+    auto session = std::make_shared<detail::HttpSession<TlsStream>>(shared_from_this(), std::move(stream));
+    session->start(std::move(initial));
+}
+
+}  // namespace rr::server::http

@@ -1,0 +1,497 @@
+// The HTTP and WebSocket sessions of HttpServer, as templates over the byte stream: Beast's TCP stream
+// (plain HTTP, ws://) is instantiated in http_server.cpp, TlsStream (HTTPS, wss://) in
+// http_server_tls.cpp. Private to server/http.
+#pragma once
+
+#include <atomic>
+#include <algorithm>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "server/http/http_server.hpp"
+#include "server/node/node.hpp"
+#include "server/transport/websocket_byte_stream.hpp"
+
+namespace rr::server::http::detail {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace bhttp = boost::beast::http;
+namespace websocket = boost::beast::websocket;
+using tcp = asio::ip::tcp;
+
+inline constexpr std::string_view kRRSubprotocol = "robotraconteur.robotraconteur.com";
+
+
+inline char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
+
+inline bool iequals(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (lower(a[i]) != lower(b[i])) return false;
+    return true;
+}
+
+inline std::vector<std::string_view> split_list(std::string_view s) {
+    std::vector<std::string_view> out;
+    while (!s.empty()) {
+        auto comma = s.find(',');
+        auto item = s.substr(0, comma);
+        while (!item.empty() && (item.front() == ' ' || item.front() == '\t')) item.remove_prefix(1);
+        while (!item.empty() && (item.back() == ' ' || item.back() == '\t')) item.remove_suffix(1);
+        if (!item.empty()) out.push_back(item);
+        if (comma == std::string_view::npos) break;
+        s.remove_prefix(comma + 1);
+    }
+    return out;
+}
+
+inline std::string_view mime_type(std::string_view path) {
+    auto dot = path.rfind('.');
+    auto ext = dot == std::string_view::npos ? std::string_view{} : path.substr(dot);
+    if (ext == ".html" || ext == ".htm") return "text/html; charset=utf-8";
+    if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+    if (ext == ".css") return "text/css; charset=utf-8";
+    if (ext == ".json" || ext == ".map") return "application/json";
+    if (ext == ".wasm") return "application/wasm";
+    if (ext == ".svg") return "image/svg+xml";
+    if (ext == ".png") return "image/png";
+    if (ext == ".ico") return "image/x-icon";
+    if (ext == ".ts" || ext == ".txt" || ext == ".md" || ext == ".robdef") return "text/plain; charset=utf-8";
+    return "application/octet-stream";
+}
+
+// Maps a URL path to a file under root; rejects anything that could leave it.
+inline std::optional<std::string> static_path(const std::string& root, std::string_view target) {
+    auto q = target.find_first_of("?#");
+    std::string_view path = target.substr(0, q);
+    if (path.empty() || path.front() != '/') return std::nullopt;
+    if (path.find("..") != std::string_view::npos || path.find('\\') != std::string_view::npos ||
+        path.find('\0') != std::string_view::npos)
+        return std::nullopt;
+    std::string full = root + std::string(path);
+    if (full.back() == '/') full += "index.html";
+    return full;
+}
+
+/// A JSON-subprotocol WebSocket session: text frames both ways, bounded outgoing queue.
+template <class Stream>
+class JsonWebSocketSession : public JsonSocket, public std::enable_shared_from_this<JsonWebSocketSession<Stream>> {
+public:
+    using std::enable_shared_from_this<JsonWebSocketSession<Stream>>::shared_from_this;
+
+    JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
+                         std::string peer)
+        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)) {}
+
+    void start() {
+        ws_.text(true);
+        ws_.auto_fragment(false);  // one frame per message, not Beast's 4 KiB fragments (one write each)
+        if (handler_->on_open) handler_->on_open(shared_from_this());
+        read();
+    }
+
+    void send(std::string text) override { enqueue(std::move(text), false); }
+    void send_urgent(std::string text) override { enqueue(std::move(text), true); }
+
+    std::size_t queued() const override { return queued_count_.load(); }
+    std::size_t queued_bytes() const override { return queued_bytes_.load(); }
+    std::uint64_t dropped() const override { return dropped_.load(); }
+
+    void close() override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self] {
+            if (self->closed_) return;
+            self->closed_ = true;
+            self->ws_.async_close(websocket::close_code::normal, [self](beast::error_code) {});
+        });
+    }
+
+    std::string peer() const override { return peer_; }
+
+private:
+    struct Outgoing {
+        std::string text;
+        bool urgent = false;
+    };
+
+    void enqueue(std::string text, bool urgent) {
+        auto self = shared_from_this();
+        queued_count_.fetch_add(1);
+        queued_bytes_.fetch_add(text.size());
+        asio::post(ws_.get_executor(), [self, text = std::move(text), urgent]() mutable {
+            if (self->closed_) {
+                self->unqueue(text);
+                return;
+            }
+            auto& q = self->queue_;
+            // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
+            if (q.size() >= self->limit_ && q.size() > (self->writing_ ? 1u : 0u)) {
+                auto victim = self->first_waiting_push();
+                if (victim == q.end()) victim = q.begin() + (self->writing_ ? 1 : 0);
+                self->unqueue(victim->text);
+                q.erase(victim);
+                self->dropped_.fetch_add(1);
+            }
+            if (urgent)
+                q.insert(self->first_waiting_push(), Outgoing{std::move(text), true});
+            else
+                q.push_back(Outgoing{std::move(text), false});
+            self->write();
+        });
+    }
+
+    // The first push not being written: urgent messages go before it, behind earlier urgent ones.
+    typename std::deque<Outgoing>::iterator first_waiting_push() {
+        return std::find_if(queue_.begin() + (writing_ ? 1 : 0), queue_.end(), [](const Outgoing& o) { return !o.urgent; });
+    }
+
+    void read() {
+        auto self = shared_from_this();
+        ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
+            if (ec) {
+                self->finish();
+                return;
+            }
+            std::string text = beast::buffers_to_string(self->buffer_.data());
+            self->buffer_.consume(self->buffer_.size());
+            // Beast 1.81 checks UTF-8 per frame and misses a text message that ends inside a UTF-8
+            // sequence when its last frame is empty (read.hpp calls finish() only after copying bytes).
+            // RFC 6455 §8.1: fail the connection with 1007, as for invalid UTF-8 anywhere else.
+            if (self->ws_.got_text() && !websocket::detail::check_utf8(text.data(), text.size())) {
+                self->fail(websocket::close_code::bad_payload, "invalid UTF-8 in a text message");
+                return;
+            }
+            if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
+            self->read();
+        });
+    }
+
+    // Ends the WebSocket with a close frame carrying `code` (the read side already stopped).
+    void fail(websocket::close_code code, const char* reason) {
+        auto self = shared_from_this();
+        closed_ = true;
+        beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(5));
+        ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) { self->finish(); });
+    }
+
+    void write() {
+        if (writing_ || queue_.empty() || closed_) return;
+        writing_ = true;
+        auto self = shared_from_this();
+        ws_.async_write(asio::buffer(queue_.front().text), [self](beast::error_code ec, std::size_t) {
+            self->writing_ = false;
+            if (ec) {
+                self->finish();
+                while (!self->queue_.empty()) {  // the message whose write just ended, if finish() kept it
+                    self->unqueue(self->queue_.front().text);
+                    self->queue_.pop_front();
+                }
+                return;
+            }
+            self->unqueue(self->queue_.front().text);
+            self->queue_.pop_front();
+            self->write();
+        });
+    }
+
+    void unqueue(const std::string& text) {
+        queued_count_.fetch_sub(1);
+        queued_bytes_.fetch_sub(text.size());
+    }
+
+    void finish() {
+        if (finished_) return;
+        finished_ = true;
+        closed_ = true;
+        // A write in flight still reads the front message: it is released when that write completes.
+        while (queue_.size() > (writing_ ? 1u : 0u)) {
+            unqueue(queue_.back().text);
+            queue_.pop_back();
+        }
+        if (handler_->on_close) handler_->on_close(shared_from_this());
+    }
+
+    websocket::stream<Stream> ws_;
+    const JsonSocketHandler* handler_;
+    std::size_t limit_;
+    std::string peer_;
+    beast::flat_buffer buffer_;
+    std::deque<Outgoing> queue_;  // front: being written while writing_
+    std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
+    std::atomic<std::uint64_t> dropped_{0};
+    bool writing_ = false;
+    bool closed_ = false;
+    bool finished_ = false;
+};
+
+/// One HTTP connection over `Stream` (Beast's TCP stream, or TlsStream for HTTPS): requests in order,
+/// routes, static files, WebSocket upgrades (raw RR to the node, JSON subprotocols to their handler).
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
+public:
+    using std::enable_shared_from_this<HttpSession<Stream>>::shared_from_this;
+
+    HttpSession(std::shared_ptr<HttpServer> server, Stream stream)
+        : server_(std::move(server)), stream_(std::move(stream)) {}
+
+    void start(std::vector<std::byte> initial) {
+        if (!initial.empty()) {
+            auto b = buffer_.prepare(initial.size());
+            std::memcpy(b.data(), initial.data(), initial.size());
+            buffer_.commit(initial.size());
+        }
+        read();
+    }
+
+private:
+    void read() {
+        parser_.emplace();
+        parser_->body_limit(server_->options().max_body_bytes);
+        parser_->header_limit(16 * 1024);
+        beast::get_lowest_layer(stream_).expires_after(server_->options().read_timeout);
+        auto self = shared_from_this();
+        bhttp::async_read(stream_, buffer_, *parser_, [self](beast::error_code ec, std::size_t) {
+            if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout) {
+                self->shutdown();
+                return;
+            }
+            if (ec) {
+                // Malformed request or over a limit: answer 400/413 once and close.
+                Request dummy;
+                dummy.version(11);
+                auto status = (ec == bhttp::error::body_limit || ec == bhttp::error::header_limit)
+                                  ? bhttp::status::payload_too_large
+                                  : bhttp::status::bad_request;
+                auto r = make_response(dummy, status, ec.message() + "\n");
+                r.keep_alive(false);
+                self->write(std::move(r));
+                return;
+            }
+            self->on_request(self->parser_->release());
+        });
+    }
+
+    void on_request(Request req) {
+        head_ = req.method() == bhttp::verb::head;
+        client_ = client();
+        auto forwarded = [&](std::string_view name) {
+            auto v = req[name];
+            return std::string_view(v.data(), v.size());
+        };
+        if (!server_->options().trusted_proxies.empty()) {
+            beast::error_code ec;
+            auto ep = beast::get_lowest_layer(stream_).socket().remote_endpoint(ec);
+            if (!ec)
+                client_ = client_origin(ep.address(), ep.port(), forwarded("X-Forwarded-For"),
+                                        forwarded("X-Forwarded-Proto"), server_->options().trusted_proxies);
+        }
+        const auto origin = req[bhttp::field::origin];
+        if (!origin.empty() && !same_origin(origin, req[bhttp::field::host], client_.scheme) &&
+            !origin_allowed(server_->options().allowed_origins, origin)) {
+            auto r = make_response(req, bhttp::status::forbidden, "Forbidden Origin\n");
+            r.keep_alive(false);
+            write(std::move(r));
+            return;
+        }
+        if (websocket::is_upgrade(req)) {
+            upgrade(std::move(req));
+            return;
+        }
+        std::string_view target(req.target().data(), req.target().size());
+        auto path = target.substr(0, target.find('?'));
+        // A route of this method, for HEAD one of GET (its headers, no body), then a route for any method.
+        const RouteHandler* route = server_->find_route(req.method(), path, false);
+        if (!route && head_) route = server_->find_route(bhttp::verb::get, path, false);
+        if (!route) route = server_->find_route(req.method(), path);
+        if (route) {
+            auto self = shared_from_this();
+            auto keep = std::make_shared<Request>(std::move(req));
+            auto ex = stream_.get_executor();
+            (*route)(*keep, [self, keep, ex](Response r) {
+                asio::post(ex, [self, r = std::move(r)]() mutable { self->write(std::move(r)); });
+            });
+            return;
+        }
+        if ((req.method() == bhttp::verb::get || req.method() == bhttp::verb::head) &&
+            !server_->options().static_root.empty()) {
+            serve_static(req);
+            return;
+        }
+        write(make_response(req, bhttp::status::not_found, "Not Found\n"));
+    }
+
+    void serve_static(const Request& req) {
+        std::string_view target(req.target().data(), req.target().size());
+        auto path = static_path(server_->options().static_root, target);
+        if (!path) {
+            write(make_response(req, bhttp::status::bad_request, "Bad path\n"));
+            return;
+        }
+        std::ifstream f(*path, std::ios::binary);
+        if (!f) {
+            write(make_response(req, bhttp::status::not_found, "Not Found\n"));
+            return;
+        }
+        std::ostringstream body;
+        body << f.rdbuf();
+        auto r = make_response(req, bhttp::status::ok, body.str(), mime_type(*path));  // write() drops it for HEAD
+        r.set(bhttp::field::cache_control, "no-cache");
+        write(std::move(r));
+    }
+
+    void upgrade(Request req) {
+        auto protocols = split_list(std::string_view(req[bhttp::field::sec_websocket_protocol].data(),
+                                                     req[bhttp::field::sec_websocket_protocol].size()));
+        std::string chosen;
+        const JsonSocketHandler* json = nullptr;
+        if (protocols.empty()) {
+            chosen.clear();  // no list: raw RR, as CORE accepts
+        } else {
+            for (auto p : protocols) {
+                if (iequals(p, kRRSubprotocol)) {
+                    chosen = std::string(kRRSubprotocol);
+                    break;
+                }
+                if ((json = server_->find_subprotocol(p))) {
+                    chosen = std::string(p);
+                    break;
+                }
+            }
+            if (chosen.empty()) {
+                std::string served = server_->subprotocol_names();
+                served += (served.empty() ? "" : ", ") + std::string(kRRSubprotocol);
+                auto r = make_response(req, bhttp::status::upgrade_required,
+                                       "Unsupported WebSocket subprotocol; this server speaks: " + served + "\n");
+                r.set(bhttp::field::sec_websocket_protocol, kRRSubprotocol);
+                r.set(bhttp::field::sec_websocket_version, "13");
+                r.keep_alive(false);
+                write(std::move(r));
+                return;
+            }
+        }
+        // Addresses before the stream moves into the WebSocket.
+        auto peer = client_.address;
+        if (server_->options().on_websocket) {
+            std::string line = "WebSocket " + (chosen.empty() || chosen == kRRSubprotocol ? std::string("rr") : chosen) +
+                               " from " + peer;
+            if (client_.forwarded)
+                line += " (" + (client_.scheme.empty() ? std::string("scheme unknown") : client_.scheme) + ", via " +
+                        remote() + ")";
+            server_->options().on_websocket(line);
+        }
+        beast::error_code lec;
+        auto local = beast::get_lowest_layer(stream_).socket().local_endpoint(lec);
+        AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer};
+        beast::get_lowest_layer(stream_).expires_never();
+        websocket::stream<Stream> ws(std::move(stream_));
+        ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
+            if (!chosen.empty()) res.set(bhttp::field::sec_websocket_protocol, chosen);
+        }));
+        ws.read_message_max(64u * 1024u * 1024u);
+        auto server = server_;
+        auto holder = std::make_shared<websocket::stream<Stream>>(std::move(ws));
+        const bool unnamed = protocols.empty();
+        holder->async_accept(req, [holder, server, json, peer, info, unnamed](beast::error_code ec) {
+            if (ec) return;
+            if (json) {
+                auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
+                                                                server->options().json_socket_queue_limit, peer);
+                s->start();
+                return;
+            }
+            if (unnamed) return sniff_unnamed(holder, server, info);
+            auto node = server->node();
+            if (!node) return;
+            holder->binary(true);
+            serve_stream(*node, WebSocketByteStream<Stream>(std::move(*holder)), info);
+        });
+    }
+
+    // No subprotocol asked for: raw RR, as CORE accepts, whose first message (CreateConnection) comes
+    // in binary frames. A text frame first is a JSON client that forgot its subprotocol: it gets an
+    // error naming the subprotocols instead of a silent drop. The bytes read go to the node first.
+    static void sniff_unnamed(std::shared_ptr<websocket::stream<Stream>> ws, std::shared_ptr<HttpServer> server,
+                              AcceptedStream info) {
+        auto buf = std::make_shared<std::vector<std::byte>>(4096);
+        beast::get_lowest_layer(*ws).expires_after(server->options().read_timeout);
+        ws->async_read_some(asio::buffer(buf->data(), buf->size()), [ws, buf, server, info](beast::error_code ec, std::size_t n) {
+            if (ec) return;  // closed or timed out before a byte: nothing to serve
+            beast::get_lowest_layer(*ws).expires_never();
+            if (ws->got_text()) return refuse_text(ws, server->subprotocol_names());
+            auto node = server->node();
+            if (!node) return;
+            buf->resize(n);
+            ws->binary(true);
+            serve_stream(*node, WebSocketByteStream<Stream>(std::move(*ws)), info, std::move(*buf));
+        });
+    }
+
+    static void refuse_text(std::shared_ptr<websocket::stream<Stream>> ws, const std::string& json_protocols) {
+        // Subprotocol names are HTTP tokens (no quotes or backslashes): safe inside a JSON string.
+        const std::string hint = json_protocols.empty()
+                                     ? std::string("this WebSocket speaks Robot Raconteur (binary frames) only")
+                                     : "open the WebSocket with the subprotocol " + json_protocols + " for the JSON API";
+        auto text = std::make_shared<std::string>(
+            "{\"error\": {\"name\": \"RobotRaconteur.ProtocolError\", \"message\": \"no WebSocket subprotocol was "
+            "asked for, so this connection speaks raw Robot Raconteur (subprotocol " +
+            std::string(kRRSubprotocol) + "); " + hint + "\"}}");
+        ws->text(true);
+        beast::get_lowest_layer(*ws).expires_after(std::chrono::seconds(5));  // the write and the close handshake
+        ws->async_write(asio::buffer(*text), [ws, text, hint](beast::error_code ec, std::size_t) {
+            if (ec) return;
+            // A close frame's reason has at most 123 bytes.
+            websocket::close_reason reason(websocket::close_code::policy_error, beast::string_view(hint).substr(0, 123));
+            ws->async_close(reason, [ws](beast::error_code) {});
+        });
+    }
+
+    ClientOrigin client() const { return ClientOrigin{remote(), "", false}; }
+
+    std::string remote() const {
+        beast::error_code ec;
+        auto ep = beast::get_lowest_layer(stream_).socket().remote_endpoint(ec);
+        return ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
+    }
+
+    void write(Response r) {
+        auto self = shared_from_this();
+        auto res = std::make_shared<Response>(std::move(r));
+        res->prepare_payload();
+        if (head_) {  // the answer to HEAD: GET's Content-Length, no body
+            res->body().clear();
+            head_ = false;
+        }
+        bhttp::async_write(stream_, *res, [self, res](beast::error_code ec, std::size_t) {
+            if (ec || !res->keep_alive()) {
+                self->shutdown();
+                return;
+            }
+            self->read();
+        });
+    }
+
+    void shutdown() {
+        beast::error_code ec;
+        auto& socket = beast::get_lowest_layer(stream_).socket();
+        socket.shutdown(tcp::socket::shutdown_send, ec);
+        socket.close(ec);
+    }
+
+    std::shared_ptr<HttpServer> server_;
+    Stream stream_;
+    beast::flat_buffer buffer_;
+    std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+    bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)
+    ClientOrigin client_;  // who sent the request being answered (behind a trusted proxy: the proxy's client)
+};
+
+}  // namespace rr::server::http::detail
