@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 
+#include <boost/asio/ssl/error.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -260,7 +261,9 @@ private:
         beast::get_lowest_layer(stream_).expires_after(server_->options().read_timeout);
         auto self = shared_from_this();
         bhttp::async_read(stream_, buffer_, *parser_, [self](beast::error_code ec, std::size_t) {
-            if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout) {
+            // A TLS client that closes without close_notify (most do, between requests) ends the session
+            // like a plain end of stream.
+            if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout || ec == asio::ssl::error::stream_truncated) {
                 self->shutdown();
                 return;
             }
