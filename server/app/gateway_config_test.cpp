@@ -184,13 +184,13 @@ TEST_CASE("bad flags are refused with the flag's name") {
 
 TEST_CASE("every example in gateway-config/ is a valid configuration") {
     int n = 0;
-    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml"}) {
+    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml", "tls.yaml"}) {
         auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/" + name);
         INFO(name);
         REQUIRE(c);
         ++n;
     }
-    CHECK(n == 4);
+    CHECK(n == 5);
     auto missing = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/nope.yaml");
     REQUIRE_FALSE(missing);
     CHECK_THAT(missing.error().message, Catch::Contains("cannot read"));
