@@ -12,6 +12,7 @@
 #include "server/transport/usb/usb_discovery.hpp"
 #include "server/transport/usb/usb_host.hpp"
 #endif
+#include "server/transport/tls/tls_stream.hpp"
 
 namespace rr::server::app {
 

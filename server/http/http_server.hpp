@@ -28,7 +28,7 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 
-#include "server/transport/tls/tls_stream.hpp"
+#include "server/transport/tls/tls_stream_fwd.hpp"
 
 namespace rr::server {
 

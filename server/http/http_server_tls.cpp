@@ -3,6 +3,7 @@
 #include <boost/beast/websocket/ssl.hpp>
 
 #include "server/http/http_session.hpp"
+#include "server/transport/tls/tls_stream.hpp"
 
 namespace rr::server::http {
 

@@ -7,6 +7,7 @@
 #include "server/common/random_ids.hpp"
 #include "server/node/service_index.hpp"
 #include "server/transport/tls/tls_listener.hpp"
+#include "server/transport/tls/tls_stream.hpp"
 
 namespace rr::server {
 

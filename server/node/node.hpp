@@ -22,7 +22,7 @@
 #include "server/node/service_registry.hpp"
 #include "server/transport/tcp_listener.hpp"
 #include "server/transport/tls/tls_context.hpp"
-#include "server/transport/tls/tls_stream.hpp"
+#include "server/transport/tls/tls_stream_fwd.hpp"
 #include "server/transport/transport.hpp"
 #include "server/transport/transport_registry.hpp"
 

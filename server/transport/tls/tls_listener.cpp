@@ -6,6 +6,7 @@
 #include <boost/beast/core/error.hpp>
 
 #include "core/session/starttls.hpp"
+#include "server/transport/tls/tls_stream.hpp"
 #include "server/transport/tcp_listener.hpp"
 
 namespace rr::server {

@@ -21,7 +21,8 @@
 
 #include "core/names/node_id.hpp"
 #include "server/transport/tls/tls_context.hpp"
-#include "server/transport/tls/tls_stream.hpp"
+#include "server/transport/tls/tls_stream_fwd.hpp"
+#include "server/transport/transport.hpp"
 
 namespace rr::server {
 

@@ -4,22 +4,19 @@
 // (tls_stream.cpp); other files see only the extern declaration below.
 #pragma once
 
-#include <functional>
+#include <type_traits>
 #include <vector>
 
 #include <boost/asio/ssl/stream.hpp>
 #include <boost/beast/core/tcp_stream.hpp>
 
 #include "server/transport/stream_pump.hpp"
+#include "server/transport/tls/tls_stream_fwd.hpp"
 #include "server/transport/transport.hpp"
 
 namespace rr::server {
 
-using TlsStream = boost::asio::ssl::stream<boost::beast::tcp_stream>;
-
-/// Takes a TLS connection (handshake done) whose first decrypted bytes (`initial`) were not `RRAC`:
-/// HTTPS requests and WSS upgrades.
-using HttpsHandler = std::function<void(TlsStream stream, std::vector<std::byte> initial)>;
+static_assert(std::is_same_v<TlsStream, boost::asio::ssl::stream<boost::beast::tcp_stream>>);
 
 /// serve_stream() for a TLS stream (non-template: the pump is compiled in tls_stream.cpp).
 bool serve_tls_stream(ConnectionSink& sink, TlsStream stream, const AcceptedStream& info, std::vector<std::byte> initial);
