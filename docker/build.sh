@@ -70,7 +70,7 @@ if [ "$base" = "$local_base" ]; then
     tar=$(mktemp --suffix=.tar)
     # The mirror apt uses on this machine (mmdebstrap's default otherwise).
     mirror=$(grep -rhoE '^(URIs:|deb) +https?://[^ ]+' /etc/apt/sources.list /etc/apt/sources.list.d/ 2>/dev/null |
-             awk '{print $2}' | grep -v security | head -1 || true)
+             awk '{print $2}' | grep -E '/debian/?$' | head -1 || true)
     mmdebstrap --quiet --variant=apt --include=ca-certificates bookworm "$tar" ${mirror:+"$mirror"}
     $tool import "$tar" "$base" >/dev/null
     rm -f "$tar"
