@@ -13,9 +13,9 @@ enum class LogFormat { text, json };
 
 /// What a message is about; empty fields are unknown (JSON: null; text: left out).
 struct LogContext {
-    std::string_view device;   ///< gateway device name (docs/gateway-config.md devices[].name)
-    std::string_view client;   ///< remote address of the client ("ip:port")
-    std::string_view request;  ///< the client's request ("GET /api/devices", a WebSocket subprotocol…)
+    std::string_view device{};   ///< gateway device name (docs/gateway-config.md devices[].name)
+    std::string_view client{};   ///< remote address of the client ("ip:port")
+    std::string_view request{};  ///< the client's request ("GET /api/devices", a WebSocket subprotocol…)
 };
 
 /// Parses "trace" … "disable" (as the config accepts); unknown text gives info.
