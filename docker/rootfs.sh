@@ -2,11 +2,14 @@
 # Build stage helper (docker/Containerfile): gathers the runtime image's root file system in OUT from
 # the build folder BUILD and the source tree SRC: binaries, the shared libraries they load (as ldd
 # resolves them, plus the dynamic loader), static busybox, CA bundle, the user rr-gateway (10001).
+# The folders the gateway writes go to OUT-rw instead: the Containerfile copies them with
+# --chown=10001:10001 (a plain COPY --from makes everything root's).
 #   rootfs.sh BUILD SRC OUT
 set -eu
 build=$1 src=$2 out=$3
 mkdir -p "$out/usr/local/bin" "$out/bin" "$out/etc/rr-gateway/examples" "$out/etc/ssl/certs" \
-         "$out/usr/local/share/rr-gateway/web" "$out/run/rr-gateway" "$out/var/lib/rr-gateway" "$out/tmp"
+         "$out/usr/local/share/rr-gateway/web" "$out/tmp" \
+         "$out-rw/run/rr-gateway" "$out-rw/var/lib/rr-gateway"
 cp "$build/server/app/rr-gateway" "$build/server/demo/rr-demo-devices" "$out/usr/local/bin/"
 strip "$out/usr/local/bin/rr-gateway" "$out/usr/local/bin/rr-demo-devices"
 cp "$src/docker/entrypoint.sh" "$out/usr/local/bin/rr-gateway-entrypoint"
@@ -28,6 +31,5 @@ printf 'root:x:0:0:root:/root:/sbin/nologin\nrr-gateway:x:10001:10001:rr-gateway
 printf 'root:x:0:\nrr-gateway:x:10001:\n' >"$out/etc/group"
 cp "$src"/gateway-config/*.yaml "$out/etc/rr-gateway/examples/" 2>/dev/null || true
 if [ -d "$src/web/dist" ]; then cp -r "$src/web/dist/." "$out/usr/local/share/rr-gateway/web/"; fi
-chown -R 10001:10001 "$out/run/rr-gateway" "$out/var/lib/rr-gateway"
-chmod 700 "$out/run/rr-gateway" "$out/var/lib/rr-gateway"
+chmod 700 "$out-rw/run/rr-gateway" "$out-rw/var/lib/rr-gateway"
 chmod 1777 "$out/tmp"
