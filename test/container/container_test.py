@@ -101,7 +101,8 @@ def main():
 
     def image_metadata():
         expect(config.get("User") == "10001:10001", "image user %r" % config.get("User"))
-        hc = config.get("Healthcheck") or {}
+        # podman puts it at the top level of `image inspect`, Docker under Config.
+        hc = cfg.get("Healthcheck") or config.get("Healthcheck") or {}
         expect("/livez" in " ".join(hc.get("Test", [])), "HEALTHCHECK %r" % hc)
         expect(size < 150 * 1000 * 1000, "image is %d bytes; expected a small runtime image" % size)
 
