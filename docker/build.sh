@@ -1,16 +1,52 @@
 #!/usr/bin/env bash
 # Builds the rr-gateway image (docker/Containerfile) with podman, or buildah when podman is missing;
-# no Docker daemon. Installs its tools from apt when missing (idempotent).
+# no Docker daemon, and no container registry unless you name a base image that lives in one.
 #
-#   docker/build.sh [--smoke]        -> ${RR_IMAGE:-localhost/rr-gateway:latest}
+#   docker/build.sh [--base IMAGE] [--tag IMAGE] [--smoke] [--print-key]
 #
-# Base image: debian:bookworm from a registry when one answers; otherwise a local one made once with
-# mmdebstrap from the Debian mirror and imported as localhost/debian:bookworm-local (set
-# RR_BASE_IMAGE to choose). The build context is the committed tree (git archive HEAD) plus web/dist
-# when the dashboard was built. --smoke then runs the image (runc, low ulimits: crun cannot set the
-# default ones in this kind of VM) and checks /livez and the demo devices over HTTP.
+#   --base IMAGE   the build stage's base (also RR_BASE_IMAGE), e.g. docker.io/library/debian:bookworm
+#                  where a registry answers. Default: localhost/debian:bookworm-local, made once from
+#                  Debian's packages with mmdebstrap (the Debian mirror, no registry) and imported.
+#   --tag IMAGE    the result (also RR_IMAGE; default localhost/rr-gateway:latest)
+#   --smoke        then run it once: /livez and the demo devices over HTTP
+#   --print-key    print the inputs key (below) and exit
+#
+# The runtime stage is FROM scratch (docker/rootfs.sh gathers its files), so nothing else is pulled.
+# The build context is the committed tree (git archive HEAD) of what the binaries are built from, plus
+# web/dist when the dashboard was built. The image carries the label rr.inputs=<sha256 of that context
+# and the base>: test/container reuses an image whose label matches instead of building again.
+# Installs podman, buildah, runc and mmdebstrap from apt when missing (idempotent).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+base=${RR_BASE_IMAGE:-}
+image=${RR_IMAGE:-localhost/rr-gateway:latest}
+smoke="" print_key=""
+while (($#)); do
+  case "$1" in
+    --base) base=$2; shift 2 ;;
+    --base=*) base=${1#*=}; shift ;;
+    --tag) image=$2; shift 2 ;;
+    --tag=*) image=${1#*=}; shift ;;
+    --smoke) smoke=1; shift ;;
+    --print-key) print_key=1; shift ;;
+    *) echo "build: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+local_base=localhost/debian:bookworm-local
+[ -n "$base" ] || base=$local_base
+
+# What the image is built from (keep in step with the Containerfile's COPY and rootfs.sh).
+inputs=(CMakeLists.txt CMakePresets.json core robdef server packaging gateway-config
+        docker/Containerfile docker/rootfs.sh docker/entrypoint.sh docker/build.sh)
+key() {
+  {
+    echo "base=$base"
+    git ls-tree -r HEAD -- "${inputs[@]}"
+    if [ -f web/dist/index.html ]; then (cd web/dist && find . -type f -print0 | sort -z | xargs -0 sha256sum); fi
+  } | sha256sum | cut -d' ' -f1
+}
+if [ -n "$print_key" ]; then key; exit 0; fi
 
 need=(podman buildah fuse-overlayfs slirp4netns uidmap runc mmdebstrap)
 missing=()
@@ -25,48 +61,50 @@ fi
 
 tool=podman
 command -v podman >/dev/null || tool=buildah
-image=${RR_IMAGE:-localhost/rr-gateway:latest}
+# crun cannot set podman's default ulimits in this kind of VM; runc with low ones works (TOOLCHAIN §5).
 run_opts=(--runtime runc --ulimit nofile=1024:1024 --ulimit nproc=1024:1024)
 
-base=${RR_BASE_IMAGE:-}
-if [ -z "$base" ]; then
-  if $tool image exists docker.io/library/debian:bookworm 2>/dev/null ||
-     timeout 60 $tool pull -q docker.io/library/debian:bookworm >/dev/null 2>&1; then
-    base=docker.io/library/debian:bookworm
-  else
-    base=localhost/debian:bookworm-local
-    if ! $tool image exists "$base"; then
-      echo "build: no registry reachable; making $base with mmdebstrap"
-      tar=$(mktemp --suffix=.tar)
-      mmdebstrap --quiet --variant=apt --include=ca-certificates bookworm "$tar"
-      $tool import "$tar" "$base" >/dev/null
-      rm -f "$tar"
-    fi
+pull=(--pull=never)
+if [ "$base" = "$local_base" ]; then
+  if ! $tool image exists "$base" 2>/dev/null; then
+    echo "build: making $base from Debian's packages (mmdebstrap, no registry)"
+    tar=$(mktemp --suffix=.tar)
+    # The mirror apt uses on this machine (mmdebstrap's default otherwise).
+    mirror=$(grep -rhoE '^(URIs:|deb) +https?://[^ ]+' /etc/apt/sources.list /etc/apt/sources.list.d/ 2>/dev/null |
+             awk '{print $2}' | grep -E '/debian/?$' | head -1 || true)
+    mmdebstrap --quiet --variant=apt --include=ca-certificates bookworm "$tar" ${mirror:+"$mirror"}
+    $tool import "$tar" "$base" >/dev/null
+    rm -f "$tar"
   fi
+else
+  pull=(--pull=missing)   # a base the user named: the engine pulls it if it is not here yet
 fi
 echo "build: base image $base"
 
 ctx=$(mktemp -d)
 trap 'rm -rf "$ctx"' EXIT
 # The committed tree (HEAD), so that edits in progress never reach the image.
-git archive --format=tar HEAD | tar -xf - -C "$ctx"
+git archive --format=tar HEAD -- "${inputs[@]}" | tar -xf - -C "$ctx"
 if [ -f web/dist/index.html ]; then
   mkdir -p "$ctx/web/dist" && cp -r web/dist/. "$ctx/web/dist/"
 else
   echo "build: web/dist not built; the image serves no dashboard (JSON API and RR only)"
 fi
-
+k=$(key)
 if [ "$tool" = podman ]; then
-  podman build "${run_opts[@]}" --network host --build-arg "BASE=$base" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
+  podman build "${run_opts[@]}" "${pull[@]}" --format docker --network host --build-arg "BASE=$base" \
+    --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
 else
-  buildah bud --runtime runc --network host --build-arg "BASE=$base" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
+  buildah bud --runtime runc "${pull[@]}" --format docker --network host --build-arg "BASE=$base" \
+    --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
 fi
-echo "build: $image"
+size=$($tool image inspect --format '{{.Size}}' "$image" 2>/dev/null || echo 0)
+echo "build: $image ($((size / 1000000)) MB, rr.inputs=$k)"
 
-if [ "${1:-}" = --smoke ]; then
+if [ -n "$smoke" ]; then
   port=${RR_SMOKE_PORT:-18480}
   name=rr-gateway-smoke-$$
-  podman run "${run_opts[@]}" --rm -d --name "$name" --network host "$image" --port "$port" >/dev/null
+  podman run "${run_opts[@]}" --rm -d --name "$name" -p "127.0.0.1:$port:8080" "$image" >/dev/null
   trap 'podman stop -t 5 "$name" >/dev/null 2>&1 || true; rm -rf "$ctx"' EXIT
   for _ in $(seq 100); do
     curl -fsS "http://127.0.0.1:$port/readyz" >/dev/null 2>&1 && break

@@ -6,7 +6,7 @@
 # Extra arguments go to rr-gateway. Stopping the gateway (Ctrl-C) stops Reynard too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
+./scripts/setup.sh run python
 
 rr_port=${REYNARD_RR_PORT:-29200}
 http_port=${REYNARD_HTTP_PORT:-29201}

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job: installs what is missing (scripts/setup.sh), builds rr-gateway (release preset), builds
+# The main job: installs what is missing for running (scripts/setup.sh run: no test tools), builds
+# rr-gateway (release preset, tests off), builds
 # the web dashboard when its build scripts exist (wasm-client/build.sh, then web/build.sh), and runs
 # rr-gateway in the foreground. With no arguments the gateway starts its two embedded demo devices
 # (experimental.create and experimental.createwebcam) and serves everything on http://localhost:8080/.
@@ -7,16 +8,17 @@
 # (see docs/gateway-config.md). RR_BUILD_DIR=build/x builds there instead of the preset's build/release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
+./scripts/setup.sh run
 
 jobs=${RR_JOBS:-$(nproc)}
 if [ -n "${RR_BUILD_DIR:-}" ]; then
   build=$RR_BUILD_DIR
-  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DRR_BUILD_TESTS=OFF >/dev/null
   cmake --build "$build" -j "$jobs" --target rr-gateway
 else
   build=build/release
-  cmake --preset release >/dev/null
+  # Tests off: running needs no Catch2 (scripts/test.sh builds and runs them in build/debug).
+  cmake --preset release -DRR_BUILD_TESTS=OFF >/dev/null
   cmake --build --preset release -j "$jobs" --target rr-gateway
 fi
 

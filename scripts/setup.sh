@@ -1,21 +1,44 @@
 #!/usr/bin/env bash
-# Installs everything the build, the tests and the gateway need. Idempotent: a second run installs
-# nothing. Debian packages (apt), Python packages into ./.venv (pip, pinned), npm packages (npm ci in
-# web/ and wasm-client/, pinned by their package-lock.json).
+# Installs what the project needs. Idempotent: a second run installs nothing.
+#
+#   ./scripts/setup.sh            everything: building, running, testing (scripts/test.sh)
+#   ./scripts/setup.sh run        only what building and running the gateway and its dashboard needs
+#                                 (scripts/run.sh): compiler, libraries, Emscripten + node for the
+#                                 dashboard's WebAssembly client, the dashboard's npm packages
+#   ./scripts/setup.sh run python  and the Python venv (.venv: the official library, Reynard;
+#                                 scripts/run-reynard.sh)
+#
+# Debian packages (apt), Python packages into ./.venv (pip, pinned), npm packages (npm ci in web/ and
+# wasm-client/, pinned by their package-lock.json).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-APT_PACKAGES=(
+parts=("$@")
+((${#parts[@]})) || parts=(run python test)
+wants() { local p; for p in "${parts[@]}"; do [ "$p" = "$1" ] && return 0; done; return 1; }
+
+# Building and running: the server, and the dashboard (its WebAssembly client needs Emscripten, which
+# also brings node; node-acorn is what Debian's emscripten 3.1.6 needs; npm for web/'s packages).
+RUN_PACKAGES=(
   cmake ninja-build g++ pkg-config ccache
-  libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev catch2 libyaml-cpp-dev
+  libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev libyaml-cpp-dev
+  emscripten node-acorn
+)
+PYTHON_PACKAGES=(python3-venv)
+# Testing only: Catch2, the USB device emulator, clang for the fuzz targets, Chromium for the browser
+# tests, nginx/openssl/htpasswd for the reverse-proxy tests.
+TEST_PACKAGES=(
+  catch2
   umockdev libumockdev-dev
   clang-14 libclang-rt-14-dev
-  python3-venv
   chromium fonts-liberation
-  emscripten node-acorn
   nginx openssl apache2-utils haproxy
   testssl.sh
 )
+APT_PACKAGES=()
+wants run && APT_PACKAGES+=("${RUN_PACKAGES[@]}")
+wants python && APT_PACKAGES+=("${PYTHON_PACKAGES[@]}")
+wants test && APT_PACKAGES+=("${RUN_PACKAGES[@]}" "${PYTHON_PACKAGES[@]}" "${TEST_PACKAGES[@]}")
 
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
@@ -30,6 +53,7 @@ if ((${#missing[@]})); then
 fi
 
 # Python: the official Robot Raconteur package (pinned) for interop tests, in a project venv.
+if wants python || wants test; then
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
@@ -40,6 +64,7 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "setup: installing Python packages from $req"
   .venv/bin/pip install -q --disable-pip-version-check -r "$req"
   echo "$want" > "$stamp"
+fi
 fi
 # npm: the dashboard's packages (web/package.json, pinned; package-lock.json). No browser downloads:
 # the browser tests use Debian's /usr/bin/chromium.
@@ -58,6 +83,7 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "$want" > "$stamp"
 fi
 # npm: the WebAssembly client's test dependency (`ws`, wasm-client/package-lock.json).
+if wants test; then
 lock=wasm-client/package-lock.json
 stamp=wasm-client/node_modules/.lock.sha
 want=$(sha256sum "$lock" | cut -d' ' -f1)
@@ -66,4 +92,5 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   (cd wasm-client && npm ci --no-audit --no-fund --loglevel=error)
   echo "$want" > "$stamp"
 fi
-echo "setup: ok"
+fi
+echo "setup: ok (${parts[*]})"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The test command: installs what is missing, builds the debug preset (ASan + UBSan), runs every
-# test (unit, interop against the official library), the server tests again under ThreadSanitizer
-# (with RR_TSAN=1), then builds the libFuzzer targets and runs each
+# The test command: installs what is missing (scripts/setup.sh: the run packages and the test tools:
+# Catch2, Chromium, nginx, clang, umockdev, the Python venv), builds the debug preset (ASan + UBSan),
+# runs every test (unit, interop against the official library), the server tests again under
+# ThreadSanitizer (with RR_TSAN=1), then builds the libFuzzer targets and runs each
 # briefly (scripts/fuzz.sh; RR_FUZZ_SECONDS=N for N seconds each, 0 for none). Exits non-zero on any failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."

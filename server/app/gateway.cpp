@@ -152,6 +152,12 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     for (const auto& p : c.trusted_proxies)
         if (auto n = http::parse_ip_network(p)) hopts.trusted_proxies.push_back(*n);
     hopts.on_websocket = [](const std::string& line) { log(LogLevel::info, line); };
+    if (log_enabled(LogLevel::debug)) {
+        // The access log: one debug line per HTTP response, with the client and its request.
+        hopts.on_response = [](std::string_view client, std::string_view request, unsigned status) {
+            log(LogLevel::debug, "HTTP " + std::to_string(status), LogContext{.client = client, .request = request});
+        };
+    }
     g->http_ = std::make_shared<http::HttpServer>(g->node_, hopts);
     Gateway* self = g.get();
     g->http_->add_route(bhttp::verb::get, "/livez", [](const http::Request& req, http::Responder respond) {
@@ -249,7 +255,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         d->set_state_listener([](const gateway::DeviceStatus& s) {
             log(s.state == gateway::DeviceState::connected ? LogLevel::info : LogLevel::warning,
                 "device " + s.name + ": " + std::string(gateway::device_state_name(s.state)) +
-                    (s.reason.empty() ? "" : " (" + s.reason + ")"));
+                    (s.reason.empty() ? "" : " (" + s.reason + ")"), LogContext{.device = s.name});
         });
         d->start();
     }

@@ -76,6 +76,7 @@ private:
 };
 
 const std::set<std::string> kLogLevels{"trace", "debug", "info", "warning", "error", "fatal", "disable"};
+const std::set<std::string> kLogFormats{"text", "json"};
 
 // NodeName syntax of the official library's NodeID cache (wire.md §13): also what rr+local accepts.
 bool valid_node_name(const std::string& name) {
@@ -108,6 +109,7 @@ void validate(const GatewayConfig& c, const std::function<void(const std::string
         error("gateway.node_name", "not a NodeName (letters, digits, _ . -, starting with a letter): \"" + c.node_name + "\"");
     if (!c.node_id.empty() && !NodeID::parse(c.node_id)) error("gateway.node_id", "not a NodeID (UUID)");
     if (!kLogLevels.count(c.log_level)) error("gateway.log_level", "unknown level \"" + c.log_level + "\"");
+    if (!kLogFormats.count(c.log_format)) error("gateway.log_format", "unknown format \"" + c.log_format + "\" (text or json)");
     if (c.max_message_size < 16 * 1024 || c.max_message_size > 100u * 1024u * 1024u)
         error("gateway.max_message_size", "must be between 16 KiB and 100 MiB");
     std::set<std::string> names;
@@ -320,7 +322,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "max_message_size", "log_level", "local", "tls"});
+                      "max_message_size", "log_level", "log_format", "local", "tls"});
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
         if (auto n = g["node_name"]) {
@@ -363,6 +365,11 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         if (auto n = g["log_level"]) {
             c.log_level = r.string(n, "gateway.log_level");
             if (!kLogLevels.count(c.log_level)) r.error(n, "gateway.log_level", "unknown level \"" + c.log_level + "\"");
+        }
+        if (auto n = g["log_format"]) {
+            c.log_format = r.string(n, "gateway.log_format");
+            if (!kLogFormats.count(c.log_format))
+                r.error(n, "gateway.log_format", "unknown format \"" + c.log_format + "\" (text or json)");
         }
     }
     if (auto d = root["demo"]) {
@@ -441,7 +448,7 @@ namespace {
 // Flags that take a value, with their official RR spellings mapped to ours.
 const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
                                         "--allow-origin", "--device",     "--demo-port", "--threads", "--trusted-proxy",
-                                        "--log-level",   "--robotraconteur-tcp-port", "--robotraconteur-nodename",
+                                        "--log-level",   "--log-format", "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level", "--tls-certificate",
                                         "--tls-private-key", "--tls-client-ca"};
 const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h", "--tls-required"};
@@ -543,6 +550,9 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             for (auto& ch : level) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
             if (!kLogLevels.count(level)) return fail(MessageErrorType::InvalidConfiguration, flag + ": unknown level \"" + v + "\"");
             c.log_level = level;
+        } else if (flag == "--log-format") {
+            if (!kLogFormats.count(v)) return fail(MessageErrorType::InvalidConfiguration, flag + ": unknown format \"" + v + "\" (text or json)");
+            c.log_format = v;
         } else if (flag == "--device") {
             auto e2 = v.find('=');
             if (e2 == std::string::npos)
@@ -592,6 +602,7 @@ Options (override the configuration file):
   --demo-port N              RR port of the demo devices' node (default: ephemeral)
   --threads N                worker threads (default: cores)
   --log-level LEVEL          trace, debug, info, warning, error
+  --log-format FORMAT        text (default) or json: one JSON object per line
   --check                    validate the configuration and exit
   --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
   --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL

@@ -80,6 +80,9 @@ struct GatewayConfig {
     std::vector<std::string> trusted_proxies;
     std::size_t max_message_size = 12u * 1024u * 1024u;
     std::string log_level = "info";
+    /// "text" (one line per message) or "json" (one object per line: time, level, message, device,
+    /// client, request); docs/deployment.md §Logs.
+    std::string log_format = "text";
     /// Serve rr+local under node_name (and the demo node's under node_name + ".demo"), so clients on
     /// this computer reach the gateway by NodeName without TCP (docs/local-transport.md).
     bool local = true;
@@ -119,7 +122,7 @@ struct CommandLine {
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
-/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --no-local,
+/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
 /// --discovery, --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).

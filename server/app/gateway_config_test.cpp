@@ -61,6 +61,7 @@ TEST_CASE("configuration errors name the key and the line") {
              Case{"gateway: [1, 2]\n", "bad.yaml:1: gateway: expected a mapping"},
              Case{"gateway:\n  port: [\n", "bad.yaml:"},
              Case{"gateway:\n  log_level: loud\n", "bad.yaml:2: gateway.log_level: unknown level"},
+             Case{"gateway:\n  log_format: xml\n", "bad.yaml:2: gateway.log_format: unknown format \"xml\""},
              Case{"gateway:\n  node_id: not-a-uuid\n", "bad.yaml:2: gateway.node_id: not a NodeID"},
          }) {
         auto c = parse_gateway_config(yaml, "bad.yaml");
@@ -161,6 +162,24 @@ TEST_CASE("command-line flags override the file, including the official RR flags
     CHECK(c.log_level == "warning");
     REQUIRE(c.devices.size() == 1);
     CHECK(c.devices[0].name == "reynard");
+}
+
+TEST_CASE("log_format: the key and --log-format (flag wins)") {
+    auto c = parse_gateway_config("gateway:\n  log_format: json\n", "x.yaml");
+    REQUIRE(c);
+    CHECK(c->log_format == "json");
+    CHECK(GatewayConfig{}.log_format == "text");
+    const char* argv[] = {"rr-gateway", "--log-format", "text"};
+    auto cmd = parse_command_line(3, argv);
+    REQUIRE(cmd);
+    REQUIRE(apply_overrides(*c, *cmd));
+    CHECK(c->log_format == "text");
+    const char* bad[] = {"rr-gateway", "--log-format=yaml"};
+    auto cmd2 = parse_command_line(2, bad);
+    REQUIRE(cmd2);
+    auto r = apply_overrides(*c, *cmd2);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("--log-format"));
 }
 
 TEST_CASE("bad flags are refused with the flag's name") {

@@ -200,7 +200,7 @@ Result<std::shared_ptr<gateway::DeviceMirror>> DiscoveredDevices::create_device(
     (*mirror)->set_state_listener([](const gateway::DeviceStatus& s) {
         log(s.state == gateway::DeviceState::connected ? LogLevel::info : LogLevel::warning,
             "discovered device " + s.name + ": " + std::string(gateway::device_state_name(s.state)) +
-                (s.reason.empty() ? "" : " (" + s.reason + ")"));
+                (s.reason.empty() ? "" : " (" + s.reason + ")"), LogContext{.device = s.name});
     });
     (*mirror)->start();
     log(LogLevel::info, "discover: device " + cfg.name + " for " + service.name + " (" + service.root_object_type +

@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     set_log_level(log_level_from_string(config.log_level));
+    if (LogFormat f; log_format_from_string(config.log_format, f)) set_log_format(f);
 
     DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port) {
         return rr::server::demo::start_demo_devices_for_gateway(*node, port);

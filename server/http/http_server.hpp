@@ -85,6 +85,10 @@ struct HttpOptions {
     /// Called once per accepted WebSocket with a line for the log: kind, client, and the proxy when the
     /// client came through a trusted one (`WebSocket rr from 198.51.100.1 (https, via 10.0.0.1:5123)`).
     std::function<void(const std::string&)> on_websocket;
+    /// Called after each HTTP response is queued (not for WebSocket upgrades): the client's address
+    /// ("ip:port"), the request line ("GET /livez"; "" when the request could not be parsed) and the
+    /// status code. On the connection's thread: keep it short (the gateway's access log).
+    std::function<void(std::string_view client, std::string_view request, unsigned status)> on_response;
 };
 
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin);

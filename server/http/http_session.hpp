@@ -297,6 +297,11 @@ private:
                 client_ = client_origin(ep.address(), ep.port(), forwarded("X-Forwarded-For"),
                                         forwarded("X-Forwarded-Proto"), server_->options().trusted_proxies);
         }
+        if (server_->options().on_response) {
+            request_line_.assign(req.method_string().data(), req.method_string().size());
+            request_line_ += ' ';
+            request_line_.append(req.target().data(), req.target().size());
+        }
         const auto origin = req[bhttp::field::origin];
         if (!origin.empty() && !same_origin(origin, req[bhttp::field::host], client_.scheme) &&
             !origin_allowed(server_->options().allowed_origins, origin)) {
@@ -466,6 +471,11 @@ private:
     }
 
     void write(Response r) {
+        if (const auto& hook = server_->options().on_response) {
+            // The client as the request named it (behind a trusted proxy: the proxy's client).
+            hook(request_line_.empty() || client_.address.empty() ? remote() : client_.address, request_line_, r.result_int());
+            request_line_.clear();
+        }
         auto self = shared_from_this();
         auto res = std::make_shared<Response>(std::move(r));
         res->prepare_payload();
@@ -495,6 +505,7 @@ private:
     std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
     bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)
     ClientOrigin client_;  // who sent the request being answered (behind a trusted proxy: the proxy's client)
+    std::string request_line_;  // "METHOD target" of that request, for HttpOptions::on_response
 };
 
 }  // namespace rr::server::http::detail

@@ -6,8 +6,9 @@
   config   a bad configuration file makes rr-gateway exit non-zero before listening, naming the file,
            the line and the key; so does an unknown flag.
   metrics  /metrics (Prometheus text, parsed with prometheus_client) has every series that
-           docs/deployment.md §Monitoring lists, with its type, and the counters follow the traffic of an
-           official RR client.
+           docs/deployment.md §Monitoring lists, with its type and label names, serves none it does not
+           list (without and with --discovery), and the counters follow the traffic of an official RR
+           client.
 
 Usage: process_test.py --gateway PATH --case origin|config|metrics [--doc docs/deployment.md]
 Prints a JSON summary; exit status 0 only if every check passed.
@@ -133,11 +134,56 @@ def case_config(checks, exe):
 
 
 def documented_series(doc):
-    """`| `name` | type | …` rows of the Monitoring table in docs/deployment.md."""
-    rows = re.findall(r"^\|\s*`(rr_gateway_[a-z_]+)`\s*\|\s*(gauge|counter|histogram)\s*\|", open(doc).read(), re.M)
+    """`| `name` | type | labels | meaning |` rows of the Monitoring table in docs/deployment.md, as
+    (name, type) pairs; see documented_table for the label names."""
+    return [(name, kind) for name, kind, _, _ in documented_table(doc)]
+
+
+def documented_table(doc):
+    """(name, type, label names, only_with_discovery) for each row of the Monitoring table. Label names:
+    the first `name` of each comma-separated part of the labels column, parentheses (value lists) left
+    out; a meaning starting with "with discovery on" marks series served only with discovery on."""
+    rows = re.findall(r"^\|\s*`(rr_gateway_[a-z_]+)`\s*\|\s*(gauge|counter|histogram)\s*\|([^|]*)\|([^|]*)\|",
+                      open(doc).read(), re.M)
     if len(rows) < 5:
         raise RuntimeError("%s lists %d series; expected the Monitoring table" % (doc, len(rows)))
-    return rows
+    table = []
+    for name, kind, labels, meaning in rows:
+        labels = re.sub(r"\([^)]*\)", "", labels)
+        names = set()
+        for part in labels.split(","):
+            m = re.search(r"`([a-z_]+)`", part)
+            if m:
+                names.add(m.group(1))
+        table.append((name, kind, names, meaning.strip().startswith("with discovery on")))
+    return table
+
+
+def family_name(name):
+    # prometheus_client names a counter family without its _total suffix.
+    return name[:-len("_total")] if name.endswith("_total") else name
+
+
+def check_against_table(fams, table, discovery):
+    """Both directions: every documented series (of this mode) is served with its type and label names,
+    and every served family is documented."""
+    documented = {}
+    for name, kind, labels, only_discovery in table:
+        documented[family_name(name) if kind == "counter" else name] = name
+        if only_discovery and not discovery:
+            expect(family(fams, name) is None, "%s served without discovery" % name)
+            continue
+        fam = family(fams, name)
+        expect(fam is not None, "series %s missing from /metrics" % name)
+        expect(fam.type == kind, "%s has type %s, documented %s" % (name, fam.type, kind))
+        served = set()
+        for smp in fam.samples:
+            if smp.name.endswith("_created"):
+                continue
+            served |= set(smp.labels)
+        expect(served == labels, "%s has labels %s, documented %s" % (name, sorted(served), sorted(labels)))
+    for n in fams:
+        expect(n in documented, "/metrics serves %s, which docs/deployment.md does not document" % n)
 
 
 def scrape(port):
@@ -168,14 +214,11 @@ def case_metrics(checks, exe, doc):
     port = gw.port
     try:
         gwproc.wait_ready(port)
-        series = documented_series(doc)
+        table = documented_table(doc)
 
         def present():
             fams = scrape(port)
-            for name, kind in series:
-                fam = family(fams, name)
-                expect(fam is not None, "series %s missing from /metrics" % name)
-                expect(fam.type == kind, "%s has type %s, documented %s" % (name, fam.type, kind))
+            check_against_table(fams, table, discovery=False)
             up = family(fams, "rr_gateway_device_up")
             for dev in ("create", "webcam"):
                 s = samples(up, "rr_gateway_device_up", device=dev)
@@ -220,6 +263,18 @@ def case_metrics(checks, exe, doc):
             RRN.Shutdown()
         finally:
             gw.stop()
+
+    gw = gwproc.start_gateway(exe, ["--discovery"])
+    try:
+        gwproc.wait_ready(gw.port)
+
+        def with_discovery():
+            check_against_table(scrape(gw.port), documented_table(doc), discovery=True)
+
+        checks.run("with --discovery: every documented series, type and labels; nothing undocumented",
+                   with_discovery)
+    finally:
+        gw.stop()
 
 
 def main():
