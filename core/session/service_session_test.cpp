@@ -275,7 +275,7 @@ TEST_CASE("service session: login with the connect, wrong password refused, logo
     }
 }
 
-TEST_CASE("service session: lock operations reach a service that handles locks; others answer as before") {
+TEST_CASE("service session: lock operations reach a service that handles locks, others answer as before") {
     auto op = [](const char* name) {
         MessageEntry e;
         e.entry_type = MessageEntryType::ClientSessionOpReq;

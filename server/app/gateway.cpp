@@ -35,9 +35,10 @@ std::string escape_label(std::string_view v) {
 
 // The NodeName of a node that will serve rr+local, held for this process, and its NodeID from the
 // NodeID cache (docs/local-transport.md). Errors name the fix.
-Result<std::optional<local::NodeNameReservation>> reserve_local_name(bool local, const std::string& name) {
+Result<std::optional<local::NodeNameReservation>> reserve_local_name(bool local, const std::string& name,
+                                                                     const NodeID& configured_id) {
     if (!local || name.empty()) return std::optional<local::NodeNameReservation>();
-    auto r = local::reserve_node_name(local::default_node_directories(), name);
+    auto r = local::reserve_node_name(local::default_node_directories(), name, configured_id);
     if (!r)
         return fail(r.error().type, "rr+local: " + r.error().message +
                                         (r.error().type == MessageErrorType::InvalidOperation
@@ -69,7 +70,8 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     opts.threads = c.threads;
     opts.server.stream.limits.max_message_size = c.max_message_size;
     opts.server.stream.heartbeat_period = std::chrono::milliseconds(12000);  // a server's period (wire.md §6.3)
-    auto reservation = reserve_local_name(c.local, c.node_name);
+    // A configured NodeID is what a new NodeID cache entry gets (a first start on a fresh machine).
+    auto reservation = reserve_local_name(c.local, c.node_name, opts.node_id);
     if (!reservation) return reservation.take_error();
     if (*reservation && c.node_id.empty()) opts.node_id = (*reservation)->node_id;
     g->node_ = Node::create(opts);
@@ -108,7 +110,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         NodeOptions dopts;
         dopts.node_name = c.node_name + ".demo";
         dopts.threads = 2;
-        auto demo_reservation = reserve_local_name(c.local, dopts.node_name);
+        auto demo_reservation = reserve_local_name(c.local, dopts.node_name, NodeID{});
         if (!demo_reservation) return demo_reservation.take_error();
         if (*demo_reservation) dopts.node_id = (*demo_reservation)->node_id;
         g->demo_node_ = Node::create(dopts);

@@ -72,7 +72,7 @@ TEST_CASE("configuration errors name the key and the line") {
     }
 }
 
-TEST_CASE("usb: starts when the configuration names rr+usb, or when enabled; allow-list ids") {
+TEST_CASE("usb: starts when the configuration names rr+usb, or when enabled, allow-list ids") {
     auto none = parse_gateway_config("devices:\n  - name: a\n    url: rr+tcp://x:1/?service=s\n", "t.yaml");
     REQUIRE(none);
     CHECK(none->usb.enabled == UsbSettings::Mode::automatic);
@@ -236,7 +236,7 @@ TEST_CASE("gateway.trusted_proxies and --trusted-proxy take addresses and CIDR r
     CHECK_THAT(applied.error().message, Catch::Contains("--trusted-proxy"));
 }
 
-TEST_CASE("gateway.tls and the devices' TLS keys parse; incomplete TLS settings name the key") {
+TEST_CASE("gateway.tls and the devices' TLS keys parse, incomplete TLS settings name the key") {
     auto c = parse_gateway_config(R"(
 gateway:
   tls:

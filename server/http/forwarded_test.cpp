@@ -17,7 +17,7 @@ std::vector<IpNetwork> nets(std::initializer_list<const char*> texts) {
 }
 }  // namespace
 
-TEST_CASE("forwarded: trusted proxy ranges parse; hosts, bad prefixes and garbage do not") {
+TEST_CASE("forwarded: trusted proxy ranges parse, hosts, bad prefixes and garbage do not") {
     CHECK(parse_ip_network("127.0.0.1")->prefix_bits == 32);
     CHECK(parse_ip_network("10.0.0.0/8")->prefix_bits == 8);
     CHECK(parse_ip_network("::1")->prefix_bits == 128);

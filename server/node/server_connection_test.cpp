@@ -195,8 +195,8 @@ TEST_CASE("misbehaving peers are answered or dropped while other clients keep wo
     Fixture f;
     auto good = f.connect();
 
-    // Not RR, not HTTP: 404 and close.
-    CHECK(raw_exchange(f.port, "XXXXhello").rfind("HTTP/1.1 404", 0) == 0);
+    // Not RR, not the start of an HTTP request: dropped without an answer.
+    CHECK(raw_exchange(f.port, "XXXXhello").empty());
     // RRAC with a 4 GiB MessageSize: closed without allocating.
     std::string huge = "RRAC";
     huge += std::string("\xff\xff\xff\xff", 4);

@@ -102,7 +102,7 @@ TEST_CASE("object locks: user lock blocks other users on the object and its chil
     CHECK(scalar_of<double>(a.ok(get_value()), "value") == 1.5);
 }
 
-TEST_CASE("object locks: client lock blocks the user's other sessions; closing sessions release locks") {
+TEST_CASE("object locks: client lock blocks the user's other sessions, closing sessions release locks") {
     LockFixture lf;
     auto a = lf.f.connect(login("alice", "a"));
     auto a2 = lf.f.connect(login("alice", "a"));

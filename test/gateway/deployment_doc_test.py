@@ -137,6 +137,10 @@ class Scratch:
 
     def env(self):
         e = dict(gwproc.gateway_env())
+        # rr+local's system folders (used when this test runs as root) below the scratch root, never the
+        # machine's /var/lib/robotraconteur: a NodeID cached there by another run would not match lab.yaml's.
+        for k, d in [("RUN", "/run/robotraconteur"), ("STATE", "/var/lib/robotraconteur"), ("CONFIG", "/etc/robotraconteur")]:
+            e["ROBOTRACONTEUR_SYSTEM_%s_DIR" % k] = self.path(d)
         e["PATH"] = os.pathsep.join([self.path("/usr/bin"), self.path("/usr/local/bin"), e.get("PATH", "")])
         # The client's trust: the page's CA bundle once made (§6), before that the certificate itself.
         trust = self.ca_bundle or self.path("/etc/ssl/certs/localhost.pem")

@@ -239,7 +239,8 @@ def run_checks(url, ck):
         released = time.monotonic()
         RRN.MonitorExit(a2)
         deadline = time.monotonic() + 6
-        while "t" not in done and "error" not in done and time.monotonic() < deadline:
+        # "read" is set after "t" on bob's thread: wait for it, not for "t" alone.
+        while "read" not in done and "error" not in done and time.monotonic() < deadline:
             time.sleep(0.02)
         expect("t" in done, "bob's MonitorEnter did not return after alice's MonitorExit: %r" % done)
         expect(done["t"] - released < 3.0, "hand-over took %.1f s" % (done["t"] - released))

@@ -131,6 +131,15 @@ def main():
             fail("/api/discovered services: %r" % node["services"])
         print("/api/discovered: %s (%s) at %s" % (node["nodename"], node["source"], want_url), flush=True)
 
+        # What a browser uses: the JSON API (REST) reads properties of devices behind rr+usb.
+        name_prop = get_json(port, "/api/devices/webcam/properties/Name?object=Webcams[1]")
+        if name_prop != {"value": "Right"}:
+            fail("REST webcam Webcams[1].Name over rr+usb: %r" % name_prop)
+        dist = get_json(port, "/api/devices/create/properties/DistanceTraveled")
+        if not isinstance(dist.get("value"), int):
+            fail("REST create DistanceTraveled over rr+usb: %r" % dist)
+        print("JSON API -> gateway -> rr+usb: webcam Webcams[1].Name, create DistanceTraveled ok", flush=True)
+
         # The official client through the gateway (rr+tcp) to the discovered USB device.
         from RobotRaconteur.Client import RRN
         c = RRN.ConnectService(base + "usb_usbtest")

@@ -167,7 +167,7 @@ TEST_CASE("local discovery: a running node is found with CORE's URL, its NodeNam
     s.node->shutdown();
 }
 
-TEST_CASE("local discovery: only entries a running process holds count; malformed ones are skipped") {
+TEST_CASE("local discovery: only entries a running process holds count, malformed ones are skipped") {
     TempNodeDirs tmp;
     const std::string dir = tmp.dirs.user_run_dir + "/transport/local";
     const std::string user = *current_user_name();

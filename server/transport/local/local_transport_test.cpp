@@ -232,6 +232,19 @@ TEST_CASE("local: the NodeID cache gives a NodeName the same NodeID on every sta
     REQUIRE(r);
     CHECK(r->node_id == first);
 
+    SECTION("a configured NodeID is what a new cache entry gets, an existing entry stays") {
+        const std::string other = unique_node_name("local.cache");
+        const NodeID wanted = *NodeID::parse("6c3d4b2a-0f1e-4d5c-9b8a-7e6f5d4c3b2a");
+        {
+            auto o = reserve_node_name(tmp.dirs, other, wanted);
+            REQUIRE(o);
+            CHECK(o->node_id == wanted);
+            CHECK(read_file(o->nodeid_file) == wanted.to_braced_string());
+        }
+        auto o = reserve_node_name(tmp.dirs, other, *NodeID::parse("3f2504e0-4f89-11d3-9a0c-0305e82c3301"));
+        REQUIRE(o);
+        CHECK(o->node_id == wanted);  // the cache wins; the caller reports a mismatch
+    }
     SECTION("a cache file written by hand (any NodeID form, blanks) is used") {
         const std::string other = unique_node_name("local.cache");
         std::filesystem::create_directories(std::filesystem::path(file).parent_path());

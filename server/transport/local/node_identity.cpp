@@ -44,11 +44,11 @@ Result<NodeID> parse_cached_id(std::string_view text, const std::string& path) {
 }
 
 // Reads the NodeID from a locked cache file, writing a fresh one into an empty file.
-Result<NodeID> load_or_create(LockedFile& f) {
+Result<NodeID> load_or_create(LockedFile& f, const NodeID& wanted) {
     auto size = f.size();
     if (!size) return size.take_error();
     if (*size == 0) {
-        NodeID id = random_node_id();
+        NodeID id = wanted.is_any() ? random_node_id() : wanted;
         auto w = f.replace(id.to_braced_string());
         if (!w) return w.take_error();
         return id;
@@ -85,7 +85,7 @@ std::optional<InProcessClaim> InProcessClaim::take(std::string key) {
     return out;
 }
 
-Result<NodeNameReservation> reserve_node_name(const NodeDirectories& dirs, std::string_view name) {
+Result<NodeNameReservation> reserve_node_name(const NodeDirectories& dirs, std::string_view name, const NodeID& wanted) {
     if (!is_valid_node_name(name))
         return fail(MessageErrorType::InvalidArgument,
                     "\"" + std::string(name) + "\" is an invalid NodeName (letters, digits, '_', '.', '-', starting with a letter)");
@@ -150,7 +150,7 @@ Result<NodeNameReservation> reserve_node_name(const NodeDirectories& dirs, std::
         }
         return f.take_error();
     }
-    auto id = load_or_create(*f);
+    auto id = load_or_create(*f, wanted);
     if (!id) return id.take_error();
     r.node_id = *id;
     r.nodeid_file = file;

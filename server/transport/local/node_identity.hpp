@@ -53,6 +53,9 @@ struct NodeNameReservation {
 ///      locked while read, and an empty (new) file gets a fresh random NodeID written as `{…}`, as CORE
 ///      writes it. A file that does not hold a NodeID is an IOError naming it (CORE: "Error in UUID name
 ///      store file"); a missing user config dir (no HOME) is a SystemResourceError.
-Result<NodeNameReservation> reserve_node_name(const NodeDirectories& dirs, std::string_view name);
+/// `wanted` (a NodeID the node is configured with) is what a new, empty cache file gets instead of a
+/// random one; an existing cache entry is returned as it is (the caller reports a mismatch).
+Result<NodeNameReservation> reserve_node_name(const NodeDirectories& dirs, std::string_view name,
+                                              const NodeID& wanted = NodeID{});
 
 }  // namespace rr::server::local

@@ -35,7 +35,7 @@ TestPki::Issued server_cert(TestPki& pki, const TestPki::Issued& ca, const std::
 
 }  // namespace
 
-TEST_CASE("tls: a server context loads a chain and its key; TLS 1.2 and 1.3 only") {
+TEST_CASE("tls: a server context loads a chain and its key, TLS 1.2 and 1.3 only") {
     TestPki pki;
     auto ca = pki.ca("Test CA");
     auto leaf = server_cert(pki, ca, "gateway.test");
