@@ -130,7 +130,8 @@ std::string ConnectionUrl::to_string() const {
         const bool id = !node_id.is_any();
         const bool name_in_path =
             !id && node_name.find_first_of("/?{") == std::string::npos && !NodeID::parse(node_name);
-        const bool service_in_path = service.find('?') == std::string::npos;
+        // The parser keeps only the path's second segment, so a service with '/' goes in the query.
+        const bool service_in_path = service.find_first_of("?/") == std::string::npos;
         s += "/" + (id ? node_id.to_braced_string() : name_in_path ? node_name : std::string()) + "/" +
              (service_in_path ? service : std::string());
         if (!name_in_path && !node_name.empty()) add("nodename", node_name);

@@ -88,6 +88,13 @@ TEST_CASE("legacy tcp:// URLs print in their own form and parse back to the same
     REQUIRE(renamed);
     renamed->service = "other";
     CHECK(renamed->to_string() == "tcp://h:1/node/other");
+    // A service from ?service= that holds '/' cannot go in the path, where only one segment is read
+    // (found by fuzz_connection_url).
+    auto slashed = parse_connection_url("tcp://h:1/node/x?service=a/b");
+    REQUIRE(slashed);
+    CHECK(slashed->service == "a/b");
+    CHECK(slashed->to_string() == "tcp://h:1/node/?service=a/b");
+    CHECK(parse_connection_url(slashed->to_string())->service == "a/b");
     // CORE reads the second path segment as the service; a NodeID needs its braces.
     CHECK(parse_connection_url("tcp://h:1/node/svc/extra")->service == "svc");
     CHECK(parse_connection_url("tcp://h:1/d835c41d339c47a884dbf00a8fefd2fa/svc")->node_name ==
