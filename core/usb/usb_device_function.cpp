@@ -119,46 +119,7 @@ Result<ControlOutcome> DeviceFunction::on_control(const SetupPacket& setup, std:
 }
 
 Result<DeviceEvent> DeviceFunction::on_bulk_out(std::span<const std::byte> transfer) {
-    auto p = parse_subpacket(transfer);
-    if (!p) return p.take_error();
-    DeviceEvent ev;
-    ev.stream_id = p->stream_id;
-    switch (p->kind) {
-        case SubpacketKind::Empty:
-            return ev;
-        case SubpacketKind::Command:
-            return fail(MessageErrorType::ProtocolError,
-                        "USB host sent a command sub-packet (flags 1), which the protocol does not define");
-        case SubpacketKind::Data:
-        case SubpacketKind::Notification:
-            break;
-    }
-    if (!out_.contains(p->stream_id))
-        return fail(MessageErrorType::InvalidEndpoint,
-                    "USB host sent " + std::string(p->kind == SubpacketKind::Data ? "data" : "a notification") +
-                        " for stream " + std::to_string(p->stream_id) + ", which is not open");
-    if (p->kind == SubpacketKind::Data) {
-        ev.kind = DeviceEvent::Kind::Data;
-        ev.payload = p->payload;
-        return ev;
-    }
-    switch (p->notification) {
-        case Notification::SocketClosed:
-            out_.remove(p->stream_id);
-            ev.kind = DeviceEvent::Kind::HostClosed;
-            return ev;
-        case Notification::PauseRequest:
-            out_.set_paused(p->stream_id, true);
-            ev.kind = DeviceEvent::Kind::Paused;
-            return ev;
-        case Notification::ResumeRequest:
-            out_.set_paused(p->stream_id, false);
-            ev.kind = DeviceEvent::Kind::Resumed;
-            return ev;
-        case Notification::Null:
-            break;
-    }
-    return ev;
+    return read_inbound_subpacket(out_, transfer, "USB host");
 }
 
 Result<void> DeviceFunction::pause_receive(std::int32_t id, bool paused) {

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "core/usb/usb_descriptors.hpp"
+#include "core/usb/usb_inbound.hpp"
 #include "core/usb/usb_scheduler.hpp"
 
 namespace rr::usb {
@@ -54,18 +55,9 @@ struct ControlOutcome {
     std::int32_t stream_id = -1;
 };
 
-struct DeviceEvent {
-    enum class Kind {
-        Ignored,       ///< zero-length transfer (CORE's host sends one after RESET_ALL_STREAM)
-        Data,          ///< `payload` for `stream_id`
-        HostClosed,    ///< the host sent "socket closed" for `stream_id` (forgotten here)
-        Paused,        ///< the host asked the device to stop sending on `stream_id`
-        Resumed,
-    };
-    Kind kind = Kind::Ignored;
-    std::int32_t stream_id = 0;
-    std::span<const std::byte> payload;
-};
+/// What a bulk OUT transfer from the host meant (Closed: the host closed the stream; Ignored: a
+/// zero-length transfer, which CORE's host sends after RESET_ALL_STREAM).
+using DeviceEvent = StreamEvent;
 
 class DeviceFunction {
 public:

@@ -38,49 +38,9 @@ void HostMux::remember_closed(std::int32_t id) noexcept {
 }
 
 Result<HostEvent> HostMux::on_in_transfer(std::span<const std::byte> transfer) {
-    auto p = parse_subpacket(transfer);
-    if (!p) return p.take_error();
-    HostEvent ev;
-    ev.stream_id = p->stream_id;
-    switch (p->kind) {
-        case SubpacketKind::Empty:
-            return ev;
-        case SubpacketKind::Command:
-            return fail(MessageErrorType::ProtocolError,
-                        "USB device sent a command sub-packet (flags 1), which the protocol does not define");
-        case SubpacketKind::Data:
-        case SubpacketKind::Notification:
-            break;
-    }
-    if (!out_.contains(p->stream_id)) {
-        if (recently_closed(p->stream_id)) return ev;
-        return fail(MessageErrorType::InvalidEndpoint,
-                    "USB device sent " + std::string(p->kind == SubpacketKind::Data ? "data" : "a notification") +
-                        " for stream " + std::to_string(p->stream_id) + ", which the host did not open");
-    }
-    if (p->kind == SubpacketKind::Data) {
-        ev.kind = HostEvent::Kind::Data;
-        ev.payload = p->payload;
-        return ev;
-    }
-    switch (p->notification) {
-        case Notification::SocketClosed:
-            out_.remove(p->stream_id);
-            remember_closed(p->stream_id);
-            ev.kind = HostEvent::Kind::StreamClosed;
-            return ev;
-        case Notification::PauseRequest:
-            out_.set_paused(p->stream_id, true);
-            ev.kind = HostEvent::Kind::Paused;
-            return ev;
-        case Notification::ResumeRequest:
-            out_.set_paused(p->stream_id, false);
-            ev.kind = HostEvent::Kind::Resumed;
-            return ev;
-        case Notification::Null:
-            break;
-    }
-    return ev;  // parse_subpacket admits no other code
+    auto ev = read_inbound_subpacket(out_, transfer, "USB device", std::span(closed_.data(), closed_count_));
+    if (ev && ev->kind == HostEvent::Kind::Closed) remember_closed(ev->stream_id);
+    return ev;
 }
 
 }  // namespace rr::usb

@@ -23,22 +23,14 @@
 #include <cstdint>
 #include <span>
 
+#include "core/usb/usb_inbound.hpp"
 #include "core/usb/usb_scheduler.hpp"
 
 namespace rr::usb {
 
-struct HostEvent {
-    enum class Kind {
-        Ignored,       ///< zero-length transfer, or data/notification for a stream closed a moment ago
-        Data,          ///< `payload` for `stream_id`
-        StreamClosed,  ///< the device closed `stream_id` (forgotten here; no CLOSE_STREAM needed)
-        Paused,        ///< the device asked the host to stop sending on `stream_id`
-        Resumed,       ///< … and to go on
-    };
-    Kind kind = Kind::Ignored;
-    std::int32_t stream_id = 0;
-    std::span<const std::byte> payload;
-};
+/// What a bulk IN transfer from the device meant (Closed: the device closed the stream, forgotten here,
+/// no CLOSE_STREAM needed; Ignored: zero-length, or late data for a stream closed a moment ago).
+using HostEvent = StreamEvent;
 
 class HostMux {
 public:

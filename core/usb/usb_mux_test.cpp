@@ -173,7 +173,7 @@ TEST_CASE("usb host mux: inbound events and the two error classes") {
     // The device closes 2: no CLOSE_STREAM needed afterwards.
     auto closed = m.on_in_transfer(note_packet(2, Notification::SocketClosed));
     REQUIRE(closed);
-    CHECK(closed->kind == HostEvent::Kind::StreamClosed);
+    CHECK(closed->kind == HostEvent::Kind::Closed);
     CHECK_FALSE(m.close_stream(2));
     CHECK(m.stream_count() == 0);
     // An id the device hands out again is live again.
@@ -284,7 +284,7 @@ TEST_CASE("usb device function: bulk OUT events and errors") {
     CHECK_FALSE(fn.pause_receive(99, true));
     auto closed = fn.on_bulk_out(note_packet(id, Notification::SocketClosed));
     REQUIRE(closed);
-    CHECK(closed->kind == DeviceEvent::Kind::HostClosed);
+    CHECK(closed->kind == DeviceEvent::Kind::Closed);
     CHECK_FALSE(fn.is_open(id));
 }
 
@@ -348,7 +348,7 @@ TEST_CASE("usb: host and device back to back: several streams, large messages ov
         REQUIRE(ev);
         kinds.push_back(ev->kind);
     }
-    CHECK(kinds == std::vector<HostEvent::Kind>{HostEvent::Kind::Data, HostEvent::Kind::Data, HostEvent::Kind::StreamClosed});
+    CHECK(kinds == std::vector<HostEvent::Kind>{HostEvent::Kind::Data, HostEvent::Kind::Data, HostEvent::Kind::Closed});
     CHECK_FALSE(host.is_open(ids[0]));
     CHECK(host.is_open(ids[1]));
 }

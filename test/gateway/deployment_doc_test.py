@@ -26,7 +26,6 @@ import os
 import re
 import shlex
 import shutil
-import signal
 import socket
 import ssl
 import subprocess
@@ -36,6 +35,9 @@ import time
 import urllib.request
 
 import gwproc
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "interop"))
+from doc_blocks import blocks  # noqa: E402
 from gwproc import expect
 
 PASSWORDS = {"alice": "PASSWORD", "bob": "PASSWORD-bob"}  # alice's is the one the page's examples use
@@ -50,21 +52,6 @@ def free_port():
 
 # --- the page ------------------------------------------------------------------------------------
 
-FENCE = re.compile(r"^```(\w*)\s*$")
-
-
-def blocks(text):
-    out, cur, info, start = [], None, None, 0
-    for n, line in enumerate(text.splitlines(), 1):
-        m = FENCE.match(line)
-        if cur is None and m:
-            cur, info, start = [], m.group(1), n
-        elif cur is not None and line.strip() == "```":
-            out.append((info, cur, start))
-            cur = None
-        elif cur is not None:
-            cur.append(line)
-    return out
 
 
 def commands(lines):

@@ -5,7 +5,9 @@ Both print one JSON line on stdout when listening (rr-gateway: {"port": N}; rr-d
 """
 import json
 import os
+import random
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -106,6 +108,21 @@ def wait_ready(port, timeout=30.0):
             pass
         time.sleep(0.1)
     raise RuntimeError("gateway on port %d not ready within %.0f s" % (port, timeout))
+
+
+def fixed_port():
+    """A free TCP port on 127.0.0.1 below the ephemeral range, for a device that must come back on the
+    same port after a restart (an ephemeral one could be taken meanwhile by an outgoing connection)."""
+    low = int(open("/proc/sys/net/ipv4/ip_local_port_range").read().split()[0])
+    for _ in range(100):
+        port = random.randrange(20000, min(low, 29000))
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", port))
+                return port
+            except OSError:
+                continue
+    raise RuntimeError("no free port below the ephemeral range")
 
 
 def vm_rss_kib(pid):

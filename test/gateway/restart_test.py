@@ -19,8 +19,6 @@ Prints a JSON summary; exit status 0 only if every check passed.
 import argparse
 import json
 import os
-import random
-import socket
 import sys
 import tempfile
 import time
@@ -42,7 +40,7 @@ def main():
     checks = gwproc.Checks()
     # A port below the ephemeral range: while the device is down, no other process of a parallel test
     # run can be handed it, so the restart can take it again.
-    dev_port = fixed_port()
+    dev_port = gwproc.fixed_port()
     dev = gwproc.start_devices(a.devices, port=dev_port, play_period=0)
     cfg = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False)
     cfg.write("demo:\n  enabled: false\ndevices:\n"
@@ -149,19 +147,6 @@ def main():
             os.unlink(cfg.name)
     checks.run("gateway exit status 0 on SIGTERM", lambda: expect(status == 0, "exit status %r" % status))
     return checks.exit_code()
-
-
-def fixed_port():
-    low = int(open("/proc/sys/net/ipv4/ip_local_port_range").read().split()[0])
-    for _ in range(100):
-        port = random.randrange(20000, min(low, 29000))
-        with socket.socket() as s:
-            try:
-                s.bind(("127.0.0.1", port))
-                return port
-            except OSError:
-                continue
-    raise RuntimeError("no free port below the ephemeral range")
 
 
 def try_get(fn):

@@ -25,19 +25,16 @@ import csv
 import json
 import os
 import random
-import signal
 import socket
 import statistics
-import struct
 import sys
 import tempfile
 import threading
 import time
-import urllib.request
 
 import gwproc
 import hostile_test as hostile
-from ws_conformance_test import OP_BIN, OP_TEXT, JsonEcho, RawWs, rr_message, rr_parse_entry
+from ws_conformance_test import OP_TEXT, JsonEcho, rr_message, rr_parse_entry
 
 
 class Stats:
@@ -75,7 +72,7 @@ class World:
         self.stop = threading.Event()
         self.stats = Stats()
         self.devices_up = threading.Event()
-        self.dev_port = fixed_port()
+        self.dev_port = gwproc.fixed_port()
         self.dev = gwproc.start_devices(args.devices, port=self.dev_port, play_period=0.05)
         self.devices_up.set()
         cfg = os.path.join(run_dir, "gw.yaml")
@@ -201,19 +198,6 @@ class World:
         self.stop.wait(1)
         self.devices_up.set()
         self.stats.count("device restarts")
-
-
-def fixed_port():
-    low = int(open("/proc/sys/net/ipv4/ip_local_port_range").read().split()[0])
-    for _ in range(100):
-        port = random.randrange(20000, min(low, 29000))
-        with socket.socket() as s:
-            try:
-                s.bind(("127.0.0.1", port))
-                return port
-            except OSError:
-                continue
-    raise RuntimeError("no free port below the ephemeral range")
 
 
 def main():

@@ -78,3 +78,46 @@ def tail(path, n=20):
             return "\n".join(fh.read().decode("utf-8", "replace").splitlines()[-n:])
     except OSError:
         return ""
+
+
+# The official library's folder overrides (RobotRaconteurCore's NodeDirectories): pointing all of them
+# into one scratch tree keeps a test's rr+local sockets, NodeID cache and config away from the machine's.
+RR_DIR_VARS = (("ROBOTRACONTEUR_SYSTEM_RUN_DIR", "sysrun"), ("ROBOTRACONTEUR_SYSTEM_STATE_DIR", "sysstate"),
+               ("ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", "sysconfig"), ("ROBOTRACONTEUR_USER_RUN_DIR", "run"),
+               ("ROBOTRACONTEUR_USER_CONFIG_DIR", "config"))
+
+
+def scratch_rr_env(tree, env=None):
+    """A copy of `env` (default: os.environ) whose ROBOTRACONTEUR_*_DIR folders all lie below `tree`."""
+    out = dict(os.environ if env is None else env)
+    for var, sub in RR_DIR_VARS:
+        out[var] = os.path.join(tree, sub)
+    return out
+
+
+def fail(msg):
+    """Prints FAIL and ends the script with status 1 (the orchestrators' way to stop at a failed step)."""
+    print("FAIL: " + msg, flush=True)
+    raise SystemExit(1)
+
+
+def get_json(port, path, timeout=10):
+    """GET http://127.0.0.1:PORT/PATH as JSON (raises OSError / urllib errors)."""
+    import urllib.request
+    with urllib.request.urlopen("http://127.0.0.1:%d%s" % (port, path), timeout=timeout) as r:
+        return json.loads(r.read())
+
+
+def wait_for(pred, timeout, what, interval=0.1):
+    """Polls `pred` until it returns something true (returned); OSError counts as not yet. fail() on timeout."""
+    deadline = time.monotonic() + timeout
+    last = None
+    while time.monotonic() < deadline:
+        try:
+            last = pred()
+            if last:
+                return last
+        except OSError as e:
+            last = e
+        time.sleep(interval)
+    fail("%s within %.0f s (last: %r)" % (what, timeout, last))

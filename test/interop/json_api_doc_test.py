@@ -19,7 +19,6 @@ HTTP uses the standard library (urllib); the WebSocket side uses websocket-clien
 import argparse
 import json
 import os
-import re
 import subprocess
 import sys
 import time
@@ -27,6 +26,7 @@ import urllib.error
 import urllib.request
 
 from child_procs import stop
+from doc_blocks import blocks
 
 try:
     import websocket  # websocket-client
@@ -92,22 +92,6 @@ def match(expected, actual, exact, path="$"):
 
 # --- the document ------------------------------------------------------------------------------
 
-FENCE = re.compile(r"^```(\w*)\s*$")
-
-
-def blocks(text):
-    """(info, lines, line number) of every fenced block."""
-    out, cur, info, start = [], None, None, 0
-    for n, line in enumerate(text.splitlines(), 1):
-        m = FENCE.match(line)
-        if cur is None and m:
-            cur, info, start = [], m.group(1), n
-        elif cur is not None and line.strip() == "```":
-            out.append((info, cur, start))
-            cur = None
-        elif cur is not None:
-            cur.append(line)
-    return out
 
 
 def split_comments(lines):

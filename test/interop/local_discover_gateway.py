@@ -11,42 +11,22 @@ Usage: local_discover_gateway.py --gateway rr-gateway
 """
 
 import argparse
-import json
 import os
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
-import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import child_procs  # noqa: E402
 
 
-def fail(msg):
-    print("FAIL: " + msg, flush=True)
-    raise SystemExit(1)
+fail, get_json = child_procs.fail, child_procs.get_json
 
 
-def get_json(port, path):
-    with urllib.request.urlopen("http://127.0.0.1:%d%s" % (port, path), timeout=10) as r:
-        return json.loads(r.read())
-
-
-def wait_for(pred, timeout, what):
-    deadline = time.monotonic() + timeout
-    last = None
-    while time.monotonic() < deadline:
-        try:
-            last = pred()
-            if last:
-                return last
-        except OSError as e:
-            last = e
-        time.sleep(0.1)
-    fail("%s within %.0f s (last: %r)" % (what, timeout, last))
+wait_for = child_procs.wait_for
 
 
 def main():
@@ -60,11 +40,7 @@ def main():
         return 77
 
     tree = tempfile.mkdtemp(prefix="rr_local_discover_")
-    env = os.environ.copy()
-    for var, sub in (("ROBOTRACONTEUR_SYSTEM_RUN_DIR", "sysrun"), ("ROBOTRACONTEUR_SYSTEM_STATE_DIR", "sysstate"),
-                     ("ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", "sysconfig"), ("ROBOTRACONTEUR_USER_RUN_DIR", "run"),
-                     ("ROBOTRACONTEUR_USER_CONFIG_DIR", "config")):
-        env[var] = os.path.join(tree, sub)
+    env = child_procs.scratch_rr_env(tree)
     name = "official.gwdiscover.%d" % os.getpid()
     cfg = os.path.join(tree, "gateway.yaml")
     with open(cfg, "w") as f:

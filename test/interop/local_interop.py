@@ -34,11 +34,10 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from child_procs import StepFailed, read_json_line, start, stop, tail  # noqa: E402
+from child_procs import StepFailed, read_json_line, scratch_rr_env, start, stop, tail  # noqa: E402
 
 START_S = 40
 CLIENT_S = 150
@@ -299,10 +298,7 @@ def main(argv=None):
     tree = None
     if args.dirs == "temp":
         tree = tempfile.mkdtemp(prefix="rr_local_dirs_")
-        for var, sub in (("ROBOTRACONTEUR_SYSTEM_RUN_DIR", "sysrun"), ("ROBOTRACONTEUR_SYSTEM_STATE_DIR", "sysstate"),
-                         ("ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", "sysconfig"), ("ROBOTRACONTEUR_USER_RUN_DIR", "run"),
-                         ("ROBOTRACONTEUR_USER_CONFIG_DIR", "config")):
-            env[var] = os.path.join(tree, sub)
+        env = scratch_rr_env(tree, env)
     r = Run(args, workdir, env)
     result = {"ok": False, "part": args.part, "dirs": args.dirs}
     rc = 1

@@ -28,9 +28,7 @@ import child_procs  # noqa: E402
 USB_NODEID, USB_NAME = "5a3c9d2e-7b41-4c8a-9e0f-31d2c4b5a6e7", "usb_demo"
 
 
-def fail(msg):
-    print("FAIL: " + msg, flush=True)
-    raise SystemExit(1)
+fail = child_procs.fail
 
 
 def index_url(scheme_prefix, nodeid):
@@ -50,11 +48,7 @@ def main():
         return 77
 
     tree = tempfile.mkdtemp(prefix="rr_usb_discover_")
-    env = os.environ.copy()
-    for var, sub in (("ROBOTRACONTEUR_SYSTEM_RUN_DIR", "sysrun"), ("ROBOTRACONTEUR_SYSTEM_STATE_DIR", "sysstate"),
-                     ("ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", "sysconfig"), ("ROBOTRACONTEUR_USER_RUN_DIR", "run"),
-                     ("ROBOTRACONTEUR_USER_CONFIG_DIR", "config")):
-        env[var] = os.path.join(tree, sub)
+    env = child_procs.scratch_rr_env(tree)
     ours_name = "ours.discover.%d" % os.getpid()
     official_name = "official.discover.%d" % os.getpid()
     procs = []

@@ -436,7 +436,7 @@ private:
                     pump_in();
                 }
                 return;
-            case Kind::HostClosed:
+            case Kind::Closed:
                 if (it != streams_.end()) it->second.buf.end(asio::error::eof, asio::error::broken_pipe);
                 return;
             case Kind::Resumed:

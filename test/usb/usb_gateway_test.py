@@ -15,13 +15,10 @@ Usage: usb_gateway_test.py --fixture rr_usb_fixture --wrapper run_under_umockdev
 """
 
 import argparse
-import json
 import os
 import subprocess
 import sys
 import tempfile
-import time
-import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 INTEROP = os.path.join(HERE, "..", "interop")
@@ -50,28 +47,11 @@ discover:
 """
 
 
-def fail(msg):
-    print("FAIL: " + msg, flush=True)
-    raise SystemExit(1)
-
-
-def get_json(port, path):
-    with urllib.request.urlopen("http://127.0.0.1:%d%s" % (port, path), timeout=10) as r:
-        return json.loads(r.read())
+fail, get_json = child_procs.fail, child_procs.get_json
 
 
 def wait_for(pred, timeout, what):
-    deadline = time.monotonic() + timeout
-    last = None
-    while time.monotonic() < deadline:
-        try:
-            last = pred()
-            if last:
-                return last
-        except OSError as e:
-            last = e
-        time.sleep(0.2)
-    fail("%s within %.0f s (last: %r)" % (what, timeout, last))
+    return child_procs.wait_for(pred, timeout, what, interval=0.2)
 
 
 def main():

@@ -230,7 +230,7 @@ void UsbHostLink::dispatch(std::span<const std::byte> transfer) {
             if (it != streams_.end()) it->second.on_data(ev->payload);
             return check_rx_flow();
         }
-        case HostEvent::Kind::StreamClosed: {
+        case HostEvent::Kind::Closed: {
             auto it = streams_.find(ev->stream_id);
             if (it != streams_.end()) it->second.end(asio::error::eof, asio::error::broken_pipe);
             return;
