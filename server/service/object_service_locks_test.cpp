@@ -2,6 +2,7 @@
 // privileges, other users and other sessions refused, children covered, release rules, release when a
 // session closes, monitor hand-over. The bookkeeping alone: object_locks_test.cpp.
 #include "server/service/object_service_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 #include <thread>
 
@@ -28,14 +29,7 @@ std::string returned(const MessageEntry& e) {
     return std::string(read_string(*el));
 }
 
-/// Polls `pred` for up to 5 s.
-bool eventually(const std::function<bool()>& pred) {
-    for (int i = 0; i < 100; ++i) {
-        if (pred()) return true;
-        std::this_thread::sleep_for(50ms);
-    }
-    return pred();
-}
+using rr::testing::eventually;
 
 struct LockFixture {
     std::shared_ptr<ServiceObject> sub;

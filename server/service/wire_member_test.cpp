@@ -1,6 +1,7 @@
 // Wire members at the entry level: connect (current value first), out value fan-out with packettime,
 // in values with time-stamp ordering, peek/poke, directions, WireClosed, disconnect.
 #include "server/service/object_service_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 #include <thread>
 
@@ -21,11 +22,7 @@ MessageEntry wire_packet(const ServiceFixture& f, const char* member, const Valu
 
 template <class F>
 bool eventually(F&& pred) {
-    for (int i = 0; i < 300; ++i) {
-        if (pred()) return true;
-        std::this_thread::sleep_for(10ms);
-    }
-    return pred();
+    return rr::testing::eventually(std::forward<F>(pred), std::chrono::seconds(3));
 }
 
 }  // namespace

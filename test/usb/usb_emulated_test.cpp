@@ -29,6 +29,7 @@
 #include "server/transport/discovery/node_discovery.hpp"
 #include "server/transport/usb/usb_discovery.hpp"
 #include "test/usb/usb_world.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::test::usb;
@@ -84,15 +85,7 @@ WorldOptions no_demo() {
     return o;
 }
 
-template <class Pred>
-bool eventually(Pred p, std::chrono::milliseconds limit = 5s) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < end) {
-        if (p()) return true;
-        std::this_thread::sleep_for(5ms);
-    }
-    return p();
-}
+using rr::testing::eventually;
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include "server/transport/local/local_connector.hpp"
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;
@@ -27,12 +28,7 @@ namespace {
 
 template <class Pred>
 bool eventually(Pred pred, std::chrono::milliseconds limit = 10000ms) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < end) {
-        if (pred()) return true;
-        std::this_thread::sleep_for(10ms);
-    }
-    return pred();
+    return rr::testing::eventually(pred, limit);
 }
 
 DiscoveryOptions loopback_options() {

@@ -21,6 +21,7 @@
 #include "server/transport/local/local_layout.hpp"
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -30,15 +31,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-template <class Pred>
-bool eventually(Pred pred, std::chrono::milliseconds limit = 5000ms) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < end) {
-        if (pred()) return true;
-        std::this_thread::sleep_for(10ms);
-    }
-    return pred();
-}
+using rr::testing::eventually;
 
 void write_file(const std::string& path, const std::string& text) {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
