@@ -26,7 +26,8 @@ RUN_PACKAGES=(
 )
 PYTHON_PACKAGES=(python3-venv)
 # Testing only: Catch2, the USB device emulator, clang for the fuzz targets, Chromium for the browser
-# tests, nginx/openssl/htpasswd for the reverse-proxy tests.
+# tests, nginx/openssl/htpasswd for the reverse-proxy tests, podman & co. for the container image
+# (docker/build.sh: no Docker daemon, the base made with mmdebstrap).
 TEST_PACKAGES=(
   catch2
   umockdev libumockdev-dev
@@ -34,6 +35,7 @@ TEST_PACKAGES=(
   chromium fonts-liberation
   nginx openssl apache2-utils haproxy
   testssl.sh
+  podman buildah runc mmdebstrap fuse-overlayfs slirp4netns uidmap
 )
 APT_PACKAGES=()
 wants run && APT_PACKAGES+=("${RUN_PACKAGES[@]}")

@@ -1,16 +1,31 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing (scripts/setup.sh: the run packages and the test tools:
-# Catch2, Chromium, nginx, clang, umockdev, the Python venv), builds the debug preset (ASan + UBSan),
-# runs every test (unit, interop against the official library), the server tests again under
-# ThreadSanitizer (with RR_TSAN=1), then builds the libFuzzer targets and runs each
-# briefly (scripts/fuzz.sh; RR_FUZZ_SECONDS=N for N seconds each, 0 for none). Exits non-zero on any failure.
+# Catch2, Chromium, nginx, clang, umockdev, podman, the Python venv), builds the WebAssembly client and
+# the dashboard, starts the container image's build in the background (nice 19: it takes the CPU the
+# tests leave idle), builds the debug preset (ASan + UBSan), runs every test (unit, interop against the
+# official library), the server tests again under ThreadSanitizer (RR_TSAN=1), then builds the
+# libFuzzer targets and runs each briefly (scripts/fuzz.sh; RR_FUZZ_SECONDS=N for N seconds each, 0 for
+# none), and last the container test on the image built meanwhile (RR_CONTAINER=0 leaves it out).
+# Exits non-zero on any failure; prints how long each phase took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
 
+t_phase=$SECONDS
+phases=()
+phase_done() { phases+=("$1 $((SECONDS - t_phase)) s"); t_phase=$SECONDS; }
+container_pid=
+finish() {
+  local rc=$?
+  if [ -n "$container_pid" ]; then kill -- -"$container_pid" 2>/dev/null || true; fi
+  echo "test: phases: ${phases[*]/%/,} total $SECONDS s"
+  exit $rc
+}
+trap finish EXIT
+
+./scripts/setup.sh
+phase_done setup
 jobs=${RR_JOBS:-$(nproc)}
-cmake --preset debug >/dev/null
-cmake --build --preset debug -j "$jobs"
+
 # The WebAssembly client package (wasm-client/dist; build folder build/wasm), tested by ctest.
 ./wasm-client/build.sh
 # The dashboard (web/dist) on the client package, for the browser tests (they skip without it).
@@ -19,7 +34,24 @@ if [ -f wasm-client/dist/robotraconteur.mjs ]; then
 else
   echo "test: wasm-client/dist missing: the browser tests will be skipped"
 fi
-ctest --preset debug -j "$jobs"
+phase_done wasm+dashboard
+
+# The container image (issue 13): docker/build.sh from the committed tree plus web/dist, in its own
+# process group at nice 19, so the builds and tests below keep the CPU and the image's compile takes
+# what they leave idle (ctest waits on sockets and timers much of the time). The container test at
+# the end runs on this image (same inputs key) and skips, with the reason, where podman cannot run.
+mkdir -p build
+if [ "${RR_CONTAINER:-1}" != 0 ] && command -v podman >/dev/null && podman info >/dev/null 2>&1; then
+  setsid nice -n 19 ./docker/build.sh --tag localhost/rr-gateway:ci >build/container-build.log 2>&1 &
+  container_pid=$!
+  echo "test: building the container image in the background (build/container-build.log)"
+fi
+
+cmake --preset debug >/dev/null
+cmake --build --preset debug -j "$jobs"
+phase_done build
+ctest --preset debug -j "$jobs" -E '^docker: the image'
+phase_done ctest
 
 # ThreadSanitizer (issue 16): the threaded server tests (node, client, gateway, transports: the
 # "server: " tests of rr_server_tests) built with -fsanitize=thread in build/tsan (preset tsan builds
@@ -31,11 +63,29 @@ if [ "${RR_TSAN:-0}" != 0 ]; then
   cmake --preset tsan >/dev/null
   cmake --build --preset tsan -j "$jobs"
   ctest --preset tsan -j "$jobs"
+  phase_done tsan
 fi
 
 # RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times (~3.5 min).
 fuzz_seconds=${RR_FUZZ_SECONDS:-}
 if [ "$fuzz_seconds" != 0 ]; then
   ./scripts/fuzz.sh $fuzz_seconds
+  phase_done fuzz
+fi
+
+if [ "${RR_CONTAINER:-1}" != 0 ]; then
+  if [ -n "$container_pid" ]; then
+    pid=$container_pid
+    container_pid=
+    if ! wait "$pid"; then
+      tail -n 60 build/container-build.log
+      echo "test: docker/build.sh failed (build/container-build.log)"
+      exit 1
+    fi
+    grep -E '^build: ' build/container-build.log || true
+    phase_done container-build-wait
+  fi
+  ctest --preset debug -R '^docker: the image' --output-on-failure
+  phase_done container
 fi
 echo "test: all passed"
