@@ -10,7 +10,14 @@ namespace {
 
 constexpr std::chrono::milliseconds kDisconnectWait{500};
 
-MessageElement make_credentials_element(const std::string& password) {
+MessageElement make_credentials_element(const ClientSessionConfig& config) {
+    if (config.credentials) {
+        MessageElement creds = *config.credentials;
+        creds.name = "credentials";
+        creds.number.reset();
+        return creds;
+    }
+    const std::string& password = config.password;
     // credentials: map{string} of varvalue, normally {"password": <string>} (wire.md §6.4).
     MessageElement creds;
     creds.name = "credentials";
@@ -169,7 +176,7 @@ void ClientSession::start_connect(MonoTime now) {
         e.elements.push_back(make_string_element("returnservicedefs", "true"));
         if (!config_.username.empty()) {
             e.elements.push_back(make_string_element("username", config_.username));
-            e.elements.push_back(make_credentials_element(config_.password));
+            e.elements.push_back(make_credentials_element(config_));
         }
     } else {
         state_ = State::legacy_servicedesc;
@@ -266,7 +273,7 @@ void ClientSession::on_connect_reply(MessageEntry&& e, const MessageHeader& h, M
                 a.service_path = config_.service_name;
                 a.request_id = connect_request_id_ = next_request_id();
                 a.elements.push_back(make_string_element("username", config_.username));
-                a.elements.push_back(make_credentials_element(config_.password));
+                a.elements.push_back(make_credentials_element(config_));
                 state_ = State::legacy_authenticate;
                 if (auto r = send_session(std::move(a), now); !r) fail_connect(r.error());
                 return;

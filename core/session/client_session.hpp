@@ -28,6 +28,9 @@ struct ClientSessionConfig {
     /// Optional credentials: username and password (sent as credentials {"password": …}).
     std::string username;
     std::string password;
+    /// When set (and `username` is not empty), sent as the `credentials` element instead of
+    /// {"password": password}: a gateway passes on what its own client sent, unchanged.
+    std::optional<MessageElement> credentials;
     /// Per-request timeout (wire.md §13: 15 s).
     std::chrono::milliseconds request_timeout{15000};
     /// Bound on the whole connect, counted from construction: CreateConnection and the service connect

@@ -50,6 +50,14 @@ public:
     /// MonitorEnter, MonitorContinueEnter, MonitorExit) reaches it as a ServiceRequest. Otherwise the
     /// session answers object locks InvalidOperation and monitor operations "OK" (nothing is locked).
     virtual bool handles_locks() const { return false; }
+    /// Whether the service admits each new client session itself, and answers later: ConnectClient and
+    /// ConnectClientCombined then produce a ServiceAdmission event (with the client's username and
+    /// `credentials` element, if any) and are answered when the host calls
+    /// ServiceSession::answer_admission(). requires_authentication() and authenticate() are not asked,
+    /// and AuthenticateUser / LogoutUser reach the service as ServiceRequests (ClientSessionOpReq) like
+    /// the lock operations. The gateway's `auth: passthrough` mirror: the device decides, on an
+    /// upstream session of the client's own.
+    virtual bool admits_sessions() const { return false; }
 };
 
 /// The node, as its connections see it. Thread-safe.

@@ -58,6 +58,7 @@ ServiceSession::ServiceSession(ServiceHost& host, ServiceSessionConfig config, M
 
 ServiceSession::~ServiceSession() {
     if (service_) host_.release_endpoint(endpoint_);
+    if (admission_) host_.release_endpoint(admission_->endpoint);
 }
 
 void ServiceSession::feed(std::span<const std::byte> bytes, MonoTime now) {
@@ -128,6 +129,10 @@ void ServiceSession::close_session() {
     pending_callbacks_.clear();
     pending_object_types_.clear();
     held_wires_.clear();
+    if (admission_) {
+        host_.release_endpoint(admission_->endpoint);  // a late answer_admission() returns false
+        admission_.reset();
+    }
     if (!service_) return;
     auto service = std::move(service_);
     service_.reset();
@@ -335,13 +340,38 @@ void ServiceSession::object_type_name(const MessageHeader& h, MessageEntry&& e, 
 }
 
 void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bool combined, MonoTime now) {
-    if (service_) {
+    if (service_ || admission_) {
         reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidOperation, "Already connected")), now);
         return;
     }
     auto service = host_.hosted_service(e.service_path);
     if (!service) {
         reply_special(h, error_reply(e, service_not_found(e.service_path)), now);
+        return;
+    }
+    const MessageElement* ret = e.find("returnservicedefs");
+    const std::string_view want = ret ? read_string(*ret) : std::string_view("true");
+    const bool return_defs = want != "false" && want != "0";
+    if (service->admits_sessions()) {
+        if (h.sender_endpoint == 0) {
+            reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidEndpoint, "client endpoint 0")), now);
+            return;
+        }
+        PendingAdmission p;
+        p.token = ++admission_counter_;
+        p.header = h;
+        p.reply = reply_to(e);
+        p.combined = combined;
+        p.return_defs = return_defs;
+        p.service = service;
+        p.endpoint = host_.allocate_endpoint();
+        ServiceAdmission ev{p.token, service, p.endpoint, {}, std::nullopt};
+        if (combined) {
+            if (const auto* user = e.find("username")) ev.username = p.username = std::string(read_string(*user));
+            if (const auto* creds = e.find("credentials")) ev.credentials = *creds;
+        }
+        admission_ = std::move(p);
+        events_.emplace_back(std::move(ev));
         return;
     }
     std::string username;
@@ -375,21 +405,41 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
         reply_special(h, error_reply(e, make_error(MessageErrorType::InvalidEndpoint, "client endpoint 0")), now);
         return;
     }
+    open_session(h, reply_to(e), combined, return_defs, std::move(service), host_.allocate_endpoint(), std::move(username),
+                 authenticated, now);
+}
+
+bool ServiceSession::answer_admission(std::uint64_t token, Result<void> outcome, MonoTime now) {
+    if (!admission_ || admission_->token != token || stream_.is_closed()) return false;
+    PendingAdmission p = std::move(*admission_);
+    admission_.reset();
+    if (!outcome) {
+        host_.release_endpoint(p.endpoint);
+        set_entry_error(p.reply, outcome.error());
+        reply_special(p.header, std::move(p.reply), now);
+        return true;
+    }
+    open_session(p.header, std::move(p.reply), p.combined, p.return_defs, std::move(p.service), p.endpoint,
+                 std::move(p.username), true, now);
+    return true;
+}
+
+void ServiceSession::open_session(const MessageHeader& h, MessageEntry reply, bool combined, bool return_defs,
+                                  std::shared_ptr<HostedService> service, std::uint32_t endpoint, std::string username,
+                                  bool authenticated, MonoTime now) {
     service_ = service;
-    endpoint_ = host_.allocate_endpoint();
+    endpoint_ = endpoint;
     client_endpoint_ = h.sender_endpoint;
     username_ = username;
     authenticated_ = authenticated;
     stream_.set_session_established(endpoint_, client_endpoint_);
 
-    MessageEntry r = reply_to(e);
+    MessageEntry r = std::move(reply);
     if (combined) {
         auto type = service->root_type();
         r.elements.push_back(make_string_element("objecttype", type.object_type));
         if (!type.implements.empty()) r.elements.push_back(make_string_list("objectimplements", type.implements));
-        const MessageElement* ret = e.find("returnservicedefs");
-        std::string_view want = ret ? read_string(*ret) : std::string_view("true");
-        if (want != "false" && want != "0") r.elements.push_back(make_string_list("servicedefs", service->service_definitions()));
+        if (return_defs) r.elements.push_back(make_string_list("servicedefs", service->service_definitions()));
         MessageElement attrs = service->attributes();
         attrs.name = "attributes";
         r.elements.push_back(std::move(attrs));
@@ -449,6 +499,10 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
 void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
     MessageEntry r = reply_to(e);
     const std::string& op = e.member_name;
+    if ((op == "AuthenticateUser" || op == "LogoutUser") && service_->admits_sessions()) {
+        events_.emplace_back(ServiceRequest{std::move(e), true});  // the service's own login (passthrough)
+        return;
+    }
     if (op == "AuthenticateUser") {
         const MessageElement* user = e.find("username");
         const MessageElement* creds = e.find("credentials");

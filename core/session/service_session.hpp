@@ -72,6 +72,17 @@ struct ServiceCallbackResponse {
     std::uint32_t request_id = 0;
     Result<MessageEntry> entry;
 };
+/// A client asks for a session with a service whose admits_sessions() is true: answer with
+/// answer_admission(token, …). `endpoint` is reserved for the session (ServiceSessionOpened carries the
+/// same one when admitted). `username` / `credentials` are what ConnectClientCombined carried (empty /
+/// nullopt when absent; a plain ConnectClient carries neither).
+struct ServiceAdmission {
+    std::uint64_t token = 0;
+    std::shared_ptr<HostedService> service;
+    std::uint32_t endpoint = 0;
+    std::string username;
+    std::optional<MessageElement> credentials;
+};
 /// The client session ended (DisconnectClient or the connection closed). No further session events.
 struct ServiceSessionClosed {
     std::shared_ptr<HostedService> service;
@@ -83,7 +94,8 @@ struct ServiceConnectionClosed {
 };
 
 using ServiceSessionEvent = std::variant<ServiceSessionOpened, ServiceSessionUser, ServiceRequest, ServiceObjectTypeQuery,
-                                         ServiceCallbackResponse, ServiceSessionClosed, ServiceConnectionClosed>;
+                                         ServiceCallbackResponse, ServiceSessionClosed, ServiceConnectionClosed,
+                                         ServiceAdmission>;
 
 class ServiceSession {
 public:
@@ -129,6 +141,11 @@ public:
     Result<std::uint32_t> request(MessageEntry entry, MonoTime now);
     /// Completes a ServiceObjectTypeQuery. Unknown tokens are ignored.
     void answer_object_type(std::uint64_t token, Result<ObjectTypeInfo> info, MonoTime now);
+    /// Completes a ServiceAdmission: OK opens the session (the connect reply, then ServiceSessionOpened);
+    /// an error is the connect's error reply (e.g. the device's AuthenticationError). Returns false when
+    /// the token is unknown or the connection closed meanwhile: the service must then drop what it
+    /// prepared for that endpoint.
+    bool answer_admission(std::uint64_t token, Result<void> outcome, MonoTime now);
     /// Ends the connection after the pending output (the host's close()).
     void close(RRError error);
 
@@ -148,6 +165,9 @@ private:
     void get_service_desc(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void object_type_name(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void close_session();
+    void open_session(const MessageHeader& h, MessageEntry reply, bool combined, bool return_defs,
+                      std::shared_ptr<HostedService> service, std::uint32_t endpoint, std::string username,
+                      bool authenticated, MonoTime now);
     void reply_special(const MessageHeader& request_header, MessageEntry reply, MonoTime now);
     Message session_message(MessageEntry entry);
     void flush_held_wires(MonoTime now);
@@ -171,6 +191,17 @@ private:
     std::uint64_t object_type_counter_ = 0;
     std::map<std::uint64_t, PendingObjectType> pending_object_types_;
     std::map<WireKey, MessageEntry> held_wires_;
+    struct PendingAdmission {
+        std::uint64_t token = 0;
+        MessageHeader header;
+        MessageEntry reply;
+        bool combined = false, return_defs = true;
+        std::shared_ptr<HostedService> service;
+        std::uint32_t endpoint = 0;
+        std::string username;
+    };
+    std::optional<PendingAdmission> admission_;  // at most one: a connection carries one session
+    std::uint64_t admission_counter_ = 0;
 };
 
 }  // namespace rr

@@ -30,7 +30,9 @@ struct FakeService : HostedService {
     ObjectTypeInfo root_type() const override { return {"example.svc.Obj", {"example.base.Thing"}}; }
     bool requires_authentication() const override { return auth; }
     bool handles_locks() const override { return locks; }
+    bool admits_sessions() const override { return admits; }
     bool locks = false;
+    bool admits = false;
     Result<void> authenticate(const std::string& user, const MessageElement* creds) override {
         const MessageElement* pw = creds ? creds->find("password") : nullptr;
         if (user == "alice" && pw && read_string(*pw) == "secret") return {};
@@ -327,6 +329,74 @@ TEST_CASE("service session: connect-time login errors are CORE's") {
         auto closed = p.take_client<ClientSessionClosed>();
         REQUIRE(closed.size() == 1);
         CHECK(closed[0].error.message == "Authentication not enabled for service");
+    }
+}
+
+TEST_CASE("service session: a service that admits sessions itself answers the connect later") {
+    SECTION("admitted: the connect waits, then opens with the reserved endpoint; logins go to the service") {
+        Pair p("svc", false, "alice", "pw");
+        p.host.service->admits = true;
+        p.host.service->auth = true;  // not asked: the service decides
+        p.pump();
+        auto asks = p.take<ServiceAdmission>(p.service_events);
+        REQUIRE(asks.size() == 1);
+        CHECK(asks[0].username == "alice");
+        REQUIRE(asks[0].credentials);
+        const MessageElement* pw = asks[0].credentials->find("password");
+        REQUIRE(pw);
+        CHECK(read_string(*pw) == "pw");
+        CHECK(p.host.live.count(asks[0].endpoint) == 1);
+        CHECK(p.take_client<ClientSessionConnected>().empty());  // still waiting
+        CHECK(p.take<ServiceSessionOpened>(p.service_events).empty());
+        CHECK(!p.service.answer_admission(asks[0].token + 1, {}, p.now));  // unknown token
+        REQUIRE(p.service.answer_admission(asks[0].token, {}, p.now));
+        p.pump();
+        REQUIRE(p.take_client<ClientSessionConnected>().size() == 1);
+        auto opened = p.take<ServiceSessionOpened>(p.service_events);
+        REQUIRE(opened.size() == 1);
+        CHECK(opened[0].endpoint == asks[0].endpoint);
+        CHECK(opened[0].username == "alice");
+
+        MessageEntry auth;
+        auth.entry_type = MessageEntryType::ClientSessionOpReq;
+        auth.service_path = "svc";
+        auth.member_name = "AuthenticateUser";
+        auth.elements.push_back(make_string_element("username", "bob"));
+        REQUIRE(p.client.request(std::move(auth), p.now));
+        REQUIRE(p.client.request(member_request("a"), p.now));  // no PermissionDenied: the service decides
+        p.pump();
+        auto requests = p.take<ServiceRequest>(p.service_events);
+        REQUIRE(requests.size() == 2);
+        CHECK(requests[0].entry.member_name == "AuthenticateUser");
+        CHECK(requests[1].entry.member_name == "a");
+    }
+    SECTION("refused: the client gets the service's error, the endpoint is freed") {
+        Pair p("svc", false, "alice", "wrong");
+        p.host.service->admits = true;
+        p.pump();
+        auto asks = p.take<ServiceAdmission>(p.service_events);
+        REQUIRE(asks.size() == 1);
+        REQUIRE(p.service.answer_admission(asks[0].token,
+                                           fail(MessageErrorType::AuthenticationError, "Invalid username or password"), p.now));
+        p.pump();
+        auto closed = p.take_client<ClientSessionClosed>();
+        REQUIRE(closed.size() == 1);
+        CHECK(closed[0].error.type == MessageErrorType::AuthenticationError);
+        CHECK(closed[0].error.message == "Invalid username or password");
+        CHECK(p.host.live.empty());
+        CHECK(p.take<ServiceSessionOpened>(p.service_events).empty());
+    }
+    SECTION("no login: username empty, no credentials; the connection closes before the answer") {
+        Pair p("svc");
+        p.host.service->admits = true;
+        p.pump();
+        auto asks = p.take<ServiceAdmission>(p.service_events);
+        REQUIRE(asks.size() == 1);
+        CHECK(asks[0].username.empty());
+        CHECK(!asks[0].credentials);
+        p.service.on_transport_closed(make_error(MessageErrorType::ConnectionError, "gone"));
+        CHECK(p.host.live.empty());
+        CHECK(!p.service.answer_admission(asks[0].token, {}, p.now));  // the host then abandons it
     }
 }
 

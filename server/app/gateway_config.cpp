@@ -382,7 +382,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         std::set<std::string> names;
         for (const auto& d : devs) {
             r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms", "tls_ca",
-                                          "tls_certificate", "tls_private_key"});
+                                          "tls_certificate", "tls_private_key", "auth", "max_passthrough_sessions"});
             gateway::DeviceConfig dc;
             if (!d["name"]) r.error(d, "devices[].name", "missing");
             if (!d["url"]) r.error(d, "devices[].url", "missing");
@@ -395,6 +395,19 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             if (auto n = d["username"]) dc.username = r.string(n, key + ".username");
             if (auto n = d["password"]) dc.password = r.string(n, key + ".password");
             if (auto n = d["required"]) dc.required = r.boolean(n, key + ".required");
+            if (auto n = d["auth"]) {
+                const std::string mode = r.string(n, key + ".auth");
+                if (mode == "passthrough")
+                    dc.auth = gateway::DeviceAuth::passthrough;
+                else if (mode == "shared")
+                    dc.auth = gateway::DeviceAuth::shared;
+                else
+                    r.error(n, key + ".auth", "expected passthrough or shared, got \"" + mode + "\"");
+            }
+            if (auto n = d["max_passthrough_sessions"]) {
+                dc.max_passthrough_sessions = r.unsigned_int(n, key + ".max_passthrough_sessions", 100000);
+                if (dc.max_passthrough_sessions == 0) r.error(n, key + ".max_passthrough_sessions", "must be at least 1");
+            }
             if (auto n = d["tls_ca"]) dc.tls_ca = r.string(n, key + ".tls_ca");
             if (auto n = d["tls_certificate"]) dc.tls_certificate = r.string(n, key + ".tls_certificate");
             if (auto n = d["tls_private_key"]) dc.tls_private_key = r.string(n, key + ".tls_private_key");

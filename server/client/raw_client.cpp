@@ -117,6 +117,7 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
     cfg.service_name = url.service;
     cfg.username = options.username;
     cfg.password = options.password;
+    cfg.credentials = options.credentials;
     cfg.request_timeout = options.request_timeout;
     cfg.local_endpoint = server::random_endpoint_id();
 

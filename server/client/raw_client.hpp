@@ -26,6 +26,8 @@ struct RawClientOptions {
     NodeID local_node_id;          ///< all-zero: random
     std::string local_node_name;
     std::string username, password;
+    /// Sent as `credentials` instead of {"password": password} when set (ClientSessionConfig::credentials).
+    std::optional<MessageElement> credentials;
     bool enable_message4 = true;
     bool enable_string_table = true;
     std::chrono::milliseconds connect_timeout{5000};

@@ -14,6 +14,14 @@ std::string_view device_state_name(DeviceState s) noexcept {
     return "unknown";
 }
 
+std::string_view device_auth_name(DeviceAuth a) noexcept {
+    switch (a) {
+        case DeviceAuth::shared: return "shared";
+        case DeviceAuth::passthrough: return "passthrough";
+    }
+    return "unknown";
+}
+
 void DeviceCounters::observe_latency(std::chrono::steady_clock::duration d) {
     const double s = std::chrono::duration<double>(d).count();
     std::size_t i = 0;
@@ -42,6 +50,21 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
     }
     std::shared_ptr<DeviceMirror> m(new DeviceMirror(std::move(node), std::move(config), std::move(*url)));
     m->service_ = std::make_shared<MirrorService>(m, m->config_.name, m->url_.service);
+    if (m->config_.auth == DeviceAuth::passthrough) {
+        auto node = m->node_.lock();
+        PassthroughSessions::Settings ps;
+        ps.device_name = m->config_.name;
+        ps.upstream_service = m->url_.service;
+        ps.url = m->url_;
+        ps.options = m->upstream_options(*node);
+        ps.max_sessions = m->config_.max_passthrough_sessions;
+        std::weak_ptr<DeviceMirror> weak = m;
+        ps.on_change = [weak] {
+            if (auto self = weak.lock()) self->notify_state();
+        };
+        m->service_->set_passthrough(
+            std::make_shared<PassthroughSessions>(node->io_context().get_executor(), std::move(ps), &m->counters_));
+    }
     return m;
 }
 
@@ -69,6 +92,7 @@ void DeviceMirror::stop() {
     }
     timer_.cancel();
     if (client) client->close();
+    if (service_) service_->stop_passthrough();
     if (auto node = node_.lock(); node && registered_) node->unregister_service(config_.name);
 }
 
@@ -82,14 +106,9 @@ void DeviceMirror::connect() {
         state_ = DeviceState::connecting;
         gen = ++generation_;
     }
-    RawClientOptions options;
-    options.local_node_name = node->node_name().empty() ? std::string() : node->node_name();
+    RawClientOptions options = upstream_options(*node);
     options.username = config_.username;
     options.password = config_.password;
-    options.tls_ca_file = config_.tls_ca;
-    options.tls_certificate_file = config_.tls_certificate;
-    options.tls_private_key_file = config_.tls_private_key;
-    options.transports = &node->transports();
     std::weak_ptr<DeviceMirror> weak = weak_from_this();
     RawClient::connect(
         node->io_context().get_executor(), url_, options,
@@ -124,6 +143,16 @@ void DeviceMirror::connect() {
             else
                 self->on_disconnected(r.error());
         });
+}
+
+RawClientOptions DeviceMirror::upstream_options(Node& node) const {
+    RawClientOptions options;
+    options.local_node_name = node.node_name().empty() ? std::string() : node.node_name();
+    options.tls_ca_file = config_.tls_ca;
+    options.tls_certificate_file = config_.tls_certificate;
+    options.tls_private_key_file = config_.tls_private_key;
+    options.transports = &node.transports();
+    return options;
 }
 
 void DeviceMirror::set_state_listener(std::function<void(const DeviceStatus&)> listener) {
@@ -227,6 +256,11 @@ DeviceStatus DeviceMirror::status() const {
     s.url = config_.url;
     s.required = config_.required;
     s.downstream_sessions = service_->session_count();
+    s.auth = config_.auth;
+    if (const auto& p = service_->passthrough()) {
+        s.upstream_sessions = p->session_count();
+        s.locks = p->locks();
+    }
     std::lock_guard lock(mutex_);
     s.state = state_;
     s.reason = reason_;

@@ -25,6 +25,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
+#include "server/gateway/passthrough_sessions.hpp"
 #include "server/gateway/shared_entry.hpp"
 #include "server/node/service.hpp"
 
@@ -34,6 +35,17 @@ class Node;
 
 namespace rr::server::gateway {
 
+/// How downstream clients' logins reach the device (docs/security.md).
+enum class DeviceAuth : std::uint8_t {
+    /// One upstream session (with `username`/`password` below) shared by every client; object and
+    /// monitor locks are refused with InvalidOperation (they would lock for everyone at once).
+    shared,
+    /// Every native RR client gets its own upstream session with its own credentials
+    /// (PassthroughSessions); the shared session still serves the JSON API and the definitions.
+    passthrough,
+};
+std::string_view device_auth_name(DeviceAuth a) noexcept;
+
 struct DeviceConfig {
     std::string name;  ///< service name on the gateway (a valid RR service name)
     std::string url;   ///< rr+tcp://host:port/?service=…
@@ -41,6 +53,9 @@ struct DeviceConfig {
     /// rr+wss, rrs+tcp: PEM certificates to trust ("" = the system's), and the gateway's own
     /// certificate and key to present when the device requires client certificates ("" = none).
     std::string tls_ca, tls_certificate, tls_private_key;
+    DeviceAuth auth = DeviceAuth::shared;
+    /// auth: passthrough: upstream sessions at once (one per logged-in native client); more are refused.
+    std::size_t max_passthrough_sessions = 64;
     /// /readyz waits for required devices only.
     bool required = true;
     std::chrono::milliseconds backoff_initial{500};
@@ -69,6 +84,9 @@ struct DeviceStatus {
     std::string object_type;
     bool required = true;
     std::size_t downstream_sessions = 0;
+    DeviceAuth auth = DeviceAuth::shared;
+    std::size_t upstream_sessions = 0;   ///< passthrough sessions open (or opening) to the device
+    std::vector<DeviceLockInfo> locks;   ///< locks taken through the gateway and still held
 };
 
 class MirrorService;
@@ -116,6 +134,7 @@ public:
 private:
     DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url);
     void connect();
+    RawClientOptions upstream_options(Node& node) const;
     void on_connected(std::shared_ptr<RawClient> client);
     void on_disconnected(const RRError& error);
     void schedule_reconnect();

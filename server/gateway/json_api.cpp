@@ -175,6 +175,16 @@ nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
     j["object_type"] = s.object_type.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.object_type);
     j["required"] = s.required;
     j["clients"] = s.downstream_sessions;
+    if (s.auth == DeviceAuth::passthrough) {
+        // Only passthrough devices have locks through the gateway (docs/security.md).
+        j["auth"] = std::string(device_auth_name(s.auth));
+        j["passthrough_sessions"] = s.upstream_sessions;
+        auto locks = nlohmann::json::array();
+        for (const auto& l : s.locks)
+            locks.push_back({{"path", l.path}, {"user", l.username.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.username)},
+                             {"kind", l.kind}});
+        j["locks"] = std::move(locks);
+    }
     return j;
 }
 

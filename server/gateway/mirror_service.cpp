@@ -139,11 +139,34 @@ void MirrorService::object_type(const SessionRef& session, const std::string& pa
 }
 
 void MirrorService::on_session_open(const SessionRef& session) {
-    std::lock_guard lock(mutex_);
-    sessions_.push_back(session);
+    {
+        std::lock_guard lock(mutex_);
+        sessions_.push_back(session);
+    }
+    if (passthrough_) passthrough_->attach(session);
 }
 
-void MirrorService::on_session_close(const SessionRef& session) { drop_session_state(session.endpoint()); }
+void MirrorService::on_session_close(const SessionRef& session) {
+    drop_session_state(session.endpoint());
+    if (passthrough_) passthrough_->close(session.endpoint());
+}
+
+void MirrorService::admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
+                                  std::function<void(Result<void>)> done) {
+    if (!passthrough_) {
+        Service::admit_session(endpoint, std::move(username), std::move(credentials), std::move(done));
+        return;
+    }
+    passthrough_->admit(endpoint, std::move(username), std::move(credentials), std::move(done));
+}
+
+void MirrorService::abandon_admission(std::uint32_t endpoint) {
+    if (passthrough_) passthrough_->close(endpoint);
+}
+
+void MirrorService::stop_passthrough() {
+    if (passthrough_) passthrough_->close_all();
+}
 
 std::size_t MirrorService::session_count() const {
     std::lock_guard lock(mutex_);
@@ -181,6 +204,18 @@ void MirrorService::drop_session_state(std::uint32_t endpoint) {
 void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     auto mirror = mirror_.lock();
     if (!mirror) return;
+    if (passthrough_) {
+        passthrough_->handle_entry(session, std::move(entry), std::move(responder));
+        return;
+    }
+    if (entry.entry_type == MessageEntryType::ClientSessionOpReq) {
+        // Lock operations on the shared session would lock the device for every client of the gateway
+        // at once (and MonitorExit from one client would free another's monitor): refused.
+        responder.fail(make_error(MessageErrorType::InvalidOperation,
+                                  entry.member_name + " through the gateway needs `auth: passthrough` on device \"" + name_ +
+                                      "\" (its clients share one session to the device; docs/security.md)"));
+        return;
+    }
     switch (entry.entry_type) {
         case MessageEntryType::WireConnectReq: wire_connect(session, std::move(entry), std::move(responder)); return;
         case MessageEntryType::WireDisconnectReq: wire_disconnect(session, std::move(entry), std::move(responder)); return;

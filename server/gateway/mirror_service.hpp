@@ -28,6 +28,18 @@ public:
     void on_session_open(const SessionRef& session) override;
     void on_session_close(const SessionRef& session) override;
     void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override;
+    /// Lock operations reach the mirror: forwarded on the client's own session (passthrough) or
+    /// refused with InvalidOperation (shared).
+    bool handles_locks() const override { return true; }
+    bool admits_sessions() const override { return passthrough_ != nullptr; }
+    void admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
+                       std::function<void(Result<void>)> done) override;
+    void abandon_admission(std::uint32_t endpoint) override;
+
+    /// auth: passthrough (set once, by DeviceMirror::create, before registration).
+    void set_passthrough(std::shared_ptr<PassthroughSessions> p) { passthrough_ = std::move(p); }
+    const std::shared_ptr<PassthroughSessions>& passthrough() const noexcept { return passthrough_; }
+    void stop_passthrough();
 
     // Upstream side, called by DeviceMirror.
     void on_upstream_entry(MessageEntry&& entry);
@@ -103,6 +115,7 @@ private:
     void drop_session_state(std::uint32_t endpoint);
 
     std::weak_ptr<DeviceMirror> mirror_;
+    std::shared_ptr<PassthroughSessions> passthrough_;
     const std::string name_;
     const std::string upstream_service_;
 

@@ -233,6 +233,8 @@ void ServerConnection::drain_events() {
                                                        weak_from_this(), config_.max_send_queue_bytes);
             current_->set_username(opened->username);
             service->on_session_open(SessionRef(current_));
+        } else if (auto* admission = std::get_if<ServiceAdmission>(&*ev)) {
+            on_admission(std::move(*admission));
         } else if (auto* user = std::get_if<ServiceSessionUser>(&*ev)) {
             if (current_) current_->set_username(std::move(user->username));
         } else if (auto* request = std::get_if<ServiceRequest>(&*ev)) {
@@ -271,6 +273,28 @@ void ServerConnection::on_request(ServiceRequest&& request) {
     }
     Responder responder = make_responder(request.entry);
     service->handle_entry(SessionRef(current_), std::move(request.entry), std::move(responder));
+}
+
+void ServerConnection::on_admission(ServiceAdmission&& admission) {
+    auto service = std::static_pointer_cast<Service>(admission.service);
+    std::weak_ptr<ServerConnection> weak = weak_from_this();
+    std::weak_ptr<PumpHandle> pump = pump_;
+    const std::uint32_t endpoint = admission.endpoint;
+    service->admit_session(endpoint, std::move(admission.username), std::move(admission.credentials),
+                           [weak, pump, service, endpoint, token = admission.token](Result<void> outcome) mutable {
+                               auto p = pump.lock();
+                               if (!p) {
+                                   if (outcome) service->abandon_admission(endpoint);
+                                   return;
+                               }
+                               p->post([weak, service, endpoint, token, outcome = std::move(outcome)]() mutable {
+                                   auto c = weak.lock();
+                                   const bool ok = outcome.ok();
+                                   const bool taken = c && c->session_.answer_admission(token, std::move(outcome), mono_now());
+                                   if (!taken && ok) service->abandon_admission(endpoint);
+                                   if (c) c->drain_events();
+                               });
+                           });
 }
 
 void ServerConnection::on_object_type_query(ServiceObjectTypeQuery&& query) {

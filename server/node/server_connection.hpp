@@ -112,6 +112,7 @@ public:
 private:
     void drain_events();
     void on_request(ServiceRequest&& request);
+    void on_admission(ServiceAdmission&& admission);
     void on_object_type_query(ServiceObjectTypeQuery&& query);
     Responder make_responder(const MessageEntry& request);
     void update_queue_estimate();

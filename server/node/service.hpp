@@ -101,6 +101,17 @@ public:
     /// e.g. monitor lock waits); the node outlives its registrations' use of it.
     virtual void attach(boost::asio::io_context& io) {}
 
+    /// For services whose admits_sessions() is true: decide whether a client may open a session (its
+    /// `username` and `credentials` element as the client sent them; empty / nullopt when absent), on
+    /// any thread, by calling `done` once: OK opens it (on_session_open follows with a SessionRef of
+    /// this `endpoint`), an error is what the client's connect gets. abandon_admission(endpoint) follows
+    /// an OK the client no longer wants (its connection closed meanwhile).
+    virtual void admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
+                               std::function<void(Result<void>)> done) {
+        done(fail(MessageErrorType::InvalidOperation, "service does not admit sessions"));
+    }
+    virtual void abandon_admission(std::uint32_t endpoint) {}
+
     virtual void on_session_open(const SessionRef& session) {}
     virtual void on_session_close(const SessionRef& session) {}
 

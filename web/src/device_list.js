@@ -5,6 +5,16 @@ import { h, errorText } from "./dom.js";
 
 const POLL_MS = 1000;
 
+/** Locks held on a passthrough device's objects, taken through the gateway (docs/security.md). */
+export function lockLines(d) {
+  if (!Array.isArray(d.locks)) return [];
+  return d.locks.map((l) => h("span", {
+    class: "device-lock",
+    dataset: { kind: l.kind },
+    text: `${l.kind === "monitor" ? "monitor" : `${l.kind} lock`} on ${l.path} by ${l.user ?? "an anonymous client"}`,
+  }));
+}
+
 export class DeviceList extends EventTarget {
   constructor(nav, statusEl) {
     super();
@@ -56,7 +66,8 @@ export class DeviceList extends EventTarget {
         h("span", { class: "badge", dataset: { state: d.state }, text: d.state }),
         h("span", { class: "device-type", text: d.object_type || d.url }),
         d.reason && d.state !== "connected" ? h("span", { class: "device-reason", text: d.reason }) : null,
-        h("span", { class: "device-clients", text: `${d.clients} client${d.clients === 1 ? "" : "s"}` }))));
+        h("span", { class: "device-clients", text: `${d.clients} client${d.clients === 1 ? "" : "s"}` }),
+        ...lockLines(d))));
     this.list.replaceChildren(...items);
     if (!items.length) this.list.append(h("li", { class: "hint", text: "No devices configured." }));
   }

@@ -1,0 +1,329 @@
+#include "server/gateway/passthrough_sessions.hpp"
+
+#include <algorithm>
+
+#include "core/message/error_entry.hpp"
+#include "core/names/service_path.hpp"
+#include "core/session/elements.hpp"
+#include "server/gateway/device_mirror.hpp"
+
+namespace rr::server::gateway {
+namespace {
+
+bool is_lock_op(const std::string& op) {
+    return op == "RequestObjectLock" || op == "RequestClientObjectLock" || op == "ReleaseObjectLock" ||
+           op == "ReleaseClientObjectLock" || op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit";
+}
+
+std::string reply_return(const MessageEntry& reply) {
+    if (const auto* r = reply.find("return"); r && r->type == DataTypes::string_t) return std::string(read_string(*r));
+    return {};
+}
+
+}  // namespace
+
+PassthroughSessions::PassthroughSessions(boost::asio::any_io_executor executor, Settings settings, DeviceCounters* counters)
+    : executor_(std::move(executor)), settings_(std::move(settings)), counters_(counters) {}
+
+PassthroughSessions::~PassthroughSessions() { close_all(); }
+
+std::string PassthroughSessions::to_upstream(std::string_view path) const {
+    return replace_service_name(path, settings_.upstream_service);
+}
+std::string PassthroughSessions::to_downstream(std::string_view path) const {
+    return replace_service_name(path, settings_.device_name);
+}
+
+void PassthroughSessions::admit(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
+                                std::function<void(Result<void>)> done) {
+    {
+        std::lock_guard lock(mutex_);
+        if (closed_) {
+            done(fail(MessageErrorType::ConnectionError, "device \"" + settings_.device_name + "\" is stopping"));
+            return;
+        }
+        if (links_.size() >= settings_.max_sessions) {
+            done(fail(MessageErrorType::BufferLimitViolation,
+                      "device \"" + settings_.device_name + "\": passthrough session limit (" +
+                          std::to_string(settings_.max_sessions) + " upstream sessions) reached; try again later"));
+            return;
+        }
+        Link link;
+        link.username = username;
+        links_[endpoint] = std::move(link);
+        gone_.erase(endpoint);
+    }
+    RawClientOptions options = settings_.options;
+    options.username = username;
+    options.password.clear();
+    options.credentials = std::move(credentials);
+    // The client's username without credentials: sent with an empty credentials map, so the device
+    // answers as it would to the client itself.
+    if (!username.empty() && !options.credentials) {
+        MessageElement empty;
+        empty.name = "credentials";
+        empty.type = DataTypes::dictionary_t;
+        options.credentials = std::move(empty);
+    }
+    std::weak_ptr<PassthroughSessions> weak = weak_from_this();
+    RawClient::connect(
+        executor_, settings_.url, std::move(options),
+        [weak, endpoint](MessageEntry&& e) {
+            if (auto self = weak.lock()) self->from_device(endpoint, std::move(e));
+        },
+        [weak, endpoint](const RRError& error) {
+            if (auto self = weak.lock()) self->upstream_closed(endpoint, error);
+        },
+        [weak, endpoint, done = std::move(done)](Result<std::shared_ptr<RawClient>> r) {
+            auto self = weak.lock();
+            if (!self) {
+                if (r) (*r)->close();
+                done(fail(MessageErrorType::ConnectionError, "gateway device stopped"));
+                return;
+            }
+            if (!r) {
+                {
+                    std::lock_guard lock(self->mutex_);
+                    self->links_.erase(endpoint);
+                    self->gone_.erase(endpoint);
+                }
+                done(r.take_error());
+                return;
+            }
+            bool keep = false;
+            {
+                std::lock_guard lock(self->mutex_);
+                auto it = self->links_.find(endpoint);
+                keep = !self->closed_ && it != self->links_.end() && !self->gone_.count(endpoint);
+                if (keep)
+                    it->second.client = *r;
+                else
+                    self->links_.erase(endpoint);
+                self->gone_.erase(endpoint);
+            }
+            if (!keep) {
+                (*r)->close();
+                done(fail(MessageErrorType::ConnectionError, "client gone while connecting"));
+                return;
+            }
+            done({});
+            self->changed();
+        });
+}
+
+void PassthroughSessions::attach(const SessionRef& session) {
+    std::vector<MessageEntry> early;
+    std::shared_ptr<RawClient> client;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(session.endpoint());
+        if (it == links_.end()) return;
+        it->second.session = session;
+        it->second.attached = true;
+        early.swap(it->second.early);
+        client = it->second.client;
+    }
+    for (auto& e : early) deliver(session, client, std::move(e));
+}
+
+void PassthroughSessions::close(std::uint32_t endpoint) {
+    std::shared_ptr<RawClient> client;
+    std::string username;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(endpoint);
+        if (it == links_.end()) return;
+        client = std::move(it->second.client);
+        username = it->second.username;
+        if (!client) gone_[endpoint];  // still connecting: the connect's answer closes it
+        else links_.erase(it);
+        forget_locks_of(endpoint, username);
+    }
+    if (client) client->close();
+    changed();
+}
+
+void PassthroughSessions::close_all() {
+    std::vector<std::shared_ptr<RawClient>> clients;
+    {
+        std::lock_guard lock(mutex_);
+        closed_ = true;
+        for (auto& [ep, link] : links_)
+            if (link.client) clients.push_back(std::move(link.client));
+        links_.clear();
+        locks_.clear();
+    }
+    for (auto& c : clients) c->close();
+}
+
+std::size_t PassthroughSessions::session_count() const {
+    std::lock_guard lock(mutex_);
+    return links_.size();
+}
+
+std::vector<DeviceLockInfo> PassthroughSessions::locks() const {
+    std::lock_guard lock(mutex_);
+    return locks_;
+}
+
+void PassthroughSessions::forget_locks_of(std::uint32_t endpoint, const std::string& username) {
+    // Under mutex_. Client locks and monitors belong to the session; a user lock goes with the last
+    // passthrough session of its user.
+    bool user_has_other = false;
+    for (const auto& [ep, link] : links_)
+        if (ep != endpoint && link.username == username && !link.lost && !gone_.count(ep)) user_has_other = true;
+    std::erase_if(locks_, [&](const DeviceLockInfo& l) {
+        if (l.kind == "user") return l.username == username && !user_has_other;
+        return l.endpoint == endpoint;
+    });
+}
+
+void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    std::shared_ptr<RawClient> client;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(session.endpoint());
+        if (it != links_.end() && !it->second.lost) client = it->second.client;
+    }
+    if (!client || !client->is_open()) {
+        if (!responder.done())
+            responder.fail(make_error(MessageErrorType::ConnectionError,
+                                      "the device \"" + settings_.device_name + "\" closed this client's session"));
+        return;
+    }
+    const std::string downstream_path = entry.service_path;
+    entry.service_path = to_upstream(entry.service_path);
+    if (responder.done()) {  // PipePacket, PipePacketRet, WirePacket: no answer
+        client->send(std::move(entry));
+        return;
+    }
+    const auto type = entry.entry_type;
+    const std::string op = type == MessageEntryType::ClientSessionOpReq ? entry.member_name : std::string();
+    const std::uint32_t endpoint = session.endpoint();
+    if (counters_) counters_->requests.fetch_add(1);
+    const auto start = std::chrono::steady_clock::now();
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    std::weak_ptr<PassthroughSessions> weak = weak_from_this();
+    // MonitorEnter waits on the device up to its own 5 s "Continue" answer; the default timeout covers it.
+    client->request(std::move(entry), [weak, shared, op, endpoint, downstream_path, start](Result<MessageEntry> r) {
+        auto self = weak.lock();
+        if (self && self->counters_) {
+            self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
+            if (!r || r->error != MessageErrorType::None) self->counters_->request_errors.fetch_add(1);
+        }
+        if (!r) {
+            shared->fail(r.error());
+            return;
+        }
+        if (self) {
+            r->service_path = self->to_downstream(r->service_path);
+            if (!op.empty() && r->error == MessageErrorType::None && is_lock_op(op)) {
+                self->note_lock_reply(endpoint, op, downstream_path, *r);
+                self->changed();
+            }
+        }
+        shared->respond(std::move(*r));
+    });
+}
+
+void PassthroughSessions::note_lock_reply(std::uint32_t endpoint, const std::string& op, const std::string& path,
+                                          const MessageEntry& reply) {
+    std::lock_guard lock(mutex_);
+    auto it = links_.find(endpoint);
+    if (it == links_.end()) return;
+    const std::string& user = it->second.username;
+    auto erase_at = [&](bool monitor) {
+        std::erase_if(locks_, [&](const DeviceLockInfo& l) {
+            return l.path == path && (l.kind == "monitor") == monitor && (!monitor || l.endpoint == endpoint);
+        });
+    };
+    if (op == "RequestObjectLock" || op == "RequestClientObjectLock") {
+        erase_at(false);
+        locks_.push_back(DeviceLockInfo{path, user, op == "RequestObjectLock" ? "user" : "client", endpoint});
+    } else if (op == "ReleaseObjectLock" || op == "ReleaseClientObjectLock") {
+        erase_at(false);
+    } else if (op == "MonitorEnter" || op == "MonitorContinueEnter") {
+        if (reply_return(reply) == "OK") {
+            erase_at(true);
+            locks_.push_back(DeviceLockInfo{path, user, "monitor", endpoint});
+        }
+    } else if (op == "MonitorExit") {
+        erase_at(true);
+    }
+}
+
+void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& entry) {
+    SessionRef session;
+    std::shared_ptr<RawClient> client;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(endpoint);
+        if (it == links_.end()) return;
+        if (!it->second.attached) {
+            // Between the connect's answer and the downstream session's opening: held (bounded).
+            if (it->second.early.size() < 256) it->second.early.push_back(std::move(entry));
+            return;
+        }
+        session = it->second.session;
+        client = it->second.client;
+    }
+    deliver(session, client, std::move(entry));
+}
+
+void PassthroughSessions::deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry) {
+    entry.service_path = to_downstream(entry.service_path);
+    switch (entry.entry_type) {
+        case MessageEntryType::CallbackCallReq: {
+            // The device calls exactly this client: it is the only one on this upstream session.
+            if (counters_) counters_->callbacks.fetch_add(1);
+            MessageEntry reply_header;
+            reply_header.entry_type = MessageEntryType::CallbackCallRet;
+            reply_header.service_path = to_upstream(entry.service_path);
+            reply_header.member_name = entry.member_name;
+            reply_header.request_id = entry.request_id;
+            std::weak_ptr<RawClient> weak_client = client;
+            session.request(std::move(entry), [weak_client, reply_header](Result<MessageEntry> r) mutable {
+                auto c = weak_client.lock();
+                if (!c) return;
+                MessageEntry reply = reply_header;
+                if (!r) {
+                    set_entry_error(reply, r.error());
+                } else {
+                    reply.error = r->error;
+                    reply.elements = std::move(r->elements);
+                }
+                c->send(std::move(reply));
+            });
+            return;
+        }
+        case MessageEntryType::WirePacket:
+            if (counters_) counters_->wire_packets_out.fetch_add(1);
+            (void)session.send_wire_packet(std::move(entry));
+            return;
+        case MessageEntryType::EventReq:
+            if (counters_) counters_->events.fetch_add(1);
+            (void)session.send(std::move(entry));
+            return;
+        case MessageEntryType::PipePacket:
+            if (counters_) counters_->pipe_packets.fetch_add(1);
+            if (!session.send(std::move(entry)) && counters_) counters_->pipe_drops.fetch_add(1);
+            return;
+        default: (void)session.send(std::move(entry)); return;
+    }
+}
+
+void PassthroughSessions::upstream_closed(std::uint32_t endpoint, const RRError& error) {
+    // The device ended this client's session (or went away): its locks are gone on the device too.
+    // The downstream session stays open; its requests fail with ConnectionError from now on.
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(endpoint);
+        if (it == links_.end() || !it->second.client) return;
+        it->second.lost = true;
+        forget_locks_of(endpoint, it->second.username);
+    }
+    changed();
+    (void)error;
+}
+
+}  // namespace rr::server::gateway

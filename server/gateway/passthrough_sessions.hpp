@@ -1,0 +1,118 @@
+// `auth: passthrough` for one device (docs/security.md "Logins and locks through the gateway"): every
+// downstream native RR client session of the device's mirror gets an upstream session to the device of
+// its own, opened with the username and `credentials` element the client sent (or none), so the
+// device's own users, privileges, object locks and monitor locks apply exactly as if the client had
+// connected directly. The upstream session is opened when the client connects (its connect waits for
+// the device's answer, and gets the device's own error when refused) and closed when the client goes.
+//
+// Forwarding is one to one: every member request, session operation (AuthenticateUser, LogoutUser,
+// RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter,
+// MonitorContinueEnter, MonitorExit) and packet of the client goes to its own upstream session with
+// the service path re-addressed (RequestIDs are the upstream session's), and everything the device
+// sends on that session (replies, events, wire and pipe packets, PipeClosed, WireClosed, callback
+// requests) goes back to that client only; pipe and wire indices pass unchanged, since both sides are
+// one session each.
+//
+// Lock bookkeeping: locks and monitors taken through the gateway (an OK answer of the device) are
+// remembered for the JSON API and the dashboard, with the user who took them; released ones and those
+// of closed sessions are forgotten (a user lock when the last passthrough session of its user closes,
+// as on the device). Locks taken by the device's other clients are not known to the gateway.
+//
+// Thread-safe: called from downstream connection strands and upstream client strands.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <boost/asio/any_io_executor.hpp>
+
+#include "core/names/connection_url.hpp"
+#include "server/client/raw_client.hpp"
+#include "server/node/service.hpp"
+
+namespace rr::server::gateway {
+
+struct DeviceCounters;
+
+/// A lock on a device object known to the gateway (taken through it).
+struct DeviceLockInfo {
+    std::string path;      ///< service path in gateway naming (the device's name as service name)
+    std::string username;  ///< who took it ("" for an anonymous monitor)
+    std::string kind;      ///< "user" (RequestObjectLock), "client" (RequestClientObjectLock), "monitor"
+    std::uint32_t endpoint = 0;  ///< the downstream session that took it
+};
+
+class PassthroughSessions : public std::enable_shared_from_this<PassthroughSessions> {
+public:
+    struct Settings {
+        std::string device_name;       ///< the service name on the gateway
+        std::string upstream_service;  ///< the device's service name
+        ConnectionUrl url;             ///< the device
+        RawClientOptions options;      ///< TLS, transports, node name; username/credentials set per client
+        std::size_t max_sessions = 64; ///< upstream sessions at once (admissions beyond are refused)
+        /// Called (without locks held, any thread) when sessions or known locks change.
+        std::function<void()> on_change;
+    };
+
+    /// `counters` (may be null) must outlive this object.
+    PassthroughSessions(boost::asio::any_io_executor executor, Settings settings, DeviceCounters* counters);
+    ~PassthroughSessions();
+
+    /// Opens the client's upstream session (Service::admit_session). Errors to `done`: the device's
+    /// own (e.g. AuthenticationError "Invalid username or password"), ConnectionError when it cannot be
+    /// reached, BufferLimitViolation "… passthrough session limit (N) reached" over max_sessions.
+    void admit(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
+               std::function<void(Result<void>)> done);
+    /// The admitted client's session is open: entries from the device may go to it now.
+    void attach(const SessionRef& session);
+    /// The client went (or never took its admission): closes its upstream session (DisconnectClient;
+    /// the device drops its client locks and monitors) and forgets its locks.
+    void close(std::uint32_t endpoint);
+    /// Closes every upstream session (the device mirror stops).
+    void close_all();
+
+    /// A request or packet from a client (Service::handle_entry).
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder);
+
+    std::size_t session_count() const;
+    std::vector<DeviceLockInfo> locks() const;
+
+private:
+    struct Link {
+        std::shared_ptr<RawClient> client;
+        SessionRef session;
+        std::string username;
+        std::vector<MessageEntry> early;  // device entries that came before attach()
+        bool attached = false;
+        bool lost = false;  // the device ended the upstream session
+    };
+
+    void from_device(std::uint32_t endpoint, MessageEntry&& entry);
+    void deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry);
+    void upstream_closed(std::uint32_t endpoint, const RRError& error);
+    void note_lock_reply(std::uint32_t endpoint, const std::string& op, const std::string& path, const MessageEntry& reply);
+    void forget_locks_of(std::uint32_t endpoint, const std::string& username);
+    void changed() const {
+        if (settings_.on_change) settings_.on_change();
+    }
+    std::string to_upstream(std::string_view path) const;
+    std::string to_downstream(std::string_view path) const;
+
+    boost::asio::any_io_executor executor_;
+    const Settings settings_;
+    DeviceCounters* counters_;
+
+    mutable std::mutex mutex_;
+    std::map<std::uint32_t, Link> links_;       // admitted (or being admitted: client null)
+    std::map<std::uint32_t, std::string> gone_;  // endpoints closed while connecting (value unused)
+    std::vector<DeviceLockInfo> locks_;
+    bool closed_ = false;
+};
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,244 @@
+"""Logins, object locks, monitor locks and callbacks THROUGH the gateway with `auth: passthrough`
+(docs/security.md "Logins and locks through the gateway"): official Python clients -> rr-gateway ->
+rr_interop_service --users (official password file format).
+
+Every check of locks_logins.py runs against the gateway's mirror of the device instead of the device
+itself, and must give the same answers (the device's own users, privileges, object locks, monitor
+locks, release on disconnect and on a killed client process). Then:
+  json     the JSON API (/api/devices) shows who holds a lock / a monitor taken through the gateway,
+           and forgets it when released;
+  callback two clients calling call_callbacks() at the same time each get their own callback
+           (each has its own upstream session);
+  limit    a device with max_passthrough_sessions: 2 refuses a third client with a clear error and
+           admits it once one of the two has gone;
+  shared   a device in the default shared mode refuses RequestObjectLock and MonitorEnter with
+           InvalidOperation naming `auth: passthrough`.
+Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
+when the official package is missing.
+
+Usage: passthrough_gateway.py --gateway PATH/rr-gateway --service PATH/rr_interop_service [--timeout S]
+"""
+
+import argparse
+import hashlib
+import json
+import os
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from child_procs import StepFailed, get_json, read_json_line, start, stop, tail  # noqa: E402
+
+try:
+    import RobotRaconteur as RR
+except ImportError as e:  # pragma: no cover
+    print("SKIP: official RobotRaconteur package missing: %s" % e)
+    sys.exit(77)
+
+import locks_logins as ll  # noqa: E402  (the same checks, through the gateway)
+
+RRN = ll.RRN
+GATEWAY_USER = ("gateway", "gateway-pw")  # the gateway's own (shared) session: JSON API, definitions
+
+
+def device_status(port, name):
+    for d in get_json(port, "/api/devices"):
+        if d["name"] == name:
+            return d
+    raise AssertionError("device %s not in /api/devices" % name)
+
+
+def expect_locks(port, name, expected, what, timeout=5.0):
+    """Waits until /api/devices shows exactly `expected` ([(path, user, kind)]) for `name`."""
+    deadline = time.monotonic() + timeout
+    got = None
+    while time.monotonic() < deadline:
+        got = sorted((l["path"], l["user"], l["kind"]) for l in device_status(port, name).get("locks", []))
+        if got == sorted(expected):
+            return
+        time.sleep(0.05)
+    raise AssertionError("%s: /api/devices locks %r, expected %r" % (what, got, sorted(expected)))
+
+
+def run_extra_checks(port, ck):
+    url = "rr+tcp://127.0.0.1:%d/?service=interop" % port
+    url_small = "rr+tcp://127.0.0.1:%d/?service=small" % port
+    url_shared = "rr+tcp://127.0.0.1:%d/?service=shared" % port
+
+    def json_shows_holders():
+        d = device_status(port, "interop")
+        ll.expect(d.get("auth") == "passthrough", "auth in /api/devices: %r" % d)
+        a = ll.connect(url, "alice")
+        b = ll.connect(url, "bob")
+        try:
+            ll.expect(device_status(port, "interop")["passthrough_sessions"] >= 2, "two passthrough sessions")
+            ll.expect(RRN.RequestObjectLock(a, RR.RobotRaconteurObjectLockFlags_USER_LOCK) == "OK", "alice locks")
+            expect_locks(port, "interop", [("interop", "alice", "user")], "alice's user lock")
+            ll.expect_raises(RR.ObjectLockedException, lambda: b.base_name, "bob reads the locked root", "alice")
+            ll.expect(RRN.ReleaseObjectLock(a) == "OK", "alice releases")
+            expect_locks(port, "interop", [], "after the release")
+            child = b.get_child()
+            ll.expect(RRN.RequestObjectLock(child, RR.RobotRaconteurObjectLockFlags_CLIENT_LOCK) == "OK", "bob locks the child")
+            expect_locks(port, "interop", [("interop.child", "bob", "client")], "bob's client lock on the child")
+            RRN.MonitorEnter(a, -1)
+            expect_locks(port, "interop", [("interop.child", "bob", "client"), ("interop", "alice", "monitor")],
+                         "alice's monitor beside bob's lock")
+            RRN.MonitorExit(a)
+            RRN.DisconnectService(b)
+            b = None
+            expect_locks(port, "interop", [], "bob's client lock went with his session")
+        finally:
+            for c in (a, b):
+                if c is not None:
+                    try:
+                        RRN.DisconnectService(c)
+                    except Exception:  # noqa: BLE001
+                        pass
+
+    ck.check("json: /api/devices shows lock and monitor holders through the gateway", json_shows_holders)
+
+    def callbacks_to_the_right_client():
+        a = ll.connect(url, "alice")
+        b = ll.connect(url, "bob")
+        calls = {"a": [], "b": []}
+        try:
+            a.cb_compute.Function = lambda x, label: (calls["a"].append(x), x * 2.0)[1]
+            b.cb_compute.Function = lambda x, label: (calls["b"].append(x), x * 3.0)[1]
+            a.cb_notify.Function = lambda info: None
+            b.cb_notify.Function = lambda info: None
+            errors = []
+
+            def loop(c, factor, base):
+                try:
+                    for i in range(15):
+                        x = float(base + i)
+                        r = c.call_callbacks(x)
+                        if r != x * factor + 1.0:
+                            errors.append("call_callbacks(%s) = %s, expected %s" % (x, r, x * factor + 1.0))
+                except Exception as e:  # noqa: BLE001
+                    errors.append("%s: %s" % (type(e).__name__, e))
+
+            ta = threading.Thread(target=loop, args=(a, 2.0, 100))
+            tb = threading.Thread(target=loop, args=(b, 3.0, 200))
+            ta.start()
+            tb.start()
+            ta.join(60)
+            tb.join(60)
+            ll.expect(not errors, "; ".join(errors[:5]))
+            ll.expect(sorted(calls["a"]) == [float(100 + i) for i in range(15)], "alice's callbacks: %r" % calls["a"])
+            ll.expect(sorted(calls["b"]) == [float(200 + i) for i in range(15)], "bob's callbacks: %r" % calls["b"])
+        finally:
+            for c in (a, b):
+                try:
+                    RRN.DisconnectService(c)
+                except Exception:  # noqa: BLE001
+                    pass
+
+    ck.check("callback: each client's callback reaches that client (concurrent calls)", callbacks_to_the_right_client)
+
+    def session_limit():
+        c1 = ll.connect(url_small, "alice")
+        c2 = ll.connect(url_small, "bob")
+        c3 = None
+        try:
+            e = ll.expect_raises(RR.RobotRaconteurException, lambda: ll.connect(url_small, "carol"), "a third client",
+                                 "passthrough session limit (2 upstream sessions) reached")
+            RRN.DisconnectService(c1)
+            c1 = None
+            c3 = ll.eventually(lambda: ll.connect(url_small, "carol"), "a third client after one left")
+            ll.expect(isinstance(c3.base_name, str), "the third client reads")
+            ll.expect(device_status(port, "small")["passthrough_sessions"] == 2, "two upstream sessions")
+            del e
+        finally:
+            for c in (c1, c2, c3):
+                if c is not None:
+                    try:
+                        RRN.DisconnectService(c)
+                    except Exception:  # noqa: BLE001
+                        pass
+
+    ck.check("limit: max_passthrough_sessions refuses a client with a clear error", session_limit)
+
+    def shared_refuses_locks():
+        c = RRN.ConnectService(url_shared)  # the shared mode: the gateway's own login
+        try:
+            ll.expect(isinstance(c.base_name, str), "reads on the shared session")
+            ll.expect_raises(RR.InvalidOperationException,
+                             lambda: RRN.RequestObjectLock(c, RR.RobotRaconteurObjectLockFlags_USER_LOCK),
+                             "object lock on a shared device", "auth: passthrough")
+            ll.expect_raises(RR.InvalidOperationException, lambda: RRN.MonitorEnter(c, 1000),
+                             "monitor on a shared device", "auth: passthrough")
+        finally:
+            RRN.DisconnectService(c)
+
+    ck.check("shared: object and monitor locks refused, naming auth: passthrough", shared_refuses_locks)
+
+    def no_login_refused_with_device_error():
+        ll.expect_raises(RR.AuthenticationException, lambda: RRN.ConnectService(url_small), "no login (small)",
+                         "Username not provided")
+
+    ck.check("login: the device's own error for a client without a login", no_login_refused_with_device_error)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--service", required=True)
+    ap.add_argument("--timeout", type=float, default=240)
+    args = ap.parse_args()
+
+    tmp = tempfile.mkdtemp(prefix="rr-passthrough-")
+    users = os.path.join(tmp, "users.txt")
+    with open(users, "w") as fh:
+        for user, (pw, priv) in list(ll.USERS.items()) + [(GATEWAY_USER[0], (GATEWAY_USER[1], "_"))]:
+            fh.write("%s %s %s\n" % (user, hashlib.md5(pw.encode()).hexdigest(), priv))
+    svc_err = os.path.join(tmp, "service.err")
+    gw_err = os.path.join(tmp, "gateway.err")
+    svc = gw = None
+    ck = ll.Checks()
+    timer = threading.Timer(args.timeout, lambda: os._exit(3))
+    timer.daemon = True
+    timer.start()
+    try:
+        svc = start([args.service, "--port", "0", "--max-lifetime", str(int(args.timeout) + 30), "--users", users], svc_err)
+        dev = read_json_line(svc, 30, "rr_interop_service")["url"]
+        config = os.path.join(tmp, "gateway.yaml")
+        with open(config, "w") as fh:
+            common = "    url: %s\n    username: %s\n    password: %s\n" % (json.dumps(dev), GATEWAY_USER[0], GATEWAY_USER[1])
+            fh.write("gateway:\n  listen: 127.0.0.1\n  port: 0\ndemo:\n  enabled: false\ndevices:\n")
+            fh.write("  - name: interop\n" + common + "    auth: passthrough\n")
+            fh.write("  - name: small\n" + common + "    auth: passthrough\n    max_passthrough_sessions: 2\n")
+            fh.write("  - name: shared\n" + common)
+        gw = start([args.gateway, "--config", config, "--no-local", "--log-level", "warning"], gw_err)
+        port = read_json_line(gw, 30, "rr-gateway")["port"]
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                if all(d["state"] == "connected" for d in get_json(port, "/api/devices")):
+                    break
+            except OSError:
+                pass
+            if time.monotonic() > deadline:
+                raise StepFailed("gateway devices not connected: %s" % tail(gw_err))
+            time.sleep(0.1)
+        ll.register_transport()
+        ll.run_checks("rr+tcp://127.0.0.1:%d/?service=interop" % port, ck)
+        run_extra_checks(port, ck)
+    except StepFailed as e:
+        print(json.dumps({"error": str(e), "service_stderr": tail(svc_err), "gateway_stderr": tail(gw_err)}))
+        return 2
+    finally:
+        gw_status = stop(gw)
+        svc_status = stop(svc)
+    failed = [r for r in ck.results if not r["ok"]]
+    print(json.dumps({"checks": len(ck.results), "failed": failed, "gateway_status": gw_status,
+                      "service_status": svc_status}, indent=1))
+    if failed:
+        print("--- gateway\n" + tail(gw_err) + "\n--- service\n" + tail(svc_err), file=sys.stderr)
+    return 1 if failed or gw_status not in (0, None) or svc_status not in (0, None) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
