@@ -78,10 +78,15 @@ async function gatewayReady(port, timeoutMs = 30000) {
   }
 }
 
-// rr-gateway with the service at `deviceUrl` as device "interop"; the rr+ws URL clients use.
+// rr-gateway with the service at `deviceUrl` as device "interop"; the rr+ws URL clients use. The device
+// is in `auth: passthrough` mode (docs/security.md): the client gets its own session to the device, so
+// the monitor lock check locks on the device itself (a shared device refuses locks).
 async function behindGateway(deviceUrl) {
-  const gw = start(arg("--gateway"), ["--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
-    "--device", `interop=${deviceUrl}`]);
+  const dir = mkdtempSync(join(tmpdir(), "rr-wasm-gw-"));
+  const config = join(dir, "gateway.yaml");
+  writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: passthrough\n`);
+  const gw = start(arg("--gateway"), ["--config", config, "--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0",
+    "--log-level", "warning"]);
   const { port } = await readyLine(gw, "port");
   await gatewayReady(port);
   return `rr+ws://127.0.0.1:${port}/?service=interop`;
