@@ -299,3 +299,32 @@ TEST_CASE("TLS flags: --tls-certificate, --tls-private-key, --tls-client-ca") {
     REQUIRE_FALSE(r);
     CHECK_THAT(r.error().message, Catch::Contains("gateway.tls.private_key"));
 }
+
+TEST_CASE("devices: auth (shared | passthrough) and max_passthrough_sessions") {
+    auto c = parse_gateway_config(R"(
+devices:
+  - name: arm
+    url: rr+tcp://arm.lab:48653/?service=robot
+    auth: passthrough
+    max_passthrough_sessions: 5
+  - name: cam
+    url: rr+tcp://cam.lab:48653/?service=cam
+)", "auth.yaml");
+    REQUIRE(c);
+    REQUIRE(c->devices.size() == 2);
+    CHECK(c->devices[0].auth == rr::server::gateway::DeviceAuth::passthrough);
+    CHECK(c->devices[0].max_passthrough_sessions == 5);
+    CHECK(c->devices[1].auth == rr::server::gateway::DeviceAuth::shared);
+    CHECK(c->devices[1].max_passthrough_sessions == 64);
+    for (auto [yaml, expect] : {
+             std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    auth: tokens\n",
+                       "bad.yaml:4: devices.a.auth: expected passthrough or shared, got \"tokens\""},
+             std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    max_passthrough_sessions: 0\n",
+                       "bad.yaml:4: devices.a.max_passthrough_sessions: must be at least 1"},
+         }) {
+        auto r = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(r);
+        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+    }
+}

@@ -525,7 +525,8 @@ void MirrorService::fan_out(MessageEntry&& entry) {
     InternalSubs internal;
     {
         std::lock_guard lock(mutex_);
-        sessions = sessions_;
+        // Passthrough clients get the device's events on their own upstream sessions.
+        if (!passthrough_) sessions = sessions_;
         auto it = event_subscribers_.find({entry.service_path, entry.member_name});
         if (it != event_subscribers_.end()) internal = it->second;
     }
@@ -540,11 +541,14 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
     SessionRef target;
     {
         std::lock_guard lock(mutex_);
-        for (const auto& s : sessions_)
-            if (s.endpoint() == last_caller_ && s.alive()) target = s;
-        if (!target.alive())
+        // Passthrough: no client calls the device on the gateway's own session, so nobody is called back.
+        if (!passthrough_) {
             for (const auto& s : sessions_)
-                if (s.alive()) target = s;
+                if (s.endpoint() == last_caller_ && s.alive()) target = s;
+            if (!target.alive())
+                for (const auto& s : sessions_)
+                    if (s.alive()) target = s;
+        }
     }
     const std::uint32_t request_id = entry.request_id;
     MessageEntry reply_header;

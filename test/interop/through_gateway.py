@@ -81,6 +81,8 @@ def main():
     ap.add_argument("--ws", action="store_true", help="connect the client with rr+ws (= --scheme ws)")
     ap.add_argument("--scheme", choices=["tcp", "ws", "local", "local-id"], default="tcp")
     ap.add_argument("--timeout", type=float, default=150)
+    ap.add_argument("--auth", choices=["shared", "passthrough"], default="shared",
+                    help="the devices' auth mode (docs/security.md); passthrough: a config file sets it")
     ap.add_argument("client", nargs=argparse.REMAINDER)
     a = ap.parse_args()
     client = a.client[1:] if a.client and a.client[0] == "--" else a.client
@@ -94,8 +96,18 @@ def main():
         device = subprocess.Popen(shlex.split(a.device_cmd.replace("{unique}", unique)), stdout=subprocess.PIPE, text=True)
         dev_info = read_json_line(device, keys[0], 60)
         flags = []
-        for name, key in zip(names, keys):
-            flags += ["--device", "%s=%s" % (name, dev_info[key])]
+        if a.auth == "passthrough":
+            import json
+            import tempfile
+            cfg = tempfile.NamedTemporaryFile("w", suffix=".yaml", prefix="rr-gw-", delete=False)
+            cfg.write("devices:\n")
+            for name, key in zip(names, keys):
+                cfg.write("  - name: %s\n    url: %s\n    auth: passthrough\n" % (name, json.dumps(dev_info[key])))
+            cfg.close()
+            flags += ["--config", cfg.name]
+        else:
+            for name, key in zip(names, keys):
+                flags += ["--device", "%s=%s" % (name, dev_info[key])]
         gateway_name = "rr.gateway.%s" % unique
         local = ["--robotraconteur-nodename", gateway_name] if scheme.startswith("local") else ["--no-local"]
         gateway = subprocess.Popen([a.gateway, "--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level",
