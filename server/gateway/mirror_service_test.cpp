@@ -37,12 +37,13 @@ struct Gateway {
     std::shared_ptr<DeviceMirror> mirror;
     std::uint16_t port = 0;
 
-    explicit Gateway(std::uint16_t device_port) {
+    explicit Gateway(std::uint16_t device_port, std::function<void(DeviceConfig&)> tweak = {}) {
         DeviceConfig cfg;
         cfg.name = "dev";
         cfg.url = "rr+tcp://127.0.0.1:" + std::to_string(device_port) + "/?service=svc";
         cfg.backoff_initial = 100ms;
         cfg.backoff_max = 400ms;
+        if (tweak) tweak(cfg);
         auto m = DeviceMirror::create(node, cfg);
         REQUIRE(m);
         mirror = *m;
@@ -63,12 +64,15 @@ struct Gateway {
         return false;
     }
 
-    std::shared_ptr<RawClient> connect(RawClient::IncomingHandler incoming = {}) {
+    Result<std::shared_ptr<RawClient>> try_connect(RawClient::IncomingHandler incoming = {}) {
         std::promise<Result<std::shared_ptr<RawClient>>> p;
         auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=dev");
         RawClient::connect(node->io_context().get_executor(), *url, {}, std::move(incoming), {},
                            [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
-        auto r = p.get_future().get();
+        return p.get_future().get();
+    }
+    std::shared_ptr<RawClient> connect(RawClient::IncomingHandler incoming = {}) {
+        auto r = try_connect(std::move(incoming));
         REQUIRE(r);
         return *r;
     }
@@ -229,4 +233,79 @@ TEST_CASE("a device that restarts: errors while it is gone, then everything work
     }
     CHECK(n == 1);
     CHECK(gw.mirror->counters().reconnects.load() == 1);
+}
+
+TEST_CASE("auth: passthrough: one upstream session per client, bounded, closed with the client") {
+    Device device;
+    Gateway gw(device.port, [](DeviceConfig& c) {
+        c.auth = DeviceAuth::passthrough;
+        c.max_passthrough_sessions = 2;
+    });
+    REQUIRE(gw.wait_state(DeviceState::connected));
+    const int shared_sessions = device.service->opened.load();  // the gateway's own session
+    auto a = gw.connect();
+    auto b = gw.connect();
+    CHECK(device.service->opened.load() == shared_sessions + 2);
+    CHECK(gw.mirror->status().upstream_sessions == 2);
+    CHECK(gw.mirror->status().auth == DeviceAuth::passthrough);
+
+    auto refused = gw.try_connect();
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().type == MessageErrorType::BufferLimitViolation);
+    CHECK_THAT(refused.error().message, Catch::Contains("passthrough session limit (2 upstream sessions) reached"));
+
+    // Each client's callbacks come back on its own session: b's callme calls b, not a.
+    std::atomic<int> a_called{0};
+    auto cb_answer = [](std::shared_ptr<RawClient>* self, std::atomic<int>* counter, double factor) {
+        return [self, counter, factor](MessageEntry&& e) {
+            if (e.entry_type != MessageEntryType::CallbackCallReq) return;
+            if (counter) counter->fetch_add(1);
+            double v = 0;
+            if (const auto* el = e.find("v")) read_scalar(*el, v);
+            MessageEntry r;
+            r.entry_type = MessageEntryType::CallbackCallRet;
+            r.service_path = e.service_path;
+            r.member_name = e.member_name;
+            r.request_id = e.request_id;
+            r.elements.push_back(make_scalar_element<double>("return", v * factor));
+            (*self)->send(std::move(r));
+        };
+    };
+    std::shared_ptr<RawClient> c;
+    a->close();
+    a.reset();
+    for (int i = 0; i < 100 && gw.mirror->status().upstream_sessions != 1; ++i) std::this_thread::sleep_for(20ms);
+    CHECK(gw.mirror->status().upstream_sessions == 1);
+    for (int i = 0; i < 100 && device.service->closed.load() < 1; ++i) std::this_thread::sleep_for(20ms);
+    CHECK(device.service->closed.load() == 1);  // a's upstream session went with a
+    auto r = gw.try_connect(cb_answer(&c, &a_called, 3.0));
+    REQUIRE(r);
+    c = *r;
+    auto fn = request(MessageEntryType::FunctionCallReq, "callme");
+    fn.elements.push_back(make_scalar_element<double>("v", 2.0));
+    auto ret = call(*c, std::move(fn));
+    REQUIRE(ret);
+    CHECK(ret->error == MessageErrorType::None);
+    CHECK(scalar(*ret, "return") == 6.0);  // this client's callback (v * 3)
+    CHECK(a_called.load() == 1);
+    c->close();
+    b->close();
+}
+
+TEST_CASE("auth: shared refuses object and monitor locks with an error naming passthrough") {
+    Device device;
+    Gateway gw(device.port);
+    REQUIRE(gw.wait_state(DeviceState::connected));
+    auto c = gw.connect();
+    for (const char* op : {"RequestObjectLock", "RequestClientObjectLock", "ReleaseObjectLock", "MonitorEnter",
+                           "MonitorContinueEnter", "MonitorExit"}) {
+        INFO(op);
+        auto r = call(*c, request(MessageEntryType::ClientSessionOpReq, op));
+        REQUIRE(r);
+        CHECK(r->error == MessageErrorType::InvalidOperation);
+        auto err = entry_error(*r);
+        REQUIRE(err);
+        CHECK_THAT(err->message, Catch::Contains("needs `auth: passthrough` on device \"dev\""));
+    }
+    CHECK(gw.mirror->status().locks.empty());
 }
