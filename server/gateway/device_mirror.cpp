@@ -63,7 +63,8 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
             if (auto self = weak.lock()) self->notify_state();
         };
         m->service_->set_passthrough(
-            std::make_shared<PassthroughSessions>(node->io_context().get_executor(), std::move(ps), &m->counters_));
+            std::make_shared<PassthroughSessions>(node->io_context().get_executor(), std::move(ps),
+                                                  std::shared_ptr<DeviceCounters>(m, &m->counters_)));
     }
     return m;
 }
@@ -79,6 +80,7 @@ void DeviceMirror::start() {
         std::lock_guard lock(mutex_);
         stopped_ = false;
     }
+    if (const auto& p = service_->passthrough()) p->reopen();
     connect();
 }
 

@@ -22,8 +22,9 @@ std::string reply_return(const MessageEntry& reply) {
 
 }  // namespace
 
-PassthroughSessions::PassthroughSessions(boost::asio::any_io_executor executor, Settings settings, DeviceCounters* counters)
-    : executor_(std::move(executor)), settings_(std::move(settings)), counters_(counters) {}
+PassthroughSessions::PassthroughSessions(boost::asio::any_io_executor executor, Settings settings,
+                                         std::weak_ptr<DeviceCounters> counters)
+    : executor_(std::move(executor)), settings_(std::move(settings)), counters_(std::move(counters)) {}
 
 PassthroughSessions::~PassthroughSessions() { close_all(); }
 
@@ -36,22 +37,25 @@ std::string PassthroughSessions::to_downstream(std::string_view path) const {
 
 void PassthroughSessions::admit(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
                                 std::function<void(Result<void>)> done) {
+    std::optional<RRError> refused;
     {
         std::lock_guard lock(mutex_);
         if (closed_) {
-            done(fail(MessageErrorType::ConnectionError, "device \"" + settings_.device_name + "\" is stopping"));
-            return;
+            refused = make_error(MessageErrorType::ConnectionError, "device \"" + settings_.device_name + "\" is stopping");
+        } else if (links_.size() >= settings_.max_sessions) {
+            refused = make_error(MessageErrorType::BufferLimitViolation,
+                                 "device \"" + settings_.device_name + "\": passthrough session limit (" +
+                                     std::to_string(settings_.max_sessions) + " upstream sessions) reached; try again later");
+        } else {
+            Link link;
+            link.username = username;
+            links_[endpoint] = std::move(link);
+            gone_.erase(endpoint);
         }
-        if (links_.size() >= settings_.max_sessions) {
-            done(fail(MessageErrorType::BufferLimitViolation,
-                      "device \"" + settings_.device_name + "\": passthrough session limit (" +
-                          std::to_string(settings_.max_sessions) + " upstream sessions) reached; try again later"));
-            return;
-        }
-        Link link;
-        link.username = username;
-        links_[endpoint] = std::move(link);
-        gone_.erase(endpoint);
+    }
+    if (refused) {
+        done(fail(*refused));
+        return;
     }
     RawClientOptions options = settings_.options;
     options.username = username;
@@ -156,6 +160,11 @@ void PassthroughSessions::close_all() {
     for (auto& c : clients) c->close();
 }
 
+void PassthroughSessions::reopen() {
+    std::lock_guard lock(mutex_);
+    closed_ = false;
+}
+
 std::size_t PassthroughSessions::session_count() const {
     std::lock_guard lock(mutex_);
     return links_.size();
@@ -200,16 +209,16 @@ void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&&
     const auto type = entry.entry_type;
     const std::string op = type == MessageEntryType::ClientSessionOpReq ? entry.member_name : std::string();
     const std::uint32_t endpoint = session.endpoint();
-    if (counters_) counters_->requests.fetch_add(1);
+    if (auto k = counters_.lock()) k->requests.fetch_add(1);
     const auto start = std::chrono::steady_clock::now();
     auto shared = std::make_shared<Responder>(std::move(responder));
     std::weak_ptr<PassthroughSessions> weak = weak_from_this();
     // MonitorEnter waits on the device up to its own 5 s "Continue" answer; the default timeout covers it.
     client->request(std::move(entry), [weak, shared, op, endpoint, downstream_path, start](Result<MessageEntry> r) {
         auto self = weak.lock();
-        if (self && self->counters_) {
-            self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
-            if (!r || r->error != MessageErrorType::None) self->counters_->request_errors.fetch_add(1);
+        if (auto k = self ? self->counters_.lock() : nullptr) {
+            k->observe_latency(std::chrono::steady_clock::now() - start);
+            if (!r || r->error != MessageErrorType::None) k->request_errors.fetch_add(1);
         }
         if (!r) {
             shared->fail(r.error());
@@ -272,10 +281,11 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
 
 void PassthroughSessions::deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry) {
     entry.service_path = to_downstream(entry.service_path);
+    const auto counters = counters_.lock();
     switch (entry.entry_type) {
         case MessageEntryType::CallbackCallReq: {
             // The device calls exactly this client: it is the only one on this upstream session.
-            if (counters_) counters_->callbacks.fetch_add(1);
+            if (counters) counters->callbacks.fetch_add(1);
             MessageEntry reply_header;
             reply_header.entry_type = MessageEntryType::CallbackCallRet;
             reply_header.service_path = to_upstream(entry.service_path);
@@ -297,16 +307,16 @@ void PassthroughSessions::deliver(const SessionRef& session, const std::shared_p
             return;
         }
         case MessageEntryType::WirePacket:
-            if (counters_) counters_->wire_packets_out.fetch_add(1);
+            if (counters) counters->wire_packets_out.fetch_add(1);
             (void)session.send_wire_packet(std::move(entry));
             return;
         case MessageEntryType::EventReq:
-            if (counters_) counters_->events.fetch_add(1);
+            if (counters) counters->events.fetch_add(1);
             (void)session.send(std::move(entry));
             return;
         case MessageEntryType::PipePacket:
-            if (counters_) counters_->pipe_packets.fetch_add(1);
-            if (!session.send(std::move(entry)) && counters_) counters_->pipe_drops.fetch_add(1);
+            if (counters) counters->pipe_packets.fetch_add(1);
+            if (!session.send(std::move(entry)) && counters) counters->pipe_drops.fetch_add(1);
             return;
         default: (void)session.send(std::move(entry)); return;
     }

@@ -60,8 +60,8 @@ public:
         std::function<void()> on_change;
     };
 
-    /// `counters` (may be null) must outlive this object.
-    PassthroughSessions(boost::asio::any_io_executor executor, Settings settings, DeviceCounters* counters);
+    /// `counters`: the device's (may be empty; not kept alive by this object).
+    PassthroughSessions(boost::asio::any_io_executor executor, Settings settings, std::weak_ptr<DeviceCounters> counters);
     ~PassthroughSessions();
 
     /// Opens the client's upstream session (Service::admit_session). Errors to `done`: the device's
@@ -74,8 +74,9 @@ public:
     /// The client went (or never took its admission): closes its upstream session (DisconnectClient;
     /// the device drops its client locks and monitors) and forgets its locks.
     void close(std::uint32_t endpoint);
-    /// Closes every upstream session (the device mirror stops).
+    /// Closes every upstream session (the device mirror stops); admissions are refused until reopen().
     void close_all();
+    void reopen();
 
     /// A request or packet from a client (Service::handle_entry).
     void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder);
@@ -106,7 +107,7 @@ private:
 
     boost::asio::any_io_executor executor_;
     const Settings settings_;
-    DeviceCounters* counters_;
+    std::weak_ptr<DeviceCounters> counters_;
 
     mutable std::mutex mutex_;
     std::map<std::uint32_t, Link> links_;       // admitted (or being admitted: client null)
