@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "test/fuzz/gateway_harness.hpp"
 
@@ -31,6 +32,27 @@ namespace {
 
 using rr::fuzz::fail_input;
 using Clock = std::chrono::steady_clock;
+
+/// True when `input`, %-decoded and lower-cased, contains "canary" (so an echo of it may hold kCanary).
+bool spells_canary(std::string_view input) {
+    std::string plain;
+    plain.reserve(input.size());
+    auto hex = [](char c) -> int {
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+        return -1;
+    };
+    for (std::size_t i = 0; i < input.size(); ++i) {
+        char c = input[i];
+        if (c == '%' && i + 2 < input.size() && hex(input[i + 1]) >= 0 && hex(input[i + 2]) >= 0) {
+            c = static_cast<char>(hex(input[i + 1]) * 16 + hex(input[i + 2]));
+            i += 2;
+        }
+        plain.push_back((c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c);
+    }
+    return plain.find("canary") != std::string::npos;
+}
 
 class Fd {
 public:
@@ -93,7 +115,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             else if (n < 0 && errno != EAGAIN && errno != EINTR) write_closed = true;  // the gateway closed first
         }
     }
-    if (received.find(rr::fuzz::kCanary) != std::string::npos)
+    // The gateway echoes parts of a request in its error answers, and libFuzzer learns the canary from
+    // the comparison below: only an input that does not spell it (as text or %-encoded) proves a leak.
+    if (received.find(rr::fuzz::kCanary) != std::string::npos && !spells_canary({reinterpret_cast<const char*>(data), size}))
         fail_input("the gateway served a file from outside its web root");
     return 0;
 }
