@@ -21,7 +21,7 @@ wants() { local p; for p in "${parts[@]}"; do [ "$p" = "$1" ] && return 0; done;
 # also brings node; node-acorn is what Debian's emscripten 3.1.6 needs; npm for web/'s packages).
 RUN_PACKAGES=(
   cmake ninja-build g++ pkg-config ccache
-  libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev libyaml-cpp-dev
+  libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev libyaml-cpp-dev libjwt-dev
   emscripten node-acorn
 )
 PYTHON_PACKAGES=(python3-venv)

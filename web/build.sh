@@ -17,7 +17,7 @@ fi
 tmp=$(mktemp -d "${out%/}.tmp.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$tmp/vendor/rr" "$tmp/vendor/uplot"
-cp index.html style.css "$tmp/"
+cp index.html login.html style.css "$tmp/"
 cp -R src "$tmp/src"
 cp -R "$rr"/. "$tmp/vendor/rr/"
 cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css node_modules/uplot/LICENSE "$tmp/vendor/uplot/"

@@ -45,6 +45,19 @@ public:
     virtual Result<void> authenticate(const std::string& username, const MessageElement* credentials) {
         return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
     }
+    /// authenticate() with the client's address as the transport reported it (ServiceSessionConfig::
+    /// peer; "" when unknown), for services that rate-limit failed logins per address (the gateway).
+    virtual Result<void> authenticate_from(const std::string& username, const MessageElement* credentials,
+                                           std::string_view peer) {
+        return authenticate(username, credentials);
+    }
+    /// A login the transport carried (ServiceSessionConfig::web_login: the Cookie header of an rr+ws
+    /// upgrade from a browser that logged in to the gateway's web page): the user name the session
+    /// gets, or AuthenticationError. Asked only when the client sends no username and credentials
+    /// itself and requires_authentication() is true.
+    virtual Result<std::string> authenticate_web(std::string_view web_login) {
+        return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
+    }
     /// Whether the service implements object and monitor locks itself: then every lock session
     /// operation (RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, ReleaseClientObjectLock,
     /// MonitorEnter, MonitorContinueEnter, MonitorExit) reaches it as a ServiceRequest. Otherwise the

@@ -376,7 +376,16 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
     }
     std::string username;
     bool authenticated = false;
-    if (combined) {
+    // A browser that logged in to the web page: its session cookie came with the rr+ws upgrade.
+    bool web = false;
+    if (!config_.web_login.empty() && service->requires_authentication() && !e.find("username") && !e.find("credentials")) {
+        if (auto name = service->authenticate_web(config_.web_login)) {
+            username = std::move(*name);
+            authenticated = true;
+            web = true;
+        }
+    }
+    if (combined && !web) {
         const MessageElement* user = e.find("username");
         const MessageElement* creds = e.find("credentials");
         // CORE RobotRaconteurNode (ConnectClientCombined): the same errors and messages.
@@ -394,7 +403,7 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
         }
         if (service->requires_authentication()) {
             username = std::string(read_string(*user));
-            if (auto ok = service->authenticate(username, creds); !ok) {
+            if (auto ok = service->authenticate_from(username, creds, config_.peer); !ok) {
                 reply_special(h, error_reply(e, ok.error()), now);
                 return;
             }
@@ -511,7 +520,7 @@ void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
             return;
         }
         std::string name(read_string(*user));
-        if (auto ok = service_->authenticate(name, creds); !ok) {
+        if (auto ok = service_->authenticate_from(name, creds, config_.peer); !ok) {
             reply(error_reply(e, ok.error()), now);
             return;
         }

@@ -39,6 +39,12 @@ struct ServiceSessionConfig {
     std::chrono::milliseconds callback_timeout{15000};
     /// Wire packets are held back (newest per member kept) while more output than this waits.
     std::size_t wire_hold_bytes = 256u * 1024u;
+    /// The client's address as the transport reported it ("ip:port", "local", …; "" = unknown): passed
+    /// to HostedService::authenticate_from.
+    std::string peer;
+    /// A login the transport carried (the Cookie header of an rr+ws upgrade; "" = none): see
+    /// HostedService::authenticate_web.
+    std::string web_login;
 };
 
 /// The client session exists: `service` is the one the client connected to.

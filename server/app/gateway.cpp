@@ -129,9 +129,17 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         }
     }
 
+    // gateway.auth: the gateway's own users and permissions (auth: gateway), before any device exists.
+    auto auth = load_gateway_auth(c.auth);
+    if (!auth) return auth.take_error();
+    g->auth_ = *auth;
+
     for (const auto& d : devices) {
         auto m = gateway::DeviceMirror::create(g->node_, d);
         if (!m) return m.take_error();
+        // auth: passthrough devices check their own logins; the gateway's users apply to shared ones.
+        if (g->auth_ && d.auth != gateway::DeviceAuth::passthrough)
+            (*m)->mirror_service()->set_access(gateway::auth::MirrorAccess(g->auth_, d.name));
         g->devices_.push_back(*m);
     }
 
@@ -181,7 +189,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         respond(http::make_response(req, bhttp::status::ok, self->metrics_text(), "text/plain; version=0.0.4; charset=utf-8"));
     });
     std::shared_ptr<gateway::JsonApi> json_api;
-    if (api) json_api = api(*g->http_, g->devices_);
+    if (api) json_api = api(*g->http_, g->devices_, g->auth_);
 
     // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the
     // services that `discover:` filters select into devices.
@@ -215,6 +223,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         g->discovered_ = DiscoveredDevices::create(g->node_, g->discovery_, c.discover,
                                                    [self](const std::string& name) { return self->device(name) != nullptr; });
         g->discovered_->set_api(json_api);
+        g->discovered_->set_auth(g->auth_);
         if (json_api) {
             std::weak_ptr<DiscoveredDevices> weak = g->discovered_;
             gateway::JsonApi::DiscoveryHooks hooks;
@@ -379,6 +388,27 @@ std::string Gateway::metrics_text() const {
       << "# HELP rr_gateway_tls_failures_total TLS connections that failed before serving (handshake, certificate, timeout).\n"
          "# TYPE rr_gateway_tls_failures_total counter\n"
       << "rr_gateway_tls_failures_total " << tls_failures_->load() << "\n";
+    if (auth_) {
+        const auto& a = auth_->counters();
+        o << "# HELP rr_gateway_login_failures_total Failed logins to the gateway (wrong password, unknown user or token, bad JWT), by channel.\n"
+             "# TYPE rr_gateway_login_failures_total counter\n"
+          << "rr_gateway_login_failures_total{channel=\"rr\"} " << a.failed_rr.load() << "\n"
+          << "rr_gateway_login_failures_total{channel=\"http\"} " << a.failed_http.load() << "\n"
+          << "rr_gateway_login_failures_total{channel=\"token\"} " << a.failed_token.load() << "\n"
+          << "rr_gateway_login_failures_total{channel=\"websocket\"} " << a.failed_websocket.load() << "\n"
+          << "# HELP rr_gateway_login_rate_limited_total Login attempts refused because their address was locked out after failures.\n"
+             "# TYPE rr_gateway_login_rate_limited_total counter\n"
+          << "rr_gateway_login_rate_limited_total " << a.rate_limited.load() << "\n"
+          << "# HELP rr_gateway_login_lockouts_total Client addresses locked out after too many failed logins.\n"
+             "# TYPE rr_gateway_login_lockouts_total counter\n"
+          << "rr_gateway_login_lockouts_total " << a.lockouts.load() << "\n"
+          << "# HELP rr_gateway_logins_total Successful logins to the gateway.\n"
+             "# TYPE rr_gateway_logins_total counter\n"
+          << "rr_gateway_logins_total " << a.succeeded.load() << "\n"
+          << "# HELP rr_gateway_permission_denied_total Member requests refused by the gateway's permissions.\n"
+             "# TYPE rr_gateway_permission_denied_total counter\n"
+          << "rr_gateway_permission_denied_total " << a.denied.load() << "\n";
+    }
 
     o << "# HELP rr_gateway_device_up Device state: 1 when connected.\n# TYPE rr_gateway_device_up gauge\n";
     for (const auto& d : all) {

@@ -26,7 +26,8 @@ using DemoStarter = std::function<Result<std::vector<gateway::DeviceConfig>>(con
 /// installed (or nullptr), so that discovered devices and the discovery routes reach it
 /// (gateway::install_json_api is one).
 using ApiInstaller = std::function<std::shared_ptr<gateway::JsonApi>(
-    http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices)>;
+    http::HttpServer& http, const std::vector<std::shared_ptr<gateway::DeviceMirror>>& devices,
+    std::shared_ptr<gateway::auth::GatewayAuth> auth)>;
 
 class DiscoveredDevices;
 }  // namespace rr::server::app
@@ -70,6 +71,8 @@ public:
     bool ready() const;
     /// TLS in use (gateway.tls), or nullptr.
     const std::shared_ptr<TlsServerCredentials>& tls() const noexcept { return tls_; }
+    /// The gateway's users and permissions (gateway.auth), or nullptr when logins are off.
+    const std::shared_ptr<gateway::auth::GatewayAuth>& auth() const noexcept { return auth_; }
     /// Reads the certificate files again (SIGHUP): new connections get the new certificate, open ones
     /// keep theirs. Errors (the old certificate stays): InvalidState without TLS, else as at start.
     Result<void> reload_tls();
@@ -84,6 +87,7 @@ private:
     std::shared_ptr<http::HttpServer> http_;
     std::vector<std::shared_ptr<gateway::DeviceMirror>> devices_;
     std::shared_ptr<TlsServerCredentials> tls_;
+    std::shared_ptr<gateway::auth::GatewayAuth> auth_;  // gateway.auth; null = logins off
     std::shared_ptr<std::atomic<std::uint64_t>> tls_failures_ = std::make_shared<std::atomic<std::uint64_t>>(0);
     std::uint16_t port_ = 0;
     std::shared_ptr<discovery::NodeDiscovery> discovery_;

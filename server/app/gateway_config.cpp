@@ -315,6 +315,79 @@ void parse_usb(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
     }
 }
 
+std::vector<std::string> patterns(const YAML::Node& n, const Reader& r, const std::string& key) {
+    std::vector<std::string> out = n.IsSequence() ? r.string_list(n, key) : std::vector<std::string>{r.string(n, key)};
+    if (out.empty()) r.error(n, key, "empty list (use \"*\" for all)");
+    for (const auto& p : out)
+        if (p.empty()) r.error(n, key, "empty pattern");
+    return out;
+}
+
+void parse_auth(const YAML::Node& a, const Reader& r, GatewayAuthConfig& c) {
+    r.check_keys(a, "gateway.auth", {"users", "tokens", "jwt", "roles", "login_limit", "session_ttl_s"});
+    if (auto n = a["users"]) c.users = r.string(n, "gateway.auth.users");
+    if (auto n = a["tokens"]) c.tokens = r.string(n, "gateway.auth.tokens");
+    if (auto j = a["jwt"]) {
+        r.check_keys(j, "gateway.auth.jwt", {"algorithm", "key", "audience", "issuer", "user_claim", "roles_claim", "leeway_s"});
+        if (auto n = j["algorithm"]) c.jwt.algorithm = r.string(n, "gateway.auth.jwt.algorithm");
+        if (auto n = j["key"]) c.jwt.key = r.string(n, "gateway.auth.jwt.key");
+        if (auto n = j["audience"]) c.jwt.audience = r.string(n, "gateway.auth.jwt.audience");
+        if (auto n = j["issuer"]) c.jwt.issuer = r.string(n, "gateway.auth.jwt.issuer");
+        if (auto n = j["user_claim"]) c.jwt.user_claim = r.string(n, "gateway.auth.jwt.user_claim");
+        if (auto n = j["roles_claim"]) c.jwt.roles_claim = r.string(n, "gateway.auth.jwt.roles_claim");
+        if (auto n = j["leeway_s"]) c.jwt.leeway_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.auth.jwt.leeway_s", 3600));
+        if (c.jwt.algorithm != "HS256" && c.jwt.algorithm != "RS256" && c.jwt.algorithm != "ES256")
+            r.error(j["algorithm"] ? j["algorithm"] : j, "gateway.auth.jwt.algorithm",
+                    c.jwt.algorithm.empty() ? "missing (HS256, RS256 or ES256)" : "\"" + c.jwt.algorithm + "\" is not HS256, RS256 or ES256");
+        if (c.jwt.key.empty()) r.error(j, "gateway.auth.jwt.key", "missing (a file: the HS256 secret, or the issuer's public key as PEM)");
+        if (c.jwt.audience.empty()) r.error(j, "gateway.auth.jwt.audience", "missing (the `aud` every token must carry)");
+    }
+    if (auto roles = a["roles"]) {
+        if (!roles.IsMap()) r.error(roles, "gateway.auth.roles", "expected a mapping of role names to lists of rules");
+        for (const auto& kv : roles) {
+            const std::string name = kv.first.as<std::string>();
+            const std::string key = "gateway.auth.roles." + name;
+            if (name.empty() || name == "_" || name.find_first_of(", \t") != std::string::npos)
+                r.error(kv.first, key, "a role name has no spaces or commas (it is listed in the password file's privileges column)");
+            if (!kv.second.IsSequence()) r.error(kv.second, key, "expected a list of rules {devices, members, allow}");
+            std::vector<GatewayAuthConfig::Rule> rules;
+            std::size_t i = 0;
+            for (const auto& e : kv.second) {
+                const std::string rk = key + "[" + std::to_string(i++) + "]";
+                r.check_keys(e, rk, {"devices", "members", "allow"});
+                GatewayAuthConfig::Rule rule;
+                if (auto n = e["devices"]) rule.devices = patterns(n, r, rk + ".devices");
+                if (auto n = e["members"]) rule.members = patterns(n, r, rk + ".members");
+                auto allow = e["allow"];
+                if (!allow) r.error(e, rk + ".allow", "missing (a list of read, write, call)");
+                for (const auto& op : r.string_list(allow, rk + ".allow")) {
+                    if (op == "read") rule.read = true;
+                    else if (op == "write") rule.write = true;
+                    else if (op == "call") rule.call = true;
+                    else r.error(allow, rk + ".allow", "\"" + op + "\" is not read, write or call");
+                }
+                rules.push_back(std::move(rule));
+            }
+            c.roles.emplace_back(name, std::move(rules));
+        }
+    }
+    if (auto l = a["login_limit"]) {
+        r.check_keys(l, "gateway.auth.login_limit", {"max_failures", "window_s", "lockout_s"});
+        if (auto n = l["max_failures"]) {
+            c.max_failures = static_cast<unsigned>(r.unsigned_int(n, "gateway.auth.login_limit.max_failures", 1000));
+            if (c.max_failures == 0) r.error(n, "gateway.auth.login_limit.max_failures", "must be at least 1");
+        }
+        if (auto n = l["window_s"]) c.window_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.auth.login_limit.window_s", 86400));
+        if (auto n = l["lockout_s"]) c.lockout_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.auth.login_limit.lockout_s", 86400));
+    }
+    if (auto n = a["session_ttl_s"]) {
+        c.session_ttl_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.auth.session_ttl_s", 30u * 86400u));
+        if (c.session_ttl_s < 60) r.error(n, "gateway.auth.session_ttl_s", "must be at least 60");
+    }
+    if (!c.enabled() && !c.roles.empty())
+        r.error(a, "gateway.auth", "roles but no users, tokens or jwt: nobody could log in");
+}
+
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
@@ -322,7 +395,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "max_message_size", "log_level", "log_format", "local", "tls"});
+                      "max_message_size", "log_level", "log_format", "local", "tls", "auth"});
+        if (auto a = g["auth"]) parse_auth(a, r, c.auth);
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
         if (auto n = g["node_name"]) {

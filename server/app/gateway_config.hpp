@@ -66,6 +66,29 @@ struct GatewayTlsConfig {
     bool enabled() const noexcept { return !certificate.empty(); }
 };
 
+/// gateway.auth (docs/security.md "Gateway users and permissions"): the gateway's own logins and the
+/// role → rule policy. Files are read by load_gateway_auth (gateway_auth_config.hpp).
+struct GatewayAuthConfig {
+    std::string users;   ///< official password file; its privileges column holds each user's roles
+    std::string tokens;  ///< opaque bearer tokens: `<token> <name> <roles>` per line
+    struct Jwt {
+        std::string algorithm;  ///< HS256, RS256, ES256; "" = no JWT
+        std::string key;        ///< file: the HS256 secret, or the RS256/ES256 public key (PEM)
+        std::string audience, issuer;
+        std::string user_claim = "sub", roles_claim = "roles";
+        unsigned leeway_s = 30;
+    } jwt;
+    struct Rule {
+        std::vector<std::string> devices{"*"}, members{"*"};
+        bool read = false, write = false, call = false;
+    };
+    std::vector<std::pair<std::string, std::vector<Rule>>> roles;
+    unsigned max_failures = 5, window_s = 60, lockout_s = 300;
+    unsigned session_ttl_s = 8 * 3600;
+    /// Logins and permission checks are on.
+    bool enabled() const noexcept { return !users.empty() || !tokens.empty() || !jwt.algorithm.empty(); }
+};
+
 struct GatewayConfig {
     // gateway:
     std::string listen = "0.0.0.0";
@@ -88,6 +111,8 @@ struct GatewayConfig {
     bool local = true;
     /// HTTPS, WSS, RR over TLS and rrs+tcp on the same port.
     GatewayTlsConfig tls;
+    /// Logins and per-member permissions (auth: gateway).
+    GatewayAuthConfig auth;
     // demo:
     bool demo = true;
     std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include "server/app/gateway_auth_config.hpp"
 #include "server/app/gateway_config.hpp"
 
 using namespace rr;
@@ -203,13 +204,13 @@ TEST_CASE("bad flags are refused with the flag's name") {
 
 TEST_CASE("every example in gateway-config/ is a valid configuration") {
     int n = 0;
-    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml", "tls.yaml"}) {
+    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml", "tls.yaml", "auth.yaml"}) {
         auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/" + name);
         INFO(name);
         REQUIRE(c);
         ++n;
     }
-    CHECK(n == 5);
+    CHECK(n == 6);
     auto missing = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/nope.yaml");
     REQUIRE_FALSE(missing);
     CHECK_THAT(missing.error().message, Catch::Contains("cannot read"));
@@ -327,4 +328,112 @@ devices:
         REQUIRE_FALSE(r);
         CHECK_THAT(r.error().message, Catch::StartsWith(expect));
     }
+}
+
+TEST_CASE("gateway.auth parses users, tokens, jwt, roles and limits; bad keys are clear errors") {
+    auto c = parse_gateway_config(R"(
+gateway:
+  auth:
+    users: /etc/rr-gateway/users.txt
+    tokens: /etc/rr-gateway/tokens.txt
+    jwt:
+      algorithm: RS256
+      key: /etc/rr-gateway/idp.pem
+      audience: rr-gateway
+      issuer: https://idp
+    roles:
+      viewer:
+        - allow: [read]
+      driver:
+        - devices: create
+          members: [Drive, "Webcams[*].*"]
+          allow: [call, write]
+    login_limit: {max_failures: 3, window_s: 10, lockout_s: 20}
+    session_ttl_s: 600
+)", "auth.yaml");
+    REQUIRE(c);
+    const auto& a = c->auth;
+    CHECK(a.enabled());
+    CHECK(a.users == "/etc/rr-gateway/users.txt");
+    CHECK(a.tokens == "/etc/rr-gateway/tokens.txt");
+    CHECK(a.jwt.algorithm == "RS256");
+    CHECK(a.jwt.issuer == "https://idp");
+    CHECK(a.jwt.user_claim == "sub");
+    REQUIRE(a.roles.size() == 2);
+    CHECK(a.roles[0].first == "viewer");
+    CHECK(a.roles[0].second[0].devices == std::vector<std::string>{"*"});
+    CHECK(a.roles[0].second[0].read);
+    CHECK_FALSE(a.roles[0].second[0].write);
+    CHECK(a.roles[1].second[0].devices == std::vector<std::string>{"create"});
+    CHECK(a.roles[1].second[0].members == std::vector<std::string>{"Drive", "Webcams[*].*"});
+    CHECK(a.roles[1].second[0].call);
+    CHECK(a.roles[1].second[0].write);
+    CHECK(a.max_failures == 3);
+    CHECK(a.lockout_s == 20);
+    CHECK(a.session_ttl_s == 600);
+    CHECK_FALSE(parse_gateway_config("gateway:\n  port: 1\n", "x.yaml")->auth.enabled());
+
+    for (auto [yaml, expect] : {
+             std::pair{"gateway:\n  auth:\n    user: u.txt\n", "bad.yaml:3: gateway.auth.user: unknown key"},
+             std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - allow: [read, delete]\n",
+                       "bad.yaml:6: gateway.auth.roles.r[0].allow: \"delete\" is not read, write or call"},
+             std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - devices: [a]\n",
+                       "bad.yaml:6: gateway.auth.roles.r[0].allow: missing"},
+             std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - alow: [read]\n",
+                       "bad.yaml:6: gateway.auth.roles.r[0].alow: unknown key"},
+             std::pair{"gateway:\n  auth:\n    roles:\n      r:\n        - allow: [read]\n",
+                       "bad.yaml:3: gateway.auth: roles but no users, tokens or jwt"},
+             std::pair{"gateway:\n  auth:\n    jwt:\n      algorithm: none\n      key: k\n      audience: a\n",
+                       "bad.yaml:4: gateway.auth.jwt.algorithm: \"none\" is not HS256, RS256 or ES256"},
+             std::pair{"gateway:\n  auth:\n    jwt:\n      algorithm: HS256\n      key: k\n",
+                       "bad.yaml:4: gateway.auth.jwt.audience: missing"},
+             std::pair{"gateway:\n  auth:\n    users: u\n    login_limit: {max_failures: 0}\n",
+                       "bad.yaml:4: gateway.auth.login_limit.max_failures: must be at least 1"},
+             std::pair{"gateway:\n  auth:\n    users: u\n    roles:\n      \"a,b\": []\n",
+                       "bad.yaml:5: gateway.auth.roles.a,b: a role name has no spaces or commas"},
+         }) {
+        auto r = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(r);
+        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+    }
+}
+
+TEST_CASE("gateway.auth files: the example loads; a bad file is a configuration error naming it") {
+    auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/auth.yaml");
+    REQUIRE(c);
+    auto abs = [](std::string& p) { p = std::string(RR_SOURCE_DIR) + "/" + p; };
+    abs(c->auth.users);
+    abs(c->auth.tokens);
+    abs(c->auth.jwt.key);
+    auto a = load_gateway_auth(c->auth);
+    REQUIRE(a);
+    REQUIRE(*a);
+    CHECK((*a)->enabled());
+    CHECK((*a)->settings().users.users().size() == 3);
+    CHECK((*a)->policy().role_names() == std::vector<std::string>{"dashboard", "operator", "viewer"});
+    auto wall = (*a)->principal_for_user("wall");
+    REQUIRE(wall);
+    using rr::server::gateway::auth::Operation;
+    CHECK(wall->allows("webcam", "Webcams[0].CaptureFrame", Operation::call));
+    CHECK_FALSE(wall->allows("create", "Drive", Operation::call));
+    CHECK(wall->allows("create", "Bumpers", Operation::read));
+    CHECK_FALSE(wall->allows("create", "Bumpers", Operation::write));
+
+    GatewayAuthConfig none;
+    auto off = load_gateway_auth(none);
+    REQUIRE(off);
+    CHECK(*off == nullptr);
+
+    GatewayAuthConfig bad = c->auth;
+    bad.users = "/nonexistent/users.txt";
+    auto r = load_gateway_auth(bad);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == rr::MessageErrorType::InvalidConfiguration);
+    CHECK_THAT(r.error().message, Catch::StartsWith("gateway.auth.users: ") && Catch::Contains("/nonexistent/users.txt"));
+    bad = c->auth;
+    bad.jwt.key = c->auth.users;  // not a PEM key
+    r = load_gateway_auth(bad);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::StartsWith("gateway.auth.jwt: ") && Catch::Contains("PEM"));
 }

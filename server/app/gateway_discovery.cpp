@@ -47,6 +47,11 @@ void DiscoveredDevices::set_api(std::shared_ptr<gateway::JsonApi> api) {
     api_ = std::move(api);
 }
 
+void DiscoveredDevices::set_auth(std::shared_ptr<gateway::auth::GatewayAuth> auth) {
+    std::lock_guard lock(mutex_);
+    auth_ = std::move(auth);
+}
+
 void DiscoveredDevices::start() {
     std::weak_ptr<DiscoveredDevices> weak = weak_from_this();
     listener_ = discovery_->add_listener([weak](const discovery::DiscoveryEvent& e) {
@@ -194,6 +199,7 @@ Result<std::shared_ptr<gateway::DeviceMirror>> DiscoveredDevices::create_device(
     }
     auto mirror = gateway::DeviceMirror::create(gw, cfg);
     if (!mirror) return mirror.take_error();
+    if (auth_) (*mirror)->mirror_service()->set_access(gateway::auth::MirrorAccess(auth_, cfg.name));
     if (api_) {
         if (auto r = api_->add_device(*mirror); !r) return r.take_error();
     }

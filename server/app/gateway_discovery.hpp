@@ -38,6 +38,8 @@ public:
                                                      std::vector<DiscoverRule> rules,
                                                      std::function<bool(const std::string&)> taken);
     void set_api(std::shared_ptr<gateway::JsonApi> api);
+    /// The gateway's users and permissions: discovered devices check them like configured ones.
+    void set_auth(std::shared_ptr<gateway::auth::GatewayAuth> auth);
     /// Subscribes to discovery events (and asks for ServiceInfo2 when there are rules).
     void start();
     /// Stops and removes every discovered device.
@@ -76,6 +78,7 @@ private:
     std::vector<DiscoverRule> rules_;
     std::function<bool(const std::string&)> taken_;
     std::shared_ptr<gateway::JsonApi> api_;
+    std::shared_ptr<gateway::auth::GatewayAuth> auth_;
     std::uint64_t listener_ = 0;
     mutable std::recursive_mutex mutex_;
     std::map<std::pair<NodeID, std::string>, Entry> entries_;

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "server/app/gateway.hpp"
+#include "server/app/gateway_auth_config.hpp"
 #include "server/app/log.hpp"
 #include "server/app/web_root.hpp"
 #include "server/demo/demo_devices.hpp"
@@ -54,8 +55,19 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
+        auto auth = load_gateway_auth(config.auth);  // the password, token and key files, as the start reads them
+        if (!auth) {
+            std::cerr << "rr-gateway: configuration error: " << auth.error().message << "\n";
+            return 2;
+        }
         std::cout << "configuration ok: " << config.devices.size() << " device(s)" << (config.demo ? " + demo devices" : "")
-                  << ", port " << config.port << (config.tls.enabled() ? " (TLS)" : "") << "\n";
+                  << ", port " << config.port << (config.tls.enabled() ? " (TLS)" : "");
+        if (*auth)
+            std::cout << ", logins: " << (*auth)->settings().users.users().size() << " user(s)"
+                      << ((*auth)->settings().tokens ? ", " + std::to_string((*auth)->settings().tokens->size()) + " token(s)" : "")
+                      << ((*auth)->settings().jwt ? ", JWT " + (*auth)->settings().jwt->settings().algorithm : "") << ", "
+                      << (*auth)->policy().role_names().size() << " role(s)";
+        std::cout << "\n";
         return 0;
     }
     set_log_level(log_level_from_string(config.log_level));

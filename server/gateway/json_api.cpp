@@ -378,7 +378,20 @@ ApiError missing_element(std::string_view name, std::string_view reply) {
 
 }  // namespace
 
+std::optional<ApiError> JsonApi::check_access(const MemberAddress& a, auth::Operation op) const {
+    if (!auth_ || !auth_->enabled()) return std::nullopt;
+    if (!a.principal)
+        return api_error(401, MessageErrorType::AuthenticationError, "login required");
+    auto object = normalize_object_path(a.object);
+    const std::string key = auth::member_key(object ? std::string_view(*object) : std::string_view(a.object), a.member);
+    if (a.principal->allows(a.device, key, op)) return std::nullopt;
+    auth_->counters().denied.fetch_add(1);
+    return api_error(403, MessageErrorType::PermissionDenied,
+                     "user " + a.principal->name + " may not " + std::string(auth::operation_name(op)) + " " + key + " of " + a.device);
+}
+
 void JsonApi::get_property(const MemberAddress& address, Done done) {
+    if (auto denied = check_access(address, auth::Operation::read)) return done(ApiResult::failed(std::move(*denied)));
     auto self = shared_from_this();
     resolve(address, [self, done = std::move(done)](Resolved r) {
         if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
@@ -398,6 +411,7 @@ void JsonApi::get_property(const MemberAddress& address, Done done) {
 }
 
 void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& value, Done done) {
+    if (auto denied = check_access(address, auth::Operation::write)) return done(ApiResult::failed(std::move(*denied)));
     auto self = shared_from_this();
     resolve(address, [self, value, done = std::move(done)](Resolved r) {
         if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
@@ -416,6 +430,7 @@ void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& v
 }
 
 void JsonApi::peek_wire(const MemberAddress& address, Done done) {
+    if (auto denied = check_access(address, auth::Operation::read)) return done(ApiResult::failed(std::move(*denied)));
     auto self = shared_from_this();
     resolve(address, [self, done = std::move(done)](Resolved r) {
         if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));

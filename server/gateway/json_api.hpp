@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/codec/limits.hpp"
+#include "server/gateway/auth/gateway_auth.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
 #include "server/gateway/json_api_error.hpp"
@@ -34,6 +35,8 @@ struct MemberAddress {
     std::string device;
     std::string object;  ///< relative service path below the root object ("" = the root), e.g. `Webcams[0]`
     std::string member;
+    /// Who asks (auth: gateway): checked against the gateway's policy when logins are on.
+    auth::PrincipalPtr principal;
 };
 
 /// A member resolved against the device's definitions. The pointers point into `types`.
@@ -106,6 +109,14 @@ public:
     /// GET /api/devices/{name}/definitions: `{"definitions": [texts]}`. Errors: 404.
     ApiResult definitions(std::string_view name) const;
 
+    /// The gateway's users and permissions (docs/security.md): when they are enabled, get/set/call/peek
+    /// need a principal in the MemberAddress (401 without) whose roles allow the operation (403
+    /// PermissionDenied otherwise). Set before serving.
+    void set_auth(std::shared_ptr<auth::GatewayAuth> auth) { auth_ = std::move(auth); }
+    const std::shared_ptr<auth::GatewayAuth>& auth() const noexcept { return auth_; }
+    /// The check itself: nothing when allowed (or logins are off), else 401 / 403.
+    std::optional<ApiError> check_access(const MemberAddress& address, auth::Operation op) const;
+
     /// Finds device, object and member. Errors: 404 (unknown device / object / member), 400 (malformed
     /// object path), 503 (device not connected), 502 (definitions unusable), 504.
     void resolve(const MemberAddress& address, std::function<void(Resolved)> done);
@@ -144,6 +155,7 @@ private:
     std::map<std::uint64_t, DevicesListener> devices_listeners_;
     std::uint64_t next_devices_listener_ = 1;
     DiscoveryHooks discovery_hooks_;
+    std::shared_ptr<auth::GatewayAuth> auth_;
     mutable std::map<const DeviceMirror*, std::shared_ptr<const DeviceTypes>> types_;
 };
 

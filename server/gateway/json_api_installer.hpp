@@ -11,8 +11,14 @@
 namespace rr::server::gateway {
 
 class JsonApi;
+namespace auth {
+class GatewayAuth;
+}
 
 /// Installs the JSON API and returns it (the gateway adds discovered devices to it).
-std::shared_ptr<JsonApi> install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices);
+/// `auth` (optional): the gateway's users and permissions — adds /api/login, /api/logout, /api/whoami
+/// and checks every request (docs/security.md).
+std::shared_ptr<JsonApi> install_json_api(http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices,
+                                          std::shared_ptr<auth::GatewayAuth> auth = nullptr);
 
 }  // namespace rr::server::gateway

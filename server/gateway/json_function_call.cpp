@@ -100,6 +100,7 @@ private:
 }  // namespace
 
 void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& args, std::size_t max_items, Done done) {
+    if (auto denied = check_access(address, auth::Operation::call)) return done(ApiResult::failed(std::move(*denied)));
     if (max_items == 0) max_items = options_.default_max_items;
     if (max_items > options_.max_items_limit) {
         done(ApiResult::failed(api_error(400, MessageErrorType::InvalidArgument,

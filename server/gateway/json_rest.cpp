@@ -1,5 +1,7 @@
 #include "server/gateway/json_rest.hpp"
 
+#include "server/gateway/auth/http_auth.hpp"
+
 #include <charconv>
 #include <map>
 
@@ -99,6 +101,15 @@ std::optional<ApiError> read_max_items(const nlohmann::json& j, std::size_t& out
     return api_error(400, MessageErrorType::InvalidArgument, "max_items must be a non-negative integer");
 }
 
+// With logins on (auth: gateway), a request without a valid login gets 401 / 429.
+std::optional<ApiError> login_needed(const JsonApi& api, const http::Request& req) {
+    const auto& a = api.auth();
+    if (!a || !a->enabled()) return std::nullopt;
+    auto who = auth::authenticate_request(*a, req);
+    if (auto* e = std::get_if<ApiError>(&who)) return *e;
+    return std::nullopt;
+}
+
 class RestRouter {
 public:
     explicit RestRouter(std::shared_ptr<JsonApi> api) : api_(std::move(api)) {}
@@ -150,6 +161,18 @@ private:
 
         if (method == bhttp::verb::options) return preflight();
 
+        // auth: gateway — every request below needs a login; members are checked by JsonApi.
+        auth::PrincipalPtr principal;
+        if (const auto& a = api_->auth(); a && a->enabled()) {
+            auto who = auth::authenticate_request(*a, req);
+            if (auto* e = std::get_if<ApiError>(&who)) {
+                auto r = error_response(req, *e);
+                if (e->status == 401) r.set(bhttp::field::www_authenticate, "Bearer");
+                return respond(std::move(r));
+            }
+            principal = std::get<auth::PrincipalPtr>(std::move(who));
+        }
+
         if (seg.empty()) {
             if (method != bhttp::verb::get) return not_allowed("GET");
             return respond(json_response(req, 200, api_->device_list()));
@@ -168,7 +191,7 @@ private:
                                                          "no such resource (routes of a device: /definitions, "
                                                          "/properties/NAME, /functions/NAME, /wires/NAME)")));
 
-        MemberAddress address{device, {}, seg[2]};
+        MemberAddress address{device, {}, seg[2], principal};
         if (auto it = t.query.find("object"); it != t.query.end()) address.object = it->second;
         auto done = [req_head = std::make_shared<http::Request>(req.base(), std::string()),
                      respond](ApiResult r) { respond(result_response(*req_head, r)); };
@@ -255,12 +278,14 @@ void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
     };
     http.add_route(bhttp::verb::get, "/api/discovered",
                    [router, no_discovery](const http::Request& req, http::Responder respond) {
+                       if (auto e = login_needed(*router->api(), req)) return respond(error_response(req, *e));
                        auto hooks = router->api()->discovery_hooks();
                        if (!hooks.list) return respond(no_discovery(req));
                        respond(json_response(req, 200, hooks.list()));
                    });
     http.add_route(bhttp::verb::post, "/api/discovered/add",
                    [router, no_discovery](const http::Request& req, http::Responder respond) {
+                       if (auto e = login_needed(*router->api(), req)) return respond(error_response(req, *e));
                        auto hooks = router->api()->discovery_hooks();
                        if (!hooks.add) return respond(no_discovery(req));
                        auto body = parse_request_json(req.body());

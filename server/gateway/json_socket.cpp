@@ -8,6 +8,7 @@
 
 #include "core/session/elements.hpp"
 #include "core/value/timespec.hpp"
+#include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
@@ -42,7 +43,13 @@ public:
           options_(options),
           timer_(executor),
           convert_strand_(std::move(convert_strand)),
-          pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {}
+          pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {
+        // auth: gateway — the dashboard's session cookie, sent with the upgrade request, logs the socket in.
+        if (const auto& a = api_->auth(); a && a->enabled()) {
+            const std::string id = auth::cookie_value(socket_->cookie_header(), auth::kSessionCookie);
+            if (!id.empty()) principal_ = a->session(id);
+        }
+    }
 
     void on_message(std::string text) {
         if (text.size() > options_.max_message_bytes) {
@@ -82,6 +89,7 @@ public:
     }
 
     void push_device_state(const DeviceStatus& status) {
+        if (needs_login()) return;
         push_json(nlohmann::json{{"kind", "device_state"}, {"device", JsonApi::status_json(status)}});
     }
 
@@ -107,6 +115,7 @@ public:
 private:
     struct Subscription {
         SubKind kind = SubKind::event;
+        bool may_write = true;  // auth: gateway allows `write` on the member
         std::shared_ptr<const MemberTarget> target;  // shared: every push takes it, copying no strings
         std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, or internal pipe id
         bool mirror_known = false;
@@ -184,6 +193,15 @@ private:
         const std::string op = op_it->get<std::string>();
         auto fail_with = [&](ApiError e) { send_reply(id, ApiResult::failed(std::move(e))); };
 
+        // auth: gateway — logged in by the upgrade's cookie, or by a first {"op": "login"} message.
+        if (const auto& a = api_->auth(); a && a->enabled()) {
+            if (op == "login") return login(id, msg, *a);
+            if (needs_login())
+                return fail_with(api_error(401, MessageErrorType::AuthenticationError,
+                                           "login required: send {\"op\": \"login\", \"username\", \"password\"} or "
+                                           "{\"op\": \"login\", \"token\"} first"));
+        }
+
         if (op == "devices") return send_reply(id, ApiResult::ok(api_->device_list()));
         if (op == "device") {
             auto d = msg.find("device");
@@ -213,6 +231,7 @@ private:
 
         MemberAddress address;
         if (auto e = read_address(msg, address)) return fail_with(*e);
+        address.principal = principal();
         nlohmann::json value, args;
         std::size_t max_items = 0;
         if (op == "set") {
@@ -238,17 +257,55 @@ private:
     // --- subscriptions ----------------------------------------------------------------------------
 
     void subscribe(const nlohmann::json& id, MemberAddress address) {
+        // Receiving (wire values, events, pipe packets) needs `read`; sending on the subscription
+        // (set_out_value, send) needs `write`, decided here once.
+        if (auto denied = api_->check_access(address, auth::Operation::read)) {
+            send_reply(id, ApiResult::failed(std::move(*denied)));
+            return end_request();
+        }
+        const bool may_write = !api_->check_access(address, auth::Operation::write).has_value();
         auto self = shared_from_this();
-        api_->resolve(address, [self, id](Resolved r) {
+        api_->resolve(address, [self, id, may_write](Resolved r) {
             if (auto* e = std::get_if<ApiError>(&r)) {
                 self->send_reply(id, ApiResult::failed(*e));
                 return self->end_request();
             }
-            self->start_subscription(id, std::get<MemberTarget>(std::move(r)));
+            self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write);
         });
     }
 
-    void start_subscription(const nlohmann::json& id, MemberTarget t) {
+    bool needs_login() const {
+        const auto& a = api_->auth();
+        if (!a || !a->enabled()) return false;
+        std::lock_guard lock(mutex_);
+        return !principal_;
+    }
+    auth::PrincipalPtr principal() const {
+        std::lock_guard lock(mutex_);
+        return principal_;
+    }
+
+    void login(const nlohmann::json& id, const nlohmann::json& msg, auth::GatewayAuth& a) {
+        auto u = msg.find("username");
+        auto p = msg.find("password");
+        auto t = msg.find("token");
+        Result<auth::PrincipalPtr> who = fail(MessageErrorType::AuthenticationError, "Invalid username or password");
+        if (u != msg.end() && u->is_string() && p != msg.end() && p->is_string()) {
+            who = a.login_password(u->get<std::string>(), p->get<std::string>(), socket_->peer(), auth::LoginChannel::websocket);
+        } else if (t != msg.end() && t->is_string()) {
+            who = a.login_token(t->get<std::string>(), socket_->peer(), auth::LoginChannel::websocket);
+        } else {
+            return send_reply(id, ApiResult::failed(bad_request("login takes \"username\" and \"password\", or \"token\"")));
+        }
+        if (!who) return send_reply(id, ApiResult::failed(auth::login_error(who.error())));
+        {
+            std::lock_guard lock(mutex_);
+            principal_ = *who;
+        }
+        send_reply(id, ApiResult::ok(auth::principal_json(**who)));
+    }
+
+    void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write) {
         SubKind kind;
         switch (t.member->kind) {
             case robdef::MemberKind::wire: kind = SubKind::wire; break;
@@ -278,6 +335,7 @@ private:
             sid = next_sid_++;
             Subscription s;
             s.kind = kind;
+            s.may_write = may_write;
             s.target = std::make_shared<const MemberTarget>(t);
             subs_.emplace(sid, std::move(s));
         }
@@ -428,10 +486,21 @@ private:
         return std::nullopt;
     }
 
+    bool may_write(std::uint64_t sid) const {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        return it != subs_.end() && it->second.may_write;
+    }
+
     void set_out_value(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value) {
         MemberTarget t;
         std::uint64_t mid = 0;
         if (auto e = find_active(sid, SubKind::wire, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        if (!may_write(sid)) {
+            if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
+            return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
+                                                              "this login may not write " + t.member->name)));
+        }
         if (t.member->direction() == robdef::MemberDirection::readonly)
             return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
                                                               "wire \"" + t.member->name + "\" is read-only")));
@@ -458,6 +527,11 @@ private:
         MemberTarget t;
         std::uint64_t mid = 0;
         if (auto e = find_active(sid, SubKind::pipe, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        if (!may_write(sid)) {
+            if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
+            return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
+                                                              "this login may not write " + t.member->name)));
+        }
         if (t.member->direction() == robdef::MemberDirection::readonly)
             return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
                                                               "pipe \"" + t.member->name + "\" is read-only")));
@@ -723,6 +797,7 @@ private:
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
     std::map<std::uint64_t, Subscription> subs_;
     std::uint64_t next_sid_ = 1;
+    auth::PrincipalPtr principal_;  // auth: gateway — who logged this socket in
     std::size_t in_flight_ = 0;
     std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
     ConvertStrand convert_strand_;                  // shared by the server's sockets

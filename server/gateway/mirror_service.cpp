@@ -201,6 +201,25 @@ void MirrorService::drop_session_state(std::uint32_t endpoint) {
         for (auto& e : to_device) c->request(std::move(e), [](Result<MessageEntry>) {});
 }
 
+bool MirrorService::requires_authentication() const { return access_.active(); }
+
+Result<void> MirrorService::authenticate(const std::string& username, const MessageElement* credentials) {
+    return authenticate_from(username, credentials, {});
+}
+
+Result<void> MirrorService::authenticate_from(const std::string& username, const MessageElement* credentials,
+                                              std::string_view peer) {
+    if (!access_.active()) return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
+    auto who = access_.auth()->login_rr(username, credentials, peer);
+    if (!who) return who.take_error();
+    return {};
+}
+
+Result<std::string> MirrorService::authenticate_web(std::string_view web_login) {
+    if (!access_.active()) return fail(MessageErrorType::AuthenticationError, "Authentication Failed");
+    return access_.auth()->web_rr_user(web_login);
+}
+
 void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     auto mirror = mirror_.lock();
     if (!mirror) return;
@@ -214,6 +233,11 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         responder.fail(make_error(MessageErrorType::InvalidOperation,
                                   entry.member_name + " through the gateway needs `auth: passthrough` on device \"" + name_ +
                                       "\" (its clients share one session to the device; docs/security.md)"));
+        return;
+    }
+    if (auto denied = access_.check(session, entry)) {
+        // Packets (pipe, wire) have no reply: dropped.
+        if (!responder.done()) responder.fail(std::move(*denied));
         return;
     }
     switch (entry.entry_type) {
@@ -514,6 +538,9 @@ void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
     }
     auto m = mirror_.lock();
     for (auto& [ep, pair] : per_session) {
+        // A session that may only send on the pipe (auth: gateway) does not receive its packets.
+        if (!acks && access_.active() && !access_.may(pair.first, path, pair.second.member_name, auth::Operation::read))
+            continue;
         if (!pair.first.send(std::move(pair.second)) && m) m->counters_.pipe_drops.fetch_add(1);
     }
 }
@@ -531,8 +558,11 @@ void MirrorService::fan_out(MessageEntry&& entry) {
         if (it != event_subscribers_.end()) internal = it->second;
     }
     auto m = mirror_.lock();
-    for (const auto& s : sessions)
+    const bool check = access_.active() && entry.entry_type == MessageEntryType::EventReq;
+    for (const auto& s : sessions) {
+        if (check && !access_.may(s, entry.service_path, entry.member_name, auth::Operation::read)) continue;
         if (!s.send(entry) && m) m->counters_.event_drops.fetch_add(1);
+    }
     if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
 }
 
@@ -542,12 +572,17 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
     {
         std::lock_guard lock(mutex_);
         // Passthrough: no client calls the device on the gateway's own session, so nobody is called back.
+        // auth: gateway: only a session whose user may `call` the callback is called.
         if (!passthrough_) {
+            const std::string down_path = to_downstream(entry.service_path);
+            auto allowed = [&](const SessionRef& s) {
+                return s.alive() && access_.may(s, down_path, entry.member_name, auth::Operation::call);
+            };
             for (const auto& s : sessions_)
-                if (s.endpoint() == last_caller_ && s.alive()) target = s;
+                if (s.endpoint() == last_caller_ && allowed(s)) target = s;
             if (!target.alive())
                 for (const auto& s : sessions_)
-                    if (s.alive()) target = s;
+                    if (allowed(s)) target = s;
         }
     }
     const std::uint32_t request_id = entry.request_id;
@@ -605,7 +640,11 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
                 sessions = it->second.sessions;
                 internal = it->second.internal;
             }
+            const bool check = access_.active();
             for (const auto& s : sessions) {
+                // A session that may only set the wire's OutValue (auth: gateway) receives no InValue.
+                if (check && !access_.may(s, shared->entry().service_path, shared->entry().member_name, auth::Operation::read))
+                    continue;
                 if (s.send_wire_packet(shared->entry()) && m) m->counters_.wire_packets_out.fetch_add(1);
             }
             deliver(internal, shared);

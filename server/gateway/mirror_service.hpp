@@ -9,6 +9,7 @@
 #include <set>
 #include <tuple>
 
+#include "server/gateway/auth/mirror_access.hpp"
 #include "server/gateway/device_mirror.hpp"
 
 namespace rr::server::gateway {
@@ -40,6 +41,17 @@ public:
     void set_passthrough(std::shared_ptr<PassthroughSessions> p) { passthrough_ = std::move(p); }
     const std::shared_ptr<PassthroughSessions>& passthrough() const noexcept { return passthrough_; }
     void stop_passthrough();
+    // Logins with the gateway's own users (`auth: gateway`; server/gateway/auth/), when set_access()
+    // gave it users.
+    bool requires_authentication() const override;
+    Result<void> authenticate(const std::string& username, const MessageElement* credentials) override;
+    Result<void> authenticate_from(const std::string& username, const MessageElement* credentials,
+                                   std::string_view peer) override;
+    Result<std::string> authenticate_web(std::string_view web_login) override;
+    /// The gateway's users and permissions for this device's clients (docs/security.md): logins and
+    /// per-member checks of every request (PermissionDenied), events, pipe packets and callbacks only
+    /// to sessions allowed to receive them. Set before the service is registered (not thread-safe).
+    void set_access(auth::MirrorAccess access) { access_ = std::move(access); }
 
     // Upstream side, called by DeviceMirror.
     void on_upstream_entry(MessageEntry&& entry);
@@ -116,6 +128,7 @@ private:
 
     std::weak_ptr<DeviceMirror> mirror_;
     std::shared_ptr<PassthroughSessions> passthrough_;
+    auth::MirrorAccess access_;
     const std::string name_;
     const std::string upstream_service_;
 

@@ -38,6 +38,11 @@ namespace http {
 
 using Request = boost::beast::http::request<boost::beast::http::string_body>;
 using Response = boost::beast::http::response<boost::beast::http::string_body>;
+/// Set by the server on every request a route handler sees (a value the client sent under these names
+/// is removed first): the client's address ("ip:port"; behind a trusted proxy the proxy's client), and
+/// "1" when the request came over TLS (or, behind a trusted proxy, X-Forwarded-Proto was https).
+inline constexpr std::string_view kClientAddressField = "X-RR-Gateway-Client";
+inline constexpr std::string_view kSecureField = "X-RR-Gateway-Secure";
 /// Route handlers answer through `respond`, from any thread, exactly once.
 using Responder = std::function<void(Response)>;
 using RouteHandler = std::function<void(const Request& request, Responder respond)>;
@@ -55,6 +60,9 @@ public:
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
+    /// The Cookie header of the upgrade request ("" without one), for handlers that authenticate the
+    /// socket by a session cookie.
+    virtual std::string cookie_header() const { return {}; }
     /// Text messages accepted by send() and not yet written (the one being written included), and
     /// their bytes: for backpressure decisions by the handler. Thread-safe.
     virtual std::size_t queued() const { return 0; }

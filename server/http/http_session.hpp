@@ -10,6 +10,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 
 #include <boost/asio/ssl/error.hpp>
 #include <boost/asio/strand.hpp>
@@ -90,8 +91,8 @@ public:
     using std::enable_shared_from_this<JsonWebSocketSession<Stream>>::shared_from_this;
 
     JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
-                         std::string peer)
-        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)) {}
+                         std::string peer, std::string cookie = {})
+        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)), cookie_(std::move(cookie)) {}
 
     void start() {
         ws_.text(true);
@@ -117,6 +118,7 @@ public:
     }
 
     std::string peer() const override { return peer_; }
+    std::string cookie_header() const override { return cookie_; }
 
 private:
     struct Outgoing {
@@ -225,6 +227,7 @@ private:
     const JsonSocketHandler* handler_;
     std::size_t limit_;
     std::string peer_;
+    std::string cookie_;
     beast::flat_buffer buffer_;
     std::deque<Outgoing> queue_;  // front: being written while writing_
     std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
@@ -297,6 +300,11 @@ private:
                 client_ = client_origin(ep.address(), ep.port(), forwarded("X-Forwarded-For"),
                                         forwarded("X-Forwarded-Proto"), server_->options().trusted_proxies);
         }
+        // What route handlers learn about the client (kClientAddressField, kSecureField): never what it claims.
+        req.erase(kClientAddressField);
+        req.erase(kSecureField);
+        req.set(kClientAddressField, client_.address);
+        if (client_.forwarded ? client_.scheme == "https" : !std::is_same_v<Stream, beast::tcp_stream>) req.set(kSecureField, "1");
         if (server_->options().on_response) {
             request_line_.assign(req.method_string().data(), req.method_string().size());
             request_line_ += ' ';
@@ -399,6 +407,7 @@ private:
         beast::error_code lec;
         auto local = beast::get_lowest_layer(stream_).socket().local_endpoint(lec);
         AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer};
+        info.web_login.assign(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
         beast::get_lowest_layer(stream_).expires_never();
         websocket::stream<Stream> ws(std::move(stream_));
         ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
@@ -408,11 +417,12 @@ private:
         auto server = server_;
         auto holder = std::make_shared<websocket::stream<Stream>>(std::move(ws));
         const bool unnamed = protocols.empty();
-        holder->async_accept(req, [holder, server, json, peer, info, unnamed](beast::error_code ec) {
+        std::string cookie(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
+        holder->async_accept(req, [holder, server, json, peer, info, unnamed, cookie = std::move(cookie)](beast::error_code ec) {
             if (ec) return;
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
-                                                                server->options().json_socket_queue_limit, peer);
+                                                                server->options().json_socket_queue_limit, peer, cookie);
                 s->start();
                 return;
             }

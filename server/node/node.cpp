@@ -153,7 +153,10 @@ void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial) {
 
 std::shared_ptr<ConnectionLogic> Node::open_connection(const AcceptedStream& stream) {
     if (stopped_.load() || !can_accept()) return nullptr;
-    return std::make_shared<ServerConnection>(services_, stats_, options_.server, stream.local_url, mono_now());
+    ServerConnectionConfig config = options_.server;
+    config.peer = stream.peer;
+    config.web_login = stream.web_login;
+    return std::make_shared<ServerConnection>(services_, stats_, std::move(config), stream.local_url, mono_now());
 }
 
 bool Node::can_accept() const {

@@ -181,7 +181,7 @@ void ServerSession::request(MessageEntry entry, std::function<void(Result<Messag
 ServerConnection::ServerConnection(std::shared_ptr<ServiceRegistry> services, std::shared_ptr<NodeStats> stats,
                                    ServerConnectionConfig config, std::string local_url, MonoTime now)
     : services_(std::move(services)), stats_(std::move(stats)), config_(std::move(config)), local_url_(std::move(local_url)),
-      session_(*services_, ServiceSessionConfig{config_.stream, config_.callback_timeout, config_.wire_hold_bytes}, now) {
+      session_(*services_, ServiceSessionConfig{config_.stream, config_.callback_timeout, config_.wire_hold_bytes, config_.peer, config_.web_login}, now) {
     stats_->connections_open.fetch_add(1);
     stats_->connections_total.fetch_add(1, std::memory_order_relaxed);
 }

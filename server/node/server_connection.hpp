@@ -38,6 +38,10 @@ struct ServerConnectionConfig {
     /// reading its replies); resume when they drain.
     std::size_t read_pause_bytes = 4u * 1024u * 1024u;
     std::chrono::milliseconds callback_timeout{15000};
+    /// The client's address (AcceptedStream::peer), for services that rate-limit logins per address.
+    std::string peer;
+    /// AcceptedStream::web_login.
+    std::string web_login;
 };
 
 class ServerConnection;

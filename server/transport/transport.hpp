@@ -58,6 +58,9 @@ struct AcceptedStream {
     std::string local_url;
     /// The peer, for logs (an address, "local", a USB device path).
     std::string peer;
+    /// The Cookie header of the WebSocket upgrade that carried this stream (rr+ws from a browser), or
+    /// "": services may accept a web login made on the gateway's page (HostedService::authenticate_web).
+    std::string web_login;
 };
 
 /// Where listeners hand accepted streams (implemented by the node). Thread-safe.

@@ -36,6 +36,11 @@ export class DeviceList extends EventTarget {
   async poll() {
     try {
       const r = await fetch("api/devices", { headers: { Accept: "application/json" }, cache: "no-store" });
+      // The gateway has users (docs/security.md) and this browser is not logged in, or its session ended.
+      if (r.status === 401) {
+        location.replace("login.html");
+        return;
+      }
       if (!r.ok) throw new Error(`GET api/devices: HTTP ${r.status}`);
       this.devices = await r.json();
       this.setGatewayStatus("connected", "gateway connected");

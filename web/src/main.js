@@ -38,3 +38,20 @@ discovered.addEventListener("added", (ev) => {
 list.start();
 discovered.start();
 route();
+showUser();
+
+// With logins on (GET api/whoami says auth: true): who is logged in, and a way out.
+async function showUser() {
+  try {
+    const r = await fetch("api/whoami", { headers: { Accept: "application/json" }, cache: "no-store" });
+    if (!r.ok) return;
+    const me = await r.json();
+    if (!me.auth) return;
+    const logout = h("button", { type: "button", id: "logout", text: "Log out" });
+    logout.addEventListener("click", async () => {
+      await fetch("api/logout", { method: "POST", cache: "no-store" }).catch(() => {});
+      location.replace("login.html");
+    });
+    document.querySelector(".topbar").append(h("span", { class: "user-box" }, h("span", { id: "user-name", text: me.user }), logout));
+  } catch { /* an old gateway without api/whoami */ }
+}

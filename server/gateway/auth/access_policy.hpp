@@ -1,0 +1,71 @@
+// Per-role, per-device, per-member permissions of the gateway's own users (`auth: gateway` mode;
+// docs/security.md "Gateway users and permissions").
+//
+// A role is a list of rules; a rule names devices and members (patterns where `*` matches any run of
+// characters, everything else literally) and the operations it allows:
+//   read   property get, wire InValue (receiving wire values) and peek, memory read, event and pipe receive
+//   write  property set, wire OutValue (sending wire values) and poke, memory write, pipe send
+//   call   functions, generator functions (and their next/close/abort), callbacks
+// A member of the device's root object is named by its member name (`Drive`); a member of an object
+// below the root by `<relative service path>.<member>` (`Webcams[0].Capture`), the path in RR's
+// encoding as the JSON API's `object` parameter normalises it. Rules only allow: an operation is
+// permitted when any rule of any of the principal's roles allows it, and denied otherwise (deny by
+// default). Thread-safe once built (const after construction).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rr::server::gateway::auth {
+
+enum class Operation { read, write, call };
+
+/// "read", "write", "call".
+std::string_view operation_name(Operation op) noexcept;
+
+struct AccessRule {
+    std::vector<std::string> devices;  ///< patterns
+    std::vector<std::string> members;  ///< patterns
+    bool read = false, write = false, call = false;
+
+    bool allows(Operation op) const noexcept;
+};
+
+class AccessPolicy {
+public:
+    void add_role(std::string role, std::vector<AccessRule> rules);
+    bool has_role(std::string_view role) const;
+    std::vector<std::string> role_names() const;
+
+    /// Whether any rule of any role in `roles` allows `op` on `member_key` of `device`. Unknown roles
+    /// allow nothing.
+    bool allows(const std::vector<std::string>& roles, std::string_view device, std::string_view member_key,
+                Operation op) const;
+
+    /// `*` matches any run of characters (also none, also '.' and brackets); every other character
+    /// matches itself.
+    static bool glob_match(std::string_view pattern, std::string_view text) noexcept;
+
+private:
+    std::map<std::string, std::vector<AccessRule>, std::less<>> roles_;
+};
+
+/// The member key of `member` on the object at relative service path `object` ("" = the root).
+std::string member_key(std::string_view object, std::string_view member);
+
+/// Who is asking: a user of the password file, a bearer token, a JWT subject. Immutable.
+struct Principal {
+    std::string name;
+    std::vector<std::string> roles;
+    std::string via;  ///< "password", "token", "jwt", "session"
+    std::shared_ptr<const AccessPolicy> policy;
+
+    bool allows(std::string_view device, std::string_view member_key, Operation op) const {
+        return policy && policy->allows(roles, device, member_key, op);
+    }
+};
+
+}  // namespace rr::server::gateway::auth

@@ -1,0 +1,174 @@
+#include "server/gateway/auth/gateway_auth.hpp"
+
+#include <algorithm>
+
+#include <openssl/crypto.h>
+#include <openssl/rand.h>
+
+#include "core/session/elements.hpp"
+
+namespace rr::server::gateway::auth {
+
+GatewayAuth::GatewayAuth(GatewayAuthSettings settings)
+    : settings_(std::move(settings)), limiter_(settings_.limits) {
+    if (!settings_.policy) settings_.policy = std::make_shared<AccessPolicy>();
+    enabled_ = !settings_.users.empty() || (settings_.tokens && !settings_.tokens->empty()) || settings_.jwt.has_value();
+    for (const auto& u : settings_.users.users()) {
+        Principal p;
+        p.name = u.username;
+        p.roles = u.privileges;
+        p.via = "password";
+        user_principals_[u.username] = with_policy(std::move(p));
+    }
+}
+
+PrincipalPtr GatewayAuth::with_policy(Principal p) const {
+    p.policy = settings_.policy;
+    return std::make_shared<const Principal>(std::move(p));
+}
+
+Result<void> GatewayAuth::check_limit(const std::string& address) {
+    if (auto wait = limiter_.blocked_for(address, settings_.steady_now()); wait > 0) {
+        counters_.rate_limited.fetch_add(1);
+        return fail(MessageErrorType::AuthenticationError,
+                    "Too many failed logins from this address; try again in " + std::to_string(wait) + " s");
+    }
+    return {};
+}
+
+void GatewayAuth::record_failure(const std::string& address, LoginChannel channel) {
+    switch (channel) {
+        case LoginChannel::rr: counters_.failed_rr.fetch_add(1); break;
+        case LoginChannel::http: counters_.failed_http.fetch_add(1); break;
+        case LoginChannel::token: counters_.failed_token.fetch_add(1); break;
+        case LoginChannel::websocket: counters_.failed_websocket.fetch_add(1); break;
+    }
+    if (limiter_.failed(address, settings_.steady_now())) counters_.lockouts.fetch_add(1);
+}
+
+Result<PrincipalPtr> GatewayAuth::login_rr(std::string_view username, const MessageElement* credentials,
+                                           std::string_view peer) {
+    const std::string address = address_of(peer);
+    if (auto ok = check_limit(address); !ok) return ok.take_error();
+    if (auto ok = settings_.users.check(username, credentials); !ok) {
+        record_failure(address, LoginChannel::rr);
+        return ok.take_error();
+    }
+    auto who = principal_for_user(username);
+    if (!who) return fail(MessageErrorType::AuthenticationError, "Invalid username or password");
+    limiter_.succeeded(address);
+    counters_.succeeded.fetch_add(1);
+    return who;
+}
+
+Result<PrincipalPtr> GatewayAuth::login_password(std::string_view username, std::string_view password,
+                                                 std::string_view peer, LoginChannel channel) {
+    const std::string address = address_of(peer);
+    if (auto ok = check_limit(address); !ok) return ok.take_error();
+    const std::string digest = PasswordTable::md5_hex(password);
+    bool ok = false;
+    for (const auto& u : settings_.users.users())
+        ok |= (u.username == username) &
+              (u.password_md5.size() == digest.size() &&
+               CRYPTO_memcmp(u.password_md5.data(), digest.data(), digest.size()) == 0);
+    auto who = ok ? principal_for_user(username) : nullptr;
+    if (!who) {
+        record_failure(address, channel);
+        return fail(MessageErrorType::AuthenticationError, "Invalid username or password");
+    }
+    limiter_.succeeded(address);
+    counters_.succeeded.fetch_add(1);
+    return who;
+}
+
+Result<PrincipalPtr> GatewayAuth::login_token(std::string_view token, std::string_view peer, LoginChannel channel,
+                                              std::string* reason) {
+    const std::string address = address_of(peer);
+    if (auto ok = check_limit(address); !ok) return ok.take_error();
+    std::string why = "no token authentication configured";
+    if (settings_.tokens) {
+        if (auto p = settings_.tokens->check(token)) {
+            limiter_.succeeded(address);
+            counters_.succeeded.fetch_add(1);
+            return with_policy(std::move(*p));
+        } else {
+            why = p.error().message;
+        }
+    }
+    if (settings_.jwt && looks_like_jwt(token)) {
+        if (auto p = settings_.jwt->verify(token, settings_.unix_now())) {
+            limiter_.succeeded(address);
+            counters_.succeeded.fetch_add(1);
+            return with_policy(std::move(*p));
+        } else {
+            why = "JWT: " + p.error().message;
+        }
+    }
+    if (reason) *reason = why;
+    record_failure(address, channel);
+    return fail(MessageErrorType::AuthenticationError, "Invalid token");
+}
+
+PrincipalPtr GatewayAuth::principal_for_user(std::string_view username) const {
+    auto it = user_principals_.find(username);
+    if (it != user_principals_.end()) return it->second;
+    std::lock_guard lock(mutex_);
+    auto w = web_principals_.find(username);
+    return w == web_principals_.end() ? nullptr : w->second;
+}
+
+Result<std::string> GatewayAuth::web_rr_user(std::string_view cookie_header) {
+    // The cookie's name and value: as http_auth.hpp's cookie_value (kept here, below the HTTP layer).
+    std::string id;
+    while (!cookie_header.empty()) {
+        auto semi = cookie_header.find(';');
+        auto pair = cookie_header.substr(0, semi);
+        cookie_header = semi == std::string_view::npos ? std::string_view{} : cookie_header.substr(semi + 1);
+        while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
+        constexpr std::string_view kName = "rrgw_session=";
+        if (pair.substr(0, kName.size()) == kName) id = std::string(pair.substr(kName.size()));
+    }
+    auto who = id.empty() ? nullptr : session(id);
+    if (!who) return fail(MessageErrorType::AuthenticationError, "Username not provided");
+    if (who->via == "password") return who->name;
+    std::string name = who->name + "@" + who->via;
+    std::lock_guard lock(mutex_);
+    if (web_principals_.size() >= settings_.max_sessions && !web_principals_.count(name)) web_principals_.clear();  // bounded
+    web_principals_[name] = who;
+    return name;
+}
+
+std::string GatewayAuth::open_session(PrincipalPtr who) {
+    unsigned char raw[32];
+    if (RAND_bytes(raw, sizeof raw) != 1) return {};
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string id;
+    for (unsigned char c : raw) {
+        id += kHex[c >> 4];
+        id += kHex[c & 15];
+    }
+    const auto now = settings_.steady_now();
+    std::lock_guard lock(mutex_);
+    std::erase_if(sessions_, [&](const auto& kv) { return kv.second.expires <= now; });
+    if (sessions_.size() >= settings_.max_sessions) {
+        auto oldest = std::min_element(sessions_.begin(), sessions_.end(),
+                                       [](const auto& a, const auto& b) { return a.second.expires < b.second.expires; });
+        sessions_.erase(oldest);
+    }
+    sessions_[id] = Session{std::move(who), now + settings_.session_ttl};
+    return id;
+}
+
+PrincipalPtr GatewayAuth::session(std::string_view id) const {
+    std::lock_guard lock(mutex_);
+    auto it = sessions_.find(id);
+    if (it == sessions_.end() || it->second.expires <= settings_.steady_now()) return nullptr;
+    return it->second.who;
+}
+
+void GatewayAuth::close_session(std::string_view id) {
+    std::lock_guard lock(mutex_);
+    if (auto it = sessions_.find(id); it != sessions_.end()) sessions_.erase(it);
+}
+
+}  // namespace rr::server::gateway::auth

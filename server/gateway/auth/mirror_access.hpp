@@ -1,0 +1,53 @@
+// Permission checks of the gateway's mirror of a device for native RR clients (`auth: gateway`):
+// which operation a client's request needs (access_policy.hpp), and whether a session's user may do it.
+// Member keys come from the downstream service path: `<device>` → the member's name,
+// `<device>.<relative path>` → `<relative path>.<member>`.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "core/error/rr_error.hpp"
+#include "core/message/message.hpp"
+#include "server/gateway/auth/gateway_auth.hpp"
+#include "server/node/service.hpp"
+
+namespace rr::server::gateway::auth {
+
+/// The operation a request from a client needs; nullopt for entries that need none (PipePacketRet
+/// acknowledgements, disconnects, and anything else that is not a member operation).
+///   read:  PropertyGetReq, WireConnectReq (receives InValue), WirePeekInValueReq, WirePeekOutValueReq,
+///          MemoryRead, MemoryGetParam, PipeConnectReq (receives packets)
+///   write: PropertySetReq, WirePacket (the client's OutValue), WirePokeOutValueReq, MemoryWrite,
+///          PipePacket (sending)
+///   call:  FunctionCallReq, GeneratorNextReq
+/// (MirrorAccess::check opens a pipe endpoint or wire connection for `read` or `write`.)
+std::optional<Operation> operation_for_request(MessageEntryType type) noexcept;
+
+/// `<relative path>.<member>` for a downstream service path of device service `service`
+/// (`create` → `Drive`; `create.Webcams[0]` → `Webcams[0].Capture`).
+std::string member_key_for_path(std::string_view service, std::string_view service_path, std::string_view member);
+
+class MirrorAccess {
+public:
+    MirrorAccess() = default;
+    MirrorAccess(std::shared_ptr<GatewayAuth> auth, std::string device) : auth_(std::move(auth)), device_(std::move(device)) {}
+
+    /// Logins and checks are on.
+    bool active() const noexcept { return auth_ && auth_->enabled(); }
+    const std::shared_ptr<GatewayAuth>& auth() const noexcept { return auth_; }
+
+    /// Whether `session`'s user may do `op` on `member` of the object at downstream `service_path`.
+    bool may(const SessionRef& session, std::string_view service_path, std::string_view member, Operation op) const;
+    /// The check for a request from a client: nothing when allowed, else PermissionDenied
+    /// "<user> may not <op> <member key> of <device>" (counted in LoginCounters::denied).
+    std::optional<RRError> check(const SessionRef& session, const MessageEntry& entry) const;
+
+private:
+    std::shared_ptr<GatewayAuth> auth_;
+    std::string device_;
+};
+
+}  // namespace rr::server::gateway::auth

@@ -1,0 +1,411 @@
+#!/usr/bin/env python3
+"""The gateway's own logins and per-member permissions (`auth: gateway`, docs/security.md), tested
+with the official Python client over raw RR and with plain HTTP / WebSocket clients over the JSON API.
+
+Starts rr_interop_service (the device, no login of its own) and rr-gateway with gateway.auth: a
+password file in the official format (alice: operator, bob: viewer, carol: adder), a bearer token file,
+an HS256 JWT key, and roles:
+  operator  every member of every device: read, write, call
+  viewer    every member of `interop`: read
+  adder     `add`: call; `p_int32`: read
+Checks (each one named in the JSON summary):
+  rr        official client: right password connects; wrong password, unknown user and no credentials
+            are refused (AuthenticationException); the permission matrix (property get/set, function
+            call, generator, event receive) per user, PermissionDenied where the role does not allow;
+            the service definition a viewer sees lists every member.
+  json      POST /api/login (cookie: HttpOnly, SameSite=Strict), requests with the cookie, without it
+            (401), PUT/POST refused by role (403); bearer token; JWT valid / expired / forged / wrong
+            audience; the JSON WebSocket logged in by its first message and by the cookie.
+  limits    after 5 failed logins from this address even the right password is refused (HTTP 429,
+            RR AuthenticationException "Too many failed logins"); /metrics counts the failures.
+Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
+when the official package is missing.
+
+Usage: gateway_logins.py --gateway PATH/rr-gateway --service PATH/rr_interop_service
+"""
+
+import argparse
+import base64
+import hashlib
+import hmac
+import http.cookiejar
+import json
+import os
+import sys
+import tempfile
+import threading
+import time
+import traceback
+import urllib.error
+import urllib.request
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from child_procs import StepFailed, read_json_line, start, stop, tail  # noqa: E402
+
+try:
+    import RobotRaconteur as RR
+except ImportError as e:  # pragma: no cover
+    print("SKIP: official RobotRaconteur package missing: %s" % e)
+    sys.exit(77)
+
+RRN = RR.RobotRaconteurNode.s
+
+USERS = {"alice": ("alice-pw", "operator,objectlock"), "bob": ("bob-pw", "viewer"), "carol": ("carol-pw", "adder")}
+TOKEN = "wall-display-token-5d41402abc4b2a76"
+JWT_SECRET = b"an-hs256-secret-of-at-least-32-bytes!!"
+
+
+def b64url(data):
+    return base64.urlsafe_b64encode(data).rstrip(b"=").decode()
+
+
+def make_jwt(claims, secret=JWT_SECRET, alg="HS256"):
+    header = b64url(json.dumps({"alg": alg, "typ": "JWT"}).encode())
+    payload = b64url(json.dumps(claims).encode())
+    sig = b64url(hmac.new(secret, (header + "." + payload).encode(), hashlib.sha256).digest())
+    return header + "." + payload + "." + sig
+
+
+def creds(password):
+    return {"password": RR.VarValue(password, "string")}
+
+
+class Checks:
+    def __init__(self):
+        self.results = []
+
+    def check(self, name, fn):
+        try:
+            fn()
+            self.results.append({"check": name, "ok": True})
+        except Exception as e:  # noqa: BLE001
+            self.results.append({"check": name, "ok": False, "error": "%s: %s" % (type(e).__name__, e),
+                                 "trace": traceback.format_exc(limit=3)})
+
+
+def expect_rr_error(fn, exc_type, text=None):
+    try:
+        fn()
+    except exc_type as e:
+        if text and text not in str(e):
+            raise AssertionError("expected %r in %r" % (text, str(e)))
+        return str(e)
+    raise AssertionError("expected %s" % exc_type.__name__)
+
+
+class Http:
+    def __init__(self, base):
+        self.base = base
+        self.jar = http.cookiejar.CookieJar()
+        self.opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor(self.jar))
+
+    def call(self, method, path, body=None, headers=None, cookies=True):
+        data = json.dumps(body).encode() if body is not None else None
+        req = urllib.request.Request(self.base + path, data=data, method=method, headers=dict(headers or {}))
+        if data is not None:
+            req.add_header("Content-Type", "application/json")
+        opener = self.opener if cookies else urllib.request.build_opener()
+        try:
+            with opener.open(req, timeout=20) as r:
+                return r.status, dict(r.headers), json.loads(r.read() or b"null")
+        except urllib.error.HTTPError as e:
+            raw = e.read()
+            try:
+                return e.code, dict(e.headers), json.loads(raw or b"null")
+            except ValueError:
+                return e.code, dict(e.headers), raw.decode(errors="replace")
+
+
+def expect_status(got, status, name=None):
+    if got[0] != status:
+        raise AssertionError("expected HTTP %d, got %d %r" % (status, got[0], got[2]))
+    if name and (not isinstance(got[2], dict) or got[2].get("error", {}).get("name") != name):
+        raise AssertionError("expected error %s, got %r" % (name, got[2]))
+    return got
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--service", required=True)
+    ap.add_argument("--timeout", type=float, default=60)
+    args = ap.parse_args()
+
+    work = tempfile.mkdtemp(prefix="gw_logins_")
+    with open(os.path.join(work, "users.txt"), "w") as f:
+        f.write("# user md5 privileges(roles)\n")
+        for u, (pw, roles) in USERS.items():
+            f.write("%s %s %s\n" % (u, hashlib.md5(pw.encode()).hexdigest(), roles))
+    with open(os.path.join(work, "tokens.txt"), "w") as f:
+        f.write("%s wall viewer\n" % TOKEN)
+    with open(os.path.join(work, "jwt.key"), "wb") as f:
+        f.write(JWT_SECRET + b"\n")
+
+    device = gateway = None
+    checks = Checks()
+    try:
+        device = start([args.service, "--port", "0"], os.path.join(work, "service.err"))
+        dev = read_json_line(device, args.timeout, "rr_interop_service ready line")
+        config = """
+gateway:
+  port: 0
+  listen: 127.0.0.1
+  local: false
+  auth:
+    users: {work}/users.txt
+    tokens: {work}/tokens.txt
+    jwt:
+      algorithm: HS256
+      key: {work}/jwt.key
+      audience: rr-gateway
+    roles:
+      operator:
+        - allow: [read, write, call]
+      viewer:
+        - devices: interop
+          allow: [read]
+      adder:
+        - devices: [interop]
+          members: [add]
+          allow: [call]
+        - devices: [interop]
+          members: p_int32
+          allow: [read]
+    login_limit: {{max_failures: 5, window_s: 60, lockout_s: 60}}
+demo:
+  enabled: false
+devices:
+  - name: interop
+    url: {url}
+""".format(work=work, url=dev["url"])
+        with open(os.path.join(work, "gateway.yaml"), "w") as f:
+            f.write(config)
+        gateway = start([args.gateway, "--config", os.path.join(work, "gateway.yaml")], os.path.join(work, "gateway.err"))
+        gw = read_json_line(gateway, args.timeout, "rr-gateway ready line")
+        port = gw["port"]
+        base = "http://127.0.0.1:%d" % port
+        url = "rr+tcp://127.0.0.1:%d/?service=interop" % port
+        deadline = time.monotonic() + args.timeout
+        while True:
+            try:
+                with urllib.request.urlopen(base + "/readyz", timeout=5) as r:
+                    if r.status == 200:
+                        break
+            except Exception:  # noqa: BLE001
+                pass
+            if time.monotonic() > deadline:
+                raise StepFailed("gateway not ready: " + tail(os.path.join(work, "gateway.err")))
+            time.sleep(0.2)
+
+        RRN.RegisterTransport(RR.TcpTransport())
+        conns = {}
+
+        # ---- raw RR, the official client ----
+        def rr_logins():
+            for u in USERS:
+                conns[u] = RRN.ConnectService(url, u, creds(USERS[u][0]))
+            expect_rr_error(lambda: RRN.ConnectService(url, "alice", creds("wrong")), RR.AuthenticationException,
+                            "Invalid username or password")
+            expect_rr_error(lambda: RRN.ConnectService(url, "mallory", creds("x")), RR.AuthenticationException)
+            expect_rr_error(lambda: RRN.ConnectService(url), RR.AuthenticationException)
+        checks.check("rr: official client logs in (right / wrong password, unknown user, none)", rr_logins)
+
+        def rr_matrix():
+            a, b, c = conns["alice"], conns["bob"], conns["carol"]
+            # operator: everything
+            a.p_int32 = 7
+            assert a.p_int32 == 7
+            assert a.add(2, 3) == 5
+            assert list(a.count_up(1, 3).NextAll()) == [1, 2, 3]
+            # viewer: read only
+            assert b.p_int32 == 7
+            assert b.p_double is not None
+            expect_rr_error(lambda: setattr(b, "p_int32", 9), RR.PermissionDeniedException, "may not write p_int32")
+            expect_rr_error(lambda: b.add(1, 1), RR.PermissionDeniedException, "may not call add")
+            expect_rr_error(lambda: b.count_up(1, 2), RR.PermissionDeniedException)
+            # adder: add and p_int32 only
+            assert c.add(40, 2) == 42
+            assert c.p_int32 == 7
+            expect_rr_error(lambda: c.p_double, RR.PermissionDeniedException, "may not read p_double")
+            expect_rr_error(lambda: setattr(c, "p_int32", 1), RR.PermissionDeniedException)
+            expect_rr_error(lambda: c.reset(), RR.PermissionDeniedException)
+            assert a.p_int32 == 7  # nothing changed by the refused writes
+        checks.check("rr: permission matrix (property get/set, function, generator) per role", rr_matrix)
+
+        def rr_definition():
+            # The viewer's proxy is built from the service definition the gateway sent: every member is
+            # there, also the ones bob may not use (permissions are not hidden in the definition).
+            b = conns["bob"]
+            for m in ("add", "reset", "count_up", "ev_values", "p_int32", "p_echo", "child"):
+                assert m in dir(b), m
+        checks.check("rr: a viewer's service definition lists every member", rr_definition)
+
+        def rr_events():
+            got = {"bob": 0, "carol": 0}
+            lock = threading.Lock()
+
+            def handler(name):
+                def h(*_a):
+                    with lock:
+                        got[name] += 1
+                return h
+            conns["bob"].ev_values += handler("bob")
+            conns["carol"].ev_values += handler("carol")
+            conns["alice"].fire_events(3)
+            t_end = time.monotonic() + 10
+            while time.monotonic() < t_end and got["bob"] < 3:
+                time.sleep(0.05)
+            time.sleep(0.5)
+            assert got["bob"] == 3, got
+            assert got["carol"] == 0, got  # no read on ev_values: the event does not reach carol
+        checks.check("rr: events reach only sessions allowed to read them", rr_events)
+
+        # ---- JSON API ----
+        prop = "/api/devices/interop/properties/p_int32"
+
+        def json_cookie():
+            h = Http(base)
+            expect_status(h.call("GET", prop), 401, "RobotRaconteur.AuthenticationError")
+            expect_status(h.call("GET", "/api/devices"), 401)
+            expect_status(h.call("POST", "/api/login", {"username": "bob", "password": "nope"}), 401)
+            st, hdrs, body = expect_status(h.call("POST", "/api/login", {"username": "bob", "password": "bob-pw"}), 200)
+            assert body["user"] == "bob" and body["roles"] == ["viewer"], body
+            cookie = hdrs.get("Set-Cookie", "")
+            for part in ("rrgw_session=", "HttpOnly", "SameSite=Strict", "Path=/"):
+                assert part in cookie, cookie
+            assert "Secure" not in cookie, cookie  # plain HTTP
+            assert expect_status(h.call("GET", prop), 200)[2]["value"] == 7
+            assert expect_status(h.call("GET", "/api/whoami"), 200)[2]["user"] == "bob"
+            expect_status(h.call("PUT", prop, {"value": 1}), 403, "RobotRaconteur.PermissionDenied")
+            expect_status(h.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 403)
+            expect_status(h.call("GET", "/api/devices/interop/wires/w_double"), 404)  # allowed to read; no such wire
+            expect_status(h.call("POST", "/api/logout", {}), 200)
+            expect_status(h.call("GET", prop), 401)
+            # alice: all three
+            h2 = Http(base)
+            expect_status(h2.call("POST", "/api/login", {"username": "alice", "password": "alice-pw"}), 200)
+            expect_status(h2.call("PUT", prop, {"value": 8}), 200)
+            assert expect_status(h2.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 200)[2]["return"] == 3
+            # carol: add yes, p_double no
+            h3 = Http(base)
+            expect_status(h3.call("POST", "/api/login", {"username": "carol", "password": "carol-pw"}), 200)
+            expect_status(h3.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 200)
+            expect_status(h3.call("GET", "/api/devices/interop/properties/p_double"), 403)
+            expect_status(h3.call("PUT", prop, {"value": 9}), 403)
+        checks.check("json: cookie login, 401 without, 403 by role", json_cookie)
+
+        def json_tokens():
+            h = Http(base)
+            auth = lambda t: {"Authorization": "Bearer " + t}  # noqa: E731
+            assert expect_status(h.call("GET", prop, headers=auth(TOKEN), cookies=False), 200)[2]["value"] == 8
+            expect_status(h.call("PUT", prop, {"value": 1}, headers=auth(TOKEN), cookies=False), 403)
+            expect_status(h.call("GET", prop, headers=auth(TOKEN + "x"), cookies=False), 401)
+            now = int(time.time())
+            good = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now + 300, "roles": ["operator"]})
+            expect_status(h.call("PUT", prop, {"value": 8}, headers=auth(good), cookies=False), 200)
+            expired = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now - 600, "roles": ["operator"]})
+            expect_status(h.call("GET", prop, headers=auth(expired), cookies=False), 401)
+            forged = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now + 300, "roles": ["operator"]},
+                              secret=b"not-the-secret-not-the-secret-not-the-secret")
+            expect_status(h.call("GET", prop, headers=auth(forged), cookies=False), 401)
+            wrong_aud = make_jwt({"sub": "dave", "aud": "elsewhere", "exp": now + 300, "roles": ["operator"]})
+            expect_status(h.call("GET", prop, headers=auth(wrong_aud), cookies=False), 401)
+            future = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now + 900, "nbf": now + 600})
+            expect_status(h.call("GET", prop, headers=auth(future), cookies=False), 401)
+            viewer_jwt = make_jwt({"sub": "erin", "aud": ["x", "rr-gateway"], "exp": now + 300, "roles": "viewer"})
+            expect_status(h.call("PUT", prop, {"value": 1}, headers=auth(viewer_jwt), cookies=False), 403)
+            # A login with the token gives a cookie session too.
+            h2 = Http(base)
+            expect_status(h2.call("POST", "/api/login", {"token": good}), 200)
+            expect_status(h2.call("PUT", prop, {"value": 8}), 200)
+        checks.check("json: bearer token, JWT valid / expired / forged / wrong audience / not yet valid", json_tokens)
+
+        def json_websocket():
+            import websocket  # websocket-client
+            ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
+
+            def ask(msg):
+                ws.send(json.dumps(msg))
+                while True:
+                    r = json.loads(ws.recv())
+                    if r.get("id") == msg["id"]:
+                        return r
+            r = ask({"id": 1, "op": "get", "device": "interop", "member": "p_int32"})
+            assert r["error"]["name"] == "RobotRaconteur.AuthenticationError", r
+            r = ask({"id": 2, "op": "login", "username": "bob", "password": "wrong"})
+            assert "error" in r, r
+            r = ask({"id": 3, "op": "login", "username": "bob", "password": "bob-pw"})
+            assert r["result"]["user"] == "bob", r
+            assert ask({"id": 4, "op": "get", "device": "interop", "member": "p_int32"})["result"]["value"] == 8
+            r = ask({"id": 5, "op": "set", "device": "interop", "member": "p_int32", "value": 1})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            ws.close()
+            # Logged in by the dashboard's cookie.
+            h = Http(base)
+            st, hdrs, _ = expect_status(h.call("POST", "/api/login", {"username": "carol", "password": "carol-pw"}), 200)
+            sid = hdrs["Set-Cookie"].split(";")[0]
+            ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"],
+                                             header=["Cookie: " + sid], timeout=20)
+            assert ask({"id": 1, "op": "call", "device": "interop", "member": "add", "args": [2, 2]})["result"]["return"] == 4
+            r = ask({"id": 2, "op": "get", "device": "interop", "member": "p_double"})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            r = ask({"id": 3, "op": "subscribe", "device": "interop", "member": "ev_values"})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            ws.close()
+            # A token in the URL is not a login.
+            ws = websocket.create_connection("ws://127.0.0.1:%d/?access_token=%s" % (port, TOKEN),
+                                             subprotocols=["rr-gateway.json.v1"], timeout=20)
+            r = ask({"id": 1, "op": "get", "device": "interop", "member": "p_int32"})
+            assert r["error"]["name"] == "RobotRaconteur.AuthenticationError", r
+            ws.close()
+        checks.check("json: WebSocket login by first message and by cookie, never by URL token", json_websocket)
+
+        # ---- brute force (last: it locks this address out) ----
+        def limits():
+            h = Http(base)
+            for i in range(5):
+                expect_status(h.call("POST", "/api/login", {"username": "alice", "password": "guess%d" % i}), 401)
+            st, hdrs, body = expect_status(h.call("POST", "/api/login", {"username": "alice", "password": "alice-pw"}), 429)
+            assert "Too many failed logins" in body["error"]["message"], body
+            assert int(hdrs.get("Retry-After", "0")) > 0, hdrs
+            expect_rr_error(lambda: RRN.ConnectService(url, "alice", creds("alice-pw")), RR.AuthenticationException,
+                            "Too many failed logins")
+            with urllib.request.urlopen(base + "/metrics", timeout=10) as r:
+                text = r.read().decode()
+            vals = {}
+            for line in text.splitlines():
+                if line.startswith("rr_gateway_login"):
+                    k, v = line.rsplit(" ", 1)
+                    vals[k] = float(v)
+            assert vals.get('rr_gateway_login_failures_total{channel="http"}', 0) >= 6, vals
+            assert vals.get('rr_gateway_login_failures_total{channel="rr"}', 0) >= 2, vals
+            assert vals.get("rr_gateway_login_lockouts_total", 0) >= 1, vals
+            assert vals.get("rr_gateway_login_rate_limited_total", 0) >= 2, vals
+            # Sessions opened before the lockout carry on.
+            assert conns["alice"].p_int32 == 8
+        checks.check("limits: brute force locked out (HTTP 429, RR), /metrics counts", limits)
+
+        for c in conns.values():
+            try:
+                RRN.DisconnectService(c)
+            except Exception:  # noqa: BLE001
+                pass
+    except StepFailed as e:
+        print(json.dumps({"setup_error": str(e)}))
+        return 2
+    finally:
+        stop(gateway)
+        stop(device)
+        try:
+            RRN.Shutdown()
+        except Exception:  # noqa: BLE001
+            pass
+    ok = all(r["ok"] for r in checks.results)
+    print(json.dumps({"ok": ok, "checks": checks.results}, indent=1))
+    if not ok:
+        print(tail(os.path.join(work, "gateway.err")), file=sys.stderr)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
