@@ -1,4 +1,6 @@
 #include "server/app/gateway.hpp"
+#include "server/app/gateway_auth_config.hpp"
+#include "server/gateway/mirror_service.hpp"
 
 #include <cstdio>
 #include <sstream>

@@ -7,7 +7,7 @@ password file in the official format (alice: operator, bob: viewer, carol: adder
 an HS256 JWT key, and roles:
   operator  every member of every device: read, write, call
   viewer    every member of `interop`: read
-  adder     `add`: call; `p_int32`: read
+  adder     `add`, `call_callbacks`: call; `p_int32`: read
 Checks (each one named in the JSON summary):
   rr        official client: right password connects; wrong password, unknown user and no credentials
             are refused (AuthenticationException); the permission matrix (property get/set, function
@@ -166,7 +166,7 @@ gateway:
           allow: [read]
       adder:
         - devices: [interop]
-          members: [add]
+          members: [add, call_callbacks]
           allow: [call]
         - devices: [interop]
           members: p_int32
@@ -232,6 +232,70 @@ devices:
             assert a.p_int32 == 7  # nothing changed by the refused writes
         checks.check("rr: permission matrix (property get/set, function, generator) per role", rr_matrix)
 
+        def rr_wires_memory_pipes():
+            import numpy as np
+            a, b, c = conns["alice"], conns["bob"], conns["carol"]
+            # operator: OutValue reaches the device
+            wa = a.w_sink.Connect()
+            wa.OutValue = 7
+            t_end = time.monotonic() + 10
+            while a.w_sink_value() != 7 and time.monotonic() < t_end:
+                time.sleep(0.05)
+            assert a.w_sink_value() == 7
+            wa.Close()
+            # viewer: may connect (read), but its OutValue never reaches the device, poke is refused
+            wb = b.w_sink.Connect()
+            wb.OutValue = 99
+            time.sleep(1.0)
+            assert a.w_sink_value() == 7, "a viewer's OutValue reached the device"
+            wb.Close()
+            expect_rr_error(lambda: b.w_sink.PokeOutValue(5), RR.PermissionDeniedException, "may not write w_sink")
+            v, _ts = b.w_state.PeekInValue()
+            assert v is not None
+            expect_rr_error(lambda: c.w_state.PeekInValue(), RR.PermissionDeniedException, "may not read w_state")
+            expect_rr_error(lambda: c.w_both.Connect(), RR.PermissionDeniedException)
+            # memory
+            buf = np.zeros((4,))
+            b.mem_double.Read(0, buf, 0, 4)
+            assert b.mem_double.Length > 0
+            expect_rr_error(lambda: b.mem_double.Write(0, np.array([1.0]), 0, 1), RR.PermissionDeniedException,
+                            "may not write mem_double")
+            expect_rr_error(lambda: c.mem_double.Read(0, buf, 0, 4), RR.PermissionDeniedException)
+            a.mem_double.Write(0, np.array([5.0]), 0, 1)
+            # pipes: a viewer may open an endpoint (to receive); carol may not
+            ep = b.p_stream.Connect(-1)
+            ep.Close()
+            expect_rr_error(lambda: c.p_echo.Connect(-1), RR.PermissionDeniedException, "may not read p_echo")
+        checks.check("rr: wires (connect, OutValue, poke, peek), memory, pipes per role", rr_wires_memory_pipes)
+
+        def rr_callbacks():
+            a, c = conns["alice"], conns["carol"]
+            called = {"alice": 0, "carol": 0}
+
+            def compute(who):
+                def f(x, label):
+                    called[who] += 1
+                    return x * 2.0
+                return f
+
+            def notify(who):
+                def f(info):
+                    called[who] += 1
+                return f
+            a.cb_compute.Function = compute("alice")
+            a.cb_notify.Function = notify("alice")
+            c.cb_compute.Function = compute("carol")
+            c.cb_notify.Function = notify("carol")
+            assert a.call_callbacks(3.0) == 7.0
+            assert called["alice"] == 2, called
+            # carol may call call_callbacks but not be called back (no `call` on cb_*): the device's
+            # callbacks go to a session that may take them (alice), never to carol.
+            c.call_callbacks(3.0)
+            assert called["carol"] == 0, called
+            assert called["alice"] == 4, called
+            expect_rr_error(lambda: conns["bob"].call_callbacks(1.0), RR.PermissionDeniedException)
+        checks.check("rr: callbacks reach only sessions allowed to call them", rr_callbacks)
+
         def rr_definition():
             # The viewer's proxy is built from the service definition the gateway sent: every member is
             # there, also the ones bob may not use (permissions are not hidden in the definition).
@@ -278,7 +342,8 @@ devices:
             assert expect_status(h.call("GET", "/api/whoami"), 200)[2]["user"] == "bob"
             expect_status(h.call("PUT", prop, {"value": 1}), 403, "RobotRaconteur.PermissionDenied")
             expect_status(h.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 403)
-            expect_status(h.call("GET", "/api/devices/interop/wires/w_double"), 404)  # allowed to read; no such wire
+            expect_status(h.call("GET", "/api/devices/interop/wires/w_state"), 200)
+            expect_status(h.call("GET", "/api/devices/interop/properties/name?object=child"), 200)  # below the root
             expect_status(h.call("POST", "/api/logout", {}), 200)
             expect_status(h.call("GET", prop), 401)
             # alice: all three
@@ -292,6 +357,8 @@ devices:
             expect_status(h3.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 200)
             expect_status(h3.call("GET", "/api/devices/interop/properties/p_double"), 403)
             expect_status(h3.call("PUT", prop, {"value": 9}), 403)
+            expect_status(h3.call("GET", "/api/devices/interop/wires/w_state"), 403)
+            expect_status(h3.call("GET", "/api/devices/interop/properties/name?object=child"), 403)
         checks.check("json: cookie login, 401 without, 403 by role", json_cookie)
 
         def json_tokens():
@@ -338,6 +405,14 @@ devices:
             assert r["result"]["user"] == "bob", r
             assert ask({"id": 4, "op": "get", "device": "interop", "member": "p_int32"})["result"]["value"] == 8
             r = ask({"id": 5, "op": "set", "device": "interop", "member": "p_int32", "value": 1})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            # bob may subscribe to a wire (read) but not set its OutValue (write)
+            r = ask({"id": 6, "op": "subscribe", "device": "interop", "member": "w_both"})
+            assert "result" in r, r
+            sub = r["result"]["subscription"]
+            r = ask({"id": 7, "op": "set_out_value", "subscription": sub, "value": [1.0]})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            r = ask({"id": 8, "op": "call", "device": "interop", "member": "add", "args": [1, 1]})
             assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
             ws.close()
             # Logged in by the dashboard's cookie.

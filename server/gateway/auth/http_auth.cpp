@@ -1,5 +1,8 @@
 #include "server/gateway/auth/http_auth.hpp"
 
+#include <algorithm>
+#include <cctype>
+
 #include <boost/beast/http.hpp>
 
 #include "server/gateway/json_api.hpp"

@@ -1,6 +1,7 @@
 #include "server/gateway/auth/token_auth.hpp"
 
 #include <cerrno>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
