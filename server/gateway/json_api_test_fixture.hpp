@@ -134,7 +134,8 @@ public:
         d.backoff_initial = 100ms;
         d.backoff_max = 200ms;
         cfg.devices.push_back(d);
-        auto installer = [this, ws_options](http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices) {
+        auto installer = [this, ws_options](http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices,
+                                                   std::shared_ptr<auth::GatewayAuth>) {
             api_ = std::make_shared<JsonApi>(devices);
             install_json_rest(http, api_);
             sockets_ = install_json_socket(http, api_, ws_options);

@@ -50,6 +50,7 @@ except ImportError as e:  # pragma: no cover
 
 RRN = RR.RobotRaconteurNode.s
 
+A, B = -2147483648, 2147483647  # the two p_int32 values rr_interop_service accepts (interop_values.py)
 USERS = {"alice": ("alice-pw", "operator,objectlock"), "bob": ("bob-pw", "viewer"), "carol": ("carol-pw", "adder")}
 TOKEN = "wall-display-token-5d41402abc4b2a76"
 JWT_SECRET = b"an-hs256-secret-of-at-least-32-bytes!!"
@@ -213,23 +214,23 @@ devices:
         def rr_matrix():
             a, b, c = conns["alice"], conns["bob"], conns["carol"]
             # operator: everything
-            a.p_int32 = 7
-            assert a.p_int32 == 7
+            a.p_int32 = B
+            assert a.p_int32 == B
             assert a.add(2, 3) == 5
             assert list(a.count_up(1, 3).NextAll()) == [1, 2, 3]
             # viewer: read only
-            assert b.p_int32 == 7
+            assert b.p_int32 == B
             assert b.p_double is not None
             expect_rr_error(lambda: setattr(b, "p_int32", 9), RR.PermissionDeniedException, "may not write p_int32")
             expect_rr_error(lambda: b.add(1, 1), RR.PermissionDeniedException, "may not call add")
             expect_rr_error(lambda: b.count_up(1, 2), RR.PermissionDeniedException)
             # adder: add and p_int32 only
             assert c.add(40, 2) == 42
-            assert c.p_int32 == 7
+            assert c.p_int32 == B
             expect_rr_error(lambda: c.p_double, RR.PermissionDeniedException, "may not read p_double")
             expect_rr_error(lambda: setattr(c, "p_int32", 1), RR.PermissionDeniedException)
             expect_rr_error(lambda: c.reset(), RR.PermissionDeniedException)
-            assert a.p_int32 == 7  # nothing changed by the refused writes
+            assert a.p_int32 == B  # nothing changed by the refused writes
         checks.check("rr: permission matrix (property get/set, function, generator) per role", rr_matrix)
 
         def rr_wires_memory_pipes():
@@ -300,7 +301,7 @@ devices:
             # The viewer's proxy is built from the service definition the gateway sent: every member is
             # there, also the ones bob may not use (permissions are not hidden in the definition).
             b = conns["bob"]
-            for m in ("add", "reset", "count_up", "ev_values", "p_int32", "p_echo", "child"):
+            for m in ("add", "reset", "count_up", "ev_values", "p_int32", "p_echo", "get_child"):
                 assert m in dir(b), m
         checks.check("rr: a viewer's service definition lists every member", rr_definition)
 
@@ -338,7 +339,7 @@ devices:
             for part in ("rrgw_session=", "HttpOnly", "SameSite=Strict", "Path=/"):
                 assert part in cookie, cookie
             assert "Secure" not in cookie, cookie  # plain HTTP
-            assert expect_status(h.call("GET", prop), 200)[2]["value"] == 7
+            assert expect_status(h.call("GET", prop), 200)[2]["value"] == B
             assert expect_status(h.call("GET", "/api/whoami"), 200)[2]["user"] == "bob"
             expect_status(h.call("PUT", prop, {"value": 1}), 403, "RobotRaconteur.PermissionDenied")
             expect_status(h.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 403)
@@ -349,7 +350,7 @@ devices:
             # alice: all three
             h2 = Http(base)
             expect_status(h2.call("POST", "/api/login", {"username": "alice", "password": "alice-pw"}), 200)
-            expect_status(h2.call("PUT", prop, {"value": 8}), 200)
+            expect_status(h2.call("PUT", prop, {"value": A}), 200)
             assert expect_status(h2.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 200)[2]["return"] == 3
             # carol: add yes, p_double no
             h3 = Http(base)
@@ -364,12 +365,12 @@ devices:
         def json_tokens():
             h = Http(base)
             auth = lambda t: {"Authorization": "Bearer " + t}  # noqa: E731
-            assert expect_status(h.call("GET", prop, headers=auth(TOKEN), cookies=False), 200)[2]["value"] == 8
+            assert expect_status(h.call("GET", prop, headers=auth(TOKEN), cookies=False), 200)[2]["value"] == A
             expect_status(h.call("PUT", prop, {"value": 1}, headers=auth(TOKEN), cookies=False), 403)
             expect_status(h.call("GET", prop, headers=auth(TOKEN + "x"), cookies=False), 401)
             now = int(time.time())
             good = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now + 300, "roles": ["operator"]})
-            expect_status(h.call("PUT", prop, {"value": 8}, headers=auth(good), cookies=False), 200)
+            expect_status(h.call("PUT", prop, {"value": A}, headers=auth(good), cookies=False), 200)
             expired = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now - 600, "roles": ["operator"]})
             expect_status(h.call("GET", prop, headers=auth(expired), cookies=False), 401)
             forged = make_jwt({"sub": "dave", "aud": "rr-gateway", "exp": now + 300, "roles": ["operator"]},
@@ -384,7 +385,7 @@ devices:
             # A login with the token gives a cookie session too.
             h2 = Http(base)
             expect_status(h2.call("POST", "/api/login", {"token": good}), 200)
-            expect_status(h2.call("PUT", prop, {"value": 8}), 200)
+            expect_status(h2.call("PUT", prop, {"value": A}), 200)
         checks.check("json: bearer token, JWT valid / expired / forged / wrong audience / not yet valid", json_tokens)
 
         def json_websocket():
@@ -403,7 +404,7 @@ devices:
             assert "error" in r, r
             r = ask({"id": 3, "op": "login", "username": "bob", "password": "bob-pw"})
             assert r["result"]["user"] == "bob", r
-            assert ask({"id": 4, "op": "get", "device": "interop", "member": "p_int32"})["result"]["value"] == 8
+            assert ask({"id": 4, "op": "get", "device": "interop", "member": "p_int32"})["result"]["value"] == A
             r = ask({"id": 5, "op": "set", "device": "interop", "member": "p_int32", "value": 1})
             assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
             # bob may subscribe to a wire (read) but not set its OutValue (write)
@@ -457,7 +458,7 @@ devices:
             assert vals.get("rr_gateway_login_lockouts_total", 0) >= 1, vals
             assert vals.get("rr_gateway_login_rate_limited_total", 0) >= 2, vals
             # Sessions opened before the lockout carry on.
-            assert conns["alice"].p_int32 == 8
+            assert conns["alice"].p_int32 == A
         checks.check("limits: brute force locked out (HTTP 429, RR), /metrics counts", limits)
 
         for c in conns.values():
