@@ -62,8 +62,9 @@ GatewayHarness* start() {
     };
     auto g = server::app::Gateway::start(
         config, starter,
-        [h](server::http::HttpServer& http, const std::vector<std::shared_ptr<server::gateway::DeviceMirror>>& d) {
-            auto api = server::gateway::install_json_api(http, d);
+        [h](server::http::HttpServer& http, const std::vector<std::shared_ptr<server::gateway::DeviceMirror>>& d,
+            std::shared_ptr<server::gateway::auth::GatewayAuth> auth) {
+            auto api = server::gateway::install_json_api(http, d, std::move(auth));
             h->http = &http;
             return api;
         });

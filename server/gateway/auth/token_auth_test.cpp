@@ -38,8 +38,10 @@ KeyPair make_keys(bool rsa) {
 
 // Claims as JSON text; signed with `alg` and `key`.
 std::string make_jwt(jwt_alg_t alg, const std::string& key, const std::string& claims_json) {
-    jwt_t* j = nullptr;
-    REQUIRE(jwt_new(&j) == 0);
+    jwt_t* raw = nullptr;
+    REQUIRE(jwt_new(&raw) == 0);
+    std::unique_ptr<jwt_t, decltype(&jwt_free)> owner(raw, jwt_free);  // freed when a REQUIRE fails too
+    jwt_t* j = owner.get();
     REQUIRE(jwt_add_grants_json(j, claims_json.c_str()) == 0);
     REQUIRE(jwt_set_alg(j, alg, alg == JWT_ALG_NONE ? nullptr : reinterpret_cast<const unsigned char*>(key.data()),
                         alg == JWT_ALG_NONE ? 0 : static_cast<int>(key.size())) == 0);
@@ -47,12 +49,12 @@ std::string make_jwt(jwt_alg_t alg, const std::string& key, const std::string& c
     REQUIRE(s);
     std::string out(s);
     free(s);  // NOLINT: libjwt 1.10 allocates with malloc (no jwt_free_str yet)
-    jwt_free(j);
     return out;
 }
 
-std::string claims(std::int64_t exp, std::string extra = "") {
-    return R"({"sub":"carol","aud":"rr-gateway","roles":["viewer","driver"],"exp":)" + std::to_string(exp) + extra + "}";
+// `roles`: the roles claim's JSON value (libjwt refuses a duplicate key, so it is not added twice).
+std::string claims(std::int64_t exp, std::string extra = "", std::string roles = R"(["viewer","driver"])") {
+    return R"({"sub":"carol","aud":"rr-gateway","roles":)" + roles + R"(,"exp":)" + std::to_string(exp) + extra + "}";
 }
 
 JwtVerifier verifier(std::string alg, std::string key, std::string issuer = "") {
@@ -147,7 +149,7 @@ TEST_CASE("gateway auth: JWT ES256 and RS256 with public keys; no algorithm conf
 
     auto rsa = make_keys(true);
     auto r = verifier("RS256", rsa.public_pem);
-    auto ok = r.verify(make_jwt(JWT_ALG_RS256, rsa.private_pem, claims(kNow + 60, R"(,"roles":"viewer, driver")")), kNow);
+    auto ok = r.verify(make_jwt(JWT_ALG_RS256, rsa.private_pem, claims(kNow + 60, "", R"("viewer, driver")")), kNow);
     REQUIRE(ok);
     CHECK(ok->roles == std::vector<std::string>{"viewer", "driver"});
     CHECK_FALSE(r.verify(make_jwt(JWT_ALG_HS256, rsa.public_pem, claims(kNow + 60)), kNow));
