@@ -330,7 +330,7 @@ devices:
     }
 }
 
-TEST_CASE("gateway.auth parses users, tokens, jwt, roles and limits; bad keys are clear errors") {
+TEST_CASE("gateway.auth parses users, tokens, jwt, roles and limits, and bad keys are clear errors") {
     auto c = parse_gateway_config(R"(
 gateway:
   auth:
@@ -399,7 +399,7 @@ gateway:
     }
 }
 
-TEST_CASE("gateway.auth files: the example loads; a bad file is a configuration error naming it") {
+TEST_CASE("gateway.auth files: the example loads, and a bad file is a configuration error naming it") {
     auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/auth.yaml");
     REQUIRE(c);
     auto abs = [](std::string& p) { p = std::string(RR_SOURCE_DIR) + "/" + p; };

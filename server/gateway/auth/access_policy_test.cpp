@@ -20,7 +20,7 @@ TEST_CASE("gateway auth: glob patterns match literally except *") {
     CHECK_FALSE(AccessPolicy::glob_match("a*b*c", "axxbyy"));
 }
 
-TEST_CASE("gateway auth: rules allow per role, device and member; everything else is denied") {
+TEST_CASE("gateway auth: rules allow per role, device and member, and deny everything else") {
     AccessPolicy p;
     p.add_role("viewer", {AccessRule{{"*"}, {"*"}, true, false, false}});
     p.add_role("driver", {AccessRule{{"create"}, {"Drive", "StopAll"}, false, false, true},

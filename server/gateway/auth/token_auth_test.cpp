@@ -138,7 +138,7 @@ TEST_CASE("gateway auth: JWT HS256 with exp, nbf, aud, iss") {
     CHECK_FALSE(v.verify(std::string(20000, 'a'), kNow));
 }
 
-TEST_CASE("gateway auth: JWT ES256 and RS256 with public keys; no algorithm confusion") {
+TEST_CASE("gateway auth: JWT ES256 and RS256 with public keys, no algorithm confusion") {
     auto ec = make_keys(false);
     auto v = verifier("ES256", ec.public_pem);
     CHECK(v.verify(make_jwt(JWT_ALG_ES256, ec.private_pem, claims(kNow + 60)), kNow));
