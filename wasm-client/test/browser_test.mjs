@@ -5,7 +5,8 @@
 // Usage: node browser_test.mjs --interop-service PATH --gateway PATH [--only REGEX]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
 import { spawn, spawnSync } from "node:child_process";
-import { existsSync } from "node:fs";
+import { existsSync, mkdtempSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
 import { createRequire } from "node:module";
 import { createInterface } from "node:readline";
 import { dirname, join } from "node:path";
@@ -70,8 +71,12 @@ let code = 2;
 try {
   const svc = start(arg("--interop-service"), ["--port", "0", "--max-lifetime", "300"]);
   const dev = await readyLine(svc, "url");
-  const gw = start(arg("--gateway"), ["--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning",
-    "--web-root", pkgRoot, "--device", `interop=${dev.url}`]);
+  // `auth: passthrough` (docs/security.md): the page gets its own session to the device, so the monitor
+  // lock check locks on the device itself (a shared device refuses locks), as in node_test.mjs.
+  const config = join(mkdtempSync(join(tmpdir(), "rr-wasm-browser-")), "gateway.yaml");
+  writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(dev.url)}\n    auth: passthrough\n`);
+  const gw = start(arg("--gateway"), ["--config", config, "--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0",
+    "--log-level", "warning", "--web-root", pkgRoot]);
   const { port } = await readyLine(gw, "port");
   for (let i = 0; ; i++) {
     const r = await fetch(`http://127.0.0.1:${port}/readyz`).catch(() => null);
