@@ -1,5 +1,7 @@
 #include "core/message/error_entry.hpp"
 
+#include <utility>
+
 namespace rr {
 namespace {
 
@@ -38,6 +40,16 @@ std::optional<RRError> entry_error(const MessageEntry& entry) {
     e.message = string_value(entry, "errorstring").value_or(std::string());
     e.sub_name = string_value(entry, "errorsubname").value_or(std::string());
     return e;
+}
+
+MessageEntry relayed_reply(MessageEntry header, Result<MessageEntry> result) {
+    if (!result) {
+        set_entry_error(header, result.error());
+    } else {
+        header.error = result->error;
+        header.elements = std::move(result->elements);
+    }
+    return header;
 }
 
 }  // namespace rr

@@ -24,4 +24,8 @@ void set_entry_error(MessageEntry& entry, const RRError& error);
 /// the sub-name from `errorsubname`.
 std::optional<RRError> entry_error(const MessageEntry& entry);
 
+/// The reply a relay forwards: `header` (its EntryType, ServicePath, MemberName, RequestID) carrying
+/// the relayed reply's error code and elements, or set_entry_error() of a request that failed.
+MessageEntry relayed_reply(MessageEntry header, Result<MessageEntry> result);
+
 }  // namespace rr

@@ -605,14 +605,7 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
         auto m = weak.lock();
         auto c = m ? m->upstream() : nullptr;
         if (!c) return;
-        MessageEntry reply = reply_header;
-        if (!r) {
-            set_entry_error(reply, r.error());
-        } else {
-            reply.error = r->error;
-            reply.elements = std::move(r->elements);
-        }
-        c->send(std::move(reply));
+        c->send(relayed_reply(reply_header, std::move(r)));
     });
 }
 

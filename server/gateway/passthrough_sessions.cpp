@@ -295,14 +295,7 @@ void PassthroughSessions::deliver(const SessionRef& session, const std::shared_p
             session.request(std::move(entry), [weak_client, reply_header](Result<MessageEntry> r) mutable {
                 auto c = weak_client.lock();
                 if (!c) return;
-                MessageEntry reply = reply_header;
-                if (!r) {
-                    set_entry_error(reply, r.error());
-                } else {
-                    reply.error = r->error;
-                    reply.elements = std::move(r->elements);
-                }
-                c->send(std::move(reply));
+                c->send(relayed_reply(reply_header, std::move(r)));
             });
             return;
         }

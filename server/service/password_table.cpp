@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/session/elements.hpp"
+#include "server/common/digest_hex.hpp"
 
 namespace rr::server {
 
@@ -46,19 +47,7 @@ bool same_time_equal(std::string_view a, std::string_view b) {
 
 }  // namespace
 
-std::string PasswordTable::md5_hex(std::string_view text) {
-    unsigned char digest[EVP_MAX_MD_SIZE];
-    unsigned int len = 0;
-    EVP_Digest(text.data(), text.size(), digest, &len, EVP_md5(), nullptr);
-    static constexpr char kHex[] = "0123456789abcdef";
-    std::string out;
-    out.reserve(2 * len);
-    for (unsigned i = 0; i < len; ++i) {
-        out += kHex[digest[i] >> 4];
-        out += kHex[digest[i] & 0x0F];
-    }
-    return out;
-}
+std::string PasswordTable::md5_hex(std::string_view text) { return server::md5_hex(text); }
 
 void PasswordTable::add_user(std::string username, std::string_view password, std::vector<std::string> privileges) {
     (void)add_user_md5(std::move(username), md5_hex(password), std::move(privileges));

@@ -1,5 +1,7 @@
 #include "server/gateway/auth/token_auth.hpp"
 
+#include "server/common/digest_hex.hpp"
+
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
@@ -53,19 +55,7 @@ struct JwtFree {
 
 }  // namespace
 
-std::string BearerTokens::sha256_hex(std::string_view text) {
-    unsigned char md[EVP_MAX_MD_SIZE];
-    unsigned int n = 0;
-    EVP_Digest(text.data(), text.size(), md, &n, EVP_sha256(), nullptr);
-    static constexpr char kHex[] = "0123456789abcdef";
-    std::string out;
-    out.reserve(n * 2);
-    for (unsigned i = 0; i < n; ++i) {
-        out += kHex[md[i] >> 4];
-        out += kHex[md[i] & 15];
-    }
-    return out;
-}
+std::string BearerTokens::sha256_hex(std::string_view text) { return server::sha256_hex(text); }
 
 Result<BearerTokens> BearerTokens::parse(std::string_view text) {
     BearerTokens t;
