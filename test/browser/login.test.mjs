@@ -132,6 +132,14 @@ test("a viewer sees live data but cannot write", async () => {
   });
   assert.equal(call.status, 403, JSON.stringify(call));
   assert.equal(call.body?.error?.name, "RobotRaconteur.PermissionDenied");
+  // The dashboard shows the refusal where it happens: Drive through the page's RR session.
+  const drive = page.locator('.device-view[data-device="create"] .member[data-member="Drive"]');
+  await drive.locator('[aria-label="velocity"]').fill("0");
+  await drive.locator('[aria-label="radius"]').fill("32767");
+  await drive.locator("button[type=submit]").click();
+  const refusal = drive.locator(".member-error");
+  await refusal.waitFor({ state: "visible", timeout: 15000 });
+  assert.match(await refusal.textContent(), /PermissionDenied|may not call/i);
   await page.screenshot({ path: path.join(s.artifacts, "51-login-viewer.png") });
   await context.close();
 });
