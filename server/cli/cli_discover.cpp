@@ -57,11 +57,11 @@ bool needs_discovery(const ConnectionUrl& url) {
 }
 
 ExitCode run_discover(const CommandLine& cl, std::ostream& out, std::ostream& err) {
-    client::IoThreads io(2);
+    auto io = command_io_threads(2);  // shared with rr+usb: service info is read from USB nodes too
     DiscoveryOptions o;
     o.listen = true;
     o.interfaces = cl.interfaces;
-    auto d = NodeDiscovery::create(io.executor(), o);
+    auto d = NodeDiscovery::create(io->executor(), o);
     d->want_services(true);
     if (auto r = d->start(); !r) {
         err << "rr: " << error_name(r.error().type) << ": " << r.error().message << std::endl;
@@ -124,11 +124,11 @@ ExitCode run_discover(const CommandLine& cl, std::ostream& out, std::ostream& er
 
 Result<std::vector<std::string>> resolve_through_discovery(const ConnectionUrl& url, double timeout_s,
                                                            const std::vector<std::string>& interfaces) {
-    client::IoThreads io(1);
+    auto io = command_io_threads(1);
     DiscoveryOptions o;
     o.listen = true;
     o.interfaces = interfaces;
-    auto d = NodeDiscovery::create(io.executor(), o);
+    auto d = NodeDiscovery::create(io->executor(), o);
     if (auto r = d->start(); !r) return r.take_error();
     const auto deadline = std::chrono::steady_clock::now() + seconds(timeout_s);
     std::vector<NodeEntry> found;

@@ -5,6 +5,7 @@
 
 #include "core/json/value_json.hpp"
 #include "core/names/connection_url.hpp"
+#include "server/cli/cli_usb.hpp"
 #include "server/transport/websocket_connector.hpp"
 
 namespace rr::cli {
@@ -66,7 +67,7 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
     if (auto colon = cl.http_login.find(':'); colon != std::string::npos)
         options.http_authorization = server::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
     options.enable_message4 = !cl.disable_message4;
-    target.io = std::make_unique<client::IoThreads>(1);
+    target.io = command_io_threads(1);
     auto c = Client::connect(target.io->executor(), url, options);
     if (!c) return Failure{ExitCode::connect_failure, c.error()};
     target.client = *c;

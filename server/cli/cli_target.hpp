@@ -30,7 +30,7 @@ struct MemberInfo {
 
 /// The connected client. Errors: connect_failure (or usage_error for a URL that does not parse).
 struct Target {
-    std::unique_ptr<client::IoThreads> io;
+    std::shared_ptr<client::IoThreads> io;  ///< command_io_threads(): shared with rr+usb when on
     std::shared_ptr<client::Client> client;
     client::ObjectProxy object;  ///< the root, or the object at the objref path
 

@@ -16,17 +16,23 @@ namespace rr::cli {
 
 namespace {
 
-// The host, started on first use; shut down by the guard.
+// The host, started on first use; shut down by the guard. Its io threads also run the commands' client
+// strands (command_io_threads): the host completes a connect by posting to the client's strand from its
+// own thread, which is only safe while that strand's io_context lives, so the two share one that lasts
+// until the guard goes.
 class LazyUsb {
 public:
+    std::shared_ptr<client::IoThreads> io() {
+        std::lock_guard lock(mutex_);
+        return io_locked();
+    }
     Result<std::shared_ptr<server::usb::UsbHost>> host() {
         std::lock_guard lock(mutex_);
         if (closed_) return fail(MessageErrorType::ConnectionError, "rr+usb: shut down");
         if (host_) return host_;
         if (start_error_) return fail(*start_error_);
-        io_ = std::make_unique<client::IoThreads>(1);
         server::usb::UsbHostOptions o;
-        auto h = server::usb::UsbHost::create(io_->executor(), o);
+        auto h = server::usb::UsbHost::create(io_locked()->executor(), o);
         if (!h) {
             start_error_ = make_error(h.error().type, "rr+usb: " + h.error().message);
             return fail(*start_error_);
@@ -36,7 +42,7 @@ public:
     }
     void close() {
         std::shared_ptr<server::usb::UsbHost> h;
-        std::unique_ptr<client::IoThreads> io;
+        std::shared_ptr<client::IoThreads> io;
         {
             std::lock_guard lock(mutex_);
             closed_ = true;
@@ -48,13 +54,18 @@ public:
             for (int i = 0; i < 200 && !h->idle(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
         }
         h.reset();
-        io.reset();  // joins the host's strand thread
+        io.reset();  // joins the host's strand thread (unless a command still holds it)
     }
 
 private:
+    std::shared_ptr<client::IoThreads> io_locked() {
+        if (!io_) io_ = std::make_shared<client::IoThreads>(2);
+        return io_;
+    }
+
     std::mutex mutex_;
     bool closed_ = false;
-    std::unique_ptr<client::IoThreads> io_;
+    std::shared_ptr<client::IoThreads> io_;
     std::shared_ptr<server::usb::UsbHost> host_;
     std::optional<RRError> start_error_;
 };
@@ -110,6 +121,11 @@ std::unique_ptr<UsbGuard> install_usb_transport() {
     return std::make_unique<RealGuard>(usb);
 }
 
+std::shared_ptr<client::IoThreads> command_io_threads(unsigned threads) {
+    if (auto usb = current()) return usb->io();
+    return std::make_shared<client::IoThreads>(threads);
+}
+
 Result<std::vector<CliUsbDevice>> list_usb_devices(std::chrono::milliseconds timeout) {
     auto usb = current();
     if (!usb) return fail(MessageErrorType::NotImplementedError, "rr+usb is not set up in this program");
@@ -130,6 +146,8 @@ class NoGuard final : public UsbGuard {};
 }  // namespace
 
 std::unique_ptr<UsbGuard> install_usb_transport() { return std::make_unique<NoGuard>(); }
+
+std::shared_ptr<client::IoThreads> command_io_threads(unsigned threads) { return std::make_shared<client::IoThreads>(threads); }
 
 Result<std::vector<CliUsbDevice>> list_usb_devices(std::chrono::milliseconds) {
     return fail(MessageErrorType::NotImplementedError, "this rr was built without libusb (no rr+usb)");

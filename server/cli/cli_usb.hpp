@@ -14,6 +14,10 @@
 #include "core/error/rr_error.hpp"
 #include "core/names/node_id.hpp"
 
+namespace rr::client {
+class IoThreads;
+}
+
 namespace rr::cli {
 
 /// Keeps the CLI's USB host; destroying it shuts libusb down (keep it until the end of main).
@@ -25,6 +29,12 @@ public:
 /// Registers the lazy rr+usb connector in server::default_transports(). Returns the guard (a no-op
 /// one when the build has no libusb).
 std::unique_ptr<UsbGuard> install_usb_transport();
+
+/// The io threads a command runs its client (and discovery) on. With rr+usb installed these are the USB
+/// host's own, kept until the guard goes: the host hands a connect's result to the client's strand
+/// from its thread, so the client's io_context must outlive the host's work on it. Otherwise new ones
+/// with `threads` threads.
+std::shared_ptr<client::IoThreads> command_io_threads(unsigned threads);
 
 /// An RR USB device as `rr discover` shows it.
 struct CliUsbDevice {
