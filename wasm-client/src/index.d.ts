@@ -159,6 +159,10 @@ export interface ConnectOptions {
   nodeName?: string;
   /** WebSocket class to use (default: globalThis.WebSocket, else the `ws` package in node). */
   WebSocket?: any;
+  /** Node only, rr+wss only: PEM certificate(s) the server's chain must lead to, used instead of node's
+   *  built-in CA list (node's `--use-openssl-ca` flag makes that list the system's). A browser uses its
+   *  own trust store and rejects this option with InvalidArgument. */
+  ca?: string | Uint8Array | Array<string | Uint8Array>;
 }
 
 /** Connects to `url` (`rr+ws://host:port/?service=name`, or rr+wss) and returns the root object's proxy. */

@@ -29,9 +29,12 @@ export function loadModule() {
   return modulePromise;
 }
 
+const inNode = typeof process !== "undefined" && !!process.versions?.node;
+
 async function webSocketClass(options) {
   if (options.WebSocket) return options.WebSocket;
-  if (typeof globalThis.WebSocket === "function") return globalThis.WebSocket;
+  // A given CA needs the `ws` package's TLS options: node's global WebSocket (node 22) takes none.
+  if (typeof globalThis.WebSocket === "function" && (options.ca === undefined || !inNode)) return globalThis.WebSocket;
   const name = "ws";  // node: the `ws` package (kept out of bundlers' static analysis)
   const m = await import(/* @vite-ignore */ name);
   return m.WebSocket ?? m.default;
@@ -92,7 +95,9 @@ export class Connection {
       endpoint,
       now: now(),
     });
-    this.ws = new WebSocketImpl(url.wsUrl, WEBSOCKET_PROTOCOL);
+    // ca: the `ws` package's TLS option (node); a browser checks certificates against its own store.
+    this.ws = options.ca === undefined ? new WebSocketImpl(url.wsUrl, WEBSOCKET_PROTOCOL)
+      : new WebSocketImpl(url.wsUrl, WEBSOCKET_PROTOCOL, { ca: options.ca });
     this.ws.binaryType = "arraybuffer";
   }
 
@@ -132,7 +137,8 @@ export class Connection {
         this.scheduleFlush();
         if (!r.ok) this.flush();
       };
-      this.ws.onerror = () => this.fail(`WebSocket error (${this.url.wsUrl})`);
+      // node's `ws` says why (e.g. "self-signed certificate"); browsers give no reason.
+      this.ws.onerror = (ev) => this.fail(`WebSocket error (${this.url.wsUrl})${ev?.message ? `: ${ev.message}` : ""}`);
       this.ws.onclose = (ev) => this.fail(`WebSocket closed${ev?.code ? ` (code ${ev.code})` : ""}`);
     });
   }
@@ -274,10 +280,16 @@ export class Connection {
 /**
  * Connects to the service named in `url` (rr+ws:// or rr+wss://) and returns the root object's proxy.
  * Options: timeoutMs (connect and per request, default 15000), username, password, nodeName,
- * WebSocket (a WebSocket class; default globalThis.WebSocket, else the `ws` package in node).
+ * WebSocket (a WebSocket class; default globalThis.WebSocket, else the `ws` package in node), ca (node
+ * only: the PEM certificates an rr+wss server's chain must lead to, instead of node's own list).
  */
 export async function connect(url, options = {}) {
   const u = parseUrl(url);
+  if (options.ca !== undefined && !inNode && !options.WebSocket)
+    throw new RRError("RobotRaconteur.InvalidArgument",
+      "the ca option works in node only: a browser checks an rr+wss certificate against its own trust store", 18);
+  if (options.ca !== undefined && !u.wsUrl.startsWith("wss:"))
+    throw new RRError("RobotRaconteur.InvalidArgument", `the ca option is for rr+wss URLs, not ${url}`, 18);
   if (!webcrypto) webcrypto = (await import("node:crypto")).webcrypto;  // node 18 has no global crypto
   const M = await loadModule();
   const WS = await webSocketClass(options);

@@ -5,6 +5,7 @@
 //   3. the official Python service (test/interop/official_service.py), rr+ws on its TCP port
 //   4. the official service with message format v2 only; 5. ours with v4 string tables;
 //   6. ours behind nginx terminating TLS (rr+wss), when nginx and openssl are installed
+//   7. the gateway serving TLS itself (rr+wss, its certificate given with the ca option; refused without)
 //
 // Usage: node node_test.mjs --interop-service PATH --gateway PATH --python PATH [--only REGEX] [--target NAME]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
@@ -81,15 +82,30 @@ async function gatewayReady(port, timeoutMs = 30000) {
 // rr-gateway with the service at `deviceUrl` as device "interop"; the rr+ws URL clients use. The device
 // is in `auth: passthrough` mode (docs/security.md): the client gets its own session to the device, so
 // the monitor lock check locks on the device itself (a shared device refuses locks).
-async function behindGateway(deviceUrl) {
+// `moreConfig`: YAML put before the devices (e.g. a gateway: section). With gateway.tls the port still
+// answers plain HTTP (tls.required is off), so the readiness check is the same.
+async function behindGateway(deviceUrl, moreConfig = "") {
   const dir = mkdtempSync(join(tmpdir(), "rr-wasm-gw-"));
   const config = join(dir, "gateway.yaml");
-  writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: passthrough\n`);
+  writeFileSync(config, `${moreConfig}devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: passthrough\n`);
   const gw = start(arg("--gateway"), ["--config", config, "--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0",
     "--log-level", "warning"]);
   const { port } = await readyLine(gw, "port");
   await gatewayReady(port);
   return `rr+ws://127.0.0.1:${port}/?service=interop`;
+}
+
+/** A self-signed certificate for 127.0.0.1 in a fresh temporary folder (removed at exit). */
+function selfSignedCertificate(prefix) {
+  const tmp = mkdtempSync(join(tmpdir(), prefix));
+  process.on("exit", () => rmSync(tmp, { recursive: true, force: true }));
+  const cert = join(tmp, "cert.pem");
+  const key = join(tmp, "key.pem");
+  const gen = spawnSync("openssl", ["req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
+    "-nodes", "-days", "1", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1", "-keyout", key,
+    "-out", cert]);
+  if (gen.status !== 0) throw new Error(`openssl: ${gen.stderr}`);
+  return { tmp, cert, key };
 }
 
 const targets = {
@@ -125,14 +141,7 @@ const targets = {
     if (!nginx || spawnSync("sh", ["-c", "command -v openssl"]).status !== 0) return null;
     const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--max-lifetime", "300"]);
     const { port } = await readyLine(svc, "ws_url");
-    const tmp = mkdtempSync(join(tmpdir(), "rr-wasm-wss-"));
-    process.on("exit", () => rmSync(tmp, { recursive: true, force: true }));
-    const cert = join(tmp, "cert.pem");
-    const key = join(tmp, "key.pem");
-    const gen = spawnSync("openssl", ["req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
-      "-nodes", "-days", "1", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1", "-keyout", key,
-      "-out", cert]);
-    if (gen.status !== 0) throw new Error(`openssl: ${gen.stderr}`);
+    const { tmp, cert, key } = selfSignedCertificate("rr-wasm-wss-");
     const tlsPort = await freePort();
     writeFileSync(join(tmp, "nginx.conf"), `pid ${tmp}/nginx.pid; error_log ${tmp}/error.log;
 events {}
@@ -149,13 +158,7 @@ http {
 }
 `);
     start(nginx, ["-p", tmp, "-c", join(tmp, "nginx.conf"), "-g", "daemon off;"]);
-    const ca = readFileSync(cert);
-    const { WebSocket } = await import("ws");
-    options.WebSocket = class extends WebSocket {
-      constructor(url, protocols) {
-        super(url, protocols, { ca });
-      }
-    };
+    options.ca = readFileSync(cert);
     for (let i = 0; ; i++) {  // until nginx listens
       const up = await new Promise((resolve) => {
         const s = connectTcp(tlsPort, "127.0.0.1", () => resolve(true)).on("error", () => resolve(false));
@@ -166,6 +169,32 @@ http {
       await new Promise((r) => setTimeout(r, 100));
     }
     return `rr+wss://127.0.0.1:${tlsPort}/?service=interop`;
+  },
+  // rr+wss served by the gateway itself (gateway.tls), its certificate trusted through the ca option;
+  // without that option node's own CA list refuses the self-signed certificate, and says so.
+  async "gateway-wss"() {
+    if (spawnSync("sh", ["-c", "command -v openssl"]).status !== 0) return null;
+    const { cert, key } = selfSignedCertificate("rr-wasm-gwtls-");
+    const svc = start(arg("--interop-service"), ["--port", "0", "--max-lifetime", "300"]);
+    const url = await behindGateway((await readyLine(svc, "url")).url,
+      `gateway:\n  tls:\n    certificate: ${JSON.stringify(cert)}\n    private_key: ${JSON.stringify(key)}\n`);
+    const wssUrl = url.replace("rr+ws://", "rr+wss://");
+    const refused = await rr.connect(wssUrl, { timeoutMs: 10000 }).then((c) => c.$client.close().then(() => null), (e) => e);
+    if (!refused || refused.errorName !== "RobotRaconteur.ConnectionError" || !/certificate/i.test(refused.message)) {
+      console.log(`  FAIL rr+wss without ca: expected a ConnectionError naming the certificate, got ${refused?.errorName}: ${refused?.message}`);
+      failed++;
+    } else {
+      console.log(`  ok rr+wss without ca is refused: ${refused.message}`);
+    }
+    const misused = await rr.connect(url, { ca: readFileSync(cert) }).then(() => null, (e) => e);
+    if (misused?.errorName !== "RobotRaconteur.InvalidArgument") {
+      console.log(`  FAIL ca with an rr+ws URL: expected InvalidArgument, got ${misused?.errorName}: ${misused?.message}`);
+      failed++;
+    } else {
+      console.log(`  ok ca with an rr+ws URL: ${misused.message}`);
+    }
+    options.ca = readFileSync(cert, "utf8");
+    return wssUrl;
   },
   async "ours-stringtable"() {
     const svc = start(arg("--interop-service"), ["--port", "0", "--websocket", "--enable-stringtable",
