@@ -16,7 +16,14 @@ Unexpected config_error(const std::string& key, const std::string& message) {
 }  // namespace
 
 Result<std::shared_ptr<ga::GatewayAuth>> load_gateway_auth(const GatewayAuthConfig& c) {
-    if (!c.enabled()) return std::shared_ptr<ga::GatewayAuth>();
+    auto s = load_gateway_auth_settings(c);
+    if (!s) return s.take_error();
+    if (!*s) return std::shared_ptr<ga::GatewayAuth>();
+    return std::make_shared<ga::GatewayAuth>(std::move(**s));
+}
+
+Result<std::optional<ga::GatewayAuthSettings>> load_gateway_auth_settings(const GatewayAuthConfig& c) {
+    if (!c.enabled()) return std::optional<ga::GatewayAuthSettings>();
     ga::GatewayAuthSettings s;
     if (!c.users.empty()) {
         auto users = PasswordTable::load_file(c.users);
@@ -61,7 +68,7 @@ Result<std::shared_ptr<ga::GatewayAuth>> load_gateway_auth(const GatewayAuthConf
     s.limits.window = std::chrono::seconds(c.window_s);
     s.limits.lockout = std::chrono::seconds(c.lockout_s);
     s.session_ttl = std::chrono::seconds(c.session_ttl_s);
-    return std::make_shared<ga::GatewayAuth>(std::move(s));
+    return std::optional<ga::GatewayAuthSettings>(std::move(s));
 }
 
 }  // namespace rr::server::app

@@ -410,8 +410,8 @@ TEST_CASE("gateway.auth files: the example loads, and a bad file is a configurat
     REQUIRE(a);
     REQUIRE(*a);
     CHECK((*a)->enabled());
-    CHECK((*a)->settings().users.users().size() == 3);
-    CHECK((*a)->policy().role_names() == std::vector<std::string>{"dashboard", "operator", "viewer"});
+    CHECK((*a)->summary().users == 3);
+    CHECK((*a)->policy()->role_names() == std::vector<std::string>{"dashboard", "operator", "viewer"});
     auto wall = (*a)->principal_for_user("wall");
     REQUIRE(wall);
     using rr::server::gateway::auth::Operation;

@@ -21,6 +21,47 @@ std::atomic<bool> g_stop{false};  // lock-free: safe to set from a signal handle
 std::atomic<bool> g_reload{false};
 void on_signal(int) { g_stop.store(true); }
 void on_hangup(int) { g_reload.store(true); }
+// SIGHUP: the TLS certificate (renewed by certbot & co.; open connections keep theirs), and gateway.auth's
+// users, tokens, JWT key and roles read again from the configuration file. A file that does not load
+// leaves what is in force; everything else in the file needs a restart (docs/security.md).
+void reload_on_hangup(Gateway& gateway, const CommandLine& cmd) {
+    if (!gateway.tls()) {
+        log(LogLevel::info, "SIGHUP: no TLS configured, no certificate to reload");
+    } else if (auto r = gateway.reload_tls(); r) {
+        log(LogLevel::info, "SIGHUP: TLS certificate reloaded: " + gateway.tls()->describe());
+    } else {
+        log(LogLevel::error, "SIGHUP: TLS certificate not reloaded, the previous one stays in use: " + r.error().message);
+    }
+    if (!gateway.auth()) {
+        log(LogLevel::info, "SIGHUP: logins are off (gateway.auth); turning them on needs a restart");
+        return;
+    }
+    GatewayConfig config;
+    if (cmd.config_file) {
+        auto loaded = load_gateway_config(*cmd.config_file);
+        if (!loaded) {
+            log(LogLevel::error, "SIGHUP: logins not reloaded, the previous ones stay in force: " + loaded.error().message);
+            return;
+        }
+        config = std::move(*loaded);
+    }
+    if (auto r = apply_overrides(config, cmd); !r) {
+        log(LogLevel::error, "SIGHUP: logins not reloaded, the previous ones stay in force: " + r.error().message);
+        return;
+    }
+    auto settings = load_gateway_auth_settings(config.auth);
+    Result<void> done = settings ? (*settings ? gateway.auth()->reload(std::move(**settings))
+                                              : Result<void>(fail(MessageErrorType::InvalidConfiguration,
+                                                                  "gateway.auth configures no users, tokens or JWT key; "
+                                                                  "restart the gateway to turn logins off")))
+                                 : Result<void>(settings.take_error());
+    if (!done) {
+        log(LogLevel::error, "SIGHUP: logins not reloaded, the previous ones stay in force: " + done.error().message);
+        return;
+    }
+    log(LogLevel::info, "SIGHUP: logins reloaded: " + server::gateway::auth::describe(gateway.auth()->summary()));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -62,11 +103,7 @@ int main(int argc, char** argv) {
         }
         std::cout << "configuration ok: " << config.devices.size() << " device(s)" << (config.demo ? " + demo devices" : "")
                   << ", port " << config.port << (config.tls.enabled() ? " (TLS)" : "");
-        if (*auth)
-            std::cout << ", logins: " << (*auth)->settings().users.users().size() << " user(s)"
-                      << ((*auth)->settings().tokens ? ", " + std::to_string((*auth)->settings().tokens->size()) + " token(s)" : "")
-                      << ((*auth)->settings().jwt ? ", JWT " + (*auth)->settings().jwt->settings().algorithm : "") << ", "
-                      << (*auth)->policy().role_names().size() << " role(s)";
+        if (*auth) std::cout << ", logins: " << describe((*auth)->summary());
         std::cout << "\n";
         return 0;
     }
@@ -98,16 +135,7 @@ int main(int argc, char** argv) {
               << "}" << std::endl;
     while (!g_stop) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        if (g_reload.exchange(false)) {
-            // SIGHUP: the certificate again (renewed by certbot & co.); open connections keep theirs.
-            if (!tls) {
-                log(LogLevel::info, "SIGHUP: no TLS configured, nothing to reload");
-            } else if (auto r = (*gateway)->reload_tls(); r) {
-                log(LogLevel::info, "SIGHUP: TLS certificate reloaded: " + (*gateway)->tls()->describe());
-            } else {
-                log(LogLevel::error, "SIGHUP: TLS certificate not reloaded, the previous one stays in use: " + r.error().message);
-            }
-        }
+        if (g_reload.exchange(false)) reload_on_hangup(**gateway, *cmd);
     }
     log(LogLevel::info, "shutting down");
     (*gateway)->stop();

@@ -436,11 +436,20 @@ def process_python(s, lines, line_no, checks):
 def https_get(s, port, path, headers=None):
     ctx = ssl.create_default_context(cafile=s.path("/etc/ssl/certs/localhost.pem"))
     req = urllib.request.Request("https://localhost:%d%s" % (port, path), headers=headers or {})
-    try:
-        with urllib.request.urlopen(req, context=ctx, timeout=10) as r:
-            return r.status, r.read().decode()
-    except urllib.error.HTTPError as e:
-        return e.code, e.read().decode()
+    # Right after `nginx -s reload` a port the new configuration adds can reset a connection while the
+    # workers change over (seen under load): such a reset is retried for a few seconds.
+    deadline = time.monotonic() + 10
+    while True:
+        try:
+            with urllib.request.urlopen(req, context=ctx, timeout=10) as r:
+                return r.status, r.read().decode()
+        except urllib.error.HTTPError as e:
+            return e.code, e.read().decode()
+        except (urllib.error.URLError, ConnectionResetError) as e:
+            reset = isinstance(getattr(e, "reason", e), ConnectionResetError)
+            if not reset or time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)
 
 
 def check_htpasswd(s):

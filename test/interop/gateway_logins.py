@@ -16,6 +16,8 @@ Checks (each one named in the JSON summary):
   json      POST /api/login (cookie: HttpOnly, SameSite=Strict), requests with the cookie, without it
             (401), PUT/POST refused by role (403); bearer token; JWT valid / expired / forged / wrong
             audience; the JSON WebSocket logged in by its first message and by the cookie.
+  reload    SIGHUP after the password file changed: a removed user is refused (new logins, and the
+            requests of its open session), a new user logs in; a broken file is logged and changes nothing.
   limits    after 5 failed logins from this address even the right password is refused (HTTP 429,
             RR AuthenticationException "Too many failed logins"); /metrics counts the failures.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
@@ -31,6 +33,7 @@ import hmac
 import http.cookiejar
 import json
 import os
+import signal
 import sys
 import tempfile
 import threading
@@ -437,6 +440,52 @@ devices:
         checks.check("json: WebSocket login by first message and by cookie, never by URL token", json_websocket)
 
         # ---- brute force (last: it locks this address out) ----
+        def wait_log(text, after):
+            deadline = time.monotonic() + 15
+            while True:
+                with open(os.path.join(work, "gateway.err")) as f:
+                    log = f.read()[after:]
+                if text in log:
+                    return log
+                if time.monotonic() > deadline:
+                    raise AssertionError("no %r in the gateway's log after SIGHUP: %s" % (text, log[-800:]))
+                time.sleep(0.1)
+
+        def write_users(lines):
+            path = os.path.join(work, "users.txt")
+            with open(path + ".new", "w") as f:
+                f.write("".join(l + "\n" for l in lines))
+            os.replace(path + ".new", path)
+
+        def reload_users():
+            def line(u, pw, roles):
+                return "%s %s %s" % (u, hashlib.md5(pw.encode()).hexdigest(), roles)
+            # bob leaves, dave (operator) joins; alice stays as she was.
+            write_users([line("alice", *USERS["alice"]), line("dave", "dave-pw", "operator")])
+            mark = os.path.getsize(os.path.join(work, "gateway.err"))
+            os.kill(gateway.pid, signal.SIGHUP)
+            wait_log("SIGHUP: logins reloaded: 2 user(s), 1 token(s), JWT HS256, 3 role(s)", mark)
+            expect_rr_error(lambda: RRN.ConnectService(url, "bob", creds("bob-pw")), RR.AuthenticationException,
+                            "Invalid username or password")
+            # bob's session from before: its requests are refused from now on (no user, no roles).
+            expect_rr_error(lambda: conns["bob"].p_int32, RR.PermissionDeniedException, "may not read p_int32")
+            d = RRN.ConnectService(url, "dave", creds("dave-pw"))
+            assert d.add(20, 22) == 42
+            RRN.DisconnectService(d)
+            h = Http(base)
+            expect_status(h.call("POST", "/api/login", {"username": "dave", "password": "dave-pw"}), 200)
+            # A broken file on the next SIGHUP is logged and changes nothing.
+            write_users([line("alice", *USERS["alice"]), "dave not-an-md5-digest operator"])
+            mark = os.path.getsize(os.path.join(work, "gateway.err"))
+            os.kill(gateway.pid, signal.SIGHUP)
+            wait_log("SIGHUP: logins not reloaded, the previous ones stay in force: gateway.auth.users", mark)
+            d = RRN.ConnectService(url, "dave", creds("dave-pw"))
+            assert d.add(1, 2) == 3
+            RRN.DisconnectService(d)
+            assert conns["alice"].add(2, 2) == 4
+        checks.check("reload: SIGHUP reads the users again (one leaves, one joins; a broken file changes nothing)",
+                     reload_users)
+
         def limits():
             h = Http(base)
             for i in range(5):

@@ -9,22 +9,81 @@
 
 namespace rr::server::gateway::auth {
 
-GatewayAuth::GatewayAuth(GatewayAuthSettings settings)
-    : settings_(std::move(settings)), limiter_(settings_.limits) {
-    if (!settings_.policy) settings_.policy = std::make_shared<AccessPolicy>();
-    enabled_ = !settings_.users.empty() || (settings_.tokens && !settings_.tokens->empty()) || settings_.jwt.has_value();
-    for (const auto& u : settings_.users.users()) {
+namespace {
+
+bool configures_logins(const GatewayAuthSettings& s) {
+    return !s.users.empty() || (s.tokens && !s.tokens->empty()) || s.jwt.has_value();
+}
+
+}  // namespace
+
+std::shared_ptr<const GatewayAuth::Credentials> GatewayAuth::make_credentials(GatewayAuthSettings& s) {
+    auto c = std::make_shared<Credentials>();
+    c->users = std::move(s.users);
+    c->tokens = std::move(s.tokens);
+    c->jwt = std::move(s.jwt);
+    c->policy = s.policy ? std::move(s.policy) : std::make_shared<AccessPolicy>();
+    for (const auto& u : c->users.users()) {
         Principal p;
         p.name = u.username;
         p.roles = u.privileges;
         p.via = "password";
-        user_principals_[u.username] = with_policy(std::move(p));
+        c->user_principals[u.username] = with_policy(std::move(p), *c);
     }
+    s.users = PasswordTable{};
+    s.tokens.reset();
+    s.jwt.reset();
+    return c;
 }
 
-PrincipalPtr GatewayAuth::with_policy(Principal p) const {
-    p.policy = settings_.policy;
+GatewayAuth::GatewayAuth(GatewayAuthSettings settings)
+    : settings_(std::move(settings)), limiter_(settings_.limits) {
+    enabled_ = configures_logins(settings_);
+    credentials_.store(make_credentials(settings_));
+}
+
+PrincipalPtr GatewayAuth::with_policy(Principal p, const Credentials& c) {
+    p.policy = c.policy;
     return std::make_shared<const Principal>(std::move(p));
+}
+
+CredentialSummary GatewayAuth::summary() const {
+    auto c = credentials();
+    CredentialSummary out;
+    out.users = c->users.users().size();
+    out.tokens = c->tokens ? c->tokens->size() : 0;
+    out.jwt_algorithm = c->jwt ? c->jwt->settings().algorithm : "";
+    out.roles = c->policy->role_names().size();
+    return out;
+}
+
+std::string describe(const CredentialSummary& s) {
+    std::string out = std::to_string(s.users) + " user(s)";
+    if (s.tokens) out += ", " + std::to_string(s.tokens) + " token(s)";
+    if (!s.jwt_algorithm.empty()) out += ", JWT " + s.jwt_algorithm;
+    return out + ", " + std::to_string(s.roles) + " role(s)";
+}
+
+Result<void> GatewayAuth::reload(GatewayAuthSettings fresh) {
+    if (!configures_logins(fresh))
+        return fail(MessageErrorType::InvalidConfiguration,
+                    "the reloaded gateway.auth has no users, tokens or JWT key: logins stay on with the previous "
+                    "ones (restart the gateway to turn logins off)");
+    auto next = make_credentials(fresh);
+    std::lock_guard lock(mutex_);
+    credentials_.store(next);
+    for (auto it = sessions_.begin(); it != sessions_.end();) {
+        auto& who = it->second.who;
+        auto user = who->via == "password" ? next->user_principals.find(who->name) : next->user_principals.end();
+        if (user == next->user_principals.end()) {
+            it = sessions_.erase(it);
+        } else {
+            who = user->second;
+            ++it;
+        }
+    }
+    web_principals_.clear();
+    return {};
 }
 
 Result<void> GatewayAuth::check_limit(const std::string& address) {
@@ -50,7 +109,7 @@ Result<PrincipalPtr> GatewayAuth::login_rr(std::string_view username, const Mess
                                            std::string_view peer) {
     const std::string address = address_of(peer);
     if (auto ok = check_limit(address); !ok) return ok.take_error();
-    if (auto ok = settings_.users.check(username, credentials); !ok) {
+    if (auto ok = this->credentials()->users.check(username, credentials); !ok) {
         record_failure(address, LoginChannel::rr);
         return ok.take_error();
     }
@@ -66,12 +125,13 @@ Result<PrincipalPtr> GatewayAuth::login_password(std::string_view username, std:
     const std::string address = address_of(peer);
     if (auto ok = check_limit(address); !ok) return ok.take_error();
     const std::string digest = PasswordTable::md5_hex(password);
+    auto c = credentials();
     bool ok = false;
-    for (const auto& u : settings_.users.users())
+    for (const auto& u : c->users.users())
         ok |= (u.username == username) &
               (u.password_md5.size() == digest.size() &&
                CRYPTO_memcmp(u.password_md5.data(), digest.data(), digest.size()) == 0);
-    auto who = ok ? principal_for_user(username) : nullptr;
+    auto who = ok ? c->user_principals.find(username)->second : nullptr;
     if (!who) {
         record_failure(address, channel);
         return fail(MessageErrorType::AuthenticationError, "Invalid username or password");
@@ -86,20 +146,21 @@ Result<PrincipalPtr> GatewayAuth::login_token(std::string_view token, std::strin
     const std::string address = address_of(peer);
     if (auto ok = check_limit(address); !ok) return ok.take_error();
     std::string why = "no token authentication configured";
-    if (settings_.tokens) {
-        if (auto p = settings_.tokens->check(token)) {
+    auto c = credentials();
+    if (c->tokens) {
+        if (auto p = c->tokens->check(token)) {
             limiter_.succeeded(address);
             counters_.succeeded.fetch_add(1);
-            return with_policy(std::move(*p));
+            return with_policy(std::move(*p), *c);
         } else {
             why = p.error().message;
         }
     }
-    if (settings_.jwt && looks_like_jwt(token)) {
-        if (auto p = settings_.jwt->verify(token, settings_.unix_now())) {
+    if (c->jwt && looks_like_jwt(token)) {
+        if (auto p = c->jwt->verify(token, settings_.unix_now())) {
             limiter_.succeeded(address);
             counters_.succeeded.fetch_add(1);
-            return with_policy(std::move(*p));
+            return with_policy(std::move(*p), *c);
         } else {
             why = "JWT: " + p.error().message;
         }
@@ -110,8 +171,9 @@ Result<PrincipalPtr> GatewayAuth::login_token(std::string_view token, std::strin
 }
 
 PrincipalPtr GatewayAuth::principal_for_user(std::string_view username) const {
-    auto it = user_principals_.find(username);
-    if (it != user_principals_.end()) return it->second;
+    auto c = credentials();
+    auto it = c->user_principals.find(username);
+    if (it != c->user_principals.end()) return it->second;
     std::lock_guard lock(mutex_);
     auto w = web_principals_.find(username);
     return w == web_principals_.end() ? nullptr : w->second;

@@ -59,15 +59,40 @@ struct LoginCounters {
 
 enum class LoginChannel { rr, http, token, websocket };
 
+/// How many users, tokens and roles are in force, and the JWT algorithm ("" = none): for logs and --check.
+struct CredentialSummary {
+    std::size_t users = 0;
+    std::size_t tokens = 0;
+    std::string jwt_algorithm;
+    std::size_t roles = 0;
+};
+
+/// "3 user(s), 2 token(s), JWT RS256, 4 role(s)" (tokens and JWT only when there are any).
+std::string describe(const CredentialSummary& s);
+
 class GatewayAuth {
 public:
     explicit GatewayAuth(GatewayAuthSettings settings);
 
     /// Any user, token or JWT key configured: logins required, permissions checked.
     bool enabled() const noexcept { return enabled_; }
-    bool has_users() const noexcept { return !settings_.users.empty(); }
-    const AccessPolicy& policy() const noexcept { return *settings_.policy; }
+    bool has_users() const { return !credentials()->users.empty(); }
+    /// The roles' rules in force (a reload swaps them; hold the pointer, not a reference into it).
+    std::shared_ptr<const AccessPolicy> policy() const { return credentials()->policy; }
+    /// The settings given at construction: limits, session lifetime, clocks. Users, tokens, JWT key and
+    /// policy are in credentials() (they change on reload()).
     const GatewayAuthSettings& settings() const noexcept { return settings_; }
+    CredentialSummary summary() const;
+
+    /// Replaces the users, tokens, JWT key and roles' rules with `fresh`'s (SIGHUP, docs/security.md);
+    /// its limits, session lifetime and clocks are ignored (those of the start stay). Logins in progress
+    /// finish against the credentials they started with. Open cookie sessions of a password user get the
+    /// user's new roles, or end when the user is gone; cookie sessions opened with a token or JWT end (a
+    /// revoked token must not live on), and so do the roles of RR sessions those opened. An RR session of
+    /// a password user is checked against the new roles from its next request on. Errors:
+    /// InvalidConfiguration when `fresh` configures no user, token or key at all (turning logins off
+    /// needs a restart, so that a truncated file cannot open the gateway to everyone).
+    Result<void> reload(GatewayAuthSettings fresh);
 
     /// RR login (ConnectClientCombined / AuthenticateUser): `credentials` as the client sent it.
     /// Errors: AuthenticationError (PasswordTable's messages; "Too many failed logins from this
@@ -102,15 +127,26 @@ public:
     const LoginCounters& counters() const noexcept { return counters_; }
 
 private:
+    /// What reload() replaces, swapped as a whole so that a check sees one consistent set.
+    struct Credentials {
+        PasswordTable users;
+        std::optional<BearerTokens> tokens;
+        std::optional<JwtVerifier> jwt;
+        std::shared_ptr<const AccessPolicy> policy;
+        std::map<std::string, PrincipalPtr, std::less<>> user_principals;
+    };
+    static std::shared_ptr<const Credentials> make_credentials(GatewayAuthSettings& s);
+    std::shared_ptr<const Credentials> credentials() const { return credentials_.load(); }
+
     Result<void> check_limit(const std::string& address);
     void record_failure(const std::string& address, LoginChannel channel);
-    PrincipalPtr with_policy(Principal p) const;
+    static PrincipalPtr with_policy(Principal p, const Credentials& c);
 
-    GatewayAuthSettings settings_;
+    GatewayAuthSettings settings_;  // users, tokens, jwt and policy moved out into credentials_
+    std::atomic<std::shared_ptr<const Credentials>> credentials_;
     bool enabled_ = false;
     LoginLimiter limiter_;
     LoginCounters counters_;
-    std::map<std::string, PrincipalPtr, std::less<>> user_principals_;
     struct Session {
         PrincipalPtr who;
         std::chrono::steady_clock::time_point expires;

@@ -133,3 +133,68 @@ TEST_CASE("gateway auth: a web session's cookie names the RR user of an rr+ws se
     CHECK_FALSE(f.auth->web_rr_user(""));
     CHECK_FALSE(f.auth->web_rr_user("other=" + id));
 }
+
+TEST_CASE("gateway auth: reload swaps users, tokens and roles, and sessions follow their user") {
+    Fixture f;
+    auto alice = f.auth->login_password("alice", "alice-pw", "10.0.0.1:1", LoginChannel::http);
+    auto bob = f.auth->login_password("bob", "bob-pw", "10.0.0.1:1", LoginChannel::http);
+    auto wall = f.auth->login_token("wall-display-token-0123456789", "10.0.0.3:1", LoginChannel::token);
+    REQUIRE((alice && bob && wall));
+    const auto alice_session = f.auth->open_session(*alice);
+    const auto bob_session = f.auth->open_session(*bob);
+    const auto wall_session = f.auth->open_session(*wall);
+    auto wall_rr = f.auth->web_rr_user("rrgw_session=" + wall_session);
+    REQUIRE(wall_rr);
+    REQUIRE(f.auth->principal_for_user(*wall_rr));
+
+    // The new files: alice gone, bob an operator now, carol new; another token; viewer may not read.
+    GatewayAuthSettings fresh;
+    fresh.users.add_user("bob", "bob-pw2", {"operator"});
+    fresh.users.add_user("carol", "carol-pw", {"viewer"});
+    fresh.tokens = *BearerTokens::parse("kiosk-token-abcdefghijklmnopqrstuvwxyz kiosk viewer\n");
+    auto p = std::make_shared<AccessPolicy>();
+    p->add_role("viewer", {AccessRule{{"*"}, {"Bumpers"}, true, false, false}});
+    p->add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});
+    fresh.policy = p;
+    REQUIRE(f.auth->reload(std::move(fresh)));
+    CHECK(f.auth->summary().users == 2);
+    CHECK(f.auth->summary().tokens == 1);
+    CHECK(describe(f.auth->summary()) == "2 user(s), 1 token(s), 2 role(s)");
+
+    CHECK_FALSE(f.auth->login_password("alice", "alice-pw", "10.0.0.4:1", LoginChannel::http));
+    CHECK_FALSE(f.auth->login_password("bob", "bob-pw", "10.0.0.4:1", LoginChannel::http));
+    auto bob2 = f.auth->login_password("bob", "bob-pw2", "10.0.0.4:1", LoginChannel::http);
+    REQUIRE(bob2);
+    CHECK((*bob2)->allows("create", "Drive", Operation::call));
+    auto carol_cred = password_credentials("carol-pw");
+    auto carol = f.auth->login_rr("carol", &carol_cred, "10.0.0.4:1");
+    REQUIRE(carol);
+    CHECK((*carol)->allows("create", "Bumpers", Operation::read));
+    CHECK_FALSE((*carol)->allows("create", "Drive", Operation::read));
+    CHECK_FALSE(f.auth->login_token("wall-display-token-0123456789", "10.0.0.5:1", LoginChannel::token));
+    CHECK(f.auth->login_token("kiosk-token-abcdefghijklmnopqrstuvwxyz", "10.0.0.5:1", LoginChannel::token));
+
+    // Sessions: alice's ends, bob's carries his new roles, the token's ends (and its RR user's roles).
+    CHECK_FALSE(f.auth->session(alice_session));
+    auto bob_now = f.auth->session(bob_session);
+    REQUIRE(bob_now);
+    CHECK(bob_now->allows("create", "Drive", Operation::call));
+    CHECK_FALSE(f.auth->session(wall_session));
+    CHECK_FALSE(f.auth->principal_for_user(*wall_rr));
+    // An RR session of a user still in the file is checked against the new roles.
+    REQUIRE(f.auth->principal_for_user("bob"));
+    CHECK(f.auth->principal_for_user("bob")->allows("create", "Drive", Operation::call));
+    CHECK_FALSE(f.auth->principal_for_user("alice"));
+}
+
+TEST_CASE("gateway auth: a reload without users, tokens or key is refused and changes nothing") {
+    Fixture f;
+    GatewayAuthSettings empty;
+    auto r = f.auth->reload(std::move(empty));
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == rr::MessageErrorType::InvalidConfiguration);
+    CHECK(r.error().message.find("restart") != std::string::npos);
+    CHECK(f.auth->enabled());
+    CHECK(f.auth->login_password("alice", "alice-pw", "10.0.0.1:1", LoginChannel::http));
+    CHECK(f.auth->summary().users == 2);
+}
