@@ -59,10 +59,22 @@ phase_done ctest
 # only explained third-party false positives). RR_TSAN=1 runs it. Off by default until a clean run has
 # been recorded in docs/reliability.md: the build could not be completed on the loaded machine where
 # this step was written, and an unverified race or TSan-slowed timeout must not block every CI run.
+# On a failure it names this step, the failed tests and prints each ThreadSanitizer report from the
+# full log (build/tsan/ctest.log), so a race is not lost among the other tests' output.
 if [ "${RR_TSAN:-0}" != 0 ]; then
   cmake --preset tsan >/dev/null
-  cmake --build --preset tsan -j "$jobs"
-  ctest --preset tsan -j "$jobs"
+  if ! cmake --build --preset tsan -j "$jobs"; then
+    echo "test: FAILED: the ThreadSanitizer build (RR_TSAN, preset tsan, build/tsan) did not compile"
+    exit 1
+  fi
+  if ! ctest --preset tsan -j "$jobs" --output-log build/tsan/ctest.log; then
+    echo "test: FAILED: the ThreadSanitizer step (RR_TSAN=1, ctest --preset tsan; full log build/tsan/ctest.log)"
+    echo "test: failed TSan tests (re-run one: ctest --preset tsan -R '<name>'):"
+    sed 's/^[0-9]*:/  /' build/tsan/Testing/Temporary/LastTestsFailed.log 2>/dev/null || true
+    echo "test: ThreadSanitizer reports:"
+    awk '/WARNING: ThreadSanitizer|ERROR: ThreadSanitizer/,/SUMMARY: ThreadSanitizer/' build/tsan/ctest.log | head -n 400
+    exit 1
+  fi
   phase_done tsan
 fi
 
