@@ -673,6 +673,8 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
         } else if (flag == "--web-root") {
             c.web_root = v;
         } else if (flag == "--allow-origin") {
+            if (auto why = origin_problem(v); !why.empty())
+                return fail(MessageErrorType::InvalidConfiguration, flag + ": \"" + v + "\" " + why);
             c.allowed_origins.push_back(v);
         } else if (flag == "--trusted-proxy") {
             if (!http::parse_ip_network(v))

@@ -506,3 +506,20 @@ gateway:
         CHECK_THAT(r.error().message, Catch::Contains(expect));
     }
 }
+
+TEST_CASE("--allow-origin is checked like gateway.allowed_origins") {
+    const char* good[] = {"rr-gateway", "--allow-origin", "https://lab.example.org"};
+    auto cmd = parse_command_line(3, good);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK(c.allowed_origins == std::vector<std::string>{"https://lab.example.org"});
+
+    const char* bad[] = {"rr-gateway", "--allow-origin", "https://lab.example.org/dashboard"};
+    auto cmd2 = parse_command_line(3, bad);
+    REQUIRE(cmd2);
+    GatewayConfig c2;
+    auto r = apply_overrides(c2, *cmd2);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::StartsWith("--allow-origin: \"https://lab.example.org/dashboard\" has a path"));
+}
