@@ -430,7 +430,7 @@ std::string origin_problem(const std::string& e) {
 
 void parse_limits(const YAML::Node& l, const Reader& r, GatewayLimitsConfig& c) {
     r.check_keys(l, "gateway.limits",
-                 {"connections_per_address", "messages_per_second", "bytes_per_second", "burst_s", "hard_limit_s"});
+                 {"connections_per_address", "messages_per_second", "bytes_per_second", "burst_s"});
     if (auto n = l["connections_per_address"])
         c.connections_per_address = r.unsigned_int(n, "gateway.limits.connections_per_address", 1000000);
     if (auto n = l["messages_per_second"])
@@ -444,7 +444,6 @@ void parse_limits(const YAML::Node& l, const Reader& r, GatewayLimitsConfig& c) 
         c.burst_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.limits.burst_s", 3600));
         if (c.burst_s == 0) r.error(n, "gateway.limits.burst_s", "must be at least 1");
     }
-    if (auto n = l["hard_limit_s"]) c.hard_limit_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.limits.hard_limit_s", 86400));
 }
 
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {

@@ -442,10 +442,9 @@ TEST_CASE("gateway.limits: defaults, values, and errors naming the key") {
     auto d = parse_gateway_config("", "empty.yaml");
     REQUIRE(d);
     CHECK(d->limits.connections_per_address == 256);
-    CHECK(d->limits.messages_per_second == 5000);
-    CHECK(d->limits.bytes_per_second == 64u * 1024u * 1024u);
+    CHECK(d->limits.messages_per_second == 0);
+    CHECK(d->limits.bytes_per_second == 0);
     CHECK(d->limits.burst_s == 1);
-    CHECK(d->limits.hard_limit_s == 0);
 
     auto c = parse_gateway_config(R"(
 gateway:
@@ -454,14 +453,12 @@ gateway:
     messages_per_second: 100
     bytes_per_second: 0
     burst_s: 3
-    hard_limit_s: 30
 )", "limits.yaml");
     REQUIRE(c);
     CHECK(c->limits.connections_per_address == 2);
     CHECK(c->limits.messages_per_second == 100);
     CHECK(c->limits.bytes_per_second == 0);
     CHECK(c->limits.burst_s == 3);
-    CHECK(c->limits.hard_limit_s == 30);
 
     struct Case {
         const char* yaml;
