@@ -140,20 +140,39 @@ std::string client_address(const tcp::socket& socket) {
 }
 
 // 429 for an HTTP request or WebSocket upgrade over the per-address limit (RFC 6585 §4), then close.
+// What the client sent after its first four bytes is read and dropped (for at most 2 s) before the
+// close, so that the close is a FIN, not a reset that could discard the answer at the client.
 void refuse_http(tcp::socket socket, const std::string& reason) {
     struct Out {
         tcp::socket socket;
+        asio::steady_timer timer;
         std::string text;
+        std::array<char, 512> sink{};
+        void drain(std::shared_ptr<Out> self) {
+            socket.async_read_some(asio::buffer(sink), [self](boost::system::error_code ec, std::size_t) {
+                if (!ec) return self->drain(self);
+                self->timer.cancel();
+                boost::system::error_code ignored;
+                self->socket.close(ignored);
+            });
+        }
     };
     const std::string body = reason + "\n";
-    auto out = std::make_shared<Out>(Out{std::move(socket), {}});
+    auto executor = socket.get_executor();
+    auto out = std::make_shared<Out>(Out{std::move(socket), asio::steady_timer(executor), {}, {}});
     out->text = "HTTP/1.1 429 Too Many Requests\r\nConnection: close\r\nRetry-After: 5\r\n"
                 "Content-Type: text/plain; charset=utf-8\r\nContent-Length: " +
                 std::to_string(body.size()) + "\r\n\r\n" + body;
-    asio::async_write(out->socket, asio::buffer(out->text), [out](boost::system::error_code, std::size_t) {
+    asio::async_write(out->socket, asio::buffer(out->text), [out](boost::system::error_code ec, std::size_t) {
         boost::system::error_code ignored;
+        if (ec) return out->socket.close(ignored);
         out->socket.shutdown(tcp::socket::shutdown_send, ignored);
-        out->socket.close(ignored);
+        out->timer.expires_after(std::chrono::seconds(2));
+        out->timer.async_wait([out](boost::system::error_code tec) {
+            boost::system::error_code ignored2;
+            if (!tec) out->socket.close(ignored2);
+        });
+        out->drain(out);
     });
 }
 
