@@ -148,8 +148,9 @@ int main(int argc, char** argv) {
     must(node->register_service(service), "register");
     if (websocket) {
         auto http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
-        node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial) {
-            http_server->handle(std::move(socket), std::move(initial));
+        node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
+                                         std::shared_ptr<const void> hold) {
+            http_server->handle(std::move(socket), std::move(initial), std::move(hold));
         });
     }
     const std::uint16_t bound = must(node->listen_tcp("127.0.0.1", port), "listen");

@@ -3,11 +3,13 @@
 #include "server/gateway/mirror_service.hpp"
 
 #include <cstdio>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
 #include "server/app/gateway_discovery.hpp"
 #include "server/app/log.hpp"
+#include "server/common/token_bucket.hpp"
 #include "server/transport/discovery/discovery_sources.hpp"
 #include "server/transport/local/local_listener.hpp"
 #ifdef RR_HAVE_USB
@@ -59,6 +61,32 @@ Result<void> serve_local(const std::shared_ptr<Node>& node, std::optional<local:
     return {};
 }
 
+// Warnings about a limit that bites, at most a burst of 5 then 1 per second: a flood of refused
+// connections must not flood the log too. Lines held back are counted in the next one written.
+class LimitLog {
+public:
+    void warn(const std::string& line) {
+        std::uint64_t held = 0;
+        {
+            std::lock_guard lock(mutex_);
+            const auto now = TokenBucket::Clock::now();
+            if (bucket_.wait_time(now) > std::chrono::nanoseconds{0}) {  // in debt: hold this line back
+                ++held_;
+                return;
+            }
+            bucket_.take(1, now);
+            held = held_;
+            held_ = 0;
+        }
+        log(LogLevel::warning, held ? line + " (" + std::to_string(held) + " similar lines held back)" : line);
+    }
+
+private:
+    std::mutex mutex_;
+    TokenBucket bucket_{1, 5, TokenBucket::Clock::now()};
+    std::uint64_t held_ = 0;
+};
+
 }  // namespace
 
 Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarter demo, ApiInstaller api) {
@@ -72,6 +100,21 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     opts.threads = c.threads;
     opts.server.stream.limits.max_message_size = c.max_message_size;
     opts.server.stream.heartbeat_period = std::chrono::milliseconds(12000);  // a server's period (wire.md §6.3)
+    // gateway.limits (docs/security.md "Connection limits"): both kinds of warning share one log budget.
+    auto limit_log = std::make_shared<LimitLog>();
+    if (c.limits.connections_per_address) {
+        g->address_limiter_ = AddressLimiter::create(c.limits.connections_per_address);
+        opts.address_limiter = g->address_limiter_;
+        opts.on_limited = [limit_log](const std::string&, const std::string& reason) {
+            limit_log->warn("connection refused: " + reason + " (gateway.limits.connections_per_address)");
+        };
+    }
+    opts.read_rates = ReadRates{c.limits.messages_per_second, c.limits.bytes_per_second, c.limits.burst_s};
+    if (opts.read_rates.enabled())
+        opts.on_throttled = [limit_log](const std::string& peer) {
+            limit_log->warn("connection from " + peer +
+                            " over its rate (gateway.limits.messages_per_second / bytes_per_second): reads paused");
+        };
     // A configured NodeID is what a new NodeID cache entry gets (a first start on a fresh machine).
     auto reservation = reserve_local_name(c.local, c.node_name, opts.node_id);
     if (!reservation) return reservation.take_error();
@@ -256,12 +299,13 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         }
         g->discovered_->start();
     }
-    g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial) {
-        h->handle(std::move(s), std::move(initial));
+    g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial,
+                                                 std::shared_ptr<const void> hold) {
+        h->handle(std::move(s), std::move(initial), std::move(hold));
     });
     if (g->tls_)
-        g->node_->set_https_handler([h = g->http_](TlsStream s, std::vector<std::byte> initial) {
-            h->handle_tls(std::move(s), std::move(initial));
+        g->node_->set_https_handler([h = g->http_](TlsStream s, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+            h->handle_tls(std::move(s), std::move(initial), std::move(hold));
         });
 
     for (auto& d : g->devices_) {
@@ -379,6 +423,11 @@ std::string Gateway::metrics_text() const {
       << "# HELP rr_gateway_accepted_connections_total RR connections accepted since start.\n"
          "# TYPE rr_gateway_accepted_connections_total counter\n"
       << "rr_gateway_accepted_connections_total " << stats->connections_total.load() << "\n"
+      << "# HELP rr_gateway_limited_total Times a gateway.limits limit bit: connections refused, reads paused.\n"
+         "# TYPE rr_gateway_limited_total counter\n"
+      << "rr_gateway_limited_total{limit=\"connections_per_address\"} "
+      << (address_limiter_ ? address_limiter_->refused() : 0) << "\n"
+      << "rr_gateway_limited_total{limit=\"rate\"} " << node_->reads_throttled() << "\n"
       << "# HELP rr_gateway_messages_total RR messages to and from clients.\n"
          "# TYPE rr_gateway_messages_total counter\n"
       << "rr_gateway_messages_total{direction=\"in\"} " << stats->messages_in.load() << "\n"

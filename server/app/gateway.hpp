@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "server/app/gateway_config.hpp"
+#include "server/common/address_limiter.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
@@ -83,6 +84,8 @@ private:
     Gateway() = default;
     GatewayConfig config_;
     std::shared_ptr<Node> node_;
+    /// gateway.limits.connections_per_address (null when 0 = unlimited).
+    std::shared_ptr<AddressLimiter> address_limiter_;
     std::shared_ptr<Node> demo_node_;
     std::shared_ptr<http::HttpServer> http_;
     std::vector<std::shared_ptr<gateway::DeviceMirror>> devices_;

@@ -388,6 +388,64 @@ void parse_auth(const YAML::Node& a, const Reader& r, GatewayAuthConfig& c) {
         r.error(a, "gateway.auth", "roles but no users, tokens or jwt: nobody could log in");
 }
 
+// An allowlist entry: "*", "scheme://" (any origin of that scheme), "scheme://host[:port]" or
+// "scheme://*.domain[:port]" (http_server.cpp origin_allowed). An Origin never has a path, so an entry
+// with one (or a trailing slash) could never match: refused rather than silently useless.
+std::string origin_problem(const std::string& e) {
+    if (e == "*") return {};
+    auto sep = e.find("://");
+    if (sep == std::string::npos || sep == 0) return "is not an origin (scheme://host[:port], scheme:// or *)";
+    for (std::size_t i = 0; i < sep; ++i) {
+        const char ch = e[i];
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '+' && ch != '-' && ch != '.')
+            return "has a bad scheme";
+    }
+    auto host = std::string_view(e).substr(sep + 3);
+    if (host.empty()) return {};
+    if (host.find_first_of("/?#") != std::string_view::npos) return "has a path (an Origin is scheme://host[:port] only)";
+    for (char ch : host)
+        if (std::isspace(static_cast<unsigned char>(ch)) || ch == '@') return "has a bad host";
+    std::size_t colon = std::string_view::npos;
+    if (host.front() == '[') {  // IPv6 literal: [::1]:port
+        auto close = host.find(']');
+        if (close == std::string_view::npos) return "has a bad host";
+        if (close + 1 < host.size()) {
+            if (host[close + 1] != ':') return "has a bad host";
+            colon = close + 1;
+        }
+    } else {
+        colon = host.rfind(':');
+    }
+    if (colon != std::string_view::npos) {
+        auto port = host.substr(colon + 1);
+        unsigned v = 0;
+        auto [p, ec] = std::from_chars(port.data(), port.data() + port.size(), v);
+        if (port.empty() || ec != std::errc() || p != port.data() + port.size() || v == 0 || v > 65535)
+            return "has a bad port";
+        host = host.substr(0, colon);
+    }
+    if (host.empty() || host == "*.") return "has no host";
+    return {};
+}
+
+void parse_limits(const YAML::Node& l, const Reader& r, GatewayLimitsConfig& c) {
+    r.check_keys(l, "gateway.limits",
+                 {"connections_per_address", "messages_per_second", "bytes_per_second", "burst_s"});
+    if (auto n = l["connections_per_address"])
+        c.connections_per_address = r.unsigned_int(n, "gateway.limits.connections_per_address", 1000000);
+    if (auto n = l["messages_per_second"])
+        c.messages_per_second = r.unsigned_int(n, "gateway.limits.messages_per_second", 100000000);
+    if (auto n = l["bytes_per_second"]) {
+        c.bytes_per_second = r.unsigned_int(n, "gateway.limits.bytes_per_second", std::uint64_t{1} << 40);
+        if (c.bytes_per_second != 0 && c.bytes_per_second < 1024)
+            r.error(n, "gateway.limits.bytes_per_second", "must be 0 (unlimited) or at least 1024");
+    }
+    if (auto n = l["burst_s"]) {
+        c.burst_s = static_cast<unsigned>(r.unsigned_int(n, "gateway.limits.burst_s", 3600));
+        if (c.burst_s == 0) r.error(n, "gateway.limits.burst_s", "must be at least 1");
+    }
+}
+
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
@@ -395,7 +453,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "max_message_size", "log_level", "log_format", "local", "tls", "auth"});
+                      "max_message_size", "log_level", "log_format", "local", "tls", "auth", "limits"});
+        if (auto l = g["limits"]) parse_limits(l, r, c.limits);
         if (auto a = g["auth"]) parse_auth(a, r, c.auth);
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
         if (auto n = g["port"]) c.port = static_cast<std::uint16_t>(r.unsigned_int(n, "gateway.port", 65535));
@@ -410,7 +469,12 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         }
         if (auto n = g["threads"]) c.threads = static_cast<unsigned>(r.unsigned_int(n, "gateway.threads", 256));
         if (auto n = g["web_root"]) c.web_root = r.string(n, "gateway.web_root");
-        if (auto n = g["allowed_origins"]) c.allowed_origins = r.string_list(n, "gateway.allowed_origins");
+        if (auto n = g["allowed_origins"]) {
+            c.allowed_origins = r.string_list(n, "gateway.allowed_origins");
+            for (const auto& o : c.allowed_origins)
+                if (auto why = origin_problem(o); !why.empty())
+                    r.error(n, "gateway.allowed_origins", "\"" + o + "\" " + why);
+        }
         if (auto n = g["trusted_proxies"]) {
             c.trusted_proxies = r.string_list(n, "gateway.trusted_proxies");
             for (const auto& p : c.trusted_proxies)
@@ -608,6 +672,8 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
         } else if (flag == "--web-root") {
             c.web_root = v;
         } else if (flag == "--allow-origin") {
+            if (auto why = origin_problem(v); !why.empty())
+                return fail(MessageErrorType::InvalidConfiguration, flag + ": \"" + v + "\" " + why);
             c.allowed_origins.push_back(v);
         } else if (flag == "--trusted-proxy") {
             if (!http::parse_ip_network(v))

@@ -89,6 +89,20 @@ struct GatewayAuthConfig {
     bool enabled() const noexcept { return !users.empty() || !tokens.empty() || !jwt.algorithm.empty(); }
 };
 
+/// Per-connection and per-address limits on the gateway's port (docs/security.md "Connection limits").
+/// 0 = unlimited for each. Defaults: 256 connections per address (generous: no legitimate client, test
+/// or benchmark comes near it); rates off (a legitimate wire or pipe stream has no natural ceiling).
+struct GatewayLimitsConfig {
+    /// Open connections (raw RR, WebSocket and HTTP alike) from one client IP address.
+    std::size_t connections_per_address = 256;
+    /// Messages per second one connection may send (RR messages, WebSocket frames, HTTP requests).
+    std::uint64_t messages_per_second = 0;
+    /// Bytes per second one connection may send.
+    std::uint64_t bytes_per_second = 0;
+    /// Burst: how many seconds of rate a connection may save up while idle (at least 1).
+    unsigned burst_s = 1;
+};
+
 struct GatewayConfig {
     // gateway:
     std::string listen = "0.0.0.0";
@@ -97,7 +111,11 @@ struct GatewayConfig {
     std::string node_id;  ///< empty = random
     unsigned threads = 0;
     std::string web_root;  ///< empty = the built-in default (web/ next to the executable's project)
+    /// Browser Origins allowed besides the same origin: "https://lab.example.org", "https://*.example.org",
+    /// "https://" (any https origin), "*"; validated by the parser. Empty = same-origin only.
     std::vector<std::string> allowed_origins;
+    /// Connections per client address, messages/s and bytes/s per connection.
+    GatewayLimitsConfig limits;
     /// Reverse proxies whose X-Forwarded-For/-Proto are believed: addresses or CIDR ranges
     /// ("127.0.0.1", "10.0.0.0/8", "::1"); validated by the parser. Empty = none (the headers are ignored).
     std::vector<std::string> trusted_proxies;

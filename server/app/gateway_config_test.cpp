@@ -437,3 +437,86 @@ TEST_CASE("gateway.auth files: the example loads, and a bad file is a configurat
     REQUIRE_FALSE(r);
     CHECK_THAT(r.error().message, Catch::StartsWith("gateway.auth.jwt: ") && Catch::Contains("PEM"));
 }
+
+TEST_CASE("gateway.limits: defaults, values, and errors naming the key") {
+    auto d = parse_gateway_config("", "empty.yaml");
+    REQUIRE(d);
+    CHECK(d->limits.connections_per_address == 256);
+    CHECK(d->limits.messages_per_second == 0);
+    CHECK(d->limits.bytes_per_second == 0);
+    CHECK(d->limits.burst_s == 1);
+
+    auto c = parse_gateway_config(R"(
+gateway:
+  limits:
+    connections_per_address: 2
+    messages_per_second: 100
+    bytes_per_second: 0
+    burst_s: 3
+)", "limits.yaml");
+    REQUIRE(c);
+    CHECK(c->limits.connections_per_address == 2);
+    CHECK(c->limits.messages_per_second == 100);
+    CHECK(c->limits.bytes_per_second == 0);
+    CHECK(c->limits.burst_s == 3);
+
+    struct Case {
+        const char* yaml;
+        const char* expect;
+    };
+    for (auto [yaml, expect] : {
+             Case{"gateway:\n  limits:\n    messages_per_second: -5\n",
+                  "bad.yaml:3: gateway.limits.messages_per_second: expected a non-negative integer, got \"-5\""},
+             Case{"gateway:\n  limits:\n    bytes_per_second: 10\n",
+                  "bad.yaml:3: gateway.limits.bytes_per_second: must be 0 (unlimited) or at least 1024"},
+             Case{"gateway:\n  limits:\n    conections_per_address: 2\n", "bad.yaml:3: gateway.limits.conections_per_address: unknown key"},
+             Case{"gateway:\n  limits:\n    burst_s: 0\n", "bad.yaml:3: gateway.limits.burst_s: must be at least 1"},
+             Case{"gateway:\n  limits: 5\n", "bad.yaml:2: gateway.limits: expected a mapping"},
+         }) {
+        auto r = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::InvalidConfiguration);
+        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+    }
+}
+
+TEST_CASE("gateway.allowed_origins: entries the Origin check can match are accepted, others are refused") {
+    auto c = parse_gateway_config(R"(
+gateway:
+  allowed_origins: ["https://lab.example.org", "http://localhost:9090", "https://*.example.org", "https://", "*",
+                    "http://[::1]:8080"]
+)", "o.yaml");
+    REQUIRE(c);
+    CHECK(c->allowed_origins.size() == 6);
+    for (auto [yaml, expect] : {
+             std::pair{"gateway:\n  allowed_origins: [lab.example.org]\n", "\"lab.example.org\" is not an origin"},
+             std::pair{"gateway:\n  allowed_origins: [\"https://lab.example.org/\"]\n", "\"https://lab.example.org/\" has a path"},
+             std::pair{"gateway:\n  allowed_origins: [\"https://lab.example.org:99999\"]\n", "has a bad port"},
+             std::pair{"gateway:\n  allowed_origins: [\"ht tp://x\"]\n", "has a bad scheme"},
+             std::pair{"gateway:\n  allowed_origins: https://x\n", "expected a list of strings"},
+         }) {
+        auto r = parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(r);
+        CHECK_THAT(r.error().message, Catch::StartsWith("bad.yaml:2: gateway.allowed_origins: "));
+        CHECK_THAT(r.error().message, Catch::Contains(expect));
+    }
+}
+
+TEST_CASE("--allow-origin is checked like gateway.allowed_origins") {
+    const char* good[] = {"rr-gateway", "--allow-origin", "https://lab.example.org"};
+    auto cmd = parse_command_line(3, good);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK(c.allowed_origins == std::vector<std::string>{"https://lab.example.org"});
+
+    const char* bad[] = {"rr-gateway", "--allow-origin", "https://lab.example.org/dashboard"};
+    auto cmd2 = parse_command_line(3, bad);
+    REQUIRE(cmd2);
+    GatewayConfig c2;
+    auto r = apply_overrides(c2, *cmd2);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::StartsWith("--allow-origin: \"https://lab.example.org/dashboard\" has a path"));
+}

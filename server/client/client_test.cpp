@@ -205,8 +205,9 @@ TEST_CASE("client: transports are pluggable by URL scheme") {
 TEST_CASE("client: rr+ws is built in, a peer that never answers the upgrade times out") {
     Fixture f;
     auto http_server = std::make_shared<server::http::HttpServer>(f.node, server::http::HttpOptions{});
-    f.node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial) {
-        http_server->handle(std::move(socket), std::move(initial));
+    f.node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
+                                         std::shared_ptr<const void> hold) {
+        http_server->handle(std::move(socket), std::move(initial), std::move(hold));
     });
     const std::string ws_url = "rr+ws://127.0.0.1:" + std::to_string(f.port) + "/?service=svc";
     auto c = Client::connect(f.io.executor(), ws_url, {});

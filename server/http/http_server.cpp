@@ -59,9 +59,9 @@ Response make_response(const Request& request, bhttp::status status, std::string
 HttpServer::HttpServer(std::weak_ptr<Node> node, HttpOptions options)
     : node_(std::move(node)), options_(std::move(options)) {}
 
-void HttpServer::handle(tcp::socket socket, std::vector<std::byte> initial) {
+void HttpServer::handle(tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
     auto session = std::make_shared<HttpSession<beast::tcp_stream>>(shared_from_this(), beast::tcp_stream(std::move(socket)));
-    session->start(std::move(initial));
+    session->start(std::move(initial), std::move(hold));
 }
 
 void HttpServer::add_route(bhttp::verb method, std::string path, RouteHandler handler, bool prefix) {

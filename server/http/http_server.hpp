@@ -110,10 +110,11 @@ public:
     HttpServer(std::weak_ptr<Node> node, HttpOptions options);
 
     /// Entry point for the node (Node::set_http_handler).
-    void handle(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial);
+    /// `hold` is kept alive as long as the connection runs, upgrades included (AcceptedStream::hold).
+    void handle(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold = {});
     /// Entry point for TLS connections (Node::set_https_handler): HTTPS requests and WSS upgrades,
     /// served exactly as their plain counterparts (http_server_tls.cpp).
-    void handle_tls(TlsStream stream, std::vector<std::byte> initial);
+    void handle_tls(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold = {});
 
     /// Exact-path route for a method (GET, POST, PUT…); `prefix` routes match a path prefix.
     void add_route(boost::beast::http::verb method, std::string path, RouteHandler handler, bool prefix = false);

@@ -88,8 +88,8 @@ struct Fixture {
                                                          s->send_urgent("reply");
                                                      },
                                                      {}});
-        node->set_http_handler([s = server](tcp::socket sock, std::vector<std::byte> initial) {
-            s->handle(std::move(sock), std::move(initial));
+        node->set_http_handler([s = server](tcp::socket sock, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+            s->handle(std::move(sock), std::move(initial), std::move(hold));
         });
         REQUIRE(node->register_service(std::make_shared<TinyService>()));
         port = *node->listen_tcp("127.0.0.1", 0);

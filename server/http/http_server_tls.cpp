@@ -7,9 +7,9 @@
 
 namespace rr::server::http {
 
-void HttpServer::handle_tls(TlsStream stream, std::vector<std::byte> initial) {
+void HttpServer::handle_tls(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
     auto session = std::make_shared<detail::HttpSession<TlsStream>>(shared_from_this(), std::move(stream));
-    session->start(std::move(initial));
+    session->start(std::move(initial), std::move(hold));
 }
 
 }  // namespace rr::server::http

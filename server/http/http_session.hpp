@@ -118,6 +118,8 @@ public:
     }
 
     std::string peer() const override { return peer_; }
+    /// Keeps `hold` alive as long as the session (the connection's per-address slot).
+    void keep(std::shared_ptr<const void> hold) { hold_ = std::move(hold); }
     std::string cookie_header() const override { return cookie_; }
 
 private:
@@ -227,6 +229,7 @@ private:
     const JsonSocketHandler* handler_;
     std::size_t limit_;
     std::string peer_;
+    std::shared_ptr<const void> hold_;
     std::string cookie_;
     beast::flat_buffer buffer_;
     std::deque<Outgoing> queue_;  // front: being written while writing_
@@ -247,7 +250,8 @@ public:
     HttpSession(std::shared_ptr<HttpServer> server, Stream stream)
         : server_(std::move(server)), stream_(std::move(stream)) {}
 
-    void start(std::vector<std::byte> initial) {
+    void start(std::vector<std::byte> initial, std::shared_ptr<const void> hold = {}) {
+        hold_ = std::move(hold);
         if (!initial.empty()) {
             auto b = buffer_.prepare(initial.size());
             std::memcpy(b.data(), initial.data(), initial.size());
@@ -406,8 +410,9 @@ private:
         }
         beast::error_code lec;
         auto local = beast::get_lowest_layer(stream_).socket().local_endpoint(lec);
-        AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer};
+        AcceptedStream info{lec ? std::string() : tcp_base_url(local), peer, {}, {}};
         info.web_login.assign(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
+        info.hold = hold_;
         beast::get_lowest_layer(stream_).expires_never();
         websocket::stream<Stream> ws(std::move(stream_));
         ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
@@ -423,6 +428,7 @@ private:
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
                                                                 server->options().json_socket_queue_limit, peer, cookie);
+                s->keep(info.hold);
                 s->start();
                 return;
             }
@@ -511,6 +517,7 @@ private:
 
     std::shared_ptr<HttpServer> server_;
     Stream stream_;
+    std::shared_ptr<const void> hold_;  // the connection's per-address slot (AcceptedStream::hold)
     beast::flat_buffer buffer_;
     std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
     bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)

@@ -62,9 +62,11 @@ void Node::shutdown() {
 Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t port, NodeTlsOptions tls) {
     TcpListenerOptions opts;
     opts.first_bytes_timeout = options_.first_bytes_timeout;
+    opts.address_limiter = options_.address_limiter;
+    opts.on_limited = options_.on_limited;
     std::weak_ptr<Node> weak = weak_from_this();
-    opts.http = [weak](tcp::socket socket, std::vector<std::byte> initial) {
-        if (auto node = weak.lock()) node->dispatch_http(std::move(socket), std::move(initial));
+    opts.http = [weak](tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+        if (auto node = weak.lock()) node->dispatch_http(std::move(socket), std::move(initial), std::move(hold));
     };
     if (tls.credentials) {
         auto t = std::make_shared<TlsListenOptions>();
@@ -72,8 +74,8 @@ Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t
         t->node_id = options_.node_id;
         t->node_name = options_.node_name;
         t->timeout = options_.first_bytes_timeout;
-        t->https = [weak](TlsStream stream, std::vector<std::byte> initial) {
-            if (auto node = weak.lock()) node->dispatch_https(std::move(stream), std::move(initial));
+        t->https = [weak](TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+            if (auto node = weak.lock()) node->dispatch_https(std::move(stream), std::move(initial), std::move(hold));
         };
         t->on_failure = std::move(tls.on_failure);
         t->required = tls.required;
@@ -119,28 +121,28 @@ void Node::set_https_handler(HttpsHandler handler) {
     https_handler_ = std::move(handler);
 }
 
-void Node::dispatch_https(TlsStream stream, std::vector<std::byte> initial) {
+void Node::dispatch_https(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
     HttpsHandler handler;
     {
         std::lock_guard lock(mutex_);
         handler = https_handler_;
     }
     if (handler) {
-        handler(std::move(stream), std::move(initial));
+        handler(std::move(stream), std::move(initial), std::move(hold));
         return;
     }
     boost::system::error_code ignored;
     stream.lowest_layer().close(ignored);
 }
 
-void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial) {
+void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
     HttpHandler handler;
     {
         std::lock_guard lock(mutex_);
         handler = http_handler_;
     }
     if (handler) {
-        handler(std::move(socket), std::move(initial));
+        handler(std::move(socket), std::move(initial), std::move(hold));
         return;
     }
     static constexpr char kNotFound[] = "HTTP/1.1 404 File Not Found\r\nConnection: close\r\nContent-Length: 0\r\n\r\n";
@@ -157,6 +159,16 @@ std::shared_ptr<ConnectionLogic> Node::open_connection(const AcceptedStream& str
     config.peer = stream.peer;
     config.web_login = stream.web_login;
     return std::make_shared<ServerConnection>(services_, stats_, std::move(config), stream.local_url, mono_now());
+}
+
+std::unique_ptr<ReadThrottle> Node::make_read_throttle() {
+    if (!options_.read_rates.enabled()) return nullptr;
+    return std::make_unique<ReadThrottle>(options_.read_rates, ReadThrottle::Clock::now());
+}
+
+void Node::read_throttled(const std::string& peer) {
+    reads_throttled_.fetch_add(1, std::memory_order_relaxed);
+    if (options_.on_throttled) options_.on_throttled(peer);
 }
 
 bool Node::can_accept() const {

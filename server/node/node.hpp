@@ -37,6 +37,15 @@ struct NodeOptions {
     std::size_t max_connections = 0;
     /// How long an accepted TCP socket may take to send its first 4 bytes (wire.md §6.1: 5 s).
     std::chrono::milliseconds first_bytes_timeout{5000};
+    /// Open connections per client IP address on TCP listeners (nullptr: no limit; TcpListenerOptions).
+    std::shared_ptr<AddressLimiter> address_limiter;
+    /// Told about each connection the limiter refuses (address, reason), e.g. to log it. Optional.
+    std::function<void(const std::string& address, const std::string& reason)> on_limited;
+    /// Messages/s and bytes/s each accepted connection may send (all 0: unpaced). A connection over
+    /// its rate has its reads paused (ReadThrottle); it is not closed.
+    ReadRates read_rates;
+    /// Told each time a connection's reads are paused for going over read_rates (peer). Optional.
+    std::function<void(const std::string& peer)> on_throttled;
 };
 
 /// TLS on a TCP listener (docs/security.md).
@@ -113,12 +122,16 @@ public:
     std::shared_ptr<ConnectionLogic> open_connection(const AcceptedStream& stream) override;
     void track(const std::shared_ptr<PumpHandle>& pump) override;
     bool can_accept() const override;
+    std::unique_ptr<ReadThrottle> make_read_throttle() override;
+    void read_throttled(const std::string& peer) override;
+    /// Times a connection's reads were paused for going over NodeOptions::read_rates.
+    std::uint64_t reads_throttled() const noexcept { return reads_throttled_.load(std::memory_order_relaxed); }
 
 private:
     explicit Node(NodeOptions options);
     void start_threads();
-    void dispatch_http(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial);
-    void dispatch_https(TlsStream stream, std::vector<std::byte> initial);
+    void dispatch_http(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold);
+    void dispatch_https(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold);
     void services_changed();
 
     NodeOptions options_;
@@ -137,6 +150,7 @@ private:
     std::vector<std::function<void()>> services_changed_callbacks_;
     std::string service_state_nonce_;  // guarded by mutex_
     std::atomic<bool> stopped_{false};
+    std::atomic<std::uint64_t> reads_throttled_{0};
 };
 
 }  // namespace rr::server

@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include <boost/asio/bind_executor.hpp>
 #include <boost/asio/socket_base.hpp>
@@ -15,6 +16,7 @@
 #include <boost/asio/strand.hpp>
 #include <boost/asio/write.hpp>
 
+#include "server/common/read_throttle.hpp"
 #include "server/transport/connection_logic.hpp"
 
 namespace rr::server {
@@ -42,12 +44,26 @@ public:
     StreamPump(Stream stream, Strand strand, std::shared_ptr<ConnectionLogic> logic)
         : stream_(std::move(stream)), strand_(std::move(strand)), timer_(strand_), logic_(std::move(logic)) {}
 
+    /// Keeps `hold` alive until the pump is destroyed (the connection's per-address slot).
+    void keep(std::shared_ptr<const void> hold) { hold_ = std::move(hold); }
+
+    /// Paces reads with `throttle` (before start()): after each read the pump pauses reading for as
+    /// long as the throttle says, calling `on_pause` when a pause begins.
+    void throttle(std::unique_ptr<ReadThrottle> throttle, std::function<void()> on_pause) {
+        throttle_ = std::move(throttle);
+        on_pause_ = std::move(on_pause);
+        throttle_timer_.emplace(strand_);
+    }
+
     /// Starts reading; `initial` bytes (already read while detecting the protocol) are fed first.
     void start(std::span<const std::byte> initial = {}) {
         auto self = this->shared_from_this();
         std::vector<std::byte> first(initial.begin(), initial.end());
         asio::dispatch(strand_, [self, first = std::move(first)] {
-            if (!first.empty()) self->logic_->on_bytes(first, mono_now());
+            if (!first.empty()) {
+                self->logic_->on_bytes(first, mono_now());
+                if (self->throttle_) self->pace(first);  // the framing count starts at the stream's first byte
+            }
             self->read();
             self->after_work();
         });
@@ -84,7 +100,7 @@ public:
 
 private:
     void read() {
-        if (reading_) return;
+        if (reading_ || throttled_) return;
         if (!logic_->wants_read()) {
             read_paused_ = true;  // resumed by after_work() once the output has drained
             return;
@@ -100,10 +116,28 @@ private:
                                         self->transport_failed(ec);
                                         return;
                                     }
-                                    self->logic_->on_bytes(std::span<const std::byte>(self->buffer_.data(), n), mono_now());
+                                    const std::span<const std::byte> got(self->buffer_.data(), n);
+                                    self->logic_->on_bytes(got, mono_now());
+                                    if (self->throttle_) self->pace(got);
                                     self->after_work();
                                     if (!self->closed_ && !self->logic_->wants_close()) self->read();
                                 }));
+    }
+
+    // Charges the bytes just read to the throttle; over the rate, reads pause (TCP back-pressure) until
+    // the throttle's wait has passed.
+    void pace(std::span<const std::byte> got) {
+        const auto wait = throttle_->charge(got, ReadThrottle::Clock::now());
+        if (wait <= std::chrono::nanoseconds{0}) return;
+        throttled_ = true;
+        if (on_pause_) on_pause_();
+        throttle_timer_->expires_after(wait);
+        auto self = this->shared_from_this();
+        throttle_timer_->async_wait(asio::bind_executor(strand_, [self](boost::system::error_code ec) {
+            self->throttled_ = false;
+            if (ec || self->closed_ || self->logic_->wants_close()) return;
+            self->read();
+        }));
     }
 
     void after_work() {
@@ -170,6 +204,7 @@ private:
         if (closed_) return;
         closed_ = true;
         timer_.cancel();
+        if (throttle_timer_) throttle_timer_->cancel();
         boost::system::error_code ignored;
         if constexpr (requires(Stream& s) { s.lowest_layer(); }) {
             stream_.lowest_layer().shutdown(asio::socket_base::shutdown_both, ignored);
@@ -187,6 +222,11 @@ private:
     Strand strand_;
     asio::steady_timer timer_;
     std::shared_ptr<ConnectionLogic> logic_;
+    std::shared_ptr<const void> hold_;
+    std::unique_ptr<ReadThrottle> throttle_;
+    std::function<void()> on_pause_;
+    std::optional<asio::steady_timer> throttle_timer_;
+    bool throttled_ = false;
     std::array<std::byte, 64 * 1024> buffer_{};
     std::vector<std::byte> write_buffer_;
     bool writing_ = false;

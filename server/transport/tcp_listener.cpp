@@ -1,6 +1,7 @@
 #include "server/transport/tcp_listener.hpp"
 
 #include "server/transport/tls/tls_listener.hpp"
+#include "server/common/address_limiter.hpp"
 
 #include <array>
 #include <string_view>
@@ -122,7 +123,60 @@ struct TcpListener::Detect {
     tcp::socket socket;
     asio::steady_timer timer;
     std::array<std::byte, 4> head{};
+    std::shared_ptr<const void> hold;  // the per-address slot (null without a limiter)
+    std::string refused;               // non-empty: over the per-address limit, this is why
 };
+
+namespace {
+
+// The client's IP address as the limiter counts it: an IPv4-mapped IPv6 address counts as IPv4.
+std::string client_address(const tcp::socket& socket) {
+    boost::system::error_code ec;
+    auto remote = socket.remote_endpoint(ec);
+    if (ec) return {};
+    auto a = remote.address();
+    if (a.is_v6() && a.to_v6().is_v4_mapped()) a = asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6());
+    return a.to_string();
+}
+
+// 429 for an HTTP request or WebSocket upgrade over the per-address limit (RFC 6585 §4), then close.
+// What the client sent after its first four bytes is read and dropped (for at most 2 s) before the
+// close, so that the close is a FIN, not a reset that could discard the answer at the client.
+void refuse_http(tcp::socket socket, const std::string& reason) {
+    struct Out {
+        tcp::socket socket;
+        asio::steady_timer timer;
+        std::string text;
+        std::array<char, 512> sink{};
+        void drain(std::shared_ptr<Out> self) {
+            socket.async_read_some(asio::buffer(sink), [self](boost::system::error_code ec, std::size_t) {
+                if (!ec) return self->drain(self);
+                self->timer.cancel();
+                boost::system::error_code ignored;
+                self->socket.close(ignored);
+            });
+        }
+    };
+    const std::string body = reason + "\n";
+    auto executor = socket.get_executor();
+    auto out = std::make_shared<Out>(Out{std::move(socket), asio::steady_timer(executor), {}, {}});
+    out->text = "HTTP/1.1 429 Too Many Requests\r\nConnection: close\r\nRetry-After: 5\r\n"
+                "Content-Type: text/plain; charset=utf-8\r\nContent-Length: " +
+                std::to_string(body.size()) + "\r\n\r\n" + body;
+    asio::async_write(out->socket, asio::buffer(out->text), [out](boost::system::error_code ec, std::size_t) {
+        boost::system::error_code ignored;
+        if (ec) return out->socket.close(ignored);
+        out->socket.shutdown(tcp::socket::shutdown_send, ignored);
+        out->timer.expires_after(std::chrono::seconds(2));
+        out->timer.async_wait([out](boost::system::error_code tec) {
+            boost::system::error_code ignored2;
+            if (!tec) out->socket.close(ignored2);
+        });
+        out->drain(out);
+    });
+}
+
+}  // namespace
 
 void TcpListener::detect(tcp::socket socket) {
     auto sink = sink_.lock();
@@ -134,7 +188,17 @@ void TcpListener::detect(tcp::socket socket) {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
 
-    auto d = std::make_shared<Detect>(Detect{std::move(socket), asio::steady_timer(socket.get_executor()), {}});
+    auto d = std::make_shared<Detect>(Detect{std::move(socket), asio::steady_timer(socket.get_executor()), {}, {}, {}});
+    if (auto& limiter = options_.address_limiter) {
+        const auto address = client_address(d->socket);
+        if (auto slot = limiter->acquire(address)) {
+            d->hold = std::move(slot);
+        } else {
+            d->refused = "too many connections from " + address + " (at most " +
+                         std::to_string(limiter->max_per_address()) + " per address)";
+            if (options_.on_limited) options_.on_limited(address, d->refused);
+        }
+    }
     d->timer.expires_after(options_.first_bytes_timeout);
     d->timer.async_wait([d](boost::system::error_code ec) {
         if (!ec) {
@@ -161,7 +225,12 @@ void TcpListener::detect(tcp::socket socket) {
         }
         if (first[0] == std::byte{0x16}) {
             d->timer.cancel();  // from here the TLS handshake's own timeout applies
+            if (!d->refused.empty()) {
+                d->socket.close(ec2);  // over the per-address limit: no handshake (logged by on_limited)
+                return;
+            }
             auto info = accepted_info(d->socket);
+            info.hold = d->hold;
             accept_direct_tls(std::move(d->socket), std::move(info), self->sink_, self->options_.tls);
             return;
         }
@@ -175,11 +244,18 @@ void TcpListener::read_head(std::shared_ptr<Detect> d) {
         d->timer.cancel();
         if (ec) return;
         const auto& h = d->head;
+        if (!d->refused.empty()) {  // over the per-address limit (logged by on_limited)
+            if (could_begin_http(h)) return refuse_http(std::move(d->socket), d->refused);
+            boost::system::error_code ignored2;
+            d->socket.close(ignored2);
+            return;
+        }
         std::vector<std::byte> initial(h.begin(), h.end());
         if (is_rrac(h)) {
             auto sink = self->sink_.lock();
             if (!sink) return;
             auto info = accepted_info(d->socket);
+            info.hold = d->hold;
             if (self->options_.tls)  // STARTTLS (rrs+tcp) or plain RR: the first message decides
                 accept_rr_or_starttls(std::move(d->socket), std::move(initial), std::move(info), self->sink_,
                                       self->options_.tls);
@@ -201,7 +277,7 @@ void TcpListener::read_head(std::shared_ptr<Detect> d) {
             });
         } else if (self->options_.http) {
             // Anything else is HTTP (plain requests and WebSocket upgrades).
-            self->options_.http(std::move(d->socket), std::move(initial));
+            self->options_.http(std::move(d->socket), std::move(initial), d->hold);
         } else {
             // Without an HTTP handler the node answers 404 and closes, as CORE does.
             static constexpr char kNotFound[] = "HTTP/1.1 404 File Not Found\r\nConnection: close\r\nContent-Length: 0\r\n\r\n";

@@ -5,6 +5,8 @@
 // ClientHello) → the TLS handshake, then the decrypted stream is classified again (RR over TLS,
 // HTTPS, WSS); and a first RR message StreamOp STARTTLS → rrs+tcp. Without TLS options the plain
 // paths are exactly as before (no extra read, copy or allocation).
+// With an AddressLimiter, a connection beyond the limit of open connections from its IP address is
+// refused (HTTP: 429 with the reason; RR: closed) and each accepted one holds its slot until it ends.
 // Sockets get TCP_NODELAY. A socket that sends nothing within first_bytes_timeout is dropped.
 #pragma once
 
@@ -20,9 +22,12 @@
 namespace rr::server {
 
 /// Takes a socket whose first bytes (`initial`) were not `RRAC`: HTTP requests, WebSocket upgrades.
-using HttpHandler = std::function<void(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial)>;
+/// `hold` is kept alive as long as the connection runs (AcceptedStream::hold; may be null).
+using HttpHandler = std::function<void(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
+                                       std::shared_ptr<const void> hold)>;
 
 struct TlsListenOptions;
+class AddressLimiter;
 
 /// Runs a plain RR connection whose first bytes (`initial`, starting with `RRAC`) were already read.
 bool serve_plain_rr(ConnectionSink& sink, boost::asio::ip::tcp::socket socket, const AcceptedStream& info,
@@ -39,6 +44,11 @@ struct TcpListenerOptions {
     HttpHandler http;
     /// TLS on this port (nullptr: none; a first byte 0x16 then goes to `http` like any non-RR socket).
     std::shared_ptr<const TlsListenOptions> tls;
+    /// Open connections per client IP address (nullptr: no limit). A connection over the limit is
+    /// refused: an HTTP request or WebSocket upgrade gets 429 with the reason, raw RR and TLS are closed.
+    std::shared_ptr<AddressLimiter> address_limiter;
+    /// Told about each connection refused by `address_limiter` (address, reason), for the log.
+    std::function<void(const std::string& address, const std::string& reason)> on_limited;
 };
 
 class TcpListener : public Listener, public std::enable_shared_from_this<TcpListener> {

@@ -61,6 +61,9 @@ struct AcceptedStream {
     /// The Cookie header of the WebSocket upgrade that carried this stream (rr+ws from a browser), or
     /// "": services may accept a web login made on the gateway's page (HostedService::authenticate_web).
     std::string web_login;
+    /// Kept alive as long as the connection runs (its place in the per-address connection count,
+    /// AddressLimiter::Slot; docs/security.md "Connection limits"); may be null.
+    std::shared_ptr<const void> hold;
 };
 
 /// Where listeners hand accepted streams (implemented by the node). Thread-safe.
@@ -74,6 +77,10 @@ public:
     /// False while new connections would be refused (limit reached): listeners then close a new
     /// socket without reading from it.
     virtual bool can_accept() const { return true; }
+    /// The pacing of a new accepted connection's reads (messages/s, bytes/s), or nullptr: unpaced.
+    virtual std::unique_ptr<ReadThrottle> make_read_throttle() { return nullptr; }
+    /// A connection's reads were paused because it went over its rate (for metrics and the log).
+    virtual void read_throttled(const std::string& peer) { (void)peer; }
 };
 
 /// Runs an accepted byte stream: asks `sink` for its logic (closing the stream when refused), then
@@ -92,6 +99,11 @@ bool serve_stream(ConnectionSink& sink, Stream stream, const AcceptedStream& inf
     }
     typename StreamPump<Stream>::Strand strand(stream.get_executor());
     auto pump = std::make_shared<StreamPump<Stream>>(std::move(stream), strand, logic);
+    pump->keep(info.hold);
+    if (auto throttle = sink.make_read_throttle()) {
+        // The sink (the node) outlives its pumps: it owns the io_context that runs them.
+        pump->throttle(std::move(throttle), [s = &sink, peer = info.peer] { s->read_throttled(peer); });
+    }
     logic->attach(pump);
     sink.track(pump);
     pump->start(initial);

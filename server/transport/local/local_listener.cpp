@@ -251,7 +251,7 @@ void LocalListener::Impl::detect(unix_socket::socket socket) {
                 d->socket.close(ignored);  // not the RR stream protocol
                 return;
             }
-        serve_stream(*sink, std::move(d->socket), AcceptedStream{std::string(kLocalBaseUrl), "local"},
+        serve_stream(*sink, std::move(d->socket), AcceptedStream{std::string(kLocalBaseUrl), "local", {}, {}},
                      std::vector<std::byte>(d->head.begin(), d->head.end()));
     });
 }

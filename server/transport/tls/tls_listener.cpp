@@ -89,7 +89,7 @@ struct TlsAccept : std::enable_shared_from_this<TlsAccept> {
                     if (!sink) return self->fail("node stopped");
                     serve_tls_stream(*sink, std::move(self->stream), self->info, std::move(self->head));
                 } else if (self->options->https) {
-                    self->options->https(std::move(self->stream), std::move(self->head));
+                    self->options->https(std::move(self->stream), std::move(self->head), self->info.hold);
                 } else {
                     self->fail("neither RR nor a served protocol after the handshake");
                 }

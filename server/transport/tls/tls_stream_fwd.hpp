@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <boost/asio/any_io_executor.hpp>
@@ -29,6 +30,8 @@ using TlsStream = boost::asio::ssl::stream<
 
 /// Takes a TLS connection (handshake done) whose first decrypted bytes (`initial`) were not `RRAC`:
 /// HTTPS requests and WSS upgrades.
-using HttpsHandler = std::function<void(TlsStream stream, std::vector<std::byte> initial)>;
+/// `hold`: keep alive as long as the connection runs (AcceptedStream::hold).
+using HttpsHandler =
+    std::function<void(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold)>;
 
 }  // namespace rr::server

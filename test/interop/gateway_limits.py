@@ -1,0 +1,279 @@
+#!/usr/bin/env python3
+"""The gateway's per-address connection limit (gateway.limits.connections_per_address,
+docs/security.md "Connection limits"), tested with plain sockets.
+
+Starts rr-gateway (no devices, demo off) with connections_per_address: 2 on 0.0.0.0 and checks:
+  refused   two JSON WebSockets from 127.0.0.1 stay open; a third connection from 127.0.0.1 is
+            refused: an HTTP request gets 429 with the reason in the body, a raw RR connection
+            (`RRAC` …) is closed without an answer.
+  others    meanwhile 127.0.0.2 (Linux routes 127/8 to lo; the client socket is bound to it) still
+            gets /metrics (200), and both WebSockets from 127.0.0.1 still answer.
+  released  after one WebSocket from 127.0.0.1 closes, a new request from 127.0.0.1 is served.
+  counted   /metrics reports rr_gateway_limited_total{limit="connections_per_address"} >= the
+            refusals made, and the gateway's log has a warning naming the address.
+Then restarts it with messages_per_second: 20 (burst_s: 1) and, with the official Python client
+(skipped when missing), checks:
+  throttled a client calling the gateway's service index as fast as it can gets about 20 calls/s
+            over 4 s (at most the rate plus its one-second burst, and at least half the rate: slowed,
+            not cut off), and rr_gateway_limited_total{limit="rate"} counts the pauses.
+  unharmed  meanwhile a second client's calls on its own connection return promptly, and the
+            flooding client is still connected afterwards.
+Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
+when websocket-client is missing or 127.0.0.2 cannot be bound.
+
+Usage: gateway_limits.py --gateway PATH/rr-gateway
+"""
+
+import argparse
+import json
+import os
+import re
+import socket
+import sys
+import tempfile
+import time
+import traceback
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from child_procs import StepFailed, read_json_line, start, stop, tail  # noqa: E402
+
+try:
+    import websocket  # websocket-client
+except ImportError as e:  # pragma: no cover
+    print("SKIP: websocket-client missing: %s" % e)
+    sys.exit(77)
+
+JSON_PROTOCOL = "rr-gateway.json.v1"
+METRIC = 'rr_gateway_limited_total{limit="connections_per_address"}'
+RATE_METRIC = 'rr_gateway_limited_total{limit="rate"}'
+RATE = 20
+
+
+def http_get(port, path, source="127.0.0.1", timeout=10):
+    """One HTTP/1.1 GET over a fresh socket bound to `source`; returns (status, body) or (None, why)."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.settimeout(timeout)
+    try:
+        s.bind((source, 0))
+        s.connect(("127.0.0.1", port))
+        s.sendall(("GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n" % (path, port)).encode())
+        data = b""
+        while True:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+    except OSError as e:
+        return None, "%s: %s" % (type(e).__name__, e)
+    finally:
+        s.close()
+    head, _, body = data.partition(b"\r\n\r\n")
+    m = re.match(rb"HTTP/1\.1 (\d+)", head)
+    if not m:
+        return None, "no HTTP answer: %r" % data[:200]
+    return int(m.group(1)), body.decode("utf-8", "replace")
+
+
+def raw_rr_refused(port, timeout=10):
+    """A raw RR connection from 127.0.0.1 that sends `RRAC` and a few more bytes: True when the gateway
+    closes it without sending anything."""
+    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    try:
+        s.sendall(b"RRAC" + b"\x00" * 12)
+        try:
+            return s.recv(4096) == b""
+        except ConnectionResetError:
+            return True
+    finally:
+        s.close()
+
+
+def json_ws(port):
+    ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=[JSON_PROTOCOL], timeout=20)
+    return ws
+
+
+def ws_alive(ws):
+    """The JSON WebSocket answers a request (any well-formed answer counts: the connection works)."""
+    ws.send(json.dumps({"id": 1, "op": "devices"}))
+    return bool(json.loads(ws.recv()))
+
+
+def metric(port, source="127.0.0.2", name=METRIC):
+    status, body = http_get(port, "/metrics", source)
+    if status != 200:
+        raise StepFailed("/metrics from %s: %s %s" % (source, status, body[:200] if body else ""))
+    for line in body.splitlines():
+        if line.startswith(name + " "):
+            return int(float(line.split()[-1]))
+    raise StepFailed("/metrics has no %s" % name)
+
+
+def rate_checks(c, args, work):
+    """The messages_per_second phase (official client); returns False when it had to be skipped."""
+    try:
+        import threading
+
+        import RobotRaconteur as RR
+    except ImportError as e:
+        c.results.append({"check": "throttled", "ok": True, "detail": "SKIPPED: official package missing: %s" % e})
+        return False
+    rrn = RR.RobotRaconteurNode.s
+    rrn.RegisterTransport(RR.TcpTransport())
+    gateway = None
+    try:
+        with open(os.path.join(work, "rate.yaml"), "w") as f:
+            f.write("gateway:\n  listen: 127.0.0.1\n  port: 0\n  local: false\n"
+                    "  limits:\n    messages_per_second: %d\n    burst_s: 1\n"
+                    "demo:\n  enabled: false\n" % RATE)
+        gateway = start([args.gateway, "--config", os.path.join(work, "rate.yaml")], os.path.join(work, "rate.err"))
+        port = read_json_line(gateway, args.timeout, "rr-gateway ready line (rate)")["port"]
+        url = "rr+tcp://127.0.0.1:%d/?service=RobotRaconteurServiceIndex" % port
+        flood = rrn.ConnectService(url)
+        other = rrn.ConnectService(url)
+        time.sleep(1.5)  # both buckets full again after the connection handshakes
+        calls = [0]
+        stop_at = time.monotonic() + 4.0
+        err = []
+
+        def flooder():
+            try:
+                while time.monotonic() < stop_at:
+                    flood.GetLocalNodeServices()
+                    calls[0] += 1
+            except Exception as e:  # noqa: BLE001
+                err.append(repr(e))
+
+        t0 = time.monotonic()
+        th = threading.Thread(target=flooder)
+        th.start()
+        time.sleep(1.5)  # the flood is in its paced phase now
+        worst = 0.0
+        for _ in range(5):
+            s0 = time.monotonic()
+            other.GetLocalNodeServices()
+            worst = max(worst, time.monotonic() - s0)
+            time.sleep(0.1)
+        th.join(30)
+        elapsed = time.monotonic() - t0
+        rate = calls[0] / elapsed
+        # Requests are RR messages from the client; the burst is RATE messages; heartbeats are rare.
+        c.check("throttled: a flooding client gets about messages_per_second calls/s",
+                not err and calls[0] <= RATE * (elapsed + 1) + 5 and rate >= RATE / 2,
+                "%d calls in %.2f s = %.1f/s (limit %d/s, burst %d) %s" % (calls[0], elapsed, rate, RATE, RATE, err))
+        c.check("unharmed: a second client's calls return promptly during the flood", worst < 0.5,
+                "slowest of 5 calls: %.3f s" % worst)
+        try:
+            flood.GetLocalNodeServices()
+            still = True
+        except Exception as e:  # noqa: BLE001
+            still = repr(e)
+        c.check("unharmed: the flooding client is slowed, not disconnected", still is True, str(still))
+        paused = metric(port, source="127.0.0.1", name=RATE_METRIC)
+        c.check("throttled: /metrics counts the pauses", paused > 0, "%s = %d" % (RATE_METRIC, paused))
+        time.sleep(0.2)
+        log = tail(os.path.join(work, "rate.err"), 200)
+        c.check("throttled: the log says reads were paused", "over its rate" in log and "reads paused" in log, log[-600:])
+    finally:
+        try:
+            rrn.Shutdown()
+        except Exception:  # noqa: BLE001
+            pass
+        stop(gateway)
+    return True
+
+
+class Checks:
+    def __init__(self):
+        self.results = []
+
+    def check(self, name, ok, detail=""):
+        self.results.append({"check": name, "ok": bool(ok), "detail": detail})
+        return ok
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--timeout", type=float, default=30)
+    args = ap.parse_args()
+
+    probe = socket.socket()
+    try:
+        probe.bind(("127.0.0.2", 0))
+    except OSError as e:
+        print("SKIP: cannot bind 127.0.0.2 (%s)" % e)
+        return 77
+    finally:
+        probe.close()
+
+    c = Checks()
+    gateway = None
+    opened = []
+    with tempfile.TemporaryDirectory(prefix="rr-limits-") as work:
+        try:
+            with open(os.path.join(work, "gateway.yaml"), "w") as f:
+                f.write("gateway:\n  listen: 0.0.0.0\n  port: 0\n  local: false\n"
+                        "  limits:\n    connections_per_address: 2\n"
+                        "demo:\n  enabled: false\n")
+            gateway = start([args.gateway, "--config", os.path.join(work, "gateway.yaml")], os.path.join(work, "gateway.err"))
+            port = read_json_line(gateway, args.timeout, "rr-gateway ready line")["port"]
+
+            opened = [json_ws(port), json_ws(port)]
+            c.check("refused: two WebSockets from 127.0.0.1 open", all(ws_alive(w) for w in opened))
+
+            status, body = http_get(port, "/metrics")
+            c.check("refused: third connection from 127.0.0.1 (HTTP) gets 429 with the reason",
+                    status == 429 and "too many connections from 127.0.0.1" in body and "at most 2" in body,
+                    "%s %r" % (status, body))
+            c.check("refused: third connection from 127.0.0.1 (raw RR) is closed", raw_rr_refused(port))
+
+            status, body = http_get(port, "/metrics", source="127.0.0.2")
+            c.check("others: 127.0.0.2 is served meanwhile", status == 200, "%s" % status)
+            c.check("others: the two WebSockets from 127.0.0.1 still work", all(ws_alive(w) for w in opened))
+
+            count = metric(port)
+            c.check("counted: /metrics counts the refusals", count >= 2, "%s = %d" % (METRIC, count))
+
+            opened.pop().close()
+            served = None
+            for _ in range(50):  # the gateway notices the close asynchronously
+                served, body = http_get(port, "/metrics")
+                if served == 200:
+                    break
+                time.sleep(0.1)
+            c.check("released: after a WebSocket closes, 127.0.0.1 is served again", served == 200, "%s" % served)
+
+            time.sleep(0.2)
+            log = tail(os.path.join(work, "gateway.err"), 200)
+            c.check("counted: the log warns naming the address",
+                    "connection refused: too many connections from 127.0.0.1" in log, log[-600:])
+            for w in opened:
+                w.close()
+            opened = []
+            stop(gateway)
+            gateway = None
+
+            rate_checks(c, args, work)
+        except StepFailed as e:
+            c.results.append({"check": "setup", "ok": False, "detail": str(e)})
+            print(json.dumps({"results": c.results, "gateway_log": tail(os.path.join(work, "gateway.err"))}, indent=1))
+            return 2
+        except Exception:  # noqa: BLE001
+            c.results.append({"check": "setup", "ok": False, "detail": traceback.format_exc()})
+            print(json.dumps({"results": c.results, "gateway_log": tail(os.path.join(work, "gateway.err"))}, indent=1))
+            return 2
+        finally:
+            for w in opened:
+                try:
+                    w.close()
+                except Exception:  # noqa: BLE001
+                    pass
+            stop(gateway)
+    ok = all(r["ok"] for r in c.results)
+    print(json.dumps({"ok": ok, "results": c.results}, indent=1))
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
