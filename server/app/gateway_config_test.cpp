@@ -504,7 +504,7 @@ gateway:
     }
 }
 
-TEST_CASE("--allow-origin is checked like gateway.allowed_origins") {
+TEST_CASE("gateway command line: --allow-origin is checked like gateway.allowed_origins") {
     const char* good[] = {"rr-gateway", "--allow-origin", "https://lab.example.org"};
     auto cmd = parse_command_line(3, good);
     REQUIRE(cmd);

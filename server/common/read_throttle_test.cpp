@@ -74,7 +74,7 @@ TEST_CASE("read throttle: messages per second, with a burst of burst_s seconds")
     CHECK(t.charge(one, t0 + 300ms) == 0ns);
 }
 
-TEST_CASE("read throttle: bytes per second; the average over a flood stays at the rate") {
+TEST_CASE("read throttle: bytes per second, and the average over a flood stays at the rate") {
     const T t0{};
     ReadThrottle t(ReadRates{0, 10000, 1}, t0);  // 10 kB/s, burst 10 kB
     const auto chunk = stream_of(1, 5000);

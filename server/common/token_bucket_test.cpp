@@ -43,7 +43,7 @@ TEST_CASE("token bucket: a message bigger than the burst passes, and its size is
     CHECK(b.wait_time(t0 + 5s) == 0ns);
 }
 
-TEST_CASE("token bucket: rate 0 is unlimited; burst 0 means one second's worth; time going back is ignored") {
+TEST_CASE("token bucket: rate 0 is unlimited, burst 0 means one second of rate, time going back is ignored") {
     const T t0{};
     TokenBucket none(0, 0, t0);
     CHECK(none.unlimited());
@@ -76,7 +76,7 @@ TEST_CASE("address limiter: the third connection from one address is refused, an
     CHECK(l->addresses() == 0);  // no entry stays behind for an address with nothing open
 }
 
-TEST_CASE("address limiter: 0 is unlimited; a slot outliving its limiter is harmless") {
+TEST_CASE("address limiter: 0 is unlimited, and a slot outliving its limiter is harmless") {
     auto l = AddressLimiter::create(0);
     std::vector<std::shared_ptr<AddressLimiter::Slot>> slots;
     for (int i = 0; i < 100; ++i) slots.push_back(l->acquire("::1"));
