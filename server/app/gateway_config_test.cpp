@@ -6,6 +6,19 @@
 using namespace rr;
 using namespace rr::server::app;
 
+namespace {
+
+// `yaml` (as bad.yaml) is refused with InvalidConfiguration, and the message starts with `expect`.
+void check_refused(const std::string& yaml, const std::string& expect) {
+    auto c = parse_gateway_config(yaml, "bad.yaml");
+    INFO(yaml);
+    REQUIRE_FALSE(c);
+    CHECK(c.error().type == MessageErrorType::InvalidConfiguration);
+    CHECK_THAT(c.error().message, Catch::StartsWith(expect));
+}
+
+}  // namespace
+
 TEST_CASE("a full configuration parses") {
     auto c = parse_gateway_config(R"(
 gateway:
@@ -65,11 +78,7 @@ TEST_CASE("configuration errors name the key and the line") {
              Case{"gateway:\n  log_format: xml\n", "bad.yaml:2: gateway.log_format: unknown format \"xml\""},
              Case{"gateway:\n  node_id: not-a-uuid\n", "bad.yaml:2: gateway.node_id: not a NodeID"},
          }) {
-        auto c = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(c);
-        CHECK(c.error().type == MessageErrorType::InvalidConfiguration);
-        CHECK_THAT(c.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
 }
 
@@ -132,10 +141,7 @@ discovery:
                   "bad.yaml:2: devices.b.url: rr+usb is turned off"},
              Case{"discovery:\n  local: yes please\n", "bad.yaml:2: discovery.local: expected true or false"},
          }) {
-        auto c = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(c);
-        CHECK_THAT(c.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
     // A --device flag naming rr+usb with USB turned off is refused too.
     auto off = parse_gateway_config("usb:\n  enabled: false\n", "t.yaml");
@@ -274,10 +280,7 @@ devices:
              std::pair{"devices:\n  - name: a\n    url: rrs+tcp://x/?service=s\n    tls_certificate: c.pem\n",
                        "bad.yaml:2: devices.a: tls_certificate and tls_private_key go together"},
          }) {
-        auto r = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(r);
-        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
 }
 
@@ -323,10 +326,7 @@ devices:
              std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    max_passthrough_sessions: 0\n",
                        "bad.yaml:4: devices.a.max_passthrough_sessions: must be at least 1"},
          }) {
-        auto r = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(r);
-        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
 }
 
@@ -392,10 +392,7 @@ gateway:
              std::pair{"gateway:\n  auth:\n    users: u\n    roles:\n      \"a,b\": []\n",
                        "bad.yaml:5: gateway.auth.roles.a,b: a role name has no spaces or commas"},
          }) {
-        auto r = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(r);
-        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
 }
 
@@ -473,11 +470,7 @@ gateway:
              Case{"gateway:\n  limits:\n    burst_s: 0\n", "bad.yaml:3: gateway.limits.burst_s: must be at least 1"},
              Case{"gateway:\n  limits: 5\n", "bad.yaml:2: gateway.limits: expected a mapping"},
          }) {
-        auto r = parse_gateway_config(yaml, "bad.yaml");
-        INFO(yaml);
-        REQUIRE_FALSE(r);
-        CHECK(r.error().type == MessageErrorType::InvalidConfiguration);
-        CHECK_THAT(r.error().message, Catch::StartsWith(expect));
+        check_refused(yaml, expect);
     }
 }
 
