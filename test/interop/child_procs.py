@@ -2,6 +2,7 @@
 that dies with us, read its JSON ready line, stop it (SIGTERM, then SIGKILL)."""
 
 import ctypes
+import hashlib
 import json
 import os
 import selectors
@@ -121,3 +122,18 @@ def wait_for(pred, timeout, what, interval=0.1):
             last = e
         time.sleep(interval)
     fail("%s within %.0f s (last: %r)" % (what, timeout, last))
+
+
+def password_line(user, password, privileges):
+    """One entry of the official password file: `user md5hex(password) privileges` (comma-separated)."""
+    return "%s %s %s" % (user, hashlib.md5(password.encode()).hexdigest(), privileges)
+
+
+def write_password_file(path, entries):
+    """Writes the official password file from (user, password, privileges) triples or ready lines, in one
+    rename (a gateway reloading it on SIGHUP never reads half a file)."""
+    lines = ["# official password file format: user md5(password) privileges"]
+    lines += [e if isinstance(e, str) else password_line(*e) for e in entries]
+    with open(path + ".new", "w") as f:
+        f.write("".join(l + "\n" for l in lines))
+    os.replace(path + ".new", path)

@@ -43,7 +43,7 @@ import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, read_json_line, start, stop, tail  # noqa: E402
+from child_procs import StepFailed, read_json_line, start, stop, tail, write_password_file  # noqa: E402
 
 try:
     import RobotRaconteur as RR
@@ -136,10 +136,7 @@ def main():
     args = ap.parse_args()
 
     work = tempfile.mkdtemp(prefix="gw_logins_")
-    with open(os.path.join(work, "users.txt"), "w") as f:
-        f.write("# user md5 privileges(roles)\n")
-        for u, (pw, roles) in USERS.items():
-            f.write("%s %s %s\n" % (u, hashlib.md5(pw.encode()).hexdigest(), roles))
+    write_password_file(os.path.join(work, "users.txt"), [(u, pw, roles) for u, (pw, roles) in USERS.items()])
     with open(os.path.join(work, "tokens.txt"), "w") as f:
         f.write("%s wall viewer\n" % TOKEN)
     with open(os.path.join(work, "jwt.key"), "wb") as f:
@@ -451,17 +448,12 @@ devices:
                     raise AssertionError("no %r in the gateway's log after SIGHUP: %s" % (text, log[-800:]))
                 time.sleep(0.1)
 
-        def write_users(lines):
-            path = os.path.join(work, "users.txt")
-            with open(path + ".new", "w") as f:
-                f.write("".join(l + "\n" for l in lines))
-            os.replace(path + ".new", path)
+        def write_users(entries):
+            write_password_file(os.path.join(work, "users.txt"), entries)
 
         def reload_users():
-            def line(u, pw, roles):
-                return "%s %s %s" % (u, hashlib.md5(pw.encode()).hexdigest(), roles)
             # bob leaves, dave (operator) joins; alice stays as she was.
-            write_users([line("alice", *USERS["alice"]), line("dave", "dave-pw", "operator")])
+            write_users([("alice", *USERS["alice"]), ("dave", "dave-pw", "operator")])
             mark = os.path.getsize(os.path.join(work, "gateway.err"))
             os.kill(gateway.pid, signal.SIGHUP)
             wait_log("SIGHUP: logins reloaded: 2 user(s), 1 token(s), JWT HS256, 3 role(s)", mark)
@@ -475,7 +467,7 @@ devices:
             h = Http(base)
             expect_status(h.call("POST", "/api/login", {"username": "dave", "password": "dave-pw"}), 200)
             # A broken file on the next SIGHUP is logged and changes nothing.
-            write_users([line("alice", *USERS["alice"]), "dave not-an-md5-digest operator"])
+            write_users([("alice", *USERS["alice"]), "dave not-an-md5-digest operator"])
             mark = os.path.getsize(os.path.join(work, "gateway.err"))
             os.kill(gateway.pid, signal.SIGHUP)
             wait_log("SIGHUP: logins not reloaded, the previous ones stay in force: gateway.auth.users", mark)

@@ -19,7 +19,6 @@ Usage: locks_logins.py --service PATH/rr_interop_service [--timeout S]
 """
 
 import argparse
-import hashlib
 import json
 import os
 import signal
@@ -31,7 +30,7 @@ import time
 import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail  # noqa: E402
+from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail, write_password_file  # noqa: E402
 
 try:
     import RobotRaconteur as RR
@@ -271,10 +270,7 @@ def main():
 
     tmp = tempfile.mkdtemp(prefix="rr-locks-")
     users = os.path.join(tmp, "users.txt")
-    with open(users, "w") as fh:
-        fh.write("# official password file format: user md5(password) privileges\n")
-        for user, (pw, priv) in USERS.items():
-            fh.write("%s %s %s\n" % (user, hashlib.md5(pw.encode()).hexdigest(), priv))
+    write_password_file(users, [(user, pw, priv) for user, (pw, priv) in USERS.items()])
     err = os.path.join(tmp, "service.err")
     svc = None
     ck = Checks()

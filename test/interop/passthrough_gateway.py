@@ -20,7 +20,6 @@ Usage: passthrough_gateway.py --gateway PATH/rr-gateway --service PATH/rr_intero
 """
 
 import argparse
-import hashlib
 import json
 import os
 import sys
@@ -29,7 +28,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, get_json, read_json_line, start, stop, tail  # noqa: E402
+from child_procs import StepFailed, get_json, read_json_line, start, stop, tail, write_password_file  # noqa: E402
 
 try:
     import RobotRaconteur as RR
@@ -191,9 +190,8 @@ def main():
 
     tmp = tempfile.mkdtemp(prefix="rr-passthrough-")
     users = os.path.join(tmp, "users.txt")
-    with open(users, "w") as fh:
-        for user, (pw, priv) in list(ll.USERS.items()) + [(GATEWAY_USER[0], (GATEWAY_USER[1], "_"))]:
-            fh.write("%s %s %s\n" % (user, hashlib.md5(pw.encode()).hexdigest(), priv))
+    write_password_file(users, [(user, pw, priv) for user, (pw, priv) in
+                                list(ll.USERS.items()) + [(GATEWAY_USER[0], (GATEWAY_USER[1], "_"))]])
     svc_err = os.path.join(tmp, "service.err")
     gw_err = os.path.join(tmp, "gateway.err")
     svc = gw = None
