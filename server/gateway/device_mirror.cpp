@@ -1,5 +1,6 @@
 #include "server/gateway/device_mirror.hpp"
 
+#include "core/session/elements.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
 
@@ -301,6 +302,51 @@ void DeviceMirror::request(MessageEntry entry, std::function<void(Result<Message
         if (!r || r->error != MessageErrorType::None) self->counters_.request_errors.fetch_add(1);
         done(std::move(r));
     });
+}
+
+void DeviceMirror::request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session) {
+    if (session == 0) return request(std::move(entry), std::move(done));
+    const auto& p = service_->passthrough();
+    if (!p) {
+        done(fail(MessageErrorType::InvalidOperation, "device \"" + config_.name + "\" has no sessions of its own (auth: shared)"));
+        return;
+    }
+    p->request(session, std::move(entry), std::move(done));
+}
+
+void DeviceMirror::open_api_session(std::string username, std::string password,
+                                    std::function<void(Result<std::uint32_t>)> done) {
+    const auto& p = service_->passthrough();
+    auto node = node_.lock();
+    if (!p || !node) {
+        done(fail(MessageErrorType::InvalidOperation,
+                  "device \"" + config_.name +
+                      "\" is auth: shared: every client uses the gateway's own login to it (device_login needs auth: passthrough)"));
+        return;
+    }
+    // An endpoint id of the node's own numbering, so it never meets a native client's session.
+    const std::uint32_t session = node->allocate_endpoint();
+    MessageElement credentials;
+    credentials.name = "credentials";
+    credentials.type = DataTypes::dictionary_t;
+    credentials.elements.push_back(make_string_element("password", password));
+    std::weak_ptr<DeviceMirror> weak = weak_from_this();
+    p->admit(session, std::move(username), std::move(credentials), [weak, p, session, done = std::move(done)](Result<void> r) {
+        if (!r) {
+            if (auto self = weak.lock())
+                if (auto n = self->node_.lock()) n->release_endpoint(session);
+            done(r.take_error());
+            return;
+        }
+        p->attach_api(session);
+        done(session);
+    });
+}
+
+void DeviceMirror::close_api_session(std::uint32_t session) {
+    if (session == 0) return;
+    if (const auto& p = service_->passthrough()) p->close(session);
+    if (auto node = node_.lock()) node->release_endpoint(session);
 }
 
 std::uint64_t DeviceMirror::subscribe(std::string path, std::string member, bool is_wire,

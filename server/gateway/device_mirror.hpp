@@ -113,6 +113,17 @@ public:
     /// Sends a request to the device on behalf of the gateway itself (JSON API). The entry's service
     /// path uses the gateway's name for the device; the reply's is rewritten back the same way.
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
+    /// The same on a JSON API client's own session (open_api_session); `session` 0 = the shared one.
+    void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session);
+
+    /// auth: passthrough: opens an upstream session of the device's own, logged in as `username` with
+    /// {"password": password}, for a JSON API client (the `device_login` op, docs/json-api.md); it counts
+    /// against max_passthrough_sessions. `done` gets its id for request() / close_api_session(), or the
+    /// error: InvalidOperation on a shared device, the device's own (AuthenticationError …),
+    /// ConnectionError, BufferLimitViolation over the session limit.
+    void open_api_session(std::string username, std::string password, std::function<void(Result<std::uint32_t>)> done);
+    /// Closes it (the device releases its client locks and monitors). Unknown ids are ignored.
+    void close_api_session(std::uint32_t session);
     /// Subscribes the gateway itself to a wire or event (JSON API): `on_entry` gets upstream WirePacket /
     /// EventReq entries for that member (paths in gateway naming), one SharedEntry per value shared by
     /// every subscriber. Returns an id for unsubscribe().

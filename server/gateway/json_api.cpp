@@ -239,6 +239,12 @@ ApiResult JsonApi::definitions(std::string_view name) const {
 }
 
 void JsonApi::resolve(const MemberAddress& address, std::function<void(Resolved)> done) {
+    if (address.device_session != 0) {
+        done = [session = address.device_session, inner = std::move(done)](Resolved r) {
+            if (auto* t = std::get_if<MemberTarget>(&r)) t->device_session = session;
+            inner(std::move(r));
+        };
+    }
     auto device = find_device(address.device);
     if (!device) {
         done(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + address.device + "\""));
@@ -368,7 +374,7 @@ void send_to_device(const MemberTarget& t, MessageEntry e, JsonApi::Done done,
         if (!r) return done(ApiResult::failed(device_error(r.error())));
         if (auto err = entry_error(*r)) return done(ApiResult::failed(device_error(*err)));
         done(ok(*r));
-    });
+    }, t.device_session);
 }
 
 ApiError missing_element(std::string_view name, std::string_view reply) {

@@ -37,6 +37,9 @@ struct MemberAddress {
     std::string member;
     /// Who asks (auth: gateway): checked against the gateway's policy when logins are on.
     auth::PrincipalPtr principal;
+    /// auth: passthrough: the client's own session to the device (DeviceMirror::open_api_session), so
+    /// the device's users, privileges and locks apply; 0 = the gateway's shared session.
+    std::uint32_t device_session = 0;
 };
 
 /// A member resolved against the device's definitions. The pointers point into `types`.
@@ -48,6 +51,8 @@ struct MemberTarget {
     const robdef::ServiceDefinition* service = nullptr;  ///< defines the object (context for unqualified names)
     const robdef::ServiceEntryDefinition* object = nullptr;
     const robdef::MemberDefinition* member = nullptr;
+    /// Where get/set/call/peek go: MemberAddress::device_session (0 = the shared session).
+    std::uint32_t device_session = 0;
 
     std::string_view context() const noexcept { return service->name; }
 };

@@ -53,7 +53,7 @@ public:
                 self->items_.push_back(std::move(j.value));
             }
             self->step();
-        });
+        }, t_.device_session);
     }
 
 private:
@@ -73,7 +73,7 @@ private:
                     return self->finish(device_error(*err));
             }
             self->finish(error);
-        });
+        }, t_.device_session);
     }
 
     void finish(std::optional<ApiError> error) {
@@ -192,7 +192,7 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
                                                         "FunctionCallRes of a generator has no \"index\" element")));
             auto run = std::make_shared<GeneratorRun>(self, t, index, std::move(gen_items), param_generator, max_items, done);
             run->step();
-        });
+        }, t.device_session);
     });
 }
 

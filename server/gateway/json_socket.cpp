@@ -77,15 +77,19 @@ public:
     /// Ends every subscription; nothing is sent afterwards.
     void close() {
         std::map<std::uint64_t, Subscription> subs;
+        std::map<std::string, DeviceLogin, std::less<>> logins;
         {
             std::lock_guard lock(mutex_);
             if (closed_) return;
             closed_ = true;
             subs.swap(subs_);
+            logins.swap(device_logins_);
             timer_.cancel();
         }
         for (auto& [sid, s] : subs)
             if (s.mirror_known) unsubscribe_upstream(s.kind, *s.target, s.mirror_id);
+        for (auto& [name, l] : logins)
+            if (auto d = l.device.lock()) d->close_api_session(l.session);
     }
 
     void push_device_state(const DeviceStatus& status) {
@@ -113,6 +117,13 @@ public:
     }
 
 private:
+    /// A `device_login`: this socket's own session to a passthrough device.
+    struct DeviceLogin {
+        std::weak_ptr<DeviceMirror> device;
+        std::uint32_t session = 0;
+        std::string username;
+    };
+
     struct Subscription {
         SubKind kind = SubKind::event;
         bool may_write = true;  // auth: gateway allows `write` on the member
@@ -202,6 +213,8 @@ private:
                                            "{\"op\": \"login\", \"token\"} first"));
         }
 
+        if (op == "device_login") return device_login(id, msg);
+        if (op == "device_logout") return device_logout(id, msg);
         if (op == "devices") return send_reply(id, ApiResult::ok(api_->device_list()));
         if (op == "device") {
             auto d = msg.find("device");
@@ -232,6 +245,7 @@ private:
         MemberAddress address;
         if (auto e = read_address(msg, address)) return fail_with(*e);
         address.principal = principal();
+        address.device_session = device_session(address.device);
         nlohmann::json value, args;
         std::size_t max_items = 0;
         if (op == "set") {
@@ -303,6 +317,84 @@ private:
             principal_ = *who;
         }
         send_reply(id, ApiResult::ok(auth::principal_json(**who)));
+    }
+
+    // --- device logins (auth: passthrough) --------------------------------------------------------
+
+    std::uint32_t device_session(std::string_view device) const {
+        std::lock_guard lock(mutex_);
+        auto it = device_logins_.find(device);
+        return it == device_logins_.end() ? 0 : it->second.session;
+    }
+
+    // {"op": "device_login", "device", "username", "password"}: from now on this socket's get, set,
+    // call and peek on the device go on a session of its own, logged in to the device as that user.
+    void device_login(const nlohmann::json& id, const nlohmann::json& msg) {
+        auto d = msg.find("device");
+        auto u = msg.find("username");
+        auto p = msg.find("password");
+        if (d == msg.end() || !d->is_string() || u == msg.end() || !u->is_string() || u->get_ref<const std::string&>().empty() ||
+            (p != msg.end() && !p->is_string()))
+            return send_reply(id, ApiResult::failed(bad_request(
+                                      "device_login takes \"device\", \"username\" (non-empty strings) and \"password\" (string)")));
+        const std::string name = d->get<std::string>();
+        auto device = api_->find_device(name);
+        if (!device)
+            return send_reply(id, ApiResult::failed(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + name + "\"")));
+        if (device->config().auth != DeviceAuth::passthrough)
+            return send_reply(id, ApiResult::failed(api_error(
+                                      400, MessageErrorType::InvalidOperation,
+                                      "device \"" + name + "\" is auth: shared: every client uses the gateway's own login to it; "
+                                      "device_login needs auth: passthrough")));
+        if (!begin_request(id)) return;
+        std::string username = u->get<std::string>();
+        std::string password = p == msg.end() ? std::string() : p->get<std::string>();
+        auto self = shared_from_this();
+        std::weak_ptr<DeviceMirror> weak_device = device;
+        device->open_api_session(username, std::move(password), [self, id, name, username, weak_device](Result<std::uint32_t> r) {
+            if (!r) {
+                self->send_reply(id, ApiResult::failed(device_error(r.error())));
+                return self->end_request();
+            }
+            std::optional<DeviceLogin> replaced;
+            bool keep = true;
+            {
+                std::lock_guard lock(self->mutex_);
+                if (self->closed_) {
+                    keep = false;
+                } else {
+                    if (auto it = self->device_logins_.find(name); it != self->device_logins_.end()) replaced = it->second;
+                    self->device_logins_[name] = DeviceLogin{weak_device, *r, username};
+                }
+            }
+            auto device = weak_device.lock();
+            if (device && replaced) device->close_api_session(replaced->session);
+            if (!keep) {
+                if (device) device->close_api_session(*r);
+                return self->end_request();
+            }
+            self->send_reply(id, ApiResult::ok(nlohmann::json{{"device", name}, {"username", username}}));
+            self->end_request();
+        });
+    }
+
+    // {"op": "device_logout", "device"}: back to the gateway's shared session (the device releases this
+    // socket's client locks and monitors).
+    void device_logout(const nlohmann::json& id, const nlohmann::json& msg) {
+        auto d = msg.find("device");
+        if (d == msg.end() || !d->is_string()) return send_reply(id, ApiResult::failed(bad_request("\"device\" (string) is required")));
+        std::optional<DeviceLogin> login;
+        {
+            std::lock_guard lock(mutex_);
+            if (auto it = device_logins_.find(d->get_ref<const std::string&>()); it != device_logins_.end()) {
+                login = it->second;
+                device_logins_.erase(it);
+            }
+        }
+        if (!login)
+            return send_reply(id, ApiResult::failed(bad_request("this socket has no device_login for \"" + d->get<std::string>() + "\"")));
+        if (auto device = login->device.lock()) device->close_api_session(login->session);
+        send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
 
     void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write) {
@@ -798,6 +890,7 @@ private:
     std::map<std::uint64_t, Subscription> subs_;
     std::uint64_t next_sid_ = 1;
     auth::PrincipalPtr principal_;  // auth: gateway — who logged this socket in
+    std::map<std::string, DeviceLogin, std::less<>> device_logins_;  // by device name
     std::size_t in_flight_ = 0;
     std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
     ConvertStrand convert_strand_;                  // shared by the server's sockets

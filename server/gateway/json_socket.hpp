@@ -1,8 +1,8 @@
 // The WebSocket half of the JSON API (docs/json-api.md §WebSocket): subprotocol `rr-gateway.json.v1`
 // on the gateway's HttpServer. Text messages, one JSON object each.
 //
-// Client → gateway: requests {"id", "op", …}; op ∈ devices, device, get, set, call, peek, subscribe,
-// unsubscribe, set_out_value, send. Each is answered once with {"id", "result"} or {"id", "error"}.
+// Client → gateway: requests {"id", "op", …}; op ∈ login, device_login, device_logout, devices,
+// device, get, set, call, peek, subscribe, unsubscribe, set_out_value, send. Each is answered once with {"id", "result"} or {"id", "error"}.
 // Gateway → client, unasked: {"subscription", "kind": "wire"|"event"|"pipe"|"pipe_ack"|"closed", …} for
 // subscriptions, and {"kind": "device_state", "device": {…}} whenever a device's state changes.
 //

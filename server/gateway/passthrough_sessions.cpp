@@ -130,6 +130,15 @@ void PassthroughSessions::attach(const SessionRef& session) {
     for (auto& e : early) deliver(session, client, std::move(e));
 }
 
+void PassthroughSessions::attach_api(std::uint32_t endpoint) {
+    std::lock_guard lock(mutex_);
+    auto it = links_.find(endpoint);
+    if (it == links_.end()) return;
+    it->second.api = true;
+    it->second.attached = true;
+    it->second.early.clear();
+}
+
 void PassthroughSessions::close(std::uint32_t endpoint) {
     std::shared_ptr<RawClient> client;
     std::string username;
@@ -187,51 +196,70 @@ void PassthroughSessions::forget_locks_of(std::uint32_t endpoint, const std::str
     });
 }
 
+std::shared_ptr<RawClient> PassthroughSessions::open_client(std::uint32_t endpoint) const {
+    std::lock_guard lock(mutex_);
+    auto it = links_.find(endpoint);
+    if (it == links_.end() || it->second.lost || !it->second.client || !it->second.client->is_open()) return nullptr;
+    return it->second.client;
+}
+
+RRError PassthroughSessions::session_gone() const {
+    return make_error(MessageErrorType::ConnectionError,
+                      "the device \"" + settings_.device_name + "\" closed this client's session");
+}
+
 void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
-    std::shared_ptr<RawClient> client;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = links_.find(session.endpoint());
-        if (it != links_.end() && !it->second.lost) client = it->second.client;
-    }
-    if (!client || !client->is_open()) {
-        if (!responder.done())
-            responder.fail(make_error(MessageErrorType::ConnectionError,
-                                      "the device \"" + settings_.device_name + "\" closed this client's session"));
+    auto client = open_client(session.endpoint());
+    if (!client) {
+        if (!responder.done()) responder.fail(session_gone());
         return;
     }
-    const std::string downstream_path = entry.service_path;
-    entry.service_path = to_upstream(entry.service_path);
     if (responder.done()) {  // PipePacket, PipePacketRet, WirePacket: no answer
+        entry.service_path = to_upstream(entry.service_path);
         client->send(std::move(entry));
         return;
     }
-    const auto type = entry.entry_type;
-    const std::string op = type == MessageEntryType::ClientSessionOpReq ? entry.member_name : std::string();
-    const std::uint32_t endpoint = session.endpoint();
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    forward(session.endpoint(), client, std::move(entry), [shared](Result<MessageEntry> r) {
+        if (!r)
+            shared->fail(r.error());
+        else
+            shared->respond(std::move(*r));
+    });
+}
+
+void PassthroughSessions::request(std::uint32_t endpoint, MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {
+    auto client = open_client(endpoint);
+    if (!client) {
+        done(fail(session_gone()));
+        return;
+    }
+    forward(endpoint, client, std::move(entry), std::move(done));
+}
+
+void PassthroughSessions::forward(std::uint32_t endpoint, const std::shared_ptr<RawClient>& client, MessageEntry&& entry,
+                                  std::function<void(Result<MessageEntry>)> done) {
+    const std::string downstream_path = entry.service_path;
+    entry.service_path = to_upstream(entry.service_path);
+    const std::string op = entry.entry_type == MessageEntryType::ClientSessionOpReq ? entry.member_name : std::string();
     if (auto k = counters_.lock()) k->requests.fetch_add(1);
     const auto start = std::chrono::steady_clock::now();
-    auto shared = std::make_shared<Responder>(std::move(responder));
     std::weak_ptr<PassthroughSessions> weak = weak_from_this();
     // MonitorEnter waits on the device up to its own 5 s "Continue" answer; the default timeout covers it.
-    client->request(std::move(entry), [weak, shared, op, endpoint, downstream_path, start](Result<MessageEntry> r) {
+    client->request(std::move(entry), [weak, done = std::move(done), op, endpoint, downstream_path, start](Result<MessageEntry> r) {
         auto self = weak.lock();
         if (auto k = self ? self->counters_.lock() : nullptr) {
             k->observe_latency(std::chrono::steady_clock::now() - start);
             if (!r || r->error != MessageErrorType::None) k->request_errors.fetch_add(1);
         }
-        if (!r) {
-            shared->fail(r.error());
-            return;
-        }
-        if (self) {
+        if (r && self) {
             r->service_path = self->to_downstream(r->service_path);
             if (!op.empty() && r->error == MessageErrorType::None && is_lock_op(op)) {
                 self->note_lock_reply(endpoint, op, downstream_path, *r);
                 self->changed();
             }
         }
-        shared->respond(std::move(*r));
+        done(std::move(r));
     });
 }
 
@@ -263,18 +291,35 @@ void PassthroughSessions::note_lock_reply(std::uint32_t endpoint, const std::str
 
 void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& entry) {
     SessionRef session;
-    std::shared_ptr<RawClient> client;
+    std::shared_ptr<RawClient> client, api_client;
     {
         std::lock_guard lock(mutex_);
         auto it = links_.find(endpoint);
         if (it == links_.end()) return;
-        if (!it->second.attached) {
+        if (it->second.api) {
+            api_client = it->second.client;
+        } else if (!it->second.attached) {
             // Between the connect's answer and the downstream session's opening: held (bounded).
             if (it->second.early.size() < 256) it->second.early.push_back(std::move(entry));
             return;
+        } else {
+            session = it->second.session;
+            client = it->second.client;
         }
-        session = it->second.session;
-        client = it->second.client;
+    }
+    if (api_client) {
+        // A JSON API session has nobody to run a callback: the device gets an error instead of a wait.
+        if (entry.entry_type == MessageEntryType::CallbackCallReq) {
+            MessageEntry reply_header;
+            reply_header.entry_type = MessageEntryType::CallbackCallRet;
+            reply_header.service_path = entry.service_path;
+            reply_header.member_name = entry.member_name;
+            reply_header.request_id = entry.request_id;
+            api_client->send(relayed_reply(
+                reply_header, fail(MessageErrorType::InvalidOperation,
+                                   "callback \"" + entry.member_name + "\": this session is a JSON API client's, which has no callbacks")));
+        }
+        return;
     }
     deliver(session, client, std::move(entry));
 }

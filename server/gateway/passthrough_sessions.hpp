@@ -71,6 +71,15 @@ public:
                std::function<void(Result<void>)> done);
     /// The admitted client's session is open: entries from the device may go to it now.
     void attach(const SessionRef& session);
+    /// The admitted session serves a JSON API client (a `device_login` of docs/json-api.md), which has
+    /// no RR session downstream: the device's callback requests on it are answered with an error, and
+    /// its other entries (events, wire and pipe packets) are not kept: the JSON API subscribes through
+    /// the device's shared session.
+    void attach_api(std::uint32_t endpoint);
+    /// A request of an attached JSON API session, forwarded on its own upstream session; the service
+    /// paths are in gateway naming both ways. Errors to `done`: ConnectionError when the session is
+    /// gone (closed by the device or never admitted), and the device's own.
+    void request(std::uint32_t endpoint, MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     /// The client went (or never took its admission): closes its upstream session (DisconnectClient;
     /// the device drops its client locks and monitors) and forgets its locks.
     void close(std::uint32_t endpoint);
@@ -91,9 +100,14 @@ private:
         std::string username;
         std::vector<MessageEntry> early;  // device entries that came before attach()
         bool attached = false;
+        bool api = false;   // a JSON API session (attach_api): no downstream RR session
         bool lost = false;  // the device ended the upstream session
     };
 
+    std::shared_ptr<RawClient> open_client(std::uint32_t endpoint) const;
+    RRError session_gone() const;
+    void forward(std::uint32_t endpoint, const std::shared_ptr<RawClient>& client, MessageEntry&& entry,
+                 std::function<void(Result<MessageEntry>)> done);
     void from_device(std::uint32_t endpoint, MessageEntry&& entry);
     void deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry);
     void upstream_closed(std::uint32_t endpoint, const RRError& error);

@@ -111,6 +111,11 @@ public:
     /// (service_index.hpp), as every CORE node serves it (wire.md §11.2).
     std::shared_ptr<Service> find_service(std::string_view name) const;
 
+    /// A local endpoint id of this node's numbering for a session that no connection opens (the
+    /// gateway's JSON API device logins), so it never equals a connected client's; release it after.
+    std::uint32_t allocate_endpoint() { return services_->allocate_endpoint(); }
+    void release_endpoint(std::uint32_t endpoint) { services_->release_endpoint(endpoint); }
+
     /// Stops listening, closes every connection and joins the worker threads. Idempotent.
     void shutdown();
 

@@ -12,7 +12,12 @@ locks, release on disconnect and on a killed client process). Then:
   limit    a device with max_passthrough_sessions: 2 refuses a third client with a clear error and
            admits it once one of the two has gone;
   shared   a device in the default shared mode refuses RequestObjectLock and MonitorEnter with
-           InvalidOperation naming `auth: passthrough`.
+           InvalidOperation naming `auth: passthrough`;
+  device_login  a JSON WebSocket logs in to the device as one of its users (`device_login`): a wrong
+           password gets the device's own error; while alice holds a user lock, the socket logged in
+           as alice reads the locked object, one logged in as bob (and one without a device login,
+           on the gateway's shared session) get ObjectLockedError; device_logout goes back to the
+           shared session; a shared device refuses device_login.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when the official package is missing.
 
@@ -179,6 +184,71 @@ def run_extra_checks(port, ck):
                          "Username not provided")
 
     ck.check("login: the device's own error for a client without a login", no_login_refused_with_device_error)
+
+    def json_device_login():
+        import websocket  # websocket-client
+
+        def open_socket():
+            ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
+            counter = [0]
+
+            def ask(msg):
+                counter[0] += 1
+                msg = dict(msg, id=counter[0])
+                ws.send(json.dumps(msg))
+                while True:
+                    r = json.loads(ws.recv())
+                    if r.get("id") == msg["id"]:
+                        return r
+            return ws, ask
+
+        def error_of(r):
+            return (r.get("error") or {}).get("name", ""), (r.get("error") or {}).get("message", "")
+
+        get_root = {"op": "get", "device": "interop", "member": "base_name"}
+        ws_a, ask_a = open_socket()
+        ws_b, ask_b = open_socket()
+        ws_n, ask_n = open_socket()
+        holder = None
+        try:
+            sessions_before = device_status(port, "interop")["passthrough_sessions"]
+            name, msg = error_of(ask_a({"op": "device_login", "device": "interop", "username": "alice", "password": "wrong"}))
+            ll.expect(name == "RobotRaconteur.AuthenticationError", "wrong password: %s %s" % (name, msg))
+            r = ask_a({"op": "device_login", "device": "interop", "username": "alice", "password": ll.USERS["alice"][0]})
+            ll.expect(r.get("result") == {"device": "interop", "username": "alice"}, "alice's device_login: %r" % r)
+            r = ask_b({"op": "device_login", "device": "interop", "username": "bob", "password": ll.USERS["bob"][0]})
+            ll.expect("result" in r, "bob's device_login: %r" % r)
+            ll.expect(device_status(port, "interop")["passthrough_sessions"] == sessions_before + 2,
+                      "two more passthrough sessions")
+            name, msg = error_of(ask_n({"op": "device_login", "device": "shared", "username": "alice", "password": "x"}))
+            ll.expect(name == "RobotRaconteur.InvalidOperation" and "passthrough" in msg, "shared device: %s %s" % (name, msg))
+
+            holder = ll.connect(url, "alice")  # a native RR client of alice's locks the root object
+            ll.expect(RRN.RequestObjectLock(holder, RR.RobotRaconteurObjectLockFlags_USER_LOCK) == "OK", "alice locks")
+            r = ask_a(get_root)
+            ll.expect("result" in r, "alice's socket reads the object alice locked: %r" % r)
+            for who, ask in (("bob's socket", ask_b), ("a socket without device_login", ask_n)):
+                name, msg = error_of(ask(get_root))
+                ll.expect(name == "RobotRaconteur.ObjectLockedError" and "alice" in msg,
+                          "%s under alice's lock: %s %s" % (who, name, msg))
+            r = ask_a({"op": "device_logout", "device": "interop"})
+            ll.expect(r.get("result") == {}, "device_logout: %r" % r)
+            name, msg = error_of(ask_a(get_root))
+            ll.expect(name == "RobotRaconteur.ObjectLockedError", "after device_logout: shared session: %s %s" % (name, msg))
+            ll.expect(RRN.ReleaseObjectLock(holder) == "OK", "alice releases")
+            ll.expect("result" in ask_b(get_root), "bob's socket reads after the release")
+        finally:
+            for ws in (ws_a, ws_b, ws_n):
+                ws.close()
+            if holder is not None:
+                try:
+                    RRN.DisconnectService(holder)
+                except Exception:  # noqa: BLE001
+                    pass
+        ll.eventually(lambda: ll.expect(device_status(port, "interop")["passthrough_sessions"] == sessions_before,
+                                        "closed sockets close their device sessions"), "sessions closed")
+
+    ck.check("json: device_login gives a WebSocket the device's own user, locks apply", json_device_login)
 
 
 def main():
