@@ -110,6 +110,20 @@ std::optional<ApiError> login_needed(const JsonApi& api, const http::Request& re
     return std::nullopt;
 }
 
+// POST /api/discovered/add with logins on: a principal allowed to add devices (Principal::may_add_devices).
+std::optional<ApiError> may_add_devices(const JsonApi& api, const http::Request& req) {
+    const auto& a = api.auth();
+    if (!a || !a->enabled()) return std::nullopt;
+    auto who = auth::authenticate_request(*a, req);
+    if (auto* e = std::get_if<ApiError>(&who)) return *e;
+    const auto& p = std::get<auth::PrincipalPtr>(who);
+    if (p && p->may_add_devices()) return std::nullopt;
+    a->counters().denied.fetch_add(1);
+    return api_error(403, MessageErrorType::PermissionDenied,
+                     "user " + (p ? p->name : std::string("?")) +
+                         " may not add devices: that takes a role allowed read, write and call on every device and member");
+}
+
 class RestRouter {
 public:
     explicit RestRouter(std::shared_ptr<JsonApi> api) : api_(std::move(api)) {}
@@ -285,7 +299,7 @@ void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
                    });
     http.add_route(bhttp::verb::post, "/api/discovered/add",
                    [router, no_discovery](const http::Request& req, http::Responder respond) {
-                       if (auto e = login_needed(*router->api(), req)) return respond(error_response(req, *e));
+                       if (auto e = may_add_devices(*router->api(), req)) return respond(error_response(req, *e));
                        auto hooks = router->api()->discovery_hooks();
                        if (!hooks.add) return respond(no_discovery(req));
                        auto body = parse_request_json(req.body());

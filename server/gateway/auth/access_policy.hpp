@@ -66,6 +66,12 @@ struct Principal {
     bool allows(std::string_view device, std::string_view member_key, Operation op) const {
         return policy && policy->allows(roles, device, member_key, op);
     }
+    /// Adding devices while running (POST /api/discovered/add) changes the gateway for everyone: it
+    /// takes rules that allow read, write and call on every member of every device (devices and
+    /// members "*" or left out, as the `operator` role of gateway-config/auth.yaml).
+    bool may_add_devices() const {
+        return allows("*", "*", Operation::read) && allows("*", "*", Operation::write) && allows("*", "*", Operation::call);
+    }
 };
 
 }  // namespace rr::server::gateway::auth

@@ -41,6 +41,22 @@ TEST_CASE("gateway auth: rules allow per role, device and member, and deny every
     CHECK_FALSE(nobody.allows("create", "Drive", Operation::call));
 }
 
+TEST_CASE("gateway auth: adding devices takes read, write and call on every device and member") {
+    auto p = std::make_shared<AccessPolicy>();
+    p->add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});  // the config's "left out"
+    p->add_role("split", {AccessRule{{"*"}, {"*"}, true, true, false}, AccessRule{{"*"}, {"*"}, false, false, true}});
+    p->add_role("viewer", {AccessRule{{"*"}, {"*"}, true, false, false}});
+    p->add_role("create_only", {AccessRule{{"create"}, {"*"}, true, true, true}});
+    p->add_role("most_members", {AccessRule{{"*"}, {"Drive*"}, true, true, true}});
+    CHECK(Principal{"a", {"operator"}, "password", p}.may_add_devices());
+    CHECK(Principal{"b", {"split"}, "password", p}.may_add_devices());  // rules add up
+    CHECK(Principal{"c", {"viewer", "operator"}, "password", p}.may_add_devices());
+    CHECK_FALSE(Principal{"d", {"viewer"}, "password", p}.may_add_devices());
+    CHECK_FALSE(Principal{"e", {"create_only"}, "password", p}.may_add_devices());
+    CHECK_FALSE(Principal{"f", {"most_members"}, "password", p}.may_add_devices());
+    CHECK_FALSE(Principal{"g", {}, "password", p}.may_add_devices());
+}
+
 TEST_CASE("gateway auth: member keys and the operation each RR request needs") {
     CHECK(member_key("", "Drive") == "Drive");
     CHECK(member_key("Webcams[0]", "Capture") == "Webcams[0].Capture");
