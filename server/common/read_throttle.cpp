@@ -39,4 +39,11 @@ std::chrono::nanoseconds ReadThrottle::charge(std::span<const std::byte> bytes, 
     return wait;
 }
 
+std::chrono::nanoseconds ReadThrottle::charge_message(std::uint64_t size, Clock::time_point now) noexcept {
+    std::chrono::nanoseconds wait{0};
+    if (!messages_.unlimited()) wait = std::max(wait, messages_.take(1, now));
+    if (!bytes_.unlimited()) wait = std::max(wait, bytes_.take(size, now));
+    return wait;
+}
+
 }  // namespace rr::server

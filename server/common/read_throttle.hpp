@@ -3,7 +3,7 @@
 // read and the time, and gets back how long to pause reading before the next read. A peer over its
 // rate is slowed down by TCP back-pressure (its reads paused), never disconnected.
 //
-// Messages are counted from the RR stream framing (wire.md §1.2: every message starts with `RRAC` and a
+// For RR byte streams, messages are counted from the RR stream framing (wire.md §1.2: every message starts with `RRAC` and a
 // uint32 little-endian total size), so a message split across reads is counted once, when its header
 // is complete. The count does not validate anything: a peer that breaks the framing is closed by the
 // protocol logic, not here.
@@ -48,6 +48,9 @@ public:
 
     /// Charges `bytes` just read at `now`; returns how long to pause reading (zero: read on).
     std::chrono::nanoseconds charge(std::span<const std::byte> bytes, Clock::time_point now) noexcept;
+    /// Charges one whole message of `size` bytes, for protocols whose framing the caller parsed itself
+    /// (an HTTP request, a JSON WebSocket message); returns how long to pause before the next read.
+    std::chrono::nanoseconds charge_message(std::uint64_t size, Clock::time_point now) noexcept;
 
 private:
     TokenBucket messages_;

@@ -97,3 +97,13 @@ TEST_CASE("read throttle: the stricter of the two rates sets the pause") {
     ReadThrottle m(ReadRates{2, 1u << 20, 1}, t0);  // few messages, many bytes
     CHECK(m.charge(stream_of(4, 16), t0) == 1s);    // 2 messages of debt at 2/s
 }
+
+TEST_CASE("read throttle: whole messages of other protocols (HTTP requests, JSON WebSocket messages)") {
+    const T t0{};
+    ReadThrottle t(ReadRates{5, 1000, 1}, t0);  // 5 messages/s, 1000 bytes/s, 1 s of burst
+    for (int i = 0; i < 5; ++i) CHECK(t.charge_message(100, t0) == 0ns);
+    CHECK(t.charge_message(100, t0) == 200ms);   // the sixth message: one message of debt at 5/s
+    CHECK(t.charge_message(2000, t0) == 1600ms);  // bytes: 400 left of the burst, 2000 taken, at 1000/s
+    ReadThrottle off(ReadRates{}, t0);
+    for (int i = 0; i < 1000; ++i) REQUIRE(off.charge_message(1u << 20, t0) == 0ns);
+}

@@ -11,13 +11,16 @@
 #include <optional>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
 #include <boost/asio/ssl/error.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "server/common/read_throttle.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/transport/websocket_byte_stream.hpp"
@@ -84,6 +87,38 @@ inline std::optional<std::string> static_path(const std::string& root, std::stri
     return full;
 }
 
+/// Paces one connection's reads by the node's per-connection rates (gateway.limits messages_per_second
+/// and bytes_per_second, Node::make_read_throttle): every message read is charged, and the next read
+/// waits as long as the throttle says (back-pressure; nothing is dropped). Without rates: no cost.
+/// Used on the connection's own strand only.
+class ReadPacer {
+public:
+    ReadPacer(const std::shared_ptr<Node>& node, const asio::any_io_executor& executor)
+        : node_(node), throttle_(node ? node->make_read_throttle() : nullptr), timer_(executor) {}
+
+    /// A message of `bytes` was read from `peer`.
+    void charge(std::size_t bytes, const std::string& peer) {
+        if (!throttle_) return;
+        pause_ = throttle_->charge_message(bytes, ReadThrottle::Clock::now());
+        if (pause_ > std::chrono::nanoseconds::zero())
+            if (auto n = node_.lock()) n->read_throttled(peer);
+    }
+    /// Runs `read` now, or after the pause the last charge asked for.
+    template <class Read>
+    void then(Read read) {
+        if (pause_ <= std::chrono::nanoseconds::zero()) return read();
+        timer_.expires_after(std::exchange(pause_, std::chrono::nanoseconds::zero()));
+        timer_.async_wait([read = std::move(read)](beast::error_code) mutable { read(); });
+    }
+    void cancel() { timer_.cancel(); }
+
+private:
+    std::weak_ptr<Node> node_;
+    std::unique_ptr<ReadThrottle> throttle_;
+    asio::steady_timer timer_;
+    std::chrono::nanoseconds pause_{0};
+};
+
 /// A JSON-subprotocol WebSocket session: text frames both ways, bounded outgoing queue.
 template <class Stream>
 class JsonWebSocketSession : public JsonSocket, public std::enable_shared_from_this<JsonWebSocketSession<Stream>> {
@@ -91,8 +126,9 @@ public:
     using std::enable_shared_from_this<JsonWebSocketSession<Stream>>::shared_from_this;
 
     JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
-                         std::string peer, std::string cookie = {})
-        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)), cookie_(std::move(cookie)) {}
+                         std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {})
+        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)), cookie_(std::move(cookie)),
+          pacer_(node, ws_.get_executor()) {}
 
     void start() {
         ws_.text(true);
@@ -161,6 +197,12 @@ private:
 
     void read() {
         auto self = shared_from_this();
+        pacer_.then([self] { self->read_now(); });
+    }
+
+    void read_now() {
+        if (finished_) return;
+        auto self = shared_from_this();
         ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
             if (ec) {
                 self->finish();
@@ -175,6 +217,7 @@ private:
                 self->fail(websocket::close_code::bad_payload, "invalid UTF-8 in a text message");
                 return;
             }
+            self->pacer_.charge(text.size(), self->peer_);
             if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
             self->read();
         });
@@ -222,6 +265,7 @@ private:
             unqueue(queue_.back().text);
             queue_.pop_back();
         }
+        pacer_.cancel();
         if (handler_->on_close) handler_->on_close(shared_from_this());
     }
 
@@ -235,6 +279,7 @@ private:
     std::deque<Outgoing> queue_;  // front: being written while writing_
     std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
     std::atomic<std::uint64_t> dropped_{0};
+    ReadPacer pacer_;
     bool writing_ = false;
     bool closed_ = false;
     bool finished_ = false;
@@ -248,7 +293,7 @@ public:
     using std::enable_shared_from_this<HttpSession<Stream>>::shared_from_this;
 
     HttpSession(std::shared_ptr<HttpServer> server, Stream stream)
-        : server_(std::move(server)), stream_(std::move(stream)) {}
+        : server_(std::move(server)), stream_(std::move(stream)), pacer_(server_->node(), stream_.get_executor()) {}
 
     void start(std::vector<std::byte> initial, std::shared_ptr<const void> hold = {}) {
         hold_ = std::move(hold);
@@ -262,12 +307,17 @@ public:
 
 private:
     void read() {
+        auto self = shared_from_this();
+        pacer_.then([self] { self->read_now(); });
+    }
+
+    void read_now() {
         parser_.emplace();
         parser_->body_limit(server_->options().max_body_bytes);
         parser_->header_limit(16 * 1024);
         beast::get_lowest_layer(stream_).expires_after(server_->options().read_timeout);
         auto self = shared_from_this();
-        bhttp::async_read(stream_, buffer_, *parser_, [self](beast::error_code ec, std::size_t) {
+        bhttp::async_read(stream_, buffer_, *parser_, [self](beast::error_code ec, std::size_t n) {
             // A TLS client that closes without close_notify (most do, between requests) ends the session
             // like a plain end of stream.
             if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout || ec == asio::ssl::error::stream_truncated) {
@@ -286,6 +336,7 @@ private:
                 self->write(std::move(r));
                 return;
             }
+            self->pacer_.charge(n, self->remote());
             self->on_request(self->parser_->release());
         });
     }
@@ -427,7 +478,8 @@ private:
             if (ec) return;
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
-                                                                server->options().json_socket_queue_limit, peer, cookie);
+                                                                server->options().json_socket_queue_limit, peer, cookie,
+                                                                server->node());
                 s->keep(info.hold);
                 s->start();
                 return;
@@ -523,6 +575,7 @@ private:
     bool head_ = false;  // the request being answered is HEAD (one at a time: read, answer, read)
     ClientOrigin client_;  // who sent the request being answered (behind a trusted proxy: the proxy's client)
     std::string request_line_;  // "METHOD target" of that request, for HttpOptions::on_response
+    ReadPacer pacer_;  // gateway.limits rates: requests and their bytes
 };
 
 }  // namespace rr::server::http::detail
