@@ -42,6 +42,15 @@ std::optional<RRError> entry_error(const MessageEntry& entry) {
     return e;
 }
 
+MessageEntry reply_to(const MessageEntry& request) {
+    MessageEntry r;
+    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request.entry_type) + 1);
+    r.service_path = request.service_path;
+    r.member_name = request.member_name;
+    r.request_id = request.request_id;
+    return r;
+}
+
 MessageEntry relayed_reply(MessageEntry header, Result<MessageEntry> result) {
     if (!result) {
         set_entry_error(header, result.error());

@@ -24,6 +24,10 @@ void set_entry_error(MessageEntry& entry, const RRError& error);
 /// the sub-name from `errorsubname`.
 std::optional<RRError> entry_error(const MessageEntry& entry);
 
+/// The header of the reply to `request` (wire.md §4: a reply's EntryType is its request's plus one):
+/// that type, the request's ServicePath, MemberName and RequestID; no elements, no error.
+MessageEntry reply_to(const MessageEntry& request);
+
 /// The reply a relay forwards: `header` (its EntryType, ServicePath, MemberName, RequestID) carrying
 /// the relayed reply's error code and elements, or set_entry_error() of a request that failed.
 MessageEntry relayed_reply(MessageEntry header, Result<MessageEntry> result);

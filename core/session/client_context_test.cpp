@@ -5,6 +5,7 @@
 #include <deque>
 #include <functional>
 
+#include "core/message/error_entry.hpp"
 #include "core/session/client_context.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
@@ -86,15 +87,6 @@ MessageElement string_list(std::string name, std::vector<std::string_view> items
         e.elements.push_back(std::move(c));
     }
     return e;
-}
-
-MessageEntry reply_to(const MessageEntry& req) {
-    MessageEntry r;
-    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(req.entry_type) + 1);
-    r.service_path = req.service_path;
-    r.member_name = req.member_name;
-    r.request_id = req.request_id;
-    return r;
 }
 
 MessageEntry error_reply(const MessageEntry& req, RRError err) {

@@ -1,5 +1,6 @@
 #include "core/session/service_session.hpp"
 
+#include "core/message/error_entry.hpp"
 #include "core/names/service_path.hpp"
 #include "core/session/elements.hpp"
 
@@ -20,15 +21,6 @@ MessageElement make_string_list(std::string name, const std::vector<std::string>
         list.elements.push_back(std::move(item));
     }
     return list;
-}
-
-MessageEntry reply_to(const MessageEntry& request) {
-    MessageEntry r;
-    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request.entry_type) + 1);
-    r.service_path = request.service_path;
-    r.member_name = request.member_name;
-    r.request_id = request.request_id;
-    return r;
 }
 
 MessageEntry error_reply(const MessageEntry& request, const RRError& error) {

@@ -4,6 +4,7 @@
 
 #include <set>
 
+#include "core/message/error_entry.hpp"
 #include "core/session/client_session.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/service_session.hpp"
@@ -149,14 +150,6 @@ MessageEntry member_request(std::string member, MessageEntryType type = MessageE
     return e;
 }
 
-MessageEntry reply_for(const MessageEntry& request) {
-    MessageEntry r;
-    r.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request.entry_type) + 1);
-    r.service_path = request.service_path;
-    r.member_name = request.member_name;
-    r.request_id = request.request_id;
-    return r;
-}
 
 }  // namespace
 
@@ -191,10 +184,10 @@ TEST_CASE("service session: member requests go to the host in order and the repl
     CHECK(requests[1].entry.member_name == "b");
     CHECK(requests[0].needs_reply);
     // Answer the second first: each reply finds its request by RequestID.
-    MessageEntry r2 = reply_for(requests[1].entry);
+    MessageEntry r2 = reply_to(requests[1].entry);
     r2.elements.push_back(make_scalar_element<std::int32_t>("return", 7));
     p.service.reply(std::move(r2), p.now);
-    p.service.reply(reply_for(requests[0].entry), p.now);
+    p.service.reply(reply_to(requests[0].entry), p.now);
     p.pump();
     auto responses = p.take_client<ClientResponse>();
     REQUIRE(responses.size() == 2);
@@ -215,7 +208,7 @@ TEST_CASE("service session: a reply over the size limit becomes an error reply w
     p.pump();
     auto requests = p.take<ServiceRequest>(p.service_events);
     REQUIRE(requests.size() == 1);
-    MessageEntry r = reply_for(requests[0].entry);
+    MessageEntry r = reply_to(requests[0].entry);
     std::vector<std::uint8_t> huge(13u * 1024u * 1024u);
     r.elements.push_back(make_array_element<std::uint8_t>("return", huge));
     p.service.reply(std::move(r), p.now);
@@ -433,7 +426,7 @@ TEST_CASE("service session: callbacks to the client are answered, time out, or f
     auto incoming = p.take_client<ClientIncoming>();
     REQUIRE(incoming.size() == 1);
     CHECK(incoming[0].entry.entry_type == MessageEntryType::CallbackCallReq);
-    MessageEntry answer = reply_for(incoming[0].entry);
+    MessageEntry answer = reply_to(incoming[0].entry);
     answer.elements.push_back(make_scalar_element<double>("return", 2.5));
     REQUIRE(p.client.reply(std::move(answer), p.now));
     p.pump();

@@ -2,6 +2,7 @@
 
 #include <charconv>
 
+#include "core/message/error_entry.hpp"
 #include "core/names/service_path.hpp"
 #include "core/session/elements.hpp"
 #include "robdef/parser.hpp"
@@ -585,12 +586,7 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
                     if (allowed(s)) target = s;
         }
     }
-    const std::uint32_t request_id = entry.request_id;
-    MessageEntry reply_header;
-    reply_header.entry_type = MessageEntryType::CallbackCallRet;
-    reply_header.service_path = entry.service_path;
-    reply_header.member_name = entry.member_name;
-    reply_header.request_id = request_id;
+    MessageEntry reply_header = reply_to(entry);
     if (!target.alive()) {
         if (c) {
             set_entry_error(reply_header, make_error(MessageErrorType::OperationFailed, "no client connected through the gateway"));

@@ -310,13 +310,8 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
     if (api_client) {
         // A JSON API session has nobody to run a callback: the device gets an error instead of a wait.
         if (entry.entry_type == MessageEntryType::CallbackCallReq) {
-            MessageEntry reply_header;
-            reply_header.entry_type = MessageEntryType::CallbackCallRet;
-            reply_header.service_path = entry.service_path;
-            reply_header.member_name = entry.member_name;
-            reply_header.request_id = entry.request_id;
             api_client->send(relayed_reply(
-                reply_header, fail(MessageErrorType::InvalidOperation,
+                reply_to(entry), fail(MessageErrorType::InvalidOperation,
                                    "callback \"" + entry.member_name + "\": this session is a JSON API client's, which has no callbacks")));
         }
         return;
@@ -331,11 +326,8 @@ void PassthroughSessions::deliver(const SessionRef& session, const std::shared_p
         case MessageEntryType::CallbackCallReq: {
             // The device calls exactly this client: it is the only one on this upstream session.
             if (counters) counters->callbacks.fetch_add(1);
-            MessageEntry reply_header;
-            reply_header.entry_type = MessageEntryType::CallbackCallRet;
+            MessageEntry reply_header = reply_to(entry);
             reply_header.service_path = to_upstream(entry.service_path);
-            reply_header.member_name = entry.member_name;
-            reply_header.request_id = entry.request_id;
             std::weak_ptr<RawClient> weak_client = client;
             session.request(std::move(entry), [weak_client, reply_header](Result<MessageEntry> r) mutable {
                 auto c = weak_client.lock();
