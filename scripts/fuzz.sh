@@ -22,7 +22,8 @@ cd "$(dirname "$0")/.."
 # to start the gateway and run slower (every input goes through the gateway's threads and sockets).
 declare -A CI_SECONDS=(
   [fuzz_robdef_parser]=15 [fuzz_message_reader]=15 [fuzz_message_structured]=20 [fuzz_connection_url]=10
-  [fuzz_service_path]=10 [fuzz_gateway_config]=15 [fuzz_json_socket]=30 [fuzz_json_rest]=30 [fuzz_gateway_port]=40
+  [fuzz_service_path]=10 [fuzz_gateway_config]=15 [fuzz_discovery_packet]=10 [fuzz_usb_descriptors]=10
+  [fuzz_usb_packets]=10 [fuzz_json_socket]=20 [fuzz_json_rest]=20 [fuzz_gateway_port]=25
 )
 
 mode=ci

@@ -88,7 +88,7 @@ ctest --preset debug -j "$jobs" -E '^docker: the image'
 phase_done ctest
 if [ -n "$tsan_pid" ]; then tsan_step; fi
 
-# RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times (~3.5 min).
+# RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times (~3 min).
 fuzz_seconds=${RR_FUZZ_SECONDS:-}
 if [ "$fuzz_seconds" != 0 ]; then
   ./scripts/fuzz.sh $fuzz_seconds
