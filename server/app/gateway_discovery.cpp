@@ -129,11 +129,23 @@ void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
                 it = entries_.erase(it);
             }
         }
+    }
+    // Retired before new devices are made, so that a service that moved keeps its device name.
+    const bool freed = frees_capped_place(gone);
+    for (auto& e : gone) retire(std::move(e), "the node no longer offers it there");
+    {
+        std::lock_guard lock(mutex_);
+        if (stopped_) return;
+        std::vector<std::string> node_urls;
+        for (const auto& u : node.urls) node_urls.push_back(u.url);
         for (const auto& s : *node.services) {
             if (entries_.count({node.node_id, s.name})) continue;
             for (std::size_t r = 0; r < rules_.size(); ++r) {
                 auto m = core::match_service(rules_[r].filter, s, node_urls);
                 if (!m) continue;
+                // The service index may still list an rr+local or rr+usb URL the node no longer has.
+                std::erase_if(m->urls, [&](const std::string& u) { return !endpoint_still_known(node, u); });
+                if (m->urls.empty()) continue;
                 if (const auto max = rules_[r].filter.max_count) {
                     const auto held = std::count_if(entries_.begin(), entries_.end(),
                                                     [&](const auto& kv) { return kv.second.rule == static_cast<int>(r); });
@@ -145,7 +157,32 @@ void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
             }
         }
     }
-    for (auto& e : gone) retire(std::move(e), "the node no longer offers it there");
+    if (freed) refill_capped_rules(nullptr);
+}
+
+bool DiscoveredDevices::frees_capped_place(const std::vector<Entry>& gone) const {
+    return std::any_of(gone.begin(), gone.end(), [&](const Entry& e) {
+        return e.rule >= 0 && rules_[static_cast<std::size_t>(e.rule)].filter.max_count;
+    });
+}
+
+void DiscoveredDevices::refill_capped_rules(const NodeID* lost) {
+    // A rule at its `max` passed over other matching services; a freed place goes to one of them now,
+    // as the official subscription's max count does (otherwise only their next change would). Runs on
+    // the discovery strand only. A sync below that frees another place asks for one more pass instead
+    // of recursing, and the passes are bounded, so two views of a node that disagree cannot loop.
+    if (refilling_) {
+        refill_again_ = true;
+        return;
+    }
+    refilling_ = true;
+    for (int pass = 0; pass < 4; ++pass) {
+        refill_again_ = false;
+        for (const auto& n : discovery_->nodes())
+            if (!lost || n.node_id != *lost) sync_node(n);
+        if (!refill_again_) break;
+    }
+    refilling_ = false;
 }
 
 void DiscoveredDevices::drop_node(const NodeID& id, const std::string& why) {
@@ -161,7 +198,9 @@ void DiscoveredDevices::drop_node(const NodeID& id, const std::string& why) {
             }
         }
     }
+    const bool freed = frees_capped_place(gone);
     for (auto& e : gone) retire(std::move(e), why);
+    if (freed) refill_capped_rules(&id);
 }
 
 std::string DiscoveredDevices::unique_name(std::string base) const {

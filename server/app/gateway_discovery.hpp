@@ -66,6 +66,12 @@ private:
     void on_event(const discovery::DiscoveryEvent& e);
     void sync_node(const rr::discovery::NodeEntry& node);
     void drop_node(const NodeID& id, const std::string& why);
+    /// Whether retiring `gone` frees a place of a rule with a `max` count.
+    bool frees_capped_place(const std::vector<Entry>& gone) const;
+    /// Matches every known node again (but `lost`) so that capped rules take services they passed over.
+    void refill_capped_rules(const NodeID* lost);
+    bool refilling_ = false;     ///< refill_capped_rules is running (discovery strand only)
+    bool refill_again_ = false;  ///< a sync during it freed another place
     Result<std::shared_ptr<gateway::DeviceMirror>> create_device(const rr::discovery::NodeEntry& node,
                                                                  const rr::discovery::ServiceInfo2& service,
                                                                  const std::vector<std::string>& urls, int rule,
