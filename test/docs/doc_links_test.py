@@ -14,6 +14,7 @@ import sys
 
 LINK = re.compile(r"\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
 FENCE = re.compile(r"^\s*(```|~~~)")
+CODE_SPAN = re.compile(r"`[^`]*`")
 
 
 def tracked_markdown(root: pathlib.Path):
@@ -31,7 +32,7 @@ def broken_links(md: pathlib.Path):
             continue
         if in_fence:
             continue
-        for target in LINK.findall(line):
+        for target in LINK.findall(CODE_SPAN.sub("", line)):
             if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
                 continue
             path = target.split("#", 1)[0]

@@ -361,7 +361,7 @@ def skip(reason):
 
 NO_SYSTEMD = "no systemd here (PID 1 is not systemd)"
 RULES = [
-    (r"^cmake --workflow --preset package$", do_pack),
+    (r"^\./scripts/package\.sh$", do_pack),
     (r"^sudo apt-get install \./build/package/", do_apt_install_deb),
     (r"^cmake --preset release$", skip("the test's build tree stands in for a Release build")),
     (r"^cmake --build --preset release$", skip("the test's build tree stands in for a Release build")),

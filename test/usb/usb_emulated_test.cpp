@@ -456,7 +456,7 @@ std::string check_permission_report(const std::string& path) {
             if (!found) problem = "the device is not listed";
             else if (!found->error) problem = "no error reported";
             else if (found->error->type != MessageErrorType::SystemResourcePermissionDenied) problem = "wrong type: " + found->error->message;
-            else if (found->error->message.find("99-robotraconteur-usb.rules") == std::string::npos) problem = "no hint: " + found->error->message;
+            else if (found->error->message.find("70-robotraconteur-usb.rules") == std::string::npos) problem = "no hint: " + found->error->message;
             if (problem.empty()) {  // connecting names the cause too
                 std::promise<Result<server::usb::UsbByteStream>> p;
                 (*host)->open_stream(parse_connection_url(std::string("rr+usb:///?nodename=") + kDeviceNodeName + "&service=x").value(),
@@ -489,7 +489,7 @@ std::string check_gateway_and_cli_report() {
     std::string problem;
     auto reason_ok = [&] {
         auto s = (*gw)->device("board")->status();
-        return s.state != server::gateway::DeviceState::connected && s.reason.find("99-robotraconteur-usb.rules") != std::string::npos;
+        return s.state != server::gateway::DeviceState::connected && s.reason.find("70-robotraconteur-usb.rules") != std::string::npos;
     };
     if (!eventually(reason_ok, 10s)) problem = "device reason: " + (*gw)->device("board")->status().reason;
     (*gw)->stop();
@@ -503,7 +503,7 @@ std::string check_gateway_and_cli_report() {
     const auto code = cli::run_command(*cl, out, err, stop);
     if (code != cli::ExitCode::connect_failure) return "rr exit status " + std::to_string(static_cast<int>(code));
     if (err.str().find("SystemResourcePermissionDenied") == std::string::npos ||
-        err.str().find("99-robotraconteur-usb.rules") == std::string::npos)
+        err.str().find("70-robotraconteur-usb.rules") == std::string::npos)
         return "rr error: " + err.str();
     return {};
 }

@@ -27,7 +27,7 @@ inline boost::system::error_code make_error_code(usb_errc e) noexcept { return {
 std::string libusb_error_text(int libusb_error);
 
 /// The udev rule shipped with the gateway, and the hint every permission error carries.
-inline constexpr const char* kUdevRuleFile = "gateway-config/99-robotraconteur-usb.rules";
+inline constexpr const char* kUdevRuleFile = "gateway-config/70-robotraconteur-usb.rules";
 /// "no permission to open USB device VID:PID at PATH: install …" (SystemResourcePermissionDenied).
 RRError permission_error(std::uint16_t vendor_id, std::uint16_t product_id, const std::string& device_path);
 

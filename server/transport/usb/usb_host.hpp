@@ -13,7 +13,7 @@
 // rescan every `poll_interval`; connect also rescans when no device matches. Unplugging fails the
 // device's streams (usb_errc::device_unplugged); a re-plugged device is found again and connects anew.
 // A device the process may not open is listed with a permission error naming the udev rule
-// (gateway-config/99-robotraconteur-usb.rules), not left out.
+// (gateway-config/70-robotraconteur-usb.rules), not left out.
 //
 // Threading: the table runs on the host's strand; libusb's events on its own thread (usb_libusb.hpp).
 // Public functions are thread-safe; `done` callbacks run on the host's strand (or the link's).

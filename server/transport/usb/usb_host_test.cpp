@@ -138,7 +138,7 @@ TEST_CASE("usb host: permission errors name the udev rule") {
     CHECK(e.type == MessageErrorType::SystemResourcePermissionDenied);
     CHECK(e.message.find("1209:0001") != std::string::npos);
     CHECK(e.message.find("/dev/bus/usb/001/002") != std::string::npos);
-    CHECK(e.message.find("gateway-config/99-robotraconteur-usb.rules") != std::string::npos);
+    CHECK(e.message.find("gateway-config/70-robotraconteur-usb.rules") != std::string::npos);
 }
 
 TEST_CASE("usb host: on a bus without RR devices enumerate is empty and connect says no device") {
