@@ -18,6 +18,8 @@ Then restarts it with messages_per_second: 20 (burst_s: 1) and, with the officia
             not cut off), and rr_gateway_limited_total{limit="rate"} counts the pauses.
   unharmed  meanwhile a second client's calls on its own connection return promptly, and the
             flooding client is still connected afterwards.
+  JSON/HTTP a JSON WebSocket and an HTTP keep-alive connection sending requests back to back are
+            paced to about the same rate, and the WebSocket stays open.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when websocket-client is missing or 127.0.0.2 cannot be bound.
 
@@ -174,6 +176,7 @@ def rate_checks(c, args, work):
         time.sleep(0.2)
         log = tail(os.path.join(work, "rate.err"), 200)
         c.check("throttled: the log says reads were paused", "over its rate" in log and "reads paused" in log, log[-600:])
+        json_http_rate_checks(c, port)
     finally:
         try:
             rrn.Shutdown()
@@ -181,6 +184,58 @@ def rate_checks(c, args, work):
             pass
         stop(gateway)
     return True
+
+
+def flood_for(seconds, one_request):
+    """Calls one_request() back to back for `seconds`; returns (calls, elapsed, errors)."""
+    calls, err = 0, []
+    t0 = time.monotonic()
+    try:
+        while time.monotonic() - t0 < seconds:
+            one_request()
+            calls += 1
+    except Exception as e:  # noqa: BLE001
+        err.append(repr(e))
+    return calls, time.monotonic() - t0, err
+
+
+def json_http_rate_checks(c, port):
+    """messages_per_second on the JSON WebSocket (one JSON message = one message) and on an HTTP
+    keep-alive connection (one request = one message), each on a fresh connection (a full bucket)."""
+    import http.client
+
+    ws = json_ws(port)
+    counter = [0]
+
+    def ws_request():
+        counter[0] += 1
+        ws.send(json.dumps({"id": counter[0], "op": "devices"}))
+        while json.loads(ws.recv()).get("id") != counter[0]:
+            pass
+
+    calls, elapsed, err = flood_for(3.0, ws_request)
+    rate = calls / elapsed
+    c.check("throttled: a JSON WebSocket sending requests back to back gets about messages_per_second",
+            not err and calls <= RATE * (elapsed + 1) + 5 and rate >= RATE / 2,
+            "%d requests in %.2f s = %.1f/s (limit %d/s, burst %d) %s" % (calls, elapsed, rate, RATE, RATE, err))
+    c.check("unharmed: the flooding JSON WebSocket is slowed, not closed", not err and ws_alive(ws), str(err))
+    ws.close()
+
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+
+    def http_request():
+        conn.request("GET", "/api/devices")
+        r = conn.getresponse()
+        r.read()
+        if r.status != 200:
+            raise StepFailed("GET /api/devices: %d" % r.status)
+
+    calls, elapsed, err = flood_for(3.0, http_request)
+    rate = calls / elapsed
+    c.check("throttled: HTTP requests back to back on one keep-alive connection get about messages_per_second",
+            not err and calls <= RATE * (elapsed + 1) + 5 and rate >= RATE / 2,
+            "%d requests in %.2f s = %.1f/s (limit %d/s, burst %d) %s" % (calls, elapsed, rate, RATE, RATE, err))
+    conn.close()
 
 
 class Checks:
