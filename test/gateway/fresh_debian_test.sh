@@ -57,8 +57,18 @@ echo "ok: user rr-gateway, gateway.yaml 640 root:rr-gateway, the unit"
 
 mount -t proc proc "$root/proc"
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-# As the unit runs it: user rr-gateway, the installed configuration (a free port instead of 8080).
+# As the unit runs it: user rr-gateway, the installed configuration (a free port instead of 8080), the
+# unit's RuntimeDirectory and StateDirectory (systemd makes them, owned by the user) and its
+# Environment= line with systemd's %t (/run) and %S (/var/lib) filled in. No systemd runs in the root.
+unit="$root/lib/systemd/system/rr-gateway.service"
+run_dir=$(sed -n 's/^RuntimeDirectory=//p' "$unit")
+state_dir=$(sed -n 's/^StateDirectory=//p' "$unit")
+unit_env=$(sed -n 's/^Environment=//p' "$unit" | sed -e 's#%t#/run#g' -e 's#%S#/var/lib#g')
+[ -n "$run_dir" ] && [ -n "$state_dir" ] || fail "the unit has no RuntimeDirectory/StateDirectory"
+chroot "$root" install -d -o rr-gateway -g rr-gateway -m 0755 "/run/$run_dir" "/var/lib/$state_dir"
+# shellcheck disable=SC2086  # the unit's VAR=value words, split as systemd does (no quotes in them)
 chroot "$root" setpriv --reuid=rr-gateway --regid=rr-gateway --init-groups \
+  env HOME=/nonexistent $unit_env \
   /usr/bin/rr-gateway --config /etc/rr-gateway/gateway.yaml --port "$port" --log-level warning >"$work/gw.out" 2>&1 &
 gw=$!
 for _ in $(seq 150); do
@@ -66,11 +76,12 @@ for _ in $(seq 150); do
   sleep 0.2
 done
 curl -fsS "http://127.0.0.1:$port/api/devices" | grep -q '"create"' || { cat "$work/gw.out"; fail "the installed gateway does not serve its demo devices"; }
+chroot "$root" find "/run/$run_dir" -type s | grep -q . || fail "no rr+local socket in /run/$run_dir (the unit's Environment=)"
 kill "$gw"
 wait "$gw" || fail "the gateway exited with $? on SIGTERM"
 gw=
 umount "$root/proc"
-echo "ok: the installed gateway ran as rr-gateway with /etc/rr-gateway/gateway.yaml"
+echo "ok: the installed gateway ran as rr-gateway with /etc/rr-gateway/gateway.yaml and the unit's environment"
 
 chroot "$root" sh -c 'DEBIAN_FRONTEND=noninteractive apt-get purge -y rr-gateway' >/dev/null 2>&1 || fail "apt-get purge"
 [ ! -e "$root/etc/rr-gateway" ] && [ ! -e "$root/usr/bin/rr-gateway" ] || fail "files left after purge"
