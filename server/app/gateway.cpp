@@ -49,7 +49,11 @@ Result<std::optional<local::NodeNameReservation>> reserve_local_name(bool local,
                                              ? " (another gateway or node with NodeName \"" + name +
                                                    "\" runs on this computer: give this gateway another gateway.node_name "
                                                    "(--robotraconteur-nodename) or turn rr+local off (gateway.local: false, --no-local))"
-                                             : std::string()));
+                                         : r.error().message.find("ROBOTRACONTEUR_USER_CONFIG_DIR") != std::string::npos
+                                             ? " (or turn rr+local off: gateway.local: false, --no-local)"
+                                             : " (set ROBOTRACONTEUR_USER_CONFIG_DIR and ROBOTRACONTEUR_USER_RUN_DIR to "
+                                               "writable folders, as the systemd unit does, or turn rr+local off: "
+                                               "gateway.local: false, --no-local)"));
     return std::optional<local::NodeNameReservation>(std::move(*r));
 }
 
