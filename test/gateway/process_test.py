@@ -4,7 +4,8 @@
   origin   a browser Origin that is not allowed gets 403 for HTTP requests and for WebSocket upgrades
            (RR subprotocol and JSON subprotocol); allowed and same-origin requests pass.
   config   a bad configuration file makes rr-gateway exit non-zero before listening, naming the file,
-           the line and the key; so does an unknown flag.
+           the line and the key; so does an unknown flag; so does a second gateway whose NodeName
+           another gateway on this computer serves over rr+local.
   metrics  /metrics (Prometheus text, parsed with prometheus_client) has every series that
            docs/deployment.md §Monitoring lists, with its type and label names, serves none it does not
            list (without and with --discovery), and the counters follow the traffic of an official RR
@@ -16,6 +17,7 @@ Prints a JSON summary; exit status 0 only if every check passed.
 import argparse
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -131,6 +133,35 @@ def case_config(checks, exe):
         expect(r.returncode == 0 and "configuration ok" in r.stdout, "a good file passes --check: %r" % (r,))
 
     checks.run("a good config passes --check", good)
+
+    def node_name_taken():
+        # rr+local on (the default) in a scratch tree of node directories: a second gateway with the
+        # same NodeName exits at once, naming it and the way out; the first keeps serving.
+        tree = tempfile.mkdtemp(prefix="rr_gw_taken_")
+        env = gwproc.gateway_env()
+        for var, sub in (("ROBOTRACONTEUR_SYSTEM_RUN_DIR", "sysrun"), ("ROBOTRACONTEUR_SYSTEM_STATE_DIR", "sysstate"),
+                         ("ROBOTRACONTEUR_SYSTEM_CONFIG_DIR", "sysconfig"), ("ROBOTRACONTEUR_USER_RUN_DIR", "run"),
+                         ("ROBOTRACONTEUR_USER_CONFIG_DIR", "config")):
+            env[var] = os.path.join(tree, sub)
+        name = "gw.taken.%d" % os.getpid()
+        argv = [exe, "--listen", "127.0.0.1", "--port", "0", "--no-demo", "--robotraconteur-nodename=" + name]
+        first = gwproc.Proc(argv, env=env)
+        try:
+            t0 = time.monotonic()
+            r = subprocess.run(argv, capture_output=True, text=True, timeout=30, env=env)
+            took = time.monotonic() - t0
+            expect(r.returncode != 0, "second gateway: exit status %d" % r.returncode)
+            expect(name in r.stderr and "--no-local" in r.stderr, "names the NodeName and --no-local: %r" % r.stderr)
+            expect('"port"' not in r.stdout, "no ready line: %r" % r.stdout)
+            expect(took < 10, "exits at once (%.1f s)" % took)
+            expect(first.alive() and gwproc.http_status("http://127.0.0.1:%d/livez" % first.port)[0] == 200,
+                   "the first gateway still serves")
+        finally:
+            status = first.stop()
+            shutil.rmtree(tree, ignore_errors=True)
+        expect(status == 0, "the first gateway exits 0 on SIGTERM, got %s" % status)
+
+    checks.run("a second gateway with a NodeName in use (rr+local) -> exit != 0 naming it", node_name_taken)
 
 
 def documented_series(doc):
