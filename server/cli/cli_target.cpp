@@ -6,6 +6,7 @@
 #include "core/json/value_json.hpp"
 #include "core/names/connection_url.hpp"
 #include "server/cli/cli_usb.hpp"
+#include "server/transport/websocket_connector.hpp"
 
 namespace rr::cli {
 
