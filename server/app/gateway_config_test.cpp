@@ -55,6 +55,23 @@ TEST_CASE("an empty configuration gives the defaults (demo on, port 8080)") {
     CHECK(c->port == 8080);
     CHECK(c->demo);
     CHECK(c->devices.empty());
+    CHECK(c->local);  // rr+local served under the gateway's NodeName unless turned off
+}
+
+TEST_CASE("gateway.local: false and --no-local turn the gateway's rr+local off") {
+    auto off = parse_gateway_config("gateway:\n  local: false\n", "t.yaml");
+    REQUIRE(off);
+    CHECK_FALSE(off->local);
+    auto bad = parse_gateway_config("gateway:\n  local: sometimes\n", "bad.yaml");
+    REQUIRE_FALSE(bad);
+    CHECK_THAT(bad.error().message, Catch::Contains("bad.yaml:2: gateway.local: expected true or false"));
+    const char* argv[] = {"rr-gateway", "--no-local"};
+    auto cmd = parse_command_line(2, argv);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    REQUIRE(c.local);
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK_FALSE(c.local);
 }
 
 TEST_CASE("configuration errors name the key and the line") {

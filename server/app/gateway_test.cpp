@@ -1,6 +1,7 @@
 // The assembled Gateway with a device node: health endpoints, metrics, and RR through the gateway.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <thread>
 
 #include <boost/beast/core.hpp>
@@ -178,6 +179,29 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     cfg.devices.clear();
     auto third = Gateway::start(cfg, demo);
     INFO((third ? std::string() : third.error().message));
-    CHECK(third);
+    REQUIRE(third);
+    (*third)->stop();
+
+    // gateway.local: false (--no-local): no rr+local entry or socket under the gateway's NodeName, and
+    // none for its demo node; a local client finds nothing.
+    cfg.local = false;
+    auto quiet = Gateway::start(cfg, demo);
+    INFO((quiet ? std::string() : quiet.error().message));
+    REQUIRE(quiet);
+    for (int i = 0; i < 500 && !(*quiet)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*quiet)->ready());
+    // (The run directories hold the by-nodename / by-nodeid entries and sockets. The NodeID cache and
+    // the NodeName lock files, nodeids/NAME.pid, of the earlier gateways stay, as the official node's do.)
+    for (const auto& run_dir : {tmp.dirs.system_run_dir, tmp.dirs.user_run_dir}) {
+        if (!std::filesystem::exists(run_dir)) continue;
+        for (const auto& f : std::filesystem::recursive_directory_iterator(run_dir)) {
+            if (f.path().parent_path().filename() == "nodeids") continue;
+            INFO(f.path().string());
+            CHECK(f.path().filename().string().find(name) == std::string::npos);
+            CHECK_FALSE(f.is_socket());
+        }
+    }
+    CHECK_FALSE(client::Client::connect(io.executor(), "rr+local:///?nodename=" + name + ".demo&service=create"));
+    (*quiet)->stop();
     device->shutdown();
 }

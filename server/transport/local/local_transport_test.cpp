@@ -516,6 +516,30 @@ TEST_CASE("local: an entry or a socket this user may not open is a permission er
     node->shutdown();
 }
 
+TEST_CASE("local: a run directory this user may not write is a permission error naming it") {
+    if (::getuid() != 0 && ::geteuid() != 0) {
+        WARN("skipped: needs root (to act as another user on a directory root owns)");
+        return;
+    }
+    TempNodeDirs tmp;  // root-owned, mode 0755: another user may read but not write
+    const std::string name = unique_node_name("local.nowrite");
+    auto r = reserve_node_name(tmp.dirs, name);
+    REQUIRE(r);
+    NodeOptions o;
+    o.node_id = r->node_id;
+    o.node_name = name;
+    o.threads = 1;
+    auto node = Node::create(o);
+    LocalListenOptions opts;
+    opts.dirs = tmp.dirs;
+    Result<std::shared_ptr<LocalListener>> l = fail(MessageErrorType::None, "");
+    as_nobody([&] { l = listen_local(node, opts, std::move(*r)); });
+    REQUIRE_FALSE(l);
+    CHECK(l.error().type == MessageErrorType::SystemResourcePermissionDenied);
+    CHECK_THAT(l.error().message, Catch::Contains(tmp.root));
+    node->shutdown();
+}
+
 TEST_CASE("local: a NodeName held by another process is refused, and free again when it exits") {
     // The other process: Python's fcntl.lockf takes the same kind of lock CORE takes (fcntl F_SETLK).
     if (::access("/usr/bin/python3", X_OK) != 0) {
