@@ -4,14 +4,15 @@ Robot Raconteur Python client: every member of experimental.create.Create and of
 experimental.createwebcam.WebcamHost / Webcam, with the behaviour the devices document.
 
 Either starts the standalone executable (`--devices build/.../rr-demo-devices`, ephemeral port; it must
-exit with status 0 on SIGTERM, so under ASan/LSan a leak fails the test) or uses running devices
+exit with status 0 on SIGTERM, so under ASan/LSan a leak fails the test; with `--local` it serves rr+local
+too and the client connects by NodeName over rr+local) or uses running devices
 (`--create URL --webcam URL`, e.g. the demo devices behind a gateway).
 
 Prints one JSON summary on stdout; exit status 0 only if every check passed (1 = a check failed,
 2 = could not start / connect, 3 = overall timeout).
 
 Usage:
-    demo_official_client.py --devices PATH [--timeout S] [--verbose]
+    demo_official_client.py --devices PATH [--local] [--timeout S] [--verbose]
     demo_official_client.py --create rr+tcp://127.0.0.1:P/?service=create \
                             --webcam rr+tcp://127.0.0.1:P/?service=webcam
 """
@@ -391,8 +392,9 @@ class Runner:
                 self.results.append((s, "connect", False, "%s: %s" % (type(e).__name__, e)))
 
 
-def start_devices(exe, timeout=30.0):
-    p = subprocess.Popen([exe, "--port", "0", "--play-period", "1", "--max-lifetime", "300"],
+def start_devices(exe, timeout=30.0, local=False):
+    extra = ["--local", "--node-name", "rr.demo.official_client.%d" % os.getpid()] if local else []
+    p = subprocess.Popen([exe, "--port", "0", "--play-period", "1", "--max-lifetime", "300"] + extra,
                          stdout=subprocess.PIPE, stderr=sys.stderr, text=True)
     line = [None]
 
@@ -423,6 +425,8 @@ def main(argv=None):
     ap.add_argument("--devices", help="rr-demo-devices executable to start")
     ap.add_argument("--create", help="URL of a running create service")
     ap.add_argument("--webcam", help="URL of a running webcam service")
+    ap.add_argument("--local", action="store_true",
+                    help="with --devices: start them with rr+local and connect by NodeName over rr+local")
     ap.add_argument("--timeout", type=float, default=120.0, help="overall time limit (s)")
     ap.add_argument("--verbose", action="store_true")
     args = ap.parse_args(argv)
@@ -443,18 +447,22 @@ def main(argv=None):
     try:
         if args.devices:
             try:
-                proc, ready = start_devices(args.devices)
+                proc, ready = start_devices(args.devices, local=args.local)
             except Exception as e:
                 summary["error"] = "cannot start %s: %s" % (args.devices, e)
                 print(json.dumps(summary), flush=True)
                 return 2
             create_url, webcam_url = ready["create_url"], ready["webcam_url"]
+            if args.local:
+                create_url, webcam_url = ready["local_create_url"], ready["local_webcam_url"]
         else:
             create_url, webcam_url = args.create, args.webcam
         summary.update({"create_url": create_url, "webcam_url": webcam_url})
 
         RRN.SetLogLevelFromEnvVariable()
         RRN.RegisterTransport(RR.TcpTransport())
+        if create_url.startswith("rr+local:"):
+            RRN.RegisterTransport(RR.LocalTransport())
         r = Runner(create_url, webcam_url)
         r.verbose = args.verbose
         r.run()
