@@ -1,5 +1,5 @@
 // The hostile-peer cases the TCP port survives (server/service/peer_limits_test.cpp), over rr+local:
-// a message over 512 KiB before the client session exists, wrong magic and a truncated message inside an
+// a message over 512 KiB before the client session exists, max_message_size once it exists, wrong magic and a truncated message inside an
 // established stream, an unknown special request, max_connections, a peer that never speaks and one
 // that speaks something else than RR. Other clients stay unaffected.
 #include <catch2/catch.hpp>
@@ -14,6 +14,7 @@
 #include "core/session/elements.hpp"
 #include "core/session/stream_connection.hpp"
 #include "server/client/client.hpp"
+#include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/local/local_connector.hpp"
@@ -97,6 +98,71 @@ TEST_CASE("local limits: a message over 512 KiB before the client session exists
     over.send_special(MessageEntryType::GetServiceDesc, "svc", 600u * 1024u);
     CHECK(is_closed_event(over.next_event(5s)));
     check_others_unaffected(n);
+}
+
+TEST_CASE("local limits: max_message_size is configurable and applies once the session exists") {
+    NodeOptions options;
+    options.server.stream.limits.max_message_size = 1u << 20;
+    LocalNode n(options);
+    default_transports().add("rr+local", std::make_shared<LocalConnector>([d = n.tmp.dirs] { return d; }));
+    client::IoThreads io{1};
+    auto connect = [&] {
+        std::promise<Result<std::shared_ptr<RawClient>>> p;
+        RawClient::connect(io.executor(), *parse_connection_url(n.url()), {}, {}, {},
+                           [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+        return p.get_future().get();
+    };
+    auto call = [](RawClient& c, std::size_t padding) {
+        MessageEntry e;
+        e.entry_type = MessageEntryType::PropertyGetReq;
+        e.service_path = "svc";
+        e.member_name = "x";
+        std::vector<std::uint8_t> pad(padding, 0x33);
+        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
+        std::promise<Result<MessageEntry>> p;
+        c.request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
+        return p.get_future().get();
+    };
+    auto c = connect();
+    default_transports().add("rr+local", std::make_shared<LocalConnector>());
+    REQUIRE(c);
+    // 700 KiB: over the pre-session limit, under the configured one: answered.
+    auto ok = call(**c, 700u * 1024u);
+    REQUIRE(ok);
+    CHECK(ok->error == MessageErrorType::None);
+    // 2 MiB: over the configured limit: the node drops the connection.
+    auto over = call(**c, 2u << 20);
+    REQUIRE_FALSE(over);
+    CHECK(over.error().type == MessageErrorType::ConnectionError);
+    for (int i = 0; i < 100 && (*c)->is_open(); ++i) std::this_thread::sleep_for(10ms);
+    CHECK_FALSE((*c)->is_open());
+    check_others_unaffected(n);
+}
+
+TEST_CASE("local limits: messages_per_second paces a flooding client over rr+local") {
+    // gateway.limits' rates apply to every accepted connection, the Unix socket's too (transport.hpp).
+    NodeOptions options;
+    options.read_rates.messages_per_second = 20;
+    options.read_rates.burst_s = 1;
+    LocalNode n(options);
+    default_transports().add("rr+local", std::make_shared<LocalConnector>([d = n.tmp.dirs] { return d; }));
+    client::IoThreads io{1};
+    auto c = client::Client::connect(io.executor(), n.url());
+    default_transports().add("rr+local", std::make_shared<LocalConnector>());
+    REQUIRE(c);
+    std::this_thread::sleep_for(1200ms);  // the bucket full again after the handshake
+    int calls = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - t0 < 2s) {
+        REQUIRE((*c)->root().get("x"));
+        ++calls;
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    INFO(calls << " calls in " << elapsed << " s");
+    CHECK(calls <= 20 * (elapsed + 1) + 5);  // the 1-second burst plus the rate
+    CHECK(calls >= 10 * elapsed);             // slowed, not stopped
+    CHECK(n.node->reads_throttled() > 0);
+    CHECK((*c)->close_wait().ok());
 }
 
 TEST_CASE("local limits: wrong magic, a truncated message, an unknown special request") {
