@@ -10,10 +10,10 @@
 #include "server/app/gateway_discovery.hpp"
 #include "server/app/log.hpp"
 #include "server/common/token_bucket.hpp"
-#include "server/transport/discovery/discovery_sources.hpp"
+#include "server/discovery/discovery_sources.hpp"
 #include "server/transport/local/local_listener.hpp"
 #ifdef RR_HAVE_USB
-#include "server/transport/usb/usb_discovery.hpp"
+#include "server/discovery/usb_discovery.hpp"
 #include "server/transport/usb/usb_host.hpp"
 #endif
 #include "server/transport/tls/tls_stream.hpp"

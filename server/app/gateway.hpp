@@ -16,7 +16,7 @@
 #include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
 
 namespace rr::server::app {
 

@@ -6,7 +6,7 @@
 #include "server/app/log.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
-#include "server/transport/discovery/discovery_json.hpp"
+#include "server/discovery/discovery_json.hpp"
 
 namespace rr::server::app {
 

@@ -18,7 +18,7 @@
 #include "server/app/gateway_config.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/json_api.hpp"
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
 
 namespace rr::server {
 class Node;

@@ -10,7 +10,7 @@
 #include "server/app/gateway_auth_config.hpp"
 #include "server/app/log.hpp"
 #include "server/app/web_root.hpp"
-#include "server/demo/demo_devices.hpp"
+#include "server/app/demo_starter.hpp"
 #include "server/gateway/json_api_installer.hpp"
 
 using namespace rr;
@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
     if (LogFormat f; log_format_from_string(config.log_format, f)) set_log_format(f);
 
     DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port) {
-        return rr::server::demo::start_demo_devices_for_gateway(*node, port);
+        return rr::server::app::start_demo_devices_for_gateway(*node, port);
     };
     auto gateway = Gateway::start(config, demo, rr::server::gateway::install_json_api);
     if (!gateway) {

@@ -11,7 +11,7 @@
 
 #include "server/app/gateway.hpp"
 #include "server/client/client.hpp"
-#include "server/demo/demo_devices.hpp"
+#include "server/app/demo_starter.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/local/local_test_support.hpp"
 
@@ -143,7 +143,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     d.url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
     cfg.devices.push_back(d);
     DemoStarter demo = [](const std::shared_ptr<Node>& node, std::uint16_t demo_port) {
-        return demo::start_demo_devices_for_gateway(*node, demo_port);
+        return app::start_demo_devices_for_gateway(*node, demo_port);
     };
     auto gw = Gateway::start(cfg, demo);
     REQUIRE(gw);

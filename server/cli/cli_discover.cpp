@@ -7,8 +7,8 @@
 #include "server/cli/cli_target.hpp"
 #include "server/cli/cli_usb.hpp"
 #include "server/client/client.hpp"
-#include "server/transport/discovery/discovery_json.hpp"
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/discovery_json.hpp"
+#include "server/discovery/node_discovery.hpp"
 #include "server/transport/local/local_discovery.hpp"
 
 namespace rr::cli {

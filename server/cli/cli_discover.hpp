@@ -1,5 +1,5 @@
 // `rr discover` and NodeName/NodeID resolution for `rr info rr+tcp:///?nodename=NAME&service=S`
-// (docs/cli.md, docs/discovery.md), on server/transport/discovery.
+// (docs/cli.md, docs/discovery.md), on server/discovery.
 #pragma once
 
 #include <ostream>

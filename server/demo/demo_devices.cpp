@@ -51,21 +51,11 @@ Result<DemoDevices> start_demo_devices(Node& node, const DemoOptions& options) {
     return d;
 }
 
-std::vector<gateway::DeviceConfig> demo_device_configs(std::uint16_t port, const DemoOptions& options) {
-    std::vector<gateway::DeviceConfig> out;
-    for (const std::string& name : {options.create_service, options.webcam_service}) {
-        gateway::DeviceConfig c;
-        c.name = name;
-        c.url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=" + name;
-        out.push_back(std::move(c));
-    }
+std::vector<DemoDeviceUrl> demo_device_urls(std::uint16_t port, const DemoOptions& options) {
+    std::vector<DemoDeviceUrl> out;
+    for (const std::string& name : {options.create_service, options.webcam_service})
+        out.push_back({name, "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=" + name});
     return out;
-}
-
-Result<std::vector<gateway::DeviceConfig>> start_demo_devices_for_gateway(Node& node, std::uint16_t port) {
-    auto devices = start_demo_devices(node);
-    if (!devices) return devices.take_error();
-    return demo_device_configs(port);
 }
 
 }  // namespace rr::server::demo

@@ -10,7 +10,6 @@
 
 #include "server/demo/create_device.hpp"
 #include "server/demo/webcam_device.hpp"
-#include "server/gateway/device_mirror.hpp"
 #include "server/node/node.hpp"
 #include "server/service/object_service.hpp"
 
@@ -40,12 +39,15 @@ Result<DemoDevices> make_demo_devices(const DemoOptions& options = {});
 /// registered then).
 Result<DemoDevices> start_demo_devices(Node& node, const DemoOptions& options = {});
 
-/// How a gateway reaches them on a node listening on 127.0.0.1:`port`:
-/// {create, rr+tcp://127.0.0.1:PORT/?service=create}, {webcam, rr+tcp://127.0.0.1:PORT/?service=webcam}.
-std::vector<gateway::DeviceConfig> demo_device_configs(std::uint16_t port, const DemoOptions& options = {});
+/// One demo service and the URL that reaches it.
+struct DemoDeviceUrl {
+    std::string service;
+    std::string url;
+};
 
-/// start_demo_devices on `node` (listening on 127.0.0.1:`port`), then demo_device_configs: what the
-/// gateway's demo starter does. Errors: those of start_demo_devices.
-Result<std::vector<gateway::DeviceConfig>> start_demo_devices_for_gateway(Node& node, std::uint16_t port);
+/// How a client reaches them on a node listening on 127.0.0.1:`port`:
+/// {create, rr+tcp://127.0.0.1:PORT/?service=create}, {webcam, rr+tcp://127.0.0.1:PORT/?service=webcam}.
+/// (The gateway turns these into its devices: server/app/demo_starter.hpp.)
+std::vector<DemoDeviceUrl> demo_device_urls(std::uint16_t port, const DemoOptions& options = {});
 
 }  // namespace rr::server::demo

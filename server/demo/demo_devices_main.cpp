@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
         const std::string base = "rr+local:///?nodename=" + node_name + "&service=";
         local_urls = ", \"local_create_url\": \"" + base + "create\", \"local_webcam_url\": \"" + base + "webcam\"";
     }
-    const auto configs = demo::demo_device_configs(*bound, demo_options);
+    const auto configs = demo::demo_device_urls(*bound, demo_options);
     std::cout << "{\"port\": " << *bound << ", \"create_url\": \"" << configs[0].url << "\", \"webcam_url\": \""
               << configs[1].url << "\", \"nodeid\": \"" << node->node_id().to_braced_string() << "\", \"nodename\": \""
               << node_name << "\"" << local_urls << "}" << std::endl;

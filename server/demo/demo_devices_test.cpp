@@ -165,20 +165,20 @@ struct NodeFixture {
 
 TEST_CASE("demo starter: registers create and webcam on the demo node and returns their loopback URLs") {
     NodeFixture f;
-    auto configs = start_demo_devices_for_gateway(*f.node, f.port);
-    REQUIRE(configs);
-    REQUIRE(configs->size() == 2);
+    REQUIRE(start_demo_devices(*f.node));
+    auto configs = demo_device_urls(f.port);
+    REQUIRE(configs.size() == 2);
     const std::string base = "rr+tcp://127.0.0.1:" + std::to_string(f.port) + "/?service=";
-    CHECK((*configs)[0].name == "create");
-    CHECK((*configs)[0].url == base + "create");
-    CHECK((*configs)[1].name == "webcam");
-    CHECK((*configs)[1].url == base + "webcam");
+    CHECK(configs[0].service == "create");
+    CHECK(configs[0].url == base + "create");
+    CHECK(configs[1].service == "webcam");
+    CHECK(configs[1].url == base + "webcam");
     auto names = f.node->service_names();
     CHECK(std::find(names.begin(), names.end(), "create") != names.end());
     CHECK(std::find(names.begin(), names.end(), "webcam") != names.end());
 
     // A second start on the same node fails (names taken) and leaves the first one working.
-    CHECK_FALSE(start_demo_devices_for_gateway(*f.node, f.port));
+    CHECK_FALSE(start_demo_devices(*f.node));
 
     auto c = connect(f.node->io_context().get_executor(), f.port, "create");
     auto dist = c.ok(req(MessageEntryType::PropertyGetReq, "create", "DistanceTraveled"));

@@ -3,7 +3,7 @@
 // must still be answered. Turning a frame into JSON takes about a second under ASan; done on the device
 // connection's strand, it held every reply from the device behind the frames queued before it (10 s
 // and more: RequestTimeout).
-#include "server/demo/demo_devices.hpp"
+#include "server/app/demo_starter.hpp"
 #include "server/gateway/json_api_test_fixture.hpp"
 
 using namespace rr;
@@ -31,7 +31,7 @@ TEST_CASE("json socket: requests to a device are answered while its pipe streams
     cfg.demo = true;
     cfg.threads = 2;
     std::shared_ptr<JsonSocketServer> sockets;
-    auto g = app::Gateway::start(cfg, [](const std::shared_ptr<Node>& node, std::uint16_t port) { return demo::start_demo_devices_for_gateway(*node, port); }, [&](http::HttpServer& http, const auto& devices, std::shared_ptr<auth::GatewayAuth>) {
+    auto g = app::Gateway::start(cfg, [](const std::shared_ptr<Node>& node, std::uint16_t port) { return app::start_demo_devices_for_gateway(*node, port); }, [&](http::HttpServer& http, const auto& devices, std::shared_ptr<auth::GatewayAuth>) {
         auto api = std::make_shared<JsonApi>(devices);
         sockets = install_json_socket(http, api);
         return api;

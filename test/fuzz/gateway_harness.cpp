@@ -9,7 +9,7 @@
 
 #include "server/app/gateway.hpp"
 #include "server/app/log.hpp"
-#include "server/demo/demo_devices.hpp"
+#include "server/app/demo_starter.hpp"
 #include "server/gateway/json_api_installer.hpp"
 
 namespace rr::fuzz {
@@ -58,7 +58,7 @@ GatewayHarness* start() {
         -> Result<std::vector<server::gateway::DeviceConfig>> {
         auto devices = server::demo::start_demo_devices(*node, demo);
         if (!devices) return devices.take_error();
-        return server::demo::demo_device_configs(port, demo);
+        return server::app::demo_device_configs(port, demo);
     };
     auto g = server::app::Gateway::start(
         config, starter,

@@ -14,7 +14,7 @@
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
 #include "server/common/random_ids.hpp"
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;

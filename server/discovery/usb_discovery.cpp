@@ -1,4 +1,4 @@
-#include "server/transport/usb/usb_discovery.hpp"
+#include "server/discovery/usb_discovery.hpp"
 
 #include <boost/asio/post.hpp>
 

@@ -1,4 +1,4 @@
-#include "server/transport/discovery/discovery_sources.hpp"
+#include "server/discovery/discovery_sources.hpp"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,7 +14,7 @@
 #include "core/names/connection_url.hpp"
 #include "server/client/client.hpp"
 #include "server/common/random_ids.hpp"
-#include "server/transport/discovery/local_addresses.hpp"
+#include "server/discovery/local_addresses.hpp"
 
 namespace rr::server::discovery {
 

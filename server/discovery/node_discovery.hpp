@@ -46,7 +46,7 @@
 
 #include "core/discovery/discovery_timing.hpp"
 #include "core/discovery/node_table.hpp"
-#include "server/transport/discovery/local_addresses.hpp"
+#include "server/discovery/local_addresses.hpp"
 #include "server/transport/transport_registry.hpp"
 
 namespace rr::server::discovery {

@@ -1,4 +1,4 @@
-#include "server/transport/discovery/local_addresses.hpp"
+#include "server/discovery/local_addresses.hpp"
 
 #include <ifaddrs.h>
 #include <net/if.h>

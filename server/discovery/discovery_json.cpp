@@ -1,4 +1,4 @@
-#include "server/transport/discovery/discovery_json.hpp"
+#include "server/discovery/discovery_json.hpp"
 
 #include "core/json/value_json.hpp"
 #include "robdef/service_definition_set.hpp"

@@ -2,7 +2,7 @@
 // of this computer (server/transport/local/local_discovery.hpp) feed NodeDiscovery::add_node() with
 // NodeSource::local and their rr+local URLs, and take those URLs back (remove_urls) when the node's
 // entry goes or its process ends. A node also known by UDP then keeps its other URLs. USB devices have
-// their own source next to the USB transport (server/transport/usb/usb_discovery.hpp).
+// their own source next to the USB transport (server/discovery/usb_discovery.hpp).
 #pragma once
 
 #include <chrono>
@@ -14,7 +14,7 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "server/transport/discovery/node_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
 #include "server/transport/local/local_discovery.hpp"
 
 namespace rr::server::discovery {

@@ -10,7 +10,7 @@
 #include "server/common/random_ids.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
-#include "server/transport/discovery/discovery_sources.hpp"
+#include "server/discovery/discovery_sources.hpp"
 #include "server/transport/local/local_connector.hpp"
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"

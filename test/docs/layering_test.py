@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""The server folders include only the folders below them, in the order docs/architecture.md lists them
+("Folders and their dependencies"). Library sources only: tests (`*_test.cpp`), test fixtures and test
+support files may reach across. Prints each upward include as file:line and exits 1 when there is one.
+
+Usage: layering_test.py REPO_ROOT
+"""
+import pathlib
+import re
+import sys
+
+INCLUDE = re.compile(r'^\s*#\s*include\s+"server/([a-z_]+)/')
+LISTED = re.compile(r"^ (server/[a-z_]+|core/)\s")
+
+
+def folder_order(doc: pathlib.Path):
+    text = doc.read_text(encoding="utf-8")
+    section = text.split("## Folders and their dependencies", 1)[1]
+    block = section.split("```", 2)[1]
+    order = [m.group(1).rstrip("/").split("/")[-1] for line in block.splitlines() if (m := LISTED.match(line))]
+    return order  # top first
+
+
+def is_test_file(p: pathlib.Path) -> bool:
+    n = p.name
+    return n.endswith("_test.cpp") or "test_" in n or "fixture" in n or "test_support" in n
+
+
+def main():
+    root = pathlib.Path(sys.argv[1]).resolve()
+    order = folder_order(root / "docs" / "architecture.md")
+    rank = {name: i for i, name in enumerate(order)}
+    server = root / "server"
+    on_disk = sorted(d.name for d in server.iterdir() if d.is_dir())
+    unlisted = [d for d in on_disk if d not in rank]
+    bad = ["server/%s: folder not listed in docs/architecture.md" % d for d in unlisted]
+    checked = 0
+    for p in sorted(server.rglob("*")):
+        if p.suffix not in (".cpp", ".hpp") or is_test_file(p):
+            continue
+        src = p.relative_to(server).parts[0]
+        if src not in rank:
+            continue
+        for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1):
+            m = INCLUDE.match(line)
+            if not m:
+                continue
+            checked += 1
+            dst = m.group(1)
+            if dst != src and (dst not in rank or rank[dst] < rank[src]):
+                bad.append("%s:%d: server/%s includes server/%s, which is above it" % (p.relative_to(root), n, src, dst))
+    for b in bad:
+        print(b)
+    print("layering: %d folders in order %s; %d includes checked; %d problems" % (len(order), " > ".join(order), checked, len(bad)))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
