@@ -26,8 +26,8 @@
 #include "server/cli/cli_options.hpp"
 #include "server/cli/cli_usb.hpp"
 #include "core/usb/usb_protocol.hpp"
-#include "server/transport/discovery/node_discovery.hpp"
-#include "server/transport/usb/usb_discovery.hpp"
+#include "server/discovery/node_discovery.hpp"
+#include "server/discovery/usb_discovery.hpp"
 #include "test/usb/usb_world.hpp"
 #include "test/support/eventually.hpp"
 
