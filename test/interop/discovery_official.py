@@ -4,10 +4,12 @@
     discovery_official.py serve --name NODENAME --port N
         ServerNodeSetup(NODENAME, N) (official defaults: TCP server, IPv6 link-local announce and listen)
         serving "thing" (experimental.discovery_test.Thing, implements Base, attribute tags="fox,arm").
-        Prints {"port": N, "nodeid": "..."} when ready; runs until SIGTERM.
+        Prints {"port": N, "nodeid": "..."} when ready; runs until SIGTERM. --ipv4-only: announce and
+        listen on IPv4 broadcast only (IPNodeDiscoveryFlags_IPV4_BROADCAST), not IPv6.
     discovery_official.py find --type T --name NODENAME --wait S
         ClientNodeSetup(), waits S seconds for announces, then RRN.FindServiceByType(T, ["rr+tcp"]) and
         RRN.FindNodeByName(NODENAME, ["rr+tcp"]); prints {"services": [...], "nodes": [...]}.
+        --ipv4-only: listens on IPv4 broadcast only.
     discovery_official.py hostile --iface IF --flood N
         Sends hostile datagrams to FF02::BA86%IF port 48653: truncated, oversized, a bad UUID, a lying
         URL, a global address, then N announces of distinct NodeIDs. Prints {"sent": count}.
@@ -48,7 +50,12 @@ def serve(args):
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *a: stop.set())
     signal.signal(signal.SIGINT, lambda *a: stop.set())
-    with RR.ServerNodeSetup(args.name, args.port):
+    with RR.ServerNodeSetup(args.name, args.port) as setup:
+        if args.ipv4_only:  # announce and listen on IPv4 broadcast only (the official IPV4_BROADCAST flag)
+            setup.tcp_transport.DisableNodeAnnounce()
+            setup.tcp_transport.DisableNodeDiscoveryListening()
+            setup.tcp_transport.EnableNodeAnnounce(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
+            setup.tcp_transport.EnableNodeDiscoveryListening(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
         RRN.RegisterServiceType(ROBDEF)
         ctx = RRN.RegisterService("thing", "experimental.discovery_test.Thing", Thing())
         ctx.SetServiceAttributes({"tags": RR.VarValue("fox,arm", "string")})
@@ -60,7 +67,10 @@ def serve(args):
 def find(args):
     import RobotRaconteur as RR
     RRN = RR.RobotRaconteurNode.s
-    with RR.ClientNodeSetup():
+    with RR.ClientNodeSetup() as setup:
+        if args.ipv4_only:  # listen on IPv4 broadcast only
+            setup.tcp_transport.DisableNodeDiscoveryListening()
+            setup.tcp_transport.EnableNodeDiscoveryListening(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
         time.sleep(args.wait)
         services = []
         for s in RRN.FindServiceByType(args.type, ["rr+tcp"]):
@@ -109,10 +119,12 @@ def main():
     a = sub.add_parser("serve")
     a.add_argument("--name", required=True)
     a.add_argument("--port", type=int, default=29321)
+    a.add_argument("--ipv4-only", action="store_true")
     a = sub.add_parser("find")
     a.add_argument("--type", required=True)
     a.add_argument("--name", required=True)
     a.add_argument("--wait", type=float, default=5)
+    a.add_argument("--ipv4-only", action="store_true")
     a = sub.add_parser("hostile")
     a.add_argument("--iface", required=True)
     a.add_argument("--flood", type=int, default=2000)
