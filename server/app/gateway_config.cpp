@@ -537,10 +537,10 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
                 const std::string mode = r.string(n, key + ".auth");
                 if (mode == "passthrough")
                     dc.auth = gateway::DeviceAuth::passthrough;
-                else if (mode == "shared")
+                else if (mode == "shared" || mode == "gateway")  // "gateway": the gateway's logins apply (issue 10's name)
                     dc.auth = gateway::DeviceAuth::shared;
                 else
-                    r.error(n, key + ".auth", "expected passthrough or shared, got \"" + mode + "\"");
+                    r.error(n, key + ".auth", "expected shared (alias gateway) or passthrough, got \"" + mode + "\"");
             }
             if (auto n = d["max_passthrough_sessions"]) {
                 dc.max_passthrough_sessions = r.unsigned_int(n, key + ".max_passthrough_sessions", 100000);

@@ -227,13 +227,13 @@ TEST_CASE("bad flags are refused with the flag's name") {
 
 TEST_CASE("every example in gateway-config/ is a valid configuration") {
     int n = 0;
-    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml", "tls.yaml", "auth.yaml"}) {
+    for (const char* name : {"demo.yaml", "reynard.yaml", "lab.yaml", "usb-boards.yaml", "tls.yaml", "auth.yaml", "secure.yaml"}) {
         auto c = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/" + name);
         INFO(name);
         REQUIRE(c);
         ++n;
     }
-    CHECK(n == 6);
+    CHECK(n == 7);
     auto missing = load_gateway_config(std::string(RR_SOURCE_DIR) + "/gateway-config/nope.yaml");
     REQUIRE_FALSE(missing);
     CHECK_THAT(missing.error().message, Catch::Contains("cannot read"));
@@ -321,7 +321,7 @@ TEST_CASE("TLS flags: --tls-certificate, --tls-private-key, --tls-client-ca") {
     CHECK_THAT(r.error().message, Catch::Contains("gateway.tls.private_key"));
 }
 
-TEST_CASE("devices: auth (shared | passthrough) and max_passthrough_sessions") {
+TEST_CASE("devices: auth (shared, alias gateway | passthrough) and max_passthrough_sessions") {
     auto c = parse_gateway_config(R"(
 devices:
   - name: arm
@@ -330,16 +330,20 @@ devices:
     max_passthrough_sessions: 5
   - name: cam
     url: rr+tcp://cam.lab:48653/?service=cam
+  - name: door
+    url: rr+tcp://door.lab:48653/?service=door
+    auth: gateway
 )", "auth.yaml");
     REQUIRE(c);
-    REQUIRE(c->devices.size() == 2);
+    REQUIRE(c->devices.size() == 3);
+    CHECK(c->devices[2].auth == rr::server::gateway::DeviceAuth::shared);  // "gateway" is shared's other name
     CHECK(c->devices[0].auth == rr::server::gateway::DeviceAuth::passthrough);
     CHECK(c->devices[0].max_passthrough_sessions == 5);
     CHECK(c->devices[1].auth == rr::server::gateway::DeviceAuth::shared);
     CHECK(c->devices[1].max_passthrough_sessions == 64);
     for (auto [yaml, expect] : {
              std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    auth: tokens\n",
-                       "bad.yaml:4: devices.a.auth: expected passthrough or shared, got \"tokens\""},
+                       "bad.yaml:4: devices.a.auth: expected shared (alias gateway) or passthrough, got \"tokens\""},
              std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    max_passthrough_sessions: 0\n",
                        "bad.yaml:4: devices.a.max_passthrough_sessions: must be at least 1"},
          }) {
