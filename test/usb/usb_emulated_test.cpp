@@ -427,7 +427,23 @@ TEST_CASE("usb emulated: malformed and stray sub-packets from the device", "[mal
     // The device is still attached: a new connection claims it again.
     auto again = connect(*w, "usbtest");
     CHECK(again->root().call("nop"));
-    REQUIRE(again->close_wait());
+
+    // Unknown wFlags (0x0080, neither data, command nor notification): a protocol fault as well.
+    std::vector<std::byte> odd(12);
+    rr::usb::write_data_subpacket(odd, dev->streams().back(), std::vector<std::byte>(4, std::byte{3}));
+    store_le<std::uint16_t>(odd.data() + 2, 0x0080);
+    std::promise<RRError> closed_again;
+    again->set_closed_handler([&](const RRError& e) { closed_again.set_value(e); });
+    dev->inject_in_transfer(odd);
+    auto g = closed_again.get_future();
+    REQUIRE(g.wait_for(5s) == std::future_status::ready);
+    auto e2 = g.get();
+    INFO(e2.message);
+    CHECK(e2.message.find("USB device broke the rr+usb protocol") != std::string::npos);
+    CHECK(eventually([&] { return w->host->idle(); }));
+    auto third = connect(*w, "usbtest");
+    CHECK(third->root().call("nop"));
+    REQUIRE(third->close_wait());
 }
 
 namespace {
