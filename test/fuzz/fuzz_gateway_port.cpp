@@ -83,8 +83,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     addr.sin_family = AF_INET;
     addr.sin_port = htons(g.port);
     addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0)
-        fail_input("connect(): " + std::to_string(errno));
+    if (::connect(fd.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+        // Interrupted by a signal (libFuzzer's timer sends SIGALRM each second): the connection goes on
+        // in the kernel; wait for it to finish and take its result. (A harness false alarm, seen in a
+        // long run.)
+        if (errno != EINTR) fail_input("connect(): " + std::to_string(errno));
+        pollfd w{fd.get(), POLLOUT, 0};
+        int r = 0;
+        do r = ::poll(&w, 1, 5000);
+        while (r < 0 && errno == EINTR);
+        int err = 0;
+        socklen_t len = sizeof err;
+        if (r <= 0 || ::getsockopt(fd.get(), SOL_SOCKET, SO_ERROR, &err, &len) != 0 || err != 0)
+            fail_input("connect() after EINTR: " + std::to_string(r <= 0 ? errno : err));
+    }
 
     // Send everything (reading meanwhile, so a gateway that answers early never blocks us), then close
     // the sending side and read until the gateway closes.
