@@ -186,9 +186,9 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     for (const auto& d : devices) {
         auto m = gateway::DeviceMirror::create(g->node_, d);
         if (!m) return m.take_error();
-        // auth: passthrough devices check their own logins; the gateway's users apply to shared ones.
-        if (g->auth_ && d.auth != gateway::DeviceAuth::passthrough)
-            (*m)->mirror_service()->set_access(gateway::auth::MirrorAccess(g->auth_, d.name));
+        // The gateway's roles apply to every device. A passthrough device checks its clients' passwords
+        // itself; the roles then apply to the user name the device accepted (MirrorService::handle_entry).
+        if (g->auth_) (*m)->mirror_service()->set_access(gateway::auth::MirrorAccess(g->auth_, d.name));
         g->devices_.push_back(*m);
     }
 

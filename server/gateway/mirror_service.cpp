@@ -225,6 +225,13 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
     auto mirror = mirror_.lock();
     if (!mirror) return;
     if (passthrough_) {
+        // The device checked the client's password; the gateway's roles (gateway.auth) still apply to
+        // that user name, so a device without logins of its own is not open to anyone. Packets have no
+        // reply: dropped.
+        if (auto denied = access_.check(session, entry)) {
+            if (!responder.done()) responder.fail(std::move(*denied));
+            return;
+        }
         passthrough_->handle_entry(session, std::move(entry), std::move(responder));
         return;
     }

@@ -178,6 +178,9 @@ demo:
 devices:
   - name: interop
     url: {url}
+  - name: interop_pt
+    url: {url}
+    auth: passthrough
 """.format(work=work, url=dev["url"])
         with open(os.path.join(work, "gateway.yaml"), "w") as f:
             f.write(config)
@@ -232,6 +235,21 @@ devices:
             expect_rr_error(lambda: c.reset(), RR.PermissionDeniedException)
             assert a.p_int32 == B  # nothing changed by the refused writes
         checks.check("rr: permission matrix (property get/set, function, generator) per role", rr_matrix)
+
+        def rr_passthrough_roles():
+            # A passthrough device with no logins of its own admits only clients that send no username
+            # (it refuses a login: "Authentication not enabled"), and the gateway's roles then decide by
+            # user name: anonymous may do nothing (deny by default), so the device is not open to anyone.
+            pt_url = "rr+tcp://127.0.0.1:%d/?service=interop_pt" % port
+            anon = RRN.ConnectService(pt_url)
+            try:
+                expect_rr_error(lambda: anon.p_int32, RR.PermissionDeniedException, "anonymous may not read p_int32")
+                expect_rr_error(lambda: anon.add(1, 1), RR.PermissionDeniedException, "anonymous may not call add")
+            finally:
+                RRN.DisconnectService(anon)
+            expect_rr_error(lambda: RRN.ConnectService(pt_url, "bob", creds(USERS["bob"][0])), RR.AuthenticationException,
+                            "Authentication not enabled")
+        checks.check("rr: auth passthrough device without logins: the gateway's roles still apply", rr_passthrough_roles)
 
         def rr_wires_memory_pipes():
             import numpy as np
