@@ -283,7 +283,11 @@ def main():
         found4 = wait_until("the gateway hears the official node's IPv4 broadcast", v4_node, 20)
         if any("[fe80:" in u for u in found4["urls"]):
             raise Failed("the IPv4-only node came with link-local URLs: %s" % found4["urls"])
-        # The official client in B, listening on IPv4 broadcast only, finds the gateway at its IPv4 URL.
+        # The official client in B, listening on IPv4 broadcast only, finds the gateway at its IPv4 URL. It
+        # may list the gateway's fe80 URL too: its IPv6 socket on [::]:48653 joins no group, but Linux
+        # (IPV6_MULTICAST_ALL, on by default) hands it the FF02::BA86 datagrams that the other official node
+        # in B joined; alone in B it lists only the IPv4 URL. The IPv4 URL itself can only come from our
+        # IPv4 broadcast (receivers reject a URL whose family differs from the datagram's).
         r = run(net.cmd(net.b, [args.python, official_py, "find", "--type", "experimental.create.Create",
                                 "--name", GATEWAY_NAME, "--wait", "4", "--ipv4-only"]), timeout=60)
         res = json.loads(r.stdout.strip().splitlines()[-1])
