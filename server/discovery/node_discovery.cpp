@@ -180,7 +180,9 @@ void NodeDiscovery::open_sockets() {
             joined_scopes_.push_back(scope);
         }
     }
-    if (flags & core::kIpv4Broadcast) {
+    // IPv4 broadcasts are received whatever the flags, as the official node does (its IPv4 listening
+    // socket opens regardless); kIpv4Broadcast decides only whether we send them (send_datagram).
+    {
         bool have_v4 = false;
         for (const auto& s : sockets_) have_v4 |= s->socket.local_endpoint(ec).address().is_v4();
         if (!have_v4) {

@@ -294,6 +294,13 @@ def main():
         gw_urls = [u for n in res["nodes"] if n["nodename"] == GATEWAY_NAME for u in n["urls"]]
         if not any(re.match(r"rr\+tcp://%s:%d[/?]" % (re.escape(IPV4_A), port), u) for u in gw_urls):
             raise Failed("official FindNodeByName over IPv4 broadcast: gateway URLs %s (%s)" % (gw_urls, res))
+        # Our rr discover, with default settings (no IPv4 broadcast sent), still hears IPv4 broadcasts,
+        # as the official node does.
+        r = run(net.cmd(net.a, [args.rr, "discover", "--json", "--timeout", "4"]), timeout=30)
+        listed = [json.loads(line) for line in r.stdout.splitlines() if line.strip()]
+        v4 = [n for n in listed if n["nodeid"] == official4_id]
+        if not v4 or not any(re.match(r"rr\+tcp://%s:29322[/?]" % re.escape(IPV4_B), u) for u in v4[0]["urls"]):
+            raise Failed("rr discover (default flags) did not hear the IPv4-only official node: %s" % r.stdout)
         child_procs.stop(official4)
         log("IPv4 broadcast both ways: ok (%s; official found %s)" % (found4["urls"], gw_urls))
 

@@ -56,6 +56,9 @@ def serve(args):
             setup.tcp_transport.DisableNodeDiscoveryListening()
             setup.tcp_transport.EnableNodeAnnounce(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
             setup.tcp_transport.EnableNodeDiscoveryListening(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
+            # Announce every second (the default is 55 s): a listener that sends no IPv4 requests, such as
+            # rr discover with default settings, hears it within its timeout.
+            setup.tcp_transport.NodeAnnouncePeriod = 1000
         RRN.RegisterServiceType(ROBDEF)
         ctx = RRN.RegisterService("thing", "experimental.discovery_test.Thing", Thing())
         ctx.SetServiceAttributes({"tags": RR.VarValue("fox,arm", "string")})
