@@ -16,6 +16,7 @@ phases=()
 phase_done() { phases+=("$1 $((SECONDS - t_phase)) s"); t_phase=$SECONDS; }
 container_pid=
 tsan_pid=
+fresh_pid=
 finish() {
   local rc=$?
   if [ -n "$container_pid" ]; then kill -- -"$container_pid" 2>/dev/null || true; fi
@@ -94,7 +95,6 @@ if [ -n "$tsan_pid" ]; then tsan_step; fi
 # mmdebstrap, the page's apt-get install, the gateway run as the unit runs it, purge). About 2 minutes,
 # mostly downloads from the Debian mirror: it runs beside the fuzz phase, whose single worker leaves a
 # CPU idle. RR_FRESH_DEBIAN=0 leaves it out; it reports skipped (77) without root or mmdebstrap.
-fresh_pid=
 if [ "${RR_FRESH_DEBIAN:-1}" != 0 ]; then
   RR_FRESH_DEBIAN=1 ctest --preset debug -R '^install: the package on a fresh Debian 12 root' --output-on-failure \
     >build/fresh-debian.log 2>&1 &

@@ -302,8 +302,10 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
     c->request(std::move(entry), [self, mirror, shared, type, endpoint, start](Result<MessageEntry> r) {
         mirror->counters_.observe_latency(std::chrono::steady_clock::now() - start);
         if (!r) {
+            // No answer from the device (its connection dropped, the request timed out): say which device,
+            // as not_connected() does for requests made while it is down.
             mirror->counters_.request_errors.fetch_add(1);
-            shared->fail(r.error());
+            shared->fail(make_error(r.error().type, "device \"" + self->name_ + "\": " + r.error().message));
             return;
         }
         if (r->error != MessageErrorType::None) mirror->counters_.request_errors.fetch_add(1);

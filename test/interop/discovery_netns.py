@@ -39,11 +39,11 @@ sys.path.insert(0, HERE)
 import child_procs  # noqa: E402
 
 SKIP = 77
-OFFICIAL_NAME = "disc_official"
+OFFICIAL_NAME = "disc_official_%d" % os.getpid()  # node names are machine-wide (rr+local)
 GATEWAY_NAME = "disc.gateway"
 THING_TYPE = "experimental.discovery_test.Thing"
 BASE_TYPE = "experimental.discovery_test.Base"
-OFFICIAL4_NAME = "disc_official_v4"
+OFFICIAL4_NAME = "disc_official_v4_%d" % os.getpid()
 IPV4_A, IPV4_B = "10.77.0.1", "10.77.0.2"
 
 
