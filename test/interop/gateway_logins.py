@@ -13,7 +13,8 @@ Checks (each one named in the JSON summary):
             are refused (AuthenticationException); the permission matrix (property get/set, function
             call, generator, event receive) per user, PermissionDenied where the role does not allow;
             the service definition a viewer sees lists every member.
-  json      POST /api/login (cookie: HttpOnly, SameSite=Strict), requests with the cookie, without it
+  json      POST /api/login (cookie: HttpOnly, SameSite=Strict; Secure only over TLS, here through a
+            trusted proxy saying https, never for a client that only claims it), requests with the cookie, without it
             (401), PUT/POST refused by role (403); bearer token; JWT valid / expired / forged / wrong
             audience; the JSON WebSocket logged in by its first message and by the cookie.
   reload    SIGHUP after the password file changed: a removed user is refused (new logins, and the
@@ -152,6 +153,7 @@ gateway:
   port: 0
   listen: 127.0.0.1
   local: false
+  trusted_proxies: [127.0.0.2]   # the "proxy" of the Secure-cookie check (connects from 127.0.0.2)
   auth:
     users: {work}/users.txt
     tokens: {work}/tokens.txt
@@ -342,6 +344,31 @@ devices:
             assert got["bob"] == 3, got
             assert got["carol"] == 0, got  # no read on ev_values: the event does not reach carol
         checks.check("rr: events reach only sessions allowed to read them", rr_events)
+
+        def json_cookie_secure():
+            # The cookie is Secure when the client reached the gateway over TLS: directly (HTTPS), or
+            # through a trusted proxy that says so (X-Forwarded-Proto: https); a client that only claims
+            # it gets no Secure cookie.
+            import http.client
+
+            def login_cookie(source, headers):
+                c = http.client.HTTPConnection("127.0.0.1", port, timeout=20, source_address=(source, 0))
+                try:
+                    c.request("POST", "/api/login", json.dumps({"username": "bob", "password": "bob-pw"}),
+                              dict(headers, **{"Content-Type": "application/json"}))
+                    r = c.getresponse()
+                    r.read()
+                    assert r.status == 200, (source, r.status)
+                    return r.getheader("Set-Cookie", "")
+                finally:
+                    c.close()
+
+            proxied = login_cookie("127.0.0.2", {"X-Forwarded-Proto": "https", "X-Forwarded-For": "10.9.8.7"})
+            assert "Secure" in proxied and "HttpOnly" in proxied, proxied
+            forged = login_cookie("127.0.0.1", {"X-Forwarded-Proto": "https"})
+            assert "rrgw_session=" in forged and "Secure" not in forged, forged
+        checks.check("json: Secure cookie behind a trusted proxy saying https; not for a client only claiming it",
+                     json_cookie_secure)
 
         # ---- JSON API ----
         prop = "/api/devices/interop/properties/p_int32"
