@@ -55,7 +55,8 @@ except ImportError as e:  # pragma: no cover
 RRN = RR.RobotRaconteurNode.s
 
 A, B = -2147483648, 2147483647  # the two p_int32 values rr_interop_service accepts (interop_values.py)
-USERS = {"alice": ("alice-pw", "operator,objectlock"), "bob": ("bob-pw", "viewer"), "carol": ("carol-pw", "adder")}
+USERS = {"alice": ("alice-pw", "operator,objectlock"), "bob": ("bob-pw", "viewer"), "carol": ("carol-pw", "adder"),
+         "erin": ("erin-pw", "writer")}
 TOKEN = "wall-display-token-5d41402abc4b2a76"
 JWT_SECRET = b"an-hs256-secret-of-at-least-32-bytes!!"
 
@@ -167,6 +168,10 @@ gateway:
       viewer:
         - devices: interop
           allow: [read]
+      writer:
+        - devices: [interop]
+          members: w_both
+          allow: [write]
       adder:
         - devices: [interop]
           members: [add, call_callbacks]
@@ -288,6 +293,35 @@ devices:
             ep.Close()
             expect_rr_error(lambda: c.p_echo.Connect(-1), RR.PermissionDeniedException, "may not read p_echo")
         checks.check("rr: wires (connect, OutValue, poke, peek), memory, pipes per role", rr_wires_memory_pipes)
+
+        def rr_write_only():
+            # A write-only session may open a wire and send on it, but what the device sends back (its
+            # InValue) never reaches it; an operator on the same wire gets it.
+            a, e = conns["alice"], conns["erin"]
+            we = e.w_both.Connect()
+            wa = a.w_both.Connect()
+            try:
+                we.OutValue = [1.0, 2.0, 3.0]
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end:
+                    try:
+                        if list(a.w_both.PeekOutValue()[0]) == [1.0, 2.0, 3.0]:
+                            break
+                    except RR.RobotRaconteurException:
+                        pass
+                    time.sleep(0.05)
+                assert list(a.w_both.PeekOutValue()[0]) == [1.0, 2.0, 3.0], "the writer's OutValue did not reach the device"
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and not wa.InValueValid:
+                    time.sleep(0.05)
+                assert wa.InValueValid, "the operator got no InValue (the device's echo)"
+                time.sleep(0.5)
+                assert not we.InValueValid, "a write-only session received the device's InValue"
+                expect_rr_error(lambda: e.w_both.PeekInValue(), RR.PermissionDeniedException, "may not read w_both")
+            finally:
+                we.Close()
+                wa.Close()
+        checks.check("rr: a write-only session sends on a wire but receives nothing on it", rr_write_only)
 
         def rr_callbacks():
             a, c = conns["alice"], conns["carol"]
@@ -507,7 +541,7 @@ devices:
             write_users([("alice", *USERS["alice"]), ("dave", "dave-pw", "operator")])
             mark = os.path.getsize(os.path.join(work, "gateway.err"))
             os.kill(gateway.pid, signal.SIGHUP)
-            wait_log("SIGHUP: logins reloaded: 2 user(s), 1 token(s), JWT HS256, 3 role(s)", mark)
+            wait_log("SIGHUP: logins reloaded: 2 user(s), 1 token(s), JWT HS256, 4 role(s)", mark)
             expect_rr_error(lambda: RRN.ConnectService(url, "bob", creds("bob-pw")), RR.AuthenticationException,
                             "Invalid username or password")
             # bob's session from before: its requests are refused from now on (no user, no roles).
