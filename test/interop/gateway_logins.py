@@ -513,13 +513,23 @@ devices:
             r = ask({"id": 3, "op": "subscribe", "device": "interop", "member": "ev_values"})
             assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
             ws.close()
+            # The same cookie on an upgrade from a page of another site (cross-site WebSocket): refused
+            # by the Origin check before any login is looked at, for both subprotocols.
+            for proto in ("rr-gateway.json.v1", "robotraconteur.robotraconteur.com"):
+                try:
+                    websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=[proto], timeout=20,
+                                                header=["Cookie: " + sid], origin="https://evil.example")
+                    raise AssertionError("a cross-site %s upgrade with the cookie was accepted" % proto)
+                except websocket.WebSocketBadStatusException as e:
+                    assert e.status_code == 403, (proto, e.status_code)
             # A token in the URL is not a login.
             ws = websocket.create_connection("ws://127.0.0.1:%d/?access_token=%s" % (port, TOKEN),
                                              subprotocols=["rr-gateway.json.v1"], timeout=20)
             r = ask({"id": 1, "op": "get", "device": "interop", "member": "p_int32"})
             assert r["error"]["name"] == "RobotRaconteur.AuthenticationError", r
             ws.close()
-        checks.check("json: WebSocket login by first message and by cookie, never by URL token", json_websocket)
+        checks.check("json: WebSocket login by first message and by cookie, never by URL token; cross-site upgrades "
+                     "with the cookie refused", json_websocket)
 
         # ---- brute force (last: it locks this address out) ----
         def wait_log(text, after):
