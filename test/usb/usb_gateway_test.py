@@ -19,6 +19,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 INTEROP = os.path.join(HERE, "..", "interop")
@@ -119,6 +120,39 @@ def main():
         if not isinstance(dist.get("value"), int):
             fail("REST create DistanceTraveled over rr+usb: %r" % dist)
         print("JSON API -> gateway -> rr+usb: webcam Webcams[1].Name, create DistanceTraveled ok", flush=True)
+
+        # The dashboard's path: the JSON WebSocket, a call and a wire subscription on a device behind rr+usb.
+        import json
+        import websocket  # websocket-client
+        ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
+        try:
+            def ask(msg):
+                ws.send(json.dumps(msg))
+                while True:
+                    r = json.loads(ws.recv())
+                    if r.get("id") == msg["id"]:
+                        return r
+            r = ask({"id": 1, "op": "get", "device": "webcam", "member": "Name", "object": "Webcams[0]"})
+            if r.get("result", {}).get("value") != "Left":
+                fail("JSON WebSocket get webcam Webcams[0].Name over rr+usb: %r" % r)
+            r = ask({"id": 2, "op": "call", "device": "create", "member": "Drive", "args": [100, 32767]})
+            if "result" not in r:
+                fail("JSON WebSocket call create.Drive over rr+usb: %r" % r)
+            r = ask({"id": 3, "op": "subscribe", "device": "create", "member": "packets"})
+            if "result" not in r:
+                fail("JSON WebSocket subscribe create.packets over rr+usb: %r" % r)
+            sub = r["result"].get("subscription")
+            t_end = time.monotonic() + 15
+            got = None
+            while time.monotonic() < t_end and got is None:
+                m = json.loads(ws.recv())
+                if m.get("subscription") == sub and m.get("kind") == "wire" and "value" in m:
+                    got = m
+            if got is None:
+                fail("no wire value from create.packets over rr+usb within 15 s")
+        finally:
+            ws.close()
+        print("JSON WebSocket -> gateway -> rr+usb: get, call, wire subscription ok", flush=True)
 
         # The official client through the gateway (rr+tcp) to the discovered USB device.
         from RobotRaconteur.Client import RRN
