@@ -8,7 +8,8 @@
 //       example.usbtest.Bench) plugged in, then the gateway started from CONFIG.yaml (server/app
 //       Gateway::start, the JSON API installed, no demo devices of its own). Prints one JSON line
 //       {"port": N, "device_nodeid": "…", "device_nodename": "usb_demo"} and runs until SIGTERM/SIGINT
-//       or stdin closes; exit status 0 after a clean stop.
+//       or stdin closes; exit status 0 after a clean stop. Lines on stdin: "unplug" takes the device
+//       off the bus, "plug" puts it back (at a new address); each answers "unplugged" / "plugged" on stdout.
 //   rr_usb_fixture rr ARGS…
 //       The device plugged in, then the rr command line ARGS run as rr_main runs them (the CLI's
 //       rr+usb connector installed); exits with rr's status.
@@ -18,6 +19,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <string>
 #include <thread>
 
 #include <poll.h>
@@ -39,6 +41,7 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
+EmulatedDevice* g_device = nullptr;  // the plugged device (nullptr while unplugged)
 
 int usage() {
     std::fprintf(stderr, "usage: rr_usb_fixture gateway CONFIG.yaml | rr ARGS...\n");
@@ -59,6 +62,7 @@ Result<std::unique_ptr<UsbWorld>> device() {
     (*w)->demo = std::move(*d);
     auto plugged = (*w)->plug();
     if (!plugged) return plugged.take_error();
+    g_device = *plugged;
     return w;
 }
 
@@ -81,11 +85,32 @@ int run_gateway(const std::string& config_path) {
     }
     std::cout << "{\"port\": " << (*gw)->port() << ", \"device_nodeid\": \"" << device_node_id().to_string()
               << "\", \"device_nodename\": \"" << kDeviceNodeName << "\"}" << std::endl;
+    std::string line;
+    int next_address = 10;
     while (!g_stop.load()) {
         pollfd p{0, POLLIN, 0};
         if (::poll(&p, 1, 100) > 0) {
             char b[64];
-            if (::read(0, b, sizeof b) <= 0) break;  // stdin closed: the driver is gone
+            const auto n = ::read(0, b, sizeof b);
+            if (n <= 0) break;  // stdin closed: the driver is gone
+            line.append(b, static_cast<std::size_t>(n));
+            for (auto nl = line.find('\n'); nl != std::string::npos; nl = line.find('\n')) {
+                const std::string cmd = line.substr(0, nl);
+                line.erase(0, nl + 1);
+                if (cmd == "unplug" && g_device) {
+                    (*w)->emulator->unplug(g_device);
+                    g_device = nullptr;
+                    std::cout << "unplugged" << std::endl;
+                } else if (cmd == "plug" && !g_device) {
+                    auto d = (*w)->plug(UsbWorld::device_options(static_cast<std::uint8_t>(next_address++)));
+                    if (!d) {
+                        std::fprintf(stderr, "rr_usb_fixture: plug: %s\n", d.error().message.c_str());
+                        return 1;
+                    }
+                    g_device = *d;
+                    std::cout << "plugged" << std::endl;
+                }
+            }
         }
     }
     (*gw)->stop();

@@ -182,6 +182,40 @@ def main():
                             "--webcam", base + "webcam", "--timeout", "150"], timeout=200)
         if r.returncode != 0:
             fail("demo_official_client.py through the gateway to rr+usb: status %d" % r.returncode)
+
+        # Unplug: the configured rr+usb devices go down and say why, requests to them fail with an error
+        # naming the device; re-plug (a new bus address): they come back by themselves and work again.
+        def command(cmd, answer):
+            proc.stdin.write((cmd + "\n").encode())
+            proc.stdin.flush()
+            line = proc.stdout.readline().decode().strip()
+            if line != answer:
+                fail("fixture answered %r to %s" % (line, cmd))
+
+        prop = "/api/devices/create/properties/DistanceTraveled"
+        command("unplug", "unplugged")
+
+        def down():
+            devs = {d["name"]: d for d in get_json(port, "/api/devices")}
+            return devs if all(devs[n]["state"] != "connected" for n in ("create", "webcam")) else None
+
+        devs = wait_for(down, 15, "create and webcam not connected after the unplug")
+        print("after the unplug: create %s (%s)" % (devs["create"]["state"], devs["create"]["reason"]), flush=True)
+        import urllib.error
+        import urllib.request
+        try:
+            urllib.request.urlopen("http://127.0.0.1:%d%s" % (port, prop), timeout=10)
+            fail("GET %s answered while the device was unplugged" % prop)
+        except urllib.error.HTTPError as e:
+            body = e.read().decode()
+            if "create" not in body:
+                fail("GET %s while unplugged: %d %s (does not name the device)" % (prop, e.code, body))
+        command("plug", "plugged")
+        wait_for(all_connected, 60, "create, webcam and usb_usbtest connected again after the re-plug")
+        if not isinstance(get_json(port, prop).get("value"), int):
+            fail("GET %s after the re-plug" % prop)
+        print("unplug: devices down with a reason, requests refused naming the device; re-plug: connected again",
+              flush=True)
     finally:
         if proc.poll() is None:
             try:
