@@ -17,6 +17,7 @@
 // Exits 77 (skipped) when not under umockdev-wrapper.
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -42,6 +43,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 EmulatedDevice* g_device = nullptr;  // the plugged device (nullptr while unplugged)
+EmulatedDeviceOptions g_device_options;  // how it was plugged (a re-plug uses them at a new address)
 
 int usage() {
     std::fprintf(stderr, "usage: rr_usb_fixture gateway CONFIG.yaml | rr ARGS...\n");
@@ -60,7 +62,15 @@ Result<std::unique_ptr<UsbWorld>> device() {
     auto d = server::demo::start_demo_devices(*(*w)->node, demo);
     if (!d) return d.take_error();
     (*w)->demo = std::move(*d);
-    auto plugged = (*w)->plug();
+    // RR_USB_FIXTURE_NO_BOS=1: a board without the RR BOS capability (product 0x0003), found only
+    // through an allow-list entry (usb.allow).
+    auto options = UsbWorld::device_options();
+    if (const char* v = std::getenv("RR_USB_FIXTURE_NO_BOS"); v && std::string(v) == "1") {
+        options.bos_capability = false;
+        options.layout.product_id = 0x0003;
+    }
+    g_device_options = options;
+    auto plugged = (*w)->plug(options);
     if (!plugged) return plugged.take_error();
     g_device = *plugged;
     return w;
@@ -102,7 +112,9 @@ int run_gateway(const std::string& config_path) {
                     g_device = nullptr;
                     std::cout << "unplugged" << std::endl;
                 } else if (cmd == "plug" && !g_device) {
-                    auto d = (*w)->plug(UsbWorld::device_options(static_cast<std::uint8_t>(next_address++)));
+                    auto again = g_device_options;
+                    again.address = static_cast<std::uint8_t>(next_address++);
+                    auto d = (*w)->plug(again);
                     if (!d) {
                         std::fprintf(stderr, "rr_usb_fixture: plug: %s\n", d.error().message.c_str());
                         return 1;
