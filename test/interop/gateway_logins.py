@@ -422,6 +422,7 @@ devices:
             assert expect_status(h.call("GET", "/api/whoami"), 200)[2]["user"] == "bob"
             expect_status(h.call("PUT", prop, {"value": 1}), 403, "RobotRaconteur.PermissionDenied")
             expect_status(h.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 403)
+            expect_status(h.call("POST", "/api/devices/interop/functions/count_up", {"args": [1, 3]}), 403)  # generator
             expect_status(h.call("GET", "/api/devices/interop/wires/w_state"), 200)
             expect_status(h.call("GET", "/api/devices/interop/properties/name?object=child"), 200)  # below the root
             expect_status(h.call("POST", "/api/logout", {}), 200)
@@ -431,6 +432,8 @@ devices:
             expect_status(h2.call("POST", "/api/login", {"username": "alice", "password": "alice-pw"}), 200)
             expect_status(h2.call("PUT", prop, {"value": A}), 200)
             assert expect_status(h2.call("POST", "/api/devices/interop/functions/add", {"args": [1, 2]}), 200)[2]["return"] == 3
+            assert expect_status(h2.call("POST", "/api/devices/interop/functions/count_up", {"args": [1, 3]}),
+                                 200)[2]["items"] == [1, 2, 3]
             # carol: add yes, p_double no
             h3 = Http(base)
             expect_status(h3.call("POST", "/api/login", {"username": "carol", "password": "carol-pw"}), 200)
@@ -499,6 +502,11 @@ devices:
             r = ask({"id": 7, "op": "set_out_value", "subscription": sub, "value": [1.0]})
             assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
             r = ask({"id": 8, "op": "call", "device": "interop", "member": "add", "args": [1, 1]})
+            assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
+            # a pipe: bob may open an endpoint (read) but not send on it (write)
+            r = ask({"id": 9, "op": "subscribe", "device": "interop", "member": "p_unreliable"})
+            assert r.get("result", {}).get("kind") == "pipe", r
+            r = ask({"id": 10, "op": "send", "subscription": r["result"]["subscription"], "value": "hello"})
             assert r["error"]["name"] == "RobotRaconteur.PermissionDenied", r
             ws.close()
             # Logged in by the dashboard's cookie.
