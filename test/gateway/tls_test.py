@@ -72,8 +72,8 @@ def wait_ready_https(port, cafile, cert=None, timeout=30.0):
     raise RuntimeError("gateway not ready over HTTPS within %.0f s" % timeout)
 
 
-def rr_cli(rr, *args, timeout=60):
-    return subprocess.run([rr] + list(args), capture_output=True, text=True, timeout=timeout)
+def rr_cli(rr, *args, timeout=60, env=None):
+    return subprocess.run([rr] + list(args), capture_output=True, text=True, timeout=timeout, env=env)
 
 
 def closed_within(sock, seconds):
@@ -157,6 +157,17 @@ def case_serve(a, checks, tmp):
             expect(p.returncode == 3 and "certificate verify failed" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
 
         checks.run("rr over rrs+tcp not trusting the certificate: connect failure (3)", rr_untrusted)
+
+        def rr_system_store():
+            # Without --tls-ca rr trusts OpenSSL's default store; SSL_CERT_FILE points that store at the
+            # test CA here, as update-ca-certificates would put it in /etc/ssl/certs.
+            for scheme in ("rrs+tcp", "rr+wss"):
+                p = rr_cli(a.rr, "get", "%s://localhost:%d/?service=create" % (scheme, port), "DistanceTraveled",
+                           "--timeout", "10", env=dict(os.environ, SSL_CERT_FILE=ca.cert))
+                expect(p.returncode == 0 and p.stdout.strip().lstrip("-").isdigit(),
+                       "%s: exit %d: %s %s" % (scheme, p.returncode, p.stdout, p.stderr))
+
+        checks.run("rr over rrs+tcp and rr+wss trusting the system store (SSL_CERT_FILE), no --tls-ca", rr_system_store)
 
         def rr_plain():
             p = rr_cli(a.rr, "get", "rr+tcp://127.0.0.1:%d/?service=create" % port, "DistanceTraveled", "--timeout", "10")
