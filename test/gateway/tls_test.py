@@ -169,6 +169,36 @@ def case_serve(a, checks, tmp):
 
         checks.run("rr over rrs+tcp and rr+wss trusting the system store (SSL_CERT_FILE), no --tls-ca", rr_system_store)
 
+        def secure_cookie():
+            # With logins on, the dashboard's session cookie is Secure over the gateway's own HTTPS.
+            import hashlib
+            import http.client
+            users = os.path.join(tmp, "users.txt")
+            with open(users, "w") as f:
+                f.write("ann %s operator\n" % hashlib.md5(b"ann-pw").hexdigest())
+            conf = os.path.join(tmp, "auth.yaml")
+            with open(conf, "w") as f:
+                f.write("gateway:\n  tls: {certificate: %s, private_key: %s}\n  auth:\n    users: %s\n"
+                        "    roles:\n      operator:\n        - allow: [read, write, call]\n" % (server.cert, server.key, users))
+            g2 = gwproc.start_gateway(a.gateway, ["--config", conf, "--no-demo"])
+            try:
+                gwproc.wait_ready(g2.port)
+                c = http.client.HTTPSConnection("127.0.0.1", g2.port, context=ssl.create_default_context(cafile=ca.cert),
+                                                timeout=10)
+                try:
+                    c.request("POST", "/api/login", json.dumps({"username": "ann", "password": "ann-pw"}),
+                              {"Content-Type": "application/json"})
+                    r = c.getresponse()
+                    r.read()
+                    cookie = r.getheader("Set-Cookie", "")
+                    expect(r.status == 200 and "Secure" in cookie and "HttpOnly" in cookie, "%d %r" % (r.status, cookie))
+                finally:
+                    c.close()
+            finally:
+                g2.stop()
+
+        checks.run("with logins on, the session cookie is Secure over the gateway's own HTTPS", secure_cookie)
+
         def rr_plain():
             p = rr_cli(a.rr, "get", "rr+tcp://127.0.0.1:%d/?service=create" % port, "DistanceTraveled", "--timeout", "10")
             expect(p.returncode == 0, "exit %d: %s" % (p.returncode, p.stderr))
