@@ -26,6 +26,16 @@ finish() {
   exit $rc
 }
 trap finish EXIT
+# Waits for a background job (its pid variable already cleared, so the EXIT trap leaves it alone); when
+# it failed, prints the end of its log and what failed, and stops the run.
+await_job() {
+  local pid=$1 log=$2 lines=$3 what=$4
+  if ! wait "$pid"; then
+    tail -n "$lines" "$log"
+    echo "test: FAILED: $what (log $log)"
+    exit 1
+  fi
+}
 
 ./scripts/setup.sh
 phase_done setup
@@ -62,11 +72,7 @@ fi
 tsan_step() {
   local pid=$tsan_pid
   tsan_pid=
-  if ! wait "$pid"; then
-    tail -n 40 build/tsan-build.log
-    echo "test: FAILED: the ThreadSanitizer build (preset tsan, build/tsan; log build/tsan-build.log) did not compile"
-    exit 1
-  fi
+  await_job "$pid" build/tsan-build.log 40 "the ThreadSanitizer build (preset tsan, build/tsan) did not compile"
   phase_done tsan-build-wait
   if ! ctest --preset tsan -j "$jobs" --output-log build/tsan/ctest.log; then
     echo "test: FAILED: the ThreadSanitizer step (ctest --preset tsan; full log build/tsan/ctest.log)"
@@ -110,12 +116,8 @@ fi
 if [ -n "$fresh_pid" ]; then
   pid=$fresh_pid
   fresh_pid=
-  if ! wait "$pid"; then
-    tail -n 40 build/fresh-debian.log
-    echo "test: FAILED: the package on a fresh Debian 12 root (log build/fresh-debian.log)"
-    exit 1
-  fi
-  grep -E '^(ok|SKIP|PASS)' build/fresh-debian.log || true
+  await_job "$pid" build/fresh-debian.log 40 "the package on a fresh Debian 12 root"
+  grep -E 'Test #.*(Passed|Skipped)' build/fresh-debian.log || true
   phase_done fresh-debian-wait
 fi
 
@@ -123,11 +125,7 @@ if [ "${RR_CONTAINER:-1}" != 0 ]; then
   if [ -n "$container_pid" ]; then
     pid=$container_pid
     container_pid=
-    if ! wait "$pid"; then
-      tail -n 60 build/container-build.log
-      echo "test: docker/build.sh failed (build/container-build.log)"
-      exit 1
-    fi
+    await_job "$pid" build/container-build.log 60 "docker/build.sh"
     grep -E '^build: ' build/container-build.log || true
     phase_done container-build-wait
   fi
