@@ -37,23 +37,25 @@ std::string escape_label(std::string_view v) {
     return out;
 }
 
+// What to do about an rr+local setup error: another node holds the NodeName, or the node directories
+// cannot be used (the systemd unit points them at its own folders).
+std::string local_setup_fix(const RRError& e, const std::string& name) {
+    const std::string off = "turn rr+local off (gateway.local: false, --no-local)";
+    if (e.type == MessageErrorType::InvalidOperation)
+        return " (another gateway or node with NodeName \"" + name +
+               "\" runs on this computer: give this gateway another gateway.node_name (--robotraconteur-nodename) or " + off + ")";
+    if (e.message.find("ROBOTRACONTEUR_USER_CONFIG_DIR") != std::string::npos) return " (or " + off + ")";
+    return " (set ROBOTRACONTEUR_USER_CONFIG_DIR and ROBOTRACONTEUR_USER_RUN_DIR to writable folders, as the "
+           "systemd unit does, or " + off + ")";
+}
+
 // The NodeName of a node that will serve rr+local, held for this process, and its NodeID from the
 // NodeID cache (docs/local-transport.md). Errors name the fix.
 Result<std::optional<local::NodeNameReservation>> reserve_local_name(bool local, const std::string& name,
                                                                      const NodeID& configured_id) {
     if (!local || name.empty()) return std::optional<local::NodeNameReservation>();
     auto r = local::reserve_node_name(local::default_node_directories(), name, configured_id);
-    if (!r)
-        return fail(r.error().type, "rr+local: " + r.error().message +
-                                        (r.error().type == MessageErrorType::InvalidOperation
-                                             ? " (another gateway or node with NodeName \"" + name +
-                                                   "\" runs on this computer: give this gateway another gateway.node_name "
-                                                   "(--robotraconteur-nodename) or turn rr+local off (gateway.local: false, --no-local))"
-                                         : r.error().message.find("ROBOTRACONTEUR_USER_CONFIG_DIR") != std::string::npos
-                                             ? " (or turn rr+local off: gateway.local: false, --no-local)"
-                                             : " (set ROBOTRACONTEUR_USER_CONFIG_DIR and ROBOTRACONTEUR_USER_RUN_DIR to "
-                                               "writable folders, as the systemd unit does, or turn rr+local off: "
-                                               "gateway.local: false, --no-local)"));
+    if (!r) return fail(r.error().type, "rr+local: " + r.error().message + local_setup_fix(r.error(), name));
     return std::optional<local::NodeNameReservation>(std::move(*r));
 }
 
