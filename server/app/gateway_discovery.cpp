@@ -99,12 +99,12 @@ bool endpoint_still_known(const core::NodeEntry& node, const std::string& device
 
 void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
     if (!node.services) return;
+    std::vector<std::string> node_urls;
+    for (const auto& u : node.urls) node_urls.push_back(u.url);
     std::vector<Entry> gone;
     {
         std::lock_guard lock(mutex_);
         if (stopped_) return;
-        std::vector<std::string> node_urls;
-        for (const auto& u : node.urls) node_urls.push_back(u.url);
         // Services the node no longer offers (or now offers elsewhere) go away.
         for (auto it = entries_.begin(); it != entries_.end();) {
             if (it->first.first != node.node_id) {
@@ -136,8 +136,6 @@ void DiscoveredDevices::sync_node(const core::NodeEntry& node) {
     {
         std::lock_guard lock(mutex_);
         if (stopped_) return;
-        std::vector<std::string> node_urls;
-        for (const auto& u : node.urls) node_urls.push_back(u.url);
         for (const auto& s : *node.services) {
             if (entries_.count({node.node_id, s.name})) continue;
             for (std::size_t r = 0; r < rules_.size(); ++r) {

@@ -224,14 +224,14 @@ Result<std::string> MirrorService::authenticate_web(std::string_view web_login) 
 void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     auto mirror = mirror_.lock();
     if (!mirror) return;
+    // The gateway's roles (gateway.auth), on shared and passthrough devices alike: a passthrough device
+    // checked the client's password, the roles still apply to that user name, so a device without logins
+    // of its own is not open to anyone. Packets (pipe, wire) have no reply: dropped.
+    if (auto denied = access_.check(session, entry)) {
+        if (!responder.done()) responder.fail(std::move(*denied));
+        return;
+    }
     if (passthrough_) {
-        // The device checked the client's password; the gateway's roles (gateway.auth) still apply to
-        // that user name, so a device without logins of its own is not open to anyone. Packets have no
-        // reply: dropped.
-        if (auto denied = access_.check(session, entry)) {
-            if (!responder.done()) responder.fail(std::move(*denied));
-            return;
-        }
         passthrough_->handle_entry(session, std::move(entry), std::move(responder));
         return;
     }
@@ -241,11 +241,6 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         responder.fail(make_error(MessageErrorType::InvalidOperation,
                                   entry.member_name + " through the gateway needs `auth: passthrough` on device \"" + name_ +
                                       "\" (its clients share one session to the device; docs/security.md)"));
-        return;
-    }
-    if (auto denied = access_.check(session, entry)) {
-        // Packets (pipe, wire) have no reply: dropped.
-        if (!responder.done()) responder.fail(std::move(*denied));
         return;
     }
     switch (entry.entry_type) {
