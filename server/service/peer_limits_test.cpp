@@ -59,15 +59,7 @@ Result<std::shared_ptr<RawClient>> raw_connect(asio::any_io_executor ex, std::ui
     return p.get_future().get();
 }
 
-MessageEntry padded_get(std::size_t padding) {
-    MessageEntry e;
-    e.entry_type = MessageEntryType::PropertyGetReq;
-    e.service_path = "svc";
-    e.member_name = "x";
-    std::vector<std::uint8_t> pad(padding, 0x33);
-    e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
-    return e;
-}
+using testing::padded_get;
 
 }  // namespace
 

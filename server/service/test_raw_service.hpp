@@ -135,5 +135,16 @@ private:
     std::string name_ = "svc";
 };
 
+/// A PropertyGetReq for RawTestService's `x` with `padding` bytes of uint8 array element: a request of
+/// about that size (message-size limit tests).
+inline MessageEntry padded_get(std::size_t padding) {
+    MessageEntry e;
+    e.entry_type = MessageEntryType::PropertyGetReq;
+    e.service_path = "svc";
+    e.member_name = "x";
+    std::vector<std::uint8_t> pad(padding, 0x33);
+    e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
+    return e;
+}
 
 }  // namespace rr::server::testing

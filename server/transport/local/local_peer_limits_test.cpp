@@ -113,14 +113,8 @@ TEST_CASE("local limits: max_message_size is configurable and applies once the s
         return p.get_future().get();
     };
     auto call = [](RawClient& c, std::size_t padding) {
-        MessageEntry e;
-        e.entry_type = MessageEntryType::PropertyGetReq;
-        e.service_path = "svc";
-        e.member_name = "x";
-        std::vector<std::uint8_t> pad(padding, 0x33);
-        e.elements.push_back(make_array_element("padding", std::span<const std::uint8_t>(pad)));
         std::promise<Result<MessageEntry>> p;
-        c.request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
+        c.request(server::testing::padded_get(padding), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
         return p.get_future().get();
     };
     auto c = connect();
