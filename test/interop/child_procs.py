@@ -72,6 +72,21 @@ def stop(proc, wait_s=10):
     return proc.returncode
 
 
+def stop_by_stdin(proc, wait_s=30):
+    """Closes the child's stdin (its sign to stop cleanly), waits up to `wait_s`, then stop(). Returns
+    the exit status."""
+    if proc.poll() is None:
+        try:
+            proc.stdin.close()
+        except OSError:
+            pass
+        try:
+            return proc.wait(wait_s)
+        except subprocess.TimeoutExpired:
+            return stop(proc)
+    return proc.returncode
+
+
 def tail(path, n=20):
     """The last `n` lines of a log file ("" when it cannot be read)."""
     try:

@@ -71,14 +71,7 @@ def run(args, tmp, allow):
                 fail("board without BOS and no allow entry: create is %s (%r)" % (d["state"], d["reason"]))
             print("no usb.allow entry: the board is not taken for an RR device (%s)" % d["reason"], flush=True)
     finally:
-        if proc.poll() is None:
-            proc.stdin.close()
-            try:
-                status = proc.wait(30)
-            except subprocess.TimeoutExpired:
-                status = child_procs.stop(proc)
-        else:
-            status = proc.returncode
+        status = child_procs.stop_by_stdin(proc)
     if status != 0:
         fail("rr_usb_fixture exited with %s\n%s" % (status, child_procs.tail(err_path)))
     return 0

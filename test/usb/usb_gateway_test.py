@@ -217,17 +217,7 @@ def main():
         print("unplug: devices down with a reason, requests refused naming the device; re-plug: connected again",
               flush=True)
     finally:
-        if proc.poll() is None:
-            try:
-                proc.stdin.close()
-            except OSError:
-                pass
-            try:
-                status = proc.wait(30)
-            except subprocess.TimeoutExpired:
-                status = child_procs.stop(proc)
-        else:
-            status = proc.returncode
+        status = child_procs.stop_by_stdin(proc)
     if status != 0:
         fail("rr_usb_fixture exited with %s\n%s" % (status, child_procs.tail(err_path)))
     print("PASS", flush=True)
