@@ -28,6 +28,7 @@
 #include "server/service/pipe_member.hpp"
 #include "server/service/wire_member.hpp"
 #include "server/transport/local/local_listener.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -146,14 +147,13 @@ int main(int argc, char** argv) {
     options.threads = threads;
     auto node = Node::create(options);
     must(node->register_service(service), "register");
+    std::shared_ptr<http::HttpServer> http_server;  // kept for the whole run: the listener holds it weakly
+    TcpListenerOptions tcp;
     if (websocket) {
-        auto http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
-        node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
-                                         std::shared_ptr<const void> hold) {
-            http_server->handle(std::move(socket), std::move(initial), std::move(hold));
-        });
+        http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
+        tcp.http = http::http_handler(http_server);
     }
-    const std::uint16_t bound = must(node->listen_tcp("127.0.0.1", port), "listen");
+    const std::uint16_t bound = must(listen_tcp(node, "127.0.0.1", port, std::move(tcp)), "listen");
     if (local) must(local::listen_local(node), "rr+local");
 
     if (tick_hz > 0) {

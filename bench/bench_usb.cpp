@@ -20,6 +20,7 @@
 #include <libusb.h>
 
 #include "bench/bench_common.hpp"
+#include "server/transport/tcp_listener.hpp"
 #include "test/usb/usb_world.hpp"
 
 using namespace rr;
@@ -111,7 +112,7 @@ int main(int argc, char** argv) {
          "Echo");
     auto service = must(server::ObjectService::create("bench", root), "bench service");
     must(world->node->register_service(service), "register bench");
-    const auto port = must(world->node->listen_tcp("127.0.0.1", 0), "listen");
+    const auto port = must(listen_tcp(world->node, "127.0.0.1", 0), "listen");
 
     auto dev = test::usb::UsbWorld::device_options();
     dev.layout.max_packet_size = packet;

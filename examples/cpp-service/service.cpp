@@ -20,6 +20,7 @@
 #include "server/service/object_service.hpp"
 #include "server/service/service_object.hpp"
 #include "server/service/service_types.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using rr::Result;
 using rr::Value;
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
     options.node_name = "example.counter";
     options.threads = 2;
     auto node = rr::server::Node::create(options);
-    auto bound = node->listen_tcp("127.0.0.1", port);
+    auto bound = listen_tcp(node, "127.0.0.1", port);
     if (!bound) return fail("listen", bound.error());
     auto service = rr::server::ObjectService::create("counter", counter);
     if (!service) return fail("service", service.error());

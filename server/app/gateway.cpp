@@ -16,7 +16,8 @@
 #include "server/discovery/usb_discovery.hpp"
 #include "server/transport/usb/usb_host.hpp"
 #endif
-#include "server/transport/tls/tls_stream.hpp"
+#include "server/transport/tcp_listener.hpp"
+#include "server/transport/tls/tls_listener.hpp"
 
 namespace rr::server::app {
 
@@ -165,7 +166,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         if (!demo_reservation) return demo_reservation.take_error();
         if (*demo_reservation) dopts.node_id = (*demo_reservation)->node_id;
         g->demo_node_ = Node::create(dopts);
-        auto port = g->demo_node_->listen_tcp("127.0.0.1", c.demo_port);
+        auto port = listen_tcp(g->demo_node_, "127.0.0.1", c.demo_port);
         if (!port) return port.take_error();
         if (c.local) {
             if (auto r = serve_local(g->demo_node_, std::move(*demo_reservation)); !r) return r.take_error();
@@ -262,9 +263,11 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             auto n = weak_node.lock();
             return n ? n->service_state_nonce() : std::string();
         };
-        dopts.listen_endpoints = [weak_node] {
-            auto n = weak_node.lock();
-            return n ? n->listen_endpoints() : std::vector<boost::asio::ip::tcp::endpoint>{};
+        // What the announces carry: the gateway's TCP port as bound (set below, before discovery starts).
+        dopts.listen_endpoints = [bound = g->tcp_bound_] {
+            std::vector<boost::asio::ip::tcp::endpoint> out;
+            if (bound->port() != 0) out.push_back(*bound);
+            return out;
         };
         g->discovery_ = discovery::NodeDiscovery::create(g->node_->io_context().get_executor(), dopts);
         std::weak_ptr<discovery::NodeDiscovery> weak_discovery = g->discovery_;
@@ -305,15 +308,6 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         }
         g->discovered_->start();
     }
-    g->node_->set_http_handler([h = g->http_](boost::asio::ip::tcp::socket s, std::vector<std::byte> initial,
-                                                 std::shared_ptr<const void> hold) {
-        h->handle(std::move(s), std::move(initial), std::move(hold));
-    });
-    if (g->tls_)
-        g->node_->set_https_handler([h = g->http_](TlsStream s, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-            h->handle_tls(std::move(s), std::move(initial), std::move(hold));
-        });
-
     for (auto& d : g->devices_) {
         d->set_state_listener([](const gateway::DeviceStatus& s) {
             log(s.state == gateway::DeviceState::connected ? LogLevel::info : LogLevel::warning,
@@ -323,16 +317,28 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         d->start();
     }
 
-    NodeTlsOptions tls;
-    tls.credentials = g->tls_;
-    tls.required = c.tls.required;
-    tls.on_failure = [failures = g->tls_failures_](const std::string& peer, const std::string& reason) {
-        failures->fetch_add(1);
-        log(LogLevel::debug, "TLS from " + peer + ": " + reason);
-    };
-    auto port = g->node_->listen_tcp(c.listen, c.port, std::move(tls));
+    // The gateway's one TCP port: raw RR, HTTP and WebSocket upgrades (server/http), and with
+    // gateway.tls also TLS, rrs+tcp, HTTPS and WSS (server/transport/tls).
+    TcpListenerOptions tcp_opts;
+    tcp_opts.http = http::http_handler(g->http_);
+    if (g->tls_) {
+        auto tls = std::make_shared<TlsListenOptions>();
+        tls->credentials = g->tls_;
+        tls->node_id = g->node_->node_id();
+        tls->node_name = g->node_->node_name();
+        tls->timeout = g->node_->options().first_bytes_timeout;
+        tls->required = c.tls.required;
+        tls->https = http::https_handler(g->http_);
+        tls->on_failure = [failures = g->tls_failures_](const std::string& peer, const std::string& reason) {
+            failures->fetch_add(1);
+            log(LogLevel::debug, "TLS from " + peer + ": " + reason);
+        };
+        tcp_opts.tls = std::move(tls);
+    }
+    auto port = listen_tcp(g->node_, c.listen, c.port, std::move(tcp_opts));
     if (!port) return port.take_error();
     g->port_ = *port;
+    *g->tcp_bound_ = boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address(c.listen), *port);
     if (c.local) {
         if (auto r = serve_local(g->node_, std::move(*reservation)); !r) return r.take_error();
     }

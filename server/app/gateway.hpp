@@ -16,6 +16,7 @@
 #include "server/gateway/json_api.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
+#include "server/transport/tls/tls_context.hpp"
 #include "server/discovery/node_discovery.hpp"
 
 namespace rr::server::app {
@@ -93,6 +94,8 @@ private:
     std::shared_ptr<gateway::auth::GatewayAuth> auth_;  // gateway.auth; null = logins off
     std::shared_ptr<std::atomic<std::uint64_t>> tls_failures_ = std::make_shared<std::atomic<std::uint64_t>>(0);
     std::uint16_t port_ = 0;
+    /// The TCP port as bound (discovery announces it); written once before discovery starts.
+    std::shared_ptr<boost::asio::ip::tcp::endpoint> tcp_bound_ = std::make_shared<boost::asio::ip::tcp::endpoint>();
     std::shared_ptr<discovery::NodeDiscovery> discovery_;
     std::shared_ptr<DiscoveredDevices> discovered_;
     std::shared_ptr<usb::UsbHost> usb_host_;

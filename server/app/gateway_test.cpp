@@ -14,6 +14,7 @@
 #include "server/app/demo_starter.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/local/local_test_support.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -59,7 +60,7 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     REQUIRE(device->register_service(std::make_shared<testing::RawTestService>()));
     // Reserve a port for the device, but start listening only later: the gateway starts not ready.
     auto probe = Node::create(NodeOptions{NodeID(), "probe", 1, {}, 0, 5000ms});
-    const auto port = *probe->listen_tcp("127.0.0.1", 0);
+    const auto port = *listen_tcp(probe, "127.0.0.1", 0);
     probe->shutdown();
 
     GatewayConfig cfg;
@@ -82,7 +83,7 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     CHECK(notready.result() == bhttp::status::service_unavailable);
     CHECK_THAT(notready.body(), Catch::Contains("dev:"));
 
-    REQUIRE(device->listen_tcp("127.0.0.1", port));
+    REQUIRE(listen_tcp(device, "127.0.0.1", port));
     for (int i = 0; i < 300 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
     REQUIRE((*gw)->ready());
     CHECK(http_get(gport, "/readyz").result() == bhttp::status::ok);
@@ -105,7 +106,7 @@ TEST_CASE("gateway health endpoints follow the required devices") {
 
 TEST_CASE("a gateway that cannot listen fails to start and says why") {
     auto holder = Node::create(NodeOptions{NodeID(), "holder", 1, {}, 0, 5000ms});
-    const auto port = *holder->listen_tcp("127.0.0.1", 0);
+    const auto port = *listen_tcp(holder, "127.0.0.1", 0);
     GatewayConfig cfg;
     cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = port;
@@ -129,7 +130,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
 
     auto device = Node::create(NodeOptions{NodeID(), "dev.node", 2, {}, 0, 5000ms});
     REQUIRE(device->register_service(std::make_shared<testing::RawTestService>()));
-    const auto port = *device->listen_tcp("127.0.0.1", 0);
+    const auto port = *listen_tcp(device, "127.0.0.1", 0);
 
     const std::string name = local::testing::unique_node_name("gwtest");
     GatewayConfig cfg;

@@ -7,6 +7,7 @@
 #include "server/cli/cli_commands.hpp"
 #include "server/node/node.hpp"
 #include "server/service/object_service.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::cli;
@@ -33,7 +34,7 @@ struct LoginNode {
         users.add_user("ada", "lovelace");
         service->set_users(std::move(users));
         REQUIRE(node->register_service(service));
-        auto port = node->listen_tcp("127.0.0.1", 0);
+        auto port = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(port);
         url = "rr+tcp://127.0.0.1:" + std::to_string(*port) + "/?service=clitest";
     }

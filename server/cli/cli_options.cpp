@@ -86,7 +86,7 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             flag = a.substr(0, eq);
             value = a.substr(eq + 1);
         } else {
-            static const char* kWithValue[] = {"--timeout", "--username", "--password", "--object",
+            static const char* kWithValue[] = {"--timeout", "--username", "--password", "--token", "--object",
                                                "--count",   "--seconds",  "--tls-ca",   "--http-login",
                                                "--type",    "--interface", "--tls-cert", "--tls-key"};
             bool known = false;
@@ -120,6 +120,8 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.username = value;
         } else if (flag == "--password") {
             cl.password = value;
+        } else if (flag == "--token") {
+            cl.token = value;
         } else if (flag == "--tls-ca") {
             cl.tls_ca_file = value;
         } else if (flag == "--tls-cert") {
@@ -226,6 +228,7 @@ std::string help_text(std::string_view topic) {
         "  --count N            watch: stop after N values\n"
         "  --seconds S          watch: stop after S seconds\n"
         "  --username U --password P   credentials for services that require a login\n"
+        "  --username U --token T      a gateway's bearer token or JWT instead (U: NAME@token, SUB@jwt)\n"
         "  --tls-ca FILE        rr+wss, rrs+tcp: PEM certificates to trust (default: the system's)\n"
         "  --tls-cert FILE --tls-key FILE   TLS: this client's certificate and key (mTLS)\n"
         "  --http-login U:P     rr+ws/rr+wss: login for a reverse proxy (HTTP basic auth)\n"

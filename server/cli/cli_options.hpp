@@ -47,6 +47,7 @@ struct CommandLine {
     std::optional<std::uint64_t> count;  ///< watch: stop after this many values
     std::optional<double> seconds;       ///< watch: stop after this long
     std::string username, password;
+    std::string token;  ///< --token: credentials {"token": …} (a gateway's bearer token or JWT)
     std::string tls_ca_file;           ///< rr+wss, rrs+tcp: PEM certificates to trust ("" = the system's)
     std::string tls_certificate_file;  ///< TLS: own certificate chain (mTLS), "" = none
     std::string tls_private_key_file;  ///< TLS: its private key

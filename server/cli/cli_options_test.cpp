@@ -67,6 +67,11 @@ TEST_CASE("cli: commands and their arguments") {
     CHECK(i->username == "a");
     CHECK(i->password == "b");
     CHECK_FALSE(i->member);
+    auto tk = parse({"get", "u", "p", "--username", "wall@token", "--token", "tok"});
+    REQUIRE(tk);
+    CHECK(tk->username == "wall@token");
+    CHECK(tk->token == "tok");
+    CHECK(tk->password.empty());
 
     auto h = parse({"get", "--help"});
     REQUIRE(h);

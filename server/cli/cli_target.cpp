@@ -61,6 +61,7 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
     options.request_timeout = timeout;
     options.username = cl.username;
     options.password = cl.password;
+    options.token = cl.token;
     options.tls_ca_file = cl.tls_ca_file;
     options.tls_certificate_file = cl.tls_certificate_file;
     options.tls_private_key_file = cl.tls_private_key_file;

@@ -51,6 +51,9 @@ struct ClientOptions {
     NodeID local_node_id;  ///< all-zero: random
     std::string local_node_name;
     std::string username, password;
+    /// A gateway's bearer token or JWT (docs/security.md "Native RR clients"): sent as the credentials
+    /// {"token": token} instead of a password; `username` is then `<name>@token` or `<sub>@jwt`.
+    std::string token;
     bool enable_message4 = true;
     bool enable_string_table = true;
     std::chrono::milliseconds connect_timeout{5000};      ///< TCP connect, with TLS/WebSocket handshakes (wire.md §13)

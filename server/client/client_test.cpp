@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "server/client/client.hpp"
+#include "server/transport/tcp_listener.hpp"
 #include "server/transport/websocket_connector.hpp"
 #include "server/transport/transport_registry.hpp"
 #include "server/http/http_server.hpp"
@@ -31,7 +32,7 @@ struct Fixture {
 
     Fixture() {
         REQUIRE(node->register_service(service));
-        auto p = node->listen_tcp("127.0.0.1", 0);
+        auto p = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(p);
         port = *p;
     }
@@ -205,11 +206,11 @@ TEST_CASE("client: transports are pluggable by URL scheme") {
 TEST_CASE("client: rr+ws is built in, a peer that never answers the upgrade times out") {
     Fixture f;
     auto http_server = std::make_shared<server::http::HttpServer>(f.node, server::http::HttpOptions{});
-    f.node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
-                                         std::shared_ptr<const void> hold) {
-        http_server->handle(std::move(socket), std::move(initial), std::move(hold));
-    });
-    const std::string ws_url = "rr+ws://127.0.0.1:" + std::to_string(f.port) + "/?service=svc";
+    server::TcpListenerOptions tcp;
+    tcp.http = server::http::http_handler(http_server);
+    const auto ws_port = listen_tcp(f.node, "127.0.0.1", 0, std::move(tcp));
+    REQUIRE(ws_port);
+    const std::string ws_url = "rr+ws://127.0.0.1:" + std::to_string(*ws_port) + "/?service=svc";
     auto c = Client::connect(f.io.executor(), ws_url, {});
     INFO((c ? std::string() : c.error().message));
     REQUIRE(c);

@@ -26,6 +26,7 @@
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/node_directories.hpp"
 #include "server/transport/local/node_identity.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -98,7 +99,7 @@ int main(int argc, char** argv) {
         std::cerr << "rr-demo-devices: " << devices.error().message << std::endl;
         return 1;
     }
-    auto bound = node->listen_tcp(listen, port);
+    auto bound = listen_tcp(node, listen, port);
     if (!bound) {
         std::cerr << "rr-demo-devices: " << bound.error().message << std::endl;
         return 1;

@@ -15,6 +15,7 @@
 #include "core/value/pack_value.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/demo/demo_devices.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -154,7 +155,7 @@ struct NodeFixture {
         NodeOptions o;
         o.threads = 2;
         node = Node::create(o);
-        auto p = node->listen_tcp("127.0.0.1", 0);
+        auto p = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(p);
         port = *p;
     }

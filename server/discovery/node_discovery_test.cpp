@@ -15,6 +15,7 @@
 #include "server/node/node.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/discovery/node_discovery.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;
@@ -117,7 +118,7 @@ TEST_CASE("discovery: a flood of distinct NodeIDs keeps the table within its cap
 
 TEST_CASE("discovery: ServiceInfo2 from a node's RobotRaconteurServiceIndex") {
     auto node = server::Node::create({});
-    auto tcp_port = node->listen_tcp("::1", 0);
+    auto tcp_port = listen_tcp(node, "::1", 0);
     REQUIRE(tcp_port);
     client::IoThreads io(2);
     auto d = NodeDiscovery::create(io.executor(), loopback_options());

@@ -165,6 +165,15 @@ void MirrorService::abandon_admission(std::uint32_t endpoint) {
     if (passthrough_) passthrough_->close(endpoint);
 }
 
+void MirrorService::check_passthrough_deliveries() {
+    if (!passthrough_) return;
+    if (!access_.active()) return passthrough_->set_delivery_check({});
+    passthrough_->set_delivery_check([access = access_](const SessionRef& session, const MessageEntry& entry) {
+        const auto op = entry.entry_type == MessageEntryType::CallbackCallReq ? auth::Operation::call : auth::Operation::read;
+        return access.may(session, entry.service_path, entry.member_name, op);
+    });
+}
+
 void MirrorService::stop_passthrough() {
     if (passthrough_) passthrough_->close_all();
 }

@@ -38,7 +38,10 @@ public:
     void abandon_admission(std::uint32_t endpoint) override;
 
     /// auth: passthrough (set once, by DeviceMirror::create, before registration).
-    void set_passthrough(std::shared_ptr<PassthroughSessions> p) { passthrough_ = std::move(p); }
+    void set_passthrough(std::shared_ptr<PassthroughSessions> p) {
+        passthrough_ = std::move(p);
+        check_passthrough_deliveries();
+    }
     const std::shared_ptr<PassthroughSessions>& passthrough() const noexcept { return passthrough_; }
     void stop_passthrough();
     // Logins with the gateway's own users (`auth: gateway`; server/gateway/auth/), when set_access()
@@ -51,7 +54,10 @@ public:
     /// The gateway's users and permissions for this device's clients (docs/security.md): logins and
     /// per-member checks of every request (PermissionDenied), events, pipe packets and callbacks only
     /// to sessions allowed to receive them. Set before the service is registered (not thread-safe).
-    void set_access(auth::MirrorAccess access) { access_ = std::move(access); }
+    void set_access(auth::MirrorAccess access) {
+        access_ = std::move(access);
+        check_passthrough_deliveries();
+    }
 
     // Upstream side, called by DeviceMirror.
     void on_upstream_entry(MessageEntry&& entry);
@@ -129,6 +135,9 @@ private:
     std::weak_ptr<DeviceMirror> mirror_;
     std::shared_ptr<PassthroughSessions> passthrough_;
     auth::MirrorAccess access_;
+    /// With gateway.auth on a passthrough device: the roles apply to what the device sends each client
+    /// (events, wire and pipe packets: read; callback calls: call), as on a shared device.
+    void check_passthrough_deliveries();
     const std::string name_;
     const std::string upstream_service_;
 

@@ -9,6 +9,7 @@
 #include "server/gateway/device_mirror.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -26,7 +27,7 @@ struct Device {
     explicit Device(std::uint16_t want_port = 0) {
         node = Node::create(NodeOptions{NodeID(), "device.node", 2, {}, 0, 5000ms});
         REQUIRE(node->register_service(service));
-        auto p = node->listen_tcp("127.0.0.1", want_port);
+        auto p = listen_tcp(node, "127.0.0.1", want_port);
         REQUIRE(p);
         port = *p;
     }
@@ -48,7 +49,7 @@ struct Gateway {
         REQUIRE(m);
         mirror = *m;
         mirror->start();
-        port = *node->listen_tcp("127.0.0.1", 0);
+        port = *listen_tcp(node, "127.0.0.1", 0);
     }
     ~Gateway() {
         mirror->stop();

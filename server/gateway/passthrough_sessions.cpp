@@ -118,6 +118,7 @@ void PassthroughSessions::admit(std::uint32_t endpoint, std::string username, st
 void PassthroughSessions::attach(const SessionRef& session) {
     std::vector<MessageEntry> early;
     std::shared_ptr<RawClient> client;
+    std::shared_ptr<const DeliveryCheck> check;
     {
         std::lock_guard lock(mutex_);
         auto it = links_.find(session.endpoint());
@@ -126,8 +127,15 @@ void PassthroughSessions::attach(const SessionRef& session) {
         it->second.attached = true;
         early.swap(it->second.early);
         client = it->second.client;
+        check = delivery_check_;
     }
-    for (auto& e : early) deliver(session, client, std::move(e));
+    for (auto& e : early) deliver(session, client, check, std::move(e));
+}
+
+void PassthroughSessions::set_delivery_check(DeliveryCheck check) {
+    auto c = check ? std::make_shared<const DeliveryCheck>(std::move(check)) : nullptr;
+    std::lock_guard lock(mutex_);
+    delivery_check_ = std::move(c);
 }
 
 void PassthroughSessions::attach_api(std::uint32_t endpoint) {
@@ -292,8 +300,10 @@ void PassthroughSessions::note_lock_reply(std::uint32_t endpoint, const std::str
 void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& entry) {
     SessionRef session;
     std::shared_ptr<RawClient> client, api_client;
+    std::shared_ptr<const DeliveryCheck> check;
     {
         std::lock_guard lock(mutex_);
+        check = delivery_check_;
         auto it = links_.find(endpoint);
         if (it == links_.end()) return;
         if (it->second.api) {
@@ -316,13 +326,28 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
         }
         return;
     }
-    deliver(session, client, std::move(entry));
+    deliver(session, client, check, std::move(entry));
 }
 
-void PassthroughSessions::deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry) {
+void PassthroughSessions::deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client,
+                                  const std::shared_ptr<const DeliveryCheck>& check, MessageEntry&& entry) {
     entry.service_path = to_downstream(entry.service_path);
     const auto counters = counters_.lock();
-    switch (entry.entry_type) {
+    const auto type = entry.entry_type;
+    const bool checked = type == MessageEntryType::CallbackCallReq || type == MessageEntryType::WirePacket ||
+                         type == MessageEntryType::EventReq || type == MessageEntryType::PipePacket;
+    if (check && checked && !(*check)(session, entry)) {
+        // The client's roles do not let it receive this: as on a shared device, packets and events are
+        // not sent to it, and the device's callback call gets an error instead of a client's answer.
+        if (type == MessageEntryType::CallbackCallReq && client) {
+            MessageEntry reply_header = reply_to(entry);
+            reply_header.service_path = to_upstream(entry.service_path);
+            client->send(relayed_reply(reply_header, fail(MessageErrorType::PermissionDenied,
+                                                          "the client's role may not call " + entry.member_name + " (gateway.auth)")));
+        }
+        return;
+    }
+    switch (type) {
         case MessageEntryType::CallbackCallReq: {
             // The device calls exactly this client: it is the only one on this upstream session.
             if (counters) counters->callbacks.fetch_add(1);

@@ -90,6 +90,14 @@ public:
     /// A request or packet from a client (Service::handle_entry).
     void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder);
 
+    /// Whether a client's session may receive one of the device's entries (gateway.auth roles, checked
+    /// packet by packet: docs/security.md): asked for events, wire and pipe packets (`read`) and
+    /// callback calls (`call`), with the downstream service path. True: delivered. False: a packet or
+    /// event is dropped (as on a shared device), a callback call is answered with PermissionDenied.
+    using DeliveryCheck = std::function<bool(const SessionRef& session, const MessageEntry& entry)>;
+    /// Sets the check (empty: everything is delivered). Thread-safe.
+    void set_delivery_check(DeliveryCheck check);
+
     std::size_t session_count() const;
     std::vector<DeviceLockInfo> locks() const;
 
@@ -109,7 +117,8 @@ private:
     void forward(std::uint32_t endpoint, const std::shared_ptr<RawClient>& client, MessageEntry&& entry,
                  std::function<void(Result<MessageEntry>)> done);
     void from_device(std::uint32_t endpoint, MessageEntry&& entry);
-    void deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, MessageEntry&& entry);
+    void deliver(const SessionRef& session, const std::shared_ptr<RawClient>& client, const std::shared_ptr<const DeliveryCheck>& check,
+                 MessageEntry&& entry);
     void upstream_closed(std::uint32_t endpoint, const RRError& error);
     void note_lock_reply(std::uint32_t endpoint, const std::string& op, const std::string& path, const MessageEntry& reply);
     void forget_locks_of(std::uint32_t endpoint, const std::string& username);
@@ -127,6 +136,7 @@ private:
     std::map<std::uint32_t, Link> links_;       // admitted (or being admitted: client null)
     std::map<std::uint32_t, std::string> gone_;  // endpoints closed while connecting (value unused)
     std::vector<DeviceLockInfo> locks_;
+    std::shared_ptr<const DeliveryCheck> delivery_check_;  // null: all delivered
     bool closed_ = false;
 };
 

@@ -64,6 +64,14 @@ void HttpServer::handle(tcp::socket socket, std::vector<std::byte> initial, std:
     session->start(std::move(initial), std::move(hold));
 }
 
+HttpHandler http_handler(std::weak_ptr<HttpServer> server) {
+    return [server = std::move(server)](tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+        if (auto s = server.lock()) return s->handle(std::move(socket), std::move(initial), std::move(hold));
+        boost::system::error_code ignored;
+        socket.close(ignored);
+    };
+}
+
 void HttpServer::add_route(bhttp::verb method, std::string path, RouteHandler handler, bool prefix) {
     routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
 }

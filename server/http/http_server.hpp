@@ -28,6 +28,7 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 
+#include "server/transport/tcp_listener.hpp"
 #include "server/transport/tls/tls_stream_fwd.hpp"
 
 namespace rr::server {
@@ -109,10 +110,10 @@ class HttpServer : public std::enable_shared_from_this<HttpServer> {
 public:
     HttpServer(std::weak_ptr<Node> node, HttpOptions options);
 
-    /// Entry point for the node (Node::set_http_handler).
+    /// Entry point for a TCP port's non-RR sockets (TcpListenerOptions::http; see http_handler()).
     /// `hold` is kept alive as long as the connection runs, upgrades included (AcceptedStream::hold).
     void handle(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold = {});
-    /// Entry point for TLS connections (Node::set_https_handler): HTTPS requests and WSS upgrades,
+    /// Entry point for TLS connections (TlsListenOptions::https; see https_handler()): HTTPS requests and WSS upgrades,
     /// served exactly as their plain counterparts (http_server_tls.cpp).
     void handle_tls(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold = {});
 
@@ -150,6 +151,12 @@ private:
 /// A plain response with the given status, content type and body (keep-alive copied from `request`).
 Response make_response(const Request& request, boost::beast::http::status status, std::string body,
                        std::string_view content_type = "text/plain; charset=utf-8");
+
+/// The TcpListenerOptions::http hook that hands a port's non-RR sockets to `server`, held weakly (once
+/// it is gone they are closed).
+HttpHandler http_handler(std::weak_ptr<HttpServer> server);
+/// The TlsListenOptions::https hook, the same for TLS connections that are not RR (HTTPS, WSS).
+HttpsHandler https_handler(std::weak_ptr<HttpServer> server);
 
 }  // namespace http
 }  // namespace rr::server

@@ -15,6 +15,7 @@
 #include "core/session/elements.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -88,11 +89,10 @@ struct Fixture {
                                                          s->send_urgent("reply");
                                                      },
                                                      {}});
-        node->set_http_handler([s = server](tcp::socket sock, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-            s->handle(std::move(sock), std::move(initial), std::move(hold));
-        });
         REQUIRE(node->register_service(std::make_shared<TinyService>()));
-        port = *node->listen_tcp("127.0.0.1", 0);
+        TcpListenerOptions tcp;
+        tcp.http = http_handler(server);
+        port = *listen_tcp(node, "127.0.0.1", 0, std::move(tcp));
     }
     ~Fixture() {
         node->shutdown();

@@ -12,4 +12,12 @@ void HttpServer::handle_tls(TlsStream stream, std::vector<std::byte> initial, st
     session->start(std::move(initial), std::move(hold));
 }
 
+HttpsHandler https_handler(std::weak_ptr<HttpServer> server) {
+    return [server = std::move(server)](TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
+        if (auto s = server.lock()) return s->handle_tls(std::move(stream), std::move(initial), std::move(hold));
+        boost::system::error_code ignored;
+        stream.lowest_layer().close(ignored);
+    };
+}
+
 }  // namespace rr::server::http

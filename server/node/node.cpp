@@ -1,18 +1,14 @@
 #include "server/node/node.hpp"
 
 #include <boost/asio/steady_timer.hpp>
-#include <boost/asio/write.hpp>
 
 #include "robdef/builtin/service_index.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/node/service_index.hpp"
-#include "server/transport/tls/tls_listener.hpp"
-#include "server/transport/tls/tls_stream.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
-using tcp = asio::ip::tcp;
 
 std::shared_ptr<Node> Node::create(NodeOptions options) {
     std::shared_ptr<Node> node(new Node(std::move(options)));
@@ -59,35 +55,6 @@ void Node::shutdown() {
     threads_.clear();
 }
 
-Result<std::uint16_t> Node::listen_tcp(const std::string& address, std::uint16_t port, NodeTlsOptions tls) {
-    TcpListenerOptions opts;
-    opts.first_bytes_timeout = options_.first_bytes_timeout;
-    opts.address_limiter = options_.address_limiter;
-    opts.on_limited = options_.on_limited;
-    std::weak_ptr<Node> weak = weak_from_this();
-    opts.http = [weak](tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-        if (auto node = weak.lock()) node->dispatch_http(std::move(socket), std::move(initial), std::move(hold));
-    };
-    if (tls.credentials) {
-        auto t = std::make_shared<TlsListenOptions>();
-        t->credentials = std::move(tls.credentials);
-        t->node_id = options_.node_id;
-        t->node_name = options_.node_name;
-        t->timeout = options_.first_bytes_timeout;
-        t->https = [weak](TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-            if (auto node = weak.lock()) node->dispatch_https(std::move(stream), std::move(initial), std::move(hold));
-        };
-        t->on_failure = std::move(tls.on_failure);
-        t->required = tls.required;
-        opts.tls = std::move(t);
-    }
-    auto listener = TcpListener::open(io_.get_executor(), address, port, weak, std::move(opts));
-    if (!listener) return listener.take_error();
-    add_listener(*listener);
-    (*listener)->start();
-    return (*listener)->port();
-}
-
 void Node::add_listener(std::shared_ptr<Listener> listener) {
     std::lock_guard lock(mutex_);
     listeners_.push_back(std::move(listener));
@@ -109,48 +76,6 @@ std::string Node::listen_base_url() const {
             if (!urls.empty()) return urls.front();
         }
     return "rr+tcp://127.0.0.1:0/";
-}
-
-void Node::set_http_handler(HttpHandler handler) {
-    std::lock_guard lock(mutex_);
-    http_handler_ = std::move(handler);
-}
-
-void Node::set_https_handler(HttpsHandler handler) {
-    std::lock_guard lock(mutex_);
-    https_handler_ = std::move(handler);
-}
-
-void Node::dispatch_https(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-    HttpsHandler handler;
-    {
-        std::lock_guard lock(mutex_);
-        handler = https_handler_;
-    }
-    if (handler) {
-        handler(std::move(stream), std::move(initial), std::move(hold));
-        return;
-    }
-    boost::system::error_code ignored;
-    stream.lowest_layer().close(ignored);
-}
-
-void Node::dispatch_http(tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold) {
-    HttpHandler handler;
-    {
-        std::lock_guard lock(mutex_);
-        handler = http_handler_;
-    }
-    if (handler) {
-        handler(std::move(socket), std::move(initial), std::move(hold));
-        return;
-    }
-    static constexpr char kNotFound[] = "HTTP/1.1 404 File Not Found\r\nConnection: close\r\nContent-Length: 0\r\n\r\n";
-    auto sock = std::make_shared<tcp::socket>(std::move(socket));
-    asio::async_write(*sock, asio::buffer(kNotFound, sizeof(kNotFound) - 1), [sock](boost::system::error_code, std::size_t) {
-        boost::system::error_code ignored;
-        sock->close(ignored);
-    });
 }
 
 std::shared_ptr<ConnectionLogic> Node::open_connection(const AcceptedStream& stream) {
@@ -207,14 +132,6 @@ void Node::services_changed() {
     }
     for (const auto& l : listeners) l->services_changed(nonce);
     for (const auto& c : callbacks) c();
-}
-
-std::vector<tcp::endpoint> Node::listen_endpoints() const {
-    std::lock_guard lock(mutex_);
-    std::vector<tcp::endpoint> out;
-    for (const auto& l : listeners_)
-        if (auto t = std::dynamic_pointer_cast<TcpListener>(l)) out.push_back(t->local_endpoint());
-    return out;
 }
 
 std::string Node::service_state_nonce() const {

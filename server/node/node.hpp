@@ -15,18 +15,16 @@
 
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/ip/tcp.hpp>
 
 #include "server/node/server_connection.hpp"
 #include "server/node/service.hpp"
 #include "server/node/service_registry.hpp"
-#include "server/transport/tcp_listener.hpp"
-#include "server/transport/tls/tls_context.hpp"
-#include "server/transport/tls/tls_stream_fwd.hpp"
 #include "server/transport/transport.hpp"
 #include "server/transport/transport_registry.hpp"
 
 namespace rr::server {
+
+class AddressLimiter;
 
 struct NodeOptions {
     NodeID node_id;         ///< all-zero: a random NodeID is generated
@@ -48,16 +46,6 @@ struct NodeOptions {
     std::function<void(const std::string& peer)> on_throttled;
 };
 
-/// TLS on a TCP listener (docs/security.md).
-struct NodeTlsOptions {
-    /// nullptr: no TLS on the port.
-    std::shared_ptr<TlsServerCredentials> credentials;
-    /// Refuse plain RR and plain HTTP on the port (STARTTLS and TLS only).
-    bool required = false;
-    /// Told about each failed TLS accept (peer address, reason), e.g. to log it. Optional.
-    std::function<void(const std::string& peer, const std::string& reason)> on_failure;
-};
-
 class Node : public ConnectionSink, public std::enable_shared_from_this<Node> {
 public:
     static std::shared_ptr<Node> create(NodeOptions options = {});
@@ -74,20 +62,14 @@ public:
     /// built-in transports.
     TransportRegistry& transports() noexcept { return transports_; }
 
-    /// Listens for TCP connections (raw RR, and HTTP when an HttpHandler is set) on `address:port`
-    /// (port 0 = ephemeral). With TLS credentials the port also serves RR over TLS, rrs+tcp
-    /// (STARTTLS) and, through the HttpsHandler, HTTPS and WSS. Returns the bound port. Errors:
-    /// InvalidArgument (bad address), IOError with the system message.
-    Result<std::uint16_t> listen_tcp(const std::string& address, std::uint16_t port, NodeTlsOptions tls = {});
-    /// Adds a listener of another transport (opened on io_context() with this node as its sink): it is
-    /// stopped at shutdown and its URLs are reported by listen_urls().
+    /// Adds a listener of any transport (opened on io_context() with this node as its sink: see
+    /// listen_tcp() in server/transport/tcp_listener.hpp, listen_local() in local/local_listener.hpp):
+    /// it is stopped at shutdown and its URLs are reported by listen_urls().
     void add_listener(std::shared_ptr<Listener> listener);
     /// Base URLs of every listener, in the order they were added.
     std::vector<std::string> listen_urls() const;
     /// Base URL for connections whose transport gave none: the first TCP listener's.
     std::string listen_base_url() const;
-    /// TCP endpoints the node listens on, as bound (wildcards not expanded): what discovery announces.
-    std::vector<boost::asio::ip::tcp::endpoint> listen_endpoints() const;
     /// Adds a callback run after every register_service / unregister_service (on that thread, no lock
     /// held), after the ServiceStateNonce was renewed: discovery announces the new one there.
     void on_services_changed(std::function<void()> callback);
@@ -96,11 +78,6 @@ public:
     /// announces and its rr+local entries carry the same value, so clients re-read its services when it
     /// changes, whichever way they found the node. Thread-safe.
     std::string service_state_nonce() const;
-    /// Where TCP sockets starting with anything but `RRAC` go (HTTP; default: answer 404 and close).
-    void set_http_handler(HttpHandler handler);
-    /// Where TLS connections go whose first decrypted bytes are not `RRAC` (HTTPS, WSS; default:
-    /// closed).
-    void set_https_handler(HttpsHandler handler);
 
     /// Registers a service under its name. Errors: InvalidArgument when the name is taken or invalid.
     Result<void> register_service(std::shared_ptr<Service> service);
@@ -135,8 +112,6 @@ public:
 private:
     explicit Node(NodeOptions options);
     void start_threads();
-    void dispatch_http(boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial, std::shared_ptr<const void> hold);
-    void dispatch_https(TlsStream stream, std::vector<std::byte> initial, std::shared_ptr<const void> hold);
     void services_changed();
 
     NodeOptions options_;
@@ -148,8 +123,6 @@ private:
     TransportRegistry transports_;
     mutable std::mutex mutex_;
     std::vector<std::shared_ptr<Listener>> listeners_;
-    HttpHandler http_handler_;
-    HttpsHandler https_handler_;
     std::vector<std::weak_ptr<PumpHandle>> pumps_;  // for shutdown; pruned as connections come and go
     std::shared_ptr<NodeStats> stats_ = std::make_shared<NodeStats>();
     std::vector<std::function<void()>> services_changed_callbacks_;

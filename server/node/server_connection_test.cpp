@@ -12,6 +12,7 @@
 #include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -29,7 +30,7 @@ struct Fixture {
 
     Fixture() {
         REQUIRE(node->register_service(service));
-        auto p = node->listen_tcp("127.0.0.1", 0);
+        auto p = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(p);
         port = *p;
     }

@@ -10,6 +10,7 @@
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;
@@ -55,7 +56,7 @@ std::string str_field(const Structure& s, std::string_view name) {
 TEST_CASE("node: RobotRaconteurServiceIndex lists the registered services with their URLs") {
     auto node = server::Node::create(server::NodeOptions{NodeID(), "indextest.node", 2, {}, 0, 5000ms});
     REQUIRE(node->register_service(std::make_shared<AttributedService>()));
-    auto port = node->listen_tcp("127.0.0.1", 0);
+    auto port = listen_tcp(node, "127.0.0.1", 0);
     REQUIRE(port);
     const std::string base = "rr+tcp://127.0.0.1:" + std::to_string(*port) + "/";
     rr::client::IoThreads io{1};

@@ -21,6 +21,7 @@
 #include "server/service/object_service.hpp"
 #include "server/service/pipe_member.hpp"
 #include "server/service/wire_member.hpp"
+#include "server/transport/tcp_listener.hpp"
 
 namespace rr::server::testing {
 
@@ -194,7 +195,7 @@ struct ServiceFixture {
         if (options.threads == 0) options.threads = 2;
         node = Node::create(std::move(options));
         REQUIRE(node->register_service(service));
-        auto p = node->listen_tcp("127.0.0.1", 0);
+        auto p = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(p);
         port = *p;
     }

@@ -17,6 +17,7 @@
 #include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/tcp_listener.hpp"
 #include "server/transport/test_raw_stream.hpp"
 
 using namespace rr;
@@ -31,7 +32,7 @@ std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> se
     options.threads = 2;
     auto node = Node::create(std::move(options));
     REQUIRE(node->register_service(std::move(service)));
-    auto p = node->listen_tcp("127.0.0.1", 0);
+    auto p = listen_tcp(node, "127.0.0.1", 0);
     REQUIRE(p);
     port = *p;
     return node;

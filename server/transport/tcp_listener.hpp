@@ -82,4 +82,29 @@ private:
     boost::asio::ip::tcp::endpoint bound_;
 };
 
+/// Opens an rr+tcp listener for `node` on `address:port` (port 0 = ephemeral), adds it to the node
+/// (which stops it at shutdown) and starts it. The node's limits apply: NodeOptions::first_bytes_timeout
+/// always, NodeOptions::address_limiter and on_limited unless `options` names its own. Whoever serves
+/// HTTP or TLS on the port passes its handlers in `options` (`http`; `tls`, built with the node's
+/// NodeID and NodeName for the STARTTLS reply). `NodeT`: server::Node, or anything with io_context(),
+/// options(), add_listener() and weak_from_this() as a ConnectionSink. Returns the bound port.
+/// Errors: those of TcpListener::open().
+template <class NodeT>
+Result<std::uint16_t> listen_tcp(const std::shared_ptr<NodeT>& node, const std::string& address, std::uint16_t port,
+                                 TcpListenerOptions options = {}) {
+    if (!node) return fail(MessageErrorType::InvalidArgument, "no node");
+    const auto& node_options = node->options();
+    options.first_bytes_timeout = node_options.first_bytes_timeout;
+    if (!options.address_limiter) {
+        options.address_limiter = node_options.address_limiter;
+        if (!options.on_limited) options.on_limited = node_options.on_limited;
+    }
+    std::weak_ptr<ConnectionSink> sink = node;
+    auto listener = TcpListener::open(node->io_context().get_executor(), address, port, sink, std::move(options));
+    if (!listener) return listener.take_error();
+    node->add_listener(*listener);
+    (*listener)->start();
+    return (*listener)->port();
+}
+
 }  // namespace rr::server

@@ -3,6 +3,10 @@
 ("Folders and their dependencies"). Library sources only: tests (`*_test.cpp`), test fixtures and test
 support files may reach across. Prints each upward include as file:line and exits 1 when there is one.
 
+Also the transport seam (docs/architecture.md "Transports"): the node, the clients, the service framework
+and the gateway's devices name no concrete transport; of server/transport they include only the seam
+itself (SEAM below), and reach TCP, WebSocket, TLS, rr+local and rr+usb through it.
+
 Usage: layering_test.py REPO_ROOT
 """
 import pathlib
@@ -10,6 +14,10 @@ import re
 import sys
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"server/([a-z_]+)/')
+TRANSPORT_INCLUDE = re.compile(r'^\s*#\s*include\s+"server/transport/([^"]+)"')
+# The seam: what transport-neutral folders may include from server/transport.
+SEAM = {"transport.hpp", "transport_registry.hpp", "connection_logic.hpp", "stream_pump.hpp"}
+TRANSPORT_NEUTRAL = {"node", "client", "service", "gateway"}
 LISTED = re.compile(r"^ (server/[a-z_]+|core/)\s")
 
 
@@ -42,6 +50,10 @@ def main():
         if src not in rank:
             continue
         for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1):
+            t = TRANSPORT_INCLUDE.match(line)
+            if t and src in TRANSPORT_NEUTRAL and t.group(1) not in SEAM:
+                bad.append("%s:%d: server/%s names a concrete transport (server/transport/%s); use the seam"
+                           % (p.relative_to(root), n, src, t.group(1)))
             m = INCLUDE.match(line)
             if not m:
                 continue

@@ -2,11 +2,12 @@
 """The gateway's own logins and per-member permissions (`auth: gateway`, docs/security.md), tested
 with the official Python client over raw RR and with plain HTTP / WebSocket clients over the JSON API.
 
-Starts rr_interop_service (the device, no login of its own) and rr-gateway with gateway.auth: a
+Starts rr_interop_service twice (the device without logins of its own, and again with the same
+password file, behind `auth: passthrough`) and rr-gateway with gateway.auth: a
 password file in the official format (alice: operator, bob: viewer, carol: adder), a bearer token file,
 an HS256 JWT key, and roles:
   operator  every member of every device: read, write, call
-  viewer    every member of `interop`: read
+  viewer    every member of `interop` and `interop_ptu`: read
   adder     `add`, `call_callbacks`: call; `p_int32`: read
 Checks (each one named in the JSON summary):
   rr        official client: right password connects; wrong password, unknown user and no credentials
@@ -24,7 +25,7 @@ Checks (each one named in the JSON summary):
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when the official package is missing.
 
-Usage: gateway_logins.py --gateway PATH/rr-gateway --service PATH/rr_interop_service
+Usage: gateway_logins.py --gateway PATH/rr-gateway --service PATH/rr_interop_service --rr PATH/rr
 """
 
 import argparse
@@ -134,6 +135,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--service", required=True)
+    ap.add_argument("--rr", required=True, help="our rr CLI")
     ap.add_argument("--timeout", type=float, default=60)
     args = ap.parse_args()
 
@@ -144,11 +146,15 @@ def main():
     with open(os.path.join(work, "jwt.key"), "wb") as f:
         f.write(JWT_SECRET + b"\n")
 
-    device = gateway = None
+    device = device_users = gateway = None
     checks = Checks()
     try:
         device = start([args.service, "--port", "0"], os.path.join(work, "service.err"))
         dev = read_json_line(device, args.timeout, "rr_interop_service ready line")
+        # The same service with logins of its own (the same password file), for passthrough with roles.
+        device_users = start([args.service, "--port", "0", "--users", os.path.join(work, "users.txt")],
+                             os.path.join(work, "service_users.err"))
+        dev_users = read_json_line(device_users, args.timeout, "rr_interop_service --users ready line")
         config = """
 gateway:
   port: 0
@@ -166,17 +172,17 @@ gateway:
       operator:
         - allow: [read, write, call]
       viewer:
-        - devices: interop
+        - devices: [interop, interop_ptu]
           allow: [read]
       writer:
-        - devices: [interop]
+        - devices: [interop, interop_ptu]
           members: w_both
           allow: [write]
       adder:
-        - devices: [interop]
+        - devices: [interop, interop_ptu]
           members: [add, call_callbacks]
           allow: [call]
-        - devices: [interop]
+        - devices: [interop, interop_ptu]
           members: p_int32
           allow: [read]
     login_limit: {{max_failures: 5, window_s: 60, lockout_s: 60}}
@@ -188,7 +194,12 @@ devices:
   - name: interop_pt
     url: {url}
     auth: passthrough
-""".format(work=work, url=dev["url"])
+  - name: interop_ptu
+    url: {url_users}
+    auth: passthrough
+    username: alice
+    password: alice-pw
+""".format(work=work, url=dev["url"], url_users=dev_users["url"])
         with open(os.path.join(work, "gateway.yaml"), "w") as f:
             f.write(config)
         gateway = start([args.gateway, "--config", os.path.join(work, "gateway.yaml")], os.path.join(work, "gateway.err"))
@@ -220,6 +231,34 @@ devices:
             expect_rr_error(lambda: RRN.ConnectService(url, "mallory", creds("x")), RR.AuthenticationException)
             expect_rr_error(lambda: RRN.ConnectService(url), RR.AuthenticationException)
         checks.check("rr: official client logs in (right / wrong password, unknown user, none)", rr_logins)
+
+        def rr_token_login():
+            # A bearer token in the credentials, with the user name the token logs in as (`<name>@token`):
+            # the token's roles apply (wall: viewer); the token under another user's name, or a wrong
+            # token, is refused.
+            expect_rr_error(lambda: RRN.ConnectService(url, "wall@token", {"token": RR.VarValue(TOKEN + "x", "string")}),
+                            RR.AuthenticationException, "Invalid token")
+            expect_rr_error(lambda: RRN.ConnectService(url, "alice", {"token": RR.VarValue(TOKEN, "string")}),
+                            RR.AuthenticationException, 'this token logs in as user "wall@token"')
+            # (a successful login last: it clears this address's failed-login count for the later checks)
+            t = RRN.ConnectService(url, "wall@token", {"token": RR.VarValue(TOKEN, "string")})
+            try:
+                assert t.p_int32 in (A, B)
+                expect_rr_error(lambda: setattr(t, "p_int32", A), RR.PermissionDeniedException, "may not write p_int32")
+            finally:
+                RRN.DisconnectService(t)
+        checks.check("rr: official client logs in with a bearer token (its roles; wrong name or token refused)",
+                     rr_token_login)
+
+        def cli_token_login():
+            import subprocess
+            run = lambda *extra: subprocess.run([args.rr, "get", url, "p_int32", "--timeout", "10"] + list(extra),
+                                                capture_output=True, text=True, timeout=60)
+            bad = run("--username", "wall@token", "--token", TOKEN + "x")
+            assert bad.returncode == 3 and "Invalid token" in bad.stderr, (bad.returncode, bad.stderr)
+            ok = run("--username", "wall@token", "--token", TOKEN)
+            assert ok.returncode == 0 and ok.stdout.strip() in (str(A), str(B)), (ok.returncode, ok.stdout, ok.stderr)
+        checks.check("rr CLI: --username NAME@token --token T logs in with a bearer token", cli_token_login)
 
         def rr_matrix():
             a, b, c = conns["alice"], conns["bob"], conns["carol"]
@@ -257,6 +296,53 @@ devices:
             expect_rr_error(lambda: RRN.ConnectService(pt_url, "bob", creds(USERS["bob"][0])), RR.AuthenticationException,
                             "Authentication not enabled")
         checks.check("rr: auth passthrough device without logins: the gateway's roles still apply", rr_passthrough_roles)
+
+        def rr_passthrough_packets():
+            # A passthrough device with logins of its own: each client has its own upstream session, so
+            # the device's wire echo, events and pipe packets arrive on that client's session alone. The
+            # gateway's roles still apply to each one: a write-only user's wire echo and events are not
+            # delivered (packet by packet), an operator's are.
+            ptu = "rr+tcp://127.0.0.1:%d/?service=interop_ptu" % port
+            s = {u: RRN.ConnectService(ptu, u, creds(USERS[u][0])) for u in ("alice", "bob", "carol", "erin")}
+            try:
+                wa, we = s["alice"].w_both.Connect(), s["erin"].w_both.Connect()
+                try:
+                    wa.OutValue = [1.0, 2.0, 3.0]
+                    t_end = time.monotonic() + 10
+                    while time.monotonic() < t_end and not wa.InValueValid:
+                        time.sleep(0.05)
+                    assert wa.InValueValid and list(wa.InValue) == [3.0, 2.0, 1.0], "the operator got no echo"
+                    we.OutValue = [4.0, 5.0, 6.0]
+                    t_end = time.monotonic() + 10
+                    while time.monotonic() < t_end and list(s["alice"].w_both.PeekOutValue()[0]) != [4.0, 5.0, 6.0]:
+                        time.sleep(0.05)
+                    assert list(s["alice"].w_both.PeekOutValue()[0]) == [4.0, 5.0, 6.0], "the writer's OutValue did not reach the device"
+                    time.sleep(0.5)
+                    assert not we.InValueValid, "a write-only passthrough session received the device's echo (InValue)"
+                finally:
+                    wa.Close()
+                    we.Close()
+                got = {"alice": 0, "bob": 0, "carol": 0, "erin": 0}
+                lock = threading.Lock()
+
+                def handler(name):
+                    def h(*_a):
+                        with lock:
+                            got[name] += 1
+                    return h
+                for u in got:
+                    s[u].ev_values += handler(u)
+                s["alice"].fire_events(3)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and (got["alice"] < 3 or got["bob"] < 3):
+                    time.sleep(0.05)
+                time.sleep(0.5)
+                assert got == {"alice": 3, "bob": 3, "carol": 0, "erin": 0}, got
+            finally:
+                for c in s.values():
+                    RRN.DisconnectService(c)
+        checks.check("rr: auth passthrough with the device's logins: roles apply to its wire packets and events",
+                     rr_passthrough_packets)
 
         def rr_wires_memory_pipes():
             import numpy as np
@@ -616,6 +702,7 @@ devices:
     finally:
         stop(gateway)
         stop(device)
+        stop(device_users)
         try:
             RRN.Shutdown()
         except Exception:  # noqa: BLE001

@@ -1020,15 +1020,14 @@ int main(int argc, char** argv) {
 
     auto node = Node::create(options);
     must(node->register_service(interop->service), "register");
+    std::shared_ptr<http::HttpServer> http_server;  // kept for the whole run: the listener holds it weakly
+    TcpListenerOptions tcp;
     if (websocket) {
         // RR over WebSocket on the same port; non-browser clients send no Origin and are let in.
-        auto http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
-        node->set_http_handler([http_server](boost::asio::ip::tcp::socket socket, std::vector<std::byte> initial,
-                                         std::shared_ptr<const void> hold) {
-            http_server->handle(std::move(socket), std::move(initial), std::move(hold));
-        });
+        http_server = std::make_shared<http::HttpServer>(node, http::HttpOptions{});
+        tcp.http = http::http_handler(http_server);
     }
-    const std::uint16_t bound = must(node->listen_tcp(listen_all ? "0.0.0.0" : "127.0.0.1", port), "listen");
+    const std::uint16_t bound = must(listen_tcp(node, listen_all ? "0.0.0.0" : "127.0.0.1", port, std::move(tcp)), "listen");
     std::shared_ptr<server::local::LocalListener> local_listener;
     if (local_name || local_by_id) {
         auto l = server::local::listen_local(node, {}, std::move(reservation));

@@ -107,6 +107,9 @@ void GatewayAuth::record_failure(const std::string& address, LoginChannel channe
 
 Result<PrincipalPtr> GatewayAuth::login_rr(std::string_view username, const MessageElement* credentials,
                                            std::string_view peer) {
+    const MessageElement* token = nullptr;
+    if (credentials && credentials->type == DataTypes::dictionary_t) token = credentials->find("token");
+    if (token && token->type == DataTypes::string_t) return login_rr_token(username, read_string(*token), peer);
     const std::string address = address_of(peer);
     if (auto ok = check_limit(address); !ok) return ok.take_error();
     if (auto ok = this->credentials()->users.check(username, credentials); !ok) {
@@ -118,6 +121,23 @@ Result<PrincipalPtr> GatewayAuth::login_rr(std::string_view username, const Mess
     limiter_.succeeded(address);
     counters_.succeeded.fetch_add(1);
     return who;
+}
+
+Result<PrincipalPtr> GatewayAuth::login_rr_token(std::string_view username, std::string_view token, std::string_view peer) {
+    auto who = login_token(token, peer, LoginChannel::rr);
+    if (!who) return who.take_error();
+    // The session's user name says where its roles come from, so a token never takes a password user's.
+    const std::string name = (*who)->name + "@" + (*who)->via;
+    if (username != name)
+        return fail(MessageErrorType::AuthenticationError, "this token logs in as user \"" + name + "\"; connect with that username");
+    remember_token_user(name, *who);
+    return who;
+}
+
+void GatewayAuth::remember_token_user(const std::string& name, PrincipalPtr who) {
+    std::lock_guard lock(mutex_);
+    if (web_principals_.size() >= settings_.max_sessions && !web_principals_.count(name)) web_principals_.clear();  // bounded
+    web_principals_[name] = std::move(who);
 }
 
 Result<PrincipalPtr> GatewayAuth::login_password(std::string_view username, std::string_view password,
@@ -194,9 +214,7 @@ Result<std::string> GatewayAuth::web_rr_user(std::string_view cookie_header) {
     if (!who) return fail(MessageErrorType::AuthenticationError, "Username not provided");
     if (who->via == "password") return who->name;
     std::string name = who->name + "@" + who->via;
-    std::lock_guard lock(mutex_);
-    if (web_principals_.size() >= settings_.max_sessions && !web_principals_.count(name)) web_principals_.clear();  // bounded
-    web_principals_[name] = who;
+    remember_token_user(name, who);
     return name;
 }
 

@@ -6,7 +6,7 @@
 // Once any user, token or JWT key is configured (enabled()), every client of the gateway must log in
 // and every member request is checked against the policy (deny by default). Native RR clients log in
 // with a user of the password file (the same answers as our ObjectService gives: AuthenticationError
-// "Invalid username or password", …); browsers and scripts with a password (POST /api/login, cookie
+// "Invalid username or password", …) or with a bearer token or JWT in their credentials; browsers and scripts with a password (POST /api/login, cookie
 // session), a bearer token or a JWT. Thread-safe.
 #pragma once
 
@@ -94,9 +94,13 @@ public:
     /// needs a restart, so that a truncated file cannot open the gateway to everyone).
     Result<void> reload(GatewayAuthSettings fresh);
 
-    /// RR login (ConnectClientCombined / AuthenticateUser): `credentials` as the client sent it.
-    /// Errors: AuthenticationError (PasswordTable's messages; "Too many failed logins from this
-    /// address; try again in N s" when the address is locked out).
+    /// RR login (ConnectClientCombined / AuthenticateUser): `credentials` as the client sent it. A
+    /// password user sends {"password": string}; a bearer token or JWT is sent as {"token": string}
+    /// with the user name `<name>@token` / `<name>@jwt` (the token's name or the JWT's `sub`), the
+    /// name its session then carries (as web_rr_user() gives out). Errors: AuthenticationError
+    /// (PasswordTable's messages; "Invalid token"; "this token logs in as user \"…\"" for another
+    /// user name; "Too many failed logins from this address; try again in N s" when the address is
+    /// locked out).
     Result<PrincipalPtr> login_rr(std::string_view username, const MessageElement* credentials, std::string_view peer);
     /// Password login over HTTP / the JSON WebSocket. Errors: as login_rr ("Invalid username or password").
     Result<PrincipalPtr> login_password(std::string_view username, std::string_view password, std::string_view peer,
@@ -141,6 +145,9 @@ private:
     Result<void> check_limit(const std::string& address);
     void record_failure(const std::string& address, LoginChannel channel);
     static PrincipalPtr with_policy(Principal p, const Credentials& c);
+    Result<PrincipalPtr> login_rr_token(std::string_view username, std::string_view token, std::string_view peer);
+    /// Makes principal_for_user(name) answer `who` (an RR or web session of a token or JWT login).
+    void remember_token_user(const std::string& name, PrincipalPtr who);
 
     GatewayAuthSettings settings_;  // users, tokens, jwt and policy moved out into credentials_
     std::atomic<std::shared_ptr<const Credentials>> credentials_;

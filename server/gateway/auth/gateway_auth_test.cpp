@@ -198,3 +198,39 @@ TEST_CASE("gateway auth: a reload without users, tokens or key is refused and ch
     CHECK(f.auth->login_password("alice", "alice-pw", "10.0.0.1:1", LoginChannel::http));
     CHECK(f.auth->summary().users == 2);
 }
+
+TEST_CASE("gateway auth: RR logins with a bearer token in the credentials") {
+    Fixture f;
+    auto token_credentials = [](const std::string& token) {
+        rr::MessageElement creds;
+        creds.name = "credentials";
+        creds.type = rr::DataTypes::dictionary_t;
+        creds.elements.push_back(rr::make_string_element("token", token));
+        return creds;
+    };
+    auto good = token_credentials("wall-display-token-0123456789");
+    auto who = f.auth->login_rr("wall@token", &good, "10.0.0.1:1");
+    REQUIRE(who);
+    CHECK((*who)->name == "wall");
+    // The session's user name finds the token's principal (its roles), not a password user's.
+    CHECK(f.auth->principal_for_user("wall@token") == *who);
+    CHECK(f.auth->principal_for_user("wall") == nullptr);
+
+    // The user name must be the one the token logs in as: a token cannot take alice's name and roles.
+    auto as_alice = f.auth->login_rr("alice", &good, "10.0.0.1:1");
+    REQUIRE_FALSE(as_alice);
+    CHECK(as_alice.error().type == rr::MessageErrorType::AuthenticationError);
+    CHECK(as_alice.error().message == "this token logs in as user \"wall@token\"; connect with that username");
+
+    auto bad = token_credentials("wall-display-token-012345678X");
+    auto refused = f.auth->login_rr("wall@token", &bad, "10.0.0.2:1");
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().message == "Invalid token");
+    CHECK(f.auth->counters().failed_rr == 1);
+    // Failed token logins count toward the address's lockout like failed passwords (limit 3 here).
+    CHECK_FALSE(f.auth->login_rr("wall@token", &bad, "10.0.0.2:1"));
+    CHECK_FALSE(f.auth->login_rr("wall@token", &bad, "10.0.0.2:1"));
+    auto locked = f.auth->login_rr("wall@token", &good, "10.0.0.2:1");
+    REQUIRE_FALSE(locked);
+    CHECK(locked.error().message.find("Too many failed logins") != std::string::npos);
+}

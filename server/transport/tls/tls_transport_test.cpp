@@ -20,6 +20,8 @@
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
+#include "server/transport/tcp_listener.hpp"
+#include "server/transport/tls/tls_listener.hpp"
 #include "server/transport/tls/tls_test_support.hpp"
 
 using namespace rr;
@@ -73,17 +75,22 @@ struct TlsNode {
         o.first_bytes_timeout = first_bytes;
         node = Node::create(o);
         REQUIRE(node->register_service(std::make_shared<server::testing::RawTestService>()));
-        NodeTlsOptions tls;
+        TcpListenerOptions tcp;
         if (files) {
             auto c = TlsServerCredentials::load(*files);
             REQUIRE(c);
             creds = *c;
-            tls.credentials = creds;
-            tls.required = required;
+            auto tls = std::make_shared<TlsListenOptions>();
+            tls->credentials = creds;
+            tls->node_id = node->node_id();
+            tls->node_name = node->node_name();
+            tls->timeout = first_bytes;
+            tls->required = required;
             auto f = failures;
-            tls.on_failure = [f](const std::string& peer, const std::string& reason) { f->add(reason); };
+            tls->on_failure = [f](const std::string& peer, const std::string& reason) { f->add(reason); };
+            tcp.tls = std::move(tls);
         }
-        auto p = node->listen_tcp("127.0.0.1", 0, tls);
+        auto p = listen_tcp(node, "127.0.0.1", 0, std::move(tcp));
         REQUIRE(p);
         port = *p;
     }
