@@ -176,7 +176,7 @@ gateway:
           allow: [read]
       writer:
         - devices: [interop, interop_ptu]
-          members: w_both
+          members: [w_both, p_unreliable]
           allow: [write]
       adder:
         - devices: [interop, interop_ptu]
@@ -408,6 +408,42 @@ devices:
                 we.Close()
                 wa.Close()
         checks.check("rr: a write-only session sends on a wire but receives nothing on it", rr_write_only)
+
+        def pipe_packets_forwarded():
+            with urllib.request.urlopen(base + "/metrics", timeout=10) as r:
+                for line in r.read().decode().splitlines():
+                    if line.startswith('rr_gateway_device_pipe_packets_total{device="interop"}'):
+                        return float(line.rsplit(" ", 1)[1])
+            raise AssertionError("no rr_gateway_device_pipe_packets_total for interop in /metrics")
+
+        def rr_write_only_pipe():
+            # The device echoes every p_unreliable packet to the endpoint that sent it. An operator gets
+            # its echo; a write-only session's packet reaches the device (the gateway forwards it: the
+            # pipe packet counter grows) but the echo is not delivered to it.
+            # (AsyncSendPacket: the official library never completes a synchronous SendPacket on an
+            # unreliable pipe; official_client.py "unreliable pipe echo".)
+            a, e = conns["alice"], conns["erin"]
+            pa = a.p_unreliable.Connect(-1)
+            pe = e.p_unreliable.Connect(-1)
+            try:
+                pa.AsyncSendPacket("from alice", lambda *_a: None)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and pa.Available == 0:
+                    time.sleep(0.05)
+                assert pa.Available > 0 and pa.ReceivePacket() == "from alice", "the operator got no echo"
+                before = pipe_packets_forwarded()
+                pe.AsyncSendPacket("from erin", lambda *_a: None)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and pipe_packets_forwarded() < before + 1:
+                    time.sleep(0.05)
+                assert pipe_packets_forwarded() >= before + 1, "the writer's packet was not forwarded"
+                time.sleep(1.0)
+                assert pe.Available == 0, "a write-only session received the device's pipe echo"
+                assert pa.Available == 0, "the writer's echo went to another session's endpoint"
+            finally:
+                pa.Close()
+                pe.Close()
+        checks.check("rr: a write-only session sends pipe packets but receives none", rr_write_only_pipe)
 
         def rr_callbacks():
             a, c = conns["alice"], conns["carol"]
