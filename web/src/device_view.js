@@ -2,6 +2,10 @@
 // session, the members of its root object, the event log and the service definitions. The members are
 // rebuilt on every (re)connect and whenever the gateway reports the device back after a drop, so
 // subscriptions, pipe endpoints and open objects start fresh; what was open is remembered.
+//
+// A device that refuses the session with AuthenticationError (its own logins, through an `auth:
+// passthrough` gateway device) gets a login form instead of retries; the page then connects with the
+// user's credentials, and "Log out of device" closes that session and shows the form again.
 
 import { h, errorText } from "./dom.js";
 import { DeviceSession, deviceUrl } from "./device_session.js";
@@ -9,6 +13,10 @@ import { RobdefOutline } from "./robdef_outline.js";
 import { DefinitionView } from "./definition_view.js";
 import { ObjectPanel } from "./object_panel.js";
 import { EventLog } from "./event_log.js";
+
+// Device logins of this page, by device name: kept in memory only (never in localStorage,
+// sessionStorage or cookies), so that switching between devices does not ask again; a reload forgets them.
+const deviceLogins = new Map();
 
 export class DeviceView {
   constructor(root, name, list) {
@@ -21,6 +29,11 @@ export class DeviceView {
     this.sessionBadge = h("span", { class: "badge", dataset: { state: "connecting" }, text: "connecting" });
     this.typeEl = h("code", { class: "object-type" });
     this.banner = h("div", { class: "device-error", role: "alert", hidden: true });
+    this.loginForm = this.makeLoginForm();
+    this.userName = h("span", { class: "device-user-name" });
+    this.userBox = h("span", { class: "device-user", hidden: true },
+      h("span", { class: "state-label", text: "device user" }), this.userName,
+      h("button", { type: "button", class: "small device-logout", text: "Log out of device", onclick: () => this.logout() }));
     this.members = h("div", { class: "device-members" });
     const logBox = h("section", { class: "side-section event-section" }, h("h3", { text: "Event log" }));
     this.defBox = h("section", { class: "side-section definition-section" }, h("h3", { text: "Service definition" }));
@@ -28,9 +41,9 @@ export class DeviceView {
       h("header", { class: "device-header" },
         h("h2", { text: name }), this.typeEl,
         h("span", { class: "state-label", text: "gateway → device" }), this.gatewayBadge,
-        h("span", { class: "state-label", text: "this page → gateway" }), this.sessionBadge),
+        h("span", { class: "state-label", text: "this page → gateway" }), this.sessionBadge, this.userBox),
       this.banner,
-      h("div", { class: "device-body" }, this.members, h("aside", { class: "device-side" }, logBox, this.defBox)));
+      h("div", { class: "device-body" }, h("div", { class: "device-main" }, this.loginForm.el, this.members), h("aside", { class: "device-side" }, logBox, this.defBox)));
     root.append(this.el);
     this.log = new EventLog(logBox);
 
@@ -38,9 +51,47 @@ export class DeviceView {
     list.addEventListener("update", this.onDevices);
     this.deviceUpdate(list.device(name));
 
-    this.session = new DeviceSession(deviceUrl(name));
+    this.session = new DeviceSession(deviceUrl(name), { credentials: deviceLogins.get(name) ?? null });
     this.session.addEventListener("state", (ev) => this.sessionUpdate(ev.detail));
     this.session.start();
+  }
+
+  /** The form asking for the device's own login: user, password, "Log in", the device's error. */
+  makeLoginForm() {
+    const username = h("input", { name: "username", autocomplete: "username", required: true });
+    const password = h("input", { name: "password", type: "password", autocomplete: "current-password", required: true });
+    const submit = h("button", { type: "submit", class: "device-login-submit", text: "Log in" });
+    const error = h("p", { class: "device-login-error", role: "alert", hidden: true });
+    const el = h("form", { class: "device-login", hidden: true, onsubmit: (ev) => {
+      ev.preventDefault();
+      submit.disabled = true;
+      error.hidden = true;
+      this.session.login(username.value, password.value);
+    } },
+    h("h3", { text: `Log in to ${this.name}` }),
+    h("p", { class: "hint", text: "This device has logins of its own; the gateway passes yours on to it. Kept in this page's memory only." }),
+    h("label", {}, h("span", { text: "User" }), username),
+    h("label", {}, h("span", { text: "Password" }), password),
+    submit, error);
+    return { el, username, password, submit, error };
+  }
+
+  /** Shows the login form with the device's refusal (none after a logout). */
+  showLogin(error) {
+    const f = this.loginForm;
+    f.el.hidden = false;
+    f.submit.disabled = false;
+    f.error.textContent = error ? errorText(error) : "";
+    f.error.hidden = !error;
+    f.password.value = "";
+    if (!f.username.value && this.session.username) f.username.value = this.session.username;
+    (f.username.value ? f.password : f.username).focus();
+  }
+
+  logout() {
+    deviceLogins.delete(this.name);
+    this.log.add("session", "", `logged out of ${this.name}`);
+    this.session.logout();
   }
 
   showBanner(text) {
@@ -70,10 +121,25 @@ export class DeviceView {
   sessionUpdate({ state, client, error, attempt }) {
     this.sessionBadge.dataset.state = state;
     this.sessionBadge.textContent = state === "connecting" && attempt > 1 ? `reconnecting (${attempt})` : state;
+    // The form stays up while its login connects; any other state takes it away.
+    if (state !== "login" && state !== "connecting") this.loginForm.el.hidden = true;
+    this.userBox.hidden = !(state === "connected" && this.session.username);
+    if (state === "login") {
+      this.client = null;
+      this.clear();
+      this.showBanner("");
+      this.sessionBadge.textContent = "login required";
+      deviceLogins.delete(this.name);
+      this.showLogin(error);
+      if (error) this.log.add("error", "", errorText(error));
+      return;
+    }
     if (state === "connected") {
       this.client = client;
+      if (this.session.username) deviceLogins.set(this.name, this.session.credentials);
+      this.userName.textContent = this.session.username ?? "";
       this.showBanner("");
-      this.log.add("session", "", `connected to ${this.session.url}`);
+      this.log.add("session", "", `connected to ${this.session.url}${this.session.username ? ` as ${this.session.username}` : ""}`);
       this.render(client);
     } else if (state === "closed") {
       this.client = null;
