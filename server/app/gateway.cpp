@@ -7,6 +7,9 @@
 #include <sstream>
 #include <thread>
 
+#include <openssl/crypto.h>
+#include <openssl/rand.h>
+
 #include "server/app/gateway_discovery.hpp"
 #include "server/app/log.hpp"
 #include "server/common/token_bucket.hpp"
@@ -66,6 +69,25 @@ Result<void> serve_local(const std::shared_ptr<Node>& node, std::optional<local:
     log(LogLevel::info, "rr+local: " + (*l)->url() +
                             (node->node_name().empty() ? std::string() : " (rr+local:///?nodename=" + node->node_name() + ")"));
     return {};
+}
+
+// The demo node's one user while gateway.auth is on (docs/security.md "The demo node").
+constexpr std::string_view kDemoUser = "rr-gateway-demo";
+
+// A password for the demo node's user: 32 bytes from OpenSSL's CSPRNG as hex, drawn anew at each start
+// and never written anywhere. No fallback: without randomness the gateway does not start.
+Result<std::string> random_demo_password() {
+    unsigned char raw[32];
+    if (RAND_bytes(raw, sizeof raw) != 1)
+        return fail(MessageErrorType::InternalError, "demo devices: no random bytes for the demo node's login (OpenSSL RAND_bytes)");
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    for (unsigned char b : raw) {
+        out += kHex[b >> 4];
+        out += kHex[b & 15];
+    }
+    OPENSSL_cleanse(raw, sizeof raw);
+    return out;
 }
 
 // Warnings about a limit that bites, at most a burst of 5 then 1 per second: a flood of refused
@@ -156,6 +178,12 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
 #endif
     }
 
+    // gateway.auth: the gateway's own users and permissions (auth: gateway), before any device exists
+    // (the demo node's login depends on it).
+    auto auth = load_gateway_auth(c.auth);
+    if (!auth) return auth.take_error();
+    g->auth_ = *auth;
+
     std::vector<gateway::DeviceConfig> devices = c.devices;
     if (c.demo) {
         if (!demo) return fail(MessageErrorType::InvalidConfiguration, "demo devices are not built into this binary");
@@ -171,8 +199,25 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         if (c.local) {
             if (auto r = serve_local(g->demo_node_, std::move(*demo_reservation)); !r) return r.take_error();
         }
-        auto demo_devices = demo(g->demo_node_, *port);
+        // With logins on, the demo node must not be a way around them: its port and rr+local socket are
+        // open to every process on this computer, so its services require a login only this process
+        // knows, and the gateway's own sessions to the demo devices use it.
+        DemoLogin login;
+        if (g->auth_) {
+            auto password = random_demo_password();
+            if (!password) return password.take_error();
+            login = DemoLogin{std::string(kDemoUser), std::move(*password)};
+        }
+        auto demo_devices = demo(g->demo_node_, *port, login);
         if (!demo_devices) return demo_devices.take_error();
+        if (login.required()) {
+            for (const auto& name : g->demo_node_->service_names()) {
+                auto service = g->demo_node_->find_service(name);
+                if (service && !service->requires_authentication())
+                    return fail(MessageErrorType::InternalError,
+                                "demo service \"" + name + "\" does not require a login while gateway.auth is on");
+            }
+        }
         for (auto& d : *demo_devices) {
             // A configured device of the same name wins over the demo one.
             bool taken = false;
@@ -180,11 +225,6 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             if (!taken) devices.push_back(std::move(d));
         }
     }
-
-    // gateway.auth: the gateway's own users and permissions (auth: gateway), before any device exists.
-    auto auth = load_gateway_auth(c.auth);
-    if (!auth) return auth.take_error();
-    g->auth_ = *auth;
 
     for (const auto& d : devices) {
         auto m = gateway::DeviceMirror::create(g->node_, d);

@@ -1,7 +1,8 @@
 // The assembled gateway: the gateway node (RR + HTTP + WebSocket on one port), one DeviceMirror per
 // configured device, the embedded demo devices on their own node (reached over rr+tcp on loopback, so
-// the default path is the real path), health endpoints and the JSON API. Transports for the devices:
-// the node's TransportRegistry, plus rr+usb (a UsbHost) when the configuration needs it (usb_wanted).
+// the default path is the real path; behind a per-process login while gateway.auth is on), health
+// endpoints and the JSON API. Transports for the devices: the node's TransportRegistry, plus rr+usb
+// (a UsbHost) when the configuration needs it (usb_wanted).
 // Discovery (when on) is fed by UDP, by the rr+local node directories and by the USB devices.
 #pragma once
 
@@ -21,9 +22,19 @@
 
 namespace rr::server::app {
 
-/// Starts demo devices on `demo_node` (already listening on `port`) and returns how to reach them.
-using DemoStarter = std::function<Result<std::vector<gateway::DeviceConfig>>(const std::shared_ptr<Node>& demo_node,
-                                                                             std::uint16_t port)>;
+/// The login the demo node's services require while gateway.auth is on: one user with a password drawn
+/// at random when the gateway starts, known only to this process (docs/security.md "The demo node").
+/// Empty `username`: no login (gateway.auth off; the demo node stays open as documented).
+struct DemoLogin {
+    std::string username, password;
+    bool required() const noexcept { return !username.empty(); }
+};
+
+/// Starts demo devices on `demo_node` (already listening on `port`) and returns how to reach them. When
+/// `login.required()`, every service it registers must require that login (Gateway::start refuses to
+/// start otherwise) and the returned devices must log in with it.
+using DemoStarter = std::function<Result<std::vector<gateway::DeviceConfig>>(
+    const std::shared_ptr<Node>& demo_node, std::uint16_t port, const DemoLogin& login)>;
 /// Adds routes and subprotocols (the JSON API) once the devices exist, and returns the JsonApi it
 /// installed (or nullptr), so that discovered devices and the discovery routes reach it
 /// (gateway::install_json_api is one).

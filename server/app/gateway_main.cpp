@@ -110,8 +110,8 @@ int main(int argc, char** argv) {
     set_log_level(log_level_from_string(config.log_level));
     if (LogFormat f; log_format_from_string(config.log_format, f)) set_log_format(f);
 
-    DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port) {
-        return rr::server::app::start_demo_devices_for_gateway(*node, port);
+    DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port, const DemoLogin& login) {
+        return rr::server::app::start_demo_devices_for_gateway(*node, port, login);
     };
     auto gateway = Gateway::start(config, demo, rr::server::gateway::install_json_api);
     if (!gateway) {

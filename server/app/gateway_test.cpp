@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include <boost/beast/core.hpp>
@@ -12,6 +13,8 @@
 #include "server/app/gateway.hpp"
 #include "server/client/client.hpp"
 #include "server/app/demo_starter.hpp"
+#include "server/gateway/json_api_installer.hpp"
+#include "server/service/password_table.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/local/local_test_support.hpp"
 #include "server/transport/tcp_listener.hpp"
@@ -51,6 +54,26 @@ bhttp::response<bhttp::string_body> http_head(std::uint16_t port, const std::str
     parser.skip(true);
     bhttp::read(s, b, parser);
     return parser.release();
+}
+
+bhttp::response<bhttp::string_body> http_get_bearer(std::uint16_t port, const std::string& target, const std::string& token) {
+    boost::asio::io_context io;
+    beast::tcp_stream s(io);
+    s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+    bhttp::request<bhttp::string_body> req{bhttp::verb::get, target, 11};
+    req.set(bhttp::field::host, "localhost");
+    req.set(bhttp::field::authorization, "Bearer " + token);
+    bhttp::write(s, req);
+    beast::flat_buffer b;
+    bhttp::response<bhttp::string_body> res;
+    bhttp::read(s, b, res);
+    return res;
+}
+
+DemoStarter demo_starter() {
+    return [](const std::shared_ptr<Node>& node, std::uint16_t demo_port, const DemoLogin& login) {
+        return app::start_demo_devices_for_gateway(*node, demo_port, login);
+    };
 }
 
 }  // namespace
@@ -143,9 +166,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     d.name = "dev";
     d.url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
     cfg.devices.push_back(d);
-    DemoStarter demo = [](const std::shared_ptr<Node>& node, std::uint16_t demo_port) {
-        return app::start_demo_devices_for_gateway(*node, demo_port);
-    };
+    DemoStarter demo = demo_starter();
     auto gw = Gateway::start(cfg, demo);
     REQUIRE(gw);
     for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
@@ -205,4 +226,121 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     CHECK_FALSE(client::Client::connect(io.executor(), "rr+local:///?nodename=" + name + ".demo&service=create"));
     (*quiet)->stop();
     device->shutdown();
+}
+
+TEST_CASE("gateway: with gateway.auth the demo node requires a login only the gateway knows") {
+    const auto dir = std::filesystem::temp_directory_path() / ("rr_gw_demo_login_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string token = "demo-login-test-token-0123456789";
+    {
+        std::ofstream(dir / "users.txt") << "alice " << PasswordTable::md5_hex("alice-pw") << " operator\n";
+        std::ofstream(dir / "tokens.txt") << token << " wall operator\n";
+    }
+    GatewayConfig cfg;
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer (rr+local: demo_node_logins.py)
+    cfg.port = 0;
+    cfg.listen = "127.0.0.1";
+    cfg.demo = true;
+    cfg.auth.users = (dir / "users.txt").string();
+    cfg.auth.tokens = (dir / "tokens.txt").string();
+    cfg.auth.roles.push_back({"operator", {GatewayAuthConfig::Rule{{"*"}, {"*"}, true, true, true}}});
+
+    auto gw = Gateway::start(cfg, demo_starter(), gateway::install_json_api);
+    INFO((gw ? std::string() : gw.error().message));
+    REQUIRE(gw);
+    // Ready: the gateway's own sessions logged in to the demo devices.
+    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*gw)->ready());
+
+    auto create = (*gw)->device("create");
+    REQUIRE(create);
+    const auto login = create->config();
+    CHECK(login.username == "rr-gateway-demo");
+    REQUIRE(login.password.size() == 64);
+    CHECK(login.password.find_first_not_of("0123456789abcdef") == std::string::npos);
+    REQUIRE((*gw)->device("webcam"));
+    CHECK((*gw)->device("webcam")->config().password == login.password);
+    for (const auto& name : (*gw)->demo_node()->service_names()) {
+        INFO(name);
+        CHECK((*gw)->demo_node()->find_service(name)->requires_authentication());
+    }
+
+    client::IoThreads io(1);
+    // Straight to the demo node: no credentials, a made-up password, a gateway user's password.
+    for (const auto& [user, password] : {std::pair<std::string, std::string>{"", ""},
+                                         {"rr-gateway-demo", std::string(64, 'a')},
+                                         {"alice", "alice-pw"}}) {
+        INFO("user \"" << user << "\"");
+        client::ClientOptions o;
+        o.username = user;
+        o.password = password;
+        auto c = client::Client::connect(io.executor(), login.url, o);
+        REQUIRE_FALSE(c);
+        CHECK(c.error().type == MessageErrorType::AuthenticationError);
+        CHECK(c.error().message.find(login.password) == std::string::npos);
+    }
+    // (The right one works: the refusals above are the login's, not an unreachable node's.)
+    {
+        client::ClientOptions o;
+        o.username = login.username;
+        o.password = login.password;
+        auto c = client::Client::connect(io.executor(), login.url, o);
+        INFO((c ? std::string() : c.error().message));
+        REQUIRE(c);
+        CHECK((*c)->close_wait().ok());
+    }
+
+    // Through the gateway: a gateway user reads a demo device's property.
+    {
+        client::ClientOptions o;
+        o.username = "alice";
+        o.password = "alice-pw";
+        auto c = client::Client::connect(io.executor(), "rr+tcp://127.0.0.1:" + std::to_string((*gw)->port()) + "/?service=create", o);
+        INFO((c ? std::string() : c.error().message));
+        REQUIRE(c);
+        auto d = (*c)->root().get("DistanceTraveled");
+        INFO((d ? std::string() : d.error().message));
+        CHECK(d);
+        CHECK((*c)->close_wait().ok());
+    }
+
+    // The JSON API works on the demo devices, and no answer carries the demo node's password.
+    for (const std::string target : {"/api/devices", "/api/devices/create", "/api/devices/create/properties/DistanceTraveled",
+                                     "/metrics"}) {
+        INFO(target);
+        auto res = http_get_bearer((*gw)->port(), target, token);
+        CHECK(res.result() == bhttp::status::ok);
+        CHECK(res.body().find(login.password) == std::string::npos);
+    }
+
+    // A second gateway draws another password.
+    auto other = Gateway::start(cfg, demo_starter());
+    REQUIRE(other);
+    CHECK((*other)->device("create")->config().password != login.password);
+    (*other)->stop();
+
+    // A demo starter that leaves its services open while logins are on: the gateway does not start.
+    DemoStarter careless = [](const std::shared_ptr<Node>& node, std::uint16_t demo_port, const DemoLogin&) {
+        return app::start_demo_devices_for_gateway(*node, demo_port);
+    };
+    auto refused = Gateway::start(cfg, careless);
+    REQUIRE_FALSE(refused);
+    CHECK_THAT(refused.error().message, Catch::Contains("does not require a login while gateway.auth is on"));
+
+    // Without gateway.auth nothing changes: the demo node stays open (documented).
+    cfg.auth = GatewayAuthConfig{};
+    auto open = Gateway::start(cfg, demo_starter());
+    REQUIRE(open);
+    CHECK((*open)->device("create")->config().username.empty());
+    CHECK((*open)->device("create")->config().password.empty());
+    for (int i = 0; i < 500 && !(*open)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*open)->ready());
+    auto anon = client::Client::connect(io.executor(), (*open)->device("create")->config().url);
+    INFO((anon ? std::string() : anon.error().message));
+    REQUIRE(anon);
+    CHECK((*anon)->close_wait().ok());
+    (*open)->stop();
+
+    (*gw)->stop();
+    std::filesystem::remove_all(dir);
 }

@@ -35,6 +35,10 @@ Result<DemoDevices> make_demo_devices(const DemoOptions& options) {
     auto ws = ObjectService::create(options.webcam_service, d.webcam->object());
     if (!ws) return ws.take_error();
     d.webcam_service = *ws;
+    if (!options.users.empty()) {
+        d.create_service->set_users(options.users);
+        d.webcam_service->set_users(options.users);
+    }
     return d;
 }
 

@@ -12,6 +12,7 @@
 #include "server/demo/webcam_device.hpp"
 #include "server/node/node.hpp"
 #include "server/service/object_service.hpp"
+#include "server/service/password_table.hpp"
 
 namespace rr::server::demo {
 
@@ -20,6 +21,9 @@ struct DemoOptions {
     WebcamOptions webcam;
     std::string create_service = "create";
     std::string webcam_service = "webcam";
+    /// Non-empty: both services require a login against these users (ObjectService::set_users), as
+    /// rr-gateway's demo node does while gateway.auth is on. Empty: anyone may connect.
+    PasswordTable users;
 };
 
 struct DemoDevices {

@@ -31,7 +31,7 @@ TEST_CASE("json socket: requests to a device are answered while its pipe streams
     cfg.demo = true;
     cfg.threads = 2;
     std::shared_ptr<JsonSocketServer> sockets;
-    auto g = app::Gateway::start(cfg, [](const std::shared_ptr<Node>& node, std::uint16_t port) { return app::start_demo_devices_for_gateway(*node, port); }, [&](http::HttpServer& http, const auto& devices, std::shared_ptr<auth::GatewayAuth>) {
+    auto g = app::Gateway::start(cfg, [](const std::shared_ptr<Node>& node, std::uint16_t port, const app::DemoLogin& login) { return app::start_demo_devices_for_gateway(*node, port, login); }, [&](http::HttpServer& http, const auto& devices, std::shared_ptr<auth::GatewayAuth>) {
         auto api = std::make_shared<JsonApi>(devices);
         sockets = install_json_socket(http, api);
         return api;

@@ -54,11 +54,13 @@ GatewayHarness* start() {
     server::demo::DemoOptions demo;
     demo.webcam.width = 16;
     demo.webcam.height = 12;
-    server::app::DemoStarter starter = [demo](const std::shared_ptr<server::Node>& node, std::uint16_t port)
+    server::app::DemoStarter starter = [demo](const std::shared_ptr<server::Node>& node, std::uint16_t port,
+                                              const server::app::DemoLogin& login)
         -> Result<std::vector<server::gateway::DeviceConfig>> {
-        auto devices = server::demo::start_demo_devices(*node, demo);
+        const auto options = server::app::demo_options_with_login(demo, login);
+        auto devices = server::demo::start_demo_devices(*node, options);
         if (!devices) return devices.take_error();
-        return server::app::demo_device_configs(port, demo);
+        return server::app::demo_device_configs(port, options, login);
     };
     auto g = server::app::Gateway::start(
         config, starter,
