@@ -314,8 +314,7 @@ void DeviceMirror::request(MessageEntry entry, std::function<void(Result<Message
     p->request(session, std::move(entry), std::move(done));
 }
 
-void DeviceMirror::open_api_session(std::string username, std::string password,
-                                    std::function<void(Result<std::uint32_t>)> done) {
+void DeviceMirror::open_api_session(std::string username, std::string password, std::function<void(Result<ApiSession>)> done) {
     const auto& p = service_->passthrough();
     auto node = node_.lock();
     if (!p || !node) {
@@ -330,17 +329,44 @@ void DeviceMirror::open_api_session(std::string username, std::string password,
     credentials.name = "credentials";
     credentials.type = DataTypes::dictionary_t;
     credentials.elements.push_back(make_string_element("password", password));
+    std::weak_ptr<PassthroughSessions> weak_p = p;
+    SessionEndpoints::Upstream upstream;
+    upstream.request = [weak_p, session](MessageEntry e, std::function<void(Result<MessageEntry>)> k) {
+        if (auto ps = weak_p.lock())
+            ps->request(session, std::move(e), std::move(k));
+        else
+            k(fail(MessageErrorType::ConnectionError, "gateway device stopped"));
+    };
+    upstream.send = [weak_p, session](MessageEntry e) -> Result<void> {
+        auto ps = weak_p.lock();
+        if (!ps) return fail(MessageErrorType::ConnectionError, "gateway device stopped");
+        return ps->send(session, std::move(e));
+    };
+    upstream.queued_bytes = [weak_p, session]() -> std::size_t {
+        auto ps = weak_p.lock();
+        return ps ? ps->queued_bytes(session) : 0;
+    };
+    auto endpoints = std::make_shared<SessionEndpoints>(std::move(upstream));
     std::weak_ptr<DeviceMirror> weak = weak_from_this();
-    p->admit(session, std::move(username), std::move(credentials), [weak, p, session, done = std::move(done)](Result<void> r) {
-        if (!r) {
-            if (auto self = weak.lock())
-                if (auto n = self->node_.lock()) n->release_endpoint(session);
-            done(r.take_error());
-            return;
-        }
-        p->attach_api(session);
-        done(session);
-    });
+    p->admit(session, std::move(username), std::move(credentials),
+             [weak, p, session, endpoints, done = std::move(done)](Result<void> r) {
+                 if (!r) {
+                     if (auto self = weak.lock())
+                         if (auto n = self->node_.lock()) n->release_endpoint(session);
+                     done(r.take_error());
+                     return;
+                 }
+                 std::weak_ptr<SessionEndpoints> weak_endpoints = endpoints;
+                 PassthroughSessions::ApiHandlers handlers;
+                 handlers.on_entry = [weak_endpoints](MessageEntry&& e) {
+                     if (auto ep = weak_endpoints.lock()) ep->deliver(std::move(e));
+                 };
+                 handlers.on_lost = [weak_endpoints](const RRError& error) {
+                     if (auto ep = weak_endpoints.lock()) ep->lost(error);
+                 };
+                 p->attach_api(session, std::move(handlers));
+                 done(ApiSession{session, endpoints});
+             });
 }
 
 void DeviceMirror::close_api_session(std::uint32_t session) {

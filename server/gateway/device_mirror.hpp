@@ -26,6 +26,7 @@
 #include "core/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/gateway/passthrough_sessions.hpp"
+#include "server/gateway/session_endpoints.hpp"
 #include "server/gateway/shared_entry.hpp"
 #include "server/node/service.hpp"
 
@@ -116,12 +117,18 @@ public:
     /// The same on a JSON API client's own session (open_api_session); `session` 0 = the shared one.
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session);
 
+    /// A JSON API client's own session to a passthrough device: its id for request() and
+    /// close_api_session(), and its event, wire and pipe subscriptions.
+    struct ApiSession {
+        std::uint32_t id = 0;
+        std::shared_ptr<SessionEndpoints> endpoints;
+    };
     /// auth: passthrough: opens an upstream session of the device's own, logged in as `username` with
     /// {"password": password}, for a JSON API client (the `device_login` op, docs/json-api.md); it counts
-    /// against max_passthrough_sessions. `done` gets its id for request() / close_api_session(), or the
-    /// error: InvalidOperation on a shared device, the device's own (AuthenticationError …),
-    /// ConnectionError, BufferLimitViolation over the session limit.
-    void open_api_session(std::string username, std::string password, std::function<void(Result<std::uint32_t>)> done);
+    /// against max_passthrough_sessions. `done` gets the session, or the error: InvalidOperation on a
+    /// shared device, the device's own (AuthenticationError …), ConnectionError, BufferLimitViolation
+    /// over the session limit.
+    void open_api_session(std::string username, std::string password, std::function<void(Result<ApiSession>)> done);
     /// Closes it (the device releases its client locks and monitors). Unknown ids are ignored.
     void close_api_session(std::uint32_t session);
     /// Subscribes the gateway itself to a wire or event (JSON API): `on_entry` gets upstream WirePacket /

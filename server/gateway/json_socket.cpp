@@ -87,9 +87,8 @@ public:
             timer_.cancel();
         }
         for (auto& [sid, s] : subs)
-            if (s.mirror_known) unsubscribe_upstream(s.kind, *s.target, s.mirror_id);
-        for (auto& [name, l] : logins)
-            if (auto d = l.device.lock()) d->close_api_session(l.session);
+            if (s.mirror_known && !s.own) unsubscribe_upstream(s);  // those on a device_login end with its session
+        for (auto& [name, l] : logins) end_device_login(l);
     }
 
     void push_device_state(const DeviceStatus& status) {
@@ -122,13 +121,15 @@ private:
         std::weak_ptr<DeviceMirror> device;
         std::uint32_t session = 0;
         std::string username;
+        std::shared_ptr<SessionEndpoints> endpoints;  // the subscriptions made on that session
     };
 
     struct Subscription {
         SubKind kind = SubKind::event;
         bool may_write = true;  // auth: gateway allows `write` on the member
         std::shared_ptr<const MemberTarget> target;  // shared: every push takes it, copying no strings
-        std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, or internal pipe id
+        std::shared_ptr<SessionEndpoints> own;  // made on this socket's device_login session; null: the shared one
+        std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, internal pipe id, or `own`'s id
         bool mirror_known = false;
         bool active = false;  // subscribe answered: pushes may go
         bool failed = false;  // subscribe failed before mirror_id was known
@@ -351,7 +352,7 @@ private:
         std::string password = p == msg.end() ? std::string() : p->get<std::string>();
         auto self = shared_from_this();
         std::weak_ptr<DeviceMirror> weak_device = device;
-        device->open_api_session(username, std::move(password), [self, id, name, username, weak_device](Result<std::uint32_t> r) {
+        device->open_api_session(username, std::move(password), [self, id, name, username, weak_device](Result<DeviceMirror::ApiSession> r) {
             if (!r) {
                 self->send_reply(id, ApiResult::failed(device_error(r.error())));
                 return self->end_request();
@@ -364,13 +365,12 @@ private:
                     keep = false;
                 } else {
                     if (auto it = self->device_logins_.find(name); it != self->device_logins_.end()) replaced = it->second;
-                    self->device_logins_[name] = DeviceLogin{weak_device, *r, username};
+                    self->device_logins_[name] = DeviceLogin{weak_device, r->id, username, r->endpoints};
                 }
             }
-            auto device = weak_device.lock();
-            if (device && replaced) device->close_api_session(replaced->session);
+            if (replaced) self->end_device_login(*replaced, "a new device_login to \"" + name + "\" replaced the session it was made on");
             if (!keep) {
-                if (device) device->close_api_session(*r);
+                self->end_device_login(DeviceLogin{weak_device, r->id, username, r->endpoints});
                 return self->end_request();
             }
             self->send_reply(id, ApiResult::ok(nlohmann::json{{"device", name}, {"username", username}}));
@@ -393,8 +393,36 @@ private:
         }
         if (!login)
             return send_reply(id, ApiResult::failed(bad_request("this socket has no device_login for \"" + d->get<std::string>() + "\"")));
-        if (auto device = login->device.lock()) device->close_api_session(login->session);
+        end_device_login(*login, "device_logout ended the session it was made on");
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
+    }
+
+    // Closes a device login's session; its subscriptions end, each with a "closed" push naming `why`
+    // (none when the socket itself is closing: `why` empty).
+    void end_device_login(const DeviceLogin& login, const std::string& why = {}) {
+        std::vector<std::uint64_t> ended;
+        {
+            std::lock_guard lock(mutex_);
+            for (auto it = subs_.begin(); it != subs_.end();) {
+                if (it->second.own != login.endpoints) {
+                    ++it;
+                    continue;
+                }
+                if (it->second.active && !closed_ && !why.empty()) ended.push_back(it->first);
+                it = subs_.erase(it);
+            }
+            for (auto sid : ended)
+                send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"},
+                                         {"error", error_object(api_error(503, MessageErrorType::OperationAborted, why))}});
+        }
+        if (login.endpoints) login.endpoints->forget();
+        if (auto device = login.device.lock()) device->close_api_session(login.session);
+    }
+
+    std::shared_ptr<SessionEndpoints> own_endpoints(std::string_view device) const {
+        // Under mutex_.
+        auto it = device_logins_.find(device);
+        return it == device_logins_.end() ? nullptr : it->second.endpoints;
     }
 
     void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write) {
@@ -411,6 +439,7 @@ private:
                 return end_request();
         }
         std::uint64_t sid = 0;
+        std::shared_ptr<SessionEndpoints> own;
         {
             std::lock_guard lock(mutex_);
             if (closed_) {
@@ -429,31 +458,28 @@ private:
             s.kind = kind;
             s.may_write = may_write;
             s.target = std::make_shared<const MemberTarget>(t);
+            s.own = own_endpoints(t.device->config().name);
+            own = s.own;
             subs_.emplace(sid, std::move(s));
         }
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        if (own) return start_own_subscription(id, sid, kind, t, own);
 
         if (kind == SubKind::pipe) {
-            MirrorService::InternalPipeHandlers h;
-            h.on_packet = [weak, sid](const MessageElement& packet, std::uint32_t) {
-                if (auto s = weak.lock()) s->on_pipe_packet(sid, packet);
-            };
-            h.on_ack = [weak, sid](std::uint32_t number) {
-                if (auto s = weak.lock()) s->on_pipe_ack(sid, number);
-            };
-            h.on_closed = [weak, sid](const RRError& reason) {
-                if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
-            };
             auto svc = t.device->mirror_service();
             const bool unreliable = robdef::pipe_is_unreliable(*t.object, *t.member);
-            svc->open_internal_pipe(t.path, t.member->name, unreliable, std::move(h),
-                                    [weak, sid, id, svc](Result<std::uint64_t> r) {
+            std::weak_ptr<MirrorService> weak_svc = svc;
+            svc->open_internal_pipe(t.path, t.member->name, unreliable, pipe_handlers(sid),
+                                    [weak, sid, id, weak_svc](Result<std::uint64_t> r) {
+                                        auto close = [weak_svc](std::uint64_t pipe) {
+                                            if (auto svc = weak_svc.lock()) svc->close_internal_pipe(pipe);
+                                        };
                                         auto s = weak.lock();
                                         if (!s) {
-                                            if (r) svc->close_internal_pipe(*r);
+                                            if (r) close(*r);
                                             return;
                                         }
-                                        s->pipe_opened(sid, id, std::move(r), svc);
+                                        s->endpoint_opened(sid, id, std::move(r), close);
                                     });
             return;
         }
@@ -520,9 +546,70 @@ private:
         if (flush) flush_wires();
     }
 
-    void pipe_opened(std::uint64_t sid, const nlohmann::json& id, Result<std::uint64_t> r,
-                     const std::shared_ptr<MirrorService>& svc) {
+    PipeEndpointHandlers pipe_handlers(std::uint64_t sid) {
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        PipeEndpointHandlers h;
+        h.on_packet = [weak, sid](const MessageElement& packet, std::uint32_t) {
+            if (auto s = weak.lock()) s->on_pipe_packet(sid, packet);
+        };
+        h.on_ack = [weak, sid](std::uint32_t number) {
+            if (auto s = weak.lock()) s->on_pipe_ack(sid, number);
+        };
+        h.on_closed = [weak, sid](const RRError& reason) {
+            if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
+        };
+        return h;
+    }
+
+    // A subscription on this socket's own session to a passthrough device (device_login): the
+    // device's privileges and locks for that user apply to what it receives and sends.
+    void start_own_subscription(const nlohmann::json& id, std::uint64_t sid, SubKind kind, const MemberTarget& t,
+                                const std::shared_ptr<SessionEndpoints>& own) {
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        std::weak_ptr<SessionEndpoints> weak_own = own;
+        auto opened = [weak, sid, id, weak_own, kind](Result<std::uint64_t> r) {
+            auto close = [weak_own, kind](std::uint64_t x) {
+                auto o = weak_own.lock();
+                if (!o) return;
+                if (kind == SubKind::pipe)
+                    o->close_pipe(x);
+                else
+                    o->unsubscribe(x);
+            };
+            auto s = weak.lock();
+            if (!s) {
+                if (r) close(*r);
+                return;
+            }
+            s->endpoint_opened(sid, id, std::move(r), close);
+        };
+        if (kind == SubKind::pipe) {
+            own->open_pipe(t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), pipe_handlers(sid),
+                           std::move(opened));
+            return;
+        }
+        const bool is_wire = kind == SubKind::wire;
+        SubscriptionHandlers h;
+        h.on_entry = [weak, sid, is_wire](const SharedEntryPtr& e) {
+            auto s = weak.lock();
+            if (!s) return;
+            if (is_wire)
+                s->on_wire(sid, e);
+            else
+                s->on_event(sid, e);
+        };
+        h.on_closed = [weak, sid](const RRError& reason) {
+            if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
+        };
+        own->subscribe(t.path, t.member->name, is_wire, std::move(h), std::move(opened));
+    }
+
+    // A pipe endpoint (either session) or an own-session subscription answered: `close` undoes it
+    // when the subscription ended meanwhile.
+    void endpoint_opened(std::uint64_t sid, const nlohmann::json& id, Result<std::uint64_t> r,
+                         const std::function<void(std::uint64_t)>& close) {
         std::optional<std::uint64_t> orphan;
+        bool flush = false;
         {
             std::lock_guard lock(mutex_);
             if (in_flight_) --in_flight_;
@@ -536,18 +623,27 @@ private:
             } else {
                 it->second.mirror_id = *r;
                 it->second.mirror_known = true;
-                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", "pipe"}}));
+                // Under the lock: the reply is queued before any push of this subscription.
+                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(it->second.kind)}}));
                 it->second.active = true;
+                flush = it->second.pending_wire != nullptr;
             }
         }
-        if (orphan) svc->close_internal_pipe(*orphan);
+        if (orphan) close(*orphan);
+        if (flush) flush_wires();
     }
 
-    void unsubscribe_upstream(SubKind kind, const MemberTarget& t, std::uint64_t mirror_id) {
-        if (kind == SubKind::pipe)
-            t.device->mirror_service()->close_internal_pipe(mirror_id);
-        else
-            t.device->unsubscribe(mirror_id);
+    void unsubscribe_upstream(const Subscription& s) {
+        if (s.own) {
+            if (s.kind == SubKind::pipe)
+                s.own->close_pipe(s.mirror_id);
+            else
+                s.own->unsubscribe(s.mirror_id);
+        } else if (s.kind == SubKind::pipe) {
+            s.target->device->mirror_service()->close_internal_pipe(s.mirror_id);
+        } else {
+            s.target->device->unsubscribe(s.mirror_id);
+        }
     }
 
     void unsubscribe(const nlohmann::json& id, std::uint64_t sid) {
@@ -561,12 +657,13 @@ private:
             }
         }
         if (!sub) return send_reply(id, ApiResult::failed(bad_request("no subscription " + std::to_string(sid))));
-        if (sub->mirror_known) unsubscribe_upstream(sub->kind, *sub->target, sub->mirror_id);
+        if (sub->mirror_known) unsubscribe_upstream(*sub);
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
 
     // Finds an active subscription of `kind` and copies its target.
-    std::optional<ApiError> find_active(std::uint64_t sid, SubKind kind, MemberTarget& t, std::uint64_t& mirror_id) {
+    std::optional<ApiError> find_active(std::uint64_t sid, SubKind kind, MemberTarget& t, std::uint64_t& mirror_id,
+                                        std::shared_ptr<SessionEndpoints>& own) {
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
         if (it == subs_.end() || !it->second.active) return bad_request("no subscription " + std::to_string(sid));
@@ -575,6 +672,7 @@ private:
                                " subscription, not " + robdef::with_article(kind_name(kind)));
         t = *it->second.target;
         mirror_id = it->second.mirror_id;
+        own = it->second.own;
         return std::nullopt;
     }
 
@@ -587,7 +685,8 @@ private:
     void set_out_value(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value) {
         MemberTarget t;
         std::uint64_t mid = 0;
-        if (auto e = find_active(sid, SubKind::wire, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        std::shared_ptr<SessionEndpoints> own;
+        if (auto e = find_active(sid, SubKind::wire, t, mid, own)) return send_reply(id, ApiResult::failed(*e));
         if (!may_write(sid)) {
             if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
             return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
@@ -599,18 +698,24 @@ private:
         ApiError error;
         auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
         if (!packet) return send_reply(id, ApiResult::failed(error));
-        auto client = t.device->upstream();
-        if (!client)
-            return send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::ConnectionError,
-                                                              "device \"" + t.device->config().name + "\" is not connected")));
         // A client's OutValue is the device's InValue (wire.md §6.7: WirePacket, newest wins).
         MessageEntry e;
         e.entry_type = MessageEntryType::WirePacket;
-        e.service_path = t.device->mirror_service()->to_upstream(t.path);
         e.member_name = t.member->name;
         e.metadata = "unreliable\n";
         e.elements.push_back(pack_timespec(wall_clock_timespec(), "packettime"));
         e.elements.push_back(std::move(*packet));
+        if (own) {
+            e.service_path = t.path;
+            auto sent = own->send_wire_packet(std::move(e));
+            if (!sent) return send_reply(id, ApiResult::failed(device_error(sent.error())));
+            return send_reply(id, ApiResult::ok(nlohmann::json::object()));
+        }
+        auto client = t.device->upstream();
+        if (!client)
+            return send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::ConnectionError,
+                                                              "device \"" + t.device->config().name + "\" is not connected")));
+        e.service_path = t.device->mirror_service()->to_upstream(t.path);
         client->send(std::move(e));
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
@@ -618,7 +723,8 @@ private:
     void send_packet(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value, bool request_ack) {
         MemberTarget t;
         std::uint64_t mid = 0;
-        if (auto e = find_active(sid, SubKind::pipe, t, mid)) return send_reply(id, ApiResult::failed(*e));
+        std::shared_ptr<SessionEndpoints> own;
+        if (auto e = find_active(sid, SubKind::pipe, t, mid, own)) return send_reply(id, ApiResult::failed(*e));
         if (!may_write(sid)) {
             if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
             return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
@@ -630,7 +736,8 @@ private:
         ApiError error;
         auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
         if (!packet) return send_reply(id, ApiResult::failed(error));
-        auto n = t.device->mirror_service()->send_internal_pipe_packet(mid, std::move(*packet), request_ack);
+        auto n = own ? own->send_pipe_packet(mid, std::move(*packet), request_ack)
+                     : t.device->mirror_service()->send_internal_pipe_packet(mid, std::move(*packet), request_ack);
         if (!n) return send_reply(id, ApiResult::failed(device_error(n.error())));
         send_reply(id, ApiResult::ok(nlohmann::json{{"packetnumber", *n}}));
     }

@@ -1,11 +1,10 @@
 #include "server/gateway/mirror_service.hpp"
 
-#include <charconv>
-
 #include "core/message/error_entry.hpp"
 #include "core/names/service_path.hpp"
 #include "core/session/elements.hpp"
 #include "robdef/parser.hpp"
+#include "server/gateway/pipe_entries.hpp"
 
 namespace rr::server::gateway {
 namespace {
@@ -41,19 +40,6 @@ void deliver(const Subs& subs, const SharedEntryPtr& entry) {
 
 RRError not_connected(const std::string& device) {
     return make_error(MessageErrorType::ConnectionError, "device \"" + device + "\" is not connected");
-}
-
-std::optional<std::int32_t> parse_index(std::string_view s) {
-    std::int32_t v = 0;
-    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || p != s.data() + s.size()) return std::nullopt;
-    return v;
-}
-
-std::int32_t element_index(const MessageEntry& e) {
-    std::int32_t idx = -1;
-    if (const auto* el = e.find("index")) read_scalar(*el, idx);
-    return idx;
 }
 
 void set_index(MessageEntry& e, std::int32_t idx) {
@@ -196,12 +182,7 @@ void MirrorService::drop_session_state(std::uint32_t endpoint) {
                 continue;
             }
             const auto& [ep, path, member, d] = it->first;
-            MessageEntry e;
-            e.entry_type = MessageEntryType::PipeDisconnectReq;
-            e.service_path = to_upstream(path);
-            e.member_name = member;
-            e.elements.push_back(make_scalar_element<std::int32_t>("index", it->second));
-            to_device.push_back(std::move(e));
+            to_device.push_back(pipe_disconnect_request(to_upstream(path), member, it->second));
             pipes_by_upstream_.erase({path, member, it->second});
             it = pipes_by_downstream_.erase(it);
         }
@@ -268,7 +249,7 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
             return;
         }
         case MessageEntryType::GeneratorNextReq: {
-            std::int32_t idx = element_index(entry);
+            std::int32_t idx = entry_pipe_index(entry);
             bool owned;
             {
                 std::lock_guard lock(mutex_);
@@ -441,7 +422,7 @@ void MirrorService::pipe_connect(const SessionRef& session, MessageEntry&& entry
         return;
     }
     const std::string path = entry.service_path, member = entry.member_name;
-    const std::int32_t wanted = element_index(entry);
+    const std::int32_t wanted = entry_pipe_index(entry);
     {
         std::lock_guard lock(mutex_);
         if (wanted >= 0 && pipes_by_downstream_.count({session.endpoint(), path, member, wanted})) {
@@ -463,7 +444,7 @@ void MirrorService::pipe_connect(const SessionRef& session, MessageEntry&& entry
             shared->fail(*err);
             return;
         }
-        const std::int32_t upstream = element_index(*r);
+        const std::int32_t upstream = entry_pipe_index(*r);
         std::int32_t downstream = wanted;
         {
             std::lock_guard lock(self->mutex_);
@@ -480,7 +461,7 @@ void MirrorService::pipe_connect(const SessionRef& session, MessageEntry&& entry
 }
 
 void MirrorService::pipe_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
-    const std::int32_t d = element_index(entry);
+    const std::int32_t d = entry_pipe_index(entry);
     std::optional<std::int32_t> u;
     {
         std::lock_guard lock(mutex_);
@@ -507,7 +488,7 @@ void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageE
         std::lock_guard lock(mutex_);
         for (auto& el : entry.elements) {
             // Packets name their pipe index; acks number it (wire.md §6.7).
-            std::optional<std::int32_t> d = acks ? el.number : parse_index(el.name);
+            std::optional<std::int32_t> d = acks ? el.number : parse_pipe_index(el.name);
             if (!d) continue;
             auto it = pipes_by_downstream_.find({session.endpoint(), entry.service_path, entry.member_name, *d});
             if (it == pipes_by_downstream_.end()) continue;
@@ -531,7 +512,7 @@ void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
     {
         std::lock_guard lock(mutex_);
         for (auto& el : entry.elements) {
-            std::optional<std::int32_t> u = acks ? el.number : parse_index(el.name);
+            std::optional<std::int32_t> u = acks ? el.number : parse_pipe_index(el.name);
             if (!u) continue;
             auto it = pipes_by_upstream_.find({path, entry.member_name, *u});
             if (it == pipes_by_upstream_.end()) continue;
@@ -673,7 +654,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
         case MessageEntryType::PipePacketRet: pipe_packets_from_device(std::move(entry)); return;
         case MessageEntryType::PipeClosed: {
             std::string path = to_downstream(entry.service_path);
-            const std::int32_t u = element_index(entry);
+            const std::int32_t u = entry_pipe_index(entry);
             std::optional<PipeLink> link;
             std::shared_ptr<const InternalPipeHandlers> internal;
             {
@@ -840,7 +821,7 @@ bool MirrorService::internal_pipe_packets(MessageEntry& entry) {
         std::vector<MessageElement> rest;
         for (auto& el : entry.elements) {
             // Packets name their pipe index; acks number it (wire.md §6.7).
-            std::optional<std::int32_t> u = acks ? el.number : parse_index(el.name);
+            std::optional<std::int32_t> u = acks ? el.number : parse_pipe_index(el.name);
             auto it = u ? internal_pipes_by_upstream_.find({path, entry.member_name, *u}) : internal_pipes_by_upstream_.end();
             if (it == internal_pipes_by_upstream_.end()) {
                 rest.push_back(std::move(el));
@@ -852,18 +833,10 @@ bool MirrorService::internal_pipe_packets(MessageEntry& entry) {
                 if (read_scalar(el, number)) deliveries.push_back(Delivery{handlers, MessageElement{}, number});
                 continue;
             }
-            const MessageElement* pn = el.find("packetnumber");
-            if (!pn || !read_scalar(*pn, number)) continue;
-            MessageElement* packet = nullptr;
-            for (auto& child : el.elements)
-                if (!child.number && child.name == "packet") packet = &child;
-            if (!packet) continue;
-            if (el.find("requestack")) {
-                MessageElement ack = make_scalar_element<std::uint32_t>("", number);
-                ack.number = *u;
-                ack_entry.elements.push_back(std::move(ack));
-            }
-            deliveries.push_back(Delivery{handlers, std::move(*packet), number});
+            auto got = take_pipe_packet(el);
+            if (!got) continue;
+            if (got->request_ack) ack_entry.elements.push_back(pipe_ack_element(*u, got->number));
+            deliveries.push_back(Delivery{handlers, std::move(got->packet), got->number});
         }
         entry.elements = std::move(rest);
     }
@@ -903,12 +876,7 @@ void MirrorService::open_internal_pipe(std::string path, std::string member, boo
         p.handlers = std::make_shared<const InternalPipeHandlers>(std::move(handlers));
         internal_pipes_.emplace(id, std::move(p));
     }
-    MessageEntry e;
-    e.entry_type = MessageEntryType::PipeConnectReq;
-    e.service_path = to_upstream(path);
-    e.member_name = member;
-    e.elements.push_back(make_scalar_element<std::int32_t>("index", -1));
-    if (unreliable) e.elements.push_back(make_scalar_element<std::int32_t>("unreliable", 1));
+    MessageEntry e = pipe_connect_request(to_upstream(path), member, unreliable);
     auto self = shared_from_this();
     c->request(std::move(e), [self, id, path, member, done = std::move(done)](Result<MessageEntry> r) {
         std::optional<RRError> error;
@@ -919,7 +887,7 @@ void MirrorService::open_internal_pipe(std::string path, std::string member, boo
         } else if (auto err = entry_error(*r)) {
             error = *err;
         } else {
-            u = element_index(*r);
+            u = entry_pipe_index(*r);
             std::int32_t flag = 0;
             reply_unreliable = r->find("unreliable") && read_scalar(*r->find("unreliable"), flag) && flag == 1;
             if (u < 0) error = make_error(MessageErrorType::ProtocolError, "PipeConnectRet without an index");
@@ -945,12 +913,7 @@ void MirrorService::open_internal_pipe(std::string path, std::string member, boo
         }
         if (orphan) {
             if (auto c = self->client()) {
-                MessageEntry d;
-                d.entry_type = MessageEntryType::PipeDisconnectReq;
-                d.service_path = self->to_upstream(path);
-                d.member_name = member;
-                d.elements.push_back(make_scalar_element<std::int32_t>("index", u));
-                c->request(std::move(d), [](Result<MessageEntry>) {});
+                c->request(pipe_disconnect_request(self->to_upstream(path), member, u), [](Result<MessageEntry>) {});
             }
             done(fail(MessageErrorType::OperationAborted, "pipe endpoint closed while connecting"));
             return;
@@ -966,7 +929,6 @@ Result<std::uint32_t> MirrorService::send_internal_pipe_packet(std::uint64_t id,
     constexpr std::size_t kMaxBacklogBytes = 8u << 20;
     if (c->queued_bytes() > kMaxBacklogBytes)
         return fail(MessageErrorType::BufferLimitViolation, "device connection backlog full");
-    MessageEntry e;
     std::uint32_t number;
     {
         std::lock_guard lock(mutex_);
@@ -976,21 +938,9 @@ Result<std::uint32_t> MirrorService::send_internal_pipe_packet(std::uint64_t id,
         auto& p = it->second;
         number = p.send_number == UINT32_MAX ? 0 : p.send_number + 1;
         p.send_number = number;
-        e.entry_type = MessageEntryType::PipePacket;
-        e.service_path = to_upstream(p.path);
-        e.member_name = p.member;
-        if (p.unreliable) e.metadata = "unreliable\n";
-        MessageElement d;
-        d.name = std::to_string(p.upstream_index);  // a name, also in v4 (wire.md §6.7)
-        d.type = DataTypes::dictionary_t;
-        d.elements.push_back(make_scalar_element<std::uint32_t>("packetnumber", number));
-        packet.name = "packet";
-        packet.number.reset();
-        d.elements.push_back(std::move(packet));
-        if (request_ack) d.elements.push_back(make_scalar_element<std::uint32_t>("requestack", 1));
-        e.elements.push_back(std::move(d));
         // Sent under the lock: packet numbers reach the device in order.
-        c->send(std::move(e));
+        c->send(pipe_packet_entry(to_upstream(p.path), p.member, p.upstream_index, number, std::move(packet), request_ack,
+                                  p.unreliable));
     }
     if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
     return number;
@@ -1008,12 +958,7 @@ void MirrorService::close_internal_pipe(std::uint64_t id) {
     }
     if (!p->connected) return;  // the connect reply disconnects it
     if (auto c = client()) {
-        MessageEntry d;
-        d.entry_type = MessageEntryType::PipeDisconnectReq;
-        d.service_path = to_upstream(p->path);
-        d.member_name = p->member;
-        d.elements.push_back(make_scalar_element<std::int32_t>("index", p->upstream_index));
-        c->request(std::move(d), [](Result<MessageEntry>) {});
+        c->request(pipe_disconnect_request(to_upstream(p->path), p->member, p->upstream_index), [](Result<MessageEntry>) {});
     }
 }
 

@@ -72,16 +72,9 @@ public:
                                           std::function<void(Result<void>)> done);
     void remove_internal_subscriber(std::uint64_t id);
 
-    /// What a gateway-internal pipe endpoint (JSON API) hears. Called on the upstream strand, without
-    /// locks held. `on_packet` gets the packet's `packet` element and its packet number (acks for
-    /// packets sent with `requestack` are sent by the service itself); `on_ack` the packet number the
-    /// device acknowledged; `on_closed` once, when the device closes the endpoint (PipeClosed) or the
-    /// device connection is lost — not after close_internal_pipe().
-    struct InternalPipeHandlers {
-        std::function<void(const MessageElement& packet, std::uint32_t packet_number)> on_packet;
-        std::function<void(std::uint32_t packet_number)> on_ack;
-        std::function<void(const RRError& reason)> on_closed;
-    };
+    /// What a gateway-internal pipe endpoint (JSON API) hears (on the upstream strand, without locks
+    /// held); `on_closed` also when the device connection is lost.
+    using InternalPipeHandlers = PipeEndpointHandlers;
     /// Connects a pipe endpoint of the gateway itself (PipeConnectReq with index −1 upstream: the device
     /// chooses). `done` gets an id for the calls below, or the device's error (ConnectionError when it is
     /// not connected).

@@ -138,13 +138,35 @@ void PassthroughSessions::set_delivery_check(DeliveryCheck check) {
     delivery_check_ = std::move(c);
 }
 
-void PassthroughSessions::attach_api(std::uint32_t endpoint) {
-    std::lock_guard lock(mutex_);
-    auto it = links_.find(endpoint);
-    if (it == links_.end()) return;
-    it->second.api = true;
-    it->second.attached = true;
-    it->second.early.clear();
+void PassthroughSessions::attach_api(std::uint32_t endpoint, ApiHandlers handlers) {
+    auto h = std::make_shared<const ApiHandlers>(std::move(handlers));
+    bool lost = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = links_.find(endpoint);
+        if (it == links_.end()) return;
+        it->second.api = true;
+        it->second.api_handlers = h;
+        it->second.attached = true;
+        it->second.early.clear();  // nothing is subscribed yet
+        lost = it->second.lost;
+    }
+    if (lost && h->on_lost) h->on_lost(session_gone());
+}
+
+Result<void> PassthroughSessions::send(std::uint32_t endpoint, MessageEntry entry) {
+    auto client = open_client(endpoint);
+    if (!client) return fail(session_gone());
+    entry.service_path = to_upstream(entry.service_path);
+    if (entry.entry_type == MessageEntryType::PipePacket)
+        if (auto k = counters_.lock()) k->pipe_packets.fetch_add(1);
+    client->send(std::move(entry));
+    return {};
+}
+
+std::size_t PassthroughSessions::queued_bytes(std::uint32_t endpoint) const {
+    auto client = open_client(endpoint);
+    return client ? client->queued_bytes() : 0;
 }
 
 void PassthroughSessions::close(std::uint32_t endpoint) {
@@ -301,6 +323,7 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
     SessionRef session;
     std::shared_ptr<RawClient> client, api_client;
     std::shared_ptr<const DeliveryCheck> check;
+    std::shared_ptr<const ApiHandlers> api;
     {
         std::lock_guard lock(mutex_);
         check = delivery_check_;
@@ -308,6 +331,7 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
         if (it == links_.end()) return;
         if (it->second.api) {
             api_client = it->second.client;
+            api = it->second.api_handlers;
         } else if (!it->second.attached) {
             // Between the connect's answer and the downstream session's opening: held (bounded).
             if (it->second.early.size() < 256) it->second.early.push_back(std::move(entry));
@@ -323,7 +347,16 @@ void PassthroughSessions::from_device(std::uint32_t endpoint, MessageEntry&& ent
             api_client->send(relayed_reply(
                 reply_to(entry), fail(MessageErrorType::InvalidOperation,
                                    "callback \"" + entry.member_name + "\": this session is a JSON API client's, which has no callbacks")));
+            return;
         }
+        if (!api || !api->on_entry) return;
+        if (auto k = counters_.lock()) {
+            if (entry.entry_type == MessageEntryType::EventReq) k->events.fetch_add(1);
+            if (entry.entry_type == MessageEntryType::WirePacket) k->wire_packets_in.fetch_add(1);
+            if (entry.entry_type == MessageEntryType::PipePacket) k->pipe_packets.fetch_add(1);
+        }
+        entry.service_path = to_downstream(entry.service_path);
+        api->on_entry(std::move(entry));
         return;
     }
     deliver(session, client, check, std::move(entry));
@@ -380,15 +413,21 @@ void PassthroughSessions::deliver(const SessionRef& session, const std::shared_p
 void PassthroughSessions::upstream_closed(std::uint32_t endpoint, const RRError& error) {
     // The device ended this client's session (or went away): its locks are gone on the device too.
     // The downstream session stays open; its requests fail with ConnectionError from now on.
+    std::shared_ptr<const ApiHandlers> api;
     {
         std::lock_guard lock(mutex_);
         auto it = links_.find(endpoint);
         if (it == links_.end() || !it->second.client) return;
         it->second.lost = true;
+        api = it->second.api_handlers;
         forget_locks_of(endpoint, it->second.username);
     }
     changed();
-    (void)error;
+    // A JSON API session's subscriptions end with it (the client is told, and may device_login again).
+    if (api && api->on_lost) api->on_lost(error.message.empty() ? session_gone() : make_error(MessageErrorType::ConnectionError,
+                                                                                             "the device \"" + settings_.device_name +
+                                                                                                 "\" closed this client's session: " +
+                                                                                                 error.message));
 }
 
 }  // namespace rr::server::gateway

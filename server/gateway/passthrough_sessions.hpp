@@ -71,11 +71,22 @@ public:
                std::function<void(Result<void>)> done);
     /// The admitted client's session is open: entries from the device may go to it now.
     void attach(const SessionRef& session);
-    /// The admitted session serves a JSON API client (a `device_login` of docs/json-api.md), which has
-    /// no RR session downstream: the device's callback requests on it are answered with an error, and
-    /// its other entries (events, wire and pipe packets) are not kept: the JSON API subscribes through
-    /// the device's shared session.
-    void attach_api(std::uint32_t endpoint);
+    /// What a JSON API session (a `device_login` of docs/json-api.md, which has no RR session
+    /// downstream) hears from the device. `on_entry` gets its events, wire and pipe packets, WireClosed
+    /// and PipeClosed with paths in gateway naming (the JSON API's own subscriptions on that session:
+    /// SessionEndpoints); `on_lost` once when the device ends the session. The device's callback
+    /// requests on it are answered with InvalidOperation. Called without locks held.
+    struct ApiHandlers {
+        std::function<void(MessageEntry&&)> on_entry;
+        std::function<void(const RRError&)> on_lost;
+    };
+    /// The admitted session serves a JSON API client; `on_lost` runs at once if it ended already.
+    void attach_api(std::uint32_t endpoint, ApiHandlers handlers);
+    /// An entry without a reply (WirePacket, PipePacket, PipePacketRet) on an attached JSON API
+    /// session; paths in gateway naming. Errors: ConnectionError when the session is gone.
+    Result<void> send(std::uint32_t endpoint, MessageEntry entry);
+    /// Bytes waiting to be written to the device on that session (0 when it is gone).
+    std::size_t queued_bytes(std::uint32_t endpoint) const;
     /// A request of an attached JSON API session, forwarded on its own upstream session; the service
     /// paths are in gateway naming both ways. Errors to `done`: ConnectionError when the session is
     /// gone (closed by the device or never admitted), and the device's own.
@@ -109,6 +120,7 @@ private:
         std::vector<MessageEntry> early;  // device entries that came before attach()
         bool attached = false;
         bool api = false;   // a JSON API session (attach_api): no downstream RR session
+        std::shared_ptr<const ApiHandlers> api_handlers;
         bool lost = false;  // the device ended the upstream session
     };
 

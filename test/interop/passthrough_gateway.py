@@ -15,9 +15,11 @@ locks, release on disconnect and on a killed client process). Then:
            InvalidOperation naming `auth: passthrough`;
   device_login  a JSON WebSocket logs in to the device as one of its users (`device_login`): a wrong
            password gets the device's own error; while alice holds a user lock, the socket logged in
-           as alice reads the locked object, one logged in as bob (and one without a device login,
-           on the gateway's shared session) get ObjectLockedError; device_logout goes back to the
-           shared session; a shared device refuses device_login.
+           as alice reads the locked object and subscribes to a wire, a pipe and an event on her own
+           session (the wire's answer, the pipe's echo and the events arrive), one logged in as bob
+           (and one without a device login, on the gateway's shared session) get ObjectLockedError
+           for both; device_logout ends alice's subscriptions with a "closed" push and goes back to
+           the shared session; a shared device refuses device_login.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when the official package is missing.
 
@@ -188,9 +190,12 @@ def run_extra_checks(port, ck):
     def json_device_login():
         import websocket  # websocket-client
 
+        pushes = {}  # socket -> pushes received while waiting for replies
+
         def open_socket():
             ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
             counter = [0]
+            pushes[ws] = []
 
             def ask(msg):
                 counter[0] += 1
@@ -200,7 +205,29 @@ def run_extra_checks(port, ck):
                     r = json.loads(ws.recv())
                     if r.get("id") == msg["id"]:
                         return r
+                    if "subscription" in r:
+                        pushes[ws].append(r)
             return ws, ask
+
+        def wait_push(ws, pred, what, timeout=10.0):
+            """The first push (kept or new) with pred(push); removed from the kept ones."""
+            deadline = time.monotonic() + timeout
+            while True:
+                for p in pushes[ws]:
+                    if pred(p):
+                        pushes[ws].remove(p)
+                        return p
+                left = deadline - time.monotonic()
+                ll.expect(left > 0, "no push: %s (have %r)" % (what, pushes[ws][-5:]))
+                ws.settimeout(left)
+                try:
+                    r = json.loads(ws.recv())
+                except websocket.WebSocketTimeoutException:
+                    continue
+                finally:
+                    ws.settimeout(20)
+                if "subscription" in r:
+                    pushes[ws].append(r)
 
         def error_of(r):
             return (r.get("error") or {}).get("name", ""), (r.get("error") or {}).get("message", "")
@@ -231,8 +258,44 @@ def run_extra_checks(port, ck):
                 name, msg = error_of(ask(get_root))
                 ll.expect(name == "RobotRaconteur.ObjectLockedError" and "alice" in msg,
                           "%s under alice's lock: %s %s" % (who, name, msg))
+            # Subscriptions follow the device_login too: alice's socket connects the wire, pipe and
+            # event on her own session (the device lets her past her lock), bob's and the gateway's
+            # shared session are refused by the device.
+            subscribe_w = {"op": "subscribe", "device": "interop", "member": "w_both"}
+            r = ask_a(subscribe_w)
+            ll.expect(r.get("result", {}).get("kind") == "wire", "alice subscribes to w_both under her lock: %r" % r)
+            sub_w = r["result"]["subscription"]
+            for who, ask in (("bob's socket", ask_b), ("a socket without device_login", ask_n)):
+                name, msg = error_of(ask(subscribe_w))
+                ll.expect(name == "RobotRaconteur.ObjectLockedError" and "alice" in msg,
+                          "%s subscribes under alice's lock: %s %s" % (who, name, msg))
+            # w_both answers a client's OutValue on that client's connection only, reversed.
+            r = ask_a({"op": "set_out_value", "subscription": sub_w, "value": [1.0, 2.0, 3.0]})
+            ll.expect(r.get("result") == {}, "alice sets w_both's OutValue: %r" % r)
+            wait_push(ws_a, lambda p: p.get("subscription") == sub_w and p.get("value") == [3.0, 2.0, 1.0],
+                      "the device's answer on alice's wire connection")
+            r = ask_a({"op": "subscribe", "device": "interop", "member": "p_unreliable"})
+            ll.expect(r.get("result", {}).get("kind") == "pipe", "alice opens p_unreliable: %r" % r)
+            sub_p = r["result"]["subscription"]
+            r = ask_a({"op": "send", "subscription": sub_p, "value": "on alice's session"})
+            ll.expect("result" in r, "alice sends on p_unreliable: %r" % r)
+            wait_push(ws_a, lambda p: p.get("subscription") == sub_p and p.get("value") == "on alice's session",
+                      "the echo on alice's pipe endpoint")
+            r = ask_a({"op": "subscribe", "device": "interop", "member": "ev_values"})
+            ll.expect(r.get("result", {}).get("kind") == "event", "alice subscribes to ev_values: %r" % r)
+            sub_e = r["result"]["subscription"]
+            r = ask_a({"op": "call", "device": "interop", "member": "fire_events", "args": [2]})
+            ll.expect("result" in r, "alice fires two events: %r" % r)
+            for n in (1, 2):
+                wait_push(ws_a, lambda p: p.get("subscription") == sub_e and p.get("kind") == "event",
+                          "event %d on alice's session" % n)
             r = ask_a({"op": "device_logout", "device": "interop"})
             ll.expect(r.get("result") == {}, "device_logout: %r" % r)
+            for sub in (sub_w, sub_p, sub_e):
+                p = wait_push(ws_a, lambda p, sub=sub: p.get("subscription") == sub and p.get("kind") == "closed",
+                              "subscription %d closed by device_logout" % sub)
+                ll.expect(p["error"]["name"] == "RobotRaconteur.OperationAborted" and "device_logout" in p["error"]["message"],
+                          "closed by device_logout: %r" % p)
             name, msg = error_of(ask_a(get_root))
             ll.expect(name == "RobotRaconteur.ObjectLockedError", "after device_logout: shared session: %s %s" % (name, msg))
             ll.expect(RRN.ReleaseObjectLock(holder) == "OK", "alice releases")
