@@ -520,6 +520,19 @@ std::string Gateway::metrics_text() const {
           << gateway::device_state_name(s.state) << "\"} " << (s.state == gateway::DeviceState::connected ? 1 : 0)
           << "\n";
     }
+    // One status per device for both gauges (status() takes the device's locks once).
+    std::vector<gateway::DeviceStatus> statuses;
+    statuses.reserve(all.size());
+    for (const auto& d : all) statuses.push_back(d->status());
+    o << "# HELP rr_gateway_device_clients RR client sessions of the device's service on the gateway.\n"
+         "# TYPE rr_gateway_device_clients gauge\n";
+    for (const auto& s : statuses)
+        o << "rr_gateway_device_clients{device=\"" << escape_label(s.name) << "\"} " << s.downstream_sessions << "\n";
+    o << "# HELP rr_gateway_device_passthrough_sessions Upstream sessions of clients' own to an auth: passthrough device "
+         "(native clients and JSON API device logins; 0 for shared devices).\n"
+         "# TYPE rr_gateway_device_passthrough_sessions gauge\n";
+    for (const auto& s : statuses)
+        o << "rr_gateway_device_passthrough_sessions{device=\"" << escape_label(s.name) << "\"} " << s.upstream_sessions << "\n";
     auto counter = [&](const char* name, const char* help, auto field) {
         o << "# HELP " << name << " " << help << "\n# TYPE " << name << " counter\n";
         for (const auto& d : all)

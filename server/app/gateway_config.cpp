@@ -520,7 +520,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         std::set<std::string> names;
         for (const auto& d : devs) {
             r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms", "tls_ca",
-                                          "tls_certificate", "tls_private_key", "auth", "max_passthrough_sessions"});
+                                          "tls_certificate", "tls_private_key", "auth", "max_passthrough_sessions",
+                                          "json_api_requires_device_login"});
             gateway::DeviceConfig dc;
             if (!d["name"]) r.error(d, "devices[].name", "missing");
             if (!d["url"]) r.error(d, "devices[].url", "missing");
@@ -545,6 +546,12 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             if (auto n = d["max_passthrough_sessions"]) {
                 dc.max_passthrough_sessions = r.unsigned_int(n, key + ".max_passthrough_sessions", 100000);
                 if (dc.max_passthrough_sessions == 0) r.error(n, key + ".max_passthrough_sessions", "must be at least 1");
+            }
+            if (auto n = d["json_api_requires_device_login"]) {
+                dc.json_api_requires_device_login = r.boolean(n, key + ".json_api_requires_device_login");
+                if (dc.json_api_requires_device_login && dc.auth != gateway::DeviceAuth::passthrough)
+                    r.error(n, key + ".json_api_requires_device_login",
+                            "needs auth: passthrough (only a passthrough device has logins of its own for JSON API clients)");
             }
             if (auto n = d["tls_ca"]) dc.tls_ca = r.string(n, key + ".tls_ca");
             if (auto n = d["tls_certificate"]) dc.tls_certificate = r.string(n, key + ".tls_certificate");

@@ -328,6 +328,7 @@ devices:
     url: rr+tcp://arm.lab:48653/?service=robot
     auth: passthrough
     max_passthrough_sessions: 5
+    json_api_requires_device_login: true
   - name: cam
     url: rr+tcp://cam.lab:48653/?service=cam
   - name: door
@@ -339,6 +340,8 @@ devices:
     CHECK(c->devices[2].auth == rr::server::gateway::DeviceAuth::shared);  // "gateway" is shared's other name
     CHECK(c->devices[0].auth == rr::server::gateway::DeviceAuth::passthrough);
     CHECK(c->devices[0].max_passthrough_sessions == 5);
+    CHECK(c->devices[0].json_api_requires_device_login);
+    CHECK_FALSE(c->devices[1].json_api_requires_device_login);
     CHECK(c->devices[1].auth == rr::server::gateway::DeviceAuth::shared);
     CHECK(c->devices[1].max_passthrough_sessions == 64);
     for (auto [yaml, expect] : {
@@ -346,6 +349,12 @@ devices:
                        "bad.yaml:4: devices.a.auth: expected shared (alias gateway) or passthrough, got \"tokens\""},
              std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    max_passthrough_sessions: 0\n",
                        "bad.yaml:4: devices.a.max_passthrough_sessions: must be at least 1"},
+             std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    json_api_requires_device_login: true\n",
+                       "bad.yaml:4: devices.a.json_api_requires_device_login: needs auth: passthrough (only a passthrough device "
+                       "has logins of its own for JSON API clients)"},
+             std::pair{"devices:\n  - name: a\n    url: rr+tcp://x/?service=s\n    auth: passthrough\n"
+                       "    json_api_requires_device_login: maybe\n",
+                       "bad.yaml:5: devices.a.json_api_requires_device_login: expected true or false"},
          }) {
         check_refused(yaml, expect);
     }

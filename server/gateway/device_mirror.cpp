@@ -260,6 +260,7 @@ DeviceStatus DeviceMirror::status() const {
     s.required = config_.required;
     s.downstream_sessions = service_->session_count();
     s.auth = config_.auth;
+    s.json_api_requires_device_login = config_.json_api_requires_device_login;
     if (const auto& p = service_->passthrough()) {
         s.upstream_sessions = p->session_count();
         s.locks = p->locks();

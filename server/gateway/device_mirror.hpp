@@ -57,6 +57,9 @@ struct DeviceConfig {
     DeviceAuth auth = DeviceAuth::shared;
     /// auth: passthrough: upstream sessions at once (one per logged-in native client); more are refused.
     std::size_t max_passthrough_sessions = 64;
+    /// auth: passthrough: JSON API member requests (REST, and the WebSocket without a `device_login`)
+    /// are refused with AuthenticationError instead of using the gateway's own session to the device.
+    bool json_api_requires_device_login = false;
     /// /readyz waits for required devices only.
     bool required = true;
     std::chrono::milliseconds backoff_initial{500};
@@ -87,6 +90,7 @@ struct DeviceStatus {
     std::size_t downstream_sessions = 0;
     DeviceAuth auth = DeviceAuth::shared;
     std::size_t upstream_sessions = 0;   ///< passthrough sessions open (or opening) to the device
+    bool json_api_requires_device_login = false;
     std::vector<DeviceLockInfo> locks;   ///< locks taken through the gateway and still held
 };
 

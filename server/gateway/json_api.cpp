@@ -179,6 +179,7 @@ nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
         // Only passthrough devices have locks through the gateway (docs/security.md).
         j["auth"] = std::string(device_auth_name(s.auth));
         j["passthrough_sessions"] = s.upstream_sessions;
+        j["json_api_requires_device_login"] = s.json_api_requires_device_login;
         auto locks = nlohmann::json::array();
         for (const auto& l : s.locks)
             locks.push_back({{"path", l.path}, {"user", l.username.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.username)},
@@ -385,6 +386,15 @@ ApiError missing_element(std::string_view name, std::string_view reply) {
 }  // namespace
 
 std::optional<ApiError> JsonApi::check_access(const MemberAddress& a, auth::Operation op) const {
+    if (a.device_session == 0) {
+        // The device lets JSON API clients in only with a login of its own (an unknown device is left
+        // to resolve(), which names it).
+        if (auto d = find_device(a.device); d && d->config().json_api_requires_device_login)
+            return api_error(401, MessageErrorType::AuthenticationError,
+                             "device \"" + a.device +
+                                 "\" takes JSON API requests only with a login of its own: send {\"op\": \"device_login\", "
+                                 "\"device\", \"username\", \"password\"} on the WebSocket first (REST requests have no device session)");
+    }
     if (!auth_ || !auth_->enabled()) return std::nullopt;
     if (!a.principal)
         return api_error(401, MessageErrorType::AuthenticationError, "login required");

@@ -20,6 +20,8 @@ locks, release on disconnect and on a killed client process). Then:
            (and one without a device login, on the gateway's shared session) get ObjectLockedError
            for both; device_logout ends alice's subscriptions with a "closed" push and goes back to
            the shared session; a shared device refuses device_login.
+  strict   a device with json_api_requires_device_login refuses REST requests and WebSocket requests
+           without a device_login (AuthenticationError naming device_login) and serves them after one.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when the official package is missing.
 
@@ -156,6 +158,13 @@ def run_extra_checks(port, ck):
             c3 = ll.eventually(lambda: ll.connect(url_small, "carol"), "a third client after one left")
             ll.expect(isinstance(c3.base_name, str), "the third client reads")
             ll.expect(device_status(port, "small")["passthrough_sessions"] == 2, "two upstream sessions")
+            import urllib.request
+            with urllib.request.urlopen("http://127.0.0.1:%d/metrics" % port, timeout=10) as r:
+                metrics = r.read().decode()
+            for line in ('rr_gateway_device_passthrough_sessions{device="small"} 2',
+                         'rr_gateway_device_clients{device="small"} 2',
+                         'rr_gateway_device_passthrough_sessions{device="shared"} 0'):
+                ll.expect(line in metrics.splitlines(), "/metrics has %r" % line)
             del e
         finally:
             for c in (c1, c2, c3):
@@ -313,6 +322,56 @@ def run_extra_checks(port, ck):
 
     ck.check("json: device_login gives a WebSocket the device's own user, locks apply", json_device_login)
 
+    def json_requires_device_login():
+        import urllib.error
+        import urllib.request
+        import websocket  # websocket-client
+        ll.expect(device_status(port, "strict").get("json_api_requires_device_login") is True,
+                  "/api/devices names the requirement")
+        ll.expect(device_status(port, "interop").get("json_api_requires_device_login") is False,
+                  "and its absence on the other passthrough device")
+        # REST has no device session: refused, not served by the gateway's own login to the device.
+        try:
+            urllib.request.urlopen("http://127.0.0.1:%d/api/devices/strict/properties/base_name" % port, timeout=10)
+            raise AssertionError("REST read of a device that requires a device login was served")
+        except urllib.error.HTTPError as e:
+            body = json.loads(e.read())
+            ll.expect(e.code == 401 and body["error"]["name"] == "RobotRaconteur.AuthenticationError"
+                      and "device_login" in body["error"]["message"], "REST refused: %s %r" % (e.code, body))
+        ll.expect("value" in get_json(port, "/api/devices/interop/properties/base_name"),
+                  "REST on a passthrough device without the requirement still reads")
+        ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
+        counter = [0]
+
+        def ask(msg):
+            counter[0] += 1
+            msg = dict(msg, id=counter[0])
+            ws.send(json.dumps(msg))
+            while True:
+                r = json.loads(ws.recv())
+                if r.get("id") == msg["id"]:
+                    return r
+        try:
+            for op in ({"op": "get", "member": "base_name"}, {"op": "subscribe", "member": "ev_values"},
+                       {"op": "call", "member": "add", "args": [1, 2]}):
+                r = ask(dict(op, device="strict"))
+                ll.expect(r.get("error", {}).get("name") == "RobotRaconteur.AuthenticationError",
+                          "%s without device_login refused: %r" % (op["op"], r))
+            r = ask({"op": "device_login", "device": "strict", "username": "bob", "password": ll.USERS["bob"][0]})
+            ll.expect("result" in r, "bob's device_login: %r" % r)
+            ll.expect("value" in ask({"op": "get", "device": "strict", "member": "base_name"}).get("result", {}),
+                      "bob reads after his device_login")
+            r = ask({"op": "subscribe", "device": "strict", "member": "ev_values"})
+            ll.expect(r.get("result", {}).get("kind") == "event", "bob subscribes after his device_login: %r" % r)
+            ll.expect(ask({"op": "device_logout", "device": "strict"}).get("result") == {}, "device_logout")
+            r = ask({"op": "get", "device": "strict", "member": "base_name"})
+            ll.expect(r.get("error", {}).get("name") == "RobotRaconteur.AuthenticationError",
+                      "refused again after device_logout: %r" % r)
+        finally:
+            ws.close()
+
+    ck.check("json: json_api_requires_device_login refuses REST and sockets without a device_login", json_requires_device_login)
+
 
 def main():
     ap = argparse.ArgumentParser()
@@ -342,6 +401,7 @@ def main():
             fh.write("  - name: interop\n" + common + "    auth: passthrough\n")
             fh.write("  - name: small\n" + common + "    auth: passthrough\n    max_passthrough_sessions: 2\n")
             fh.write("  - name: shared\n" + common)
+            fh.write("  - name: strict\n" + common + "    auth: passthrough\n    json_api_requires_device_login: true\n")
         gw = start([args.gateway, "--config", config, "--no-local", "--log-level", "warning"], gw_err)
         port = read_json_line(gw, 30, "rr-gateway")["port"]
         deadline = time.monotonic() + 30
