@@ -486,15 +486,7 @@ private:
 
         const bool is_wire = kind == SubKind::wire;
         const std::uint64_t mid = t.device->subscribe(
-            t.path, t.member->name, is_wire,
-            [weak, sid, is_wire](const SharedEntryPtr& e) {
-                auto s = weak.lock();
-                if (!s) return;
-                if (is_wire)
-                    s->on_wire(sid, e);
-                else
-                    s->on_event(sid, e);
-            },
+            t.path, t.member->name, is_wire, value_handler(sid, is_wire),
             [weak, sid, id](Result<void> r) {
                 if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
             });
@@ -546,6 +538,19 @@ private:
         if (flush) flush_wires();
     }
 
+    // What a wire or event subscription's values go to (either session).
+    std::function<void(const SharedEntryPtr&)> value_handler(std::uint64_t sid, bool is_wire) {
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        return [weak, sid, is_wire](const SharedEntryPtr& e) {
+            auto s = weak.lock();
+            if (!s) return;
+            if (is_wire)
+                s->on_wire(sid, e);
+            else
+                s->on_event(sid, e);
+        };
+    }
+
     PipeEndpointHandlers pipe_handlers(std::uint64_t sid) {
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
         PipeEndpointHandlers h;
@@ -588,20 +593,12 @@ private:
                            std::move(opened));
             return;
         }
-        const bool is_wire = kind == SubKind::wire;
         SubscriptionHandlers h;
-        h.on_entry = [weak, sid, is_wire](const SharedEntryPtr& e) {
-            auto s = weak.lock();
-            if (!s) return;
-            if (is_wire)
-                s->on_wire(sid, e);
-            else
-                s->on_event(sid, e);
-        };
+        h.on_entry = value_handler(sid, kind == SubKind::wire);
         h.on_closed = [weak, sid](const RRError& reason) {
             if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
         };
-        own->subscribe(t.path, t.member->name, is_wire, std::move(h), std::move(opened));
+        own->subscribe(t.path, t.member->name, kind == SubKind::wire, std::move(h), std::move(opened));
     }
 
     // A pipe endpoint (either session) or an own-session subscription answered: `close` undoes it

@@ -51,6 +51,52 @@ RRN = ll.RRN
 GATEWAY_USER = ("gateway", "gateway-pw")  # the gateway's own (shared) session: JSON API, definitions
 
 
+class JsonSocket:
+    """A JSON WebSocket to the gateway: ask() sends a request and returns its reply, keeping the pushes
+    that arrive meanwhile for wait_push()."""
+
+    def __init__(self, port):
+        import websocket  # websocket-client
+        self.ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
+        self.counter = 0
+        self.pushes = []
+
+    def ask(self, msg):
+        self.counter += 1
+        msg = dict(msg, id=self.counter)
+        self.ws.send(json.dumps(msg))
+        while True:
+            r = json.loads(self.ws.recv())
+            if r.get("id") == msg["id"]:
+                return r
+            if "subscription" in r:
+                self.pushes.append(r)
+
+    def wait_push(self, pred, what, timeout=10.0):
+        """The first push (kept or new) with pred(push); removed from the kept ones."""
+        import websocket  # websocket-client
+        deadline = time.monotonic() + timeout
+        while True:
+            for p in self.pushes:
+                if pred(p):
+                    self.pushes.remove(p)
+                    return p
+            left = deadline - time.monotonic()
+            ll.expect(left > 0, "no push: %s (have %r)" % (what, self.pushes[-5:]))
+            self.ws.settimeout(left)
+            try:
+                r = json.loads(self.ws.recv())
+            except websocket.WebSocketTimeoutException:
+                continue
+            finally:
+                self.ws.settimeout(20)
+            if "subscription" in r:
+                self.pushes.append(r)
+
+    def close(self):
+        self.ws.close()
+
+
 def device_status(port, name):
     for d in get_json(port, "/api/devices"):
         if d["name"] == name:
@@ -197,54 +243,12 @@ def run_extra_checks(port, ck):
     ck.check("login: the device's own error for a client without a login", no_login_refused_with_device_error)
 
     def json_device_login():
-        import websocket  # websocket-client
-
-        pushes = {}  # socket -> pushes received while waiting for replies
-
-        def open_socket():
-            ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
-            counter = [0]
-            pushes[ws] = []
-
-            def ask(msg):
-                counter[0] += 1
-                msg = dict(msg, id=counter[0])
-                ws.send(json.dumps(msg))
-                while True:
-                    r = json.loads(ws.recv())
-                    if r.get("id") == msg["id"]:
-                        return r
-                    if "subscription" in r:
-                        pushes[ws].append(r)
-            return ws, ask
-
-        def wait_push(ws, pred, what, timeout=10.0):
-            """The first push (kept or new) with pred(push); removed from the kept ones."""
-            deadline = time.monotonic() + timeout
-            while True:
-                for p in pushes[ws]:
-                    if pred(p):
-                        pushes[ws].remove(p)
-                        return p
-                left = deadline - time.monotonic()
-                ll.expect(left > 0, "no push: %s (have %r)" % (what, pushes[ws][-5:]))
-                ws.settimeout(left)
-                try:
-                    r = json.loads(ws.recv())
-                except websocket.WebSocketTimeoutException:
-                    continue
-                finally:
-                    ws.settimeout(20)
-                if "subscription" in r:
-                    pushes[ws].append(r)
-
         def error_of(r):
             return (r.get("error") or {}).get("name", ""), (r.get("error") or {}).get("message", "")
 
         get_root = {"op": "get", "device": "interop", "member": "base_name"}
-        ws_a, ask_a = open_socket()
-        ws_b, ask_b = open_socket()
-        ws_n, ask_n = open_socket()
+        ws_a, ws_b, ws_n = JsonSocket(port), JsonSocket(port), JsonSocket(port)
+        ask_a, ask_b, ask_n = ws_a.ask, ws_b.ask, ws_n.ask
         holder = None
         try:
             sessions_before = device_status(port, "interop")["passthrough_sessions"]
@@ -281,14 +285,14 @@ def run_extra_checks(port, ck):
             # w_both answers a client's OutValue on that client's connection only, reversed.
             r = ask_a({"op": "set_out_value", "subscription": sub_w, "value": [1.0, 2.0, 3.0]})
             ll.expect(r.get("result") == {}, "alice sets w_both's OutValue: %r" % r)
-            wait_push(ws_a, lambda p: p.get("subscription") == sub_w and p.get("value") == [3.0, 2.0, 1.0],
+            ws_a.wait_push(lambda p: p.get("subscription") == sub_w and p.get("value") == [3.0, 2.0, 1.0],
                       "the device's answer on alice's wire connection")
             r = ask_a({"op": "subscribe", "device": "interop", "member": "p_unreliable"})
             ll.expect(r.get("result", {}).get("kind") == "pipe", "alice opens p_unreliable: %r" % r)
             sub_p = r["result"]["subscription"]
             r = ask_a({"op": "send", "subscription": sub_p, "value": "on alice's session"})
             ll.expect("result" in r, "alice sends on p_unreliable: %r" % r)
-            wait_push(ws_a, lambda p: p.get("subscription") == sub_p and p.get("value") == "on alice's session",
+            ws_a.wait_push(lambda p: p.get("subscription") == sub_p and p.get("value") == "on alice's session",
                       "the echo on alice's pipe endpoint")
             r = ask_a({"op": "subscribe", "device": "interop", "member": "ev_values"})
             ll.expect(r.get("result", {}).get("kind") == "event", "alice subscribes to ev_values: %r" % r)
@@ -296,12 +300,12 @@ def run_extra_checks(port, ck):
             r = ask_a({"op": "call", "device": "interop", "member": "fire_events", "args": [2]})
             ll.expect("result" in r, "alice fires two events: %r" % r)
             for n in (1, 2):
-                wait_push(ws_a, lambda p: p.get("subscription") == sub_e and p.get("kind") == "event",
+                ws_a.wait_push(lambda p: p.get("subscription") == sub_e and p.get("kind") == "event",
                           "event %d on alice's session" % n)
             r = ask_a({"op": "device_logout", "device": "interop"})
             ll.expect(r.get("result") == {}, "device_logout: %r" % r)
             for sub in (sub_w, sub_p, sub_e):
-                p = wait_push(ws_a, lambda p, sub=sub: p.get("subscription") == sub and p.get("kind") == "closed",
+                p = ws_a.wait_push(lambda p, sub=sub: p.get("subscription") == sub and p.get("kind") == "closed",
                               "subscription %d closed by device_logout" % sub)
                 ll.expect(p["error"]["name"] == "RobotRaconteur.OperationAborted" and "device_logout" in p["error"]["message"],
                           "closed by device_logout: %r" % p)
@@ -325,7 +329,6 @@ def run_extra_checks(port, ck):
     def json_requires_device_login():
         import urllib.error
         import urllib.request
-        import websocket  # websocket-client
         ll.expect(device_status(port, "strict").get("json_api_requires_device_login") is True,
                   "/api/devices names the requirement")
         ll.expect(device_status(port, "interop").get("json_api_requires_device_login") is False,
@@ -340,17 +343,8 @@ def run_extra_checks(port, ck):
                       and "device_login" in body["error"]["message"], "REST refused: %s %r" % (e.code, body))
         ll.expect("value" in get_json(port, "/api/devices/interop/properties/base_name"),
                   "REST on a passthrough device without the requirement still reads")
-        ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=20)
-        counter = [0]
-
-        def ask(msg):
-            counter[0] += 1
-            msg = dict(msg, id=counter[0])
-            ws.send(json.dumps(msg))
-            while True:
-                r = json.loads(ws.recv())
-                if r.get("id") == msg["id"]:
-                    return r
+        ws = JsonSocket(port)
+        ask = ws.ask
         try:
             for op in ({"op": "get", "member": "base_name"}, {"op": "subscribe", "member": "ev_values"},
                        {"op": "call", "member": "add", "args": [1, 2]}):
