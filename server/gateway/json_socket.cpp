@@ -551,9 +551,9 @@ private:
         };
     }
 
-    PipeEndpointHandlers pipe_handlers(std::uint64_t sid) {
+    GatewayPipeHandlers pipe_handlers(std::uint64_t sid) {
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
-        PipeEndpointHandlers h;
+        GatewayPipeHandlers h;
         h.on_packet = [weak, sid](const MessageElement& packet, std::uint32_t) {
             if (auto s = weak.lock()) s->on_pipe_packet(sid, packet);
         };

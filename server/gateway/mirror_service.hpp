@@ -74,7 +74,7 @@ public:
 
     /// What a gateway-internal pipe endpoint (JSON API) hears (on the upstream strand, without locks
     /// held); `on_closed` also when the device connection is lost.
-    using InternalPipeHandlers = PipeEndpointHandlers;
+    using InternalPipeHandlers = GatewayPipeHandlers;
     /// Connects a pipe endpoint of the gateway itself (PipeConnectReq with index −1 upstream: the device
     /// chooses). `done` gets an id for the calls below, or the device's error (ConnectionError when it is
     /// not connected).

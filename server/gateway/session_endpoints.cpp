@@ -158,7 +158,7 @@ Result<void> SessionEndpoints::send_wire_packet(MessageEntry entry) {
 
 // --- pipes ----------------------------------------------------------------------------------------
 
-void SessionEndpoints::open_pipe(std::string path, std::string member, bool unreliable, PipeEndpointHandlers handlers,
+void SessionEndpoints::open_pipe(std::string path, std::string member, bool unreliable, GatewayPipeHandlers handlers,
                                  std::function<void(Result<std::uint64_t>)> done) {
     std::uint64_t id = 0;
     {
@@ -169,7 +169,7 @@ void SessionEndpoints::open_pipe(std::string path, std::string member, bool unre
             p.path = path;
             p.member = member;
             p.unreliable = unreliable;
-            p.handlers = std::make_shared<const PipeEndpointHandlers>(std::move(handlers));
+            p.handlers = std::make_shared<const GatewayPipeHandlers>(std::move(handlers));
             pipes_.emplace(id, std::move(p));
         }
     }
@@ -299,7 +299,7 @@ void SessionEndpoints::deliver(MessageEntry&& entry) {
         case MessageEntryType::PipePacket:
         case MessageEntryType::PipePacketRet: pipe_entry(std::move(entry)); return;
         case MessageEntryType::PipeClosed: {
-            std::shared_ptr<const PipeEndpointHandlers> h;
+            std::shared_ptr<const GatewayPipeHandlers> h;
             {
                 std::lock_guard lock(mutex_);
                 auto it = pipes_by_index_.find({entry.service_path, entry.member_name, entry_pipe_index(entry)});
@@ -318,7 +318,7 @@ void SessionEndpoints::deliver(MessageEntry&& entry) {
 void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
     const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
     struct Delivery {
-        std::shared_ptr<const PipeEndpointHandlers> handlers;
+        std::shared_ptr<const GatewayPipeHandlers> handlers;
         MessageElement packet;
         std::uint32_t number = 0;
     };
@@ -361,7 +361,7 @@ void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
 
 void SessionEndpoints::lost(const RRError& reason) {
     std::vector<std::shared_ptr<const SubscriptionHandlers>> subs;
-    std::vector<std::shared_ptr<const PipeEndpointHandlers>> pipes;
+    std::vector<std::shared_ptr<const GatewayPipeHandlers>> pipes;
     std::vector<std::function<void(Result<std::uint64_t>)>> waiting;
     {
         std::lock_guard lock(mutex_);

@@ -33,7 +33,7 @@ namespace rr::server::gateway {
 /// packet's `packet` element and its number (acknowledgements the sender asked for are sent already);
 /// `on_ack` a packet number the device acknowledged; `on_closed` once, when the device closes the
 /// endpoint (PipeClosed) or the session ends: not after the owner closed it.
-struct PipeEndpointHandlers {
+struct GatewayPipeHandlers {
     std::function<void(const MessageElement& packet, std::uint32_t packet_number)> on_packet;
     std::function<void(std::uint32_t packet_number)> on_ack;
     std::function<void(const RRError& reason)> on_closed;
@@ -74,7 +74,7 @@ public:
 
     /// Connects a pipe endpoint (PipeConnectReq, index −1: the device chooses). `done` gets an id for
     /// the calls below or the device's error.
-    void open_pipe(std::string path, std::string member, bool unreliable, PipeEndpointHandlers handlers,
+    void open_pipe(std::string path, std::string member, bool unreliable, GatewayPipeHandlers handlers,
                    std::function<void(Result<std::uint64_t>)> done);
     /// Sends `packet` (packed for the pipe's type) on the endpoint; returns its packet number (1, 2, …).
     /// Errors: InvalidArgument (unknown or closed id), BufferLimitViolation (the device does not read:
@@ -111,7 +111,7 @@ private:
         bool connected = false;
         std::int32_t index = -1;
         std::uint32_t send_number = 0;
-        std::shared_ptr<const PipeEndpointHandlers> handlers;
+        std::shared_ptr<const GatewayPipeHandlers> handlers;
     };
 
     RRError gone() const;

@@ -15,7 +15,7 @@ using namespace rr::server::gateway;
 
 namespace {
 
-struct FakeSession {
+struct FakeUpstreamSession {
     struct Pending {
         MessageEntry request;
         std::function<void(Result<MessageEntry>)> done;
@@ -58,7 +58,7 @@ struct FakeSession {
     }
 };
 
-MessageEntry wire_packet(double v) {
+MessageEntry endpoints_wire_packet(double v) {
     MessageEntry e;
     e.entry_type = MessageEntryType::WirePacket;
     e.service_path = "arm";
@@ -70,7 +70,7 @@ MessageEntry wire_packet(double v) {
 }  // namespace
 
 TEST_CASE("session endpoints: one wire connection for two subscriptions, disconnected after the last") {
-    FakeSession fake;
+    FakeUpstreamSession fake;
     auto ep = fake.make();
     std::vector<double> got1, got2;
     std::optional<Result<std::uint64_t>> r1, r2;
@@ -93,14 +93,14 @@ TEST_CASE("session endpoints: one wire connection for two subscriptions, disconn
     REQUIRE(r2);
     REQUIRE(r1->ok());
     REQUIRE(r2->ok());
-    ep->deliver(wire_packet(1.5));
+    ep->deliver(endpoints_wire_packet(1.5));
     CHECK(got1 == std::vector<double>{1.5});
     CHECK(got2 == std::vector<double>{1.5});
 
     // Sending needs the connection; a wire this session has not connected is refused.
-    CHECK(ep->send_wire_packet(wire_packet(2)).ok());
+    CHECK(ep->send_wire_packet(endpoints_wire_packet(2)).ok());
     CHECK(fake.sent.size() == 1);
-    MessageEntry other = wire_packet(2);
+    MessageEntry other = endpoints_wire_packet(2);
     other.member_name = "v";
     auto refused = ep->send_wire_packet(std::move(other));
     REQUIRE_FALSE(refused.ok());
@@ -108,7 +108,7 @@ TEST_CASE("session endpoints: one wire connection for two subscriptions, disconn
 
     ep->unsubscribe(**r1);
     CHECK(fake.requests.empty());  // the other subscription still uses it
-    ep->deliver(wire_packet(2.5));
+    ep->deliver(endpoints_wire_packet(2.5));
     CHECK(got1 == std::vector<double>{1.5});
     CHECK(got2 == std::vector<double>{1.5, 2.5});
     ep->unsubscribe(**r2);
@@ -118,7 +118,7 @@ TEST_CASE("session endpoints: one wire connection for two subscriptions, disconn
 }
 
 TEST_CASE("session endpoints: a refused wire connect fails every waiting subscription with the device's error") {
-    FakeSession fake;
+    FakeUpstreamSession fake;
     auto ep = fake.make();
     std::optional<Result<std::uint64_t>> r1, r2;
     ep->subscribe("arm", "w", true, {}, [&](Result<std::uint64_t> r) { r1 = r; });
@@ -135,7 +135,7 @@ TEST_CASE("session endpoints: a refused wire connect fails every waiting subscri
 }
 
 TEST_CASE("session endpoints: events need no request, and WireClosed or a lost session closes subscriptions once") {
-    FakeSession fake;
+    FakeUpstreamSession fake;
     auto ep = fake.make();
     int events = 0;
     std::vector<std::string> closed;
@@ -180,12 +180,12 @@ TEST_CASE("session endpoints: events need no request, and WireClosed or a lost s
 }
 
 TEST_CASE("session endpoints: a pipe endpoint numbers its packets, acknowledges what the device asks, and hears acks") {
-    FakeSession fake;
+    FakeUpstreamSession fake;
     auto ep = fake.make();
     std::vector<std::string> packets;
     std::vector<std::uint32_t> acks;
     std::optional<std::string> closed;
-    PipeEndpointHandlers h;
+    GatewayPipeHandlers h;
     h.on_packet = [&](const MessageElement& p, std::uint32_t n) { packets.push_back(std::string(read_string(p)) + "#" + std::to_string(n)); };
     h.on_ack = [&](std::uint32_t n) { acks.push_back(n); };
     h.on_closed = [&](const RRError& e) { closed = e.message; };
@@ -242,7 +242,7 @@ TEST_CASE("session endpoints: a pipe endpoint numbers its packets, acknowledges 
 }
 
 TEST_CASE("session endpoints: a pipe closed while connecting is disconnected when the device answers") {
-    FakeSession fake;
+    FakeUpstreamSession fake;
     auto ep = fake.make();
     std::optional<Result<std::uint64_t>> opened;
     ep->open_pipe("arm", "p", false, {}, [&](Result<std::uint64_t> r) { opened = r; });
