@@ -18,7 +18,6 @@
 #include <variant>
 #include <vector>
 
-#include "core/session/event_queue.hpp"
 #include "core/session/stream_connection.hpp"
 
 namespace rr {
@@ -162,7 +161,7 @@ private:
     std::uint16_t message_id_ = 0;
     std::vector<std::string> pending_imports_;
     std::map<std::uint32_t, Pending> pending_;
-    EventQueue<ClientSessionEvent> events_;
+    std::deque<ClientSessionEvent> events_;
     MonoTime last_send_;
     MonoTime connect_deadline_;
     std::optional<MonoTime> connect_limit_;  // construction + config_.connect_timeout, when set

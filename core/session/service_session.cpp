@@ -109,7 +109,10 @@ void ServiceSession::on_timer(MonoTime now) {
 }
 
 std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
-    return events_.pop();
+    if (events_.empty()) return std::nullopt;
+    ServiceSessionEvent ev = std::move(events_.front());
+    events_.pop_front();
+    return ev;
 }
 
 void ServiceSession::close_session() {
