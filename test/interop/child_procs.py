@@ -152,3 +152,20 @@ def write_password_file(path, entries):
     with open(path + ".new", "w") as f:
         f.write("".join(l + "\n" for l in lines))
     os.replace(path + ".new", path)
+
+
+class Checks:
+    """Named checks of an interop script: each runs, and its outcome (with the error and a short trace
+    when it failed) is kept in `results` for the script's JSON summary."""
+
+    def __init__(self):
+        self.results = []
+
+    def check(self, name, fn):
+        import traceback
+        try:
+            fn()
+            self.results.append({"check": name, "ok": True})
+        except Exception as e:  # noqa: BLE001
+            self.results.append({"check": name, "ok": False, "error": "%s: %s" % (type(e).__name__, e),
+                                 "trace": traceback.format_exc(limit=3)})

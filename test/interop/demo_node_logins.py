@@ -33,13 +33,12 @@ import shutil
 import sys
 import tempfile
 import time
-import traceback
 import urllib.error
 import urllib.parse
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, read_json_line, scratch_rr_env, start, stop, tail, write_password_file  # noqa: E402
+from child_procs import Checks, StepFailed, read_json_line, scratch_rr_env, start, stop, tail, write_password_file  # noqa: E402
 
 # The official library reads its node folders from the environment: point this process (the client)
 # and the gateway (started with this environment) at one scratch tree before the library loads.
@@ -61,19 +60,6 @@ HEX64 = re.compile(r"[0-9a-fA-F]{64}")
 
 def creds(password):
     return {"password": RR.VarValue(password, "string")}
-
-
-class Checks:
-    def __init__(self):
-        self.results = []
-
-    def check(self, name, fn):
-        try:
-            fn()
-            self.results.append({"check": name, "ok": True})
-        except Exception as e:  # noqa: BLE001
-            self.results.append({"check": name, "ok": False, "error": "%s: %s" % (type(e).__name__, e),
-                                 "trace": traceback.format_exc(limit=3)})
 
 
 def expect_refused(what, connect):

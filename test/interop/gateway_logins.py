@@ -40,12 +40,11 @@ import sys
 import tempfile
 import threading
 import time
-import traceback
 import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, read_json_line, start, stop, tail, write_password_file  # noqa: E402
+from child_procs import Checks, StepFailed, read_json_line, start, stop, tail, write_password_file  # noqa: E402
 
 try:
     import RobotRaconteur as RR
@@ -75,19 +74,6 @@ def make_jwt(claims, secret=JWT_SECRET, alg="HS256"):
 
 def creds(password):
     return {"password": RR.VarValue(password, "string")}
-
-
-class Checks:
-    def __init__(self):
-        self.results = []
-
-    def check(self, name, fn):
-        try:
-            fn()
-            self.results.append({"check": name, "ok": True})
-        except Exception as e:  # noqa: BLE001
-            self.results.append({"check": name, "ok": False, "error": "%s: %s" % (type(e).__name__, e),
-                                 "trace": traceback.format_exc(limit=3)})
 
 
 def expect_rr_error(fn, exc_type, text=None):
