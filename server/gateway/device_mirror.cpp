@@ -192,8 +192,6 @@ void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
     {
         std::lock_guard lock(mutex_);
         client_ = client;
-        state_ = DeviceState::connected;
-        reason_.clear();
         backoff_ = config_.backoff_initial;
         definitions_ = client->info().service_definitions;
         object_type_ = client->info().object_type;
@@ -217,6 +215,14 @@ void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
         }
     }
     service_->on_upstream_connected(client);
+    {
+        // Connected (and so /readyz ready) only once the service is registered and upstream-ready: a
+        // client that waited for readiness must find the service.
+        std::lock_guard lock(mutex_);
+        if (client_ != client) return;  // lost in between: on_disconnected already reported it
+        state_ = DeviceState::connected;
+        reason_.clear();
+    }
     notify_state();
 }
 

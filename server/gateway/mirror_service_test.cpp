@@ -2,6 +2,7 @@
 // level with RawClient as the downstream client.
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <future>
 #include <thread>
 
@@ -122,6 +123,32 @@ TEST_CASE("the gateway re-hosts a device under its own name") {
     CHECK(status.state == DeviceState::connected);
     CHECK(status.downstream_sessions == 1);
     CHECK(gw.mirror->counters().requests.load() >= 2);
+}
+
+TEST_CASE("a device counts as connected only once its service is registered on the gateway node") {
+    // /readyz and Gateway::ready() poll status(): a client that waited for "connected" must find the service.
+    Device device;
+    auto node = Node::create(NodeOptions{NodeID(), "gateway.node", 2, {}, 0, 5000ms});
+    DeviceConfig cfg;
+    cfg.name = "dev";
+    cfg.url = "rr+tcp://127.0.0.1:" + std::to_string(device.port) + "/?service=svc";
+    auto m = DeviceMirror::create(node, cfg);
+    REQUIRE(m);
+    std::atomic<int> registrations{0};
+    std::atomic<bool> connected_before_registered{false};
+    node->on_services_changed([&, mirror = std::weak_ptr<DeviceMirror>(*m)] {
+        auto self = mirror.lock();
+        if (!self || !node->find_service("dev")) return;
+        ++registrations;
+        if (self->status().state == DeviceState::connected) connected_before_registered = true;
+    });
+    (*m)->start();
+    for (int i = 0; i < 500 && (*m)->status().state != DeviceState::connected; ++i) std::this_thread::sleep_for(10ms);
+    CHECK((*m)->status().state == DeviceState::connected);
+    CHECK(registrations.load() == 1);
+    CHECK_FALSE(connected_before_registered.load());
+    (*m)->stop();
+    node->shutdown();
 }
 
 TEST_CASE("events and wire values fan out to every client, callbacks go to the caller") {
