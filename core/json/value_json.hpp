@@ -27,6 +27,7 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -38,11 +39,27 @@
 
 namespace rr {
 
+/// Where value_to_json puts numeric arrays instead of writing them as JSON numbers (the gateway's binary
+/// WebSocket pushes, docs/json-api.md "Binary pushes"). Each numeric array (T[], T[N], T[N-], and the
+/// items of T[*]; not scalars, not bool) becomes
+///   {"$binary": i, "type": "<keyword>", "length": items, "offset": bytes}
+/// with its little-endian bytes in blobs[i] (zero-copy: the array's own storage); `offset` is where
+/// they start when the blobs are laid out in order, each padded to a multiple of 8 bytes (so every
+/// typed view is aligned). A multi-dim array is {"dims": […], "array": {"$binary": …}}. Complex items
+/// are re then im; `length` counts items.
+struct BinaryArrays {
+    std::vector<SharedBytes> blobs;
+    std::size_t bytes = 0;  ///< the blobs' size laid out as above (padding included)
+
+    static constexpr std::size_t padded(std::size_t n) noexcept { return (n + 7) & ~std::size_t{7}; }
+};
+
 /// `value` as JSON for robdef type `type` (named types resolved through `lookup`, unqualified ones in
-/// `context_service`). The value must match the type as for pack_value (pack_value.hpp).
+/// `context_service`). The value must match the type as for pack_value (pack_value.hpp). With `binary`,
+/// numeric arrays go there as described above.
 Result<nlohmann::json> value_to_json(const Value& value, const robdef::TypeDefinition& type,
                                      const robdef::TypeLookup& lookup, std::string_view context_service,
-                                     const Limits& limits = {});
+                                     const Limits& limits = {}, BinaryArrays* binary = nullptr);
 
 /// The Value of robdef type `type` that `json` denotes. Builds values that pack_value accepts for the
 /// same type (scalar pods have one item, struct fields come in definition order).

@@ -3,6 +3,7 @@
 // the larger values of core/value's test service and the Value → JSON direction's own errors.
 #include <catch2/catch.hpp>
 
+#include <cstring>
 #include <limits>
 
 #include "core/json/value_json.hpp"
@@ -344,4 +345,52 @@ TEST_CASE("json: nesting depth is limited both ways") {
     auto h = value_from_json(json::parse(text), type_of("varvalue"), example_lookup(), kSvc);
     REQUIRE_FALSE(h);
     CHECK(h.error().type == MessageErrorType::ProtocolError);
+}
+
+TEST_CASE("json: with BinaryArrays, numeric arrays become {\"$binary\"} references to their bytes") {
+    BinaryArrays bin;
+    auto j = value_to_json(Value::array<double>({1.5, -2, 3}), type_of("double[]"), example_lookup(), kSvc, {}, &bin);
+    REQUIRE(j);
+    CHECK(*j == json{{"$binary", 0}, {"type", "double"}, {"length", 3}, {"offset", 0}});
+    REQUIRE(bin.blobs.size() == 1);
+    CHECK(bin.bytes == 24);
+    REQUIRE(bin.blobs[0].size() == 24);
+    double back[3];
+    std::memcpy(back, bin.blobs[0].data(), 24);
+    CHECK(back[0] == 1.5);
+    CHECK(back[1] == -2);
+    CHECK(back[2] == 3);
+
+    // Scalars stay numbers, bool arrays stay JSON; the next reference takes the next index.
+    j = value_to_json(Value::scalar(2.5), type_of("double"), example_lookup(), kSvc, {}, &bin);
+    CHECK(*j == json(2.5));
+    j = value_to_json(Value::array<bool>({true, false}), type_of("bool[]"), example_lookup(), kSvc, {}, &bin);
+    CHECK(*j == json{true, false});
+    j = value_to_json(Value::array<std::uint8_t>({}), type_of("uint8[]"), example_lookup(), kSvc, {}, &bin);
+    CHECK(*j == json{{"$binary", 1}, {"type", "uint8"}, {"length", 0}, {"offset", 24}});
+    j = value_to_json(Value::array<std::uint8_t>({1, 2, 3}), type_of("uint8[]"), example_lookup(), kSvc, {}, &bin);
+    CHECK(*j == json{{"$binary", 2}, {"type", "uint8"}, {"length", 3}, {"offset", 24}});
+    j = value_to_json(Value::array<std::int16_t>({-1}), type_of("int16[]"), example_lookup(), kSvc, {}, &bin);
+    CHECK(*j == json{{"$binary", 3}, {"type", "int16"}, {"length", 1}, {"offset", 32}});  // 3 bytes padded to 8
+    CHECK(bin.blobs.size() == 4);
+    CHECK(bin.bytes == 40);
+
+    // Inside a struct: the vector and the multi-dim fields, the rest as in the text form.
+    BinaryArrays in_struct;
+    auto outer = value_to_json(rich_values()[0].value, type_of("Outer"), example_lookup(), kSvc, {}, &in_struct);
+    REQUIRE(outer);
+    auto text = to_json_ok(rich_values()[0].value, "Outer");
+    CHECK((*outer)["v"] == json{{"$binary", 0}, {"type", "double"}, {"length", 3}, {"offset", 0}});
+    CHECK((*outer)["m"]["dims"] == text["m"]["dims"]);
+    CHECK((*outer)["m"]["array"]["type"] == "double");
+    CHECK((*outer)["inner"] == text["inner"]);
+    CHECK((*outer)["flag"] == text["flag"]);
+    CHECK(in_struct.blobs.size() >= 3);
+
+    // A value that fails leaves no blobs behind.
+    BinaryArrays failed;
+    auto bad = value_to_json(Value("text"), type_of("double[]"), example_lookup(), kSvc, {}, &failed);
+    CHECK_FALSE(bad);
+    CHECK(failed.blobs.empty());
+    CHECK(failed.bytes == 0);
 }

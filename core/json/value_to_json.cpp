@@ -33,8 +33,8 @@ json multidim_json(const std::vector<std::uint32_t>& dims, json array) {
 
 class ToJson {
 public:
-    ToJson(const robdef::TypeLookup& lookup, std::size_t max_depth)
-        : lookup_(lookup), cache_(lookup), path_({}), max_depth_(max_depth) {}
+    ToJson(const robdef::TypeLookup& lookup, std::size_t max_depth, BinaryArrays* binary)
+        : lookup_(lookup), binary_(binary), cache_(lookup), path_({}), max_depth_(max_depth) {}
 
     Result<json> to(const Value& v, const TypeDefinition& t, std::string_view ctx);
 
@@ -76,7 +76,11 @@ private:
     json namedarray_object(const NumericArray& a, std::size_t& offset, const NamedArrayShape& shape);
     Result<json> var(const Value& v);
 
+    /// The numeric array as JSON numbers, or as a {"$binary": …} reference when binary_ is set.
+    json array_json(const NumericArray& a);
+
     const robdef::TypeLookup& lookup_;
+    BinaryArrays* binary_;
     TypeCache cache_;
     NamedArrayShapeCache shapes_;
     ValuePath path_;
@@ -164,13 +168,25 @@ Result<json> ToJson::numeric(const Value& v, const TypeDefinition& t) {
         auto* m = v.get_if<MultiDimArray>();
         if (!m || m->array.type() != t.base) return expected(t, {}, m ? Value(m->array) : v);
         if (auto r = check_dims(m->dims, m->array.size(), t); !r) return relay(r.error());
-        return multidim_json(m->dims, json_numbers::array_to_json(m->array));
+        return multidim_json(m->dims, array_json(m->array));
     }
     auto* a = v.get_if<NumericArray>();
     if (!a || a->type() != t.base) return expected(t, {}, v);
     if (auto r = check_count(a->size(), t); !r) return relay(r.error());
     if (t.array == ArrayKind::none) return json_numbers::item_to_json(*a, 0);
-    return json_numbers::array_to_json(*a);
+    return array_json(*a);
+}
+
+json ToJson::array_json(const NumericArray& a) {
+    if (!binary_ || a.type() == DataTypes::bool_t) return json_numbers::array_to_json(a);
+    json ref = json::object();
+    ref["$binary"] = binary_->blobs.size();
+    ref["type"] = std::string(data_type_keyword(a.type()));
+    ref["length"] = a.size();
+    ref["offset"] = binary_->bytes;
+    binary_->blobs.push_back(a.to_bytes());
+    binary_->bytes += BinaryArrays::padded(binary_->blobs.back().size());
+    return ref;
 }
 
 Result<json> ToJson::named(const Value& v, const TypeDefinition& t, std::string_view ctx) {
@@ -296,7 +312,7 @@ Result<json> ToJson::pod_field(const Value& v, const PodFieldPlan& plan) {
         }
         if (!a || a->type() != wt.base) return expected(decl, {}, a ? Value(*a) : v);
         if (auto r = check(dims, a->size()); !r) return r.take_error();
-        return multidim_json(plan.dims, json_numbers::array_to_json(*a));
+        return multidim_json(plan.dims, array_json(*a));
     }
     if (plan.named.kind == NamedTypeKind::pod) {
         auto* p = v.get_if<PodArray>();
@@ -398,11 +414,21 @@ Result<json> ToJson::var(const Value& v) {
 }  // namespace
 
 Result<json> value_to_json(const Value& value, const TypeDefinition& type, const robdef::TypeLookup& lookup,
-                           std::string_view context_service, const Limits& limits) {
+                           std::string_view context_service, const Limits& limits, BinaryArrays* binary) {
+    const std::size_t blobs_before = binary ? binary->blobs.size() : 0, bytes_before = binary ? binary->bytes : 0;
     try {
-        ToJson t(lookup, limits.max_nesting_depth);
-        return t.to(value, type, context_service);
+        ToJson t(lookup, limits.max_nesting_depth, binary);
+        auto j = t.to(value, type, context_service);
+        if (!j && binary) {  // no references to them were returned
+            binary->blobs.resize(blobs_before);
+            binary->bytes = bytes_before;
+        }
+        return j;
     } catch (const std::exception& e) {
+        if (binary) {
+            binary->blobs.resize(blobs_before);
+            binary->bytes = bytes_before;
+        }
         return fail(MessageErrorType::InternalError, std::string("JSON: ") + e.what());
     }
 }

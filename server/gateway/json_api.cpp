@@ -325,11 +325,11 @@ void JsonApi::finish_resolve(std::shared_ptr<DeviceMirror> device, std::shared_p
 }
 
 ApiResult JsonApi::element_json(const MessageElement& element, const robdef::TypeDefinition& type,
-                                const MemberTarget& t) const {
+                                const MemberTarget& t, BinaryArrays* binary) const {
     if (type.is_void()) return ApiResult::ok(nullptr);
     auto v = unpack_value(element, type, t.types->set(), t.context(), options_.limits);
     if (!v) return ApiResult::failed(ApiError{502, v.error().name, "value from the device: " + v.error().message});
-    auto j = value_to_json(*v, type, t.types->set(), t.context(), options_.limits);
+    auto j = value_to_json(*v, type, t.types->set(), t.context(), options_.limits, binary);
     if (!j) return ApiResult::failed(ApiError{502, j.error().name, "value from the device: " + j.error().message});
     return ApiResult::ok(std::move(*j));
 }

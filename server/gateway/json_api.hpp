@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/codec/limits.hpp"
+#include "core/json/value_json.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
@@ -138,10 +139,11 @@ public:
     /// `{"value": …, "time": {"seconds", "nanoseconds"}}`: the newest value of a wire (WirePeekInValue).
     void peek_wire(const MemberAddress& address, Done done);
 
-    /// The element as JSON for `type` of `target`'s service. Errors: 502 (the device sent a value
-    /// that does not fit its own definition).
+    /// The element as JSON for `type` of `target`'s service; with `binary`, numeric arrays go there
+    /// (value_json.hpp BinaryArrays). Errors: 502 (the device sent a value that does not fit its own
+    /// definition).
     ApiResult element_json(const MessageElement& element, const robdef::TypeDefinition& type,
-                           const MemberTarget& target) const;
+                           const MemberTarget& target, BinaryArrays* binary = nullptr) const;
     /// JSON as an element named `name` packed for `type`. Errors: 400 (value_error, `where` names it).
     Result<MessageElement> element_from_json(const nlohmann::json& json, const robdef::TypeDefinition& type,
                                              const MemberTarget& target, std::string_view name,

@@ -26,6 +26,7 @@
 #include "server/app/gateway.hpp"
 #include "server/gateway/json_api_installer.hpp"
 #include "server/gateway/json_rest.hpp"
+#include "server/gateway/binary_push.hpp"
 #include "server/gateway/json_socket.hpp"
 
 extern char** environ;
@@ -320,7 +321,14 @@ private:
                 cv_.notify_all();
                 return;
             }
-            inbox_.push_back(json::parse(beast::buffers_to_string(buffer_.data()), nullptr, false));
+            if (ws_.got_binary()) {
+                // A binary push: kept as the JSON it decodes to, marked so tests can tell.
+                auto j = decode_binary_push(beast::buffers_to_string(buffer_.data()));
+                inbox_.push_back(j ? *j : json{{"$bad_binary", j.error().message}});
+                inbox_.back()["$binary_message"] = true;
+            } else {
+                inbox_.push_back(json::parse(beast::buffers_to_string(buffer_.data()), nullptr, false));
+            }
             buffer_.consume(buffer_.size());
             cv_.notify_all();
             if (!paused_) start_read();

@@ -9,6 +9,7 @@
 #include "core/session/elements.hpp"
 #include "core/value/timespec.hpp"
 #include "server/gateway/auth/http_auth.hpp"
+#include "server/gateway/binary_push.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
@@ -127,6 +128,7 @@ private:
     struct Subscription {
         SubKind kind = SubKind::event;
         bool may_write = true;  // auth: gateway allows `write` on the member
+        bool binary = false;    // "binary": true: values with numeric arrays go as binary pushes
         std::shared_ptr<const MemberTarget> target;  // shared: every push takes it, copying no strings
         std::shared_ptr<SessionEndpoints> own;  // made on this socket's device_login session; null: the shared one
         std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, internal pipe id, or `own`'s id
@@ -261,17 +263,24 @@ private:
                 max_items = m->get<std::size_t>();
             }
         }
+        bool binary = false;
+        if (op == "subscribe") {
+            if (auto b = msg.find("binary"); b != msg.end()) {
+                if (!b->is_boolean()) return fail_with(bad_request("\"binary\" must be true or false"));
+                binary = b->get<bool>();
+            }
+        }
         if (!begin_request(id)) return;
         if (op == "get") return api_->get_property(address, replier(id));
         if (op == "set") return api_->set_property(address, value, replier(id));
         if (op == "call") return api_->call_function(address, args, max_items, replier(id));
         if (op == "peek") return api_->peek_wire(address, replier(id));
-        subscribe(id, std::move(address));
+        subscribe(id, std::move(address), binary);
     }
 
     // --- subscriptions ----------------------------------------------------------------------------
 
-    void subscribe(const nlohmann::json& id, MemberAddress address) {
+    void subscribe(const nlohmann::json& id, MemberAddress address, bool binary) {
         // Receiving (wire values, events, pipe packets) needs `read`; sending on the subscription
         // (set_out_value, send) needs `write`, decided here once.
         if (auto denied = api_->check_access(address, auth::Operation::read)) {
@@ -280,12 +289,12 @@ private:
         }
         const bool may_write = !api_->check_access(address, auth::Operation::write).has_value();
         auto self = shared_from_this();
-        api_->resolve(address, [self, id, may_write](Resolved r) {
+        api_->resolve(address, [self, id, may_write, binary](Resolved r) {
             if (auto* e = std::get_if<ApiError>(&r)) {
                 self->send_reply(id, ApiResult::failed(*e));
                 return self->end_request();
             }
-            self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write);
+            self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write, binary);
         });
     }
 
@@ -425,7 +434,7 @@ private:
         return it == device_logins_.end() ? nullptr : it->second.endpoints;
     }
 
-    void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write) {
+    void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write, bool binary) {
         SubKind kind;
         switch (t.member->kind) {
             case robdef::MemberKind::wire: kind = SubKind::wire; break;
@@ -457,6 +466,7 @@ private:
             Subscription s;
             s.kind = kind;
             s.may_write = may_write;
+            s.binary = binary;
             s.target = std::make_shared<const MemberTarget>(t);
             s.own = own_endpoints(t.device->config().name);
             own = s.own;
@@ -749,7 +759,7 @@ private:
     }
 
     // Takes a push slot for subscription `sid`: false (and counted) when the client is too far behind.
-    bool take_push(std::uint64_t sid, std::shared_ptr<const MemberTarget>& t, std::uint64_t& dropped) {
+    bool take_push(std::uint64_t sid, std::shared_ptr<const MemberTarget>& t, std::uint64_t& dropped, bool& binary) {
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
         if (it == subs_.end() || !it->second.active || closed_) return false;
@@ -760,26 +770,50 @@ private:
         }
         t = it->second.target;
         dropped = std::exchange(it->second.dropped, 0);
+        binary = it->second.binary;
         return true;
+    }
+
+    // A push whose body (a JSON object's text, shared by all subscribers) is `r`: a binary message
+    // when it refers to arrays, else text.
+    void send_push(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, const SharedEntry::BinaryRendering& r) {
+        if (r.arrays.empty())
+            socket_->send(push_text(sid, kind, dropped, r.body));
+        else
+            socket_->send_binary(binary_push_message(push_text(sid, kind, dropped, r.body), r.arrays));
     }
 
     void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
         std::shared_ptr<const MemberTarget> t;
         std::uint64_t dropped = 0;
-        if (!take_push(sid, t, dropped)) return;
+        bool binary = false;
+        if (!take_push(sid, t, dropped, binary)) return;
+        if (binary)
+            return send_push(sid, "event", dropped, e->rendered_binary([&](const MessageEntry& entry) {
+                return render_binary([&](BinaryArrays* b) { return event_body(entry, *t, b); });
+            }));
         const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_body(entry, *t)); });
         socket_->send(push_text(sid, "event", dropped, body));
     }
 
+    // A push body made with numeric arrays set aside (`body(arrays)` returns the JSON object).
+    template <class Body>
+    static SharedEntry::BinaryRendering render_binary(Body&& body) {
+        BinaryArrays arrays;
+        nlohmann::json j = body(&arrays);
+        if (j.contains("error")) arrays.blobs.clear();  // made before a later part failed: nothing refers to them
+        return SharedEntry::BinaryRendering{json_text(j), std::move(arrays.blobs)};
+    }
+
     // {"args": {…}} or {"error": …}: the part of an event push every subscriber shares.
-    nlohmann::json event_body(const MessageEntry& e, const MemberTarget& t) const {
+    nlohmann::json event_body(const MessageEntry& e, const MemberTarget& t, BinaryArrays* binary = nullptr) const {
         auto args = nlohmann::json::object();
         for (const auto& p : t.member->parameters) {
             const auto* el = e.find(p.name);
             if (!el)
                 return {{"error", error_object(api_error(502, MessageErrorType::MessageElementNotFound,
                                                          "event from the device has no \"" + p.name + "\" element"))}};
-            auto j = api_->element_json(*el, p, t);
+            auto j = api_->element_json(*el, p, t, binary);
             if (!j) return {{"error", error_object(*j.error)}};
             args[p.name] = std::move(j.value);
         }
@@ -817,7 +851,8 @@ private:
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
         std::shared_ptr<const MemberTarget> t;
         std::uint64_t dropped = 0;
-        if (!take_push(sid, t, dropped)) return;
+        bool binary = false;
+        if (!take_push(sid, t, dropped, binary)) return;
         const std::size_t bytes = payload_bytes(packet);
         if (!pipe_budget_.try_acquire(bytes)) {
             std::lock_guard lock(mutex_);
@@ -825,26 +860,33 @@ private:
             ++push_drops_;
             return;
         }
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped, bytes] {
-            self->convert_pipe_packet(sid, packet, *t, dropped);
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped, bytes, binary] {
+            self->convert_pipe_packet(sid, packet, *t, dropped, binary);
             self->pipe_budget_.release(bytes);
         });
     }
 
     // On the conversion strand (packets of one socket stay in order).
-    void convert_pipe_packet(std::uint64_t sid, const MessageElement& packet, const MemberTarget& t, std::uint64_t dropped) {
+    void convert_pipe_packet(std::uint64_t sid, const MessageElement& packet, const MemberTarget& t, std::uint64_t dropped,
+                             bool binary) {
         if (!push_allowed(sid)) return;
         nlohmann::json msg{{"subscription", sid}, {"kind", "pipe"}};
-        auto j = api_->element_json(packet, t.member->type, t);
+        BinaryArrays arrays;
+        auto j = api_->element_json(packet, t.member->type, t, binary ? &arrays : nullptr);
         if (j)
             msg["value"] = std::move(j.value);
         else
             msg["error"] = error_object(*j.error);
         if (dropped) msg["dropped"] = dropped;
         auto text = json_text(msg);
+        if (!arrays.blobs.empty()) text = binary_push_message(text, arrays.blobs);
         // Under the lock: never after the subscription's "closed" push or its unsubscribe reply.
         std::lock_guard lock(mutex_);
-        if (push_allowed_locked(sid)) socket_->send(std::move(text));
+        if (!push_allowed_locked(sid)) return;
+        if (arrays.blobs.empty())
+            socket_->send(std::move(text));
+        else
+            socket_->send_binary(std::move(text));
     }
 
     bool push_allowed(std::uint64_t sid) const {
@@ -904,6 +946,7 @@ private:
             std::uint64_t sid;
             SharedEntryPtr entry;
             std::shared_ptr<const MemberTarget> target;
+            bool binary;
         };
         std::vector<Item> batch;
         for (;;) {
@@ -928,11 +971,17 @@ private:
                 }
                 for (auto& [sid, sub] : subs_) {
                     if (!sub.active || !sub.pending_wire) continue;
-                    batch.push_back(Item{sid, std::move(sub.pending_wire), sub.target});
+                    batch.push_back(Item{sid, std::move(sub.pending_wire), sub.target, sub.binary});
                     sub.pending_wire = nullptr;
                 }
             }
             for (auto& item : batch) {
+                if (item.binary) {
+                    send_push(item.sid, "wire", 0, item.entry->rendered_binary([&](const MessageEntry& e) {
+                        return render_binary([&](BinaryArrays* b) { return wire_body(e, *item.target, b); });
+                    }));
+                    continue;
+                }
                 const std::string& body = item.entry->rendered(
                     [&](const MessageEntry& e) { return json_text(wire_body(e, *item.target)); });
                 socket_->send(push_text(item.sid, "wire", 0, body));
@@ -946,7 +995,7 @@ private:
     }
 
     // {"value": …, "time": …} or {"error": …}: the part of a wire push every subscriber shares.
-    nlohmann::json wire_body(const MessageEntry& e, const MemberTarget& t) const {
+    nlohmann::json wire_body(const MessageEntry& e, const MemberTarget& t, BinaryArrays* binary = nullptr) const {
         nlohmann::json msg = nlohmann::json::object();
         const auto* p = e.find("packet");
         const auto* ts = e.find("packettime");
@@ -956,7 +1005,7 @@ private:
             return msg;
         }
         auto time = unpack_timespec(*ts);
-        auto j = api_->element_json(*p, t.member->type, t);
+        auto j = api_->element_json(*p, t.member->type, t, binary);
         if (!time) {
             msg["error"] = error_object(ApiError{502, time.error().name, time.error().message});
         } else if (!j) {

@@ -4,7 +4,9 @@
 // Client → gateway: requests {"id", "op", …}; op ∈ login, device_login, device_logout, devices,
 // device, get, set, call, peek, subscribe, unsubscribe, set_out_value, send. Each is answered once with {"id", "result"} or {"id", "error"}.
 // Gateway → client, unasked: {"subscription", "kind": "wire"|"event"|"pipe"|"pipe_ack"|"closed", …} for
-// subscriptions, and {"kind": "device_state", "device": {…}} whenever a device's state changes.
+// subscriptions, and {"kind": "device_state", "device": {…}} whenever a device's state changes. A
+// subscription made with "binary": true gets values with numeric arrays as binary messages
+// (binary_push.hpp), rendered once per value for all such subscribers, as the text form is.
 //
 // Backpressure (a client that reads slowly never grows the gateway's memory without bound):
 //   * the socket's own queue holds at most HttpOptions::json_socket_queue_limit messages (oldest dropped);

@@ -34,6 +34,61 @@ auto push_of(std::uint64_t sid, std::string kind) {
 
 }  // namespace
 
+TEST_CASE("json socket: \"binary\": true sends values with numeric arrays as binary pushes, the rest as text") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    WsClient ws(gw.port());
+    auto subscribe_as = [&](const std::string& m, bool binary) {
+        auto r = ws.request(member("subscribe", m, {{"binary", binary}}));
+        INFO(r.dump());
+        REQUIRE(r.contains("result"));
+        return r["result"]["subscription"].get<std::uint64_t>();
+    };
+    auto is_binary = [](const json& j) { return j.value("$binary_message", false); };
+
+    // The same wire twice: text and binary pushes carry the same value.
+    const auto text_state = subscribe_as("w_state", false);
+    const auto bin_state = subscribe_as("w_state", true);
+    CHECK(ws.request(member("call", "update_state", {{"args", {515151}}}))["result"] == json{{"return", nullptr}});
+    auto as_text = ws.wait_push([&](const json& j) { return push_of(text_state, "wire")(j) && j["value"]["id"] == 515151; });
+    auto as_binary = ws.wait_push([&](const json& j) { return push_of(bin_state, "wire")(j) && j["value"]["id"] == 515151; });
+    REQUIRE(as_text);
+    REQUIRE(as_binary);
+    CHECK_FALSE(is_binary(*as_text));
+    CHECK(is_binary(*as_binary));
+    CHECK((*as_binary)["value"] == (*as_text)["value"]);
+    CHECK((*as_binary)["time"] == (*as_text)["time"]);
+
+    // Events: a struct argument with a double[] goes binary; an event without arrays stays text.
+    const auto values = subscribe_as("ev_values", true);
+    const auto empty = subscribe_as("ev_empty", true);
+    ws.request(member("call", "fire_events", {{"args", {2}}}));
+    for (int seq = 0; seq < 2; ++seq) {
+        auto ev = ws.wait_push([&](const json& j) { return push_of(values, "event")(j) && j["args"]["seq"] == seq; });
+        REQUIRE(ev);
+        CHECK(is_binary(*ev));
+        CHECK((*ev)["args"]["data"] == json{{"id", seq}, {"label", "event"}, {"values", {seq * 1.5}}});
+    }
+    auto ev_empty = ws.wait_push(push_of(empty, "event"));
+    REQUIRE(ev_empty);
+    CHECK_FALSE(is_binary(*ev_empty));
+
+    // Pipes: double[] packets from the device.
+    const auto stream = subscribe_as("p_stream", true);
+    ws.request(member("call", "send_stream", {{"args", {2}}}));
+    for (int i = 0; i < 2; ++i) {
+        auto p = ws.wait_push([&](const json& j) { return push_of(stream, "pipe")(j) && j["value"][0] == double(i); });
+        REQUIRE(p);
+        CHECK(is_binary(*p));
+        CHECK((*p)["value"] == json{double(i), i * 0.5});
+    }
+
+    // Requests and their replies stay text; a "binary" that is not a bool is refused.
+    CHECK(error_name(ws.request(member("subscribe", "w_state", {{"binary", "yes"}}))) == "RobotRaconteur.InvalidArgument");
+    for (const auto& j : ws.pushes()) CHECK_FALSE(j.contains("$bad_binary"));
+}
+
 TEST_CASE("json socket: requests are answered by id") {
     if (!interop_service_built()) return;
     InteropProcess device;

@@ -1,13 +1,16 @@
 // One upstream wire value or event as the gateway's own subscribers (the JSON API sockets) see it:
-// a single shared copy for all of them, plus one cached rendering made by the first subscriber that
-// needs it, so a value fanned out to N WebSocket clients is converted to JSON once, not N times.
+// a single shared copy for all of them, plus one cached rendering (of each form: text, binary) made by
+// the first subscriber that needs it, so a value fanned out to N WebSocket clients is converted to JSON
+// once, not N times.
 #pragma once
 
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "core/codec/shared_bytes.hpp"
 #include "core/message/message.hpp"
 
 namespace rr::server::gateway {
@@ -26,10 +29,23 @@ public:
         return rendered_;
     }
 
+    /// Like rendered(), for the subscribers of binary pushes (binary_push.hpp): the body's text with
+    /// "$binary" references, and the arrays they refer to.
+    struct BinaryRendering {
+        std::string body;
+        std::vector<SharedBytes> arrays;
+    };
+    template <class Render>
+    const BinaryRendering& rendered_binary(Render&& render) const {
+        std::call_once(binary_once_, [&] { binary_ = std::forward<Render>(render)(entry_); });
+        return binary_;
+    }
+
 private:
     MessageEntry entry_;
-    mutable std::once_flag once_;
+    mutable std::once_flag once_, binary_once_;
     mutable std::string rendered_;
+    mutable BinaryRendering binary_;
 };
 
 using SharedEntryPtr = std::shared_ptr<const SharedEntry>;

@@ -58,13 +58,16 @@ public:
     /// written and after earlier send_urgent() messages, which keep their order): answers to the
     /// client's requests do not wait behind a backlog of pushes. Thread-safe.
     virtual void send_urgent(std::string text) { send(std::move(text)); }
+    /// Queues `bytes` as one binary message (the gateway's binary pushes), in order with send() and
+    /// under the same queue limit. Thread-safe.
+    virtual void send_binary(std::string bytes) = 0;
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
     /// The Cookie header of the upgrade request ("" without one), for handlers that authenticate the
     /// socket by a session cookie.
     virtual std::string cookie_header() const { return {}; }
-    /// Text messages accepted by send() and not yet written (the one being written included), and
+    /// Messages accepted by send() (and send_binary()) and not yet written (the one being written included), and
     /// their bytes: for backpressure decisions by the handler. Thread-safe.
     virtual std::size_t queued() const { return 0; }
     virtual std::size_t queued_bytes() const { return 0; }

@@ -139,6 +139,7 @@ public:
 
     void send(std::string text) override { enqueue(std::move(text), false); }
     void send_urgent(std::string text) override { enqueue(std::move(text), true); }
+    void send_binary(std::string bytes) override { enqueue(std::move(bytes), false, true); }
 
     std::size_t queued() const override { return queued_count_.load(); }
     std::size_t queued_bytes() const override { return queued_bytes_.load(); }
@@ -162,13 +163,14 @@ private:
     struct Outgoing {
         std::string text;
         bool urgent = false;
+        bool binary = false;
     };
 
-    void enqueue(std::string text, bool urgent) {
+    void enqueue(std::string text, bool urgent, bool binary = false) {
         auto self = shared_from_this();
         queued_count_.fetch_add(1);
         queued_bytes_.fetch_add(text.size());
-        asio::post(ws_.get_executor(), [self, text = std::move(text), urgent]() mutable {
+        asio::post(ws_.get_executor(), [self, text = std::move(text), urgent, binary]() mutable {
             if (self->closed_) {
                 self->unqueue(text);
                 return;
@@ -183,9 +185,9 @@ private:
                 self->dropped_.fetch_add(1);
             }
             if (urgent)
-                q.insert(self->first_waiting_push(), Outgoing{std::move(text), true});
+                q.insert(self->first_waiting_push(), Outgoing{std::move(text), true, binary});
             else
-                q.push_back(Outgoing{std::move(text), false});
+                q.push_back(Outgoing{std::move(text), false, binary});
             self->write();
         });
     }
@@ -235,6 +237,7 @@ private:
         if (writing_ || queue_.empty() || closed_) return;
         writing_ = true;
         auto self = shared_from_this();
+        ws_.binary(queue_.front().binary);  // the message type of the next write
         ws_.async_write(asio::buffer(queue_.front().text), [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
             if (ec) {

@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "server/gateway/binary_push.hpp"
 #include "server/gateway/json_socket.hpp"
 #include "test/fuzz/gateway_harness.hpp"
 
@@ -30,6 +31,11 @@ class FakeSocket : public rr::server::http::JsonSocket {
 public:
     void send(std::string text) override { take(std::move(text)); }
     void send_urgent(std::string text) override { take(std::move(text)); }
+    void send_binary(std::string bytes) override {
+        auto j = rr::server::gateway::decode_binary_push(bytes);
+        if (!j) rr::fuzz::fail_input("the gateway sent a binary message that is not a binary push: " + j.error().message);
+        take(j->dump());
+    }
     void close() override {
         std::lock_guard lock(mutex_);
         closed_by_server_ = true;

@@ -1,0 +1,37 @@
+// Binary pushes of the JSON WebSocket (docs/json-api.md "Binary pushes"): a subscription made with
+// "binary": true gets each value whose JSON has numeric arrays as one binary WebSocket message
+//
+//   0        "RRJB"
+//   4        uint32 LE: J, the length of the JSON text
+//   8        the push as JSON text (UTF-8), each numeric array replaced by
+//            {"$binary": i, "type": "<RR type>", "length": items, "offset": bytes} (BinaryArrays)
+//   8+J      zero bytes up to B, the next multiple of 8
+//   B        the arrays' little-endian bytes, array i at B + offset, each padded to a multiple of 8
+//
+// so a browser makes a typed array over the message (new Float64Array(buffer, B + offset, length))
+// without copying or parsing numbers; values without numeric arrays stay text messages.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/codec/shared_bytes.hpp"
+#include "core/error/rr_error.hpp"
+
+namespace rr::server::gateway {
+
+inline constexpr std::string_view kBinaryPushMagic = "RRJB";
+
+/// The message for `json_text` (a push with "$binary" references) and the arrays it refers to.
+std::string binary_push_message(std::string_view json_text, const std::vector<SharedBytes>& blobs);
+
+/// The push a binary message carries, each "$binary" reference replaced by the array's JSON numbers
+/// (what the text form of the same push holds): the reference decoder, for tests and tools.
+/// Errors: ProtocolError for a message that is not one (magic, lengths, a reference outside the
+/// message, an unknown type, bad JSON).
+Result<nlohmann::json> decode_binary_push(std::string_view message);
+
+}  // namespace rr::server::gateway
