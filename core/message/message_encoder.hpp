@@ -2,6 +2,7 @@
 // records every entry/element size in pre-order; write() replays them. Not part of the public API.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -48,7 +49,13 @@ private:
     std::uint32_t next_size();
 
     const Message& m_;
-    std::vector<std::uint32_t> sizes_;  // entry and element sizes, pre-order
+    /// Entry and element sizes, pre-order: the first kInlineSizes in the encoder itself, so a message
+    /// of a few entries and elements is encoded without allocating for them.
+    static constexpr std::size_t kInlineSizes = 16;
+    std::array<std::uint32_t, kInlineSizes> inline_sizes_{};
+    std::vector<std::uint32_t> more_sizes_;
+    std::size_t size_count_ = 0;
+    std::uint32_t& size_slot(std::size_t i) { return i < kInlineSizes ? inline_sizes_[i] : more_sizes_[i - kInlineSizes]; }
     std::size_t cursor_ = 0;
     std::uint32_t total_ = 0;
     std::uint32_t header_size_ = 0;

@@ -56,7 +56,8 @@ std::uint64_t xlen_size(std::size_t n) noexcept {
 Result<std::uint32_t> MessageEncoder::measure() {
     if (m_.entries.size() > 0xFFFF)
         return fail(MessageErrorType::InvalidArgument, std::to_string(m_.entries.size()) + " entries (max 65535)");
-    sizes_.clear();
+    size_count_ = 0;
+    more_sizes_.clear();
     if (m_.version != 2 && m_.version != 4)
         return fail(MessageErrorType::InvalidArgument, "unknown message version " + std::to_string(m_.version));
     auto total = m_.version == 2 ? measure_v2() : measure_v4();
@@ -101,11 +102,14 @@ Result<std::uint64_t> MessageEncoder::check_payload(const MessageElement& e) con
 }
 
 std::size_t MessageEncoder::reserve_size_slot() {
-    sizes_.push_back(0);
-    return sizes_.size() - 1;
+    if (size_count_ < kInlineSizes)
+        inline_sizes_[size_count_] = 0;
+    else
+        more_sizes_.push_back(0);
+    return size_count_++;
 }
 
-std::uint32_t MessageEncoder::next_size() { return sizes_[cursor_++]; }
+std::uint32_t MessageEncoder::next_size() { return size_slot(cursor_++); }
 
 }  // namespace detail
 }  // namespace rr

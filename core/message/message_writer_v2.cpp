@@ -65,7 +65,7 @@ Result<std::uint64_t> MessageEncoder::measure_entry_v2(const MessageEntry& entry
         size += *n;
         if (size > kMax32) return fail(MessageErrorType::InvalidArgument, "entry over 4 GiB");
     }
-    sizes_[slot] = static_cast<std::uint32_t>(size);
+    size_slot(slot) = static_cast<std::uint32_t>(size);
     return size;
 }
 
@@ -91,7 +91,7 @@ Result<std::uint64_t> MessageEncoder::measure_element_v2(const MessageElement& e
         if (size > kMax32) return fail(MessageErrorType::InvalidArgument, "element over 4 GiB");
     }
     if (size > kMax32) return fail(MessageErrorType::InvalidArgument, "element over 4 GiB");
-    sizes_[slot] = static_cast<std::uint32_t>(size);
+    size_slot(slot) = static_cast<std::uint32_t>(size);
     return size;
 }
 

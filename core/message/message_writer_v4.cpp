@@ -131,7 +131,7 @@ Result<std::uint64_t> MessageEncoder::measure_entry_v4(const MessageEntry& entry
     }
     const std::uint64_t size = size_plus_uint_x(s);
     if (size > kMax32) return fail(MessageErrorType::InvalidArgument, "entry over 4 GiB");
-    sizes_[slot] = static_cast<std::uint32_t>(size);
+    size_slot(slot) = static_cast<std::uint32_t>(size);
     return size;
 }
 
@@ -163,7 +163,7 @@ Result<std::uint64_t> MessageEncoder::measure_element_v4(const MessageElement& e
     }
     const std::uint64_t size = size_plus_uint_x(s);
     if (size > kMax32) return fail(MessageErrorType::InvalidArgument, "element over 4 GiB");
-    sizes_[slot] = static_cast<std::uint32_t>(size);
+    size_slot(slot) = static_cast<std::uint32_t>(size);
     return size;
 }
 

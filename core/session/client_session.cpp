@@ -147,7 +147,7 @@ Result<void> ClientSession::send_special(MessageEntry entry, MonoTime now, std::
     m.header.message_id = ++message_id_;
     m.entries.push_back(std::move(entry));
     last_send_ = now;
-    return stream_.send(m, now);
+    return stream_.send(std::move(m), now);
 }
 
 Result<void> ClientSession::send_session(MessageEntry entry, MonoTime now) {
@@ -161,7 +161,7 @@ Result<void> ClientSession::send_session(MessageEntry entry, MonoTime now) {
     if (entry.metadata == "unreliable\n") m.header.metadata = entry.metadata;  // wire.md §1.6
     m.entries.push_back(std::move(entry));
     last_send_ = now;
-    return stream_.send(m, now);
+    return stream_.send(std::move(m), now);
 }
 
 void ClientSession::start_connect(MonoTime now) {
@@ -428,10 +428,7 @@ void ClientSession::on_timer(MonoTime now) {
 }
 
 std::optional<ClientSessionEvent> ClientSession::poll_event() {
-    if (events_.empty()) return std::nullopt;
-    ClientSessionEvent e = std::move(events_.front());
-    events_.pop_front();
-    return e;
+    return events_.pop();
 }
 
 void ClientSession::fail_connect(RRError error) { close(std::move(error)); }

@@ -18,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/session/event_queue.hpp"
 #include "core/session/stream_connection.hpp"
 
 namespace rr {
@@ -161,7 +162,7 @@ private:
     std::uint16_t message_id_ = 0;
     std::vector<std::string> pending_imports_;
     std::map<std::uint32_t, Pending> pending_;
-    std::deque<ClientSessionEvent> events_;
+    EventQueue<ClientSessionEvent> events_;
     MonoTime last_send_;
     MonoTime connect_deadline_;
     std::optional<MonoTime> connect_limit_;  // construction + config_.connect_timeout, when set

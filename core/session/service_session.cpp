@@ -109,10 +109,7 @@ void ServiceSession::on_timer(MonoTime now) {
 }
 
 std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
-    if (events_.empty()) return std::nullopt;
-    ServiceSessionEvent ev = std::move(events_.front());
-    events_.pop_front();
-    return ev;
+    return events_.pop();
 }
 
 void ServiceSession::close_session() {

@@ -27,6 +27,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/session/event_queue.hpp"
 #include "core/session/service_host.hpp"
 #include "core/session/stream_connection.hpp"
 
@@ -181,7 +182,7 @@ private:
     ServiceHost& host_;
     ServiceSessionConfig config_;
     StreamConnection stream_;
-    std::deque<ServiceSessionEvent> events_;
+    EventQueue<ServiceSessionEvent> events_;
     bool closed_reported_ = false;
 
     std::shared_ptr<HostedService> service_;

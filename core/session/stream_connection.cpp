@@ -312,25 +312,49 @@ Result<void> StreamConnection::send_frame(std::span<const std::byte> frame, Mono
     return {};
 }
 
+Result<void> StreamConnection::send(Message&& message, MonoTime now) {
+    if (state_ != State::connected)
+        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
+    return queue_owned(message, send_version(), now, true);
+}
+
+// v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this
+// session's nodes and endpoints (CORE, wire.md §2.3), except for one entry below 500.
+bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bool omit_routing) const {
+    return m.version != version || (omit_routing_applies(m, version, omit_routing) && !m.header.v4_flags);
+}
+
+bool StreamConnection::omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const {
+    return omit_routing && version == 4 && session_established_ && m.entries.size() == 1 &&
+           static_cast<std::uint16_t>(m.entries.front().entry_type) >= 500 &&
+           m.header.sender_node_id == config_.local_node_id && m.header.receiver_node_id == negotiated_.remote_node_id &&
+           m.header.sender_endpoint == local_endpoint_ && m.header.receiver_endpoint == remote_endpoint_ &&
+           m.header.sender_node_name.empty() && m.header.receiver_node_name.empty();
+}
+
+void StreamConnection::relabel(Message& m, std::uint16_t version, bool omit_routing) const {
+    const bool omit = omit_routing_applies(m, version, omit_routing) && !m.header.v4_flags;
+    m.version = version;
+    if (omit)
+        m.header.v4_flags =
+            static_cast<std::uint8_t>(default_v4_flags(m) & ~(message_flags::routing_info | message_flags::endpoint_info));
+}
+
 Result<void> StreamConnection::queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
+    if (!needs_relabel(m, version, omit_routing)) return append_encoded(m, now);
+    Message copy = m;
+    relabel(copy, version, omit_routing);
+    return append_encoded(copy, now);
+}
+
+Result<void> StreamConnection::queue_owned(Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
+    if (needs_relabel(m, version, omit_routing)) relabel(m, version, omit_routing);
+    return append_encoded(m, now);
+}
+
+Result<void> StreamConnection::append_encoded(const Message& m, MonoTime now) {
     const std::size_t before = output_.size();
-    Result<void> r;
-    const bool can_omit = omit_routing && version == 4 && session_established_ && m.entries.size() == 1 &&
-                          static_cast<std::uint16_t>(m.entries.front().entry_type) >= 500 &&
-                          m.header.sender_node_id == config_.local_node_id &&
-                          m.header.receiver_node_id == negotiated_.remote_node_id &&
-                          m.header.sender_endpoint == local_endpoint_ && m.header.receiver_endpoint == remote_endpoint_ &&
-                          m.header.sender_node_name.empty() && m.header.receiver_node_name.empty();
-    if (m.version == version && !(can_omit && !m.header.v4_flags)) {
-        r = encode_message(m, output_);
-    } else {
-        Message copy = m;
-        copy.version = version;
-        if (can_omit && !copy.header.v4_flags)
-            copy.header.v4_flags = static_cast<std::uint8_t>(
-                default_v4_flags(copy) & ~(message_flags::routing_info | message_flags::endpoint_info));
-        r = encode_message(copy, output_);
-    }
+    Result<void> r = encode_message(m, output_);
     if (!r) {
         output_.resize(before);
         return r;
@@ -387,10 +411,7 @@ void StreamConnection::take_output(std::vector<std::byte>& out) {
 }
 
 std::optional<StreamEvent> StreamConnection::poll_event() {
-    if (events_.empty()) return std::nullopt;
-    StreamEvent e = std::move(events_.front());
-    events_.pop_front();
-    return e;
+    return events_.pop();
 }
 
 std::optional<MonoTime> StreamConnection::next_deadline() const {

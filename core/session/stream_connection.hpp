@@ -12,6 +12,8 @@
 // and make is_closed() true; the host then drops the transport after flushing pending_output().
 #pragma once
 
+#include "core/session/event_queue.hpp"
+
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -105,6 +107,9 @@ public:
     /// connection is negotiated or after close; BufferLimitViolation when the encoded message is over
     /// the limit (512 KiB until set_session_established(), then max_message_size − 100 as CORE).
     Result<void> send(const Message& message, MonoTime now);
+    /// The same for a message the caller gives up: its format fields are set in place (no copy of
+    /// its elements when the format or routing flags differ from what it carries).
+    Result<void> send(Message&& message, MonoTime now);
     /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
     Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);
 
@@ -142,6 +147,12 @@ private:
     Result<void> handle_create_connection_reply(const Message& m, const MessageEntry& e);
     void queue_create_connection(MonoTime now);
     Result<void> queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
+    Result<void> queue_owned(Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
+    /// Whether `m` must be re-labelled before encoding (format `version`, or routing omitted), and how.
+    bool needs_relabel(const Message& m, std::uint16_t version, bool omit_routing) const;
+    bool omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const;
+    void relabel(Message& m, std::uint16_t version, bool omit_routing) const;
+    Result<void> append_encoded(const Message& m, MonoTime now);
     void close(RRError error);
     std::size_t send_limit() const noexcept;
     std::size_t receive_limit() const noexcept;
@@ -153,7 +164,7 @@ private:
     MessageStreamReader reader_;
     std::vector<std::byte> output_;
     std::size_t output_offset_ = 0;
-    std::deque<StreamEvent> events_;
+    EventQueue<StreamEvent> events_;
     MonoTime started_;
     MonoTime last_send_;
     MonoTime last_receive_;

@@ -17,6 +17,16 @@ std::size_t estimate_size(const MessageEntry& e) {
     return n;
 }
 
+// The connection whose strand handler (on_bytes, on_timer) runs on this thread, if any: a reply
+// completed inside it is queued at once, without a dispatch through the pump.
+thread_local const ServerConnection* tls_handling = nullptr;
+
+struct HandlingScope {
+    const ServerConnection* previous;
+    explicit HandlingScope(const ServerConnection* c) : previous(std::exchange(tls_handling, c)) {}
+    ~HandlingScope() { tls_handling = previous; }
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -67,29 +77,31 @@ std::string SessionRef::local_url() const {
     return p ? p->local_url() : std::string();
 }
 
-Responder::Responder(std::function<void(MessageEntry)> send, MessageEntry request_header)
-    : send_(std::move(send)), request_(std::move(request_header)) {
-    request_.elements.clear();
-}
+Responder::Responder(std::shared_ptr<ReplySink> sink, const MessageEntry& request)
+    : sink_(std::move(sink)),
+      request_type_(request.entry_type),
+      request_id_(request.request_id),
+      service_path_(request.service_path),
+      member_name_(request.member_name) {}
 
 Responder::~Responder() {
-    if (send_) fail(make_error(MessageErrorType::InternalError, "request was not answered"));
+    if (sink_) fail(make_error(MessageErrorType::InternalError, "request was not answered"));
 }
 
 void Responder::respond(MessageEntry reply) {
-    if (!send_) return;
+    if (!sink_) return;
     if (reply.entry_type == MessageEntryType::Null)
-        reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_.entry_type) + 1);
-    reply.service_path = request_.service_path;
-    reply.member_name = request_.member_name;
-    reply.request_id = request_.request_id;
-    auto send = std::move(send_);
-    send_ = nullptr;
-    send(std::move(reply));
+        reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_type_) + 1);
+    reply.service_path = std::move(service_path_);
+    reply.member_name = std::move(member_name_);
+    reply.request_id = request_id_;
+    auto sink = std::move(sink_);
+    sink_ = nullptr;
+    sink->send_reply(std::move(reply));
 }
 
 void Responder::fail(RRError error) {
-    if (!send_) return;
+    if (!sink_) return;
     MessageEntry r;
     set_entry_error(r, error);
     respond(std::move(r));
@@ -192,6 +204,7 @@ ServerConnection::~ServerConnection() {
 }
 
 void ServerConnection::on_bytes(std::span<const std::byte> bytes, MonoTime now) {
+    HandlingScope scope(this);
     stats_->bytes_in.fetch_add(bytes.size(), std::memory_order_relaxed);
     session_.feed(bytes, now);
     drain_events();
@@ -204,6 +217,7 @@ void ServerConnection::take_output(std::vector<std::byte>& out) {
 }
 
 void ServerConnection::on_timer(MonoTime now) {
+    HandlingScope scope(this);
     session_.on_timer(now);
     drain_events();
 }
@@ -313,19 +327,33 @@ void ServerConnection::on_object_type_query(ServiceObjectTypeQuery&& query) {
     });
 }
 
+/// One per connection, shared by its Responders (no allocation per request).
+class ServerConnection::ConnectionReplySink final : public ReplySink {
+public:
+    ConnectionReplySink(std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump)
+        : connection_(std::move(connection)), pump_(std::move(pump)) {}
+
+    void send_reply(MessageEntry reply) override {
+        // The responder may complete on any thread; on the strand itself the reply goes out at once.
+        if (auto c = connection_.lock(); c && tls_handling == c.get()) {
+            c->reply(std::move(reply));
+            return;
+        }
+        auto p = pump_.lock();
+        if (!p) return;
+        p->dispatch([weak = connection_, reply = std::move(reply)]() mutable {
+            if (auto c = weak.lock()) c->reply(std::move(reply));
+        });
+    }
+
+private:
+    std::weak_ptr<ServerConnection> connection_;
+    std::weak_ptr<PumpHandle> pump_;
+};
+
 Responder ServerConnection::make_responder(const MessageEntry& request) {
-    std::weak_ptr<ServerConnection> weak = weak_from_this();
-    std::weak_ptr<PumpHandle> pump = pump_;
-    return Responder(
-        [weak, pump](MessageEntry reply) {
-            // The responder may complete on any thread; on the strand itself the reply goes out at once.
-            auto p = pump.lock();
-            if (!p) return;
-            p->dispatch([weak, reply = std::move(reply)]() mutable {
-                if (auto c = weak.lock()) c->reply(std::move(reply));
-            });
-        },
-        request);
+    if (!reply_sink_) reply_sink_ = std::make_shared<ConnectionReplySink>(weak_from_this(), pump_);
+    return Responder(reply_sink_, request);
 }
 
 void ServerConnection::reply(MessageEntry entry) {

@@ -120,6 +120,7 @@ private:
     void on_object_type_query(ServiceObjectTypeQuery&& query);
     Responder make_responder(const MessageEntry& request);
     void update_queue_estimate();
+    class ConnectionReplySink;
 
     std::shared_ptr<ServiceRegistry> services_;
     std::shared_ptr<NodeStats> stats_;
@@ -127,6 +128,7 @@ private:
     std::string local_url_;
     ServiceSession session_;
     std::weak_ptr<PumpHandle> pump_;
+    std::shared_ptr<ReplySink> reply_sink_;    // made on the first request (needs weak_from_this)
     std::shared_ptr<ServerSession> current_;  // the open client session's handle, if any
     std::map<std::uint32_t, std::function<void(Result<MessageEntry>)>> callbacks_;
     std::uint64_t messages_in_seen_ = 0, messages_out_seen_ = 0;

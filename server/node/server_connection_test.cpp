@@ -1,7 +1,10 @@
 // Node + ServerConnection + RawClient over real loopback TCP, with a hand-written entry-level service.
 #include <catch2/catch.hpp>
 
+#include <condition_variable>
+#include <deque>
 #include <future>
+#include <mutex>
 #include <thread>
 
 #include <boost/asio/connect.hpp>
@@ -25,10 +28,10 @@ using testing::kDef;
 
 struct Fixture {
     std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "rawtest.node", 2, {}, 0, 5000ms});
-    std::shared_ptr<RawTestService> service = std::make_shared<RawTestService>();
+    std::shared_ptr<RawTestService> service;
     std::uint16_t port = 0;
 
-    Fixture() {
+    explicit Fixture(std::shared_ptr<RawTestService> s = std::make_shared<RawTestService>()) : service(std::move(s)) {
         REQUIRE(node->register_service(service));
         auto p = listen_tcp(node, "127.0.0.1", 0);
         REQUIRE(p);
@@ -283,4 +286,136 @@ TEST_CASE("a client that sends requests but never reads replies is throttled, ot
     auto ok = Fixture::call(*good, request(MessageEntryType::PropertyGetReq, "x"));
     REQUIRE(ok);
     CHECK(ok->error == MessageErrorType::None);
+}
+
+namespace {
+
+// RawTestService whose `add` with an even `a` is answered by a thread of its own (a service completing
+// replies off the connection's strand, like a device answering for a gateway); an odd `a` is answered
+// inside handle_entry, on the connection's own handler. While held, deferred requests wait.
+class ForeignThreadReplyService : public RawTestService {
+public:
+    ForeignThreadReplyService() : worker_([this] { run(); }) {}
+    ~ForeignThreadReplyService() override { stop(); }
+
+    void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
+        std::int32_t a = 0, b = 0;
+        const auto* ea = e.find("a");
+        const auto* eb = e.find("b");
+        if (e.entry_type == MessageEntryType::FunctionCallReq && e.member_name == "add" && ea && eb &&
+            read_scalar(*ea, a) && read_scalar(*eb, b) && a % 2 == 0) {
+            std::lock_guard lock(queue_mutex_);
+            queue_.emplace_back(std::move(responder), a + b);
+            queued_.fetch_add(1);
+            wake_.notify_all();
+            return;
+        }
+        RawTestService::handle_entry(session, std::move(e), std::move(responder));
+    }
+
+    void hold(bool on) {
+        std::lock_guard lock(queue_mutex_);
+        held_ = on;
+        wake_.notify_all();
+    }
+    void stop() {
+        {
+            std::lock_guard lock(queue_mutex_);
+            if (stopping_) return;
+            stopping_ = true;
+            held_ = false;
+            wake_.notify_all();
+        }
+        worker_.join();
+    }
+
+    std::atomic<int> queued_{0}, answered_{0};
+
+private:
+    void run() {
+        std::unique_lock lock(queue_mutex_);
+        for (;;) {
+            wake_.wait(lock, [&] { return stopping_ || (!held_ && !queue_.empty()); });
+            if (queue_.empty() && stopping_) return;
+            auto [responder, sum] = std::move(queue_.front());
+            queue_.pop_front();
+            lock.unlock();
+            MessageEntry r;
+            r.elements.push_back(make_scalar_element<std::int32_t>("return", sum));
+            responder.respond(std::move(r));
+            answered_.fetch_add(1);
+            lock.lock();
+        }
+    }
+
+    std::mutex queue_mutex_;
+    std::condition_variable wake_;
+    std::deque<std::pair<Responder, std::int32_t>> queue_;
+    bool held_ = false, stopping_ = false;
+    std::thread worker_;  // last: started once the members above exist
+};
+
+MessageEntry add_call(std::int32_t a, std::int32_t b) {
+    MessageEntry e = request(MessageEntryType::FunctionCallReq, "add");
+    e.elements.push_back(make_scalar_element<std::int32_t>("a", a));
+    e.elements.push_back(make_scalar_element<std::int32_t>("b", b));
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("replies completed on another thread and on the connection's own handler reach their own requests") {
+    auto service = std::make_shared<ForeignThreadReplyService>();
+    Fixture f(service);
+    constexpr int kClients = 2, kCalls = 200;
+    struct Tally {
+        std::atomic<int> done{0}, wrong{0};
+        std::promise<void> all;
+    };
+    auto tally = std::make_shared<Tally>();
+    std::vector<std::shared_ptr<RawClient>> clients;
+    for (int c = 0; c < kClients; ++c) clients.push_back(f.connect());
+    // Both kinds in flight at once on each connection, from both clients: each reply carries its own
+    // request's sum, so a reply queued for the wrong request or connection shows.
+    for (int i = 0; i < kCalls; ++i) {
+        for (int c = 0; c < kClients; ++c) {
+            const std::int32_t a = i, b = 1000 * (c + 1);
+            clients[c]->request(add_call(a, b), [tally, a, b](Result<MessageEntry> r) {
+                std::int32_t got = -1;
+                const bool ok = r && r->error == MessageErrorType::None && r->find("return") &&
+                                read_scalar(*r->find("return"), got) && got == a + b;
+                if (!ok) tally->wrong.fetch_add(1);
+                if (tally->done.fetch_add(1) + 1 == kClients * kCalls) tally->all.set_value();
+            });
+        }
+    }
+    REQUIRE(tally->all.get_future().wait_for(30s) == std::future_status::ready);
+    CHECK(tally->wrong == 0);
+    CHECK(service->answered_ == kClients * kCalls / 2);
+}
+
+TEST_CASE("replies completed on another thread after the client has gone are dropped, the node keeps serving") {
+    auto service = std::make_shared<ForeignThreadReplyService>();
+    Fixture f(service);
+    service->hold(true);
+    {
+        auto c = f.connect();
+        for (int i = 0; i < 20; ++i) c->request(add_call(2 * i, 1), [](Result<MessageEntry>) {});
+        for (int i = 0; i < 500 && service->queued_ < 20; ++i) std::this_thread::sleep_for(10ms);
+        REQUIRE(service->queued_ == 20);
+        c->close();
+    }
+    for (int i = 0; i < 500 && service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE(service->closed == 1);
+    service->hold(false);  // the 20 Responders now complete with their connection and pump gone
+    for (int i = 0; i < 500 && service->answered_ < 20; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(service->answered_ == 20);
+
+    auto c = f.connect();
+    auto r = Fixture::call(*c, add_call(4, 5));
+    REQUIRE(r);
+    std::int32_t sum = 0;
+    REQUIRE(r->find("return"));
+    CHECK(read_scalar(*r->find("return"), sum));
+    CHECK(sum == 9);
 }

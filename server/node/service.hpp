@@ -66,11 +66,20 @@ private:
     std::uint32_t endpoint_ = 0;
 };
 
+/// Where the replies of one connection's requests go (ServerConnection's). Thread-safe.
+class ReplySink {
+public:
+    virtual ~ReplySink() = default;
+    /// Sends a complete reply entry (header fields set) to the client; from any thread.
+    virtual void send_reply(MessageEntry reply) = 0;
+};
+
 /// Completes one request exactly once, from any thread.
 class Responder {
 public:
     Responder() = default;
-    Responder(std::function<void(MessageEntry)> send, MessageEntry request_header);
+    /// Keeps the request's header fields (not its elements: a large argument is not copied).
+    Responder(std::shared_ptr<ReplySink> sink, const MessageEntry& request);
     Responder(Responder&&) noexcept = default;
     Responder& operator=(Responder&&) noexcept = default;
     ~Responder();  // an unanswered request is answered with InternalError
@@ -80,12 +89,13 @@ public:
     void respond(MessageEntry reply);
     /// Sends an error reply (wire.md §5.2).
     void fail(RRError error);
-    bool done() const noexcept { return !send_; }
-    const MessageEntry& request() const noexcept { return request_; }
+    bool done() const noexcept { return !sink_; }
 
 private:
-    std::function<void(MessageEntry)> send_;
-    MessageEntry request_;  // fields only, no elements
+    std::shared_ptr<ReplySink> sink_;
+    MessageEntryType request_type_ = MessageEntryType::Null;
+    std::uint32_t request_id_ = 0;
+    std::string service_path_, member_name_;
 };
 
 /// A service a node hosts: what the session protocol needs (HostedService: definitions, root type,
