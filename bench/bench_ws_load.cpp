@@ -2,17 +2,20 @@
 // subprotocol rr-gateway.json.v1). One thread, one io_context, N connections.
 //
 // Usage:
-//   rr_bench_ws_load --port P --clients N fanout [--seconds S] [--device D] [--member M] [--hz H]
+//   rr_bench_ws_load --port P --clients N fanout [--seconds S] [--device D] [--member M] [--hz H] [--binary]
 //       each client subscribes to wire M of device D (default bench / Ticks, whose values are
 //       [stamp_us, sequence, ...]); after every client has its first value, values are counted for
 //       S seconds (default 5). Prints one JSON line: delivered values/s (all clients), the expected
 //       rate N × H, the fraction of the values the device sent in each client's window that reached
 //       it (delivered_of_sent; below 1: coalesced, as wires keep only the newest value), latency
-//       from the device's stamp to arrival (p50/p99/max µs), the load generator's own CPU%.
+//       from the device's stamp to arrival (p50/p99/max µs), the load generator's own CPU%, and the
+//       bytes received per value. --binary subscribes with "binary": true (binary pushes: the double[]
+//       arrives as raw bytes, read in place).
 //   rr_bench_ws_load --port P --clients N idle
 //       opens N connections (no subscription), prints {"opened": N, …} and keeps them open until a
 //       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
 // Connections are opened at most 64 at a time (the gateway's listen backlog is finite).
+#include <cstring>
 #include <deque>
 #include <iostream>
 #include <memory>
@@ -50,6 +53,7 @@ struct Stats {
     std::size_t with_value = 0;     // clients that received at least one value
     std::size_t opened = 0, failed = 0;
     std::uint64_t delivered = 0;    // values counted while measuring
+    std::uint64_t bytes = 0;        // message bytes received while measuring
     std::vector<double> latency_us; // while measuring
     std::string first_error;
 };
@@ -102,29 +106,54 @@ private:
     }
     void read() {
         auto self = shared_from_this();
-        ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
+        ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t n) {
             if (ec) return;
-            self->on_message(beast::buffers_to_string(self->buffer_.data()));
+            const auto data = self->buffer_.data();
+            const std::string_view bytes(static_cast<const char*>(data.data()), data.size());
+            if (self->ws_.got_binary())
+                self->on_binary(bytes);
+            else
+                self->on_message(bytes);
+            if (self->stats_.measuring) self->stats_.bytes += n;
             self->buffer_.consume(self->buffer_.size());
             self->read();
         });
     }
-    void on_message(const std::string& text) {
+    void on_message(std::string_view text) {
         const double now = rr::bench::wall_clock_us();
         auto msg = nlohmann::json::parse(text, nullptr, false);
         if (msg.is_discarded() || msg.value("kind", "") != "wire") return;
         const auto& v = msg["value"];
         if (!v.is_array() || v.size() < 2 || v[1].get<double>() < 0) return;
+        on_value(now, v[0].get<double>(), v[1].get<double>());
+    }
+    // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array.
+    void on_binary(std::string_view m) {
+        const double now = rr::bench::wall_clock_us();
+        if (m.size() < 8 || m.substr(0, 4) != "RRJB") return;
+        std::uint32_t json_bytes = 0;
+        std::memcpy(&json_bytes, m.data() + 4, 4);
+        if (json_bytes > m.size() - 8) return;
+        auto msg = nlohmann::json::parse(m.substr(8, json_bytes), nullptr, false);
+        if (msg.is_discarded() || msg.value("kind", "") != "wire" || !msg["value"].is_object()) return;
+        const auto& ref = msg["value"];
+        const std::size_t at = ((8 + std::size_t{json_bytes} + 7) & ~std::size_t{7}) + ref.value("offset", std::size_t{0});
+        if (ref.value("type", "") != "double" || ref.value("length", 0) < 2 || at + 16 > m.size()) return;
+        double v[2];
+        std::memcpy(v, m.data() + at, 16);
+        on_value(now, v[0], v[1]);
+    }
+    void on_value(double now, double stamp_us, double seq) {
+        if (seq < 0) return;
         if (!got_value_) {
             got_value_ = true;
             ++stats_.with_value;
         }
         if (!stats_.measuring) return;
-        const double seq = v[1].get<double>();
         if (first_seq_ < 0) first_seq_ = seq;
         last_seq_ = seq;
         ++stats_.delivered;
-        stats_.latency_us.push_back(now - v[0].get<double>());
+        stats_.latency_us.push_back(now - stamp_us);
     }
 
     websocket::stream<beast::tcp_stream> ws_;
@@ -151,6 +180,7 @@ int main(int argc, char** argv) {
     std::size_t clients = 10;
     double seconds = 5, hz = 100;
     std::string mode, device = "bench", member = "Ticks";
+    bool binary = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -160,9 +190,10 @@ int main(int argc, char** argv) {
         else if (a == "--hz") hz = std::stod(value());
         else if (a == "--device") device = value();
         else if (a == "--member") member = value();
+        else if (a == "--binary") binary = true;
         else if (a == "fanout" || a == "idle") mode = a;
         else {
-            std::cerr << "usage: " << argv[0] << " --port P --clients N (fanout [--seconds S] [--hz H] | idle)\n";
+            std::cerr << "usage: " << argv[0] << " --port P --clients N (fanout [--seconds S] [--hz H] [--binary] | idle)\n";
             return 2;
         }
     }
@@ -177,7 +208,8 @@ int main(int argc, char** argv) {
     const tcp::endpoint endpoint(asio::ip::make_address("127.0.0.1"), port);
     const std::string host = "127.0.0.1:" + std::to_string(port);
     std::optional<nlohmann::json> subscribe;
-    if (mode == "fanout") subscribe = nlohmann::json{{"id", 1}, {"op", "subscribe"}, {"device", device}, {"member", member}};
+    if (mode == "fanout")
+        subscribe = nlohmann::json{{"id", 1}, {"op", "subscribe"}, {"device", device}, {"member", member}, {"binary", binary}};
 
     // Open the connections, at most kMaxConnecting in progress.
     std::vector<std::shared_ptr<Connection>> conns;
@@ -245,6 +277,8 @@ int main(int argc, char** argv) {
                                 {"max_us", stats.latency_us.empty() ? 0.0
                                                                     : *std::max_element(stats.latency_us.begin(), stats.latency_us.end())},
                                 {"loadgen_cpu_pct", 100.0 * (cpu1.cpu_us - cpu0.cpu_us) / wall},
+                                {"binary", binary},
+                                {"bytes_per_value", stats.delivered ? double(stats.bytes) / double(stats.delivered) : 0.0},
                                 {"error", stats.first_error}}
                      .dump()
               << std::endl;

@@ -28,7 +28,7 @@ namespace bhttp = boost::beast::http;
 
 namespace {
 
-bhttp::response<bhttp::string_body> http_get(std::uint16_t port, const std::string& target) {
+bhttp::response<bhttp::string_body> gateway_http_get(std::uint16_t port, const std::string& target) {
     boost::asio::io_context io;
     beast::tcp_stream s(io);
     s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
@@ -80,7 +80,7 @@ DemoStarter demo_starter() {
 
 TEST_CASE("gateway health endpoints follow the required devices") {
     auto device = Node::create(NodeOptions{NodeID(), "dev.node", 2, {}, 0, 5000ms});
-    REQUIRE(device->register_service(std::make_shared<testing::RawTestService>()));
+    REQUIRE(device->register_service(std::make_shared<rr::server::testing::RawTestService>()));
     // Reserve a port for the device, but start listening only later: the gateway starts not ready.
     auto probe = Node::create(NodeOptions{NodeID(), "probe", 1, {}, 0, 5000ms});
     const auto port = *listen_tcp(probe, "127.0.0.1", 0);
@@ -101,17 +101,17 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     REQUIRE(gw);
     const auto gport = (*gw)->port();
 
-    CHECK(http_get(gport, "/livez").result() == bhttp::status::ok);
-    auto notready = http_get(gport, "/readyz");
+    CHECK(gateway_http_get(gport, "/livez").result() == bhttp::status::ok);
+    auto notready = gateway_http_get(gport, "/readyz");
     CHECK(notready.result() == bhttp::status::service_unavailable);
     CHECK_THAT(notready.body(), Catch::Contains("dev:"));
 
     REQUIRE(listen_tcp(device, "127.0.0.1", port));
     for (int i = 0; i < 300 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
     REQUIRE((*gw)->ready());
-    CHECK(http_get(gport, "/readyz").result() == bhttp::status::ok);
+    CHECK(gateway_http_get(gport, "/readyz").result() == bhttp::status::ok);
 
-    auto metrics = http_get(gport, "/metrics");
+    auto metrics = gateway_http_get(gport, "/metrics");
     CHECK(metrics.result() == bhttp::status::ok);
     // The Prometheus text format's content type, also for HEAD (which had 404 text/plain, issue 15).
     CHECK(metrics[bhttp::field::content_type] == "text/plain; version=0.0.4; charset=utf-8");
@@ -152,7 +152,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
         REQUIRE(::setenv(var, dir.c_str(), 1) == 0);
 
     auto device = Node::create(NodeOptions{NodeID(), "dev.node", 2, {}, 0, 5000ms});
-    REQUIRE(device->register_service(std::make_shared<testing::RawTestService>()));
+    REQUIRE(device->register_service(std::make_shared<rr::server::testing::RawTestService>()));
     const auto port = *listen_tcp(device, "127.0.0.1", 0);
 
     const std::string name = local::testing::unique_node_name("gwtest");
