@@ -36,6 +36,7 @@
 #include <boost/beast/websocket.hpp>
 
 #include "bench/bench_common.hpp"
+#include "server/gateway/binary_push.hpp"
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
@@ -130,17 +131,15 @@ private:
     // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array.
     void on_binary(std::string_view m) {
         const double now = rr::bench::wall_clock_us();
-        if (m.size() < 8 || m.substr(0, 4) != "RRJB") return;
-        std::uint32_t json_bytes = 0;
-        std::memcpy(&json_bytes, m.data() + 4, 4);
-        if (json_bytes > m.size() - 8) return;
-        auto msg = nlohmann::json::parse(m.substr(8, json_bytes), nullptr, false);
+        auto parts = rr::server::gateway::split_binary_push(m);
+        if (!parts) return;
+        auto msg = nlohmann::json::parse(parts->json_text, nullptr, false);
         if (msg.is_discarded() || msg.value("kind", "") != "wire" || !msg["value"].is_object()) return;
         const auto& ref = msg["value"];
-        const std::size_t at = ((8 + std::size_t{json_bytes} + 7) & ~std::size_t{7}) + ref.value("offset", std::size_t{0});
-        if (ref.value("type", "") != "double" || ref.value("length", 0) < 2 || at + 16 > m.size()) return;
+        const std::size_t at = ref.value("offset", std::size_t{0});
+        if (ref.value("type", "") != "double" || ref.value("length", 0) < 2 || at + 16 > parts->arrays.size()) return;
         double v[2];
-        std::memcpy(v, m.data() + at, 16);
+        std::memcpy(v, parts->arrays.data() + at, 16);
         on_value(now, v[0], v[1]);
     }
     void on_value(double now, double stamp_us, double seq) {

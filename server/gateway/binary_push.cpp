@@ -80,16 +80,22 @@ std::string binary_push_message(std::string_view json_text, const std::vector<Sh
     return out;
 }
 
-Result<nlohmann::json> decode_binary_push(std::string_view message) {
+Result<BinaryPushParts> split_binary_push(std::string_view message) {
     if (message.size() < kHeaderBytes || message.substr(0, 4) != kBinaryPushMagic) return bad("no RRJB header");
     std::uint32_t json_bytes = 0;
     for (int i = 0; i < 4; ++i) json_bytes |= std::uint32_t(static_cast<unsigned char>(message[4 + i])) << (8 * i);
     if (json_bytes > message.size() - kHeaderBytes) return bad("the JSON text runs past the message");
     const std::size_t base = BinaryArrays::padded(kHeaderBytes + json_bytes);
     if (base > message.size()) return bad("the arrays start past the message");
-    auto j = nlohmann::json::parse(message.substr(kHeaderBytes, json_bytes), nullptr, false);
+    return BinaryPushParts{message.substr(kHeaderBytes, json_bytes), message.substr(base)};
+}
+
+Result<nlohmann::json> decode_binary_push(std::string_view message) {
+    auto parts = split_binary_push(message);
+    if (!parts) return parts.take_error();
+    auto j = nlohmann::json::parse(parts->json_text, nullptr, false);
     if (j.is_discarded()) return bad("the JSON text does not parse");
-    if (auto r = resolve(j, message.substr(base), 0); !r) return r.take_error();
+    if (auto r = resolve(j, parts->arrays, 0); !r) return r.take_error();
     return j;
 }
 

@@ -28,6 +28,15 @@ inline constexpr std::string_view kBinaryPushMagic = "RRJB";
 /// The message for `json_text` (a push with "$binary" references) and the arrays it refers to.
 std::string binary_push_message(std::string_view json_text, const std::vector<SharedBytes>& blobs);
 
+/// The two parts of a binary message: the JSON text, and the arrays (starting at B, so a reference's
+/// `offset` counts from arrays.data()). Views into `message`. Errors: ProtocolError (no RRJB header,
+/// lengths past the message).
+struct BinaryPushParts {
+    std::string_view json_text;
+    std::string_view arrays;
+};
+Result<BinaryPushParts> split_binary_push(std::string_view message);
+
 /// The push a binary message carries, each "$binary" reference replaced by the array's JSON numbers
 /// (what the text form of the same push holds): the reference decoder, for tests and tools.
 /// Errors: ProtocolError for a message that is not one (magic, lengths, a reference outside the

@@ -47,6 +47,12 @@ TEST_CASE("binary push: header, JSON text, and 8-aligned little-endian arrays") 
     std::memcpy(&w, m.data() + base + 24, 2);
     CHECK(w == -3);
 
+    auto parts = split_binary_push(m);
+    REQUIRE(parts);
+    CHECK(parts->json_text == text);
+    CHECK(parts->arrays.data() == m.data() + base);
+    CHECK(parts->arrays.size() == 32);
+
     auto decoded = decode_binary_push(m);
     INFO((decoded ? std::string() : decoded.error().message));
     REQUIRE(decoded);
