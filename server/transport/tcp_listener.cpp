@@ -29,7 +29,9 @@ Result<std::shared_ptr<TcpListener>> TcpListener::open(asio::any_io_executor exe
     boost::system::error_code ec;
     auto addr = asio::ip::make_address(address, ec);
     if (ec) return fail(MessageErrorType::InvalidArgument, "bad listen address \"" + address + "\": " + ec.message());
-    tcp::acceptor acceptor(executor);
+    // The acceptor's own strand: stop() closes it while an accept completion may be starting the
+    // next accept on another worker thread (a data race ThreadSanitizer reported).
+    tcp::acceptor acceptor(asio::make_strand(executor));
     tcp::endpoint ep(addr, port);
     acceptor.open(ep.protocol(), ec);
     if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
@@ -37,11 +39,12 @@ Result<std::shared_ptr<TcpListener>> TcpListener::open(asio::any_io_executor exe
     if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
     if (ec)
         return fail(MessageErrorType::IOError, "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message());
-    return std::shared_ptr<TcpListener>(new TcpListener(std::move(acceptor), std::move(sink), std::move(options)));
+    return std::shared_ptr<TcpListener>(new TcpListener(executor, std::move(acceptor), std::move(sink), std::move(options)));
 }
 
-TcpListener::TcpListener(tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink, TcpListenerOptions options)
-    : acceptor_(std::move(acceptor)), sink_(std::move(sink)), options_(std::move(options)) {
+TcpListener::TcpListener(asio::any_io_executor executor, tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink,
+                         TcpListenerOptions options)
+    : executor_(std::move(executor)), acceptor_(std::move(acceptor)), sink_(std::move(sink)), options_(std::move(options)) {
     boost::system::error_code ec;
     bound_ = acceptor_.local_endpoint(ec);
 }
@@ -72,7 +75,7 @@ std::vector<std::string> TcpListener::urls() const {
 
 void TcpListener::accept() {
     auto self = shared_from_this();
-    acceptor_.async_accept(asio::make_strand(acceptor_.get_executor()), [self](boost::system::error_code ec, tcp::socket socket) {
+    acceptor_.async_accept(asio::make_strand(executor_), [self](boost::system::error_code ec, tcp::socket socket) {
         if (ec == asio::error::operation_aborted || !self->acceptor_.is_open()) return;
         if (!ec) self->detect(std::move(socket));
         self->accept();

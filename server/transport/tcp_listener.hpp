@@ -70,13 +70,15 @@ public:
     boost::asio::ip::tcp::endpoint local_endpoint() const;
 
 private:
-    TcpListener(boost::asio::ip::tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink, TcpListenerOptions options);
+    TcpListener(boost::asio::any_io_executor executor, boost::asio::ip::tcp::acceptor acceptor,
+                std::weak_ptr<ConnectionSink> sink, TcpListenerOptions options);
     void accept();
     void detect(boost::asio::ip::tcp::socket socket);
     struct Detect;
     void read_head(std::shared_ptr<Detect> d);
 
-    boost::asio::ip::tcp::acceptor acceptor_;
+    boost::asio::any_io_executor executor_;  ///< the io_context's, for each connection's own strand
+    boost::asio::ip::tcp::acceptor acceptor_;  ///< on a strand of its own (accept vs stop())
     std::weak_ptr<ConnectionSink> sink_;
     TcpListenerOptions options_;
     boost::asio::ip::tcp::endpoint bound_;
