@@ -211,7 +211,7 @@ TEST_CASE("auth shared: a user lock at the gateway refuses other users on the ob
     CHECK(b.error(op("ReleaseClientObjectLock")).message == "Invalid command");
 }
 
-TEST_CASE("auth shared: a client lock binds the user's other sessions; closing sessions release locks") {
+TEST_CASE("auth shared: a client lock binds the user's other sessions, closing sessions release locks") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto a2 = gw.connect("alice", "a");
@@ -291,7 +291,7 @@ TEST_CASE("auth shared: [nolock] and [nolockread] members pass gateway-held obje
     CHECK(returned(a.ok(op("MonitorExit"))) == "OK");
 }
 
-TEST_CASE("auth shared: wire packets on a connection opened before the lock pass; new connections are refused") {
+TEST_CASE("auth shared: wire packets on a connection opened before the lock pass, new connections are refused") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto b = gw.connect("bob", "b");
