@@ -270,6 +270,8 @@ DeviceStatus DeviceMirror::status() const {
     if (const auto& p = service_->passthrough()) {
         s.upstream_sessions = p->session_count();
         s.locks = p->locks();
+    } else {
+        s.locks = service_->gateway_locks();
     }
     std::lock_guard lock(mutex_);
     s.state = state_;

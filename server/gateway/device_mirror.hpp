@@ -8,7 +8,9 @@
 // client); pipes map each downstream endpoint to its own upstream endpoint; callbacks from the device
 // go to the downstream client that most recently called into the device; generators are owned by the
 // client that created them. A device that goes away fails pending requests with ConnectionError;
-// downstream wire connections stay open and are re-subscribed when the device returns.
+// downstream wire connections stay open and are re-subscribed when the device returns. Object and
+// monitor locks of the clients are held by the mirror itself (ServiceLocks; they survive a device
+// restart) and checked before a request is forwarded.
 #pragma once
 
 #include <atomic>
@@ -39,7 +41,7 @@ namespace rr::server::gateway {
 /// How downstream clients' logins reach the device (docs/security.md).
 enum class DeviceAuth : std::uint8_t {
     /// One upstream session (with `username`/`password` below) shared by every client; object and
-    /// monitor locks are refused with InvalidOperation (they would lock for everyone at once).
+    /// monitor locks are held at the gateway (they bind the gateway's clients, not the device's others).
     shared,
     /// Every native RR client gets its own upstream session with its own credentials
     /// (PassthroughSessions); the shared session still serves the JSON API and the definitions.
@@ -91,7 +93,7 @@ struct DeviceStatus {
     DeviceAuth auth = DeviceAuth::shared;
     std::size_t upstream_sessions = 0;   ///< passthrough sessions open (or opening) to the device
     bool json_api_requires_device_login = false;
-    std::vector<DeviceLockInfo> locks;   ///< locks taken through the gateway and still held
+    std::vector<DeviceLockInfo> locks;   ///< locks taken through the gateway (passthrough) or held at it (shared)
 };
 
 class MirrorService;

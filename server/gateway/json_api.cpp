@@ -9,6 +9,8 @@
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/timespec.hpp"
+#include "server/gateway/mirror_service.hpp"
+#include "server/service/service_locks.hpp"
 
 namespace rr::server::gateway {
 
@@ -175,17 +177,17 @@ nlohmann::json JsonApi::status_json(const DeviceStatus& s) {
     j["object_type"] = s.object_type.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.object_type);
     j["required"] = s.required;
     j["clients"] = s.downstream_sessions;
+    j["auth"] = std::string(device_auth_name(s.auth));
     if (s.auth == DeviceAuth::passthrough) {
-        // Only passthrough devices have locks through the gateway (docs/security.md).
-        j["auth"] = std::string(device_auth_name(s.auth));
         j["passthrough_sessions"] = s.upstream_sessions;
         j["json_api_requires_device_login"] = s.json_api_requires_device_login;
-        auto locks = nlohmann::json::array();
-        for (const auto& l : s.locks)
-            locks.push_back({{"path", l.path}, {"user", l.username.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.username)},
-                             {"kind", l.kind}});
-        j["locks"] = std::move(locks);
     }
+    // Taken through the gateway (passthrough) or held at it (shared); docs/security.md "Who holds a lock".
+    auto locks = nlohmann::json::array();
+    for (const auto& l : s.locks)
+        locks.push_back({{"path", l.path}, {"user", l.username.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.username)},
+                         {"kind", l.kind}});
+    j["locks"] = std::move(locks);
     return j;
 }
 
@@ -240,9 +242,13 @@ ApiResult JsonApi::definitions(std::string_view name) const {
 }
 
 void JsonApi::resolve(const MemberAddress& address, std::function<void(Resolved)> done) {
-    if (address.device_session != 0) {
-        done = [session = address.device_session, inner = std::move(done)](Resolved r) {
-            if (auto* t = std::get_if<MemberTarget>(&r)) t->device_session = session;
+    if (address.device_session != 0 || address.principal) {
+        done = [session = address.device_session, user = address.principal ? address.principal->rr_user_name() : std::string(),
+                inner = std::move(done)](Resolved r) {
+            if (auto* t = std::get_if<MemberTarget>(&r)) {
+                t->device_session = session;
+                t->user = user;
+            }
             inner(std::move(r));
         };
     }
@@ -406,6 +412,13 @@ std::optional<ApiError> JsonApi::check_access(const MemberAddress& a, auth::Oper
                      "user " + a.principal->name + " may not " + std::string(auth::operation_name(op)) + " " + key + " of " + a.device);
 }
 
+std::optional<ApiError> JsonApi::check_locks(const MemberTarget& t, MessageEntryType type) const {
+    if (t.device_session != 0) return std::nullopt;
+    auto ok = t.device->mirror_service()->check_api_request(t.path, t.user, passes_object_locks(t.member->modifiers, type));
+    if (ok) return std::nullopt;
+    return api_error(409, ok.error().type, ok.error().message);
+}
+
 void JsonApi::get_property(const MemberAddress& address, Done done) {
     if (auto denied = check_access(address, auth::Operation::read)) return done(ApiResult::failed(std::move(*denied)));
     auto self = shared_from_this();
@@ -416,6 +429,7 @@ void JsonApi::get_property(const MemberAddress& address, Done done) {
         if (t.member->direction() == robdef::MemberDirection::writeonly)
             return done(ApiResult::failed(api_error(405, MessageErrorType::WriteOnlyMember,
                                                     "property \"" + t.member->name + "\" is write-only")));
+        if (auto locked = self->check_locks(t, MessageEntryType::PropertyGetReq)) return done(ApiResult::failed(std::move(*locked)));
         send_to_device(t, member_request(MessageEntryType::PropertyGetReq, t), done, [self, t](const MessageEntry& reply) {
             const auto* v = reply.find("value");
             if (!v) return ApiResult::failed(missing_element("value", "PropertyGetRes"));
@@ -439,6 +453,7 @@ void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& v
         ApiError error;
         auto el = self->element_from_json(value, t.member->type, t, "value", error, "value");
         if (!el) return done(ApiResult::failed(error));
+        if (auto locked = self->check_locks(t, MessageEntryType::PropertySetReq)) return done(ApiResult::failed(std::move(*locked)));
         auto e = member_request(MessageEntryType::PropertySetReq, t);
         e.elements.push_back(std::move(*el));
         send_to_device(t, std::move(e), done, [](const MessageEntry&) { return ApiResult::ok(nlohmann::json::object()); });
@@ -455,6 +470,7 @@ void JsonApi::peek_wire(const MemberAddress& address, Done done) {
         if (t.member->direction() == robdef::MemberDirection::writeonly)
             return done(ApiResult::failed(api_error(405, MessageErrorType::WriteOnlyMember,
                                                     "wire \"" + t.member->name + "\" is write-only")));
+        if (auto locked = self->check_locks(t, MessageEntryType::WirePeekInValueReq)) return done(ApiResult::failed(std::move(*locked)));
         send_to_device(t, member_request(MessageEntryType::WirePeekInValueReq, t), done,
                        [self, t](const MessageEntry& reply) {
                            const auto* p = reply.find("packet");

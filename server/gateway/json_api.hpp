@@ -54,6 +54,9 @@ struct MemberTarget {
     const robdef::MemberDefinition* member = nullptr;
     /// Where get/set/call/peek go: MemberAddress::device_session (0 = the shared session).
     std::uint32_t device_session = 0;
+    /// The gateway user the request acts as (Principal::rr_user_name of MemberAddress::principal; ""
+    /// without logins), for the locks held at the gateway (JsonApi::check_locks).
+    std::string user;
 
     std::string_view context() const noexcept { return service->name; }
 };
@@ -105,7 +108,8 @@ public:
     void set_discovery_hooks(DiscoveryHooks hooks);
     DiscoveryHooks discovery_hooks() const;
 
-    /// `{"name", "url", "state", "reason", "object_type", "required", "clients"}` of one device.
+    /// `{"name", "url", "state", "reason", "object_type", "required", "clients", "auth", "locks"}` of one
+    /// device, and a passthrough device's `passthrough_sessions` and `json_api_requires_device_login`.
     static nlohmann::json status_json(const DeviceStatus& status);
     /// GET /api/devices: `[status_json…]`, in configuration order.
     nlohmann::json device_list() const;
@@ -122,6 +126,15 @@ public:
     const std::shared_ptr<auth::GatewayAuth>& auth() const noexcept { return auth_; }
     /// The check itself: nothing when allowed (or logins are off), else 401 / 403.
     std::optional<ApiError> check_access(const MemberAddress& address, auth::Operation op) const;
+
+    /// The locks held at the gateway on an `auth: shared` device (docs/security.md "auth: shared"): a
+    /// JSON API request has no session of its own, so it passes only the user locks of its user
+    /// (`target.user`), never a client lock or another session's monitor; a `[nolock]` member (and a
+    /// `[nolockread]` one for `PropertyGetReq`) passes object locks. `type` is the RR request the
+    /// operation makes. Nothing when it may go on (always on the device's own session of a
+    /// `device_login`); else 409 with ObjectLockedError ("Object locked by alice") or InvalidOperation
+    /// (a monitor).
+    std::optional<ApiError> check_locks(const MemberTarget& target, MessageEntryType type) const;
 
     /// Finds device, object and member. Errors: 404 (unknown device / object / member), 400 (malformed
     /// object path), 503 (device not connected), 502 (definitions unusable), 504.

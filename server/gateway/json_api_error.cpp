@@ -14,6 +14,7 @@ ApiError device_error(const RRError& error) {
         case MessageErrorType::MemberNotFound: status = 404; break;
         case MessageErrorType::ReadOnlyMember:
         case MessageErrorType::WriteOnlyMember: status = 405; break;
+        case MessageErrorType::ObjectLockedError: status = 409; break;  // as a lock held at the gateway
         case MessageErrorType::ConnectionError: status = 503; break;
         case MessageErrorType::RequestTimeout: status = 504; break;
         default: break;

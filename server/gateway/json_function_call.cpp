@@ -171,6 +171,8 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
             call.elements.push_back(std::move(*el));
         }
 
+        // A generator is checked once, at its call: its items are one JSON API request.
+        if (auto locked = self->check_locks(t, MessageEntryType::FunctionCallReq)) return done(ApiResult::failed(std::move(*locked)));
         t.device->request(std::move(call), [self, t, generator, param_generator, max_items, done,
                                              gen_items = std::move(gen_items)](Result<MessageEntry> r) mutable {
             if (!r) return done(ApiResult::failed(device_error(r.error())));

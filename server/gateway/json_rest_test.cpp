@@ -77,6 +77,9 @@ TEST_CASE("json api: devices, definitions, the member summary") {
     CHECK(d["object_type"] == "experimental.interop_test.Root");
     CHECK(d["required"] == true);
     CHECK(d["clients"].is_number_unsigned());
+    CHECK(d["auth"] == "shared");
+    CHECK(d["locks"] == json::array());  // held at the gateway: none yet
+    CHECK_FALSE(d.contains("passthrough_sessions"));
     CHECK(http_get(gw.port(), "/api/devices/").body == list.body);
 
     auto info = http_get(gw.port(), "/api/devices/interop");

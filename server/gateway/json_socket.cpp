@@ -447,6 +447,15 @@ private:
                                                                "; subscribe takes a wire, an event or a pipe")));
                 return end_request();
         }
+        // Opening a wire connection or a pipe endpoint is a request the locks held at the gateway
+        // decide; events reach every client in RR, locked or not.
+        if (kind != SubKind::event) {
+            if (auto locked = api_->check_locks(t, kind == SubKind::wire ? MessageEntryType::WireConnectReq
+                                                                        : MessageEntryType::PipeConnectReq)) {
+                send_reply(id, ApiResult::failed(std::move(*locked)));
+                return end_request();
+            }
+        }
         std::uint64_t sid = 0;
         std::shared_ptr<SessionEndpoints> own;
         {

@@ -54,7 +54,12 @@ void set_index(MessageEntry& e, std::int32_t idx) {
 }  // namespace
 
 MirrorService::MirrorService(std::weak_ptr<DeviceMirror> mirror, std::string name, std::string upstream_service)
-    : mirror_(std::move(mirror)), name_(std::move(name)), upstream_service_(std::move(upstream_service)) {}
+    : mirror_(std::move(mirror)), name_(std::move(name)), upstream_service_(std::move(upstream_service)) {
+    // Lock holders are part of the device's status (JSON API pushes, the dashboard).
+    locks_->set_on_change([weak = mirror_] {
+        if (auto m = weak.lock()) m->notify_state();
+    });
+}
 
 std::string MirrorService::to_upstream(std::string_view path) const { return replace_service_name(path, upstream_service_); }
 std::string MirrorService::to_downstream(std::string_view path) const { return replace_service_name(path, name_); }
@@ -135,7 +140,19 @@ void MirrorService::on_session_open(const SessionRef& session) {
 
 void MirrorService::on_session_close(const SessionRef& session) {
     drop_session_state(session.endpoint());
-    if (passthrough_) passthrough_->close(session.endpoint());
+    if (passthrough_) {
+        passthrough_->close(session.endpoint());
+        return;
+    }
+    // Its client locks and monitors go; its user's user locks with the user's last session here.
+    const std::string user = session.username();
+    bool last_of_user = true;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& s : sessions_)
+            if (!user.empty() && s.username() == user) last_of_user = false;
+    }
+    locks_->session_closed(session.endpoint(), user, last_of_user);
 }
 
 void MirrorService::admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
@@ -226,13 +243,29 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         return;
     }
     if (entry.entry_type == MessageEntryType::ClientSessionOpReq) {
-        // Lock operations on the shared session would lock the device for every client of the gateway
-        // at once (and MonitorExit from one client would free another's monitor): refused.
-        responder.fail(make_error(MessageErrorType::InvalidOperation,
-                                  entry.member_name + " through the gateway needs `auth: passthrough` on device \"" + name_ +
-                                      "\" (its clients share one session to the device; docs/security.md)"));
+        lock_op(session, std::move(entry), std::move(responder));
         return;
     }
+    const auto type = entry.entry_type;
+    const bool packet = type == MessageEntryType::PipePacket || type == MessageEntryType::PipePacketRet ||
+                        type == MessageEntryType::WirePacket;
+    if (!packet) {
+        // Locks held at the gateway bind every member request, as ObjectService's do; packets on
+        // connections opened before a lock pass (CORE checks requests only).
+        auto ok = locks_->check(entry.service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, false);
+        if (!ok && ok.error().type == MessageErrorType::ObjectLockedError) {
+            recheck_nolock(session, std::move(entry), std::move(responder));
+            return;
+        }
+        if (!ok) {
+            responder.fail(ok.error());
+            return;
+        }
+    }
+    dispatch_shared(session, std::move(entry), std::move(responder));
+}
+
+void MirrorService::dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     switch (entry.entry_type) {
         case MessageEntryType::WireConnectReq: wire_connect(session, std::move(entry), std::move(responder)); return;
         case MessageEntryType::WireDisconnectReq: wire_disconnect(session, std::move(entry), std::move(responder)); return;
@@ -241,7 +274,17 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         case MessageEntryType::PipePacket:
         case MessageEntryType::PipePacketRet: pipe_packets_from_client(session, std::move(entry)); return;
         case MessageEntryType::WirePacket: {
-            // A client's OutValue is the device's InValue: passed on as it is.
+            // A client's OutValue is the device's InValue, passed on as it is; only on a wire this client
+            // connected (the upstream connection is the gateway's, so an unconnected client's packet
+            // would otherwise pass a lock taken after it).
+            bool connected;
+            {
+                std::lock_guard lock(mutex_);
+                auto it = wires_.find({entry.service_path, entry.member_name});
+                connected = it != wires_.end() &&
+                            std::find(it->second.sessions.begin(), it->second.sessions.end(), session) != it->second.sessions.end();
+            }
+            if (!connected) return;
             if (auto c = client()) {
                 entry.service_path = to_upstream(entry.service_path);
                 c->send(std::move(entry));
@@ -264,6 +307,93 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         }
         default: forward(session, std::move(entry), std::move(responder)); return;
     }
+}
+
+// --- locks held at the gateway (auth: shared) ---------------------------------------------------------
+
+ServiceLocks::Privileges MirrorService::privileges(const std::string& user) const {
+    if (user.empty() || !access_.active()) return {};
+    auto who = access_.auth()->principal_for_user(user);
+    if (!who) return {};
+    return ServiceLocks::Privileges{who->has_privilege("objectlock"), who->has_privilege("objectlockoverride")};
+}
+
+void MirrorService::lock_op(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    const std::string user = session.username();
+    const auto granted = privileges(user);
+    if (auto ok = ServiceLocks::check_privileges(entry.member_name, user, granted); !ok) {
+        responder.fail(ok.error());
+        return;
+    }
+    ServiceLocks::Requester who{session.endpoint(), user};
+    if (entry.service_path == name_) {
+        locks_->handle_op(who, granted, entry, std::move(responder));
+        return;
+    }
+    // An object below the root must exist on the device (its ObjectNotFound otherwise), as our
+    // ObjectService resolves the path before locking it.
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    auto op = std::make_shared<MessageEntry>(std::move(entry));
+    auto self = shared_from_this();
+    object_type(session, op->service_path, [self, who, granted, op, shared](Result<ObjectTypeInfo> r) {
+        if (!r) {
+            shared->fail(r.error());
+            return;
+        }
+        self->locks_->handle_op(who, granted, *op, std::move(*shared));
+    });
+}
+
+void MirrorService::recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    auto request = std::make_shared<MessageEntry>(std::move(entry));
+    auto self = shared_from_this();
+    auto decide = [self, session, request, shared](Result<ObjectTypeInfo> type) {
+        bool nolock = false;
+        if (type) nolock = passes_object_locks(self->member_modifiers(type->object_type, request->member_name), request->entry_type);
+        auto ok = self->locks_->check(request->service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, nolock);
+        if (!ok) {
+            shared->fail(ok.error());
+            return;
+        }
+        self->dispatch_shared(session, std::move(*request), std::move(*shared));
+    };
+    if (request->service_path == name_) {
+        decide(root_type());
+        return;
+    }
+    object_type(session, request->service_path, std::move(decide));
+}
+
+std::vector<std::string> MirrorService::member_modifiers(const std::string& type, const std::string& member) {
+    auto texts = service_definitions();
+    std::shared_ptr<const DeviceTypes> types;
+    {
+        std::lock_guard lock(mutex_);
+        if (types_ && types_->texts() == texts) types = types_;
+    }
+    if (!types) {
+        auto parsed = DeviceTypes::parse(std::move(texts));
+        if (!parsed) return {};
+        types = *parsed;
+        std::lock_guard lock(mutex_);
+        types_ = types;
+    }
+    auto obj = types->find_object(type);
+    const auto* m = obj ? obj->entry->find_member(member) : nullptr;
+    return m ? m->modifiers : std::vector<std::string>{};
+}
+
+Result<void> MirrorService::check_api_request(const std::string& path, const std::string& user, bool nolock) {
+    if (passthrough_) return {};
+    return locks_->check(path, ServiceLocks::Requester{0, user}, nolock);
+}
+
+std::vector<DeviceLockInfo> MirrorService::gateway_locks() const {
+    std::vector<DeviceLockInfo> out;
+    if (passthrough_) return out;
+    for (auto& h : locks_->held()) out.push_back(DeviceLockInfo{std::move(h.path), std::move(h.username), std::move(h.kind), h.endpoint});
+    return out;
 }
 
 void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder) {
@@ -486,18 +616,22 @@ void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageE
     const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
     {
         std::lock_guard lock(mutex_);
-        for (auto& el : entry.elements) {
+        // Only packets of this client's own endpoints go on: an index it did not open could name
+        // another client's upstream endpoint (or pass a lock taken since).
+        std::erase_if(entry.elements, [&](MessageElement& el) {
             // Packets name their pipe index; acks number it (wire.md §6.7).
             std::optional<std::int32_t> d = acks ? el.number : parse_pipe_index(el.name);
-            if (!d) continue;
+            if (!d) return true;
             auto it = pipes_by_downstream_.find({session.endpoint(), entry.service_path, entry.member_name, *d});
-            if (it == pipes_by_downstream_.end()) continue;
+            if (it == pipes_by_downstream_.end()) return true;
             if (acks)
                 el.number = it->second;
             else
                 el.name = std::to_string(it->second);
-        }
+            return false;
+        });
     }
+    if (entry.elements.empty()) return;
     if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
     entry.service_path = to_upstream(entry.service_path);
     c->send(std::move(entry));

@@ -11,6 +11,8 @@
 
 #include "server/gateway/auth/mirror_access.hpp"
 #include "server/gateway/device_mirror.hpp"
+#include "server/gateway/device_types.hpp"
+#include "server/service/service_locks.hpp"
 
 namespace rr::server::gateway {
 
@@ -29,9 +31,10 @@ public:
     void on_session_open(const SessionRef& session) override;
     void on_session_close(const SessionRef& session) override;
     void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override;
-    /// Lock operations reach the mirror: forwarded on the client's own session (passthrough) or
-    /// refused with InvalidOperation (shared).
+    /// Lock operations reach the mirror: forwarded on the client's own session (passthrough), or
+    /// decided by the gateway's own lock table (shared; docs/security.md "auth: shared").
     bool handles_locks() const override { return true; }
+    void attach(boost::asio::io_context& io) override { locks_->attach(io); }
     bool admits_sessions() const override { return passthrough_ != nullptr; }
     void admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
                        std::function<void(Result<void>)> done) override;
@@ -89,6 +92,15 @@ public:
     std::string to_upstream(std::string_view path) const;
     std::string to_downstream(std::string_view path) const;
 
+    /// Locks held at the gateway (auth: shared): a JSON API request to the object at `path` (gateway
+    /// naming) made by gateway user `user` ("" without logins), which has no session of its own: it
+    /// passes `user`'s user locks and nothing else (no client lock, no monitor). `nolock`: the member
+    /// passes object locks (passes_object_locks). Always passes on a passthrough device, whose locks
+    /// the device keeps. Errors: ObjectLockedError, InvalidOperation (monitor), as for a native client.
+    Result<void> check_api_request(const std::string& path, const std::string& user, bool nolock);
+    /// The locks and monitors held at the gateway (auth: shared), paths in gateway naming.
+    std::vector<DeviceLockInfo> gateway_locks() const;
+
 private:
     using MemberKey = std::pair<std::string, std::string>;  // downstream service path, member
     struct InternalSub {
@@ -124,9 +136,23 @@ private:
     void callback_from_device(MessageEntry&& entry);
     void fan_out(MessageEntry&& entry);
     void drop_session_state(std::uint32_t endpoint);
+    /// auth: shared: a client's request after the roles (and, for member requests, the locks).
+    void dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// auth: shared: RequestObjectLock … MonitorExit, decided by locks_.
+    void lock_op(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// auth: shared: a member request an object lock refused: passes when the device's definition
+    /// marks the member [nolock] / [nolockread] (the object's type asked of the device when below the root).
+    void recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// The robdef modifiers of `member` of object type `type` (empty when unknown).
+    std::vector<std::string> member_modifiers(const std::string& type, const std::string& member);
+    /// objectlock / objectlockoverride of a gateway user (none without gateway.auth).
+    ServiceLocks::Privileges privileges(const std::string& user) const;
 
     std::weak_ptr<DeviceMirror> mirror_;
     std::shared_ptr<PassthroughSessions> passthrough_;
+    // auth: shared: the object and monitor locks of this device's gateway clients, held here (the
+    // device sees one session); unused on a passthrough device.
+    const std::shared_ptr<ServiceLocks> locks_ = std::make_shared<ServiceLocks>();
     auth::MirrorAccess access_;
     /// With gateway.auth on a passthrough device: the roles apply to what the device sends each client
     /// (events, wire and pipe packets: read; callback calls: call), as on a shared device.
@@ -154,6 +180,7 @@ private:
     std::map<std::tuple<std::string, std::string, std::int32_t>, std::uint64_t> internal_pipes_by_upstream_;
     bool internal_pipe_packets(MessageEntry& entry);
     std::uint64_t next_internal_id_ = 1;
+    std::shared_ptr<const DeviceTypes> types_;  // the device's definitions parsed, for member modifiers
 };
 
 }  // namespace rr::server::gateway

@@ -20,13 +20,20 @@ using testing::RawTestService;
 
 namespace {
 
+std::shared_ptr<Node> test_node(const char* name) {
+    NodeOptions o;
+    o.node_name = name;
+    o.threads = 2;
+    return Node::create(std::move(o));
+}
+
 struct Device {
     std::shared_ptr<Node> node;
     std::shared_ptr<RawTestService> service = std::make_shared<RawTestService>();
     std::uint16_t port = 0;
 
     explicit Device(std::uint16_t want_port = 0) {
-        node = Node::create(NodeOptions{NodeID(), "device.node", 2, {}, 0, 5000ms});
+        node = test_node("device.node");
         REQUIRE(node->register_service(service));
         auto p = listen_tcp(node, "127.0.0.1", want_port);
         REQUIRE(p);
@@ -35,7 +42,7 @@ struct Device {
 };
 
 struct Gateway {
-    std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "gateway.node", 2, {}, 0, 5000ms});
+    std::shared_ptr<Node> node = test_node("gateway.node");
     std::shared_ptr<DeviceMirror> mirror;
     std::uint16_t port = 0;
 
@@ -128,7 +135,7 @@ TEST_CASE("the gateway re-hosts a device under its own name") {
 TEST_CASE("a device counts as connected only once its service is registered on the gateway node") {
     // /readyz and Gateway::ready() poll status(): a client that waited for "connected" must find the service.
     Device device;
-    auto node = Node::create(NodeOptions{NodeID(), "gateway.node", 2, {}, 0, 5000ms});
+    auto node = test_node("gateway.node");
     DeviceConfig cfg;
     cfg.name = "dev";
     cfg.url = "rr+tcp://127.0.0.1:" + std::to_string(device.port) + "/?service=svc";
@@ -318,22 +325,4 @@ TEST_CASE("auth: passthrough: one upstream session per client, bounded, closed w
     CHECK(a_called.load() == 1);
     c->close();
     b->close();
-}
-
-TEST_CASE("auth: shared refuses object and monitor locks with an error naming passthrough") {
-    Device device;
-    Gateway gw(device.port);
-    REQUIRE(gw.wait_state(DeviceState::connected));
-    auto c = gw.connect();
-    for (const char* op : {"RequestObjectLock", "RequestClientObjectLock", "ReleaseObjectLock", "MonitorEnter",
-                           "MonitorContinueEnter", "MonitorExit"}) {
-        INFO(op);
-        auto r = call(*c, request(MessageEntryType::ClientSessionOpReq, op));
-        REQUIRE(r);
-        CHECK(r->error == MessageErrorType::InvalidOperation);
-        auto err = entry_error(*r);
-        REQUIRE(err);
-        CHECK_THAT(err->message, Catch::Contains("needs `auth: passthrough` on device \"dev\""));
-    }
-    CHECK(gw.mirror->status().locks.empty());
 }

@@ -51,6 +51,13 @@ Result<void> ObjectLocks::check(std::string_view path, std::string_view username
     return fail(locked("Object locked by " + h->username));
 }
 
+std::vector<ObjectLocks::Holder> ObjectLocks::locks() const {
+    std::vector<Holder> out;
+    out.reserve(locks_.size());
+    for (const auto& [p, h] : locks_) out.push_back(h);
+    return out;
+}
+
 void ObjectLocks::session_closed(std::uint32_t endpoint, std::string_view username, bool last_session_of_user) {
     for (auto it = locks_.begin(); it != locks_.end();) {
         const Holder& h = it->second;
@@ -187,6 +194,13 @@ void ObjectLocks::monitor_session_closed(std::uint32_t endpoint, Clock::time_poi
 std::uint32_t ObjectLocks::monitor_holder(const std::string& path) const {
     auto it = monitors_.find(path);
     return it == monitors_.end() ? 0 : it->second.holder;
+}
+
+std::vector<std::pair<std::string, std::uint32_t>> ObjectLocks::monitor_holders(Clock::time_point now) const {
+    std::vector<std::pair<std::string, std::uint32_t>> out;
+    for (const auto& [path, m] : monitors_)
+        if (m.holder != 0 && now - m.last_use < kMonitorIdle) out.emplace_back(path, m.holder);
+    return out;
 }
 
 }  // namespace rr::server

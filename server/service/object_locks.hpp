@@ -66,6 +66,8 @@ public:
     /// `last_session_of_user`.
     void session_closed(std::uint32_t endpoint, std::string_view username, bool last_session_of_user);
     std::size_t lock_count() const noexcept { return locks_.size(); }
+    /// Every object lock held, by path.
+    std::vector<Holder> locks() const;
 
     // --- monitor locks ---
     /// A monitor handed to a waiting session (answer its pending MonitorEnter/ContinueEnter "OK"), or
@@ -97,6 +99,11 @@ public:
     void monitor_session_closed(std::uint32_t endpoint, Clock::time_point now, std::vector<MonitorEvent>& events);
     /// The session holding the monitor of `path` (0: none).
     std::uint32_t monitor_holder(const std::string& path) const;
+    /// Every monitor held at `now` (path, holding session), by path; holders idle for kMonitorIdle
+    /// are left out (they lose the monitor at its next use).
+    std::vector<std::pair<std::string, std::uint32_t>> monitor_holders(Clock::time_point now) const;
+    /// Nothing is locked or monitored, and nobody waits.
+    bool empty() const noexcept { return locks_.empty() && monitors_.empty(); }
 
 private:
     struct Waiter {

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "server/service/object_locks.hpp"
+#include "server/service/service_locks.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -127,4 +128,37 @@ TEST_CASE("object locks: monitor hand-over, refresh, idle expiry, waiter timeout
     CHECK(l.monitor_exit("svc", 6, t0 + 62s, ev));
     CHECK(l.monitor_exit("svc", 6, t0 + 62s, ev));  // nothing held: OK
     CHECK(l.monitor_holder("svc") == 0);
+}
+
+TEST_CASE("object locks: listings of locks and monitors, for who-holds-what answers") {
+    ObjectLocks l;
+    const auto t0 = ObjectLocks::Clock::time_point{} + 1000s;
+    std::vector<ObjectLocks::MonitorEvent> ev;
+    CHECK(l.empty());
+    REQUIRE(l.lock("svc.b", "bob", 7));
+    REQUIRE(l.lock("svc.a", "alice", 0));
+    REQUIRE(l.monitor_enter("svc", 3, -1, t0, ev).value());
+    CHECK_FALSE(l.empty());
+    auto locks = l.locks();
+    REQUIRE(locks.size() == 2);
+    CHECK(locks[0].path == "svc.a");
+    CHECK(locks[0].endpoint == 0);
+    CHECK(locks[1].username == "bob");
+    CHECK(locks[1].endpoint == 7);
+    using Monitors = std::vector<std::pair<std::string, std::uint32_t>>;
+    CHECK(l.monitor_holders(t0 + 29s) == Monitors{{"svc", 3}});
+    CHECK(l.monitor_holders(t0 + 30s).empty());  // idle: gone at its next use
+}
+
+TEST_CASE("object locks: [nolock] passes every request, [nolockread] property and memory reads") {
+    using T = MessageEntryType;
+    CHECK(passes_object_locks({"nolock"}, T::PropertySetReq));
+    CHECK(passes_object_locks({"readonly", "nolock"}, T::FunctionCallReq));
+    CHECK(passes_object_locks({"nolockread"}, T::PropertyGetReq));
+    CHECK(passes_object_locks({"nolockread"}, T::MemoryRead));
+    CHECK(passes_object_locks({"nolockread"}, T::MemoryGetParam));
+    CHECK_FALSE(passes_object_locks({"nolockread"}, T::PropertySetReq));
+    CHECK_FALSE(passes_object_locks({"nolockread"}, T::MemoryWrite));
+    CHECK_FALSE(passes_object_locks({}, T::PropertyGetReq));
+    CHECK_FALSE(passes_object_locks({"readonly"}, T::PropertyGetReq));
 }

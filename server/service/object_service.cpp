@@ -4,9 +4,6 @@
 #include <atomic>
 #include <limits>
 
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
-
 #include "core/names/service_path.hpp"
 #include "core/value/named_type.hpp"
 #include "server/service/member_support.hpp"
@@ -126,25 +123,13 @@ void ObjectService::on_session_open(const SessionRef& session) {
 void ObjectService::on_session_close(const SessionRef& session) {
     std::vector<std::shared_ptr<ServiceObject>> objects;
     std::vector<std::shared_ptr<Generator>> generators;  // destroyed outside the lock
-    std::vector<ObjectLocks::MonitorEvent> monitor_events;
-    std::vector<std::shared_ptr<ParkedMonitor>> parked;  // destroyed outside the lock
+    const std::string user = session.username();
+    bool last_of_user = true;
     {
         std::lock_guard lock(mutex_);
         sessions_.erase(session.endpoint());
-        const std::string user = session.username();
-        bool last_of_user = true;
         for (const auto& [e, s] : sessions_)
             if (!user.empty() && s.username() == user) last_of_user = false;
-        locks_.session_closed(session.endpoint(), user, last_of_user);
-        locks_.monitor_session_closed(session.endpoint(), std::chrono::steady_clock::now(), monitor_events);
-        for (auto it = parked_.begin(); it != parked_.end();) {
-            if (it->first.second == session.endpoint()) {
-                parked.push_back(std::move(it->second));
-                it = parked_.erase(it);
-            } else {
-                ++it;
-            }
-        }
         for (auto it = generators_.begin(); it != generators_.end();) {
             if (it->second.session == session.endpoint()) {
                 generators.push_back(std::move(it->second.generator));
@@ -157,7 +142,7 @@ void ObjectService::on_session_close(const SessionRef& session) {
             if (std::find(objects.begin(), objects.end(), obj) == objects.end()) objects.push_back(obj);
     }
     for (const auto& obj : objects) obj->session_closed(session);
-    deliver_monitor_events(monitor_events);
+    locks_->session_closed(session.endpoint(), user, last_of_user);
 }
 
 std::vector<SessionRef> ObjectService::sessions() const {
@@ -270,17 +255,16 @@ Result<void> ObjectService::release_path(const std::string& path) {
 void ObjectService::shutdown() {
     std::vector<std::shared_ptr<ServiceObject>> objects;
     std::unordered_map<std::int32_t, GeneratorEntry> generators;
-    std::map<std::pair<std::string, std::uint32_t>, std::shared_ptr<ParkedMonitor>> parked;
     {
         std::lock_guard lock(mutex_);
         shut_down_ = true;
-        parked.swap(parked_);
         for (auto& w : ever_bound_)
             if (auto o = w.lock()) objects.push_back(std::move(o));
         ever_bound_.clear();
         objects_.clear();
         generators.swap(generators_);
     }
+    locks_->shutdown();
     for (const auto& o : objects) o->clear_handlers();
 }
 
@@ -447,20 +431,9 @@ void ObjectService::handle_entry(const SessionRef& session, MessageEntry&& entry
 
 // --- locks -----------------------------------------------------------------------------------
 
-struct ObjectService::ParkedMonitor {
-    Responder responder;
-    std::unique_ptr<boost::asio::steady_timer> timer;
-};
+void ObjectService::attach(boost::asio::io_context& io) { locks_->attach(io); }
 
-void ObjectService::attach(boost::asio::io_context& io) {
-    std::lock_guard lock(mutex_);
-    io_ = &io;
-}
-
-std::optional<ObjectLocks::Holder> ObjectService::lock_holder(const std::string& path) const {
-    std::lock_guard lock(mutex_);
-    return locks_.holder(path);
-}
+std::optional<ObjectLocks::Holder> ObjectService::lock_holder(const std::string& path) const { return locks_->holder(path); }
 
 bool ObjectService::has_privilege(const std::string& username, std::string_view privilege) const {
     for (const auto& u : users_.users())
@@ -471,201 +444,31 @@ bool ObjectService::has_privilege(const std::string& username, std::string_view 
 
 Result<void> ObjectService::check_locks(const SessionRef& session, const std::string& path, const ServiceObject* obj,
                                         const MessageEntry& entry) {
-    // Members marked [nolock] pass object locks; [nolockread] lets property reads and memory reads
-    // pass (CORE: generated skels' IsRequestNoLock). Monitor locks apply to every member.
+    // Members marked [nolock] / [nolockread] pass object locks; monitor locks apply to every member.
     bool nolock = false;
-    if (obj) {
-        if (auto info = obj->member_info(entry.member_name); info && info->def) {
-            for (const auto& m : info->def->modifiers) {
-                if (m == "nolock") nolock = true;
-                if (m == "nolockread" &&
-                    (entry.entry_type == MessageEntryType::PropertyGetReq || entry.entry_type == MessageEntryType::MemoryRead ||
-                     entry.entry_type == MessageEntryType::MemoryGetParam))
-                    nolock = true;
-            }
-        }
-    }
-    std::vector<ObjectLocks::MonitorEvent> events;
-    Result<void> r;
-    const std::string username = session.username();
-    {
-        std::lock_guard lock(mutex_);
-        r = locks_.monitor_check(path, session.endpoint(), std::chrono::steady_clock::now(), events);
-        if (r && !nolock) r = locks_.check(path, username, session.endpoint());
-    }
-    deliver_monitor_events(events);
-    return r;
+    if (obj)
+        if (auto info = obj->member_info(entry.member_name); info && info->def)
+            nolock = passes_object_locks(info->def->modifiers, entry.entry_type);
+    return locks_->check(path, ServiceLocks::Requester{session.endpoint(), session.username()}, nolock);
 }
 
 void ObjectService::handle_lock_op(const SessionRef& session, MessageEntry&& entry, Responder responder) {
-    const std::string op = entry.member_name;
-    const std::string path = entry.service_path;
-    const std::uint32_t endpoint = session.endpoint();
-    const bool monitor = op.rfind("Monitor", 0) == 0;
     const std::string username = session.username();
-    bool override_ = false;
-    if (!monitor) {
-        // CORE ServerContext::ClientLockOp: object locks need a user with a locking privilege.
-        if (username.empty()) {
-            responder.fail(make_error(MessageErrorType::PermissionDenied, "User must be authenticated to lock object"));
-            return;
-        }
+    ServiceLocks::Privileges privileges;
+    {
         std::lock_guard lock(mutex_);
-        override_ = has_privilege(username, "objectlockoverride");
-        if (!override_ && !has_privilege(username, "objectlock")) {
-            responder.fail(make_error(MessageErrorType::ObjectLockedError, "User does not have object locking privileges"));
-            return;
-        }
+        privileges.override_ = has_privilege(username, "objectlockoverride");
+        privileges.lock = has_privilege(username, "objectlock");
     }
-    if (auto obj = resolve(session, path); !obj) {
+    if (auto ok = ServiceLocks::check_privileges(entry.member_name, username, privileges); !ok) {
+        responder.fail(ok.error());
+        return;
+    }
+    if (auto obj = resolve(session, entry.service_path); !obj) {
         responder.fail(obj.error());
         return;
     }
-    auto ok_reply = [&responder](const char* text) {
-        MessageEntry r;
-        r.elements.push_back(make_string_element("return", text));
-        responder.respond(std::move(r));
-    };
-    std::vector<ObjectLocks::MonitorEvent> events;
-    const auto now = std::chrono::steady_clock::now();
-    if (op == "RequestObjectLock" || op == "RequestClientObjectLock" || op == "ReleaseObjectLock") {
-        Result<void> r;
-        {
-            std::lock_guard lock(mutex_);
-            if (op == "ReleaseObjectLock") r = locks_.release(path, username, endpoint, override_);
-            else r = locks_.lock(path, username, op == "RequestClientObjectLock" ? endpoint : 0);
-        }
-        if (!r) responder.fail(r.error());
-        else ok_reply("OK");
-        return;
-    }
-    if (op == "MonitorEnter") {
-        const MessageElement* t = entry.find("timeout");
-        std::int32_t timeout = -1;
-        if (!t || !read_scalar(*t, timeout)) {
-            responder.fail(make_error(MessageErrorType::InvalidArgument, "MonitorEnter needs an int32 \"timeout\""));
-            return;
-        }
-        Result<bool> r = false;
-        {
-            std::lock_guard lock(mutex_);
-            r = locks_.monitor_enter(path, endpoint, timeout, now, events);
-        }
-        deliver_monitor_events(events);
-        if (!r) responder.fail(r.error());
-        else if (*r) ok_reply("OK");
-        else {
-            auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(kMonitorWait);
-            if (timeout >= 0 && std::chrono::milliseconds(timeout) + std::chrono::milliseconds(1) < wait)
-                wait = std::chrono::milliseconds(timeout) + std::chrono::milliseconds(1);
-            park_monitor(path, endpoint, std::move(responder), wait);
-        }
-        return;
-    }
-    if (op == "MonitorContinueEnter") {
-        Result<bool> r = false;
-        {
-            std::lock_guard lock(mutex_);
-            r = locks_.monitor_continue(path, endpoint, now, events);
-        }
-        deliver_monitor_events(events);
-        if (!r) responder.fail(r.error());
-        else if (*r) ok_reply("OK");
-        else park_monitor(path, endpoint, std::move(responder), std::chrono::duration_cast<std::chrono::milliseconds>(kMonitorWait));
-        return;
-    }
-    if (op == "MonitorExit") {
-        Result<void> r;
-        {
-            std::lock_guard lock(mutex_);
-            r = locks_.monitor_exit(path, endpoint, now, events);
-        }
-        deliver_monitor_events(events);
-        if (!r) responder.fail(r.error());
-        else ok_reply("OK");
-        return;
-    }
-    // ReleaseClientObjectLock is a known command name that CORE's ClientLockOp answers this way.
-    responder.fail(make_error(MessageErrorType::InvalidOperation, "Invalid command"));
-}
-
-void ObjectService::park_monitor(const std::string& path, std::uint32_t endpoint, Responder responder,
-                                 std::chrono::milliseconds wait) {
-    auto parked = std::make_shared<ParkedMonitor>();
-    parked->responder = std::move(responder);
-    std::shared_ptr<ParkedMonitor> replaced;
-    bool granted_meanwhile = false;
-    {
-        std::lock_guard lock(mutex_);
-        // Handed over between monitor_enter/continue and now (its event found nothing parked).
-        granted_meanwhile = locks_.monitor_holder(path) == endpoint;
-        if (io_ && !shut_down_ && !granted_meanwhile) {
-            parked->timer = std::make_unique<boost::asio::steady_timer>(*io_, wait);
-            replaced = std::move(parked_[{path, endpoint}]);
-            parked_[{path, endpoint}] = parked;
-        }
-    }
-    if (replaced && !replaced->responder.done()) {
-        MessageEntry r;
-        r.elements.push_back(make_string_element("return", "Continue"));
-        replaced->responder.respond(std::move(r));
-    }
-    if (!parked->timer) {  // no io_context: the client asks again at once
-        MessageEntry r;
-        r.elements.push_back(make_string_element("return", granted_meanwhile ? "OK" : "Continue"));
-        parked->responder.respond(std::move(r));
-        return;
-    }
-    std::weak_ptr<ObjectService> weak = weak_from_this();
-    std::weak_ptr<ParkedMonitor> weak_parked = parked;
-    parked->timer->async_wait([weak, weak_parked, path, endpoint](const boost::system::error_code& ec) {
-        if (ec) return;
-        auto self = weak.lock();
-        if (!self) return;
-        std::vector<ObjectLocks::MonitorEvent> events;
-        std::shared_ptr<ParkedMonitor> mine;
-        {
-            std::lock_guard lock(self->mutex_);
-            self->locks_.monitor_poll(std::chrono::steady_clock::now(), events);
-        }
-        self->deliver_monitor_events(events);  // may answer this request "OK" or RequestTimeout
-        {
-            std::lock_guard lock(self->mutex_);
-            auto it = self->parked_.find({path, endpoint});
-            if (it != self->parked_.end() && it->second == weak_parked.lock()) {
-                mine = std::move(it->second);
-                self->parked_.erase(it);
-            }
-        }
-        if (mine && !mine->responder.done()) {
-            MessageEntry r;
-            r.elements.push_back(make_string_element("return", "Continue"));
-            mine->responder.respond(std::move(r));
-        }
-    });
-}
-
-void ObjectService::deliver_monitor_events(std::vector<ObjectLocks::MonitorEvent>& events) {
-    for (const auto& ev : events) {
-        std::shared_ptr<ParkedMonitor> p;
-        {
-            std::lock_guard lock(mutex_);
-            auto it = parked_.find({ev.path, ev.endpoint});
-            if (it == parked_.end()) continue;  // not parked: its next MonitorContinueEnter learns it
-            p = std::move(it->second);
-            parked_.erase(it);
-        }
-        if (p->timer) p->timer->cancel();
-        if (p->responder.done()) continue;
-        if (ev.granted) {
-            MessageEntry r;
-            r.elements.push_back(make_string_element("return", "OK"));
-            p->responder.respond(std::move(r));
-        } else {
-            p->responder.fail(make_error(MessageErrorType::RequestTimeout, "Timed out waiting for the monitor lock"));
-        }
-    }
-    events.clear();
+    locks_->handle_op(ServiceLocks::Requester{session.endpoint(), username}, privileges, entry, std::move(responder));
 }
 
 }  // namespace rr::server

@@ -14,7 +14,7 @@
 //                   (ConnectClientCombined `username` + `credentials{password}` or AuthenticateUser)
 //                   before member requests are accepted, and events skip sessions not logged in.
 //   object locks    RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock and MonitorEnter /
-//                   MonitorContinueEnter / MonitorExit with CORE's semantics (object_locks.hpp): object
+//                   MonitorContinueEnter / MonitorExit with CORE's semantics (service_locks.hpp): object
 //                   locks need a logged-in user with the `objectlock` or `objectlockoverride` privilege
 //                   (PermissionDenied / ObjectLockedError otherwise); every member request (not pipe or
 //                   wire packets) to a locked object from another user or session gets ObjectLockedError
@@ -36,7 +36,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "server/service/object_locks.hpp"
+#include "server/service/service_locks.hpp"
 #include "server/service/password_table.hpp"
 #include "server/service/service_object.hpp"
 
@@ -81,7 +81,7 @@ public:
     static constexpr std::size_t kMaxGeneratorsPerSession = 1024;
     static constexpr std::chrono::minutes kGeneratorIdleTimeout{10};
     /// A waiting MonitorEnter / MonitorContinueEnter is answered "Continue" after this (CORE: 5 s).
-    static constexpr std::chrono::seconds kMonitorWait{5};
+    static constexpr std::chrono::seconds kMonitorWait = ServiceLocks::kMonitorWait;
 
     // --- Service ---
     const std::string& name() const override { return name_; }
@@ -115,14 +115,8 @@ private:
     /// `obj`: the object at `path` when resolved (for its members' [nolock] / [nolockread]).
     Result<void> check_locks(const SessionRef& session, const std::string& path, const ServiceObject* obj,
                              const MessageEntry& entry);
-    /// Keeps a MonitorEnter / MonitorContinueEnter that must wait: answered "Continue" after
-    /// kMonitorWait (or at once without an io_context), "OK" when granted, RequestTimeout.
-    void park_monitor(const std::string& path, std::uint32_t endpoint, Responder responder, std::chrono::milliseconds wait);
-    /// Answers parked monitor requests for `events` (call without mutex_ held).
-    void deliver_monitor_events(std::vector<ObjectLocks::MonitorEvent>& events);
     bool has_privilege(const std::string& username, std::string_view privilege) const;  // mutex_ held
 
-    struct ParkedMonitor;
     struct GeneratorEntry {
         std::uint32_t session = 0;
         std::string path, member;
@@ -141,9 +135,7 @@ private:
     std::mt19937 rng_;
     MessageElement attributes_;
     PasswordTable users_;
-    ObjectLocks locks_;
-    std::map<std::pair<std::string, std::uint32_t>, std::shared_ptr<ParkedMonitor>> parked_;  // (path, endpoint)
-    boost::asio::io_context* io_ = nullptr;
+    const std::shared_ptr<ServiceLocks> locks_ = std::make_shared<ServiceLocks>();
     bool shut_down_ = false;
 };
 

@@ -73,7 +73,6 @@ class Runner:
         self.results = []  # (section, name, ok, error)
         self.section = ""
         self.verbose = False
-        self.monitor_refused = False
 
     def check(self, name, fn):
         if self.verbose:
@@ -532,22 +531,7 @@ class Runner:
             finally:
                 RRN.MonitorExit(c)
 
-        def monitor_refused():
-            # A gateway device in the default shared mode refuses locks (docs/security.md).
-            try:
-                RRN.MonitorEnter(c, 5)
-            except RR.InvalidOperationException as e:
-                if "auth: passthrough" not in str(e):
-                    raise AssertionError("MonitorEnter refused without naming auth: passthrough: %s" % e)
-            else:
-                RRN.MonitorExit(c)
-                raise AssertionError("MonitorEnter through a shared gateway device was not refused")
-            expect_equal(c.ro_value, iv.RO_VALUE, "read after the refusal")
-
-        if self.monitor_refused:
-            self.check("monitor lock refused (shared gateway device)", monitor_refused)
-        else:
-            self.check("monitor lock", monitor)
+        self.check("monitor lock", monitor)
         self.check("final reset", lambda: c.reset())
 
     SECTIONS = ["connection", "properties", "functions", "generators", "events", "objrefs", "pipes",
@@ -567,8 +551,6 @@ def main(argv=None):
     ap.add_argument("--heartbeat", type=float, default=None, help="TCP heartbeat period in seconds")
     ap.add_argument("--idle", type=float, default=0.0, help="stay connected and idle this long at the end (s)")
     ap.add_argument("--timeout", type=float, default=90.0, help="overall time limit (s)")
-    ap.add_argument("--monitor-refused", action="store_true",
-                    help="expect MonitorEnter to be refused (a gateway device in auth: shared mode)")
     ap.add_argument("--verbose", action="store_true", help="print each check's name on stderr")
     ap.add_argument("--only", default="", help="comma-separated sections (default: all): " +
                     ",".join(Runner.SECTIONS))
@@ -611,7 +593,6 @@ def main(argv=None):
             return 2
         r = Runner(c)
         r.verbose = args.verbose
-        r.monitor_refused = args.monitor_refused
         r.run(sections)
         if args.idle > 0:
             time.sleep(args.idle)

@@ -11,8 +11,10 @@ locks, release on disconnect and on a killed client process). Then:
            (each has its own upstream session);
   limit    a device with max_passthrough_sessions: 2 refuses a third client with a clear error and
            admits it once one of the two has gone;
-  shared   a device in the default shared mode refuses RequestObjectLock and MonitorEnter with
-           InvalidOperation naming `auth: passthrough`;
+  shared   a device in the default shared mode holds locks at the gateway: an anonymous client's
+           RequestObjectLock is refused with PermissionDenied (this gateway has no users), its
+           MonitorEnter is held at the gateway and listed in /api/devices (shared_locks_gateway.py
+           has the rest);
   device_login  a JSON WebSocket logs in to the device as one of its users (`device_login`): a wrong
            password gets the device's own error; while alice holds a user lock, the socket logged in
            as alice reads the locked object and subscribes to a wire, a pipe and an event on her own
@@ -222,19 +224,23 @@ def run_extra_checks(port, ck):
 
     ck.check("limit: max_passthrough_sessions refuses a client with a clear error", session_limit)
 
-    def shared_refuses_locks():
-        c = RRN.ConnectService(url_shared)  # the shared mode: the gateway's own login
+    def shared_holds_locks():
+        c = RRN.ConnectService(url_shared)  # the shared mode: the gateway's own login to the device
         try:
             ll.expect(isinstance(c.base_name, str), "reads on the shared session")
-            ll.expect_raises(RR.InvalidOperationException,
+            ll.expect_raises(RR.PermissionDeniedException,
                              lambda: RRN.RequestObjectLock(c, RR.RobotRaconteurObjectLockFlags_USER_LOCK),
-                             "object lock on a shared device", "auth: passthrough")
-            ll.expect_raises(RR.InvalidOperationException, lambda: RRN.MonitorEnter(c, 1000),
-                             "monitor on a shared device", "auth: passthrough")
+                             "an anonymous object lock on a shared device", "User must be authenticated to lock object")
+            RRN.MonitorEnter(c, 1000)
+            try:
+                expect_locks(port, "shared", [("shared", None, "monitor")], "the monitor held at the gateway")
+            finally:
+                RRN.MonitorExit(c)
+            expect_locks(port, "shared", [], "after MonitorExit")
         finally:
             RRN.DisconnectService(c)
 
-    ck.check("shared: object and monitor locks refused, naming auth: passthrough", shared_refuses_locks)
+    ck.check("shared: locks held at the gateway (anonymous: no object lock, a monitor)", shared_holds_locks)
 
     def no_login_refused_with_device_error():
         ll.expect_raises(RR.AuthenticationException, lambda: RRN.ConnectService(url_small), "no login (small)",

@@ -5,7 +5,7 @@ import { h, errorText } from "./dom.js";
 
 const POLL_MS = 1000;
 
-/** Locks held on a passthrough device's objects, taken through the gateway (docs/security.md). */
+/** Locks the gateway knows on a device's objects: held at it (shared) or taken through it (passthrough); docs/security.md. */
 export function lockLines(d) {
   if (!Array.isArray(d.locks)) return [];
   return d.locks.map((l) => h("span", {

@@ -72,6 +72,16 @@ struct Principal {
     bool may_add_devices() const {
         return allows("*", "*", Operation::read) && allows("*", "*", Operation::write) && allows("*", "*", Operation::call);
     }
+    /// Whether the privilege column of the user's password file line (a token's or JWT's roles) lists
+    /// `privilege`: `objectlock`, `objectlockoverride` (docs/security.md).
+    bool has_privilege(std::string_view privilege) const {
+        for (const auto& r : roles)
+            if (r == privilege) return true;
+        return false;
+    }
+    /// The user name the principal's RR sessions carry: the user's own name for a password login,
+    /// `<name>@token` / `<name>@jwt` for a token or JWT (so a token never passes for a password user).
+    std::string rr_user_name() const { return via == "password" ? name : name + "@" + via; }
 };
 
 }  // namespace rr::server::gateway::auth

@@ -127,7 +127,7 @@ Result<PrincipalPtr> GatewayAuth::login_rr_token(std::string_view username, std:
     auto who = login_token(token, peer, LoginChannel::rr);
     if (!who) return who.take_error();
     // The session's user name says where its roles come from, so a token never takes a password user's.
-    const std::string name = (*who)->name + "@" + (*who)->via;
+    const std::string name = (*who)->rr_user_name();
     if (username != name)
         return fail(MessageErrorType::AuthenticationError, "this token logs in as user \"" + name + "\"; connect with that username");
     remember_token_user(name, *who);
@@ -213,7 +213,7 @@ Result<std::string> GatewayAuth::web_rr_user(std::string_view cookie_header) {
     auto who = id.empty() ? nullptr : session(id);
     if (!who) return fail(MessageErrorType::AuthenticationError, "Username not provided");
     if (who->via == "password") return who->name;
-    std::string name = who->name + "@" + who->via;
+    std::string name = who->rr_user_name();
     remember_token_user(name, who);
     return name;
 }
