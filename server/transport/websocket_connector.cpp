@@ -111,6 +111,15 @@ static void connect_wss(asio::any_io_executor strand, const ConnectionUrl& url, 
                          "TLS: cannot load the trusted certificates" +
                              (options.tls_ca_file.empty() ? std::string() : " from " + options.tls_ca_file) + ": " +
                              ec.message()));
+    // This client's own certificate (mTLS), presented when the server asks for one.
+    if (!options.tls_certificate_file.empty() || !options.tls_private_key_file.empty()) {
+        const std::string& cert = options.tls_certificate_file;
+        const std::string& key = options.tls_private_key_file.empty() ? cert : options.tls_private_key_file;
+        tls->use_certificate_chain_file(cert, ec);
+        if (ec) return done(fail(MessageErrorType::ConnectionError, "TLS: " + cert + ": no PEM certificate chain (" + ec.message() + ")"));
+        tls->use_private_key_file(key, asio::ssl::context::pem, ec);
+        if (ec) return done(fail(MessageErrorType::ConnectionError, "TLS: " + key + ": " + ec.message()));
+    }
     tls->set_verify_mode(asio::ssl::verify_peer);
     const auto deadline = Clock::now() + options.connect_timeout;  // TCP connect and both handshakes together
     connect_tcp(

@@ -1,7 +1,9 @@
 // rr+ws and rr+wss, client side (wire.md §8): TCP connect, for rr+wss a TLS
 // handshake (OpenSSL: the server's certificate is verified against ConnectOptions::tls_ca_file, or the
-// system's trusted certificates, and must name the URL's host), then a WebSocket handshake with the
-// subprotocol robotraconteur.robotraconteur.com to the URL's path ("/" unless given, so a service
+// system's trusted certificates, and must name the URL's host; ConnectOptions::tls_certificate_file
+// and tls_private_key_file, when set, are this client's certificate for a server that asks for one),
+// then a WebSocket handshake with the subprotocol robotraconteur.robotraconteur.com to the URL's
+// path ("/" unless given, so a service
 // behind a reverse proxy at a sub-path is reachable), then the same StreamPump as rr+tcp over
 // WebSocketByteStream (binary frames, boundaries carry no meaning). ConnectOptions::http_authorization,
 // when set, is sent as the handshake's Authorization header (a proxy's login, e.g. nginx basic auth).

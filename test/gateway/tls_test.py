@@ -10,9 +10,11 @@ Cases (--case):
   sighup  a wss JSON subscription stays open while the certificate files are replaced and SIGHUP is
           sent; new connections get the new certificate; a bad file on the next SIGHUP is logged and
           the certificate in use stays.
-  mtls    client_ca set: HTTPS and rrs+tcp without a client certificate (or with one of another CA)
-          are refused in the handshake, with one they work; with required: true plain HTTP gets 403
-          and plain rr+tcp is refused.
+  mtls    client_ca set: HTTPS, wss (the JSON API), rrs+tcp and rr+wss without a client certificate
+          (or with one of another CA) are refused in the handshake, with one they work; with
+          required: true plain HTTP gets 403 and plain rr+tcp is refused. Then the client_ca file is
+          replaced by another CA and SIGHUP sent: new connections need a certificate of the new CA
+          (the old one's are refused); a broken client_ca file on the next SIGHUP changes nothing.
   device  a gateway whose device is another gateway's demo device over rrs+tcp (tls_ca in the
           device entry): ready, and a value read through it.
   config  bad TLS files stop the start (exit 2) naming the file; --check does the same.
@@ -303,8 +305,10 @@ def case_mtls(a, checks, tmp):
     client = pki.issue(client_ca, "alice", "alice", client=True)
     rogue_ca = pki.ca("rogue-ca", "Rogue CA")
     rogue = pki.issue(rogue_ca, "mallory", "mallory", client=True)
+    live_ca = os.path.join(tmp, "client-ca-live.pem")  # replaced below, then SIGHUP
+    shutil.copy(client_ca.cert, live_ca)
     gw = gwproc.start_gateway(a.gateway, ["--tls-certificate", server.cert, "--tls-private-key", server.key,
-                                          "--tls-client-ca", client_ca.cert, "--tls-required"])
+                                          "--tls-client-ca", live_ca, "--tls-required"])
     try:
         port = gw.port
         wait_ready_https(port, ca.cert, cert=client)
@@ -344,6 +348,79 @@ def case_mtls(a, checks, tmp):
 
         checks.run("required: plain HTTP gets 403", plain_http)
         checks.run("required: plain rr+tcp is refused (3)", plain_rr)
+
+        def wss_json(cert):
+            """The answer to a JSON API request over wss presenting `cert` (or none); raises when the
+            connection fails. An HTTP refusal would mean the handshake passed: that is a failure too."""
+            sslopt = {"ca_certs": ca.cert}
+            if cert:
+                sslopt.update(certfile=cert.cert, keyfile=cert.key)
+            ws = websocket.create_connection("wss://localhost:%d/" % port, subprotocols=["rr-gateway.json.v1"],
+                                             timeout=10, origin="https://localhost:%d" % port, sslopt=sslopt)
+            try:
+                ws.send(json.dumps({"id": 1, "op": "devices"}))
+                return json.loads(ws.recv())
+            finally:
+                ws.close()
+
+        def wss_refused(cert):
+            try:
+                answer = wss_json(cert)
+            except websocket.WebSocketBadStatusException as e:
+                raise AssertionError("the TLS handshake passed, HTTP refused: %s" % e)
+            except (ssl.SSLError, OSError, websocket.WebSocketException) as e:
+                return str(e)
+            raise AssertionError("served without an accepted client certificate: %r" % answer)
+
+        def wss_with(cert):
+            answer = wss_json(cert)
+            expect(answer.get("id") == 1 and "result" in answer, "answer %r" % answer)
+
+        def rr_wss(cert, status):
+            extra = ["--tls-cert", cert.cert, "--tls-key", cert.key] if cert else []
+            p = rr_cli(a.rr, "get", "rr+wss://localhost:%d/?service=create" % port, "DistanceTraveled",
+                       "--tls-ca", ca.cert, "--timeout", "10", *extra)
+            expect(p.returncode == status, "exit %d (expected %d): %s" % (p.returncode, status, p.stderr))
+
+        checks.run("wss (JSON API) with a client certificate", lambda: wss_with(client))
+        checks.run("wss without a client certificate: refused in the handshake", lambda: wss_refused(None))
+        checks.run("wss with a certificate of another CA: refused", lambda: wss_refused(rogue))
+        checks.run("rr over rr+wss with a client certificate", lambda: rr_wss(client, 0))
+        checks.run("rr over rr+wss without one: connect failure (3)", lambda: rr_wss(None, 3))
+
+        # SIGHUP reads client_ca again: the rogue CA's certificates are now the accepted ones.
+        shutil.copy(rogue_ca.cert, live_ca)
+        os.kill(gw.pid, signal.SIGHUP)
+
+        def swapped():
+            end = time.monotonic() + 5
+            while True:
+                try:
+                    if https_get(port, "/livez", ca.cert, cert=rogue)[0] == 200:
+                        return
+                except OSError:
+                    pass
+                if time.monotonic() > end:
+                    raise AssertionError("a certificate of the new client CA is still refused after SIGHUP")
+                time.sleep(0.1)
+
+        def rr_rrs(cert, status):
+            p = rr_cli(a.rr, "get", url, "DistanceTraveled", "--tls-ca", ca.cert, "--tls-cert", cert.cert,
+                       "--tls-key", cert.key, "--timeout", "10")
+            expect(p.returncode == status, "exit %d (expected %d): %s" % (p.returncode, status, p.stderr))
+
+        checks.run("SIGHUP with a new client_ca file: its certificates are accepted", swapped)
+        checks.run("... and the old CA's are refused (HTTPS)", lambda: refused(client))
+        checks.run("... and over rrs+tcp (new CA accepted, old refused)",
+                   lambda: (rr_rrs(rogue, 0), rr_rrs(client, 3)))
+        checks.run("... and over wss (new CA accepted, old refused)", lambda: (wss_with(rogue), wss_refused(client)))
+        with open(live_ca, "w") as f:
+            f.write("not a certificate\n")
+        os.kill(gw.pid, signal.SIGHUP)
+        time.sleep(1.0)
+        checks.run("a broken client_ca file on SIGHUP changes nothing",
+                   lambda: (expect(https_get(port, "/livez", ca.cert, cert=rogue)[0] == 200, "new CA refused"),
+                            refused(client)))
         checks.run("gateway still running", lambda: expect(gw.alive(), "exited"))
     finally:
         status = gw.stop()

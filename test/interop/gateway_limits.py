@@ -18,12 +18,20 @@ Then restarts it with messages_per_second: 20 (burst_s: 1) and, with the officia
             not cut off), and rr_gateway_limited_total{limit="rate"} counts the pauses.
   unharmed  meanwhile a second client's calls on its own connection return promptly, and the
             flooding client is still connected afterwards.
+  rr+ws     the same flood over RR inside a WebSocket (rr+ws) gets the same pace and stays connected.
   JSON/HTTP a JSON WebSocket and an HTTP keep-alive connection sending requests back to back are
             paced to about the same rate, and the WebSocket stays open.
+Then restarts it with bytes_per_second: 256 KiB (burst_s: 1) in front of rr_interop_service (when
+--service is given) and checks:
+  bytes     an official client that queues 80 pipe packets of 16 KiB at once on p_echo (which echoes
+            each one) gets its echoes at about the limit: no faster than the rate allows (the burst plus
+            the rate, plus one 64 KiB read), and no slower than half of it.
+  unharmed  meanwhile a second client's calls on its own connection return promptly, and the
+            flooding client is still connected afterwards.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when websocket-client is missing or 127.0.0.2 cannot be bound.
 
-Usage: gateway_limits.py --gateway PATH/rr-gateway
+Usage: gateway_limits.py --gateway PATH/rr-gateway [--service PATH/rr_interop_service]
 """
 
 import argparse
@@ -49,6 +57,10 @@ JSON_PROTOCOL = "rr-gateway.json.v1"
 METRIC = 'rr_gateway_limited_total{limit="connections_per_address"}'
 RATE_METRIC = 'rr_gateway_limited_total{limit="rate"}'
 RATE = 20
+BYTE_RATE = 256 * 1024  # bytes/s in the bytes_per_second phase
+PACKET = 16 * 1024      # bytes of text per pipe packet there
+PACKETS = 80
+READ_CHUNK = 64 * 1024  # the most one read takes before it is charged (StreamPump's buffer)
 
 
 def http_get(port, path, source="127.0.0.1", timeout=10):
@@ -111,17 +123,31 @@ def metric(port, source="127.0.0.2", name=METRIC):
     raise StepFailed("/metrics has no %s" % name)
 
 
+_official = []
+
+
+def official_node():
+    """The official library's node with its TCP transport (rr+tcp, rr+ws), set up once: the node
+    cannot start again after Shutdown, so main() shuts it down at the end. None when not installed."""
+    if not _official:
+        try:
+            import RobotRaconteur as RR
+        except ImportError as e:
+            _official.append((None, str(e)))
+        else:
+            RR.RobotRaconteurNode.s.RegisterTransport(RR.TcpTransport())
+            _official.append((RR.RobotRaconteurNode.s, None))
+    return _official[0]
+
+
 def rate_checks(c, args, work):
     """The messages_per_second phase (official client); returns False when it had to be skipped."""
-    try:
-        import threading
+    import threading
 
-        import RobotRaconteur as RR
-    except ImportError as e:
-        c.results.append({"check": "throttled", "ok": True, "detail": "SKIPPED: official package missing: %s" % e})
+    rrn, missing = official_node()
+    if rrn is None:
+        c.results.append({"check": "throttled", "ok": True, "detail": "SKIPPED: official package missing: %s" % missing})
         return False
-    rrn = RR.RobotRaconteurNode.s
-    rrn.RegisterTransport(RR.TcpTransport())
     gateway = None
     try:
         with open(os.path.join(work, "rate.yaml"), "w") as f:
@@ -176,14 +202,113 @@ def rate_checks(c, args, work):
         time.sleep(0.2)
         log = tail(os.path.join(work, "rate.err"), 200)
         c.check("throttled: the log says reads were paused", "over its rate" in log and "reads paused" in log, log[-600:])
-        json_http_rate_checks(c, port)
-    finally:
+        # RR inside a WebSocket (rr+ws): the upgraded connection is paced by the same rate.
+        ws_client = rrn.ConnectService(url.replace("rr+tcp://", "rr+ws://"))
+        time.sleep(1.5)
+        calls_ws, elapsed_ws, err_ws = flood_for(4.0, ws_client.GetLocalNodeServices)
+        rate_ws = calls_ws / elapsed_ws
+        c.check("rr+ws: a flooding RR-over-WebSocket client gets about messages_per_second calls/s",
+                not err_ws and calls_ws <= RATE * (elapsed_ws + 1) + 5 and rate_ws >= RATE / 2,
+                "%d calls in %.2f s = %.1f/s (limit %d/s, burst %d) %s" % (calls_ws, elapsed_ws, rate_ws, RATE, RATE, err_ws))
         try:
-            rrn.Shutdown()
-        except Exception:  # noqa: BLE001
-            pass
+            ws_client.GetLocalNodeServices()
+            still = True
+        except Exception as e:  # noqa: BLE001
+            still = repr(e)
+        c.check("rr+ws: the flooding client is slowed, not disconnected", still is True, str(still))
+        json_http_rate_checks(c, port)
+        for client in (flood, other, ws_client):
+            rrn.DisconnectService(client)
+    finally:
         stop(gateway)
     return True
+
+
+def bytes_checks(c, args, work):
+    """The bytes_per_second phase: official client -> gateway -> rr_interop_service's p_echo pipe."""
+    import threading
+
+    rrn, missing = official_node()
+    if rrn is None:
+        c.results.append({"check": "bytes", "ok": True, "detail": "SKIPPED: official package missing: %s" % missing})
+        return
+    if not args.service:
+        c.results.append({"check": "bytes", "ok": True, "detail": "SKIPPED: no --service (rr_interop_service)"})
+        return
+    device = gateway = None
+    try:
+        device = start([args.service, "--port", "0"], os.path.join(work, "service.err"))
+        dev = read_json_line(device, args.timeout, "rr_interop_service ready line")
+        with open(os.path.join(work, "bytes.yaml"), "w") as f:
+            f.write("gateway:\n  listen: 127.0.0.1\n  port: 0\n  local: false\n"
+                    "  limits:\n    bytes_per_second: %d\n    burst_s: 1\n"
+                    "demo:\n  enabled: false\n"
+                    "devices:\n  - name: interop\n    url: %s\n" % (BYTE_RATE, json.dumps(dev["url"])))
+        gateway = start([args.gateway, "--config", os.path.join(work, "bytes.yaml")], os.path.join(work, "bytes.err"))
+        port = read_json_line(gateway, args.timeout, "rr-gateway ready line (bytes)")["port"]
+        deadline = time.monotonic() + args.timeout
+        while http_get(port, "/readyz")[0] != 200:  # the device is connected
+            if time.monotonic() > deadline:
+                raise StepFailed("gateway not ready: " + tail(os.path.join(work, "bytes.err")))
+            time.sleep(0.2)
+        url = "rr+tcp://127.0.0.1:%d/?service=interop" % port
+        flood = rrn.ConnectService(url)
+        other = rrn.ConnectService(url)
+        ep = flood.p_echo.Connect(-1)
+        packet = rrn.NewStructure("experimental.interop_test.Inner", flood)
+        packet.id, packet.label, packet.values = 1, "x" * PACKET, [0.0]
+        time.sleep(1.5)  # the bucket full again after the handshake and the definitions
+        t0 = time.monotonic()
+        for _ in range(PACKETS):
+            ep.AsyncSendPacket(packet, lambda *_a: None)
+        echoes = []  # arrival time of each echo
+        done = threading.Event()
+
+        def drain():
+            end = time.monotonic() + 60
+            while len(echoes) < PACKETS and time.monotonic() < end:
+                while ep.Available:
+                    ep.ReceivePacket()
+                    echoes.append(time.monotonic())
+                time.sleep(0.005)
+            done.set()
+
+        th = threading.Thread(target=drain)
+        th.start()
+        time.sleep(1.5)  # the burst is spent: the flood is paced now
+        worst = 0.0
+        for _ in range(5):
+            s0 = time.monotonic()
+            other.add(1, 2)
+            worst = max(worst, time.monotonic() - s0)
+            time.sleep(0.1)
+        done.wait(70)
+        th.join(5)
+        sent = PACKETS * PACKET  # what the gateway had to read at least (the text alone)
+        fastest = (sent - BYTE_RATE - READ_CHUNK) / BYTE_RATE  # burst + rate + one read, no faster
+        expected = (sent - BYTE_RATE) / BYTE_RATE
+        elapsed = echoes[-1] - t0 if echoes else float("inf")
+        # The steady part, from the 20th echo on: its bytes over its time, against the limit.
+        steady = (len(echoes) - 20) * PACKET / (echoes[-1] - echoes[19]) if len(echoes) > 21 else 0.0
+        c.check("bytes: a client pushing faster than bytes_per_second is paced to about the limit",
+                len(echoes) == PACKETS and elapsed >= fastest and elapsed <= 2 * expected + 2
+                and BYTE_RATE / 2 <= steady <= BYTE_RATE * 1.3,
+                "%d/%d echoes of %d B in %.2f s (no faster than %.2f s, about %.2f s expected); steady %.0f B/s "
+                "(limit %d B/s)" % (len(echoes), PACKETS, PACKET, elapsed, fastest, expected, steady, BYTE_RATE))
+        c.check("bytes: a second client's calls return promptly meanwhile", worst < 0.5, "slowest of 5 calls: %.3f s" % worst)
+        try:
+            still = flood.add(2, 3) == 5
+        except Exception as e:  # noqa: BLE001
+            still = repr(e)
+        c.check("bytes: the flooding client is slowed, not disconnected", still is True, str(still))
+        paused = metric(port, source="127.0.0.1", name=RATE_METRIC)
+        c.check("bytes: /metrics counts the pauses", paused > 0, "%s = %d" % (RATE_METRIC, paused))
+        ep.Close()
+        for client in (flood, other):
+            rrn.DisconnectService(client)
+    finally:
+        stop(gateway)
+        stop(device)
 
 
 def flood_for(seconds, one_request):
@@ -250,6 +375,7 @@ class Checks:
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gateway", required=True)
+    ap.add_argument("--service", help="rr_interop_service, the device of the bytes_per_second phase")
     ap.add_argument("--timeout", type=float, default=30)
     args = ap.parse_args()
 
@@ -310,6 +436,7 @@ def main():
             gateway = None
 
             rate_checks(c, args, work)
+            bytes_checks(c, args, work)
         except StepFailed as e:
             c.results.append({"check": "setup", "ok": False, "detail": str(e)})
             print(json.dumps({"results": c.results, "gateway_log": tail(os.path.join(work, "gateway.err"))}, indent=1))
@@ -325,6 +452,11 @@ def main():
                 except Exception:  # noqa: BLE001
                     pass
             stop(gateway)
+            if _official and _official[0][0] is not None:
+                try:
+                    _official[0][0].Shutdown()
+                except Exception:  # noqa: BLE001
+                    pass
     ok = all(r["ok"] for r in c.results)
     print(json.dumps({"ok": ok, "results": c.results}, indent=1))
     return 0 if ok else 1

@@ -8,16 +8,21 @@ password file in the official format (alice: operator, bob: viewer, carol: adder
 an HS256 JWT key, and roles:
   operator  every member of every device: read, write, call
   viewer    every member of `interop` and `interop_ptu`: read
-  adder     `add`, `call_callbacks`: call; `p_int32`: read
+  adder     `add`, `call_callbacks`, `child_by_int[*].describe`: call; `p_int32`, `child.value`: read
+  writer    `w_both`, `p_unreliable`: write
 Checks (each one named in the JSON summary):
   rr        official client: right password connects; wrong password, unknown user and no credentials
             are refused (AuthenticationException); the permission matrix (property get/set, function
             call, generator, event receive) per user, PermissionDenied where the role does not allow;
-            the service definition a viewer sees lists every member.
+            wires (OutValue, PokeOutValue reaching the device or not), memory written and read back,
+            pipes (a reader receives packets, its own packets are not delivered; a writer's are),
+            members of objects below the root (objref) by rule; the service definition a viewer sees
+            lists every member.
   json      POST /api/login (cookie: HttpOnly, SameSite=Strict; Secure only over TLS, here through a
             trusted proxy saying https, never for a client that only claims it), requests with the cookie, without it
             (401), PUT/POST refused by role (403); bearer token; JWT valid / expired / forged / wrong
-            audience; the JSON WebSocket logged in by its first message and by the cookie.
+            audience; the JSON WebSocket logged in by its first message and by the cookie, its `peek`
+            allowed with read and refused without.
   reload    SIGHUP after the password file changed: a removed user is refused (new logins, and the
             requests of its open session), a new user logs in; a broken file is logged and changes nothing.
   limits    after 5 failed logins from this address even the right password is refused (HTTP 429,
@@ -166,10 +171,10 @@ gateway:
           allow: [write]
       adder:
         - devices: [interop, interop_ptu]
-          members: [add, call_callbacks]
+          members: [add, call_callbacks, "child_by_int[*].describe"]
           allow: [call]
         - devices: [interop, interop_ptu]
-          members: p_int32
+          members: [p_int32, child.value]
           allow: [read]
     login_limit: {{max_failures: 5, window_s: 60, lockout_s: 60}}
 demo:
@@ -431,6 +436,100 @@ devices:
                 pe.Close()
         checks.check("rr: a write-only session sends pipe packets but receives none", rr_write_only_pipe)
 
+        def denied_total():
+            with urllib.request.urlopen(base + "/metrics", timeout=10) as r:
+                for line in r.read().decode().splitlines():
+                    if line.startswith("rr_gateway_permission_denied_total "):
+                        return float(line.rsplit(" ", 1)[1])
+            raise AssertionError("no rr_gateway_permission_denied_total in /metrics")
+
+        def rr_read_only_pipes():
+            # A viewer (read only) receives what the device sends on a pipe; a packet it sends itself is
+            # dropped by the gateway (p_echo would send it straight back to that endpoint, which may read,
+            # so an echo here means the device got it). An operator's packet on the same pipe is echoed.
+            a, b = conns["alice"], conns["bob"]
+            stream = b.p_stream.Connect(-1)
+            try:
+                a.send_stream(3)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and stream.Available < 3:
+                    time.sleep(0.05)
+                got = [list(stream.ReceivePacket()) for _ in range(stream.Available)]
+                assert got == [[0.0, 0.0], [1.0, 0.5], [2.0, 1.0]], got
+            finally:
+                stream.Close()
+            pa, pb = a.p_echo.Connect(-1), b.p_echo.Connect(-1)
+            try:
+                def inner(i, label):
+                    v = RRN.NewStructure("experimental.interop_test.Inner", a)
+                    v.id, v.label, v.values = i, label, [float(i)]
+                    return v
+                pa.AsyncSendPacket(inner(1, "from alice"), lambda *_a: None)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and pa.Available == 0:
+                    time.sleep(0.05)
+                assert pa.Available == 1 and pa.ReceivePacket().label == "from alice", "the operator got no echo"
+                forwarded, denied = pipe_packets_forwarded(), denied_total()
+                pb.AsyncSendPacket(inner(2, "from bob"), lambda *_a: None)
+                t_end = time.monotonic() + 10
+                while time.monotonic() < t_end and denied_total() == denied:
+                    time.sleep(0.05)
+                assert denied_total() > denied, "the viewer's packet was not refused"
+                time.sleep(1.0)
+                assert pb.Available == 0, "a read-only session's pipe packet reached the device (its echo came back)"
+                assert pipe_packets_forwarded() == forwarded, "a read-only session's pipe packet was forwarded"
+            finally:
+                pa.Close()
+                pb.Close()
+        checks.check("rr: a read-only session receives pipe packets; the packets it sends are not delivered",
+                     rr_read_only_pipes)
+
+        def rr_poke_and_memory_allowed():
+            import numpy as np
+            a, b, e = conns["alice"], conns["bob"], conns["erin"]
+            # erin (writer on w_both) pokes; the device has the value (its PeekOutValue, read by alice).
+            e.w_both.PokeOutValue([7.0, 8.0, 9.0])
+            assert list(a.w_both.PeekOutValue()[0]) == [7.0, 8.0, 9.0], "the writer's poke did not reach the device"
+            expect_rr_error(lambda: b.w_both.PokeOutValue([1.0]), RR.PermissionDeniedException, "may not write w_both")
+            assert list(a.w_both.PeekOutValue()[0]) == [7.0, 8.0, 9.0], "a refused poke changed the device's value"
+            # alice (operator) writes memory; alice and bob (viewer) read the same values back.
+            a.mem_double.Write(2, np.array([6.5, -1.25]), 0, 2)
+            for who in (a, b):
+                buf = np.zeros((2,))
+                who.mem_double.Read(2, buf, 0, 2)
+                assert list(buf) == [6.5, -1.25], list(buf)
+            expect_rr_error(lambda: b.mem_double.Write(2, np.array([99.0]), 0, 1), RR.PermissionDeniedException)
+            buf = np.zeros((1,))
+            a.mem_double.Read(2, buf, 0, 1)
+            assert buf[0] == 6.5, "a refused memory write changed the device's memory"
+        checks.check("rr: PokeOutValue and memory writes allowed by role reach the device (read back)",
+                     rr_poke_and_memory_allowed)
+
+        def rr_child_objects():
+            # Members below the root are named child.value, child_by_int[7].describe, child.leaf.x: rules
+            # match those names, so carol (adder) gets exactly her two and nothing else down there.
+            a, b, c = conns["alice"], conns["bob"], conns["carol"]
+            cc, c7 = c.get_child(), c.get_child_by_int(7)
+            assert cc.value == 1
+            expect_rr_error(lambda: cc.name, RR.PermissionDeniedException, "may not read child.name of interop")
+            expect_rr_error(lambda: cc.describe(), RR.PermissionDeniedException, "may not call child.describe")
+            expect_rr_error(lambda: setattr(cc, "value", 5), RR.PermissionDeniedException, "may not write child.value")
+            expect_rr_error(lambda: cc.get_leaf().x, RR.PermissionDeniedException, "may not read child.leaf.x")
+            assert c7.describe() == "child[7] value=107"
+            expect_rr_error(lambda: c7.value, RR.PermissionDeniedException, "may not read child_by_int[7].value")
+            expect_rr_error(lambda: c.get_child_by_int(0).name, RR.PermissionDeniedException,
+                            "may not read child_by_int[0].name")
+            # bob (viewer) reads at every depth and writes nowhere; alice (operator) writes below the root.
+            bc = b.get_child()
+            assert bc.name == "child[plain]" and bc.get_leaf().x == 1.5
+            expect_rr_error(lambda: setattr(bc, "value", 5), RR.PermissionDeniedException, "may not write child.value")
+            expect_rr_error(lambda: bc.describe(), RR.PermissionDeniedException, "may not call child.describe")
+            a.get_child().value = 42
+            assert cc.value == 42 and bc.value == 42
+            assert a.get_child().describe() == "child[plain] value=42"
+            a.get_child().value = 1
+        checks.check("rr: members of objects below the root (objref) allowed and refused by rule", rr_child_objects)
+
         def rr_callbacks():
             a, c = conns["alice"], conns["carol"]
             called = {"alice": 0, "carol": 0}
@@ -646,6 +745,35 @@ devices:
             ws.close()
         checks.check("json: WebSocket login by first message and by cookie, never by URL token; cross-site upgrades "
                      "with the cookie refused", json_websocket)
+
+        def json_websocket_peek():
+            import websocket  # websocket-client
+            # peek is a read: bob (viewer) gets the wire's value, carol (no read on w_state) and erin
+            # (write only on w_both) are refused; erin's refusal is not for want of a value (bob reads it).
+            results = {}
+            for user, member in (("bob", "w_state"), ("carol", "w_state"), ("bob", "w_both"), ("erin", "w_both")):
+                ws = websocket.create_connection("ws://127.0.0.1:%d/" % port, subprotocols=["rr-gateway.json.v1"],
+                                                 timeout=20)
+                try:
+                    def ask(msg):
+                        ws.send(json.dumps(msg))
+                        while True:
+                            r = json.loads(ws.recv())
+                            if r.get("id") == msg["id"]:
+                                return r
+                    assert "result" in ask({"id": 1, "op": "login", "username": user, "password": USERS[user][0]})
+                    results[(user, member)] = ask({"id": 2, "op": "peek", "device": "interop", "member": member})
+                finally:
+                    ws.close()
+            r = results[("bob", "w_state")]
+            assert isinstance(r.get("result", {}).get("value"), dict) and "time" in r["result"], r
+            assert "value" in results[("bob", "w_both")].get("result", {}), results
+            for key in (("carol", "w_state"), ("erin", "w_both")):
+                err = results[key].get("error", {})
+                assert err.get("name") == "RobotRaconteur.PermissionDenied", (key, results[key])
+                assert "may not read %s" % key[1] in err.get("message", ""), (key, err)
+        checks.check("json: WebSocket peek needs read (viewer yes; no-read and write-only roles refused)",
+                     json_websocket_peek)
 
         # ---- brute force (last: it locks this address out) ----
         def wait_log(text, after):

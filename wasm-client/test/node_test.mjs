@@ -5,7 +5,9 @@
 //   3. the official Python service (test/interop/official_service.py), rr+ws on its TCP port
 //   4. the official service with message format v2 only; 5. ours with v4 string tables;
 //   6. ours behind nginx terminating TLS (rr+wss), when nginx and openssl are installed
-//   7. the gateway serving TLS itself (rr+wss, its certificate given with the ca option; refused without)
+//   7. the gateway serving TLS itself (rr+wss, its certificate given with the ca option; refused without;
+//      trusted without the option by node processes told of it through NODE_EXTRA_CA_CERTS, or through
+//      --use-openssl-ca with SSL_CERT_FILE, as docs/security.md "Browsers and the wasm client" says)
 //
 // Usage: node node_test.mjs --interop-service PATH --gateway PATH --python PATH [--only REGEX] [--target NAME]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
@@ -14,7 +16,7 @@ import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "no
 import { createServer, connect as connectTcp } from "node:net";
 import { tmpdir } from "node:os";
 import { createInterface } from "node:readline";
-import { fileURLToPath } from "node:url";
+import { fileURLToPath, pathToFileURL } from "node:url";
 import { dirname, join } from "node:path";
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -193,6 +195,20 @@ http {
     } else {
       console.log(`  ok ca with an rr+ws URL: ${misused.message}`);
     }
+    // Trust from the process's CA store, no ca option: a fresh node per case, since node reads these
+    // settings once at start. The refused cases show it is the setting, not the store, that trusts.
+    const cases = [
+      { name: "NODE_EXTRA_CA_CERTS=cert.pem", env: { NODE_EXTRA_CA_CERTS: cert }, ok: true },
+      { name: "--use-openssl-ca with SSL_CERT_FILE=cert.pem", flags: ["--use-openssl-ca"], env: { SSL_CERT_FILE: cert }, ok: true },
+      { name: "--use-openssl-ca (the system's store alone)", flags: ["--use-openssl-ca"], ok: false },
+      { name: "SSL_CERT_FILE=cert.pem without --use-openssl-ca", env: { SSL_CERT_FILE: cert }, ok: false },
+    ];
+    for (const k of cases) {
+      const got = await connectInFreshNode(wssUrl, k.flags ?? [], k.env ?? {});
+      const pass = k.ok ? got.sum === 5 : got.error === "RobotRaconteur.ConnectionError" && /certificate/i.test(got.message);
+      console.log(`  ${pass ? "ok" : "FAIL"} rr+wss without ca, ${k.name}: ${k.ok ? "expected add(2, 3) = 5" : "expected refused"}, got ${JSON.stringify(got)}`);
+      if (!pass) failed++;
+    }
     options.ca = readFileSync(cert, "utf8");
     return wssUrl;
   },
@@ -202,6 +218,43 @@ http {
     return (await readyLine(svc, "ws_url")).ws_url;
   },
 };
+
+/** Connects to `url` (no ca option) in a new node process with `flags` and `env` on top of a CA-neutral
+ * environment; resolves {sum} (add(2, 3)) or {error, message}. */
+function connectInFreshNode(url, flags, env) {
+  const script = `
+const rr = await import(${JSON.stringify(pathToFileURL(dist).href)});
+let out;
+try {
+  const c = await rr.connect(${JSON.stringify(url)}, { timeoutMs: 10000 });
+  out = { sum: await c.add(2, 3) };
+  await c.$client.close();
+} catch (e) {
+  out = { error: e.errorName ?? String(e), message: e.message };
+}
+console.log(JSON.stringify(out));
+process.exit(0);
+`;
+  const base = { ...process.env };
+  for (const k of ["NODE_EXTRA_CA_CERTS", "SSL_CERT_FILE", "SSL_CERT_DIR", "NODE_OPTIONS"]) delete base[k];
+  return new Promise((resolve) => {
+    const p = spawn(process.execPath, [...flags, "--input-type=module", "-e", script],
+      { env: { ...base, ...env }, stdio: ["ignore", "pipe", "pipe"] });
+    let out = "";
+    let err = "";
+    p.stdout.on("data", (d) => { out += d; });
+    p.stderr.on("data", (d) => { err += d; });
+    const timer = setTimeout(() => p.kill("SIGKILL"), 30000);
+    p.on("exit", (code) => {
+      clearTimeout(timer);
+      try {
+        resolve(JSON.parse(out.trim().split("\n").pop()));
+      } catch {
+        resolve({ error: `node exited with ${code}`, message: (out + err).slice(-500) });
+      }
+    });
+  });
+}
 
 function freePort() {
   return new Promise((resolve) => {
