@@ -89,11 +89,16 @@ async function logIn(user, password) {
 async function read(device, member) {
   const c = card(device, member);
   const out = c.locator("output.value");
-  const reads = Number((await out.getAttribute("data-reads")) || 0);
+  const error = c.locator(".member-error");
+  const count = async (loc, attr) => Number((await loc.getAttribute(attr)) || 0);
+  // The previous read's error may still be on the card: wait for this read's own outcome.
+  const reads = await count(out, "data-reads");
+  const errors = await count(error, "data-shown");
   await c.locator("button", { hasText: /^Read$/ }).click();
-  const errorShown = async () => !(await c.locator(".member-error").isHidden());
-  await waitFor(async () => Number((await out.getAttribute("data-reads")) || 0) > reads || (await errorShown()), `${member} read`);
-  return (await errorShown()) ? { error: await c.locator(".member-error").textContent() } : { value: await out.textContent() };
+  await waitFor(async () => (await count(out, "data-reads")) > reads || (await count(error, "data-shown")) > errors,
+    `${member} read`);
+  return (await count(error, "data-shown")) > errors && !(await error.isHidden())
+    ? { error: await error.textContent() } : { value: await out.textContent() };
 }
 
 before(async () => {

@@ -44,7 +44,10 @@ export function memberCard(ctx, member) {
     typeEl, body, error);
   return {
     el, body, tools,
-    showError(err) { error.textContent = errorText(err); error.hidden = false; el.classList.add("has-error"); },
+    showError(err) {
+      error.textContent = errorText(err); error.hidden = false; el.classList.add("has-error");
+      error.dataset.shown = String(Number(error.dataset.shown || 0) + 1);  // tells a new error from a stale one
+    },
     clearError() { error.hidden = true; error.textContent = ""; el.classList.remove("has-error"); },
   };
 }
