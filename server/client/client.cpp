@@ -108,7 +108,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     cfg.memory_max_transfer_size = options.memory_max_transfer_size;
 
     std::shared_ptr<Client> client(new Client());
-    client->strand_.emplace(asio::make_strand(executor));
+    client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(executor)));
     client->wait_limit_ = options.request_timeout + 5s;
     auto logic = std::make_shared<Logic>(std::move(cfg));
     client->logic_ = logic;

@@ -38,6 +38,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/session/client_context.hpp"
+#include "server/common/caller_runs_executor.hpp"
 #include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"
 #include "server/transport/transport_registry.hpp"
@@ -78,7 +79,9 @@ struct ClientOptions {
     const server::TransportRegistry* transports = nullptr;
 };
 
-using ClientStrand = boost::asio::strand<boost::asio::any_io_executor>;
+/// The connection's strand: a blocking call runs its own request on it when it is idle
+/// (server/common/caller_runs_executor.hpp), so the reply is the call's only wake-up.
+using ClientStrand = boost::asio::strand<server::CallerRunsExecutor>;
 
 /// The transport options of `options` (server/transport/transport.hpp).
 server::ConnectOptions connect_options(const ClientOptions& options);
@@ -330,9 +333,12 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
     if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
     auto w = std::make_shared<detail::SyncWaiter<T>>();
     auto f = w->promise.get_future();
-    run([w, start = std::move(start)](ClientContext& ctx, MonoTime now) {
-        start(ctx, now, [w](Result<T> r) { w->set(std::move(r)); });
-    });
+    {
+        server::CallerRunsExecutor::Scope caller_runs;
+        run([w, start = std::move(start)](ClientContext& ctx, MonoTime now) {
+            start(ctx, now, [w](Result<T> r) { w->set(std::move(r)); });
+        });
+    }
     w.reset();
     if (f.wait_for(wait_limit_) != std::future_status::ready)
         return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");

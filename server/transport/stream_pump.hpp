@@ -7,7 +7,9 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <type_traits>
 
+#include <boost/asio/basic_stream_socket.hpp>
 #include <boost/asio/bind_executor.hpp>
 #include <boost/asio/socket_base.hpp>
 #include <boost/asio/dispatch.hpp>
@@ -22,6 +24,16 @@
 namespace rr::server {
 
 namespace asio = boost::asio;
+
+/// A plain socket (TCP, Unix): the pump writes to it directly from its strand, without an
+/// asynchronous write's completion round trip through the io_context (a post and, with several
+/// worker threads, a wake-up per message). TLS and WebSocket streams keep asynchronous writes.
+template <class Stream>
+concept DirectWriteSocket = requires(Stream& s, boost::system::error_code& ec) {
+    typename Stream::protocol_type;
+    requires std::is_base_of_v<asio::basic_stream_socket<typename Stream::protocol_type, typename Stream::executor_type>,
+                               Stream>;
+};
 
 /// Type-erased handle a ConnectionLogic owner uses to run code on the connection's strand.
 class PumpHandle {
@@ -57,6 +69,13 @@ public:
 
     /// Starts reading; `initial` bytes (already read while detecting the protocol) are fed first.
     void start(std::span<const std::byte> initial = {}) {
+        if constexpr (DirectWriteSocket<Stream>) {
+            // Synchronous writes must not block the strand: a full socket buffer returns would_block
+            // and the rest goes out asynchronously.
+            boost::system::error_code ec;
+            stream_.non_blocking(true, ec);
+            direct_write_ = !ec;
+        }
         auto self = this->shared_from_this();
         std::vector<std::byte> first(initial.begin(), initial.end());
         asio::dispatch(strand_, [self, first = std::move(first)] {
@@ -143,6 +162,7 @@ private:
     void after_work() {
         if (closed_) return;
         flush();
+        if (closed_) return;
         arm_timer();
         if (read_paused_ && !closed_ && logic_->wants_read() && !logic_->wants_close()) read();
     }
@@ -154,9 +174,27 @@ private:
             return;
         }
         logic_->take_output(write_buffer_);
+        std::size_t written = 0;
+        if constexpr (DirectWriteSocket<Stream>) {
+            if (direct_write_) {
+                boost::system::error_code ec;
+                written = stream_.write_some(asio::buffer(write_buffer_.data(), write_buffer_.size()), ec);
+                if (ec == asio::error::would_block || ec == asio::error::try_again) {
+                    written = 0;
+                } else if (ec) {
+                    write_buffer_.clear();
+                    transport_failed(ec);
+                    return;
+                }
+                if (written == write_buffer_.size()) {
+                    write_buffer_.clear();
+                    return;
+                }
+            }
+        }
         writing_ = true;
         auto self = this->shared_from_this();
-        asio::async_write(stream_, asio::buffer(write_buffer_.data(), write_buffer_.size()),
+        asio::async_write(stream_, asio::buffer(write_buffer_.data() + written, write_buffer_.size() - written),
                           asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t) {
                               self->writing_ = false;
                               self->write_buffer_.clear();
@@ -230,6 +268,7 @@ private:
     std::array<std::byte, 64 * 1024> buffer_{};
     std::vector<std::byte> write_buffer_;
     bool writing_ = false;
+    bool direct_write_ = false;
     bool reading_ = false;
     bool read_paused_ = false;
     bool closed_ = false;
