@@ -56,7 +56,7 @@ TEST_CASE("caller runs executor: outside a scope a dispatch goes to the worker t
     CHECK(dispatched_on(strand) == w.thread.get_id());
 }
 
-TEST_CASE("caller runs executor: a scope serves one dispatch; what that work posts runs on the worker") {
+TEST_CASE("caller runs executor: a scope serves one dispatch, and what that work posts runs on the worker") {
     Worker w;
     auto strand = asio::make_strand(CallerRunsExecutor(w.io.get_executor()));
     asio::any_io_executor ex = strand;
@@ -82,7 +82,7 @@ TEST_CASE("caller runs executor: a scope is used up by its first dispatch") {
     CHECK(dispatched_on(strand) == w.thread.get_id());
 }
 
-TEST_CASE("caller runs executor: a busy strand is not entered; the work runs after the holder, on the worker") {
+TEST_CASE("caller runs executor: a busy strand is not entered, the work runs after the holder on the worker") {
     Worker w;
     auto strand = asio::make_strand(CallerRunsExecutor(w.io.get_executor()));
     asio::any_io_executor ex = strand;
