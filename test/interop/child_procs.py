@@ -144,10 +144,11 @@ def password_line(user, password, privileges):
     return "%s %s %s" % (user, hashlib.md5(password.encode()).hexdigest(), privileges)
 
 
-def write_password_file(path, entries):
+def write_password_file(path, entries, comment=True):
     """Writes the official password file from (user, password, privileges) triples or ready lines, in one
-    rename (a gateway reloading it on SIGHUP never reads half a file)."""
-    lines = ["# official password file format: user md5(password) privileges"]
+    rename (a gateway reloading it on SIGHUP never reads half a file). comment=False leaves out the
+    leading `#` line, which the official library cannot read (it takes every line for a user)."""
+    lines = ["# official password file format: user md5(password) privileges"] if comment else []
     lines += [e if isinstance(e, str) else password_line(*e) for e in entries]
     with open(path + ".new", "w") as f:
         f.write("".join(l + "\n" for l in lines))

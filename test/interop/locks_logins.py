@@ -1,7 +1,11 @@
 """Logins and object / monitor locks: official Python clients against OUR service (rr_interop_service
-with --users, i.e. ObjectService + PasswordTable, server/service/object_locks.hpp).
+with --users, i.e. ObjectService + PasswordTable, server/service/object_locks.hpp), or, with
+--official, against the official library's own service (official_service.py --users: the library's
+PasswordFileUserAuthenticator and ServiceSecurityPolicy, its ServerContext's locks), which is the
+reference: every check must give the same answers against both.
 
-The password file is in the official format (`user md5hex privileges`). Checks:
+The password file is in the official format (`user md5hex privileges`; for the official service
+without the leading `#` line, which the library would read as a user). Checks:
   logins   no credentials, a wrong password and an unknown user are refused (AuthenticationException);
            the right password connects and reads.
   locks    a user without the objectlock privilege cannot lock; a user lock by alice refuses bob on the
@@ -10,11 +14,16 @@ The password file is in the official format (`user md5hex privileges`). Checks:
            DisconnectService releases a client lock; a client PROCESS killed with SIGKILL releases its
            user lock; objectlockoverride releases another user's lock.
   monitor  MonitorEnter by one session refuses the other's requests; the other's MonitorEnter waits
-           and returns once the first calls MonitorExit.
+           and returns once the first calls MonitorExit; a monitor whose holder disconnects is released.
+
+Where the official library answers differently from our service, the check asserts each one's own
+answer, and the difference is named in DIFFERENCES (with the official source) and in the JSON
+summary's "differences_from_reference": see Expected. Against the official service the answers
+asserted are the official library's, observed.
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors,
 77 when the official package is missing.
 
-Usage: locks_logins.py --service PATH/rr_interop_service [--timeout S]
+Usage: locks_logins.py (--service PATH/rr_interop_service | --official) [--timeout S]
        locks_logins.py --child-lock URL USER PASSWORD   (internal: the process that gets killed)
 """
 
@@ -39,6 +48,7 @@ except ImportError as e:  # pragma: no cover
     sys.exit(77)
 
 RRN = RR.RobotRaconteurNode.s
+OFFICIAL_SERVICE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "official_service.py")
 
 USERS = {
     "alice": ("alice-pw", "objectlock"),
@@ -46,6 +56,72 @@ USERS = {
     "carol": ("carol-pw", "_"),
     "admin": ("admin-pw", "objectlockoverride"),
 }
+
+
+# Where the official library (the reference) and our service answer differently, as observed with
+# official clients and read in RobotRaconteurCore (robotraconteur/robotraconteur). Our service's side
+# is what server/service does today; each is a product difference to resolve, not a choice.
+DIFFERENCES = {
+    "login_error_text": (
+        "A refused ConnectClientCombined: CORE answers every authentication failure (no username, no "
+        "credentials, wrong password, unknown user, no password in the credentials) with "
+        "AuthenticationError \"Authentication Failed\" (RobotRaconteurNode.cpp, the ConnectClientCombined "
+        "case's catch around AuthenticateUser); our service sends the specific reason (\"Username not "
+        "provided\", \"Invalid username or password\", ...)."),
+    "dead_session_lingers": (
+        "A client whose connection drops without DisconnectClient (process killed): CORE keeps its "
+        "session, so its client locks stay and it still counts as a session of its user (a user lock stays "
+        "after the user's other sessions end), until the endpoint inactivity timeout (600 s, "
+        "ServerEndpoint::PeriodicCleanupTask) or until a send to it fails (ServerContext::SendEvent -> "
+        "RemoveClient); ServerEndpoint does not act on TransportConnectionClosed (Endpoint.cpp). Our "
+        "service closes the session when the connection drops."),
+    "monitor_outlives_session": (
+        "A session holding a monitor closes (DisconnectService): CORE's RemoveClient leaves monitors "
+        "alone, and the monitor is released only when its thread sees 30 s without a request from the "
+        "holder (Service_lock.cpp, ServerContext_MonitorObjectSkel::thread_func); our service releases it "
+        "with the session."),
+}
+
+
+class Expected:
+    """The answers a target gives where the official library and our service differ (DIFFERENCES).
+    `device` is "official" or "ours"; `gateway` says the clients reach it through rr-gateway in auth:
+    passthrough, which closes a gone client's upstream session with DisconnectClient."""
+
+    def __init__(self, device="ours", gateway=False):
+        self.device, self.gateway = device, gateway
+        official = device == "official"
+        self.login_error_text = official
+        self.dead_session_lingers = official and not gateway
+        self.monitor_outlives_session = official
+
+    def login_refused(self, reason):
+        """The text of the AuthenticationError for a refused login (`reason` is our service's text)."""
+        return "Authentication Failed" if self.login_error_text else reason
+
+    def differences_from_reference(self):
+        """The DIFFERENCES in which this target answers unlike the official library reached the same way."""
+        if self.device == "official":
+            return []
+        ref = Expected("official", self.gateway)
+        return sorted(k for k in DIFFERENCES if getattr(self, k) != getattr(ref, k))
+
+
+def start_device(service, users, extra_users, err, lifetime):
+    """Writes the password file `users` (USERS plus `extra_users`, {user: (password, privileges)}) and
+    starts the device that requires those logins: our rr_interop_service at path `service`, or the
+    official service (official_service.py on this interpreter) when `service` is None. Returns (process,
+    its ready line)."""
+    entries = [(user, pw, priv) for user, (pw, priv) in list(USERS.items()) + list(extra_users.items())]
+    if service is None:
+        write_password_file(users, entries, comment=False)
+        cmd, what = [sys.executable, OFFICIAL_SERVICE], "official_service.py"
+    else:
+        write_password_file(users, entries)
+        cmd, what = [service], "rr_interop_service"
+    proc = start(cmd + ["--port", "0", "--max-lifetime", str(int(lifetime)), "--users", users], err)
+    ready = read_json_line(proc, 30, what)
+    return proc, ready
 
 
 def creds(password):
@@ -117,18 +193,23 @@ def eventually(fn, what, timeout=5.0):
     raise AssertionError("%s: still failing after %.0f s: %s" % (what, timeout, last))
 
 
-def run_checks(url, ck):
+def run_checks(url, ck, exp=None):
+    """The checks against `url`; `exp` (Expected) gives the target's answers where CORE and ours differ."""
+    exp = exp or Expected()
+
     # --- logins ---
     def no_credentials():
         # CORE refuses a ConnectClientCombined without a username when the service requires a login.
         expect_raises(RR.AuthenticationException, lambda: RRN.ConnectService(url), "connect without login",
-                      "Username not provided")
+                      exp.login_refused("Username not provided"))
 
     ck.check("login: no credentials refused", no_credentials)
     ck.check("login: wrong password refused",
-             lambda: expect_raises(RR.AuthenticationException, lambda: connect(url, "alice", "wrong"), "wrong password"))
+             lambda: expect_raises(RR.AuthenticationException, lambda: connect(url, "alice", "wrong"), "wrong password",
+                                   exp.login_refused("Invalid username or password")))
     ck.check("login: unknown user refused",
-             lambda: expect_raises(RR.AuthenticationException, lambda: connect(url, "mallory", "x"), "unknown user"))
+             lambda: expect_raises(RR.AuthenticationException, lambda: connect(url, "mallory", "x"), "unknown user",
+                                   exp.login_refused("Invalid username or password")))
 
     clients = {}
 
@@ -189,7 +270,19 @@ def run_checks(url, ck):
             time.sleep(1.0)
             expect_raises(RR.ObjectLockedException, lambda: a2.base_name, "bob's lock while bob's other session lives")
             RRN.DisconnectService(b)
-            eventually(lambda: a2.base_name, "alice reads after bob's last session ended")
+            if not exp.dead_session_lingers:
+                eventually(lambda: a2.base_name, "alice reads after bob's last session ended")
+            else:
+                # CORE: the killed client's session outlives its connection and still counts as bob's
+                # (DIFFERENCES["dead_session_lingers"]).
+                time.sleep(1.0)
+                expect_raises(RR.ObjectLockedException, lambda: a2.base_name,
+                              "bob's lock while the killed client's session lingers (CORE)", "bob")
+            # A send to the killed client's session (any event) ends it in CORE; ours has ended it already.
+            b3 = connect(url, "bob")
+            b3.fire_events(0)
+            RRN.DisconnectService(b3)
+            eventually(lambda: a2.base_name, "alice reads after bob's last session ended and an event was sent")
         finally:
             if proc.poll() is None:
                 proc.kill()
@@ -252,6 +345,25 @@ def run_checks(url, ck):
 
     ck.check("monitor: MonitorEnter blocks other sessions; the waiter gets it on MonitorExit", monitor)
 
+    def monitor_holder_disconnects():
+        m = connect(url, "carol")  # a monitor needs no privilege
+        RRN.MonitorEnter(m, -1)
+        expect_raises(RR.InvalidOperationException, lambda: a2.base_name, "alice reads carol's monitor-locked object",
+                      "monitor locked")
+        RRN.DisconnectService(m)
+        closed = time.monotonic()
+        if not exp.monitor_outlives_session:
+            eventually(lambda: a2.base_name, "alice reads after the monitor holder's session closed")
+            return
+        # CORE: the monitor stays until 30 s without a request from its holder (DIFFERENCES).
+        time.sleep(1.0)
+        expect_raises(RR.InvalidOperationException, lambda: a2.base_name,
+                      "alice reads 1 s after the monitor holder's session closed (CORE keeps the monitor)", "monitor locked")
+        eventually(lambda: a2.base_name, "alice reads once the closed session's monitor expired", timeout=40)
+        expect(time.monotonic() - closed > 20, "the monitor went after %.1f s, not ~30 s" % (time.monotonic() - closed))
+
+    ck.check("monitor: released when its holder's session closes (CORE: 30 s later)", monitor_holder_disconnects)
+
     for k in ("a2", "c", "b2", "adm"):
         try:
             RRN.DisconnectService(clients[k])
@@ -264,31 +376,34 @@ def main():
         child_lock(*sys.argv[2:5])
         return 0
     ap = argparse.ArgumentParser()
-    ap.add_argument("--service", required=True)
+    target = ap.add_mutually_exclusive_group(required=True)
+    target.add_argument("--service", help="our rr_interop_service")
+    target.add_argument("--official", action="store_true", help="the official library's service (the reference)")
     ap.add_argument("--timeout", type=float, default=150)
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-locks-")
     users = os.path.join(tmp, "users.txt")
-    write_password_file(users, [(user, pw, priv) for user, (pw, priv) in USERS.items()])
     err = os.path.join(tmp, "service.err")
+    exp = Expected("official" if args.official else "ours")
     svc = None
     ck = Checks()
     timer = threading.Timer(args.timeout, lambda: os._exit(3))
     timer.daemon = True
     timer.start()
     try:
-        svc = start([args.service, "--port", "0", "--max-lifetime", str(int(args.timeout) + 30), "--users", users], err)
-        ready = read_json_line(svc, 30, "rr_interop_service")
+        svc, ready = start_device(args.service, users, {}, err, args.timeout + 30)
         register_transport()
-        run_checks(ready["url"], ck)
+        run_checks(ready["url"], ck, exp)
     except StepFailed as e:
         print(json.dumps({"error": str(e), "service_stderr": tail(err)}))
         return 2
     finally:
         status = stop(svc)
     failed = [r for r in ck.results if not r["ok"]]
-    print(json.dumps({"checks": len(ck.results), "failed": failed, "service_status": status}, indent=1))
+    print(json.dumps({"service": exp.device, "checks": len(ck.results), "failed": failed,
+                      "differences_from_reference": exp.differences_from_reference(), "service_status": status},
+                     indent=1))
     if failed:
         print(tail(err), file=sys.stderr)
     return 1 if failed or status not in (0, None) else 0

@@ -9,7 +9,7 @@ yield known sequences, memories are readable and writable, reset() restores the 
 Usage:
     official_service.py [--port N] [--websocket] [--disable-message4] [--enable-stringtable]
                         [--heartbeat SECONDS] [--max-lifetime SECONDS] [--node-setup NAME]
-                        [--nodeid ID] [--load-tls]
+                        [--nodeid ID] [--load-tls] [--users FILE]
 
 --node-setup NAME starts the node with the library's default server setup,
 RobotRaconteur.ServerNodeSetup(NAME, port): NodeName NAME with the NodeID of its NodeID cache, the
@@ -22,6 +22,15 @@ status 3 and the library's message on stderr.
 does (TcpTransport.LoadTlsNodeCertificate: <config dir>/certificates/{NodeID}.p12, the config dir
 from ROBOTRACONTEUR_SYSTEM_CONFIG_DIR when root, else ROBOTRACONTEUR_USER_CONFIG_DIR); the ready line
 then says "tls": true or false.
+
+--users FILE requires logins: the file (the official password file format, `user md5hex privileges`
+per line) is handed unchanged to the library's PasswordFileUserAuthenticator, and the service is
+registered with a ServiceSecurityPolicy of {"requirevaliduser": "true", "allowobjectlock": "true"}, as
+the official docs and examples do. Object locks, monitor locks and their release are then the
+library's own (ServerContext in RobotRaconteurCore/src/Service.cpp): this is the reference that
+locks_logins.py compares our service with. The ready line then says "users": true. The library reads
+every non-empty line as a user, `#` lines too (as a user named "#"); a line with fewer than three
+fields, or with a fourth that is not a list of NodeIDs, makes the whole file fail to load (exit 3).
 
 When ready it prints exactly one JSON line on stdout, e.g.
     {"url": "rr+tcp://127.0.0.1:PORT/?service=interop", "port": PORT, "nodeid": "...", ...}
@@ -508,6 +517,9 @@ def main(argv=None):
     ap.add_argument("--load-tls", action="store_true", help="load the node's TLS certificate (rrs+tcp)")
     ap.add_argument("--node-setup", default=None, metavar="NAME",
                     help="use RobotRaconteur.ServerNodeSetup(NAME, port) (rr+local + TCP, library defaults)")
+    ap.add_argument("--users", default=None, metavar="FILE",
+                    help="require logins: PasswordFileUserAuthenticator from FILE (official format), "
+                         "policies requirevaliduser and allowobjectlock")
     args = ap.parse_args(argv)
 
     stop = threading.Event()
@@ -544,7 +556,18 @@ def main(argv=None):
     RRN.RegisterServiceTypeFromFile(ROBDEF)
     install_properties()
     root = RootImpl()
-    ctx = RRN.RegisterService(iv.SERVICE_NAME, iv.qn("Root"), root)
+    security = None
+    if args.users:
+        with open(args.users) as fh:
+            users_text = fh.read()
+        try:
+            authenticator = RR.PasswordFileUserAuthenticator(users_text)
+        except Exception as e:  # the library refuses the whole file on one bad line
+            log("PasswordFileUserAuthenticator(%s) failed: %s: %s" % (args.users, type(e).__name__, e))
+            RRN.Shutdown()
+            return 3
+        security = RR.ServiceSecurityPolicy(authenticator, {"requirevaliduser": "true", "allowobjectlock": "true"})
+    ctx = RRN.RegisterService(iv.SERVICE_NAME, iv.qn("Root"), root, security)
     ctx.SetServiceAttributes({
         "purpose": RR.VarValue("interop test \u2713", "string"),
         "version": RR.VarValue(np.array([1, 0], dtype=np.int32), "int32[]"),
@@ -568,6 +591,8 @@ def main(argv=None):
         "message4": not args.disable_message4,
         "stringtable": bool(args.enable_stringtable),
     }
+    if args.users:
+        ready["users"] = True
     if args.load_tls:
         ready["tls"] = tls_loaded
     if args.websocket:

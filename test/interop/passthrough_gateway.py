@@ -1,6 +1,8 @@
 """Logins, object locks, monitor locks and callbacks THROUGH the gateway with `auth: passthrough`
 (docs/security.md "Logins and locks through the gateway"): official Python clients -> rr-gateway ->
-rr_interop_service --users (official password file format).
+rr_interop_service --users (official password file format), or with --official -> the official
+library's own service (official_service.py --users), so that the forwarding is proven against an
+official device: every answer must then be the one the official library gives (locks_logins.Expected).
 
 Every check of locks_logins.py runs against the gateway's mirror of the device instead of the device
 itself, and must give the same answers (the device's own users, privileges, object locks, monitor
@@ -27,7 +29,7 @@ locks, release on disconnect and on a killed client process). Then:
 Prints one JSON summary; exit 0 when every check passed, 1 on a failed check, 2 on setup errors, 77
 when the official package is missing.
 
-Usage: passthrough_gateway.py --gateway PATH/rr-gateway --service PATH/rr_interop_service [--timeout S]
+Usage: passthrough_gateway.py --gateway PATH/rr-gateway (--service PATH/rr_interop_service | --official) [--timeout S]
 """
 
 import argparse
@@ -39,7 +41,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from child_procs import StepFailed, get_json, read_json_line, start, stop, tail, write_password_file  # noqa: E402
+from child_procs import StepFailed, get_json, read_json_line, start, stop, tail  # noqa: E402
 
 try:
     import RobotRaconteur as RR
@@ -118,7 +120,7 @@ def expect_locks(port, name, expected, what, timeout=5.0):
     raise AssertionError("%s: /api/devices locks %r, expected %r" % (what, got, sorted(expected)))
 
 
-def run_extra_checks(port, ck):
+def run_extra_checks(port, ck, exp):
     url = "rr+tcp://127.0.0.1:%d/?service=interop" % port
     url_small = "rr+tcp://127.0.0.1:%d/?service=small" % port
     url_shared = "rr+tcp://127.0.0.1:%d/?service=shared" % port
@@ -244,7 +246,7 @@ def run_extra_checks(port, ck):
 
     def no_login_refused_with_device_error():
         ll.expect_raises(RR.AuthenticationException, lambda: RRN.ConnectService(url_small), "no login (small)",
-                         "Username not provided")
+                         exp.login_refused("Username not provided"))
 
     ck.check("login: the device's own error for a client without a login", no_login_refused_with_device_error)
 
@@ -376,14 +378,15 @@ def run_extra_checks(port, ck):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gateway", required=True)
-    ap.add_argument("--service", required=True)
+    target = ap.add_mutually_exclusive_group(required=True)
+    target.add_argument("--service", help="our rr_interop_service as the device")
+    target.add_argument("--official", action="store_true", help="the official library's service as the device")
     ap.add_argument("--timeout", type=float, default=240)
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-passthrough-")
     users = os.path.join(tmp, "users.txt")
-    write_password_file(users, [(user, pw, priv) for user, (pw, priv) in
-                                list(ll.USERS.items()) + [(GATEWAY_USER[0], (GATEWAY_USER[1], "_"))]])
+    exp = ll.Expected("official" if args.official else "ours", gateway=True)
     svc_err = os.path.join(tmp, "service.err")
     gw_err = os.path.join(tmp, "gateway.err")
     svc = gw = None
@@ -392,8 +395,9 @@ def main():
     timer.daemon = True
     timer.start()
     try:
-        svc = start([args.service, "--port", "0", "--max-lifetime", str(int(args.timeout) + 30), "--users", users], svc_err)
-        dev = read_json_line(svc, 30, "rr_interop_service")["url"]
+        svc, ready = ll.start_device(args.service, users, {GATEWAY_USER[0]: (GATEWAY_USER[1], "_")}, svc_err,
+                                     args.timeout + 30)
+        dev = ready["url"]
         config = os.path.join(tmp, "gateway.yaml")
         with open(config, "w") as fh:
             common = "    url: %s\n    username: %s\n    password: %s\n" % (json.dumps(dev), GATEWAY_USER[0], GATEWAY_USER[1])
@@ -415,8 +419,8 @@ def main():
                 raise StepFailed("gateway devices not connected: %s" % tail(gw_err))
             time.sleep(0.1)
         ll.register_transport()
-        ll.run_checks("rr+tcp://127.0.0.1:%d/?service=interop" % port, ck)
-        run_extra_checks(port, ck)
+        ll.run_checks("rr+tcp://127.0.0.1:%d/?service=interop" % port, ck, exp)
+        run_extra_checks(port, ck, exp)
     except StepFailed as e:
         print(json.dumps({"error": str(e), "service_stderr": tail(svc_err), "gateway_stderr": tail(gw_err)}))
         return 2
@@ -424,7 +428,8 @@ def main():
         gw_status = stop(gw)
         svc_status = stop(svc)
     failed = [r for r in ck.results if not r["ok"]]
-    print(json.dumps({"checks": len(ck.results), "failed": failed, "gateway_status": gw_status,
+    print(json.dumps({"service": exp.device, "checks": len(ck.results), "failed": failed,
+                      "differences_from_reference": exp.differences_from_reference(), "gateway_status": gw_status,
                       "service_status": svc_status}, indent=1))
     if failed:
         print("--- gateway\n" + tail(gw_err) + "\n--- service\n" + tail(svc_err), file=sys.stderr)
