@@ -377,7 +377,8 @@ void ServiceSession::connect_client(const MessageHeader& h, MessageEntry&& e, bo
     if (combined && !web) {
         const MessageElement* user = e.find("username");
         const MessageElement* creds = e.find("credentials");
-        // CORE RobotRaconteurNode (ConnectClientCombined): the same errors and messages.
+        // CORE RobotRaconteurNode (ConnectClientCombined): the same error types; the message keeps the
+        // reason where CORE says only "Authentication Failed" (docs/security.md, differences).
         const char* refused = nullptr;
         if (!service->requires_authentication()) {
             if (user && creds) refused = "Authentication not enabled for service";
