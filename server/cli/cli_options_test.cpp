@@ -6,7 +6,7 @@ using namespace rr;
 using namespace rr::cli;
 
 namespace {
-Result<CommandLine> parse(std::vector<std::string> a) { return parse_command_line(a); }
+rr::Result<rr::cli::CommandLine> parse(std::vector<std::string> a) { return parse_command_line(a); }
 }  // namespace
 
 TEST_CASE("cli: member paths through objrefs") {

@@ -20,7 +20,8 @@ using namespace rr::server::testing;
 using namespace std::chrono_literals;
 using rr::testing::eventually;
 
-namespace {
+// Named, not anonymous: the TSan preset builds the tests as unity files.
+namespace mirror_locks_test {
 
 constexpr const char* kArmDef = R"(service example.armtest
 
@@ -39,7 +40,7 @@ object Gripper
 end
 )";
 
-std::shared_ptr<Node> make_node(const char* name) {
+std::shared_ptr<Node> make_lock_node(const char* name) {
     NodeOptions o;
     o.node_name = name;
     o.threads = 2;
@@ -49,7 +50,7 @@ std::shared_ptr<Node> make_node(const char* name) {
 struct ArmDevice {
     std::shared_ptr<ServiceObject> root, gripper;
     std::shared_ptr<ObjectService> service;
-    std::shared_ptr<Node> node = make_node("arm.node");
+    std::shared_ptr<Node> node = make_lock_node("arm.node");
     std::uint16_t port = 0;
 
     ArmDevice() {
@@ -75,7 +76,7 @@ struct ArmDevice {
 /// The gateway in front of ArmDevice as device "dev" (auth: shared), with gateway users when `users`.
 struct LockGateway {
     ArmDevice device;
-    std::shared_ptr<Node> node = make_node("gateway.node");
+    std::shared_ptr<Node> node = make_lock_node("gateway.node");
     std::shared_ptr<DeviceMirror> mirror;
     std::uint16_t port = 0;
 
@@ -139,31 +140,32 @@ struct LockGateway {
     }
 };
 
-MessageEntry op(const char* name, std::string path = "dev") { return req(MessageEntryType::ClientSessionOpReq, name, std::move(path)); }
+MessageEntry shared_lock_op(const char* name, std::string path = "dev") { return req(MessageEntryType::ClientSessionOpReq, name, std::move(path)); }
 
-MessageEntry enter(std::int32_t timeout, std::string path = "dev") {
-    auto m = op("MonitorEnter", std::move(path));
+MessageEntry enter_op(std::int32_t timeout, std::string path = "dev") {
+    auto m = shared_lock_op("MonitorEnter", std::move(path));
     m.elements.push_back(make_scalar_element<std::int32_t>("timeout", timeout));
     return m;
 }
 
-MessageEntry get(const char* member, std::string path = "dev") { return req(MessageEntryType::PropertyGetReq, member, std::move(path)); }
+MessageEntry get_req(const char* member, std::string path = "dev") { return req(MessageEntryType::PropertyGetReq, member, std::move(path)); }
 
-MessageEntry set(const char* member, double v) {
+MessageEntry set_req(const char* member, double v) {
     auto e = req(MessageEntryType::PropertySetReq, member, "dev");
     e.elements.push_back(make_scalar_element("value", v));
     return e;
 }
 
-std::string returned(const MessageEntry& e) {
+std::string op_result(const MessageEntry& e) {
     const auto* el = e.find("return");
     REQUIRE(el);
     return std::string(read_string(*el));
 }
 
-using Locks = std::vector<std::tuple<std::string, std::string, std::string>>;
+using HeldLocks = std::vector<std::tuple<std::string, std::string, std::string>>;
 
-}  // namespace
+}  // namespace mirror_locks_test
+using namespace mirror_locks_test;
 
 TEST_CASE("auth shared: a user lock at the gateway refuses other users on the object and its children") {
     LockGateway gw;
@@ -172,43 +174,43 @@ TEST_CASE("auth shared: a user lock at the gateway refuses other users on the ob
     auto b = gw.connect("bob", "b");
     auto c = gw.connect("carol", "c");
 
-    auto no_priv = c.error(op("RequestObjectLock"));
+    auto no_priv = c.error(shared_lock_op("RequestObjectLock"));
     CHECK(no_priv.type == MessageErrorType::ObjectLockedError);
     CHECK(no_priv.message == "User does not have object locking privileges");
 
-    CHECK(returned(a.ok(op("RequestObjectLock"))) == "OK");
-    CHECK(gw.locks() == Locks{{"dev", "alice", "user"}});
-    auto refused = b.error(get("pos"));
+    CHECK(op_result(a.ok(shared_lock_op("RequestObjectLock"))) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev", "alice", "user"}});
+    auto refused = b.error(get_req("pos"));
     CHECK(refused.type == MessageErrorType::ObjectLockedError);
     CHECK(refused.message == "Object locked by alice");
-    CHECK(b.error(get("width", "dev.gripper")).message == "Object locked by alice");  // a child
-    CHECK(b.error(set("pos", 2.0)).type == MessageErrorType::ObjectLockedError);
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 1.5);
-    CHECK(scalar_of<double>(a2.ok(get("width", "dev.gripper")), "value") == 0.25);  // alice's other session
-    a2.ok(set("pos", 2.0));
+    CHECK(b.error(get_req("width", "dev.gripper")).message == "Object locked by alice");  // a child
+    CHECK(b.error(set_req("pos", 2.0)).type == MessageErrorType::ObjectLockedError);
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+    CHECK(scalar_of<double>(a2.ok(get_req("width", "dev.gripper")), "value") == 0.25);  // alice's other session
+    a2.ok(set_req("pos", 2.0));
     CHECK(gw.device.root->property_value("pos").value().as<double>().value() == 2.0);  // reached the device
 
-    CHECK(b.error(op("RequestObjectLock", "dev.gripper")).message == "Object already locked");
-    CHECK(b.error(op("ReleaseObjectLock")).message == "Service locked by user alice");
-    CHECK(a.error(op("ReleaseObjectLock", "dev.gripper")).message == "Cannot release inherited lock");
-    CHECK(returned(a2.ok(op("ReleaseObjectLock"))) == "OK");  // the user's other session may release it
+    CHECK(b.error(shared_lock_op("RequestObjectLock", "dev.gripper")).message == "Object already locked");
+    CHECK(b.error(shared_lock_op("ReleaseObjectLock")).message == "Service locked by user alice");
+    CHECK(a.error(shared_lock_op("ReleaseObjectLock", "dev.gripper")).message == "Cannot release inherited lock");
+    CHECK(op_result(a2.ok(shared_lock_op("ReleaseObjectLock"))) == "OK");  // the user's other session may release it
     CHECK(gw.locks().empty());
-    CHECK(scalar_of<double>(b.ok(get("pos")), "value") == 2.0);
+    CHECK(scalar_of<double>(b.ok(get_req("pos")), "value") == 2.0);
 
     // A child locked alone; the device's answer for an object that does not exist, nothing locked.
-    CHECK(returned(b.ok(op("RequestObjectLock", "dev.gripper"))) == "OK");
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 2.0);
-    CHECK(a.error(get("width", "dev.gripper")).message == "Object locked by bob");
-    CHECK(a.error(op("RequestObjectLock")).message == "Object already locked");  // a lock below
-    CHECK(a.error(op("RequestObjectLock", "dev.nothing")).type != MessageErrorType::None);
-    CHECK(gw.locks() == Locks{{"dev.gripper", "bob", "user"}});
+    CHECK(op_result(b.ok(shared_lock_op("RequestObjectLock", "dev.gripper"))) == "OK");
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 2.0);
+    CHECK(a.error(get_req("width", "dev.gripper")).message == "Object locked by bob");
+    CHECK(a.error(shared_lock_op("RequestObjectLock")).message == "Object already locked");  // a lock below
+    CHECK(a.error(shared_lock_op("RequestObjectLock", "dev.nothing")).type != MessageErrorType::None);
+    CHECK(gw.locks() == HeldLocks{{"dev.gripper", "bob", "user"}});
 
     // objectlockoverride releases another user's lock.
     auto r = gw.connect("root", "r");
-    CHECK(r.error(get("width", "dev.gripper")).type == MessageErrorType::ObjectLockedError);
-    CHECK(returned(r.ok(op("ReleaseObjectLock", "dev.gripper"))) == "OK");
-    CHECK(scalar_of<double>(a.ok(get("width", "dev.gripper")), "value") == 0.25);
-    CHECK(b.error(op("ReleaseClientObjectLock")).message == "Invalid command");
+    CHECK(r.error(get_req("width", "dev.gripper")).type == MessageErrorType::ObjectLockedError);
+    CHECK(op_result(r.ok(shared_lock_op("ReleaseObjectLock", "dev.gripper"))) == "OK");
+    CHECK(scalar_of<double>(a.ok(get_req("width", "dev.gripper")), "value") == 0.25);
+    CHECK(b.error(shared_lock_op("ReleaseClientObjectLock")).message == "Invalid command");
 }
 
 TEST_CASE("auth shared: a client lock binds the user's other sessions, closing sessions release locks") {
@@ -217,78 +219,78 @@ TEST_CASE("auth shared: a client lock binds the user's other sessions, closing s
     auto a2 = gw.connect("alice", "a");
     auto b = gw.connect("bob", "b");
 
-    CHECK(returned(a.ok(op("RequestClientObjectLock"))) == "OK");
-    CHECK(gw.locks() == Locks{{"dev", "alice", "client"}});
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 1.5);
-    CHECK(a2.error(get("pos")).message == "Object locked by alice");
-    CHECK(b.error(get("pos")).type == MessageErrorType::ObjectLockedError);
+    CHECK(op_result(a.ok(shared_lock_op("RequestClientObjectLock"))) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev", "alice", "client"}});
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+    CHECK(a2.error(get_req("pos")).message == "Object locked by alice");
+    CHECK(b.error(get_req("pos")).type == MessageErrorType::ObjectLockedError);
     a.raw->close();  // the client lock goes with its session
     CHECK(eventually([&] { return gw.locks().empty(); }));
-    CHECK(scalar_of<double>(b.ok(get("pos")), "value") == 1.5);
+    CHECK(scalar_of<double>(b.ok(get_req("pos")), "value") == 1.5);
 
     // A user lock stays while another gateway session of its user is open, and goes with the last.
-    CHECK(returned(a2.ok(op("RequestObjectLock"))) == "OK");
+    CHECK(op_result(a2.ok(shared_lock_op("RequestObjectLock"))) == "OK");
     auto a3 = gw.connect("alice", "a");
     a2.raw->close();
     CHECK(eventually([&] { return gw.mirror->status().downstream_sessions == 2; }));
-    CHECK(b.error(get("pos")).type == MessageErrorType::ObjectLockedError);
-    CHECK(gw.locks() == Locks{{"dev", "alice", "user"}});
+    CHECK(b.error(get_req("pos")).type == MessageErrorType::ObjectLockedError);
+    CHECK(gw.locks() == HeldLocks{{"dev", "alice", "user"}});
     a3.raw->close();
     CHECK(eventually([&] { return gw.locks().empty(); }));
-    CHECK(scalar_of<double>(b.ok(get("pos")), "value") == 1.5);
+    CHECK(scalar_of<double>(b.ok(get_req("pos")), "value") == 1.5);
 }
 
 TEST_CASE("auth shared: a monitor at the gateway refuses other sessions and is handed over on MonitorExit") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto b = gw.connect("bob", "b");
-    CHECK(returned(a.ok(enter(-1))) == "OK");
-    CHECK(gw.locks() == Locks{{"dev", "alice", "monitor"}});
-    CHECK(a.error(enter(-1)).message == "Already acquiring or acquired monitor lock");
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 1.5);
-    auto blocked = b.error(get("pos"));
+    CHECK(op_result(a.ok(enter_op(-1))) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev", "alice", "monitor"}});
+    CHECK(a.error(enter_op(-1)).message == "Already acquiring or acquired monitor lock");
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+    auto blocked = b.error(get_req("pos"));
     CHECK(blocked.type == MessageErrorType::InvalidOperation);
     CHECK(blocked.message == "Object is currently monitor locked. Use MonitorEnter to obtain monitor lock");
-    CHECK(scalar_of<double>(b.ok(get("width", "dev.gripper")), "value") == 0.25);  // monitors are per object
-    CHECK(b.error(op("MonitorExit")).message == "Not monitor locked");
+    CHECK(scalar_of<double>(b.ok(get_req("width", "dev.gripper")), "value") == 0.25);  // monitors are per object
+    CHECK(b.error(shared_lock_op("MonitorExit")).message == "Not monitor locked");
 
     // b waits at the gateway; a's MonitorExit answers it "OK" well before the 5 s "Continue".
     std::promise<Result<MessageEntry>> waiting;
-    b.raw->request(enter(-1), [&](Result<MessageEntry> r) { waiting.set_value(std::move(r)); });
+    b.raw->request(enter_op(-1), [&](Result<MessageEntry> r) { waiting.set_value(std::move(r)); });
     auto fut = waiting.get_future();
     CHECK(fut.wait_for(300ms) == std::future_status::timeout);
     const auto t0 = std::chrono::steady_clock::now();
-    CHECK(returned(a.ok(op("MonitorExit"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("MonitorExit"))) == "OK");
     REQUIRE(fut.wait_for(3s) == std::future_status::ready);
     CHECK(std::chrono::steady_clock::now() - t0 < 2s);
     auto got = fut.get();
     REQUIRE(got);
-    CHECK(returned(*got) == "OK");
-    CHECK(gw.locks() == Locks{{"dev", "bob", "monitor"}});
-    CHECK(a.error(get("pos")).type == MessageErrorType::InvalidOperation);
-    CHECK(a.error(enter(200)).type == MessageErrorType::RequestTimeout);
+    CHECK(op_result(*got) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev", "bob", "monitor"}});
+    CHECK(a.error(get_req("pos")).type == MessageErrorType::InvalidOperation);
+    CHECK(a.error(enter_op(200)).type == MessageErrorType::RequestTimeout);
 
     b.raw->close();  // the holder's session goes: its monitor with it
     CHECK(eventually([&] { return gw.locks().empty(); }));
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 1.5);
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
 }
 
 TEST_CASE("auth shared: [nolock] and [nolockread] members pass gateway-held object locks, not monitors") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto b = gw.connect("bob", "b");
-    CHECK(returned(a.ok(op("RequestObjectLock"))) == "OK");
-    CHECK(b.error(get("pos")).type == MessageErrorType::ObjectLockedError);
-    CHECK(scalar_of<double>(b.ok(get("free")), "value") == 1.5);
-    b.ok(set("free", 3.0));
+    CHECK(op_result(a.ok(shared_lock_op("RequestObjectLock"))) == "OK");
+    CHECK(b.error(get_req("pos")).type == MessageErrorType::ObjectLockedError);
+    CHECK(scalar_of<double>(b.ok(get_req("free")), "value") == 1.5);
+    b.ok(set_req("free", 3.0));
     CHECK(gw.device.root->property_value("free").value().as<double>().value() == 3.0);
-    CHECK(scalar_of<double>(b.ok(get("readable")), "value") == 1.5);
-    CHECK(b.error(set("readable", 3.0)).type == MessageErrorType::ObjectLockedError);
-    CHECK(returned(a.ok(op("ReleaseObjectLock"))) == "OK");
+    CHECK(scalar_of<double>(b.ok(get_req("readable")), "value") == 1.5);
+    CHECK(b.error(set_req("readable", 3.0)).type == MessageErrorType::ObjectLockedError);
+    CHECK(op_result(a.ok(shared_lock_op("ReleaseObjectLock"))) == "OK");
 
-    CHECK(returned(a.ok(enter(-1))) == "OK");
-    CHECK(b.error(get("free")).type == MessageErrorType::InvalidOperation);
-    CHECK(returned(a.ok(op("MonitorExit"))) == "OK");
+    CHECK(op_result(a.ok(enter_op(-1))) == "OK");
+    CHECK(b.error(get_req("free")).type == MessageErrorType::InvalidOperation);
+    CHECK(op_result(a.ok(shared_lock_op("MonitorExit"))) == "OK");
 }
 
 TEST_CASE("auth shared: wire packets on a connection opened before the lock pass, new connections are refused") {
@@ -297,7 +299,7 @@ TEST_CASE("auth shared: wire packets on a connection opened before the lock pass
     auto b = gw.connect("bob", "b");
     auto c = gw.connect("bob", "b");
     b.ok(req(MessageEntryType::WireConnectReq, "w", "dev"));
-    CHECK(returned(a.ok(op("RequestObjectLock"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("RequestObjectLock"))) == "OK");
     CHECK(c.error(req(MessageEntryType::WireConnectReq, "w", "dev")).message == "Object locked by alice");
 
     std::int32_t ns = 0;
@@ -326,21 +328,21 @@ TEST_CASE("auth shared: JSON API requests act as their gateway user, with no ses
     LockGateway gw;
     auto svc = gw.mirror->mirror_service();
     auto a = gw.connect("alice", "a");
-    CHECK(returned(a.ok(op("RequestObjectLock"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("RequestObjectLock"))) == "OK");
     CHECK(svc->check_api_request("dev", "alice", false));
     CHECK(svc->check_api_request("dev.gripper", "alice", false));
     CHECK(svc->check_api_request("dev", "bob", false).error().message == "Object locked by alice");
     CHECK(svc->check_api_request("dev", "", false).error().type == MessageErrorType::ObjectLockedError);
     CHECK(svc->check_api_request("dev", "bob", true));  // a [nolock] member
-    CHECK(returned(a.ok(op("ReleaseObjectLock"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("ReleaseObjectLock"))) == "OK");
 
-    CHECK(returned(a.ok(op("RequestClientObjectLock"))) == "OK");  // the locking session only
+    CHECK(op_result(a.ok(shared_lock_op("RequestClientObjectLock"))) == "OK");  // the locking session only
     CHECK(svc->check_api_request("dev", "alice", false).error().type == MessageErrorType::ObjectLockedError);
-    CHECK(returned(a.ok(op("ReleaseObjectLock"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("ReleaseObjectLock"))) == "OK");
 
-    CHECK(returned(a.ok(enter(-1))) == "OK");  // a monitor is another session's
+    CHECK(op_result(a.ok(enter_op(-1))) == "OK");  // a monitor is another session's
     CHECK(svc->check_api_request("dev", "alice", true).error().type == MessageErrorType::InvalidOperation);
-    CHECK(returned(a.ok(op("MonitorExit"))) == "OK");
+    CHECK(op_result(a.ok(shared_lock_op("MonitorExit"))) == "OK");
     CHECK(svc->check_api_request("dev", "bob", false));
 }
 
@@ -348,14 +350,14 @@ TEST_CASE("auth shared without gateway users: object locks need a login, monitor
     LockGateway gw(false);
     auto a = gw.connect();
     auto b = gw.connect();
-    auto refused = a.error(op("RequestObjectLock"));
+    auto refused = a.error(shared_lock_op("RequestObjectLock"));
     CHECK(refused.type == MessageErrorType::PermissionDenied);
     CHECK(refused.message == "User must be authenticated to lock object");
-    CHECK(a.error(op("RequestClientObjectLock")).type == MessageErrorType::PermissionDenied);
-    CHECK(returned(a.ok(enter(-1))) == "OK");
-    CHECK(gw.locks() == Locks{{"dev", "", "monitor"}});
-    CHECK(b.error(get("pos")).type == MessageErrorType::InvalidOperation);
-    CHECK(scalar_of<double>(a.ok(get("pos")), "value") == 1.5);
-    CHECK(returned(a.ok(op("MonitorExit"))) == "OK");
-    CHECK(scalar_of<double>(b.ok(get("pos")), "value") == 1.5);
+    CHECK(a.error(shared_lock_op("RequestClientObjectLock")).type == MessageErrorType::PermissionDenied);
+    CHECK(op_result(a.ok(enter_op(-1))) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev", "", "monitor"}});
+    CHECK(b.error(get_req("pos")).type == MessageErrorType::InvalidOperation);
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+    CHECK(op_result(a.ok(shared_lock_op("MonitorExit"))) == "OK");
+    CHECK(scalar_of<double>(b.ok(get_req("pos")), "value") == 1.5);
 }
