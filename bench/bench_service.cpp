@@ -3,13 +3,16 @@
 //
 // Usage:
 //   rr_bench_service [--port N] [--websocket] [--local] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]
+//                    [--frame-hz H] [--frame-bytes B]
 //     --tick-hz H   send on the Ticks wire at H Hz from start-up until exit (fan-out benchmarks)
+//     --frame-hz H  send B-byte frames (default 921,600: 640x480 RGB) on the Frames wire at H Hz until exit
 //     --local       also serve rr+local, by NodeID (no NodeName)
 // Prints one JSON line when ready: {"url": "rr+tcp://127.0.0.1:PORT/?service=bench", "port": PORT,
 // "ws_url": … (with --websocket), "local_url": … (with --local), "pid": PID}, then runs until SIGTERM / SIGINT.
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -66,6 +69,21 @@ void send_ticks(WireMember& wire, double rate_hz, std::int64_t count, std::size_
     }
 }
 
+/// Sends frames of `bytes` bytes on the wire at `rate_hz` until stopped; bytes 0-15 hold [stamp_us, sequence]
+/// as doubles (the host is little-endian, as the robdef says).
+void send_frames(WireMember& wire, double rate_hz, std::size_t bytes, const std::atomic<bool>& stop) {
+    using clock = std::chrono::steady_clock;
+    const auto start = clock::now();
+    std::vector<std::uint8_t> frame(std::max<std::size_t>(bytes, 16));
+    for (std::size_t i = 16; i < frame.size(); ++i) frame[i] = static_cast<std::uint8_t>(i * 7);
+    for (std::int64_t i = 0; !stop.load() && !g_stop; ++i) {
+        std::this_thread::sleep_until(start + std::chrono::duration<double>(double(i) / rate_hz));
+        const double head[2] = {bench::wall_clock_us(), double(i)};
+        std::memcpy(frame.data(), head, sizeof head);
+        (void)wire.set_out_value(Value(NumericArray::from<std::uint8_t>(std::span<const std::uint8_t>(frame))));
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,8 +91,9 @@ int main(int argc, char** argv) {
     bool websocket = false;
     bool local = false;
     unsigned threads = 0;
-    double memory_mib = 10, tick_hz = 0;
+    double memory_mib = 10, tick_hz = 0, frame_hz = 0;
     int tick_size = 2;
+    std::size_t frame_bytes = 640 * 480 * 3;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -91,9 +110,12 @@ int main(int argc, char** argv) {
         else if (a == "--memory-mib") memory_mib = std::stod(value());
         else if (a == "--tick-hz") tick_hz = std::stod(value());
         else if (a == "--tick-size") tick_size = std::stoi(value());
+        else if (a == "--frame-hz") frame_hz = std::stod(value());
+        else if (a == "--frame-bytes") frame_bytes = std::stoul(value());
         else {
             std::cerr << "usage: " << argv[0]
-                      << " [--port N] [--websocket] [--local] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]\n";
+                      << " [--port N] [--websocket] [--local] [--threads N] [--memory-mib M] [--tick-hz H] [--tick-size S]"
+                         " [--frame-hz H] [--frame-bytes B]\n";
             return 2;
         }
     }
@@ -120,6 +142,13 @@ int main(int argc, char** argv) {
     must(root->set_property_value("Value", Value::scalar<double>(0.0)), "Value");
     auto ticks = must(root->wire("Ticks"), "Ticks");
     must(ticks->set_out_value(Value(NumericArray::from<double>({0.0, -1.0}))), "Ticks initial");
+    auto frames = must(root->wire("Frames"), "Frames");
+    {
+        const double head[2] = {0.0, -1.0};  // sequence -1: no frame yet
+        std::uint8_t bytes[16];
+        std::memcpy(bytes, head, sizeof bytes);
+        must(frames->set_out_value(Value(NumericArray::from<std::uint8_t>(std::span<const std::uint8_t>(bytes)))), "Frames initial");
+    }
     std::atomic<bool> stopping{false};
     std::vector<std::thread> senders;
     std::mutex senders_mutex;
@@ -159,6 +188,10 @@ int main(int argc, char** argv) {
     if (tick_hz > 0) {
         std::lock_guard lock(senders_mutex);
         senders.emplace_back([&] { send_ticks(*ticks_raw, tick_hz, -1, static_cast<std::size_t>(tick_size), stopping); });
+    }
+    if (frame_hz > 0) {
+        std::lock_guard lock(senders_mutex);
+        senders.emplace_back([&, w = frames.get()] { send_frames(*w, frame_hz, frame_bytes, stopping); });
     }
 
     nlohmann::json ready = {{"url", "rr+tcp://127.0.0.1:" + std::to_string(bound) + "/?service=bench"},

@@ -9,11 +9,14 @@
 //       rate N × H, the fraction of the values the device sent in each client's window that reached
 //       it (delivered_of_sent; below 1: coalesced, as wires keep only the newest value), latency
 //       from the device's stamp to arrival (p50/p99/max µs), the load generator's own CPU%, and the
-//       bytes received per value. --binary subscribes with "binary": true (binary pushes: the double[]
-//       arrives as raw bytes, read in place).
+//       bytes received per value, and per-client rates (min, median). --binary subscribes with
+//       "binary": true (binary pushes: the array arrives as raw bytes, read in place); --member Frames
+//       (uint8[] camera frames, rr_bench_service --frame-hz) needs --binary.
 //   rr_bench_ws_load --port P --clients N idle
 //       opens N connections (no subscription), prints {"opened": N, …} and keeps them open until a
 //       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
+//   --slow K --read-delay-ms D: the first K clients wait D ms before each read (slow consumers); the
+//       row's figures are the other clients', and "slow" holds theirs.
 // Connections are opened at most 64 at a time (the gateway's listen backlog is finite).
 #include <cstring>
 #include <deque>
@@ -56,13 +59,16 @@ struct Stats {
     std::uint64_t delivered = 0;    // values counted while measuring
     std::uint64_t bytes = 0;        // message bytes received while measuring
     std::vector<double> latency_us; // while measuring
+    std::vector<double> slow_latency_us;  // of the slow clients (--slow), kept apart
     std::string first_error;
 };
 
 class Connection : public std::enable_shared_from_this<Connection> {
 public:
-    Connection(asio::io_context& io, Stats& stats, std::function<void()> on_open_done)
-        : ws_(io), stats_(stats), on_open_done_(std::move(on_open_done)) {}
+    /// `read_delay`: wait that long before each read (a slow consumer; zero: read at once).
+    Connection(asio::io_context& io, Stats& stats, std::function<void()> on_open_done,
+               std::chrono::milliseconds read_delay = {})
+        : ws_(io), stats_(stats), on_open_done_(std::move(on_open_done)), read_delay_(read_delay), delay_(io) {}
 
     void open(tcp::endpoint endpoint, std::string host, std::optional<nlohmann::json> subscribe) {
         subscribe_ = std::move(subscribe);
@@ -75,6 +81,7 @@ public:
             self->ws_.async_handshake(host, "/", [self](beast::error_code ec) {
                 if (ec) return self->failed("handshake: " + ec.message());
                 ++self->stats_.opened;
+                self->opened_ = true;
                 self->opened_done();
                 if (self->subscribe_) {
                     self->out_ = self->subscribe_->dump();
@@ -90,6 +97,10 @@ public:
 
     /// Values the device sent while this client was measuring (sequence numbers first..last seen).
     double sent_span() const { return first_seq_ < 0 ? 0 : last_seq_ - first_seq_ + 1; }
+    /// Values this client received while measuring.
+    std::uint64_t delivered() const { return delivered_; }
+    bool opened() const { return opened_; }
+    bool slow() const { return read_delay_.count() > 0; }
 
     void close() {
         beast::error_code ec;
@@ -115,9 +126,13 @@ private:
                 self->on_binary(bytes);
             else
                 self->on_message(bytes);
-            if (self->stats_.measuring) self->stats_.bytes += n;
+            if (self->stats_.measuring && !self->slow()) self->stats_.bytes += n;
             self->buffer_.consume(self->buffer_.size());
-            self->read();
+            if (!self->slow()) return self->read();
+            self->delay_.expires_after(self->read_delay_);
+            self->delay_.async_wait([self](beast::error_code ec) {
+                if (!ec) self->read();
+            });
         });
     }
     void on_message(std::string_view text) {
@@ -128,7 +143,8 @@ private:
         if (!v.is_array() || v.size() < 2 || v[1].get<double>() < 0) return;
         on_value(now, v[0].get<double>(), v[1].get<double>());
     }
-    // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array.
+    // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array
+    // (a double[] such as Ticks, or a uint8[] frame whose first 16 bytes are those two doubles).
     void on_binary(std::string_view m) {
         const double now = rr::bench::wall_clock_us();
         auto parts = rr::server::gateway::split_binary_push(m);
@@ -137,7 +153,9 @@ private:
         if (msg.is_discarded() || msg.value("kind", "") != "wire" || !msg["value"].is_object()) return;
         const auto& ref = msg["value"];
         const std::size_t at = ref.value("offset", std::size_t{0});
-        if (ref.value("type", "") != "double" || ref.value("length", 0) < 2 || at + 16 > parts->arrays.size()) return;
+        const std::string type = ref.value("type", "");
+        const bool stamped = (type == "double" && ref.value("length", 0) >= 2) || (type == "uint8" && ref.value("length", 0) >= 16);
+        if (!stamped || at + 16 > parts->arrays.size()) return;
         double v[2];
         std::memcpy(v, parts->arrays.data() + at, 16);
         on_value(now, v[0], v[1]);
@@ -151,6 +169,8 @@ private:
         if (!stats_.measuring) return;
         if (first_seq_ < 0) first_seq_ = seq;
         last_seq_ = seq;
+        ++delivered_;
+        if (slow()) return stats_.slow_latency_us.push_back(now - stamp_us);
         ++stats_.delivered;
         stats_.latency_us.push_back(now - stamp_us);
     }
@@ -158,11 +178,14 @@ private:
     websocket::stream<beast::tcp_stream> ws_;
     Stats& stats_;
     std::function<void()> on_open_done_;
+    std::chrono::milliseconds read_delay_;
+    asio::steady_timer delay_;
     std::optional<nlohmann::json> subscribe_;
     beast::flat_buffer buffer_;
     std::string out_;
-    bool got_value_ = false;
+    bool got_value_ = false, opened_ = false;
     double first_seq_ = -1, last_seq_ = -1;
+    std::uint64_t delivered_ = 0;
 };
 
 void raise_fd_limit() {
@@ -180,6 +203,8 @@ int main(int argc, char** argv) {
     double seconds = 5, hz = 100;
     std::string mode, device = "bench", member = "Ticks";
     bool binary = false;
+    std::size_t slow = 0;
+    long read_delay_ms = 0;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -190,9 +215,12 @@ int main(int argc, char** argv) {
         else if (a == "--device") device = value();
         else if (a == "--member") member = value();
         else if (a == "--binary") binary = true;
+        else if (a == "--slow") slow = std::stoul(value());
+        else if (a == "--read-delay-ms") read_delay_ms = std::stol(value());
         else if (a == "fanout" || a == "idle") mode = a;
         else {
-            std::cerr << "usage: " << argv[0] << " --port P --clients N (fanout [--seconds S] [--hz H] [--binary] | idle)\n";
+            std::cerr << "usage: " << argv[0]
+                      << " --port P --clients N (fanout [--seconds S] [--hz H] [--binary] [--slow K --read-delay-ms D] | idle)\n";
             return 2;
         }
     }
@@ -217,10 +245,11 @@ int main(int argc, char** argv) {
         while (next < clients && in_progress < kMaxConnecting) {
             ++in_progress;
             ++next;
+            const bool is_slow = next <= slow && read_delay_ms > 0;  // the first K clients
             auto c = std::make_shared<Connection>(io, stats, [&] {
                 --in_progress;
                 pump();
-            });
+            }, std::chrono::milliseconds(is_slow ? read_delay_ms : 0));
             conns.push_back(c);
             c->open(endpoint, host, subscribe);
         }
@@ -256,10 +285,24 @@ int main(int argc, char** argv) {
     stats.measuring = false;
     const double wall = rr::bench::elapsed_us(t0, clock_type::now());
     const auto cpu1 = rr::bench::CpuSnapshot::now();
-    double device_sent = 0;  // per client: values the device sent in its window (wires keep the newest only)
+    double device_sent = 0, slow_sent = 0;  // per client: values the device sent in its window (wires keep the newest only)
+    std::vector<double> per_client, slow_per_client;
     for (auto& c : conns) {
-        device_sent += c->sent_span();
+        (c->slow() ? slow_sent : device_sent) += c->sent_span();
+        if (c->opened()) (c->slow() ? slow_per_client : per_client).push_back(double(c->delivered()) * 1e6 / wall);
         c->close();
+    }
+    std::sort(per_client.begin(), per_client.end());
+    nlohmann::json slow_row;  // the slow clients apart: what the gateway does for a consumer that falls behind
+    if (!slow_per_client.empty()) {
+        const auto& l = stats.slow_latency_us;
+        slow_row = {{"clients", slow_per_client.size()},
+                    {"read_delay_ms", read_delay_ms},
+                    {"per_client_per_s_median", rr::bench::percentile(slow_per_client, 0.5)},
+                    {"delivered_of_sent", slow_sent > 0 ? double(l.size()) / slow_sent : 0.0},
+                    {"p50_us", rr::bench::percentile(l, 0.5)},
+                    {"p99_us", rr::bench::percentile(l, 0.99)},
+                    {"max_us", l.empty() ? 0.0 : *std::max_element(l.begin(), l.end())}};
     }
     std::cout << nlohmann::json{{"mode", "fanout"},
                                 {"clients", clients},
@@ -269,14 +312,20 @@ int main(int argc, char** argv) {
                                 {"open_s", open_s},
                                 {"seconds", wall / 1e6},
                                 {"delivered_per_s", double(stats.delivered) * 1e6 / wall},
-                                {"expected_per_s", double(stats.opened) * hz},
+                                {"expected_per_s", double(per_client.size()) * hz},
                                 {"delivered_of_sent", device_sent > 0 ? double(stats.delivered) / device_sent : 0.0},
+                                {"per_client_per_s_min", per_client.empty() ? 0.0 : per_client.front()},
+                                {"per_client_per_s_median", rr::bench::percentile(per_client, 0.5)},
                                 {"p50_us", rr::bench::percentile(stats.latency_us, 0.5)},
                                 {"p99_us", rr::bench::percentile(stats.latency_us, 0.99)},
                                 {"max_us", stats.latency_us.empty() ? 0.0
                                                                     : *std::max_element(stats.latency_us.begin(), stats.latency_us.end())},
                                 {"loadgen_cpu_pct", 100.0 * (cpu1.cpu_us - cpu0.cpu_us) / wall},
+                                {"loadgen_cpu_us_per_value", stats.delivered ? (cpu1.cpu_us - cpu0.cpu_us) / double(stats.delivered) : 0.0},
+                                {"loadgen_vcsw_per_value", stats.delivered ? double(cpu1.vcsw - cpu0.vcsw) / double(stats.delivered) : 0.0},
+                                {"member", member},
                                 {"binary", binary},
+                                {"slow", slow_row},
                                 {"bytes_per_value", stats.delivered ? double(stats.bytes) / double(stats.delivered) : 0.0},
                                 {"error", stats.first_error}}
                      .dump()

@@ -10,7 +10,15 @@ Every figure is measured in the same run as its reference and reported with the 
 Latency rows run in R interleaved rounds (floor, ours, official, ... repeated) and report the median
 of the rounds' medians: single runs drift by about ±25 % on these machines (../shared/BENCHMARKING.md).
 
+Issue 14's rows, off unless asked for (--rr-fanout, --camera, --browser, or --only SECTIONS):
+  * rr-fanout: N native RR clients (rr_bench_rr_fanout) on the device's Ticks wire at 100 Hz through
+    the gateway over rr+ws, and the same N directly on the device (the reference of the same moment);
+  * camera: 640x480 RGB frames at 30 Hz (the Frames wire) to N JSON clients with binary pushes;
+  * browser: the wasm client in node and in headless Chromium (wasm_bench.mjs), Nop and a property
+    read through the gateway over rr+ws, with the native client and the TCP floor in the same rounds.
+
 Usage: run.py --build DIR [--rounds R] [--count N] [--quick] [--no-busy] [--skip-fanout] [--skip-scale]
+              [--rr-fanout] [--camera] [--browser] [--only calls,fanout,scale,rr-fanout,camera,browser]
 """
 import argparse
 import datetime
@@ -21,6 +29,7 @@ import resource
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 
@@ -127,8 +136,22 @@ def fit_slope(points):
     return {"ns_per_byte": slope * 1000, "intercept_us": my - slope * mx}
 
 
+def proc_vcsw(pid):
+    """Voluntary context switches of all a process's threads, from /proc."""
+    n = 0
+    for tid in os.listdir("/proc/%d/task" % pid):
+        try:
+            with open("/proc/%d/task/%s/status" % (pid, tid)) as f:
+                for l in f:
+                    if l.startswith("voluntary_ctxt_switches:"):
+                        n += int(l.split()[1])
+        except OSError:
+            pass  # the thread ended
+    return n
+
+
 class Sampler(threading.Thread):
-    """Samples a process's CPU and RSS every 0.2 s with wall-clock stamps."""
+    """Samples a process's CPU, RSS and voluntary context switches every 0.2 s with wall-clock stamps."""
 
     def __init__(self, pid):
         super().__init__(daemon=True)
@@ -137,16 +160,220 @@ class Sampler(threading.Thread):
     def run(self):
         while not self.stop_flag.is_set():
             try:
-                self.samples.append((time.time(),) + proc_sample(self.pid))
+                self.samples.append((time.time(),) + proc_sample(self.pid) + (proc_vcsw(self.pid),))
             except OSError:
                 return
             time.sleep(0.2)
+
+    def finish(self):
+        self.stop_flag.set()
+        self.join()
 
     def window(self, t0, t1):
         s = [x for x in self.samples if t0 <= x[0] <= t1]
         if len(s) < 2:
             return None
-        return {"cpu_pct": 100 * (s[-1][1] - s[0][1]) / (s[-1][0] - s[0][0]), "rss_kib_max": max(x[2] for x in s)}
+        dt = s[-1][0] - s[0][0]
+        return {"cpu_pct": 100 * (s[-1][1] - s[0][1]) / dt, "rss_kib_max": max(x[2] for x in s),
+                "vcsw_per_s": (s[-1][3] - s[0][3]) / dt}
+
+
+SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser")
+# Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
+# allows by default (256); 0 lifts the limit.
+UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
+
+
+def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False):
+    argv = [exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning", "--device",
+            "bench=" + device_url]
+    if unlimited:
+        path = os.path.join(tempfile.gettempdir(), "rr-bench-gateway-%d.yaml" % os.getpid())
+        with open(path, "w") as f:
+            f.write(UNLIMITED_CONFIG)
+        argv += ["--config", path]
+    gw = Proc(argv, name)
+    time.sleep(1.0)  # the gateway connects to its device
+    return gw
+
+
+def run_timed(argv, timeout=600):
+    """run_rows, with the wall-clock time each JSON line arrived (a row's measuring window ends there)."""
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    rows = []
+    timer = threading.Timer(timeout, p.kill)
+    timer.start()
+    try:
+        for line in p.stdout:
+            if line.startswith("{"):
+                rows.append((json.loads(line), time.time()))
+        err = p.stderr.read()
+        p.wait()
+    finally:
+        timer.cancel()
+    if p.returncode != 0:
+        log("FAILED (%d): %s\n%s" % (p.returncode, " ".join(argv), err[-2000:]))
+    return rows
+
+
+def sampled(pid, argv, label_fields):
+    """Runs a load generator while sampling `pid`; each row gets the server's CPU, RSS and context
+    switches over the row's measuring window (the last `seconds` before its line), per delivered value too."""
+    sampler = Sampler(pid)
+    sampler.start()
+    t0 = time.time()
+    rows = run_timed(argv)
+    time.sleep(1.0)  # the RSS once the clients are gone
+    sampler.finish()
+    out = []
+    for row, t_line in rows:
+        row.update(label_fields)
+        row["wall_s"] = t_line - t0
+        w = sampler.window(t_line - row["seconds"], t_line)
+        if w:
+            per_s = row.get("delivered_per_s") or 0
+            row.update({"server_cpu_pct": w["cpu_pct"], "server_rss_kib": w["rss_kib_max"],
+                        "server_cpu_us_per_value": w["cpu_pct"] * 1e4 / per_s if per_s else None,
+                        "server_vcsw_per_value": w["vcsw_per_s"] / per_s if per_s else None})
+        if sampler.samples:
+            row["server_rss_after_kib"] = sampler.samples[-1][2]
+        out.append(row)
+    return out
+
+
+def rr_fanout_section(exe, args, procs):
+    """Native RR clients on Ticks (100 Hz): through the gateway over rr+ws, then directly on the device
+    (its own rr+ws fan-out, the reference of the same moment). A fresh gateway per N (clean RSS)."""
+    rows = []
+    dev = Proc([exe["rr_bench_service"], "--websocket", "--tick-hz", "100"], "bench_service (100 Hz)")
+    procs.append(dev)
+    seconds = "3" if args.quick else "5"
+    for n in [10, 100, 1000]:
+        for path in ("gateway", "direct"):
+            log("rr fan-out: %d native clients over rr+ws, %s" % (n, "through the gateway" if path == "gateway" else "on the device"))
+            gw = gateway_proc(exe, dev.ready["url"], unlimited=True) if path == "gateway" else None
+            if gw:
+                procs.append(gw)
+            url = "rr+ws://127.0.0.1:%d/?service=bench" % gw.ready["port"] if gw else dev.ready["ws_url"]
+            rows += sampled(gw.p.pid if gw else dev.p.pid,
+                            [exe["rr_bench_rr_fanout"], "--url", url, "--clients", str(n), "--seconds", seconds, "--hz", "100",
+                             "--threads", str(args.rr_fanout_threads)],
+                            {"path": "ours->gateway->N x ours rr+ws" if gw else "ours->N x ours rr+ws (device direct)",
+                             "server": "gateway" if gw else "device"})
+            if gw:
+                gw.stop()
+                procs.remove(gw)
+    dev.stop()
+    procs.remove(dev)
+    return rows
+
+
+def camera_section(exe, args, procs):
+    """640x480 RGB frames (921,600 bytes) at 30 Hz on Frames → gateway → N JSON clients with binary pushes.
+    N = 1 is the reference of the same moment; a fresh gateway per N. The last row has 2 slow consumers
+    among 10 clients (each waits 200 ms before every read: at most 5 frames/s): what the gateway does
+    for a client that falls behind (a wire keeps the newest value) and what it costs the others."""
+    rows = []
+    dev = Proc([exe["rr_bench_service"], "--frame-hz", "30", "--frame-bytes", str(640 * 480 * 3)], "bench_service (frames)")
+    procs.append(dev)
+    seconds = "3" if args.quick else "5"
+    for n, slow in [(1, 0), (10, 0), (50, 0), (10, 2)]:
+        log("camera: 30 frames/s of 921,600 bytes to %d JSON clients (binary pushes)%s" % (n, ", %d slow" % slow if slow else ""))
+        gw = gateway_proc(exe, dev.ready["url"], unlimited=True)
+        procs.append(gw)
+        rows += sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout",
+                                   "--member", "Frames", "--binary", "--hz", "30", "--seconds", seconds] +
+                        (["--slow", str(slow), "--read-delay-ms", "200"] if slow else []),
+                        {"path": "device->gateway->N x JSON (binary)", "server": "gateway", "frame_bytes": 640 * 480 * 3,
+                         "hz": 30.0})
+        gw.stop()
+        procs.remove(gw)
+    dev.stop()
+    procs.remove(dev)
+    return rows
+
+
+def browser_section(exe, args, rounds, procs):
+    """Nop and a property read through the gateway over rr+ws, one call after the other: our native
+    client, the wasm client in node, the wasm client in Chromium, with the TCP floor; R rounds, interleaved.
+    Each row also gets the gateway's CPU µs per call (its /proc, connection set-up and warm-up included)."""
+    raw = []
+    dev = Proc([exe["rr_bench_service"]], "bench_service")
+    procs.append(dev)
+    gw = gateway_proc(exe, dev.ready["url"])
+    procs.append(gw)
+    port = gw.ready["port"]
+    count = str(args.browser_count)
+    wasm = ["node", os.path.join(HERE, "wasm_bench.mjs"), "--port", str(port), "--count", count, "--runtimes"]
+    plan = [("floor", [exe["rr_bench_floor"], "--count", count]),
+            ("native", [exe["rr_bench_client"], "--url", "rr+ws://127.0.0.1:%d/?service=bench" % port, "--label",
+                        "ours->gateway->ours rr+ws", "--count", count, "--ops", "nop,get"]),
+            ("wasm in node", wasm + ["node"]),
+            ("wasm in chromium", wasm + ["chromium"])]
+    skipped = set()
+    for r in range(rounds):
+        for name, argv in plan:
+            if name in skipped:
+                continue
+            log("browser row, round %d/%d: %s" % (r + 1, rounds, name))
+            before = proc_sample(gw.p.pid)[0]
+            out = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=600)
+            gw_cpu_us = (proc_sample(gw.p.pid)[0] - before) * 1e6
+            if out.returncode == 77:
+                log("skipped: " + out.stderr.strip())
+                skipped.add(name)
+                continue
+            if out.returncode != 0:
+                log("FAILED (%d): %s\n%s" % (out.returncode, " ".join(argv), out.stderr[-2000:]))
+            rows = [json.loads(l) for l in out.stdout.splitlines() if l.startswith("{")]
+            calls = sum(x.get("n", 0) for x in rows)
+            for row in rows:
+                row["round"] = r
+                if name != "floor" and calls:
+                    row["gateway_cpu_us_per_op"] = gw_cpu_us / calls
+            raw += [x for x in rows if name != "floor" or x["op"] == "tcp_64"]
+    gw.stop()
+    dev.stop()
+    procs.remove(gw)
+    procs.remove(dev)
+    return raw
+
+
+def summarize_browser(raw):
+    """One row per (path, op): medians over rounds, the ratio to the native client's p50 and to the TCP
+    floor of the same round (every round listed)."""
+    if not raw:
+        return []
+    by_round = {}
+    for row in raw:
+        by_round.setdefault(row["round"], {})[(row["label"], row["op"])] = row
+    groups = {}
+    for row in raw:
+        groups.setdefault((row["label"], row["op"]), []).append(row)
+    out = []
+    for (label, op), rows in groups.items():
+        e = median_rows(rows)
+        e["gateway_cpu_us_per_op"] = statistics.median([x["gateway_cpu_us_per_op"] for x in rows if "gateway_cpu_us_per_op" in x] or [0])
+        x_native, x_floor = [], []
+        for row in rows:
+            same = by_round[row["round"]]
+            native = same.get(("ours->gateway->ours rr+ws", op))
+            floor = same.get(("floor", "tcp_64"))
+            if native and native.get("p50_us") and label != native["label"]:
+                x_native.append(row["p50_us"] / native["p50_us"])
+            if floor and floor.get("p50_us") and label != "floor":
+                x_floor.append(row["p50_us"] / floor["p50_us"])
+        if x_native:
+            e["x_native_rounds"] = [round(x, 2) for x in x_native]
+            e["x_native"] = statistics.median(x_native)
+        if x_floor:
+            e["x_tcp_floor_rounds"] = [round(x, 2) for x in x_floor]
+            e["x_tcp_floor"] = statistics.median(x_floor)
+        out.append(e)
+    rank = {"floor": 0, "ours->gateway->ours rr+ws": 1, "wasm(node)->gateway->ours rr+ws": 2, "wasm(chromium)->gateway->ours rr+ws": 3}
+    out.sort(key=lambda e: (OP_ORDER.index(e["op"]) if e["op"] in OP_ORDER else 99, rank.get(e["label"], 9)))
+    return out
+
 
 
 def main(argv=None):
@@ -159,15 +386,34 @@ def main(argv=None):
     ap.add_argument("--skip-fanout", action="store_true")
     ap.add_argument("--skip-scale", action="store_true")
     ap.add_argument("--skip-calls", action="store_true", help="only fan-out and scale")
+    ap.add_argument("--rr-fanout", action="store_true", help="also: N native RR clients on a wire through the gateway (rr+ws)")
+    ap.add_argument("--rr-fanout-threads", type=int, default=1, help="IO threads of rr_bench_rr_fanout (default 1)")
+    ap.add_argument("--camera", action="store_true", help="also: 640x480 RGB at 30 Hz to N JSON clients (binary pushes)")
+    ap.add_argument("--browser", action="store_true", help="also: the wasm client in node and Chromium, with the native client")
+    ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
+    ap.add_argument("--only", help="run only these sections (comma-separated): " + ",".join(SECTIONS) +
+                    "; results go to latest-SECTIONS.json/.md")
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--update-doc", action="store_true",
                     help="also replace the latest figures in docs/benchmarks.md (between its latest:begin/end markers)")
     args = ap.parse_args(argv)
     if args.quick:
         args.rounds, args.count = 1, 500
+        args.browser_count = min(args.browser_count, 1000)
+    stem = "latest"
+    if args.only:
+        only = [x.strip() for x in args.only.split(",") if x.strip()]
+        bad = [x for x in only if x not in SECTIONS]
+        if bad:
+            ap.error("--only: unknown section(s) %s (sections: %s)" % (", ".join(bad), ", ".join(SECTIONS)))
+        args.skip_calls, args.skip_fanout, args.skip_scale = "calls" not in only, "fanout" not in only, "scale" not in only
+        args.rr_fanout, args.camera, args.browser = "rr-fanout" in only, "camera" in only, "browser" in only
+        stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
+    browser_rounds = args.rounds
 
     b = os.path.abspath(args.build)
-    exe = {n: os.path.join(b, "bench", n) for n in ("rr_bench_service", "rr_bench_client", "rr_bench_floor", "rr_bench_ws_load")}
+    exe = {n: os.path.join(b, "bench", n) for n in ("rr_bench_service", "rr_bench_client", "rr_bench_floor", "rr_bench_ws_load",
+                                                    "rr_bench_rr_fanout")}
     exe["rr-gateway"] = os.path.join(b, "server", "app", "rr-gateway")
     soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
     resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))  # children inherit it (10,000 sockets)
@@ -181,73 +427,71 @@ def main(argv=None):
         log("two nice-19 busy loops run for the duration (busy latency regime, ../shared/BENCHMARKING.md)")
     procs = []
     try:
-        ours = Proc([exe["rr_bench_service"], "--websocket", "--local"], "bench_service")
-        procs.append(ours)
-        official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket", "--local"], "official_service")
-        procs.append(official)
-        gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
-                   "--device", "bench=" + ours.ready["url"]], "rr-gateway")
-        procs.append(gw)
-        gw_url = "rr+tcp://127.0.0.1:%d/?service=bench" % gw.ready["port"]
-        time.sleep(1.0)  # the gateway connects to its device
-
-        ops = ",".join(CALL_OPS)
-        ours_ops = ",".join(["nop", "nop_async"] + CALL_OPS[1:])
-        cpp = lambda url, label, o=ours_ops: run_rows([exe["rr_bench_client"], "--url", url, "--label", label,
-                                                        "--count", str(args.count), "--ops", o])
-        pyc = lambda url, label, o=ops: run_rows([PY, os.path.join(HERE, "py", "official_client.py"), "--url", url,
-                                                   "--label", label, "--count", str(args.count), "--ops", o])
-        plan = [
-            ("floor", lambda: run_rows([exe["rr_bench_floor"], "--count", str(args.count)])),
-            ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp")),
-            ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp")),
-            ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws")),
-            ("official->official rr+ws", lambda: pyc(official.ready["ws_url"], "official->official rr+ws")),
-            ("ours->ours rr+local", lambda: cpp(ours.ready["local_url"], "ours->ours rr+local")),
-            ("official->official rr+local", lambda: pyc(official.ready["local_url"], "official->official rr+local")),
-            ("official->ours rr+tcp", lambda: pyc(ours.ready["url"], "official->ours rr+tcp")),
-            ("ours->official rr+tcp", lambda: cpp(official.ready["url"], "ours->official rr+tcp", ops)),
-            ("ours->gateway->ours rr+tcp", lambda: cpp(gw_url, "ours->gateway->ours rr+tcp")),
-            ("official->gateway->ours rr+tcp", lambda: pyc(gw_url, "official->gateway->ours rr+tcp")),
-        ]
-        usb = os.path.join(b, "bench", "rr_bench_usb")
-        if os.path.exists(usb):  # rr+usb against the umockdev-emulated device, and in-process rr+tcp (bench_usb.cpp)
-            plan.append(("ours->ours rr+usb", lambda: run_rows([usb, "--count", str(max(args.count // 5, 100))])))
         raw = []
         if args.skip_calls:
-            plan, args.rounds = [], 0
-        for r in range(args.rounds):
-            for name, fn in plan:
-                log("round %d/%d: %s" % (r + 1, args.rounds, name))
-                rows = fn()
-                for row in rows:
-                    row["round"] = r
-                raw += rows
-        # Streaming members: once per pair (their figures are rates, less sensitive to drift).
-        stream = ",".join(STREAM_OPS)
-        for name, fn in [] if args.skip_calls else [
-                ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp", stream)),
-                ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp", stream)),
-                ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws", stream))]:
-            log("streams: " + name)
-            raw += fn()
-        for p in reversed(procs):
-            p.stop()
-        procs = []
+            args.rounds = 0
+        else:  # the call rows' services and gateway
+            ours = Proc([exe["rr_bench_service"], "--websocket", "--local"], "bench_service")
+            procs.append(ours)
+            official = Proc([PY, os.path.join(HERE, "py", "official_service.py"), "--websocket", "--local"], "official_service")
+            procs.append(official)
+            gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
+                       "--device", "bench=" + ours.ready["url"]], "rr-gateway")
+            procs.append(gw)
+            gw_url = "rr+tcp://127.0.0.1:%d/?service=bench" % gw.ready["port"]
+            time.sleep(1.0)  # the gateway connects to its device
+
+            ops = ",".join(CALL_OPS)
+            ours_ops = ",".join(["nop", "nop_async"] + CALL_OPS[1:])
+            cpp = lambda url, label, o=ours_ops: run_rows([exe["rr_bench_client"], "--url", url, "--label", label,
+                                                            "--count", str(args.count), "--ops", o])
+            pyc = lambda url, label, o=ops: run_rows([PY, os.path.join(HERE, "py", "official_client.py"), "--url", url,
+                                                       "--label", label, "--count", str(args.count), "--ops", o])
+            plan = [
+                ("floor", lambda: run_rows([exe["rr_bench_floor"], "--count", str(args.count)])),
+                ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp")),
+                ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp")),
+                ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws")),
+                ("official->official rr+ws", lambda: pyc(official.ready["ws_url"], "official->official rr+ws")),
+                ("ours->ours rr+local", lambda: cpp(ours.ready["local_url"], "ours->ours rr+local")),
+                ("official->official rr+local", lambda: pyc(official.ready["local_url"], "official->official rr+local")),
+                ("official->ours rr+tcp", lambda: pyc(ours.ready["url"], "official->ours rr+tcp")),
+                ("ours->official rr+tcp", lambda: cpp(official.ready["url"], "ours->official rr+tcp", ops)),
+                ("ours->gateway->ours rr+tcp", lambda: cpp(gw_url, "ours->gateway->ours rr+tcp")),
+                ("official->gateway->ours rr+tcp", lambda: pyc(gw_url, "official->gateway->ours rr+tcp")),
+            ]
+            usb = os.path.join(b, "bench", "rr_bench_usb")
+            if os.path.exists(usb):  # rr+usb against the umockdev-emulated device, and in-process rr+tcp (bench_usb.cpp)
+                plan.append(("ours->ours rr+usb", lambda: run_rows([usb, "--count", str(max(args.count // 5, 100))])))
+            for r in range(args.rounds):
+                for name, fn in plan:
+                    log("round %d/%d: %s" % (r + 1, args.rounds, name))
+                    rows = fn()
+                    for row in rows:
+                        row["round"] = r
+                    raw += rows
+            # Streaming members: once per pair (their figures are rates, less sensitive to drift).
+            stream = ",".join(STREAM_OPS)
+            for name, fn in [
+                    ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp", stream)),
+                    ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp", stream)),
+                    ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws", stream))]:
+                log("streams: " + name)
+                raw += fn()
+            for p in reversed(procs):
+                p.stop()
+            procs = []
 
         fanout, scale = [], []
         if not args.skip_fanout or not args.skip_scale:
             dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
             procs.append(dev)
-            gw = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
-                       "--device", "bench=" + dev.ready["url"]], "rr-gateway")
+            gw = gateway_proc(exe, dev.ready["url"], unlimited=True)
             procs.append(gw)
-            time.sleep(1.0)
             gpid = gw.p.pid
             if not args.skip_scale:
                 # a fresh gateway: its RSS is not yet inflated by the fan-out's traffic (the allocator keeps it)
-                sg = Proc([exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning",
-                           "--device", "bench=" + dev.ready["url"]], "rr-gateway (scale)")
+                sg = gateway_proc(exe, dev.ready["url"], "rr-gateway (scale)", unlimited=True)
                 procs.append(sg)
                 for n in ([1000] if args.quick else [1000, 10000]):
                     log("scale: %d idle WebSocket connections" % n)
@@ -284,6 +528,13 @@ def main(argv=None):
                             row["gateway_cpu_pct"], row["gateway_rss_kib"] = w["cpu_pct"], w["rss_kib_max"]
                         row["wall_s"] = t1 - t0
                         fanout.append(row)
+        for p in reversed(procs):
+            p.stop()
+        procs = []
+
+        rr_fanout = rr_fanout_section(exe, args, procs) if args.rr_fanout else []
+        camera = camera_section(exe, args, procs) if args.camera else []
+        browser = browser_section(exe, args, browser_rounds, procs) if args.browser else []
     finally:
         for p in reversed(procs):
             p.stop()
@@ -292,19 +543,22 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
+    result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser})
     result["load_average_end"] = list(os.getloadavg())
     result["duration_s"] = round(time.time() - started, 1)
     result["raw"] = raw
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "latest.json"), "w") as f:
+    with open(os.path.join(args.out, stem + ".json"), "w") as f:
         json.dump(result, f, indent=1)
     md = markdown(result)
-    with open(os.path.join(args.out, "latest.md"), "w") as f:
+    with open(os.path.join(args.out, stem + ".md"), "w") as f:
         f.write(md)
     print(md)
-    if args.update_doc:
+    if args.update_doc and stem != "latest":
+        log("--update-doc ignored: --only ran part of the suite")
+    elif args.update_doc:
         update_doc(os.path.join(ROOT, "docs", "benchmarks.md"), md)
-    log("wrote %s/latest.json and latest.md in %.0f s" % (args.out, result["duration_s"]))
+    log("wrote %s/%s.json and %s.md in %.0f s" % (args.out, stem, stem, result["duration_s"]))
     return 0
 
 
@@ -409,12 +663,14 @@ def markdown(res):
                "/".join("%.2f" % x for x in res["load_average_start"]),
                "/".join("%.2f" % x for x in res["load_average_end"]),
                "two nice-19 busy loops ran throughout (busy latency regime)" if res["busy_loops"] else "no busy loops",
-               res["rounds"]), "",
-           "References measured in this run: TCP floor p50 **%s µs** (64 B ping-pong, TCP_NODELAY), Unix socket floor "
-           "p50 %s µs, TCP bulk round trip (800,000 B each way) **%s MB/s**." % (
-               fmt(refs.get("tcp_floor_p50_us"), 2), fmt(refs.get("unix_floor_p50_us"), 2), fmt(refs.get("tcp_bulk_mb_s"))), "",
-           "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor (× Unix floor for rr+local) | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
-           "|---|---|---|---|---|---|---|---|---|---|---|"]
+               res["rounds"])]
+    if res["rows"]:
+        out += ["",
+               "References measured in this run: TCP floor p50 **%s µs** (64 B ping-pong, TCP_NODELAY), Unix socket floor "
+               "p50 %s µs, TCP bulk round trip (800,000 B each way) **%s MB/s**." % (
+                   fmt(refs.get("tcp_floor_p50_us"), 2), fmt(refs.get("unix_floor_p50_us"), 2), fmt(refs.get("tcp_bulk_mb_s"))), "",
+               "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor (× Unix floor for rr+local) | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
+               "|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in res["rows"]:
         off = fmt(e.get("official_p50_us")) if "official_p50_us" in e else (
             "(%s)" % fmt(e["official_ops_per_s"], 0) if "official_ops_per_s" in e else "")
@@ -425,7 +681,8 @@ def markdown(res):
             fmt(e.get("mb_s")), fmt(e.get("x_tcp_floor"), 2) + (" (%s)" % fmt(e["x_unix_floor"], 2) if "x_unix_floor" in e else ""),
             fmt(e.get("pct_tcp_bulk")), off,
             (fmt(e["speedup_vs_official"], 2) + "×") if "speedup_vs_official" in e else ""))
-    out += ["", "\\* the official library over rr+tcp (it ran the streaming rows on rr+tcp only)."]
+    if res["rows"]:
+        out += ["", "\\* the official library over rr+tcp (it ran the streaming rows on rr+tcp only)."]
     if res["gateway_hops"]:
         out += ["", "The gateway hop (client → gateway → device minus client → device, p50):", "",
                 "| path | op | direct µs | through gateway µs | hop µs | hop × TCP floor |", "|---|---|---|---|---|---|"]
@@ -454,6 +711,62 @@ def markdown(res):
         for s in res["scale"]:
             out.append("| %s | %s | %s | %s | %s |" % (fmt(s["clients"]), fmt(s["opened"]), fmt(s["gateway_rss_base_kib"] / 1024),
                                                      fmt(s["gateway_rss_kib"] / 1024), fmt(s["rss_per_connection_kib"])))
+    if res.get("rr_fanout"):
+        out += ["", "Raw RR fan-out: the device's `Ticks` wire at 100 Hz to N native clients (`rr_bench_rr_fanout`, one process, "
+                "%s IO thread(s)) over rr+ws, through the gateway and directly on the device; latency from the device's stamp "
+                "to the client's handler; server = the gateway, or the device for the direct rows:" % res["rr_fanout"][0].get("threads", 1), "",
+                "| clients | path | opened | delivered/s | expected/s | delivered of sent | per client /s min, median | p50 µs | p99 µs | max µs "
+                "| server CPU % | server CPU µs / value | server vcsw / value | server RSS MiB | load generator CPU % | load gen CPU µs / value |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["rr_fanout"]:
+            out.append("| %s | %s | %s | %s | %s | %s | %s, %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                fmt(f["clients"]), f["path"], fmt(f["opened"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
+                "%.1f %%" % (100 * f.get("delivered_of_sent", 0)), fmt(f["per_client_per_s_min"], 0), fmt(f["per_client_per_s_median"], 0),
+                fmt(f["p50_us"]), fmt(f["p99_us"]), fmt(f["max_us"]), fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")),
+                fmt(f.get("server_vcsw_per_value"), 2), fmt(f.get("server_rss_kib", 0) / 1024), fmt(f["loadgen_cpu_pct"]),
+                fmt(f.get("loadgen_cpu_us_per_value"))))
+    if res.get("camera"):
+        out += ["", "Camera stream: 640×480 RGB frames (921,600 bytes) at 30 Hz on the device's `Frames` wire → gateway → N JSON "
+                "WebSocket clients subscribed with `\"binary\": true` (`rr_bench_ws_load --member Frames --binary`, one thread); "
+                "latency from the device's stamp to the whole frame's arrival:", "",
+                "| clients | frames/s per client min, median | sent/s | delivered of sent | MB/s delivered | p50 ms | p99 ms | max ms "
+                "| gateway CPU % | gateway CPU µs / frame | gateway RSS MiB (max, 1 s after) | load generator CPU % |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["camera"]:
+            slow = f.get("slow") or {}
+            out.append("| %s | %s, %s | %s | %s | %s | %s | %s | %s | %s | %s | %s, %s | %s |" % (
+                fmt(f["clients"]) + (" (%d of them slow)" % slow["clients"] if slow else ""), fmt(f["per_client_per_s_min"]), fmt(f["per_client_per_s_median"]), fmt(f.get("hz")),
+                "%.1f %%" % (100 * f.get("delivered_of_sent", 0)), fmt(f["delivered_per_s"] * f["bytes_per_value"] / 1e6, 0),
+                fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000), fmt(f["max_us"] / 1000), fmt(f.get("server_cpu_pct")),
+                fmt(f.get("server_cpu_us_per_value")), fmt(f.get("server_rss_kib", 0) / 1024),
+                fmt(f.get("server_rss_after_kib", 0) / 1024), fmt(f["loadgen_cpu_pct"])))
+        slows = [f for f in res["camera"] if f.get("slow")]
+        if slows:
+            out += ["", "The slow consumers of that table (each waits `read_delay_ms` before every read); the row above gives "
+                    "the other clients' figures:", "",
+                    "| clients | slow | read delay ms | frames/s per slow client (median) | delivered of sent | p50 ms | p99 ms | max ms |",
+                    "|---|---|---|---|---|---|---|---|"]
+            for f in slows:
+                w = f["slow"]
+                out.append("| %s | %s | %s | %s | %.1f %% | %s | %s | %s |" % (
+                    fmt(f["clients"]), fmt(w["clients"]), fmt(w["read_delay_ms"]), fmt(w["per_client_per_s_median"]),
+                    100 * w["delivered_of_sent"], fmt(w["p50_us"] / 1000), fmt(w["p99_us"] / 1000), fmt(w["max_us"] / 1000)))
+    if res.get("browser"):
+        out += ["", "Browser row: one call after the other through the gateway over rr+ws, the native client, the wasm client "
+                "in node (`ws` package) and in headless Chromium (`bench/wasm_bench.mjs`); × native and × TCP floor are per round "
+                "(every round listed), then the median. Client CPU: the client's process (Chromium: all its processes); "
+                "gateway CPU per call includes the connection and the warm-up:", "",
+                "| op | path | n | p50 µs | p99 µs | max µs | calls/s | client CPU µs / call | client vcsw / call | gateway CPU µs / call "
+                "| × native p50 | × TCP floor |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for e in res["browser"]:
+            rounds = lambda k: " (%s)" % ", ".join("%.2f" % x for x in e[k + "_rounds"]) if len(e.get(k + "_rounds", [])) > 1 else ""
+            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                e["op"], e["label"], fmt(e.get("n")), fmt(e.get("p50_us")), fmt(e.get("p99_us")), fmt(e.get("max_us")),
+                fmt(e.get("ops_per_s"), 0), fmt(e.get("client_cpu_us_per_op")), fmt(e.get("client_vcsw_per_op"), 2),
+                fmt(e.get("gateway_cpu_us_per_op")) if e["label"] != "floor" else "",
+                (fmt(e["x_native"], 2) + rounds("x_native")) if "x_native" in e else "",
+                (fmt(e["x_tcp_floor"], 2) + rounds("x_tcp_floor")) if "x_tcp_floor" in e else ""))
     return "\n".join(out) + "\n"
 
 
