@@ -764,7 +764,7 @@ private:
         return socket_->queued() >= options_.push_queue_limit || socket_->queued_bytes() >= options_.push_bytes_limit;
     }
     bool wire_congested() const {
-        return socket_->queued() >= options_.wire_queue_threshold || socket_->queued_bytes() >= options_.push_bytes_limit;
+        return socket_->queued() >= options_.wire_queue_threshold || socket_->queued_bytes() >= options_.wire_bytes_threshold;
     }
 
     // Takes a push slot for subscription `sid`: false (and counted) when the client is too far behind.

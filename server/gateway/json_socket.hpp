@@ -11,7 +11,8 @@
 // Backpressure (a client that reads slowly never grows the gateway's memory without bound):
 //   * the socket's own queue holds at most HttpOptions::json_socket_queue_limit messages (oldest dropped);
 //   * wire values are coalesced per subscription: the newest value waits while `wire_queue_threshold`
-//     messages are queued, and replaces an older waiting one;
+//     messages or `wire_bytes_threshold` bytes are queued, and replaces an older waiting one (so a slow
+//     reader of camera frames gets the newest frame, one or two frames behind, not a backlog);
 //   * events and pipe packets are dropped (counted, and reported as "dropped" in the next push of that
 //     subscription) while `push_queue_limit` messages or `push_bytes_limit` bytes are queued;
 //   * pipe packets become JSON on one strand shared by all sockets, never on the device connection's
@@ -46,6 +47,7 @@ struct JsonSocketOptions {
     std::size_t push_queue_limit = 768;             ///< messages queued: events / pipe packets dropped from here
     std::size_t push_bytes_limit = 8u << 20;        ///< bytes queued: pushes dropped / wire values wait from here
     std::size_t wire_queue_threshold = 8;           ///< messages queued: wire values wait (coalesced) from here
+    std::size_t wire_bytes_threshold = 1u << 20;    ///< bytes queued: wire values wait (coalesced) from here
     std::size_t max_pipe_conversions = 16;          ///< a socket's pipe packets waiting for their JSON: newer dropped (a burst of small packets must fit)
     std::size_t max_pipe_conversion_bytes = 4u << 20;  ///< and their payload bytes (one larger packet alone still goes)
     std::chrono::milliseconds wire_retry{10};       ///< how often waiting wire values retry
