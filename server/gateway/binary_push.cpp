@@ -63,20 +63,31 @@ Result<void> resolve(nlohmann::json& j, std::string_view arrays, std::size_t dep
 
 }  // namespace
 
-std::string binary_push_message(std::string_view json_text, const std::vector<SharedBytes>& blobs) {
-    const std::size_t base = BinaryArrays::padded(kHeaderBytes + json_text.size());
-    std::size_t total = base;
-    for (const auto& b : blobs) total += BinaryArrays::padded(b.size());
+std::string binary_push_head(std::string_view json_text) {
     std::string out;
-    out.reserve(total);
+    out.reserve(BinaryArrays::padded(kHeaderBytes + json_text.size()));
     out.append(kBinaryPushMagic);
     put_u32(out, static_cast<std::uint32_t>(json_text.size()));
     out.append(json_text);
-    out.resize(base, '\0');
+    out.resize(BinaryArrays::padded(out.size()), '\0');
+    return out;
+}
+
+std::string binary_push_arrays(const std::vector<SharedBytes>& blobs) {
+    std::size_t total = 0;
+    for (const auto& b : blobs) total += BinaryArrays::padded(b.size());
+    std::string out;
+    out.reserve(total);
     for (const auto& b : blobs) {
         out.append(reinterpret_cast<const char*>(b.data()), b.size());
         out.resize(BinaryArrays::padded(out.size()), '\0');
     }
+    return out;
+}
+
+std::string binary_push_message(std::string_view json_text, const std::vector<SharedBytes>& blobs) {
+    std::string out = binary_push_head(json_text);
+    out.append(binary_push_arrays(blobs));
     return out;
 }
 

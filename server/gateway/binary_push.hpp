@@ -25,8 +25,14 @@ namespace rr::server::gateway {
 
 inline constexpr std::string_view kBinaryPushMagic = "RRJB";
 
-/// The message for `json_text` (a push with "$binary" references) and the arrays it refers to.
+/// The message for `json_text` (a push with "$binary" references) and the arrays it refers to:
+/// binary_push_head(json_text) followed by binary_push_arrays(blobs).
 std::string binary_push_message(std::string_view json_text, const std::vector<SharedBytes>& blobs);
+/// The message up to the arrays: magic, length, the JSON text, zero padding to a multiple of 8.
+std::string binary_push_head(std::string_view json_text);
+/// The arrays' part: each array's bytes padded to a multiple of 8, in order (the same for every
+/// subscriber of a value, whose pushes differ only in the head).
+std::string binary_push_arrays(const std::vector<SharedBytes>& blobs);
 
 /// The two parts of a binary message: the JSON text, and the arrays (starting at B, so a reference's
 /// `offset` counts from arrays.data()). Views into `message`. Errors: ProtocolError (no RRJB header,

@@ -786,10 +786,10 @@ private:
     // A push whose body (a JSON object's text, shared by all subscribers) is `r`: a binary message
     // when it refers to arrays, else text.
     void send_push(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, const SharedEntry::BinaryRendering& r) {
-        if (r.arrays.empty())
+        if (!r.arrays)
             socket_->send(push_text(sid, kind, dropped, r.body));
         else
-            socket_->send_binary(binary_push_message(push_text(sid, kind, dropped, r.body), r.arrays));
+            socket_->send_binary(binary_push_head(push_text(sid, kind, dropped, r.body)), r.arrays);
     }
 
     void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
@@ -810,8 +810,9 @@ private:
     static SharedEntry::BinaryRendering render_binary(Body&& body) {
         BinaryArrays arrays;
         nlohmann::json j = body(&arrays);
-        if (j.contains("error")) arrays.blobs.clear();  // made before a later part failed: nothing refers to them
-        return SharedEntry::BinaryRendering{json_text(j), std::move(arrays.blobs)};
+        if (j.contains("error") || arrays.blobs.empty())  // made before a later part failed: nothing refers to them
+            return SharedEntry::BinaryRendering{json_text(j), nullptr};
+        return SharedEntry::BinaryRendering{json_text(j), std::make_shared<const std::string>(binary_push_arrays(arrays.blobs))};
     }
 
     // {"args": {…}} or {"error": …}: the part of an event push every subscriber shares.
@@ -888,14 +889,18 @@ private:
             msg["error"] = error_object(*j.error);
         if (dropped) msg["dropped"] = dropped;
         auto text = json_text(msg);
-        if (!arrays.blobs.empty()) text = binary_push_message(text, arrays.blobs);
+        std::shared_ptr<const std::string> tail;
+        if (!arrays.blobs.empty()) {
+            text = binary_push_head(text);
+            tail = std::make_shared<const std::string>(binary_push_arrays(arrays.blobs));
+        }
         // Under the lock: never after the subscription's "closed" push or its unsubscribe reply.
         std::lock_guard lock(mutex_);
         if (!push_allowed_locked(sid)) return;
-        if (arrays.blobs.empty())
+        if (!tail)
             socket_->send(std::move(text));
         else
-            socket_->send_binary(std::move(text));
+            socket_->send_binary(std::move(text), std::move(tail));
     }
 
     bool push_allowed(std::uint64_t sid) const {

@@ -33,7 +33,9 @@ public:
     /// "$binary" references, and the arrays they refer to.
     struct BinaryRendering {
         std::string body;
-        std::vector<SharedBytes> arrays;
+        /// The binary push's arrays part (binary_push_arrays), written as it is for every subscriber;
+        /// null when the body refers to no arrays (a text push).
+        std::shared_ptr<const std::string> arrays;
     };
     template <class Render>
     const BinaryRendering& rendered_binary(Render&& render) const {

@@ -61,6 +61,12 @@ public:
     /// Queues `bytes` as one binary message (the gateway's binary pushes), in order with send() and
     /// under the same queue limit. Thread-safe.
     virtual void send_binary(std::string bytes) = 0;
+    /// Queues one binary message made of `head` and then `tail`; `tail` is shared, not copied (the
+    /// same arrays go to every subscriber of a value). Thread-safe.
+    virtual void send_binary(std::string head, std::shared_ptr<const std::string> tail) {
+        head.append(*tail);
+        send_binary(std::move(head));
+    }
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;

@@ -3,6 +3,7 @@
 // http_server_tls.cpp. Private to server/http.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <algorithm>
 #include <cstring>
@@ -137,9 +138,12 @@ public:
         read();
     }
 
-    void send(std::string text) override { enqueue(std::move(text), false); }
-    void send_urgent(std::string text) override { enqueue(std::move(text), true); }
-    void send_binary(std::string bytes) override { enqueue(std::move(bytes), false, true); }
+    void send(std::string text) override { enqueue(Outgoing{std::move(text), nullptr, false, false}); }
+    void send_urgent(std::string text) override { enqueue(Outgoing{std::move(text), nullptr, true, false}); }
+    void send_binary(std::string bytes) override { enqueue(Outgoing{std::move(bytes), nullptr, false, true}); }
+    void send_binary(std::string head, std::shared_ptr<const std::string> tail) override {
+        enqueue(Outgoing{std::move(head), std::move(tail), false, true});
+    }
 
     std::size_t queued() const override { return queued_count_.load(); }
     std::size_t queued_bytes() const override { return queued_bytes_.load(); }
@@ -162,17 +166,21 @@ public:
 private:
     struct Outgoing {
         std::string text;
+        /// Bytes after `text` in the same message, shared by every socket it goes to (a binary push's
+        /// arrays: written from one buffer for all subscribers, not copied per socket).
+        std::shared_ptr<const std::string> tail;
         bool urgent = false;
         bool binary = false;
+        std::size_t size() const noexcept { return text.size() + (tail ? tail->size() : 0); }
     };
 
-    void enqueue(std::string text, bool urgent, bool binary = false) {
+    void enqueue(Outgoing out) {
         auto self = shared_from_this();
         queued_count_.fetch_add(1);
-        queued_bytes_.fetch_add(text.size());
-        asio::post(ws_.get_executor(), [self, text = std::move(text), urgent, binary]() mutable {
+        queued_bytes_.fetch_add(out.size());
+        asio::post(ws_.get_executor(), [self, out = std::move(out)]() mutable {
             if (self->closed_) {
-                self->unqueue(text);
+                self->unqueue(out);
                 return;
             }
             auto& q = self->queue_;
@@ -180,14 +188,14 @@ private:
             if (q.size() >= self->limit_ && q.size() > (self->writing_ ? 1u : 0u)) {
                 auto victim = self->first_waiting_push();
                 if (victim == q.end()) victim = q.begin() + (self->writing_ ? 1 : 0);
-                self->unqueue(victim->text);
+                self->unqueue(*victim);
                 q.erase(victim);
                 self->dropped_.fetch_add(1);
             }
-            if (urgent)
-                q.insert(self->first_waiting_push(), Outgoing{std::move(text), true, binary});
+            if (out.urgent)
+                q.insert(self->first_waiting_push(), std::move(out));
             else
-                q.push_back(Outgoing{std::move(text), false, binary});
+                q.push_back(std::move(out));
             self->write();
         });
     }
@@ -237,26 +245,29 @@ private:
         if (writing_ || queue_.empty() || closed_) return;
         writing_ = true;
         auto self = shared_from_this();
-        ws_.binary(queue_.front().binary);  // the message type of the next write
-        ws_.async_write(asio::buffer(queue_.front().text), [self](beast::error_code ec, std::size_t) {
+        const Outgoing& next = queue_.front();
+        ws_.binary(next.binary);  // the message type of the next write
+        const std::array<asio::const_buffer, 2> parts{asio::buffer(next.text),
+                                                      next.tail ? asio::buffer(*next.tail) : asio::const_buffer()};
+        ws_.async_write(parts, [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
             if (ec) {
                 self->finish();
                 while (!self->queue_.empty()) {  // the message whose write just ended, if finish() kept it
-                    self->unqueue(self->queue_.front().text);
+                    self->unqueue(self->queue_.front());
                     self->queue_.pop_front();
                 }
                 return;
             }
-            self->unqueue(self->queue_.front().text);
+            self->unqueue(self->queue_.front());
             self->queue_.pop_front();
             self->write();
         });
     }
 
-    void unqueue(const std::string& text) {
+    void unqueue(const Outgoing& out) {
         queued_count_.fetch_sub(1);
-        queued_bytes_.fetch_sub(text.size());
+        queued_bytes_.fetch_sub(out.size());
     }
 
     void finish() {
@@ -265,7 +276,7 @@ private:
         closed_ = true;
         // A write in flight still reads the front message: it is released when that write completes.
         while (queue_.size() > (writing_ ? 1u : 0u)) {
-            unqueue(queue_.back().text);
+            unqueue(queue_.back());
             queue_.pop_back();
         }
         pacer_.cancel();
