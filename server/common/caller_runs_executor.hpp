@@ -12,6 +12,8 @@
 // Outside a scope, or when the strand is busy, everything behaves as the inner executor does.
 #pragma once
 
+#include <concepts>
+#include <type_traits>
 #include <utility>
 
 #include <boost/asio/any_io_executor.hpp>
@@ -26,7 +28,12 @@ class CallerRunsExecutor {
 public:
     using inner_type = boost::asio::any_io_executor;
 
-    explicit CallerRunsExecutor(inner_type inner) noexcept : inner_(std::move(inner)) {}
+    // Constrained, not a plain converting constructor: checking whether this type is copyable must
+    // not ask whether it converts to any_io_executor, which asks whether it is an executor (clang
+    // reports the recursion as an error).
+    template <class Inner>
+        requires(!std::same_as<std::decay_t<Inner>, CallerRunsExecutor> && std::constructible_from<inner_type, Inner>)
+    explicit CallerRunsExecutor(Inner&& inner) noexcept : inner_(std::forward<Inner>(inner)) {}
 
     /// While alive, the next possibly-blocking execute() of a CallerRunsExecutor on this thread runs
     /// the function inline (once: the scope is used up by it, so work the function starts is not
