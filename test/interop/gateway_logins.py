@@ -400,12 +400,15 @@ devices:
                 wa.Close()
         checks.check("rr: a write-only session sends on a wire but receives nothing on it", rr_write_only)
 
-        def pipe_packets_forwarded():
+        def metric(prefix):
             with urllib.request.urlopen(base + "/metrics", timeout=10) as r:
                 for line in r.read().decode().splitlines():
-                    if line.startswith('rr_gateway_device_pipe_packets_total{device="interop"}'):
+                    if line.startswith(prefix):
                         return float(line.rsplit(" ", 1)[1])
-            raise AssertionError("no rr_gateway_device_pipe_packets_total for interop in /metrics")
+            raise AssertionError("no %s in /metrics" % prefix.strip())
+
+        def pipe_packets_forwarded():
+            return metric('rr_gateway_device_pipe_packets_total{device="interop"}')
 
         def rr_write_only_pipe():
             # The device echoes every p_unreliable packet to the endpoint that sent it. An operator gets
@@ -437,11 +440,7 @@ devices:
         checks.check("rr: a write-only session sends pipe packets but receives none", rr_write_only_pipe)
 
         def denied_total():
-            with urllib.request.urlopen(base + "/metrics", timeout=10) as r:
-                for line in r.read().decode().splitlines():
-                    if line.startswith("rr_gateway_permission_denied_total "):
-                        return float(line.rsplit(" ", 1)[1])
-            raise AssertionError("no rr_gateway_permission_denied_total in /metrics")
+            return metric("rr_gateway_permission_denied_total ")
 
         def rr_read_only_pipes():
             # A viewer (read only) receives what the device sends on a pipe; a packet it sends itself is
