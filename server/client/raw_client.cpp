@@ -3,6 +3,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "server/common/random_ids.hpp"
+#include "server/transport/connection_strand.hpp"
 
 namespace rr::server {
 
@@ -136,7 +137,7 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
     connect.tls_certificate_file = options.tls_certificate_file;
     connect.tls_private_key_file = options.tls_private_key_file;
     connect.http_authorization = options.http_authorization;
-    asio::any_io_executor strand = asio::make_strand(executor);
+    asio::any_io_executor strand = connection_strand(executor);
     transports.connect(strand, url, connect, logic, [logic](Result<std::shared_ptr<PumpHandle>> pump) {
         if (!pump) {
             // Never connected: the session reports the error to the connect handler (and drops it).

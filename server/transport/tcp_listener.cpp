@@ -2,6 +2,7 @@
 
 #include "server/transport/tls/tls_listener.hpp"
 #include "server/common/address_limiter.hpp"
+#include "server/transport/connection_strand.hpp"
 
 #include <array>
 #include <string_view>
@@ -75,7 +76,7 @@ std::vector<std::string> TcpListener::urls() const {
 
 void TcpListener::accept() {
     auto self = shared_from_this();
-    acceptor_.async_accept(asio::make_strand(executor_), [self](boost::system::error_code ec, tcp::socket socket) {
+    acceptor_.async_accept(connection_strand(executor_), [self](boost::system::error_code ec, tcp::socket socket) {
         if (ec == asio::error::operation_aborted || !self->acceptor_.is_open()) return;
         if (!ec) self->detect(std::move(socket));
         self->accept();

@@ -11,6 +11,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "server/common/random_ids.hpp"
+#include "server/transport/connection_strand.hpp"
 #include "server/transport/local/local_layout.hpp"
 
 namespace rr::server::local {
@@ -195,7 +196,7 @@ Result<void> LocalListener::Impl::start(LocalListenOptions options, std::optiona
 
 void LocalListener::Impl::accept() {
     auto self_ref = shared_from_this();
-    acceptor_.async_accept(asio::make_strand(acceptor_.get_executor()),
+    acceptor_.async_accept(connection_strand(acceptor_.get_executor()),
                            [self = std::move(self_ref)](boost::system::error_code ec, unix_socket::socket socket) {
                                if (ec == asio::error::operation_aborted) return;
                                if (ec) {
