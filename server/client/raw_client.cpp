@@ -3,7 +3,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "server/common/random_ids.hpp"
-#include "server/transport/connection_strand.hpp"
+#include "server/common/connection_strand.hpp"
 
 namespace rr::server {
 

@@ -2,7 +2,7 @@
 
 #include "server/transport/tls/tls_listener.hpp"
 #include "server/common/address_limiter.hpp"
-#include "server/transport/connection_strand.hpp"
+#include "server/common/connection_strand.hpp"
 
 #include <array>
 #include <string_view>

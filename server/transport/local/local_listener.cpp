@@ -11,7 +11,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "server/common/random_ids.hpp"
-#include "server/transport/connection_strand.hpp"
+#include "server/common/connection_strand.hpp"
 #include "server/transport/local/local_layout.hpp"
 
 namespace rr::server::local {
