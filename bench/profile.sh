@@ -42,7 +42,7 @@ kill -TERM "$svc"; wait "$svc" || true; svc=""
 if command -v strace > /dev/null; then
   "$BUILD/bench/rr_bench_service" --memory-mib 0.01 --threads 2 > "$tmp/ready2" &
   plain=$!
-  for _ in $(seq 1 100); do [ -s "$tmp/ready2" ] && break; sleep 0.1; done
+  for _ in $(seq 1 600); do [ -s "$tmp/ready2" ] && break; sleep 0.1; done
   url2=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/ready2")
   "$BUILD/bench/rr_bench_client" --url "$url2" --count 200 --ops nop > /dev/null
   strace -f -c -o "$tmp/strace.txt" -p "$plain" 2> /dev/null &
@@ -83,7 +83,7 @@ annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[
 # Gateway fan-out.
 "$BUILD/bench/rr_bench_service" --tick-hz 100 --memory-mib 0.01 > "$tmp/dev" &
 dev=$!
-for _ in $(seq 1 100); do [ -s "$tmp/dev" ] && break; sleep 0.1; done
+for _ in $(seq 1 600); do [ -s "$tmp/dev" ] && break; sleep 0.1; done
 durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/dev")
 valgrind --tool=callgrind --callgrind-out-file="$tmp/gw.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local --port 0 \
   --log-level warning --device "bench=$durl" > "$tmp/gw" 2>> "$tmp/valgrind.log" &
