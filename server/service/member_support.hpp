@@ -54,7 +54,16 @@ inline Result<MessageElement> pack_member(const MemberInfo& info, const Value& v
 /// `return` for a function/generator/callback reply: int32 0 for void (CORE's convention), else the
 /// value packed with `type`.
 inline Result<MessageElement> pack_return(const MemberInfo& info, const Value& v, const robdef::TypeDefinition& type) {
-    if (type.is_void()) return make_scalar_element<std::int32_t>("return", 0);
+    if (type.is_void()) {
+        // CORE answers a void function with an int32 0 named "return"; its bytes are a constant, so a
+        // reply allocates nothing for them (issue 14).
+        static constexpr std::byte kZero[sizeof(std::int32_t)]{};
+        MessageElement e;
+        e.name = "return";
+        e.type = DataTypes::int32_t;
+        e.data = SharedBytes(nullptr, kZero);  // static bytes: no owner to keep alive
+        return e;
+    }
     return pack_member(info, v, type, "return");
 }
 
