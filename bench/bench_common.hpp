@@ -15,6 +15,15 @@
 
 namespace rr::bench {
 
+/// Raises this process's open-file limit to its hard limit (a load generator holding 1,000 sockets
+/// needs more than the usual soft limit of 1,024).
+inline void raise_fd_limit() {
+    rlimit r{};
+    getrlimit(RLIMIT_NOFILE, &r);
+    r.rlim_cur = r.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &r);
+}
+
 /// Wall clock in µs since the epoch (comparable across processes on one host).
 inline double wall_clock_us() {
     return std::chrono::duration<double, std::micro>(std::chrono::system_clock::now().time_since_epoch()).count();

@@ -14,7 +14,6 @@
 #include <iostream>
 #include <mutex>
 
-#include <sys/resource.h>
 
 #include "bench/bench_common.hpp"
 #include "server/client/client.hpp"
@@ -38,13 +37,6 @@ struct Shared {
     std::size_t with_value = 0;
     std::atomic<bool> measuring{false};
 };
-
-void raise_fd_limit() {
-    rlimit r{};
-    getrlimit(RLIMIT_NOFILE, &r);
-    r.rlim_cur = r.rlim_max;
-    setrlimit(RLIMIT_NOFILE, &r);
-}
 
 }  // namespace
 
@@ -75,7 +67,7 @@ int main(int argc, char** argv) {
         std::cerr << "need --url\n";
         return 2;
     }
-    raise_fd_limit();
+    bench::raise_fd_limit();
 
     // Declared before the IO threads, so that handlers still running at exit find them.
     Shared shared;

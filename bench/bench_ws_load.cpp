@@ -25,7 +25,6 @@
 #include <string>
 #include <thread>
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <boost/asio/connect.hpp>
@@ -188,13 +187,6 @@ private:
     std::uint64_t delivered_ = 0;
 };
 
-void raise_fd_limit() {
-    rlimit r{};
-    getrlimit(RLIMIT_NOFILE, &r);
-    r.rlim_cur = r.rlim_max;
-    setrlimit(RLIMIT_NOFILE, &r);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -228,7 +220,7 @@ int main(int argc, char** argv) {
         std::cerr << "need --port and a mode (fanout | idle)\n";
         return 2;
     }
-    raise_fd_limit();
+    rr::bench::raise_fd_limit();
 
     asio::io_context io;
     Stats stats;
