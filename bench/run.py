@@ -66,10 +66,8 @@ class Proc:
 
 
 def run_rows(argv, timeout=300):
-    out = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=timeout)
-    if out.returncode != 0:
-        log("FAILED (%d): %s\n%s" % (out.returncode, " ".join(argv), out.stderr[-2000:]))
-    return [json.loads(l) for l in out.stdout.splitlines() if l.startswith("{")]
+    """The JSON lines a bench program prints (run_timed without the times)."""
+    return [row for row, _ in run_timed(argv, timeout)]
 
 
 def proc_sample(pid):
@@ -198,7 +196,9 @@ def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False):
 
 
 def run_timed(argv, timeout=600):
-    """run_rows, with the wall-clock time each JSON line arrived (a row's measuring window ends there)."""
+    """The JSON lines a bench program prints, each with the wall-clock time it arrived (a row's
+    measuring window ends there). A program still running after `timeout` s is killed; a failure is
+    logged and its rows so far are kept."""
     p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     rows = []
     timer = threading.Timer(timeout, p.kill)
