@@ -52,9 +52,14 @@ TEST_CASE("pipes: connect, echo with packet numbers and acks, service close, dis
         p->on_packet([seen](const std::shared_ptr<PipeEndpoint>& ep, Value v) {
             // No REQUIRE here: this runs on a node io thread and Catch2 v2 assertions are not thread-safe
             // (TSan reported the race on Catch's RunContext); the test thread checks echo_failures.
+            // Recorded before the echo goes out: the echo is written to the socket at once (the pump
+            // writes directly), so the test thread may see it before this handler returns.
+            {
+                std::lock_guard lock(seen->m);
+                seen->packets.emplace_back(ep->index(), v);
+            }
             const bool sent = static_cast<bool>(ep->send(v));  // echo
             std::lock_guard lock(seen->m);
-            seen->packets.emplace_back(ep->index(), v);
             if (!sent) ++seen->echo_failures;
         });
         p->on_ack([seen](const std::shared_ptr<PipeEndpoint>&, std::uint32_t n) {
