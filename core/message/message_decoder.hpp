@@ -22,7 +22,9 @@ public:
     /// Header of the message (both versions); `body` is left over the entry bytes.
     Result<MessageHeaderInfo> read_header(ByteReader& body);
     /// Entries after the header; `body` must end exactly after the last one.
-    Result<std::vector<MessageEntry>> read_entries(const MessageHeaderInfo& info, ByteReader& body);
+    /// The entries, decoded into `entries` (cleared first; its capacity is reused).
+    Result<std::vector<MessageEntry>> read_entries(const MessageHeaderInfo& info, ByteReader& body,
+                                                   std::vector<MessageEntry> entries = {});
 
 private:
     // v2 (message_reader_v2.cpp)

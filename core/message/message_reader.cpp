@@ -34,11 +34,16 @@ Result<MessageHeaderInfo> decode_message_header(std::span<const std::byte> messa
 }
 
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context) {
+    return decode_message(std::move(buffer), limits, context, {});
+}
+
+Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context,
+                               std::vector<MessageEntry> storage) {
     detail::MessageDecoder decoder(buffer.bytes(), &buffer, limits, context);
     ByteReader body;
     auto info = decoder.read_header(body);
     if (!info) return info.take_error();
-    auto entries = decoder.read_entries(*info, body);
+    auto entries = decoder.read_entries(*info, body, std::move(storage));
     if (!entries) return entries.take_error();
     Message m;
     m.version = info->version;
@@ -74,8 +79,9 @@ Result<MessageHeaderInfo> MessageDecoder::read_header(ByteReader& body) {
     return info;
 }
 
-Result<std::vector<MessageEntry>> MessageDecoder::read_entries(const MessageHeaderInfo& info, ByteReader& body) {
-    std::vector<MessageEntry> entries;
+Result<std::vector<MessageEntry>> MessageDecoder::read_entries(const MessageHeaderInfo& info, ByteReader& body,
+                                                               std::vector<MessageEntry> entries) {
+    entries.clear();
     if (info.entry_count > limits_.max_entries)
         return error(MessageErrorType::BufferLimitViolation, body,
                      std::to_string(info.entry_count) + " entries over limit " + std::to_string(limits_.max_entries));

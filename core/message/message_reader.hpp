@@ -81,5 +81,9 @@ Result<MessageHeaderInfo> decode_message_header(std::span<const std::byte> messa
 /// Element payloads in the result are views into `buffer`: no copy. `context` fills the v4 header
 /// fields a sender omitted (all-zero NodeIDs and endpoints when null).
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits = {}, const DecodeContext* context = nullptr);
+/// As above, decoding the entries into `storage` (cleared first; its capacity is reused, e.g. a vector
+/// from an EntryVectorPool, core/message/entry_vector_pool.hpp).
+Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context,
+                               std::vector<MessageEntry> storage);
 
 }  // namespace rr

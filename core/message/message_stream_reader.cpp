@@ -26,9 +26,32 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
             auto size = read_message_preamble(preamble_, limits_);
             if (!size) return stop(size.error());
             expected_ = *size;
-            body_.reserve(std::min(expected_, kInitialBufferBytes));
-            body_.assign(preamble_.begin(), preamble_.end());
             preamble_fill_ = 0;
+#if defined(__cpp_lib_smart_ptr_for_overwrite)
+            if (expected_ <= kInitialBufferBytes) {
+                // Small message: its final buffer at once, bytes and reference count in one allocation.
+                frame_ = std::make_shared_for_overwrite<std::byte[]>(expected_);
+                std::copy(preamble_.begin(), preamble_.end(), frame_.get());
+                frame_fill_ = kMessagePreambleBytes;
+            }
+#endif
+            if (!frame_) {
+                body_.reserve(std::min(expected_, kInitialBufferBytes));
+                body_.assign(preamble_.begin(), preamble_.end());
+            }
+        }
+        if (frame_) {
+            const std::size_t n = std::min(bytes.size(), expected_ - frame_fill_);
+            std::copy_n(bytes.begin(), n, frame_.get() + frame_fill_);
+            frame_fill_ += n;
+            bytes = bytes.subspan(n);
+            if (frame_fill_ == expected_) {
+                std::span<const std::byte> view(frame_.get(), expected_);
+                ready_.emplace_back(std::shared_ptr<const void>(std::move(frame_)), view);
+                frame_fill_ = 0;
+                expected_ = 0;
+            }
+            continue;
         }
         const std::size_t n = std::min(bytes.size(), expected_ - body_.size());
         if (body_.size() + n > body_.capacity()) {

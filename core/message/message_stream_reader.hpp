@@ -8,9 +8,10 @@
 //
 // Limits: the magic is checked as soon as its bytes arrive; MessageSize is checked against
 // kMinMessageSize and Limits::max_message_size right after the preamble, before any buffer for the
-// message is allocated. The buffer then grows with the bytes that actually arrive (first up to
-// 64 KiB, then doubling, and to MessageSize once a quarter of it has arrived), so a peer cannot make
-// the reader allocate more than 4 × what it has sent.
+// message is allocated. A message up to 64 KiB gets its final buffer at once (one allocation with
+// its reference count). A larger one grows with the bytes that actually arrive (first 64 KiB, then
+// doubling, and to MessageSize once a quarter of it has arrived), so a peer cannot make the reader
+// allocate more than 64 KiB or 4 × what it has sent.
 // Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
 // below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
 // over the limit, or a decode limit). After the first error every call fails with that error and no
@@ -20,6 +21,7 @@
 #include <array>
 #include <cstddef>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -53,9 +55,9 @@ public:
     /// Number of complete messages waiting.
     std::size_t ready_count() const noexcept { return ready_.size(); }
     /// Bytes of the message being assembled (0 between messages).
-    std::size_t partial_bytes() const noexcept { return preamble_fill_ + body_.size(); }
+    std::size_t partial_bytes() const noexcept { return preamble_fill_ + (frame_ ? frame_fill_ : body_.size()); }
     /// Bytes allocated for the message being assembled (for per-connection memory accounting).
-    std::size_t partial_capacity() const noexcept { return body_.capacity(); }
+    std::size_t partial_capacity() const noexcept { return frame_ ? expected_ : body_.capacity(); }
     bool failed() const noexcept { return error_.has_value(); }
     /// The error that stopped the reader, or nullptr.
     const RRError* error() const noexcept { return error_ ? &*error_ : nullptr; }
@@ -69,7 +71,9 @@ private:
     std::array<std::byte, kMessagePreambleBytes> preamble_{};
     std::size_t preamble_fill_ = 0;
     std::size_t expected_ = 0;        // MessageSize of the message in body_, 0 while reading a preamble
-    std::vector<std::byte> body_;     // the whole message being assembled, preamble included
+    std::vector<std::byte> body_;     // a message over kInitialBufferBytes being assembled, preamble included
+    std::shared_ptr<std::byte[]> frame_;  // a message up to kInitialBufferBytes being assembled (its final buffer)
+    std::size_t frame_fill_ = 0;
     std::deque<SharedBytes> ready_;
     std::optional<RRError> error_;
 };

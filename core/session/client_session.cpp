@@ -137,6 +137,7 @@ void ClientSession::on_stream_event(StreamEvent&& ev, MonoTime now) {
 
 Result<void> ClientSession::send_special(MessageEntry entry, MonoTime now, std::uint32_t receiver_endpoint) {
     Message m;
+    m.entries = stream_.entry_vectors().take();
     m.version = 2;
     m.header.sender_node_id = config_.stream.local_node_id;
     m.header.sender_node_name = config_.stream.local_node_name;
@@ -152,6 +153,7 @@ Result<void> ClientSession::send_special(MessageEntry entry, MonoTime now, std::
 
 Result<void> ClientSession::send_session(MessageEntry entry, MonoTime now) {
     Message m;
+    m.entries = stream_.entry_vectors().take();
     m.version = 2;
     m.header.sender_node_id = config_.stream.local_node_id;
     m.header.receiver_node_id = stream_.negotiated().remote_node_id;
@@ -293,6 +295,11 @@ void ClientSession::on_connect_reply(MessageEntry&& e, const MessageHeader& h, M
 }
 
 void ClientSession::on_message(Message&& m, MonoTime now) {
+    on_entries(m, now);
+    stream_.entry_vectors().give(std::move(m.entries));
+}
+
+void ClientSession::on_entries(Message& m, MonoTime now) {
     for (auto& e : m.entries) {
         const bool connecting = state_ == State::combined_connect || state_ == State::legacy_servicedesc ||
                                 state_ == State::legacy_objecttype || state_ == State::legacy_connect ||

@@ -143,6 +143,7 @@ private:
 
     void on_stream_event(StreamEvent&& ev, MonoTime now);
     void on_message(Message&& m, MonoTime now);
+    void on_entries(Message& m, MonoTime now);
     void on_connect_reply(MessageEntry&& e, const MessageHeader& h, MonoTime now);
     void start_connect(MonoTime now);
     Result<void> send_special(MessageEntry entry, MonoTime now, std::uint32_t receiver_endpoint = 0);

@@ -143,6 +143,7 @@ Message ServiceSession::session_message(MessageEntry entry) {
     m.header.receiver_endpoint = client_endpoint_;
     m.header.message_id = ++message_id_;
     if (entry.metadata == "unreliable\n") m.header.metadata = entry.metadata;
+    m.entries = stream_.entry_vectors().take();
     m.entries.push_back(std::move(entry));
     return m;
 }
@@ -225,6 +226,11 @@ void ServiceSession::reply_special(const MessageHeader& request_header, MessageE
 
 void ServiceSession::on_message(Message&& m, MonoTime now) {
     ++messages_in_;
+    on_entries(m, now);
+    stream_.entry_vectors().give(std::move(m.entries));
+}
+
+void ServiceSession::on_entries(Message& m, MonoTime now) {
     for (auto& e : m.entries) {
         if (stream_.is_closed()) return;
         const auto type = e.entry_type;

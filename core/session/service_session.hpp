@@ -165,6 +165,7 @@ private:
 
     void drain_stream(MonoTime now);
     void on_message(Message&& m, MonoTime now);
+    void on_entries(Message& m, MonoTime now);
     void handle_special(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void handle_session_entry(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void handle_session_op(MessageEntry&& e, MonoTime now);

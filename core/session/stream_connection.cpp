@@ -80,7 +80,7 @@ Result<void> StreamConnection::feed(std::span<const std::byte> bytes, MonoTime n
 
 Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
     DecodeContext ctx = decode_context();
-    auto decoded = decode_message(frame, config_.limits, &ctx);
+    auto decoded = decode_message(frame, config_.limits, &ctx, entry_vectors_.take());
     if (!decoded) return decoded.take_error();
     Message& m = *decoded;
     if (m.entries.empty()) return {};  // legal, nothing to do
@@ -92,7 +92,9 @@ Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
     if (transport_entry) {
         if (m.entries.size() != 1)
             return fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
-        return handle_transport_entry(m, first, now);
+        auto handled = handle_transport_entry(m, first, now);
+        entry_vectors_.give(std::move(m.entries));
+        return handled;
     }
     if (state_ != State::connected)
         return fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
@@ -315,7 +317,9 @@ Result<void> StreamConnection::send_frame(std::span<const std::byte> frame, Mono
 Result<void> StreamConnection::send(Message&& message, MonoTime now) {
     if (state_ != State::connected)
         return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
-    return queue_owned(message, send_version(), now, true);
+    auto queued = queue_owned(message, send_version(), now, true);
+    entry_vectors_.give(std::move(message.entries));
+    return queued;
 }
 
 // v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this

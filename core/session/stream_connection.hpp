@@ -26,6 +26,7 @@
 #include "core/codec/limits.hpp"
 #include "core/message/message.hpp"
 #include "core/message/message_reader.hpp"
+#include "core/message/entry_vector_pool.hpp"
 #include "core/message/message_stream_reader.hpp"
 
 namespace rr {
@@ -108,7 +109,8 @@ public:
     /// the limit (512 KiB until set_session_established(), then max_message_size − 100 as CORE).
     Result<void> send(const Message& message, MonoTime now);
     /// The same for a message the caller gives up: its format fields are set in place (no copy of
-    /// its elements when the format or routing flags differ from what it carries).
+    /// its elements when the format or routing flags differ from what it carries), and its entry
+    /// vector goes back to entry_vectors() once encoded.
     Result<void> send(Message&& message, MonoTime now);
     /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
     Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);
@@ -138,6 +140,11 @@ public:
     DecodeContext decode_context() const noexcept;
     std::uint16_t send_version() const noexcept { return negotiated_.message4 ? 4 : 2; }
 
+    /// Entry vectors of this connection's messages for reuse: received messages are decoded into one
+    /// taken from here; a session gives a received message's vector back once it has handled the
+    /// entries, and takes one for each message it builds to send (no allocation per call).
+    EntryVectorPool& entry_vectors() noexcept { return entry_vectors_; }
+
 private:
     enum class State : std::uint8_t { negotiating, connected, closed };
 
@@ -162,6 +169,7 @@ private:
     State state_ = State::negotiating;
     StreamConnected negotiated_;
     MessageStreamReader reader_;
+    EntryVectorPool entry_vectors_;
     std::vector<std::byte> output_;
     std::size_t output_offset_ = 0;
     EventQueue<StreamEvent> events_;

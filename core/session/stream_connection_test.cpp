@@ -238,3 +238,51 @@ TEST_CASE("StreamCheckCapability is answered as CORE does") {
     CHECK_FALSE(next_event<StreamMessage>(client));
     CHECK(client.is_connected());
 }
+
+TEST_CASE("a connection reuses the entry vectors of the messages it sends and receives") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    client.set_session_established(5, 9);
+    server.set_session_established(9, 5);
+    auto message = [](std::uint32_t request_id) {
+        Message m;
+        m.header.sender_node_id = kClientId;
+        m.header.receiver_node_id = kServerId;
+        m.header.sender_endpoint = 5;
+        m.header.receiver_endpoint = 9;
+        MessageEntry e;
+        e.entry_type = MessageEntryType::FunctionCallReq;
+        e.service_path = "svc";
+        e.member_name = "f";
+        e.request_id = request_id;
+        m.entries.push_back(std::move(e));
+        return m;
+    };
+
+    // A message given up to send(): its entry vector is kept once it is encoded.
+    Message first = message(1);
+    const MessageEntry* storage = first.entries.data();
+    const std::size_t kept = client.entry_vectors().size();  // the handshake's reply left one too
+    REQUIRE(client.send(std::move(first), t0));
+    CHECK(first.entries.empty());
+    CHECK(client.entry_vectors().size() == kept + 1);
+
+    // The next message built with a kept vector uses that storage, and still arrives whole.
+    Message second = message(2);
+    second.entries = client.entry_vectors().take();
+    CHECK(second.entries.data() == storage);
+    second.entries.push_back(message(2).entries.front());
+    REQUIRE(client.send(std::move(second), t0));
+    REQUIRE(server.feed(drain(client), t0));
+    std::vector<std::uint32_t> ids;
+    while (auto got = next_event<StreamMessage>(server)) {
+        REQUIRE(got->message.entries.size() == 1);
+        ids.push_back(got->message.entries.front().request_id);
+        // Handed back after handling: the next received message is decoded into it.
+        server.entry_vectors().give(std::move(got->message.entries));
+    }
+    CHECK(ids == std::vector<std::uint32_t>{1, 2});
+    CHECK(server.entry_vectors().size() == 2);
+}

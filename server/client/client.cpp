@@ -3,6 +3,7 @@
 #include <map>
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/strand.hpp>
 
 #include "core/message/error_entry.hpp"
 #include "server/common/random_ids.hpp"
@@ -68,6 +69,22 @@ public:
     std::function<void(const RRError&)> user_closed;  // strand only
 };
 
+namespace {
+
+// The io_context executor under `executor` (itself, or the inner executor of a strand of it).
+std::optional<asio::io_context::executor_type> io_context_executor(const asio::any_io_executor& executor) {
+    if (const auto* io = executor.target<asio::io_context::executor_type>()) return *io;
+    if (const auto* strand = executor.target<asio::strand<asio::io_context::executor_type>>())
+        return strand->get_inner_executor();
+    if (const auto* strand = executor.target<asio::strand<asio::any_io_executor>>()) {
+        const asio::any_io_executor inner = strand->get_inner_executor();
+        if (const auto* io = inner.target<asio::io_context::executor_type>()) return *io;
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 void Client::connect(asio::any_io_executor executor, std::string_view url_text, ClientOptions options,
                      ConnectHandler done) {
     auto url = parse_connection_url(url_text);
@@ -77,6 +94,10 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     const server::TransportRegistry& transports = options.transports ? *options.transports : server::default_transports();
     if (!transports.find(url->scheme))
         return done(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
+    auto io = io_context_executor(executor);
+    if (!io)
+        return done(fail(MessageErrorType::InvalidArgument,
+                         "the client's executor is neither an io_context's executor nor a strand of one"));
 
     ClientContextConfig cfg;
     cfg.session.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
@@ -108,7 +129,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     cfg.memory_max_transfer_size = options.memory_max_transfer_size;
 
     std::shared_ptr<Client> client(new Client());
-    client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(executor)));
+    client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(*io)));
     client->wait_limit_ = options.request_timeout + 5s;
     auto logic = std::make_shared<Logic>(std::move(cfg));
     client->logic_ = logic;

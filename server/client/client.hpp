@@ -108,7 +108,9 @@ public:
     using ConnectHandler = std::function<void(Result<std::shared_ptr<Client>>)>;
 
     /// Connects to `url` (must name a service) and establishes the client session; `done` runs on the
-    /// connection's strand (or at once for a bad URL / unknown scheme).
+    /// connection's strand (or at once for a bad URL / unknown scheme). `executor` is an io_context's
+    /// executor or a strand of one (InvalidArgument otherwise): the connection gets its own strand of
+    /// that io_context.
     static void connect(boost::asio::any_io_executor executor, std::string_view url, ClientOptions options,
                         ConnectHandler done);
     /// Blocking connect. Errors: those of the transport and of the connect exchange.

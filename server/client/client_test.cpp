@@ -8,6 +8,9 @@
 #include <thread>
 #include <vector>
 
+#include <boost/asio/strand.hpp>
+#include <boost/asio/thread_pool.hpp>
+
 #include "server/client/client.hpp"
 #include "server/transport/tcp_listener.hpp"
 #include "server/transport/websocket_connector.hpp"
@@ -171,6 +174,19 @@ TEST_CASE("client: connect errors") {
     o.connect_timeout = 2000ms;
     CHECK(Client::connect(f.io.executor(), "rr+tcp://127.0.0.1:1/?service=svc", o).error().type ==
           MessageErrorType::ConnectionError);
+}
+
+TEST_CASE("client: the executor is an io_context's or a strand of one") {
+    Fixture f;
+    auto on_strand = Client::connect(boost::asio::make_strand(f.io.executor()), f.url(), {});
+    REQUIRE(on_strand);
+    CHECK((*on_strand)->root().type() == "example.rawtest.Obj");
+    REQUIRE((*on_strand)->close_wait());
+    boost::asio::thread_pool pool(1);
+    auto other = Client::connect(pool.get_executor(), f.url(), {});
+    REQUIRE_FALSE(other);
+    CHECK(other.error().type == MessageErrorType::InvalidArgument);
+    pool.join();
 }
 
 TEST_CASE("client: transports are pluggable by URL scheme") {
