@@ -169,13 +169,11 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
 Result<std::shared_ptr<Client>> Client::connect(asio::any_io_executor executor, std::string_view url,
                                                 ClientOptions options) {
     auto timeout = options.connect_timeout + options.request_timeout + 5s;
-    auto w = std::make_shared<detail::SyncWaiter<std::shared_ptr<Client>>>();
-    auto f = w->promise.get_future();
-    connect(executor, url, std::move(options), [w](Result<std::shared_ptr<Client>> r) { w->set(std::move(r)); });
-    w.reset();
-    if (f.wait_for(timeout) != std::future_status::ready)
-        return fail(MessageErrorType::ConnectionError, "connect timed out");
-    return f.get();
+    auto waiter = std::make_shared<detail::SyncWaiter<std::shared_ptr<Client>>>();
+    connect(executor, url, std::move(options), detail::SyncCompletion<std::shared_ptr<Client>>(waiter));
+    auto r = waiter->wait_for(timeout);
+    if (!r) return fail(MessageErrorType::ConnectionError, "connect timed out");
+    return std::move(*r);
 }
 
 Client::~Client() {

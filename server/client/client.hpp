@@ -315,36 +315,70 @@ private:
 // --- Client::wait / query ----------------------------------------------------------------------
 
 namespace detail {
-/// Holds the promise of a blocking call; fails it with ConnectionError when dropped unanswered.
+/// The result of a blocking call, waited for by the caller (one allocation; std::promise takes two).
 template <class T>
-struct SyncWaiter {
-    std::promise<Result<T>> promise;
-    std::atomic<bool> done{false};
+class SyncWaiter {
+public:
+    /// The first result counts; later ones are ignored.
     void set(Result<T> r) {
-        if (!done.exchange(true)) promise.set_value(std::move(r));
+        {
+            std::lock_guard lock(mutex_);
+            if (result_) return;
+            result_.emplace(std::move(r));
+            answered_.store(true, std::memory_order_release);
+        }
+        ready_.notify_one();
     }
-    ~SyncWaiter() {
-        if (!done.exchange(true))
-            promise.set_value(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    bool answered() const noexcept { return answered_.load(std::memory_order_acquire); }
+    /// The result, or nullopt when none came within `limit`.
+    std::optional<Result<T>> wait_for(std::chrono::steady_clock::duration limit) {
+        std::unique_lock lock(mutex_);
+        if (!ready_.wait_for(lock, limit, [this] { return result_.has_value(); })) return std::nullopt;
+        return std::move(result_);
     }
+    std::atomic<int> completions{0};  // live SyncCompletion copies
+
+private:
+    std::mutex mutex_;
+    std::condition_variable ready_;
+    std::optional<Result<T>> result_;
+    std::atomic<bool> answered_{false};
+};
+
+/// The completion a blocking call hands to the strand. When its last copy is dropped unanswered
+/// (the connection closed first), the call fails with ConnectionError.
+template <class T>
+class SyncCompletion {
+public:
+    explicit SyncCompletion(std::shared_ptr<SyncWaiter<T>> waiter) : waiter_(std::move(waiter)) { ++waiter_->completions; }
+    SyncCompletion(const SyncCompletion& other) : waiter_(other.waiter_) { ++waiter_->completions; }
+    SyncCompletion(SyncCompletion&& other) noexcept : waiter_(std::move(other.waiter_)) {}
+    SyncCompletion& operator=(const SyncCompletion&) = delete;
+    SyncCompletion& operator=(SyncCompletion&&) = delete;
+    ~SyncCompletion() {
+        if (waiter_ && --waiter_->completions == 0 && !waiter_->answered())
+            waiter_->set(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    }
+    void operator()(Result<T> r) const { waiter_->set(std::move(r)); }
+
+private:
+    std::shared_ptr<SyncWaiter<T>> waiter_;
 };
 }  // namespace detail
 
 template <class T>
 Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T>)> start) {
     if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
-    auto w = std::make_shared<detail::SyncWaiter<T>>();
-    auto f = w->promise.get_future();
+    auto waiter = std::make_shared<detail::SyncWaiter<T>>();
     {
         server::CallerRunsExecutor::Scope caller_runs;
-        run([w, start = std::move(start)](ClientContext& ctx, MonoTime now) {
-            start(ctx, now, [w](Result<T> r) { w->set(std::move(r)); });
+        run([done = detail::SyncCompletion<T>(waiter), start = std::move(start)](ClientContext& ctx, MonoTime now) {
+            start(ctx, now, done);
         });
     }
-    w.reset();
-    if (f.wait_for(wait_limit_) != std::future_status::ready)
-        return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");
-    return f.get();
+    auto r = waiter->wait_for(wait_limit_);
+    if (!r) return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");
+    return std::move(*r);
 }
 
 template <class T>

@@ -189,6 +189,34 @@ TEST_CASE("client: the executor is an io_context's or a strand of one") {
     pool.join();
 }
 
+TEST_CASE("client: a blocking call's completion fails it when dropped unanswered, and only then") {
+    using rr::client::detail::SyncCompletion;
+    using rr::client::detail::SyncWaiter;
+    {
+        auto waiter = std::make_shared<SyncWaiter<int>>();
+        CHECK_FALSE(waiter->wait_for(1ms));  // nothing yet: the wait times out
+        {
+            rr::Completion<int> held = SyncCompletion<int>(waiter);
+            auto copy = held;
+            held = nullptr;
+            CHECK_FALSE(waiter->answered());  // a copy is still alive
+        }
+        auto r = waiter->wait_for(0ms);
+        REQUIRE(r);
+        REQUIRE_FALSE(*r);
+        CHECK(r->error().type == MessageErrorType::ConnectionError);
+    }
+    {
+        auto waiter = std::make_shared<SyncWaiter<int>>();
+        std::thread answer([done = SyncCompletion<int>(waiter)] { done(5); });
+        auto r = waiter->wait_for(10s);
+        answer.join();
+        REQUIRE(r);
+        REQUIRE(*r);
+        CHECK(**r == 5);
+    }
+}
+
 TEST_CASE("client: transports are pluggable by URL scheme") {
     Fixture f;
     // A scheme the URL parser knows but no built-in transport serves, in a registry of this test's own.
