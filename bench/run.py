@@ -10,6 +10,10 @@ Every figure is measured in the same run as its reference and reported with the 
 Latency rows run in R interleaved rounds (floor, ours, official, ... repeated) and report the median
 of the rounds' medians: single runs drift by about ±25 % on these machines (../shared/BENCHMARKING.md).
 
+Each JSON fan-out row is followed by its floor (rr_bench_floor --fanout N): the same N x 100 messages/s of
+the same size written by one thread to N plain loopback TCP sockets, no protocol: the kernel's own cost
+for the traffic, which the gateway's CPU per value is compared with.
+
 Issue 14's rows, off unless asked for (--rr-fanout, --camera, --browser, or --only SECTIONS):
   * rr-fanout: N native RR clients (rr_bench_rr_fanout) on the device's Ticks wire at 100 Hz through
     the gateway over rr+ws, and the same N directly on the device (the reference of the same moment);
@@ -527,6 +531,12 @@ def main(argv=None):
                         if w:
                             row["gateway_cpu_pct"], row["gateway_rss_kib"] = w["cpu_pct"], w["rss_kib_max"]
                         row["wall_s"] = t1 - t0
+                        # The floor of the same moment: the same N x 100 Hz messages of the same size written
+                        # to N plain loopback TCP sockets by one thread, no protocol (rr_bench_floor --fanout).
+                        floor = run_rows([exe["rr_bench_floor"], "--fanout", str(n), "--seconds", "3" if args.quick else "5",
+                                          "--hz", "100", "--bytes", str(max(16, int(round(row.get("bytes_per_value") or 128))))])
+                        if floor:
+                            row["floor"] = floor[0]
                         fanout.append(row)
         for p in reversed(procs):
             p.stop()
@@ -696,15 +706,21 @@ def markdown(res):
             out.append("| %s | %.3f | %s |" % (g["path"], g["ns_per_byte"], fmt(g["intercept_us"])))
     if res["fanout"]:
         out += ["", "Fan-out: one device wire at 100 Hz → gateway → N JSON WebSocket clients (rr-gateway.json.v1); "
-                "latency from the device's stamp to the client's arrival:", "",
-                "| clients | delivered/s | expected/s | delivered of sent | p50 µs | p99 µs | max µs | gateway CPU % | gateway RSS MiB | load generator CPU % |",
-                "|---|---|---|---|---|---|---|---|---|---|"]
+                "latency from the device's stamp to the client's arrival. Floor: right after each row, one thread writes "
+                "the same N × 100 messages/s of the same size to N plain loopback TCP sockets and another reads them "
+                "(`rr_bench_floor --fanout`, no protocol): its writer's CPU is what the kernel alone charges a sender "
+                "for this traffic:", "",
+                "| clients | delivered/s | expected/s | delivered of sent | p50 µs | p99 µs | max µs | gateway CPU % | gateway CPU µs / value | gateway RSS MiB | load generator CPU % | floor: writer CPU % | floor: writer CPU µs / value | floor: p99 µs |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for f in res["fanout"]:
-            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            fl = f.get("floor") or {}
+            per_value = (10000 * f["gateway_cpu_pct"] / f["delivered_per_s"]) if f.get("gateway_cpu_pct") and f.get("delivered_per_s") else None
+            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 fmt(f["clients"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
                 "%.1f %%" % (100 * f.get("delivered_of_sent", 0)), fmt(f["p50_us"]), fmt(f["p99_us"]),
-                fmt(f["max_us"]), fmt(f.get("gateway_cpu_pct")), fmt(f.get("gateway_rss_kib", 0) / 1024),
-                fmt(f["loadgen_cpu_pct"])))
+                fmt(f["max_us"]), fmt(f.get("gateway_cpu_pct")), fmt(per_value), fmt(f.get("gateway_rss_kib", 0) / 1024),
+                fmt(f["loadgen_cpu_pct"]), fmt(fl.get("writer_cpu_pct")), fmt(fl.get("writer_cpu_us_per_value")),
+                fmt(fl.get("p99_us"))))
     if res["scale"]:
         out += ["", "Scale: idle JSON WebSocket connections held open on the gateway (target < 50 KiB each):", "",
                 "| connections | opened | gateway RSS before MiB | with them MiB | KiB per connection |", "|---|---|---|---|---|"]
