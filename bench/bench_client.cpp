@@ -2,7 +2,9 @@
 // JSON line per measured operation (bench_common.hpp: latency_row).
 //
 // Usage:
-//   rr_bench_client --url URL [--label L] [--count N] [--ops a,b,...]
+//   rr_bench_client --url URL [--label L] [--count N] [--ops a,b,...] [--caller-io 1]
+//   --caller-io 1: no worker thread; the calling thread runs the connection's I/O while each blocking
+//   call waits (ClientOptions::caller_runs_io). Blocking ops only (nop, echoN, get, set, peek).
 // URL: rr+tcp://… or rr+ws://… naming the bench service (directly, or through a gateway).
 // Operations (default: all):
 //   nop        blocking Nop() round trip             nop_async  Nop() chained on the strand (async layer)
@@ -237,6 +239,7 @@ void memory_rates(client::ObjectProxy root, int repeats) {
 int main(int argc, char** argv) {
     std::string url, ops = "nop,nop_async,echo10,echo1000,echo100000,get,set,peek,wire,wire_rate,pipe,memory";
     std::size_t count = 5000;
+    bool caller_io = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         if (i + 1 >= argc) {
@@ -248,19 +251,26 @@ int main(int argc, char** argv) {
         else if (a == "--label") g_label = v;
         else if (a == "--count") count = std::stoul(v);
         else if (a == "--ops") ops = v;
+        else if (a == "--caller-io") caller_io = v == "1";
         else {
             std::cerr << "unknown option " << a << "\n";
             return 2;
         }
     }
-    client::IoThreads io(1);
+    client::IoThreads io(caller_io ? 0 : 1);
     client::ClientOptions options;
     options.memory_max_transfer_size = 102400;
+    options.caller_runs_io = caller_io;
     auto c = must(client::Client::connect(io.executor(), url, options), "connect " + url);
     auto root = c->root();
 
     std::stringstream list(ops);
     for (std::string op; std::getline(list, op, ',');) {
+        const bool blocking = op == "nop" || op.rfind("echo", 0) == 0 || op == "get" || op == "set" || op == "peek";
+        if (caller_io && !blocking) {
+            std::cerr << "--caller-io runs blocking ops only, not " << op << "\n";
+            return 2;
+        }
         if (op == "nop") timed("nop", count, 0, [&] { must(root.call("Nop"), "Nop"); });
         else if (op == "nop_async") nop_async(root, count);
         else if (op.rfind("echo", 0) == 0) {

@@ -454,6 +454,10 @@ def main(argv=None):
             plan = [
                 ("floor", lambda: run_rows([exe["rr_bench_floor"], "--count", str(args.count)])),
                 ("ours->ours rr+tcp", lambda: cpp(ours.ready["url"], "ours->ours rr+tcp")),
+                # the blocking calls again, the caller running the connection's I/O (no worker thread)
+                ("ours->ours rr+tcp caller-io", lambda: run_rows([exe["rr_bench_client"], "--url", ours.ready["url"], "--label",
+                                                                  "ours->ours rr+tcp caller-io", "--count", str(args.count),
+                                                                  "--ops", "nop,echo10,get", "--caller-io", "1"])),
                 ("official->official rr+tcp", lambda: pyc(official.ready["url"], "official->official rr+tcp")),
                 ("ours->ours rr+ws", lambda: cpp(ours.ready["ws_url"], "ours->ours rr+ws")),
                 ("official->official rr+ws", lambda: pyc(official.ready["ws_url"], "official->official rr+ws")),
@@ -575,7 +579,7 @@ def main(argv=None):
 LATENCY_OPS = ("nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set", "peek", "wire")
 OP_ORDER = ["tcp_64", "unix_64", "tcp_bulk", "nop", "nop_async", "echo10", "echo1000", "echo100000", "get", "set",
             "peek", "wire", "wire_rate", "pipe", "memory_read", "memory_write"]
-PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+ws", "ours->ours rr+local", "official->official rr+tcp",
+PATH_ORDER = ["floor", "ours->ours rr+tcp", "ours->ours rr+tcp caller-io", "ours->ours rr+ws", "ours->ours rr+local", "official->official rr+tcp",
               "official->official rr+ws", "official->official rr+local", "official->ours rr+tcp",
               "ours->official rr+tcp", "ours->gateway->ours rr+tcp", "official->gateway->ours rr+tcp",
               "ours->ours rr+usb", "ours->ours rr+tcp in-process"]
@@ -679,16 +683,17 @@ def markdown(res):
                "References measured in this run: TCP floor p50 **%s µs** (64 B ping-pong, TCP_NODELAY), Unix socket floor "
                "p50 %s µs, TCP bulk round trip (800,000 B each way) **%s MB/s**." % (
                    fmt(refs.get("tcp_floor_p50_us"), 2), fmt(refs.get("unix_floor_p50_us"), 2), fmt(refs.get("tcp_bulk_mb_s"))), "",
-               "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | × TCP floor (× Unix floor for rr+local) | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
-               "|---|---|---|---|---|---|---|---|---|---|---|"]
+               "| op | path | p50 µs | p99 µs | max µs | ops/s | MB/s | client CPU µs / op | client vcsw / op | × TCP floor (× Unix floor for rr+local) | % TCP bulk | official p50 µs (ops/s), same transport* | speed-up vs official |",
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in res["rows"]:
         off = fmt(e.get("official_p50_us")) if "official_p50_us" in e else (
             "(%s)" % fmt(e["official_ops_per_s"], 0) if "official_ops_per_s" in e else "")
         if off and e.get("official_path", "").split()[-1] != e["path"].split()[-1]:
             off += "*"
-        out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             e["op"], e["path"], fmt(e.get("p50_us")), fmt(e.get("p99_us")), fmt(e.get("max_us")), fmt(e.get("ops_per_s"), 0),
-            fmt(e.get("mb_s")), fmt(e.get("x_tcp_floor"), 2) + (" (%s)" % fmt(e["x_unix_floor"], 2) if "x_unix_floor" in e else ""),
+            fmt(e.get("mb_s")), fmt(e.get("client_cpu_us_per_op")), fmt(e.get("client_vcsw_per_op"), 2),
+            fmt(e.get("x_tcp_floor"), 2) + (" (%s)" % fmt(e["x_unix_floor"], 2) if "x_unix_floor" in e else ""),
             fmt(e.get("pct_tcp_bulk")), off,
             (fmt(e["speedup_vs_official"], 2) + "×") if "speedup_vs_official" in e else ""))
     if res["rows"]:

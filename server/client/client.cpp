@@ -41,7 +41,6 @@ TimeSpec wall_clock_now() {
 // --- IoThreads -------------------------------------------------------------------------------------
 
 IoThreads::IoThreads(unsigned threads) : work_(io_.get_executor()) {
-    if (threads == 0) threads = 1;
     for (unsigned i = 0; i < threads; ++i) threads_.emplace_back([this] { io_.run(); });
 }
 
@@ -130,6 +129,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
 
     std::shared_ptr<Client> client(new Client());
     client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(*io)));
+    client->caller_runs_io_ = options.caller_runs_io;
     client->wait_limit_ = options.request_timeout + 5s;
     auto logic = std::make_shared<Logic>(std::move(cfg));
     client->logic_ = logic;
@@ -170,7 +170,12 @@ Result<std::shared_ptr<Client>> Client::connect(asio::any_io_executor executor, 
                                                 ClientOptions options) {
     auto timeout = options.connect_timeout + options.request_timeout + 5s;
     auto waiter = std::make_shared<detail::SyncWaiter<std::shared_ptr<Client>>>();
+    const bool caller_runs_io = options.caller_runs_io;
     connect(executor, url, std::move(options), detail::SyncCompletion<std::shared_ptr<Client>>(waiter));
+    if (auto io = io_context_executor(executor); caller_runs_io && io) {
+        detail::run_io_until(io->context(), [&] { return waiter->answered(); }, std::chrono::steady_clock::now() + timeout);
+        timeout = {};
+    }
     auto r = waiter->wait_for(timeout);
     if (!r) return fail(MessageErrorType::ConnectionError, "connect timed out");
     return std::move(*r);
@@ -180,6 +185,13 @@ Client::~Client() {
     if (auto pump = pump_.lock()) {
         auto logic = logic_;
         pump->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
+        if (caller_runs_io_ && !on_strand()) {
+            // No worker thread writes the DisconnectClient: give it a moment on this one.
+            std::weak_ptr<PumpHandle> weak = pump;
+            pump.reset();
+            detail::run_io_until(strand_->get_inner_executor().inner().context(), [&] { return weak.expired(); },
+                                 std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
+        }
     }
 }
 
@@ -201,9 +213,25 @@ Result<void> Client::close_wait(std::chrono::milliseconds timeout) {
     if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
     close();
     if (!pump_.lock() && !open_.load()) return {};
+    if (caller_runs_io_) {
+        const auto closed = [this] { return closed_future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; };
+        detail::run_io_until(strand_->get_inner_executor().inner().context(), closed,
+                             std::chrono::steady_clock::now() + timeout);
+        timeout = {};
+    }
     if (closed_future_.wait_for(timeout) != std::future_status::ready && open_.load())
         return fail(MessageErrorType::OperationTimeout, "connection did not close in time");
     return {};
+}
+
+void Client::poll(std::chrono::milliseconds duration) {
+    if (on_strand()) return;
+    const auto until = std::chrono::steady_clock::now() + duration;
+    if (caller_runs_io_) {
+        detail::run_io_until(strand_->get_inner_executor().inner().context(), [] { return false; }, until);
+        return;
+    }
+    std::this_thread::sleep_until(until);
 }
 
 void Client::run(std::function<void(ClientContext&, MonoTime)> fn) {

@@ -77,6 +77,14 @@ struct ClientOptions {
     Limits limits;
     /// Connectors by URL scheme (nullptr: server::default_transports(), the built-in ones).
     const server::TransportRegistry* transports = nullptr;
+    /// The calling thread runs the connection's I/O while it waits: for a program whose io_context
+    /// no other thread runs (IoThreads(0)) and that calls from one thread. A blocking call then
+    /// sleeps once per reply, in the socket wait itself, instead of a worker thread waking for the
+    /// reply and then waking the caller (issue 14: one context switch per call, not two). Events,
+    /// wire values, callbacks and heartbeats are handled only while a blocking call, close_wait() or
+    /// poll() runs: call poll() at least every heartbeat_period when idle. Other threads calling at
+    /// the same time still complete, up to 1 ms later.
+    bool caller_runs_io = false;
 };
 
 /// The connection's strand: a blocking call runs its own request on it when it is idle
@@ -86,7 +94,8 @@ using ClientStrand = boost::asio::strand<server::CallerRunsExecutor>;
 /// The transport options of `options` (server/transport/transport.hpp).
 server::ConnectOptions connect_options(const ClientOptions& options);
 
-/// An io_context with worker threads, for programs that have no executor of their own.
+/// An io_context with worker threads, for programs that have no executor of their own. With 0
+/// threads nothing runs it: for clients with ClientOptions::caller_runs_io.
 class IoThreads {
 public:
     explicit IoThreads(unsigned threads = 1);
@@ -135,6 +144,9 @@ public:
     void close();
     /// close(), then waits (up to `timeout`) until the connection is closed. Not on the strand.
     Result<void> close_wait(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000));
+    /// With ClientOptions::caller_runs_io: runs the connection's pending I/O, events and timers on this
+    /// thread for `duration`. Otherwise (worker threads do that) it only waits. Not on the strand.
+    void poll(std::chrono::milliseconds duration);
 
     /// Runs `fn` on the strand (inline when already there) with the context and the current time.
     /// Not run at all when the connection is already gone.
@@ -163,6 +175,7 @@ private:
     ObjectRef root_;
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
+    bool caller_runs_io_ = false;
     std::chrono::milliseconds wait_limit_{20000};
     std::shared_ptr<std::promise<void>> closed_promise_ = std::make_shared<std::promise<void>>();
     std::shared_future<void> closed_future_ = closed_promise_->get_future().share();
@@ -345,6 +358,22 @@ private:
     std::atomic<bool> answered_{false};
 };
 
+/// Runs `io` on this thread until `done()` or `deadline`, in slices of at most 1 ms (another thread
+/// may complete what this one waits for). True when done.
+template <class Done>
+bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline) {
+    while (!done()) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now >= deadline) return false;
+        const auto slice = std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(1));
+        if (io.run_one_for(slice) == 0 && io.stopped()) {
+            io.restart();  // out of work (no worker guard): nothing here can finish it, so do not spin
+            std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(slice, std::chrono::microseconds(100)));
+        }
+    }
+    return true;
+}
+
 /// The completion a blocking call hands to the strand. When its last copy is dropped unanswered
 /// (the connection closed first), the call fails with ConnectionError.
 template <class T>
@@ -376,7 +405,11 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
             start(ctx, now, done);
         });
     }
-    auto r = waiter->wait_for(wait_limit_);
+    if (caller_runs_io_)
+        detail::run_io_until(strand_->get_inner_executor().inner().context(), [&] { return waiter->answered(); },
+                             std::chrono::steady_clock::now() + wait_limit_);
+    auto r = waiter->wait_for(caller_runs_io_ ? std::chrono::steady_clock::duration::zero()
+                                              : std::chrono::steady_clock::duration(wait_limit_));
     if (!r) return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");
     return std::move(*r);
 }

@@ -217,6 +217,49 @@ TEST_CASE("client: a blocking call's completion fails it when dropped unanswered
     }
 }
 
+TEST_CASE("client: caller_runs_io: with no worker thread the calling thread runs the connection") {
+    Fixture f;
+    rr::client::IoThreads none(0);
+    rr::client::ClientOptions o;
+    o.caller_runs_io = true;
+    auto c = Client::connect(none.executor(), f.url(), o);
+    INFO((c ? std::string() : c.error().message));
+    REQUIRE(c);
+    ObjectProxy root = (*c)->root();
+    auto x = root.get("x");
+    REQUIRE(x);
+    CHECK(*x == Value::scalar(42.5));
+
+    // Events and callbacks run on this thread, while a call or poll() runs the I/O.
+    std::vector<std::thread::id> event_threads;
+    auto sub = root.subscribe("changed", [&](const std::string&, std::vector<Value>&) {
+        event_threads.push_back(std::this_thread::get_id());
+    });
+    REQUIRE(sub);
+    REQUIRE(root.call("fire"));
+    for (int i = 0; i < 200 && event_threads.empty(); ++i) (*c)->poll(10ms);
+    REQUIRE(event_threads.size() == 1);
+    CHECK(event_threads[0] == std::this_thread::get_id());
+    std::thread::id callback_thread;
+    REQUIRE(root.set_callback("cb", [&](std::vector<Value>& a) -> Result<Value> {
+        callback_thread = std::this_thread::get_id();
+        return Value::scalar(*a.at(0).as<double>() + 0.5);
+    }));
+    auto r = root.call("callme", {Value::scalar(2.0)});
+    REQUIRE(r);
+    CHECK(*r == Value::scalar(2.5));
+    CHECK(callback_thread == std::this_thread::get_id());
+
+    // A second thread calling at the same time also completes.
+    std::thread other([&] { CHECK(root.get("x")); });
+    CHECK(root.call("add", {Value::scalar<std::int32_t>(2), Value::scalar<std::int32_t>(3)}));
+    other.join();
+
+    REQUIRE((*c)->close_wait());
+    CHECK_FALSE((*c)->is_open());
+    CHECK(root.get("x").error().type == MessageErrorType::ConnectionError);
+}
+
 TEST_CASE("client: transports are pluggable by URL scheme") {
     Fixture f;
     // A scheme the URL parser knows but no built-in transport serves, in a registry of this test's own.
