@@ -60,6 +60,22 @@ std::optional<std::vector<std::byte>> read_vector(const char* name) {
     return out;
 }
 
+// A one-entry member message from the client (endpoint 5) to the server's session (endpoint 9).
+Message member_message(MessageEntryType type, std::string member, std::uint32_t request_id) {
+    Message m;
+    m.header.sender_node_id = kClientId;
+    m.header.receiver_node_id = kServerId;
+    m.header.sender_endpoint = 5;
+    m.header.receiver_endpoint = 9;
+    MessageEntry e;
+    e.entry_type = type;
+    e.service_path = "svc";
+    e.member_name = std::move(member);
+    e.request_id = request_id;
+    m.entries.push_back(std::move(e));
+    return m;
+}
+
 template <class T>
 std::optional<T> next_event(StreamConnection& s) {
     while (auto e = s.poll_event())
@@ -106,17 +122,7 @@ TEST_CASE("client and server negotiate message format v4 or v2") {
         CHECK(client.send_version() == (server_v4 ? 4 : 2));
 
         // A member message goes through in the negotiated format and arrives decoded.
-        Message m;
-        m.header.sender_node_id = kClientId;
-        m.header.receiver_node_id = kServerId;
-        m.header.sender_endpoint = 5;
-        m.header.receiver_endpoint = 9;
-        MessageEntry e;
-        e.entry_type = MessageEntryType::PropertyGetReq;
-        e.service_path = "svc";
-        e.member_name = "x";
-        e.request_id = 3;
-        m.entries.push_back(e);
+        const Message m = member_message(MessageEntryType::PropertyGetReq, "x", 3);
         client.set_session_established(5, 9);
         server.set_session_established(9, 5);
         REQUIRE(client.send(m, t0));
@@ -246,20 +252,7 @@ TEST_CASE("a connection reuses the entry vectors of the messages it sends and re
     pump(client, server, t0);
     client.set_session_established(5, 9);
     server.set_session_established(9, 5);
-    auto message = [](std::uint32_t request_id) {
-        Message m;
-        m.header.sender_node_id = kClientId;
-        m.header.receiver_node_id = kServerId;
-        m.header.sender_endpoint = 5;
-        m.header.receiver_endpoint = 9;
-        MessageEntry e;
-        e.entry_type = MessageEntryType::FunctionCallReq;
-        e.service_path = "svc";
-        e.member_name = "f";
-        e.request_id = request_id;
-        m.entries.push_back(std::move(e));
-        return m;
-    };
+    auto message = [](std::uint32_t request_id) { return member_message(MessageEntryType::FunctionCallReq, "f", request_id); };
 
     // A message given up to send(): its entry vector is kept once it is encoded.
     Message first = message(1);
