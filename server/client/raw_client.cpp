@@ -1,5 +1,7 @@
 #include "server/client/raw_client.hpp"
 
+#include <utility>
+
 #include <boost/asio/strand.hpp>
 
 #include "server/common/random_ids.hpp"
@@ -8,6 +10,26 @@
 namespace rr::server {
 
 namespace asio = boost::asio;
+
+namespace {
+
+// Calls a request's handler exactly once: from the strand with the reply, or with ConnectionError
+// when the request never reached the session (the pump had closed and dropped it unrun).
+class ReplyGuard {
+public:
+    explicit ReplyGuard(RawClient::ReplyHandler done) : done_(std::move(done)) {}
+    ReplyGuard(const ReplyGuard&) = delete;
+    ReplyGuard& operator=(const ReplyGuard&) = delete;
+    ~ReplyGuard() {
+        if (done_) done_(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    }
+    RawClient::ReplyHandler take() { return std::exchange(done_, nullptr); }
+
+private:
+    RawClient::ReplyHandler done_;
+};
+
+}  // namespace
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
@@ -159,9 +181,10 @@ void RawClient::request(MessageEntry entry, std::chrono::milliseconds timeout, R
         return;
     }
     auto logic = logic_;
-    pump->dispatch([logic, entry = std::move(entry), timeout, done = std::move(done)]() mutable {
+    auto guard = std::make_shared<ReplyGuard>(std::move(done));
+    pump->dispatch([logic, entry = std::move(entry), timeout, guard]() mutable {
         auto t = timeout.count() < 0 ? logic->request_timeout_ : timeout;
-        logic->request(std::move(entry), t, std::move(done));
+        logic->request(std::move(entry), t, guard->take());
     });
 }
 

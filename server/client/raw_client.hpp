@@ -56,7 +56,9 @@ public:
     static void connect(boost::asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
                         IncomingHandler incoming, ClosedHandler closed, ConnectHandler done);
 
-    /// Sends a request; `done` gets the reply entry (whose Error field may be set) or a local error.
+    /// Sends a request; `done` gets the reply entry (whose Error field may be set) or a local error,
+    /// exactly once: ConnectionError when the connection closes before the request is answered,
+    /// including a request made while it closes.
     void request(MessageEntry entry, ReplyHandler done);
     /// Sends a request with its own timeout (0 = none).
     void request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done);

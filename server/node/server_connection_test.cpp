@@ -419,3 +419,23 @@ TEST_CASE("replies completed on another thread after the client has gone are dro
     CHECK(read_scalar(*r->find("return"), sum));
     CHECK(sum == 9);
 }
+
+TEST_CASE("a request made while the client connection closes is answered once, never lost") {
+    Fixture f;
+    int local_errors = 0;
+    for (int i = 0; i < 40; ++i) {
+        auto c = f.connect();
+        std::promise<Result<MessageEntry>> answered;
+        auto answer = answered.get_future();
+        c->close();  // queued on the connection's strand before the request
+        c->request(request(MessageEntryType::PropertyGetReq, "x"),
+                   [&answered](Result<MessageEntry> r) { answered.set_value(std::move(r)); });  // twice would throw
+        REQUIRE(answer.wait_for(10s) == std::future_status::ready);
+        auto r = answer.get();
+        if (!r) {
+            ++local_errors;
+            CHECK((r.error().type == MessageErrorType::ConnectionError || r.error().type == MessageErrorType::InvalidState));
+        }
+    }
+    CHECK(local_errors > 0);  // the close won the race at least once
+}
