@@ -6,6 +6,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "core/message/error_entry.hpp"
+#include "server/client/completion_guard.hpp"
 #include "server/common/random_ids.hpp"
 
 namespace rr::client {
@@ -189,7 +190,7 @@ Client::~Client() {
             // No worker thread writes the DisconnectClient: give it a moment on this one.
             std::weak_ptr<PumpHandle> weak = pump;
             pump.reset();
-            detail::run_io_until(strand_->get_inner_executor().inner().context(), [&] { return weak.expired(); },
+            detail::run_io_until(io_context(), [&] { return weak.expired(); },
                                  std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
         }
     }
@@ -215,7 +216,7 @@ Result<void> Client::close_wait(std::chrono::milliseconds timeout) {
     if (!pump_.lock() && !open_.load()) return {};
     if (caller_runs_io_) {
         const auto closed = [this] { return closed_future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; };
-        detail::run_io_until(strand_->get_inner_executor().inner().context(), closed,
+        detail::run_io_until(io_context(), closed,
                              std::chrono::steady_clock::now() + timeout);
         timeout = {};
     }
@@ -228,7 +229,7 @@ void Client::poll(std::chrono::milliseconds duration) {
     if (on_strand()) return;
     const auto until = std::chrono::steady_clock::now() + duration;
     if (caller_runs_io_) {
-        detail::run_io_until(strand_->get_inner_executor().inner().context(), [] { return false; }, until);
+        detail::run_io_until(io_context(), [] { return false; }, until);
         return;
     }
     std::this_thread::sleep_until(until);
@@ -245,26 +246,9 @@ namespace {
 
 Unexpected no_client() { return fail(MessageErrorType::InvalidOperation, "empty object proxy"); }
 
-// Calls `done` exactly once: with the operation's result, or with ConnectionError when the connection
-// is gone before the operation could start (the guard is dropped uncalled).
-template <class T>
-class AsyncGuard {
-public:
-    explicit AsyncGuard(Completion<T> done) : done_(std::move(done)) {}
-    ~AsyncGuard() {
-        if (done_) done_(fail(MessageErrorType::ConnectionError, "client connection closed"));
-    }
-    void operator()(Result<T> r) {
-        if (auto d = std::exchange(done_, nullptr)) d(std::move(r));
-    }
-
-private:
-    Completion<T> done_;
-};
-
 template <class T, class Start>
 void async_op(Client& c, Completion<T> done, Start start) {
-    auto guard = std::make_shared<AsyncGuard<T>>(std::move(done));
+    auto guard = std::make_shared<server::CompletionGuard<T>>(std::move(done));
     c.run([guard, start = std::move(start)](ClientContext& ctx, MonoTime now) mutable {
         start(ctx, now, [guard](Result<T> r) { (*guard)(std::move(r)); });
     });

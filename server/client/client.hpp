@@ -176,6 +176,8 @@ private:
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
     bool caller_runs_io_ = false;
+    /// The io_context under the connection's strand (run by the caller with caller_runs_io).
+    boost::asio::io_context& io_context() const { return strand_->get_inner_executor().inner().context(); }
     std::chrono::milliseconds wait_limit_{20000};
     std::shared_ptr<std::promise<void>> closed_promise_ = std::make_shared<std::promise<void>>();
     std::shared_future<void> closed_future_ = closed_promise_->get_future().share();
@@ -406,7 +408,7 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
         });
     }
     if (caller_runs_io_)
-        detail::run_io_until(strand_->get_inner_executor().inner().context(), [&] { return waiter->answered(); },
+        detail::run_io_until(io_context(), [&] { return waiter->answered(); },
                              std::chrono::steady_clock::now() + wait_limit_);
     auto r = waiter->wait_for(caller_runs_io_ ? std::chrono::steady_clock::duration::zero()
                                               : std::chrono::steady_clock::duration(wait_limit_));

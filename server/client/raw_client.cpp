@@ -1,9 +1,8 @@
 #include "server/client/raw_client.hpp"
 
-#include <utility>
-
 #include <boost/asio/strand.hpp>
 
+#include "server/client/completion_guard.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/common/connection_strand.hpp"
 
@@ -11,25 +10,6 @@ namespace rr::server {
 
 namespace asio = boost::asio;
 
-namespace {
-
-// Calls a request's handler exactly once: from the strand with the reply, or with ConnectionError
-// when the request never reached the session (the pump had closed and dropped it unrun).
-class ReplyGuard {
-public:
-    explicit ReplyGuard(RawClient::ReplyHandler done) : done_(std::move(done)) {}
-    ReplyGuard(const ReplyGuard&) = delete;
-    ReplyGuard& operator=(const ReplyGuard&) = delete;
-    ~ReplyGuard() {
-        if (done_) done_(fail(MessageErrorType::ConnectionError, "client connection closed"));
-    }
-    RawClient::ReplyHandler take() { return std::exchange(done_, nullptr); }
-
-private:
-    RawClient::ReplyHandler done_;
-};
-
-}  // namespace
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
@@ -181,7 +161,7 @@ void RawClient::request(MessageEntry entry, std::chrono::milliseconds timeout, R
         return;
     }
     auto logic = logic_;
-    auto guard = std::make_shared<ReplyGuard>(std::move(done));
+    auto guard = std::make_shared<CompletionGuard<MessageEntry>>(std::move(done));
     pump->dispatch([logic, entry = std::move(entry), timeout, guard]() mutable {
         auto t = timeout.count() < 0 ? logic->request_timeout_ : timeout;
         logic->request(std::move(entry), t, guard->take());
