@@ -42,13 +42,14 @@ inline double percentile(std::vector<double> samples, double q) {
     return samples[k];
 }
 
-/// Process CPU time and voluntary context switches (getrusage(RUSAGE_SELF)).
+/// CPU time and voluntary context switches of the process (getrusage(RUSAGE_SELF), the default) or of
+/// the calling thread (RUSAGE_THREAD).
 struct CpuSnapshot {
     double cpu_us = 0;
     long vcsw = 0;
-    static CpuSnapshot now() {
+    static CpuSnapshot now(int who = RUSAGE_SELF) {
         rusage u{};
-        getrusage(RUSAGE_SELF, &u);
+        getrusage(who, &u);
         auto us = [](const timeval& t) { return double(t.tv_sec) * 1e6 + double(t.tv_usec); };
         return {us(u.ru_utime) + us(u.ru_stime), u.ru_nvcsw};
     }

@@ -120,14 +120,6 @@ nlohmann::json unix_row(const std::string& op, std::size_t size, std::size_t cou
     return row;
 }
 
-/// getrusage(RUSAGE_THREAD): the calling thread's CPU µs and voluntary context switches.
-rr::bench::CpuSnapshot thread_cpu() {
-    rusage u{};
-    getrusage(RUSAGE_THREAD, &u);
-    auto us = [](const timeval& t) { return double(t.tv_sec) * 1e6 + double(t.tv_usec); };
-    return {us(u.ru_utime) + us(u.ru_stime), u.ru_nvcsw};
-}
-
 nlohmann::json fanout_floor_row(std::size_t clients, double seconds, double hz, std::size_t bytes) {
     rr::bench::raise_fd_limit();
     bytes = std::max<std::size_t>(bytes, sizeof(std::int64_t));
@@ -165,7 +157,7 @@ nlohmann::json fanout_floor_row(std::size_t clients, double seconds, double hz, 
     std::thread writer([&] {
         std::vector<char> message(bytes, 'x');
         const auto period = std::chrono::duration_cast<clock_type::duration>(std::chrono::duration<double>(1.0 / hz));
-        writer_before = thread_cpu();
+        writer_before = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
         const auto start = clock_type::now();
         for (std::size_t t = 0; t < ticks; ++t) {
             std::this_thread::sleep_until(start + t * period);
@@ -176,12 +168,12 @@ nlohmann::json fanout_floor_row(std::size_t clients, double seconds, double hz, 
             }
         }
         writer_wall_us = rr::bench::elapsed_us(start, clock_type::now());
-        writer_after = thread_cpu();
+        writer_after = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
         for (auto& w : writers) w.shutdown(tcp::socket::shutdown_send);
     });
-    const auto reader_before = thread_cpu();
+    const auto reader_before = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
     io.run();
-    const auto reader_after = thread_cpu();
+    const auto reader_after = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
     writer.join();
 
     const double sent = double(ticks * clients);
