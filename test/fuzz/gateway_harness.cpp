@@ -27,6 +27,12 @@ std::string make_web_root() {
     std::string tmpl = (fs::temp_directory_path() / "rr-fuzz-XXXXXX").string();
     if (!::mkdtemp(tmpl.data())) fail_input("cannot make a temporary folder");
     const fs::path base = tmpl;
+    static std::string removed_at_exit;  // the folder, so a fuzz run leaves nothing in /tmp
+    removed_at_exit = tmpl;
+    std::atexit([] {
+        std::error_code ignored;
+        std::filesystem::remove_all(removed_at_exit, ignored);
+    });
     fs::create_directories(base / "www" / "sub");
     std::ofstream(base / "www" / "index.html") << "<!doctype html><title>rr-fuzz</title>\n";
     std::ofstream(base / "www" / "sub" / "a.txt") << "a\n";

@@ -34,12 +34,14 @@ Usage: gateway_logins.py --gateway PATH/rr-gateway --service PATH/rr_interop_ser
 """
 
 import argparse
+import atexit
 import base64
 import hashlib
 import hmac
 import http.cookiejar
 import json
 import os
+import shutil
 import signal
 import sys
 import tempfile
@@ -131,6 +133,7 @@ def main():
     args = ap.parse_args()
 
     work = tempfile.mkdtemp(prefix="gw_logins_")
+    atexit.register(shutil.rmtree, work, True)
     write_password_file(os.path.join(work, "users.txt"), [(u, pw, roles) for u, (pw, roles) in USERS.items()])
     with open(os.path.join(work, "tokens.txt"), "w") as f:
         f.write("%s wall viewer\n" % TOKEN)

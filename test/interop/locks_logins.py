@@ -28,8 +28,10 @@ Usage: locks_logins.py (--service PATH/rr_interop_service | --official) [--timeo
 """
 
 import argparse
+import atexit
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -383,6 +385,7 @@ def main():
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-locks-")
+    atexit.register(shutil.rmtree, tmp, True)  # logs are printed before exit; os._exit on timeout keeps them
     users = os.path.join(tmp, "users.txt")
     err = os.path.join(tmp, "service.err")
     exp = Expected("official" if args.official else "ours")

@@ -17,9 +17,11 @@ Usage: our_client_interop.py --client PATH [--target official|reynard] [--disabl
 """
 
 import argparse
+import atexit
 import json
 import os
 import selectors
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -85,6 +87,8 @@ def main(argv=None):
 
     workdir = args.keep or tempfile.mkdtemp(prefix="our_client_")
     os.makedirs(workdir, exist_ok=True)
+    if not args.keep:
+        atexit.register(shutil.rmtree, workdir, True)
     result = {"ok": False, "target": args.target, "message4": not args.disable_message4}
     service = None
     sio = None

@@ -33,8 +33,10 @@ Usage: passthrough_gateway.py --gateway PATH/rr-gateway (--service PATH/rr_inter
 """
 
 import argparse
+import atexit
 import json
 import os
+import shutil
 import sys
 import tempfile
 import threading
@@ -385,6 +387,7 @@ def main():
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-passthrough-")
+    atexit.register(shutil.rmtree, tmp, True)  # logs are printed before exit; os._exit on timeout keeps them
     users = os.path.join(tmp, "users.txt")
     exp = ll.Expected("official" if args.official else "ours", gateway=True)
     svc_err = os.path.join(tmp, "service.err")

@@ -25,8 +25,10 @@ Usage: shared_locks_gateway.py --gateway PATH/rr-gateway --service PATH/rr_inter
 """
 
 import argparse
+import atexit
 import json
 import os
+import shutil
 import sys
 import tempfile
 import threading
@@ -249,6 +251,7 @@ def main():
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-shared-locks-")
+    atexit.register(shutil.rmtree, tmp, True)  # logs are printed before exit; os._exit on timeout keeps them
     users = os.path.join(tmp, "users.txt")
     write_password_file(users, [(user, pw, roles) for user, (pw, roles) in GATEWAY_USERS.items()])
     svc_err, gw_err, gw2_err = (os.path.join(tmp, n) for n in ("service.err", "gateway.err", "gateway2.err"))

@@ -19,6 +19,7 @@ device's JSON line (e.g. {dev:http_url} for reynard_harness.py).
 Exit status: the client's (0 = all checks passed); 2 = setup failed.
 """
 import argparse
+import atexit
 import json
 import os
 import shlex
@@ -104,6 +105,7 @@ def main():
             for name, key in zip(names, keys):
                 cfg.write("  - name: %s\n    url: %s\n    auth: passthrough\n" % (name, json.dumps(dev_info[key])))
             cfg.close()
+            atexit.register(os.unlink, cfg.name)
             flags += ["--config", cfg.name]
         else:
             for name, key in zip(names, keys):

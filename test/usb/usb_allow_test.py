@@ -9,7 +9,9 @@ device, and the device stays unconnected with a reason. Exit 0 when all passed, 
 Usage: usb_allow_test.py --fixture PATH/rr_usb_fixture --wrapper test/usb/run_under_umockdev.sh
 """
 import argparse
+import atexit
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -83,6 +85,7 @@ def main():
     ap.add_argument("--wrapper", required=True)
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="rr_usb_allow_")
+    atexit.register(shutil.rmtree, tmp, True)
     for allow in (True, False):
         if run(args, tmp, allow) == 77:
             print("SKIP: rr_usb_fixture exited 77 (not under umockdev-wrapper)")

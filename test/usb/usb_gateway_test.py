@@ -15,7 +15,9 @@ Usage: usb_gateway_test.py --fixture rr_usb_fixture --wrapper run_under_umockdev
 """
 
 import argparse
+import atexit
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -67,6 +69,7 @@ def main():
         return 77
 
     tmp = tempfile.mkdtemp(prefix="rr_usb_gw_")
+    atexit.register(shutil.rmtree, tmp, True)
     # The device's identity is fixed by the fixture (test/usb/usb_world.hpp).
     nodeid, name = "5a3c9d2e-7b41-4c8a-9e0f-31d2c4b5a6e7", "usb_demo"
     cfg = os.path.join(tmp, "gateway.yaml")

@@ -5,7 +5,7 @@
 // Usage: node browser_test.mjs --interop-service PATH --gateway PATH [--only REGEX]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
 import { spawn, spawnSync } from "node:child_process";
-import { existsSync, mkdtempSync, writeFileSync } from "node:fs";
+import { existsSync, mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { createRequire } from "node:module";
 import { createInterface } from "node:readline";
@@ -73,7 +73,9 @@ try {
   const dev = await readyLine(svc, "url");
   // `auth: passthrough` (docs/security.md): the page gets its own session to the device, so the monitor
   // lock check locks on the device itself (a shared device refuses locks), as in node_test.mjs.
-  const config = join(mkdtempSync(join(tmpdir(), "rr-wasm-browser-")), "gateway.yaml");
+  const configDir = mkdtempSync(join(tmpdir(), "rr-wasm-browser-"));
+  process.on("exit", () => rmSync(configDir, { recursive: true, force: true }));
+  const config = join(configDir, "gateway.yaml");
   writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(dev.url)}\n    auth: passthrough\n`);
   const gw = start(arg("--gateway"), ["--config", config, "--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0",
     "--log-level", "warning", "--web-root", pkgRoot]);

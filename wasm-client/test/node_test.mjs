@@ -88,6 +88,7 @@ async function gatewayReady(port, timeoutMs = 30000) {
 // answers plain HTTP (tls.required is off), so the readiness check is the same.
 async function behindGateway(deviceUrl, moreConfig = "") {
   const dir = mkdtempSync(join(tmpdir(), "rr-wasm-gw-"));
+  process.on("exit", () => rmSync(dir, { recursive: true, force: true }));
   const config = join(dir, "gateway.yaml");
   writeFileSync(config, `${moreConfig}devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: passthrough\n`);
   const gw = start(arg("--gateway"), ["--config", config, "--no-demo", "--no-local", "--listen", "127.0.0.1", "--port", "0",
