@@ -60,7 +60,7 @@ annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[
 {
   echo "# callgrind instruction counts for Nop() over rr+tcp (our client -> our service), N = $N"
   echo "service instructions per call: $((svc_ir / N))"
-  echo "client instructions per call:  $(((c2 - c1) / N))   (blocking layer: the caller thread waits on a future)"
+  echo "client instructions per call:  $(((c2 - c1) / N))   (blocking layer: the caller thread waits for an I/O thread to complete the call)"
   bench/callgrind_calls.py "$dump" malloc free | awk -v n="$N" '{ printf "service %s calls per call: %.1f\n", $1, $2 / n }'
   paste <(bench/callgrind_calls.py "$tmp/client.$N.out" malloc) <(bench/callgrind_calls.py "$tmp/client.$((2 * N)).out" malloc) |
     awk -v n="$N" '{ printf "client malloc calls per call: %.1f\n", ($4 - $2) / n }'

@@ -317,7 +317,7 @@ void ClientSession::on_entries(Message& m, MonoTime now) {
         switch (e.entry_type) {
             case MessageEntryType::ClientKeepAliveRet: continue;
             case MessageEntryType::ServiceClosed:
-                events_.push_back(ClientIncoming{std::move(e)});
+                events_.emplace_back(std::in_place_type<ClientIncoming>, std::move(e));
                 close(make_error(MessageErrorType::ServiceNotFound, "service closed"));
                 return;
             default: break;
@@ -327,12 +327,12 @@ void ClientSession::on_entries(Message& m, MonoTime now) {
             if (it != pending_.end()) {
                 pending_.erase(it);
                 const std::uint32_t id = e.request_id;
-                events_.push_back(ClientResponse{id, std::move(e)});
+                events_.emplace_back(std::in_place_type<ClientResponse>, id, std::move(e));
             }
             // An answer to a forgotten or timed-out request is dropped.
             continue;
         }
-        events_.push_back(ClientIncoming{std::move(e)});
+        events_.emplace_back(std::in_place_type<ClientIncoming>, std::move(e));
     }
 }
 

@@ -133,7 +133,7 @@ void ServiceSession::close_session() {
     username_.clear();
 }
 
-Message ServiceSession::session_message(MessageEntry entry) {
+Message ServiceSession::session_message(MessageEntry&& entry) {
     ++messages_out_;
     Message m;
     m.version = 2;
@@ -148,18 +148,21 @@ Message ServiceSession::session_message(MessageEntry entry) {
     return m;
 }
 
-void ServiceSession::reply(MessageEntry entry, MonoTime now) {
+void ServiceSession::reply(MessageEntry&& entry, MonoTime now) {
     if (!service_ || stream_.is_closed()) return;
+    Message m = session_message(std::move(entry));
+    auto sent = stream_.send(std::move(m), now);
+    if (sent) return;
+    // A reply must not vanish: answer with the error instead (e.g. over the size limit). A failed
+    // send leaves the message as it was, so the header fields come from the unsent reply.
+    MessageEntry& unsent = m.entries.front();
     MessageEntry header;
-    header.entry_type = entry.entry_type;
-    header.service_path = entry.service_path;
-    header.member_name = entry.member_name;
-    header.request_id = entry.request_id;
-    if (auto r = stream_.send(session_message(std::move(entry)), now); !r) {
-        // A reply must not vanish: answer with the error instead (e.g. over the size limit).
-        set_entry_error(header, r.error());
-        (void)stream_.send(session_message(std::move(header)), now);
-    }
+    header.entry_type = unsent.entry_type;
+    header.service_path = std::move(unsent.service_path);
+    header.member_name = std::move(unsent.member_name);
+    header.request_id = unsent.request_id;
+    set_entry_error(header, sent.error());
+    (void)stream_.send(session_message(std::move(header)), now);
 }
 
 Result<void> ServiceSession::send(MessageEntry entry, MonoTime now) {
@@ -481,7 +484,7 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
         }
         case MessageEntryType::PipePacket:
         case MessageEntryType::PipePacketRet:
-        case MessageEntryType::WirePacket: events_.emplace_back(ServiceRequest{std::move(e), false}); return;
+        case MessageEntryType::WirePacket: events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), false); return;
         default: break;
     }
     if (!request) return;
@@ -498,14 +501,14 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
               now);
         return;
     }
-    events_.emplace_back(ServiceRequest{std::move(e), true});
+    events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);
 }
 
 void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
     MessageEntry r = reply_to(e);
     const std::string& op = e.member_name;
     if ((op == "AuthenticateUser" || op == "LogoutUser") && service_->admits_sessions()) {
-        events_.emplace_back(ServiceRequest{std::move(e), true});  // the service's own login (passthrough)
+        events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);  // the service's own login (passthrough)
         return;
     }
     if (op == "AuthenticateUser") {
@@ -540,7 +543,7 @@ void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
                          op == "ReleaseClientObjectLock";
     if ((monitor_op || lock_op) && service_->handles_locks()) {
         // CORE ServerContext::ClientLockOp: the service owns the objects and their locks.
-        events_.emplace_back(ServiceRequest{std::move(e), true});
+        events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);
         return;
     }
     if (monitor_op) {

@@ -136,7 +136,7 @@ public:
     /// Answers a ServiceRequest: ServicePath, MemberName and RequestID must be the request's (the
     /// host's Responder sets them). A reply that cannot be sent (over the size limit) is replaced by
     /// an error reply with the same RequestID. Ignored without a session.
-    void reply(MessageEntry entry, MonoTime now);
+    void reply(MessageEntry&& entry, MonoTime now);
     /// Sends an entry the client did not ask for (EventReq, PipePacket, PipeClosed, WireClosed, …).
     /// Errors: InvalidState without a session or after close; BufferLimitViolation over the size limit.
     Result<void> send(MessageEntry entry, MonoTime now);
@@ -177,7 +177,7 @@ private:
                       std::shared_ptr<HostedService> service, std::uint32_t endpoint, std::string username,
                       bool authenticated, MonoTime now);
     void reply_special(const MessageHeader& request_header, MessageEntry reply, MonoTime now);
-    Message session_message(MessageEntry entry);
+    Message session_message(MessageEntry&& entry);
     void flush_held_wires(MonoTime now);
 
     ServiceHost& host_;

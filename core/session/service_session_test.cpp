@@ -211,6 +211,8 @@ TEST_CASE("service session: a reply over the size limit becomes an error reply w
     MessageEntry r = reply_to(requests[0].entry);
     std::vector<std::uint8_t> huge(13u * 1024u * 1024u);
     r.elements.push_back(make_array_element<std::uint8_t>("return", huge));
+    const auto reply_type = r.entry_type;
+    const auto service_path = r.service_path;
     p.service.reply(std::move(r), p.now);
     p.pump();
     auto responses = p.take_client<ClientResponse>();
@@ -218,6 +220,10 @@ TEST_CASE("service session: a reply over the size limit becomes an error reply w
     CHECK(responses[0].request_id == *id);
     REQUIRE(responses[0].entry);
     CHECK(responses[0].entry->error == MessageErrorType::BufferLimitViolation);
+    CHECK(responses[0].entry->entry_type == reply_type);
+    CHECK(responses[0].entry->member_name == "big");
+    CHECK(responses[0].entry->service_path == service_path);
+    CHECK(responses[0].entry->elements.size() == 2);  // errorname and errorstring only: the payload is gone
 }
 
 TEST_CASE("service session: an unknown service is refused with a ServiceNotFound naming it") {

@@ -318,7 +318,7 @@ Result<void> StreamConnection::send(Message&& message, MonoTime now) {
     if (state_ != State::connected)
         return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
     auto queued = queue_owned(message, send_version(), now, true);
-    entry_vectors_.give(std::move(message.entries));
+    if (queued) entry_vectors_.give(std::move(message.entries));
     return queued;
 }
 

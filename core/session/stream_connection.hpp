@@ -110,7 +110,8 @@ public:
     Result<void> send(const Message& message, MonoTime now);
     /// The same for a message the caller gives up: its format fields are set in place (no copy of
     /// its elements when the format or routing flags differ from what it carries), and its entry
-    /// vector goes back to entry_vectors() once encoded.
+    /// vector goes back to entry_vectors() once encoded. On an error the message keeps its entries,
+    /// so the caller can still answer for them (ServiceSession::reply).
     Result<void> send(Message&& message, MonoTime now);
     /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
     Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);

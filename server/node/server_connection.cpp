@@ -88,7 +88,7 @@ Responder::~Responder() {
     if (sink_) fail(make_error(MessageErrorType::InternalError, "request was not answered"));
 }
 
-void Responder::respond(MessageEntry reply) {
+void Responder::respond(MessageEntry&& reply) {
     if (!sink_) return;
     if (reply.entry_type == MessageEntryType::Null)
         reply.entry_type = static_cast<MessageEntryType>(static_cast<std::uint16_t>(request_type_) + 1);
@@ -333,7 +333,7 @@ public:
     ConnectionReplySink(std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump)
         : connection_(std::move(connection)), pump_(std::move(pump)) {}
 
-    void send_reply(MessageEntry reply) override {
+    void send_reply(MessageEntry&& reply) override {
         // The responder may complete on any thread; on the strand itself the reply goes out at once.
         if (auto c = connection_.lock(); c && tls_handling == c.get()) {
             c->reply(std::move(reply));
@@ -356,12 +356,12 @@ Responder ServerConnection::make_responder(const MessageEntry& request) {
     return Responder(reply_sink_, request);
 }
 
-void ServerConnection::reply(MessageEntry entry) {
+void ServerConnection::reply(MessageEntry&& entry) {
     session_.reply(std::move(entry), mono_now());
     drain_events();
 }
 
-void ServerConnection::send_session_entry(MessageEntry entry) {
+void ServerConnection::send_session_entry(MessageEntry&& entry) {
     // A reply sent through SessionRef::send keeps the reply rules (never lost: an error reply instead).
     if (!is_request(entry.entry_type) && entry.request_id != 0)
         session_.reply(std::move(entry), mono_now());

@@ -108,10 +108,10 @@ public:
     void on_transport_closed(RRError error) override;
 
     // Strand-side operations used by ServerSession and Responder.
-    void send_session_entry(MessageEntry entry);
+    void send_session_entry(MessageEntry&& entry);
     void send_wire_entry(const std::pair<std::string, std::string>& key);
     void send_session_request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
-    void reply(MessageEntry entry);
+    void reply(MessageEntry&& entry);
 
 private:
     void drain_events();

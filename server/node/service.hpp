@@ -71,7 +71,7 @@ class ReplySink {
 public:
     virtual ~ReplySink() = default;
     /// Sends a complete reply entry (header fields set) to the client; from any thread.
-    virtual void send_reply(MessageEntry reply) = 0;
+    virtual void send_reply(MessageEntry&& reply) = 0;
 };
 
 /// Completes one request exactly once, from any thread.
@@ -86,7 +86,7 @@ public:
 
     /// Sends `reply`: ServicePath, MemberName and RequestID are set from the request, and EntryType to
     /// request + 1 unless the reply already has one (CORE answers MemoryWrite with MemoryReadRet).
-    void respond(MessageEntry reply);
+    void respond(MessageEntry&& reply);
     /// Sends an error reply (wire.md §5.2).
     void fail(RRError error);
     bool done() const noexcept { return !sink_; }
