@@ -6,7 +6,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "core/message/error_entry.hpp"
-#include "server/client/completion_guard.hpp"
+#include "server/transport/completion_guard.hpp"
 #include "server/common/random_ids.hpp"
 
 namespace rr::client {

@@ -2,7 +2,7 @@
 
 #include <boost/asio/strand.hpp>
 
-#include "server/client/completion_guard.hpp"
+#include "server/transport/completion_guard.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/common/connection_strand.hpp"
 

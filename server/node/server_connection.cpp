@@ -1,6 +1,7 @@
 #include "server/node/server_connection.hpp"
 
 #include "core/session/elements.hpp"
+#include "server/transport/completion_guard.hpp"
 
 namespace rr::server {
 namespace {
@@ -179,11 +180,10 @@ void ServerSession::request(MessageEntry entry, std::function<void(Result<Messag
         done(fail(MessageErrorType::ConnectionError, "client session closed"));
         return;
     }
-    pump->post([conn = connection_, entry = std::move(entry), done = std::move(done)]() mutable {
-        if (auto c = conn.lock())
-            c->send_session_request(std::move(entry), std::move(done));
-        else
-            done(fail(MessageErrorType::ConnectionError, "client session closed"));
+    // The guard answers ConnectionError if the pump closes before this runs (the work is dropped).
+    auto guard = std::make_shared<CompletionGuard<MessageEntry>>(std::move(done), "client session closed");
+    pump->post([conn = connection_, entry = std::move(entry), guard]() mutable {
+        if (auto c = conn.lock()) c->send_session_request(std::move(entry), guard->take());
     });
 }
 

@@ -14,6 +14,7 @@
 #include "core/session/elements.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/node/node.hpp"
+#include "server/node/server_connection.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
 
@@ -438,4 +439,31 @@ TEST_CASE("a request made while the client connection closes is answered once, n
         }
     }
     CHECK(local_errors > 0);  // the close won the race at least once
+}
+
+namespace {
+// A pump that has closed: work posted to it is destroyed unrun (as StreamPump does after close).
+class ClosedPump final : public PumpHandle {
+public:
+    void post(std::function<void()> fn) override { ++dropped; }
+    void dispatch(std::function<void()> fn) override { ++dropped; }
+    void close() override {}
+    int dropped = 0;
+};
+}  // namespace
+
+TEST_CASE("a callback request whose work a closed pump drops is answered ConnectionError, once") {
+    auto pump = std::make_shared<ClosedPump>();
+    auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
+    int calls = 0;
+    Result<MessageEntry> got = MessageEntry{};
+    SessionRef(session).request(request(MessageEntryType::CallbackCallReq, "cb"), [&](Result<MessageEntry> r) {
+        ++calls;
+        got = std::move(r);
+    });
+    CHECK(pump->dropped == 1);
+    CHECK(calls == 1);
+    REQUIRE(!got);
+    CHECK(got.error().type == MessageErrorType::ConnectionError);
+    CHECK(got.error().message == "client session closed");
 }

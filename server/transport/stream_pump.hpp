@@ -39,7 +39,9 @@ concept DirectWriteSocket = requires(Stream& s, boost::system::error_code& ec) {
 class PumpHandle {
 public:
     virtual ~PumpHandle() = default;
-    /// Runs `fn` on the strand, then flushes output and re-arms the timer.
+    /// Runs `fn` on the strand, then flushes output and re-arms the timer. Once the pump has closed,
+    /// `fn` is destroyed unrun: a completion it carries must answer from its destructor
+    /// (server/transport/completion_guard.hpp), or its caller waits for nothing.
     virtual void post(std::function<void()> fn) = 0;
     /// Like post(), but runs `fn` at once when already on the strand.
     virtual void dispatch(std::function<void()> fn) = 0;
