@@ -23,8 +23,9 @@ public:
 
     /// The oldest event, moved out; nullopt when there is none.
     std::optional<T> pop() {
-        if (empty()) return std::nullopt;
-        std::optional<T> out(std::move(items_[head_++]));
+        std::optional<T> out;  // every path returns `out`: the compiler builds it in the caller's slot
+        if (empty()) return out;
+        out.emplace(std::move(items_[head_++]));
         if (empty()) {
             items_.clear();  // keeps the capacity
             head_ = 0;
