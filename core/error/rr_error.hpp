@@ -104,7 +104,9 @@ inline Unexpected fail(RRError error) { return Unexpected{std::move(error)}; }
 template <class T>
 class [[nodiscard]] Result {
 public:
-    Result(T value) : v_(std::in_place_index<0>, std::move(value)) {}
+    // Two overloads, not one by value: `return value;` then moves the value once, not twice.
+    Result(const T& value) : v_(std::in_place_index<0>, value) {}
+    Result(T&& value) : v_(std::in_place_index<0>, std::move(value)) {}
     Result(Unexpected u) : v_(std::in_place_index<1>, std::move(u.error)) {}
 
     bool ok() const noexcept { return v_.index() == 0; }

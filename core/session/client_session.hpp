@@ -61,12 +61,16 @@ struct ClientSessionConnected {
 /// The answer to request(): the reply entry (whose Error field may be set), or a local error such as
 /// RequestTimeout / ConnectionError.
 struct ClientResponse {
+    // Constructors, not aggregates: built in place in the event queue (see ServiceRequest).
+    ClientResponse(std::uint32_t id, Result<MessageEntry>&& e) : request_id(id), entry(std::move(e)) {}
+    ClientResponse(std::uint32_t id, MessageEntry&& e) : request_id(id), entry(std::move(e)) {}
     std::uint32_t request_id = 0;
     Result<MessageEntry> entry;
 };
 /// An entry the service sent without being asked: EventReq, PipePacket, PipePacketRet, PipeClosed,
 /// WirePacket, WireClosed, CallbackCallReq (answer with reply()), ServicePathReleasedReq, ServiceClosed.
 struct ClientIncoming {
+    explicit ClientIncoming(MessageEntry&& e) : entry(std::move(e)) {}
     MessageEntry entry;
 };
 /// Session over; no further events follow.

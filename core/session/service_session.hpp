@@ -65,6 +65,9 @@ struct ServiceSessionUser {
 /// ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit;
 /// answer with reply()).
 struct ServiceRequest {
+    // A constructor, not an aggregate: the event queue builds it in place (emplace with
+    // in_place_type), which clang before 16 cannot do for an aggregate.
+    ServiceRequest(MessageEntry&& e, bool reply) : entry(std::move(e)), needs_reply(reply) {}
     MessageEntry entry;
     bool needs_reply = true;
 };
