@@ -16,7 +16,7 @@ import sys
 INCLUDE = re.compile(r'^\s*#\s*include\s+"server/([a-z_]+)/')
 TRANSPORT_INCLUDE = re.compile(r'^\s*#\s*include\s+"server/transport/([^"]+)"')
 # The seam: what transport-neutral folders may include from server/transport.
-SEAM = {"transport.hpp", "transport_registry.hpp", "connection_logic.hpp", "stream_pump.hpp"}
+SEAM = {"transport.hpp", "transport_registry.hpp", "connection_logic.hpp", "stream_pump.hpp", "completion_guard.hpp"}
 TRANSPORT_NEUTRAL = {"node", "client", "service", "gateway"}
 LISTED = re.compile(r"^ (server/[a-z_]+|core/)\s")
 
