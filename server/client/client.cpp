@@ -6,8 +6,8 @@
 #include <boost/asio/strand.hpp>
 
 #include "core/message/error_entry.hpp"
-#include "server/transport/completion_guard.hpp"
 #include "server/common/random_ids.hpp"
+#include "server/transport/completion_guard.hpp"
 
 namespace rr::client {
 

@@ -2,14 +2,13 @@
 
 #include <boost/asio/strand.hpp>
 
-#include "server/transport/completion_guard.hpp"
-#include "server/common/random_ids.hpp"
 #include "server/common/connection_strand.hpp"
+#include "server/common/random_ids.hpp"
+#include "server/transport/completion_guard.hpp"
 
 namespace rr::server {
 
 namespace asio = boost::asio;
-
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {
