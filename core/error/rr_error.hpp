@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -89,9 +90,33 @@ struct RRError {
 /// Builds an RRError with the standard name for `type`.
 RRError make_error(MessageErrorType type, std::string message);
 
+/// An RRError on the heap: a Result on its success path then carries one null pointer, not the
+/// three strings of an RRError (every decoder step returns a Result; errors are the rare path).
+/// Copying copies the error. A moved-from box is empty: after take_error() a Result may only be
+/// destroyed or assigned.
+class ErrorBox {
+public:
+    explicit ErrorBox(RRError error) : p_(new RRError(std::move(error))) {}
+    ErrorBox(const ErrorBox& o) : p_(o.p_ ? new RRError(*o.p_) : nullptr) {}
+    ErrorBox(ErrorBox&& o) noexcept : p_(std::exchange(o.p_, nullptr)) {}
+    ErrorBox& operator=(ErrorBox o) noexcept {
+        std::swap(p_, o.p_);
+        return *this;
+    }
+    ~ErrorBox() { delete p_; }
+
+    RRError& operator*() const noexcept { return *p_; }
+    RRError* operator->() const noexcept { return p_; }
+
+private:
+    RRError* p_;
+};
+
 /// Wraps an RRError so that `return fail(...)` converts into any Result<T>.
 struct Unexpected {
-    RRError error;
+    explicit Unexpected(RRError e) : error(std::move(e)) {}
+    explicit Unexpected(ErrorBox e) noexcept : error(std::move(e)) {}
+    ErrorBox error;
 };
 
 inline Unexpected fail(MessageErrorType type, std::string message) {
@@ -99,7 +124,8 @@ inline Unexpected fail(MessageErrorType type, std::string message) {
 }
 inline Unexpected fail(RRError error) { return Unexpected{std::move(error)}; }
 
-/// Result<T>: a value or an RRError (a small expected<T, RRError> until C++23).
+/// Result<T>: a value or an RRError (a small expected<T, RRError> until C++23); the error is boxed
+/// (ErrorBox), so a Result is the size of T plus a tag.
 /// Calling value() on an error, or error() on a value, is a programming error and aborts.
 template <class T>
 class [[nodiscard]] Result {
@@ -121,8 +147,8 @@ public:
     T* operator->() { return &value(); }
     const T* operator->() const { return &value(); }
 
-    const RRError& error() const& { check(false); return std::get<1>(v_); }
-    RRError&& error() && { check(false); return std::get<1>(std::move(v_)); }
+    const RRError& error() const& { check(false); return *std::get<1>(v_); }
+    RRError&& error() && { check(false); return std::move(*std::get<1>(v_)); }
     /// Converts the error into an Unexpected for propagation: `if (!r) return r.take_error();`
     Unexpected take_error() { check(false); return Unexpected{std::get<1>(std::move(v_))}; }
 
@@ -130,25 +156,24 @@ private:
     void check(bool want_value) const {
         if (ok() != want_value) std::abort();
     }
-    std::variant<T, RRError> v_;
+    std::variant<T, ErrorBox> v_;
 };
 
 template <>
 class [[nodiscard]] Result<void> {
 public:
     Result() = default;
-    Result(Unexpected u) : err_(std::move(u.error)), has_error_(true) {}
+    Result(Unexpected u) : err_(std::move(u.error)) {}
 
-    bool ok() const noexcept { return !has_error_; }
+    bool ok() const noexcept { return !err_; }
     explicit operator bool() const noexcept { return ok(); }
-    void value() const { if (has_error_) std::abort(); }
+    void value() const { if (err_) std::abort(); }
 
-    const RRError& error() const& { if (!has_error_) std::abort(); return err_; }
-    Unexpected take_error() { if (!has_error_) std::abort(); return Unexpected{std::move(err_)}; }
+    const RRError& error() const& { if (!err_) std::abort(); return **err_; }
+    Unexpected take_error() { if (!err_) std::abort(); return Unexpected{std::move(*err_)}; }
 
 private:
-    RRError err_;
-    bool has_error_ = false;
+    std::optional<ErrorBox> err_;
 };
 
 }  // namespace rr

@@ -41,15 +41,23 @@ Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const D
                                std::vector<MessageEntry> storage) {
     detail::MessageDecoder decoder(buffer.bytes(), &buffer, limits, context);
     ByteReader body;
+    // One named result returned on every path: the message is built in the caller's slot, not moved
+    // out of a local into the Result and again out of the Result.
+    Result<Message> out{Message{}};
     auto info = decoder.read_header(body);
-    if (!info) return info.take_error();
+    if (!info) {
+        out = info.take_error();
+        return out;
+    }
     auto entries = decoder.read_entries(*info, body, std::move(storage));
-    if (!entries) return entries.take_error();
-    Message m;
-    m.version = info->version;
-    m.header = std::move(info->header);
-    m.entries = std::move(*entries);
-    return m;
+    if (!entries) {
+        out = entries.take_error();
+        return out;
+    }
+    out->version = info->version;
+    out->header = std::move(info->header);
+    out->entries = std::move(*entries);
+    return out;
 }
 
 namespace detail {

@@ -99,7 +99,8 @@ void ServiceSession::on_timer(MonoTime now) {
     stream_.on_timer(now);
     for (auto it = pending_callbacks_.begin(); it != pending_callbacks_.end();) {
         if (now >= it->second) {
-            events_.emplace_back(ServiceCallbackResponse{it->first, fail(MessageErrorType::RequestTimeout, "callback timed out")});
+            events_.emplace_back(std::in_place_type<ServiceCallbackResponse>, it->first,
+                                 fail(MessageErrorType::RequestTimeout, "callback timed out"));
             it = pending_callbacks_.erase(it);
         } else {
             ++it;
@@ -114,7 +115,8 @@ std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
 
 void ServiceSession::close_session() {
     for (auto& [id, deadline] : pending_callbacks_)
-        events_.emplace_back(ServiceCallbackResponse{id, fail(MessageErrorType::ConnectionError, "client disconnected")});
+        events_.emplace_back(std::in_place_type<ServiceCallbackResponse>, id,
+                             fail(MessageErrorType::ConnectionError, "client disconnected"));
     pending_callbacks_.clear();
     pending_object_types_.clear();
     held_wires_.clear();
@@ -479,7 +481,7 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
             if (it == pending_callbacks_.end()) return;
             pending_callbacks_.erase(it);
             const std::uint32_t id = e.request_id;
-            events_.emplace_back(ServiceCallbackResponse{id, std::move(e)});
+            events_.emplace_back(std::in_place_type<ServiceCallbackResponse>, id, std::move(e));
             return;
         }
         case MessageEntryType::PipePacket:

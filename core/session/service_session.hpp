@@ -79,6 +79,9 @@ struct ServiceObjectTypeQuery {
 };
 /// The client's answer to request() (CallbackCallRet), or RequestTimeout / ConnectionError.
 struct ServiceCallbackResponse {
+    // Built in place (as ServiceRequest): moving a temporary Result in made GCC 12 warn
+    // -Wmaybe-uninitialized about the error side of the variant at -O3.
+    ServiceCallbackResponse(std::uint32_t id, Result<MessageEntry>&& e) : request_id(id), entry(std::move(e)) {}
     std::uint32_t request_id = 0;
     Result<MessageEntry> entry;
 };

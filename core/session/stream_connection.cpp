@@ -98,7 +98,7 @@ Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
     }
     if (state_ != State::connected)
         return fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
-    events_.push_back(StreamMessage{std::move(m), std::move(frame)});
+    events_.emplace_back(std::in_place_type<StreamMessage>, StreamMessage{std::move(m), std::move(frame)});
     return {};
 }
 

@@ -87,6 +87,7 @@ Result<void> ObjectService::set_attributes(MapString attributes) {
 void ObjectService::set_users(PasswordTable users) {
     std::lock_guard lock(mutex_);
     users_ = std::move(users);
+    has_users_.store(!users_.empty(), std::memory_order_release);
 }
 
 std::vector<std::string> ObjectService::service_definitions() const {
@@ -104,10 +105,7 @@ MessageElement ObjectService::attributes() const {
     return attributes_;
 }
 
-bool ObjectService::requires_authentication() const {
-    std::lock_guard lock(mutex_);
-    return !users_.empty();
-}
+bool ObjectService::requires_authentication() const { return has_users_.load(std::memory_order_acquire); }
 
 Result<void> ObjectService::authenticate(const std::string& username, const MessageElement* credentials) {
     std::lock_guard lock(mutex_);
@@ -444,6 +442,7 @@ bool ObjectService::has_privilege(const std::string& username, std::string_view 
 
 Result<void> ObjectService::check_locks(const SessionRef& session, const std::string& path, const ServiceObject* obj,
                                         const MessageEntry& entry) {
+    if (!locks_->any()) return {};  // the common case: nothing locked, no member lookup, no username copy
     // Members marked [nolock] / [nolockread] pass object locks; monitor locks apply to every member.
     bool nolock = false;
     if (obj)

@@ -26,6 +26,7 @@
 // Threads: thread-safe. Requests run on the client's strand (see ServiceObject for handler rules).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -135,6 +136,7 @@ private:
     std::mt19937 rng_;
     MessageElement attributes_;
     PasswordTable users_;
+    std::atomic<bool> has_users_{false};  // !users_.empty(), read on every request without mutex_
     const std::shared_ptr<ServiceLocks> locks_ = std::make_shared<ServiceLocks>();
     bool shut_down_ = false;
 };

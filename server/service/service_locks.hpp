@@ -81,6 +81,9 @@ public:
     /// or, unless `nolock`, a lock of another user or session covers it (ObjectLockedError "Object
     /// locked by <user>"). A monitor holder's request keeps its monitor from going idle.
     Result<void> check(const std::string& path, const Requester& who, bool nolock);
+    /// False while no object lock or monitor is held anywhere in the service: check() then passes every
+    /// request, and callers may skip building its Requester.
+    bool any() const noexcept { return any_.load(std::memory_order_acquire); }
     /// A client session closed: its client locks, monitors and waits go, and its user's user locks when
     /// it was `last_session_of_user`.
     void session_closed(std::uint32_t endpoint, std::string_view username, bool last_session_of_user);

@@ -132,6 +132,8 @@ Result<std::shared_ptr<ServiceObject>> ServiceObject::create(std::shared_ptr<con
     }
     std::sort(obj->slots_.begin(), obj->slots_.end(),
               [](const auto& a, const auto& b) { return a->info->def->name < b->info->def->name; });
+    obj->slot_names_.reserve(obj->slots_.size());
+    for (const auto& slot : obj->slots_) obj->slot_names_.push_back(slot->info->def->name);
     return obj;
 }
 
@@ -140,10 +142,9 @@ RRError ServiceObject::user_error(std::string_view exception, std::string messag
 }
 
 ServiceObject::Slot* ServiceObject::find_slot(std::string_view name) const noexcept {
-    auto it = std::lower_bound(slots_.begin(), slots_.end(), name,
-                               [](const auto& s, std::string_view n) { return s->info->def->name < n; });
-    if (it == slots_.end() || (*it)->info->def->name != name) return nullptr;
-    return it->get();
+    auto it = std::lower_bound(slot_names_.begin(), slot_names_.end(), name);
+    if (it == slot_names_.end() || *it != name) return nullptr;
+    return slots_[static_cast<std::size_t>(it - slot_names_.begin())].get();
 }
 
 Result<ServiceObject::Slot*> ServiceObject::slot_of(std::string_view name, MemberKind kind) const {

@@ -187,6 +187,7 @@ private:
     const std::string type_;
     const std::string service_name_;
     std::vector<std::unique_ptr<Slot>> slots_;  // one per robdef member, sorted by name
+    std::vector<std::string_view> slot_names_;  // slots_[i]'s member name (the robdef's string): one flat search
     mutable std::mutex mutex_;                  // guards handlers/stored values in slots and the binding
     std::weak_ptr<ObjectService> service_;
     std::vector<std::string> paths_;

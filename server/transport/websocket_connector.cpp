@@ -44,7 +44,7 @@ RRError declined_error(const websocket::response_type& res, bool sent_login) {
     else if (status == 403)
         text += ": forbidden (Origin or address not allowed?)";
     else
-        text += " " + std::string(res.reason()) + ": the server declined the WebSocket upgrade";
+        text.append(" ").append(res.reason()).append(": the server declined the WebSocket upgrade");
     return make_error(MessageErrorType::ConnectionError, std::move(text));
 }
 
