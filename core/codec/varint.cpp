@@ -2,7 +2,7 @@
 
 namespace rr {
 
-void write_uint_x(ByteWriter& w, std::uint32_t v) {
+void detail::write_uint_x_multibyte(ByteWriter& w, std::uint32_t v) {
     if (v <= 252) {
         w.write_u8(static_cast<std::uint8_t>(v));
     } else if (v <= 0xFFFF) {
@@ -107,7 +107,7 @@ Result<std::int64_t> read_int_x_any(ByteReader& in, bool allow64) {
 
 }  // namespace
 
-Result<std::uint32_t> read_uint_x(ByteReader& r) {
+Result<std::uint32_t> detail::read_uint_x_multibyte(ByteReader& r) {
     auto v = read_uint_x_any(r, false);
     if (!v) return v.take_error();
     return static_cast<std::uint32_t>(*v);

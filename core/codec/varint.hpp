@@ -45,14 +45,35 @@ constexpr std::uint64_t size_plus_uint_x(std::uint64_t s) noexcept {
     return s + 9;
 }
 
-void write_uint_x(ByteWriter& w, std::uint32_t v);
+namespace detail {
+void write_uint_x_multibyte(ByteWriter& w, std::uint32_t v);
+Result<std::uint32_t> read_uint_x_multibyte(ByteReader& r);
+}  // namespace detail
+
+// The one-byte form (every value up to 252: most sizes, counts and flags) is inline; messages carry
+// about ten of these per entry.
+inline void write_uint_x(ByteWriter& w, std::uint32_t v) {
+    if (v <= 252)
+        w.write_u8(static_cast<std::uint8_t>(v));
+    else
+        detail::write_uint_x_multibyte(w, v);
+}
 void write_uint_x64(ByteWriter& w, std::uint64_t v);
 void write_int_x(ByteWriter& w, std::int32_t v);
 void write_int_x64(ByteWriter& w, std::int64_t v);
 
 /// Reads a 32-bit uint_x. Errors: ProtocolError (truncated, or the 64-bit marker 255).
 /// On error the cursor is left where it was (as for every read below).
-Result<std::uint32_t> read_uint_x(ByteReader& r);
+inline Result<std::uint32_t> read_uint_x(ByteReader& r) {
+    if (r.remaining() != 0) {
+        const auto first = static_cast<std::uint8_t>(r.bytes()[r.position()]);
+        if (first <= 252) {
+            (void)r.skip(1);
+            return first;
+        }
+    }
+    return detail::read_uint_x_multibyte(r);
+}
 /// Reads a 64-bit uint_x. Errors: ProtocolError (truncated).
 Result<std::uint64_t> read_uint_x64(ByteReader& r);
 /// Reads a 32-bit int_x. Errors: ProtocolError (truncated, or the 64-bit marker 127).

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -96,20 +97,19 @@ RRError make_error(MessageErrorType type, std::string message);
 /// destroyed or assigned.
 class ErrorBox {
 public:
-    explicit ErrorBox(RRError error) : p_(new RRError(std::move(error))) {}
-    ErrorBox(const ErrorBox& o) : p_(o.p_ ? new RRError(*o.p_) : nullptr) {}
-    ErrorBox(ErrorBox&& o) noexcept : p_(std::exchange(o.p_, nullptr)) {}
+    explicit ErrorBox(RRError error) : p_(std::make_unique<RRError>(std::move(error))) {}
+    ErrorBox(const ErrorBox& o) : p_(o.p_ ? std::make_unique<RRError>(*o.p_) : nullptr) {}
+    ErrorBox(ErrorBox&&) noexcept = default;
     ErrorBox& operator=(ErrorBox o) noexcept {
-        std::swap(p_, o.p_);
+        p_ = std::move(o.p_);
         return *this;
     }
-    ~ErrorBox() { delete p_; }
 
     RRError& operator*() const noexcept { return *p_; }
-    RRError* operator->() const noexcept { return p_; }
+    RRError* operator->() const noexcept { return p_.get(); }
 
 private:
-    RRError* p_;
+    std::unique_ptr<RRError> p_;
 };
 
 /// Wraps an RRError so that `return fail(...)` converts into any Result<T>.

@@ -19,21 +19,23 @@ public:
                    const DecodeContext* context)
         : message_(message), owner_(owner), limits_(limits), context_(context) {}
 
-    /// Header of the message (both versions); `body` is left over the entry bytes.
-    Result<MessageHeaderInfo> read_header(ByteReader& body);
-    /// Entries after the header; `body` must end exactly after the last one.
-    /// The entries, decoded into `entries` (cleared first; its capacity is reused).
-    Result<std::vector<MessageEntry>> read_entries(const MessageHeaderInfo& info, ByteReader& body,
-                                                   std::vector<MessageEntry> entries = {});
+    /// Header of the message (both versions): the framing fields into `info`, the header into
+    /// `header` (default-constructed: fields the message leaves out keep their defaults, or come from
+    /// the DecodeContext). `body` is left over the entry bytes.
+    Result<void> read_header(ByteReader& body, MessageHeaderInfo& info, MessageHeader& header);
+    /// Entries after the header (`info` and `header` as read_header left them), decoded into `entries`
+    /// (cleared first; its capacity is reused); `body` must end exactly after the last one.
+    Result<void> read_entries(const MessageHeaderInfo& info, const MessageHeader& header, ByteReader& body,
+                              std::vector<MessageEntry>& entries);
 
 private:
     // v2 (message_reader_v2.cpp)
-    Result<void> read_header_v2(ByteReader& r, MessageHeaderInfo& info);
+    Result<void> read_header_v2(ByteReader& r, MessageHeaderInfo& info, MessageHeader& h);
     Result<void> read_entry_v2(ByteReader& r, MessageEntry& entry);
     Result<void> read_element_v2(ByteReader& r, MessageElement& e, std::size_t depth, bool numbered);
 
     // v4 (message_reader_v4.cpp)
-    Result<void> read_header_v4(ByteReader& r, MessageHeaderInfo& info);
+    Result<void> read_header_v4(ByteReader& r, MessageHeaderInfo& info, MessageHeader& h);
     Result<void> read_entry_v4(ByteReader& r, MessageEntry& entry);
     Result<void> read_element_v4(ByteReader& r, MessageElement& e, std::size_t depth);
     Result<std::string> resolve_code(std::uint32_t code) const;

@@ -30,7 +30,9 @@ Result<MessageHeaderInfo> decode_message_header(std::span<const std::byte> messa
                                                 const DecodeContext* context) {
     detail::MessageDecoder decoder(message, nullptr, limits, context);
     ByteReader body;
-    return decoder.read_header(body);
+    MessageHeaderInfo info;
+    if (auto ok = decoder.read_header(body, info, info.header); !ok) return ok.take_error();
+    return info;
 }
 
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context) {
@@ -39,30 +41,26 @@ Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const D
 
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context,
                                std::vector<MessageEntry> storage) {
+    // One named result returned on every path: the message is built in the caller's slot.
+    Result<Message> out{Message{}};
+    out->entries = std::move(storage);
+    if (auto ok = decode_message_into(*out, buffer, limits, context); !ok) out = ok.take_error();
+    return out;
+}
+
+Result<void> decode_message_into(Message& out, const SharedBytes& buffer, const Limits& limits,
+                                 const DecodeContext* context) {
     detail::MessageDecoder decoder(buffer.bytes(), &buffer, limits, context);
     ByteReader body;
-    // One named result returned on every path: the message is built in the caller's slot, not moved
-    // out of a local into the Result and again out of the Result.
-    Result<Message> out{Message{}};
-    auto info = decoder.read_header(body);
-    if (!info) {
-        out = info.take_error();
-        return out;
-    }
-    auto entries = decoder.read_entries(*info, body, std::move(storage));
-    if (!entries) {
-        out = entries.take_error();
-        return out;
-    }
-    out->version = info->version;
-    out->header = std::move(info->header);
-    out->entries = std::move(*entries);
-    return out;
+    MessageHeaderInfo info;
+    if (auto ok = decoder.read_header(body, info, out.header); !ok) return ok;
+    out.version = info.version;
+    return decoder.read_entries(info, out.header, body, out.entries);
 }
 
 namespace detail {
 
-Result<MessageHeaderInfo> MessageDecoder::read_header(ByteReader& body) {
+Result<void> MessageDecoder::read_header(ByteReader& body, MessageHeaderInfo& info, MessageHeader& header) {
     auto size = read_message_preamble(message_, limits_);
     if (!size) return size.take_error();
     if (*size != message_.size())
@@ -72,31 +70,30 @@ Result<MessageHeaderInfo> MessageDecoder::read_header(ByteReader& body) {
     (void)r.skip(kMessagePreambleBytes);
     auto version = r.read_u16();
     if (!version) return version.take_error();
-    MessageHeaderInfo info;
     info.version = version_ = *version;
     info.message_size = *size;
     Result<void> ok;
     if (*version == 2)
-        ok = read_header_v2(r, info);
+        ok = read_header_v2(r, info, header);
     else if (*version == 4)
-        ok = read_header_v4(r, info);
+        ok = read_header_v4(r, info, header);
     else
         return fail(MessageErrorType::ProtocolError, "unknown message version " + std::to_string(*version));
-    if (!ok) return ok.take_error();
+    if (!ok) return ok;
     body = ByteReader(message_.subspan(info.header_size));
-    return info;
+    return {};
 }
 
-Result<std::vector<MessageEntry>> MessageDecoder::read_entries(const MessageHeaderInfo& info, ByteReader& body,
-                                                               std::vector<MessageEntry> entries) {
+Result<void> MessageDecoder::read_entries(const MessageHeaderInfo& info, const MessageHeader& header, ByteReader& body,
+                                          std::vector<MessageEntry>& entries) {
     entries.clear();
     if (info.entry_count > limits_.max_entries)
         return error(MessageErrorType::BufferLimitViolation, body,
                      std::to_string(info.entry_count) + " entries over limit " + std::to_string(limits_.max_entries));
     const std::size_t min_entry = version_ == 2 ? 22 : 5;
     if (auto c = check_count(body, info.entry_count, min_entry, false, "entries"); !c) return c.take_error();
-    if (version_ == 4 && !info.header.string_table.empty()) {
-        local_table_ = &info.header.string_table;
+    if (version_ == 4 && !header.string_table.empty()) {
+        local_table_ = &header.string_table;
         local_index_.reserve(local_table_->size());
         for (std::size_t i = 0; i < local_table_->size(); ++i) local_index_.emplace_back((*local_table_)[i].first, i);
         // CORE keeps the first definition of a duplicated code.
@@ -111,7 +108,7 @@ Result<std::vector<MessageEntry>> MessageDecoder::read_entries(const MessageHead
     if (!body.at_end())
         return error(MessageErrorType::ProtocolError, body,
                      std::to_string(body.remaining()) + " bytes after the last entry");
-    return entries;
+    return {};
 }
 
 Result<void> MessageDecoder::read_payload(ByteReader& r, MessageElement& e, std::uint32_t data_count,

@@ -85,5 +85,11 @@ Result<Message> decode_message(SharedBytes buffer, const Limits& limits = {}, co
 /// from an EntryVectorPool, core/message/entry_vector_pool.hpp).
 Result<Message> decode_message(SharedBytes buffer, const Limits& limits, const DecodeContext* context,
                                std::vector<MessageEntry> storage);
+/// As above, into `out`, which must be a default-constructed Message except for `out.entries`: the
+/// entries are decoded into that vector (cleared first; its capacity is reused). A host decodes a frame
+/// straight into the event or slot it will be handled from (no move of the message afterwards). On an
+/// error `out` holds part of the message and is to be dropped.
+Result<void> decode_message_into(Message& out, const SharedBytes& buffer, const Limits& limits,
+                                 const DecodeContext* context);
 
 }  // namespace rr

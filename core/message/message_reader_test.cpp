@@ -179,6 +179,28 @@ TEST_CASE("message: decoded payloads are views into the received buffer", "[shar
     CHECK(values<double>(el1) == std::vector<double>{1, 2, 3, 4, 5});
 }
 
+TEST_CASE("message: decode_message_into fills a message in place and reuses its entry vector", "[shared]") {
+    RR_REQUIRE_VECTOR(v2, "message2.bin");
+    RR_REQUIRE_VECTOR(v4, "message4.bin");
+    for (const auto* bytes : {&v2, &v4}) {
+        auto buffer = SharedBytes::copy_of(*bytes);
+        Message m;
+        m.entries.reserve(8);
+        const MessageEntry* storage = m.entries.data();
+        REQUIRE(decode_message_into(m, buffer, {}, nullptr));
+        CHECK(m.entries.data() == storage);  // the given vector, not a new one
+        CHECK(m == decode_message(buffer).value());
+        check_lite_message(m);
+    }
+    // An error is returned as decode_message returns it; the message is left to be dropped.
+    auto cut = SharedBytes::copy_of(std::span<const std::byte>(v4).first(v4.size() - 1));
+    Message m;
+    auto r = decode_message_into(m, cut, {}, nullptr);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == decode_message(cut).error().type);
+    CHECK(r.error().message == decode_message(cut).error().message);
+}
+
 TEST_CASE("message: CreateConnection request v2 (wire.md 15.4a)", "[shared]") {
     RR_REQUIRE_VECTOR(bytes, "vec_createconnection_req_v2.bin");
     check_each_split(bytes, [](const Message& m) {

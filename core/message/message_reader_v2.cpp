@@ -32,7 +32,7 @@ Result<void> read_node_id(ByteReader& r, NodeID& out) {
 
 }  // namespace
 
-Result<void> MessageDecoder::read_header_v2(ByteReader& r, MessageHeaderInfo& info) {
+Result<void> MessageDecoder::read_header_v2(ByteReader& r, MessageHeaderInfo& info, MessageHeader& h) {
     auto header_size = r.read_u16();
     if (!header_size) return header_size.take_error();
     if (*header_size < kHeaderFixedBytes || *header_size > info.message_size)
@@ -41,7 +41,6 @@ Result<void> MessageDecoder::read_header_v2(ByteReader& r, MessageHeaderInfo& in
     info.header_size = *header_size;
     auto hr = r.sub_reader(*header_size - r.position());
     if (!hr) return hr.take_error();
-    auto& h = info.header;
     Result<void> ok;
     if (!(ok = read_node_id(*hr, h.sender_node_id)) || !(ok = read_node_id(*hr, h.receiver_node_id)))
         return error(MessageErrorType::ProtocolError, *hr, "header truncated");

@@ -34,7 +34,7 @@ Result<void> read_node_id(ByteReader& r, NodeID& out) {
 
 }  // namespace
 
-Result<void> MessageDecoder::read_header_v4(ByteReader& r, MessageHeaderInfo& info) {
+Result<void> MessageDecoder::read_header_v4(ByteReader& r, MessageHeaderInfo& info, MessageHeader& h) {
     auto header_len = read_uint_x(r);
     if (!header_len) return error(MessageErrorType::ProtocolError, r, "HeaderLen: " + header_len.error().message);
     // HeaderLen counts from offset 0 and includes its own bytes; the flags byte follows it.
@@ -46,7 +46,6 @@ Result<void> MessageDecoder::read_header_v4(ByteReader& r, MessageHeaderInfo& in
     if (!hr) return hr.take_error();
     auto flags = hr->read_u8();
     if (!flags) return flags.take_error();
-    auto& h = info.header;
     h.v4_flags = *flags;
     auto truncated = [&] { return error(MessageErrorType::ProtocolError, *hr, "header field past HeaderLen"); };
 

@@ -32,12 +32,6 @@ Result<NodeID> NodeID::parse(std::string_view text) {
     return NodeID(out);
 }
 
-bool NodeID::is_any() const noexcept {
-    for (auto b : bytes_)
-        if (b != std::byte{0}) return false;
-    return true;
-}
-
 std::string NodeID::to_string() const {
     static constexpr char kHex[] = "0123456789abcdef";
     std::string s;

@@ -114,14 +114,21 @@ std::uint32_t ClientSession::next_request_id() {
 Result<void> ClientSession::feed(std::span<const std::byte> bytes, MonoTime now) {
     if (state_ == State::closed) return fail(MessageErrorType::ConnectionError, "session closed");
     auto r = stream_.feed(bytes, now);
-    while (auto ev = stream_.poll_event()) on_stream_event(std::move(*ev), now);
+    drain_stream(now);
     return r;
 }
 
 void ClientSession::on_transport_closed(RRError error) {
     stream_.on_transport_closed(error);
-    while (auto ev = stream_.poll_event()) on_stream_event(std::move(*ev), MonoTime{});
+    drain_stream(MonoTime{});
     close(std::move(error));
+}
+
+void ClientSession::drain_stream(MonoTime now) {
+    // Handled in place (no move per message). Handling runs no host code and never drains the stream
+    // itself, so the one batch vector is never in use twice; events queued meanwhile come next round.
+    for (stream_.take_events(stream_batch_); !stream_batch_.empty(); stream_.take_events(stream_batch_))
+        for (auto& ev : stream_batch_) on_stream_event(std::move(ev), now);
 }
 
 void ClientSession::on_stream_event(StreamEvent&& ev, MonoTime now) {
@@ -405,7 +412,7 @@ void ClientSession::on_timer(MonoTime now) {
         return;
     }
     stream_.on_timer(now);
-    while (auto ev = stream_.poll_event()) on_stream_event(std::move(*ev), now);
+    drain_stream(now);
     switch (state_) {
         case State::closed:
         case State::stream_connecting: return;

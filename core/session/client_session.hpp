@@ -145,6 +145,7 @@ private:
         bool has_deadline = true;
     };
 
+    void drain_stream(MonoTime now);
     void on_stream_event(StreamEvent&& ev, MonoTime now);
     void on_message(Message&& m, MonoTime now);
     void on_entries(Message& m, MonoTime now);
@@ -159,6 +160,7 @@ private:
 
     ClientSessionConfig config_;
     StreamConnection stream_;
+    std::vector<StreamEvent> stream_batch_;  // drain_stream's
     State state_ = State::stream_connecting;
     ClientSessionInfo info_;
     std::uint32_t remote_endpoint_ = 0;

@@ -1,9 +1,11 @@
 // The FIFO in which a sans-IO session leaves its events for the host (StreamConnection,
 // ServiceSession, ClientSession). A message makes one or two events, taken at once; a vector reused
 // from the front keeps its storage, where std::deque allocated a block every few messages.
+// take_all() hands a host every event at once, to handle in place.
 #pragma once
 
 #include <cstddef>
+#include <iterator>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -18,6 +20,8 @@ public:
         return items_.emplace_back(std::forward<Args>(args)...);
     }
     void push_back(T value) { items_.push_back(std::move(value)); }
+    /// Removes the newest event (one just emplaced that turned out not to be needed).
+    void pop_back() { items_.pop_back(); }
     bool empty() const noexcept { return head_ == items_.size(); }
     std::size_t size() const noexcept { return items_.size() - head_; }
 
@@ -35,6 +39,21 @@ public:
             head_ = 0;
         }
         return out;
+    }
+
+    /// Moves every queued event into `batch` (whose old events are destroyed first), oldest first, so
+    /// that a host handles them where they are instead of moving each one out as pop() does. The two
+    /// vectors swap storage, so both keep their capacity from one drain to the next.
+    void take_all(std::vector<T>& batch) {
+        batch.clear();
+        if (head_ == 0) {
+            std::swap(batch, items_);
+            return;
+        }
+        batch.insert(batch.end(), std::make_move_iterator(items_.begin() + static_cast<std::ptrdiff_t>(head_)),
+                     std::make_move_iterator(items_.end()));
+        items_.clear();
+        head_ = 0;
     }
 
 private:

@@ -70,14 +70,18 @@ void ServiceSession::close(RRError error) {
 }
 
 void ServiceSession::drain_stream(MonoTime now) {
-    while (auto ev = stream_.poll_event()) {
-        if (auto* m = std::get_if<StreamMessage>(&*ev)) {
-            on_message(std::move(m->message), now);
-        } else if (auto* c = std::get_if<StreamClosed>(&*ev)) {
-            close_session();
-            if (!closed_reported_) {
-                closed_reported_ = true;
-                events_.emplace_back(ServiceConnectionClosed{std::move(c->error)});
+    // Handled in place (no move per message). Handling runs no host code, so this is never re-entered
+    // and the one batch vector is never in use twice; stream events queued meanwhile come next round.
+    for (stream_.take_events(stream_batch_); !stream_batch_.empty(); stream_.take_events(stream_batch_)) {
+        for (auto& ev : stream_batch_) {
+            if (auto* m = std::get_if<StreamMessage>(&ev)) {
+                on_message(std::move(m->message), now);
+            } else if (auto* c = std::get_if<StreamClosed>(&ev)) {
+                close_session();
+                if (!closed_reported_) {
+                    closed_reported_ = true;
+                    events_.emplace_back(ServiceConnectionClosed{std::move(c->error)});
+                }
             }
         }
     }
@@ -112,6 +116,8 @@ void ServiceSession::on_timer(MonoTime now) {
 std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
     return events_.pop();
 }
+
+void ServiceSession::take_events(std::vector<ServiceSessionEvent>& batch) { events_.take_all(batch); }
 
 void ServiceSession::close_session() {
     for (auto& [id, deadline] : pending_callbacks_)

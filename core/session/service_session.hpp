@@ -127,6 +127,9 @@ public:
     std::optional<MonoTime> next_deadline() const;
     void on_timer(MonoTime now);
     std::optional<ServiceSessionEvent> poll_event();
+    /// Every queued event at once, oldest first, into `batch` (its old events are destroyed first; see
+    /// EventQueue::take_all), to handle in place. Events queued while handling them wait for the next call.
+    void take_events(std::vector<ServiceSessionEvent>& batch);
     bool is_closed() const noexcept { return stream_.is_closed(); }
     /// Messages received and queued for sending so far (for the host's counters).
     std::uint64_t messages_in() const noexcept { return messages_in_; }
@@ -190,6 +193,7 @@ private:
     ServiceSessionConfig config_;
     StreamConnection stream_;
     EventQueue<ServiceSessionEvent> events_;
+    std::vector<StreamEvent> stream_batch_;  // drain_stream's
     bool closed_reported_ = false;
 
     std::shared_ptr<HostedService> service_;

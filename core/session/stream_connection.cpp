@@ -24,6 +24,12 @@ std::uint32_t stream_capability_value(std::string_view name, bool v4, bool strin
     return 0;
 }
 
+// Entries the stream itself answers (never handed to the layer above).
+bool is_stream_entry(MessageEntryType type) {
+    return is_transport_internal(type) || type == MessageEntryType::ConnectionTest ||
+           type == MessageEntryType::ConnectionTestRet;
+}
+
 Message single_entry_message(MessageEntry entry) {
     Message m;
     m.version = 2;
@@ -79,27 +85,35 @@ Result<void> StreamConnection::feed(std::span<const std::byte> bytes, MonoTime n
 }
 
 Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
-    DecodeContext ctx = decode_context();
-    auto decoded = decode_message(frame, config_.limits, &ctx, entry_vectors_.take());
-    if (!decoded) return decoded.take_error();
-    Message& m = *decoded;
-    if (m.entries.empty()) return {};  // legal, nothing to do
-
-    const MessageEntry& first = m.entries.front();
-    const auto type = first.entry_type;
-    const bool transport_entry = is_transport_internal(type) || type == MessageEntryType::ConnectionTest ||
-                                 type == MessageEntryType::ConnectionTestRet;
-    if (transport_entry) {
-        if (m.entries.size() != 1)
-            return fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
-        auto handled = handle_transport_entry(m, first, now);
-        entry_vectors_.give(std::move(m.entries));
-        return handled;
+    // Decoded straight into the event it becomes for the layer above: the message is not moved again.
+    // Nothing else is queued until the slot is either kept or popped.
+    auto& slot = std::get<StreamMessage>(events_.emplace_back(std::in_place_type<StreamMessage>));
+    Message& m = slot.message;
+    m.entries = entry_vectors_.take();
+    const DecodeContext ctx = decode_context();
+    auto decoded = decode_message_into(m, frame, config_.limits, &ctx);
+    const bool keep = decoded && !m.entries.empty() && !is_stream_entry(m.entries.front().entry_type);
+    if (keep && state_ == State::connected) {
+        slot.frame = std::move(frame);
+        return {};
     }
-    if (state_ != State::connected)
+    Message message = std::move(m);  // a transport entry queues events of its own: out of the slot first
+    events_.pop_back();
+    if (!decoded || message.entries.empty()) {  // an empty message is legal, with nothing to do
+        entry_vectors_.give(std::move(message.entries));
+        return decoded;
+    }
+    if (keep) {
+        entry_vectors_.give(std::move(message.entries));
         return fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
-    events_.emplace_back(std::in_place_type<StreamMessage>, StreamMessage{std::move(m), std::move(frame)});
-    return {};
+    }
+    if (message.entries.size() != 1) {
+        entry_vectors_.give(std::move(message.entries));
+        return fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
+    }
+    auto handled = handle_transport_entry(message, message.entries.front(), now);
+    entry_vectors_.give(std::move(message.entries));
+    return handled;
 }
 
 Result<void> StreamConnection::handle_transport_entry(const Message& m, const MessageEntry& e, MonoTime now) {
@@ -324,35 +338,36 @@ Result<void> StreamConnection::send(Message&& message, MonoTime now) {
 
 // v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this
 // session's nodes and endpoints (CORE, wire.md §2.3), except for one entry below 500.
-bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bool omit_routing) const {
-    return m.version != version || (omit_routing_applies(m, version, omit_routing) && !m.header.v4_flags);
+bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bool omit) const {
+    return m.version != version || (omit && !m.header.v4_flags);
 }
 
 bool StreamConnection::omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const {
     return omit_routing && version == 4 && session_established_ && m.entries.size() == 1 &&
            static_cast<std::uint16_t>(m.entries.front().entry_type) >= 500 &&
-           m.header.sender_node_id == config_.local_node_id && m.header.receiver_node_id == negotiated_.remote_node_id &&
            m.header.sender_endpoint == local_endpoint_ && m.header.receiver_endpoint == remote_endpoint_ &&
-           m.header.sender_node_name.empty() && m.header.receiver_node_name.empty();
+           m.header.sender_node_name.empty() && m.header.receiver_node_name.empty() &&
+           m.header.sender_node_id == config_.local_node_id && m.header.receiver_node_id == negotiated_.remote_node_id;
 }
 
-void StreamConnection::relabel(Message& m, std::uint16_t version, bool omit_routing) const {
-    const bool omit = omit_routing_applies(m, version, omit_routing) && !m.header.v4_flags;
+void StreamConnection::relabel(Message& m, std::uint16_t version, bool omit) const {
     m.version = version;
-    if (omit)
+    if (omit && !m.header.v4_flags)
         m.header.v4_flags =
             static_cast<std::uint8_t>(default_v4_flags(m) & ~(message_flags::routing_info | message_flags::endpoint_info));
 }
 
 Result<void> StreamConnection::queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
-    if (!needs_relabel(m, version, omit_routing)) return append_encoded(m, now);
+    const bool omit = omit_routing_applies(m, version, omit_routing);
+    if (!needs_relabel(m, version, omit)) return append_encoded(m, now);
     Message copy = m;
-    relabel(copy, version, omit_routing);
+    relabel(copy, version, omit);
     return append_encoded(copy, now);
 }
 
 Result<void> StreamConnection::queue_owned(Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
-    if (needs_relabel(m, version, omit_routing)) relabel(m, version, omit_routing);
+    const bool omit = omit_routing_applies(m, version, omit_routing);
+    if (needs_relabel(m, version, omit)) relabel(m, version, omit);
     return append_encoded(m, now);
 }
 
@@ -417,6 +432,8 @@ void StreamConnection::take_output(std::vector<std::byte>& out) {
 std::optional<StreamEvent> StreamConnection::poll_event() {
     return events_.pop();
 }
+
+void StreamConnection::take_events(std::vector<StreamEvent>& batch) { events_.take_all(batch); }
 
 std::optional<MonoTime> StreamConnection::next_deadline() const {
     switch (state_) {

@@ -128,6 +128,9 @@ public:
     std::size_t pending_output_size() const noexcept { return output_.size() - output_offset_; }
 
     std::optional<StreamEvent> poll_event();
+    /// Every queued event at once, oldest first, into `batch` (its old events are destroyed first; see
+    /// EventQueue::take_all): the host handles them in place, without moving each one out.
+    void take_events(std::vector<StreamEvent>& batch);
 
     std::optional<MonoTime> next_deadline() const;
     void on_timer(MonoTime now);
@@ -156,10 +159,11 @@ private:
     void queue_create_connection(MonoTime now);
     Result<void> queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
     Result<void> queue_owned(Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
-    /// Whether `m` must be re-labelled before encoding (format `version`, or routing omitted), and how.
-    bool needs_relabel(const Message& m, std::uint16_t version, bool omit_routing) const;
+    /// Whether the v4 routing omission applies to `m` (asked once per message; `omit` below).
     bool omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const;
-    void relabel(Message& m, std::uint16_t version, bool omit_routing) const;
+    /// Whether `m` must be re-labelled before encoding (format `version`, or routing omitted), and how.
+    bool needs_relabel(const Message& m, std::uint16_t version, bool omit) const;
+    void relabel(Message& m, std::uint16_t version, bool omit) const;
     Result<void> append_encoded(const Message& m, MonoTime now);
     void close(RRError error);
     std::size_t send_limit() const noexcept;

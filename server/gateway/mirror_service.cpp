@@ -249,7 +249,7 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
     const auto type = entry.entry_type;
     const bool packet = type == MessageEntryType::PipePacket || type == MessageEntryType::PipePacketRet ||
                         type == MessageEntryType::WirePacket;
-    if (!packet) {
+    if (!packet && locks_->any()) {  // while nothing is locked: no username copy per request
         // Locks held at the gateway bind every member request, as ObjectService's do; packets on
         // connections opened before a lock pass (CORE checks requests only).
         auto ok = locks_->check(entry.service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, false);

@@ -37,6 +37,8 @@ SessionRef::SessionRef(std::weak_ptr<ServerSession> s) : session_(std::move(s)) 
     if (auto p = session_.lock()) endpoint_ = p->endpoint();
 }
 
+SessionRef::SessionRef(const std::shared_ptr<ServerSession>& s) : session_(s), endpoint_(s ? s->endpoint() : 0) {}
+
 std::string SessionRef::username() const {
     auto p = session_.lock();
     return p ? p->username() : std::string();
@@ -240,42 +242,47 @@ void ServerConnection::drain_events() {
         bool& flag;
         ~Done() { flag = false; }
     } done_draining{draining_};
-    while (auto ev = session_.poll_event()) {
-        if (auto* opened = std::get_if<ServiceSessionOpened>(&*ev)) {
-            auto service = std::static_pointer_cast<Service>(opened->service);
-            current_ = std::make_shared<ServerSession>(opened->endpoint, opened->client_endpoint, service, pump_,
-                                                       weak_from_this(), config_.max_send_queue_bytes);
-            current_->set_username(opened->username);
-            service->on_session_open(SessionRef(current_));
-        } else if (auto* admission = std::get_if<ServiceAdmission>(&*ev)) {
-            on_admission(std::move(*admission));
-        } else if (auto* user = std::get_if<ServiceSessionUser>(&*ev)) {
-            if (current_) current_->set_username(std::move(user->username));
-        } else if (auto* request = std::get_if<ServiceRequest>(&*ev)) {
-            on_request(std::move(*request));
-        } else if (auto* query = std::get_if<ServiceObjectTypeQuery>(&*ev)) {
-            on_object_type_query(std::move(*query));
-        } else if (auto* response = std::get_if<ServiceCallbackResponse>(&*ev)) {
-            auto it = callbacks_.find(response->request_id);
-            if (it == callbacks_.end()) continue;
-            auto done = std::move(it->second);
-            callbacks_.erase(it);
-            done(std::move(response->entry));
-        } else if (std::holds_alternative<ServiceSessionClosed>(*ev)) {
-            if (!current_) continue;
-            auto s = std::move(current_);
-            current_.reset();
-            s->mark_closed();
-            s->service()->on_session_close(SessionRef(s));
-        }
-        // ServiceConnectionClosed: the pump closes the transport (wants_close()).
-    }
+    // Handled in place, a batch at a time (no move per event); events queued by the handlers come in
+    // the next batch, so the order is the order they were queued in.
+    for (session_.take_events(batch_); !batch_.empty(); session_.take_events(batch_))
+        for (auto& event : batch_) handle_event(event);
     const auto in = session_.messages_in(), out = session_.messages_out();
     stats_->messages_in.fetch_add(in - messages_in_seen_, std::memory_order_relaxed);
     stats_->messages_out.fetch_add(out - messages_out_seen_, std::memory_order_relaxed);
     messages_in_seen_ = in;
     messages_out_seen_ = out;
     update_queue_estimate();
+}
+
+void ServerConnection::handle_event(ServiceSessionEvent& event) {
+    if (auto* opened = std::get_if<ServiceSessionOpened>(&event)) {
+        auto service = std::static_pointer_cast<Service>(opened->service);
+        current_ = std::make_shared<ServerSession>(opened->endpoint, opened->client_endpoint, service, pump_,
+                                                   weak_from_this(), config_.max_send_queue_bytes);
+        current_->set_username(opened->username);
+        service->on_session_open(SessionRef(current_));
+    } else if (auto* admission = std::get_if<ServiceAdmission>(&event)) {
+        on_admission(std::move(*admission));
+    } else if (auto* user = std::get_if<ServiceSessionUser>(&event)) {
+        if (current_) current_->set_username(std::move(user->username));
+    } else if (auto* request = std::get_if<ServiceRequest>(&event)) {
+        on_request(std::move(*request));
+    } else if (auto* query = std::get_if<ServiceObjectTypeQuery>(&event)) {
+        on_object_type_query(std::move(*query));
+    } else if (auto* response = std::get_if<ServiceCallbackResponse>(&event)) {
+        auto it = callbacks_.find(response->request_id);
+        if (it == callbacks_.end()) return;
+        auto done = std::move(it->second);
+        callbacks_.erase(it);
+        done(std::move(response->entry));
+    } else if (std::holds_alternative<ServiceSessionClosed>(event)) {
+        if (!current_) return;
+        auto s = std::move(current_);
+        current_.reset();
+        s->mark_closed();
+        s->service()->on_session_close(SessionRef(s));
+    }
+    // ServiceConnectionClosed: the pump closes the transport (wants_close()).
 }
 
 void ServerConnection::on_request(ServiceRequest&& request) {
@@ -285,8 +292,9 @@ void ServerConnection::on_request(ServiceRequest&& request) {
         service->handle_entry(SessionRef(current_), std::move(request.entry), Responder());
         return;
     }
-    Responder responder = make_responder(request.entry);
-    service->handle_entry(SessionRef(current_), std::move(request.entry), std::move(responder));
+    // The Responder is built in the parameter's place; std::move only names the entry, which the
+    // callee takes by reference, so make_responder reads it intact whatever the argument order.
+    service->handle_entry(SessionRef(current_), std::move(request.entry), make_responder(request.entry));
 }
 
 void ServerConnection::on_admission(ServiceAdmission&& admission) {
@@ -330,13 +338,15 @@ void ServerConnection::on_object_type_query(ServiceObjectTypeQuery&& query) {
 /// One per connection, shared by its Responders (no allocation per request).
 class ServerConnection::ConnectionReplySink final : public ReplySink {
 public:
-    ConnectionReplySink(std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump)
-        : connection_(std::move(connection)), pump_(std::move(pump)) {}
+    ConnectionReplySink(ServerConnection& owner, std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump)
+        : owner_(&owner), connection_(std::move(connection)), pump_(std::move(pump)) {}
 
     void send_reply(MessageEntry&& reply) override {
-        // The responder may complete on any thread; on the strand itself the reply goes out at once.
-        if (auto c = connection_.lock(); c && tls_handling == c.get()) {
-            c->reply(std::move(reply));
+        // The responder may complete on any thread; on the strand, while the connection handles its
+        // bytes or timer, the reply goes out at once. Handling keeps it alive, so no weak_ptr lock; the
+        // expiry check tells it from a later connection at the same address.
+        if (tls_handling == owner_ && !connection_.expired()) {
+            owner_->reply(std::move(reply));
             return;
         }
         auto p = pump_.lock();
@@ -347,12 +357,13 @@ public:
     }
 
 private:
+    ServerConnection* owner_;  // compared with tls_handling; used only while it handles (see send_reply)
     std::weak_ptr<ServerConnection> connection_;
     std::weak_ptr<PumpHandle> pump_;
 };
 
 Responder ServerConnection::make_responder(const MessageEntry& request) {
-    if (!reply_sink_) reply_sink_ = std::make_shared<ConnectionReplySink>(weak_from_this(), pump_);
+    if (!reply_sink_) reply_sink_ = std::make_shared<ConnectionReplySink>(*this, weak_from_this(), pump_);
     return Responder(reply_sink_, request);
 }
 

@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "core/session/service_session.hpp"
 #include "server/node/service.hpp"
@@ -115,6 +116,7 @@ public:
 
 private:
     void drain_events();
+    void handle_event(ServiceSessionEvent& event);
     void on_request(ServiceRequest&& request);
     void on_admission(ServiceAdmission&& admission);
     void on_object_type_query(ServiceObjectTypeQuery&& query);
@@ -132,6 +134,7 @@ private:
     std::shared_ptr<ServerSession> current_;  // the open client session's handle, if any
     std::map<std::uint32_t, std::function<void(Result<MessageEntry>)>> callbacks_;
     std::uint64_t messages_in_seen_ = 0, messages_out_seen_ = 0;
+    std::vector<ServiceSessionEvent> batch_;  // drain_events' (only the outermost call uses it)
     bool draining_ = false;
 };
 

@@ -34,6 +34,8 @@ class SessionRef {
 public:
     SessionRef() = default;
     explicit SessionRef(std::weak_ptr<ServerSession> s);
+    /// From a session known to be alive (the connection's own, per request): no weak_ptr lock.
+    explicit SessionRef(const std::shared_ptr<ServerSession>& s);
 
     /// This client's endpoint id (unique within the node while it lives).
     std::uint32_t endpoint() const noexcept { return endpoint_; }

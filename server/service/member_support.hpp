@@ -51,20 +51,24 @@ inline Result<MessageElement> pack_member(const MemberInfo& info, const Value& v
     return pack_value(v, type, name, info.types->set(), info.service_name);
 }
 
-/// `return` for a function/generator/callback reply: int32 0 for void (CORE's convention), else the
-/// value packed with `type`.
-inline Result<MessageElement> pack_return(const MemberInfo& info, const Value& v, const robdef::TypeDefinition& type) {
+/// Appends `return` of a function/generator/callback reply to `reply`: int32 0 for void (CORE's
+/// convention), else the value packed with `type`. Errors: as pack_value (`reply` is then unchanged).
+inline Result<void> append_return(MessageEntry& reply, const MemberInfo& info, const Value& v,
+                                  const robdef::TypeDefinition& type) {
     if (type.is_void()) {
         // CORE answers a void function with an int32 0 named "return"; its bytes are a constant, so a
-        // reply allocates nothing for them (issue 14).
+        // reply allocates nothing for them, and the element is built where it stays (issue 14).
         static constexpr std::byte kZero[sizeof(std::int32_t)]{};
-        MessageElement e;
+        MessageElement& e = reply.elements.emplace_back();
         e.name = "return";
         e.type = DataTypes::int32_t;
         e.data = SharedBytes(nullptr, kZero);  // static bytes: no owner to keep alive
-        return e;
+        return {};
     }
-    return pack_member(info, v, type, "return");
+    auto e = pack_member(info, v, type, "return");
+    if (!e) return e.take_error();
+    reply.elements.push_back(std::move(*e));
+    return {};
 }
 
 /// MemberNotFound with the official library's text.

@@ -154,6 +154,8 @@ std::vector<SessionRef> ObjectService::sessions() const {
 }
 
 Result<std::shared_ptr<ServiceObject>> ObjectService::resolve(const SessionRef& session, const std::string& path) {
+    // The root, which most requests address, stays bound until shutdown: no lock and no map lookup.
+    if (path == name_ && !shut_down_.load(std::memory_order_acquire)) return root_;
     {
         std::lock_guard lock(mutex_);
         if (auto it = objects_.find(path); it != objects_.end()) return it->second;
@@ -358,11 +360,12 @@ void ObjectService::handle_generator_next(const SessionRef& session, MessageEntr
     generator->async_next(std::move(parameter), [pending](Result<Value> r) {
         if (pending->done.exchange(true)) return;
         const auto& def = *pending->info->def;
-        Result<MessageElement> e = r ? detail::pack_return(*pending->info, *r,
-                                                           def.type.container == robdef::ContainerKind::generator
-                                                               ? without_container(def.type)
-                                                               : robdef::TypeDefinition{})
-                                     : Result<MessageElement>(fail(r.error()));
+        MessageEntry reply;
+        Result<void> e = r ? detail::append_return(reply, *pending->info, *r,
+                                                   def.type.container == robdef::ContainerKind::generator
+                                                       ? without_container(def.type)
+                                                       : robdef::TypeDefinition{})
+                           : Result<void>(fail(r.error()));
         if (!e) {
             // Any error ends the generator (StopIteration is the normal end).
             if (auto s = pending->service.lock()) {
@@ -376,8 +379,6 @@ void ObjectService::handle_generator_next(const SessionRef& session, MessageEntr
             pending->responder.fail(e.error());
             return;
         }
-        MessageEntry reply;
-        reply.elements.push_back(std::move(*e));
         pending->responder.respond(std::move(reply));
     });
 }

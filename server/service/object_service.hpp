@@ -138,7 +138,7 @@ private:
     PasswordTable users_;
     std::atomic<bool> has_users_{false};  // !users_.empty(), read on every request without mutex_
     const std::shared_ptr<ServiceLocks> locks_ = std::make_shared<ServiceLocks>();
-    bool shut_down_ = false;
+    std::atomic<bool> shut_down_{false};  // set under mutex_; resolve() reads it without, for the root
 };
 
 }  // namespace rr::server

@@ -67,6 +67,40 @@ TEST_CASE("ObjectService: connect reply, definitions, attributes, object types")
     CHECK_FALSE(ObjectService::create("other", f.root));
 }
 
+TEST_CASE("members: each member is found by its name, and no other name is") {
+    auto types = ServiceTypes::create({kObjTestDef}).value();
+    auto thing = ServiceObject::create(types, "example.objtest.Thing").value();
+    // Names of equal length (add, mid, sub, ask, buf, nas…) are told apart byte by byte; the rest by length.
+    const char* members[] = {"value", "ro", "wo", "label", "add", "mid", "fail_user", "later", "unimplemented",
+                             "call_back", "count", "sum", "sink", "changed", "sub", "subs", "named", "listed",
+                             "listed_named", "anything", "samples", "lossy", "feed", "ask", "tell", "level",
+                             "in_only", "state", "buf", "grid", "pods", "nas", "rom"};
+    for (const char* name : members) {
+        INFO(name);
+        auto info = thing->member_info(name);
+        REQUIRE(info);
+        CHECK(info->def->name == name);
+    }
+    for (const char* other : {"", "a", "ad", "adc", "ade", "zzz", "aaa", "Add", "adds", "values", "listed_name",
+                              "listed_namedx", "unimplementeD"})
+        CHECK_FALSE(thing->member_info(other));
+}
+
+TEST_CASE("requests to the root object fail with ObjectNotFound once the service is shut down") {
+    ServiceFixture f([](ServiceFixture& f) {
+        REQUIRE(f.root->set_function("add", [](const SessionRef&, std::vector<Value> a) -> Result<Value> {
+            return Value::scalar<std::int32_t>(*a[0].as<std::int32_t>() + *a[1].as<std::int32_t>());
+        }));
+    });
+    auto c = f.connect();
+    auto add = req(MessageEntryType::FunctionCallReq, "add");
+    add.elements.push_back(make_scalar_element<std::int32_t>("a", 1));
+    add.elements.push_back(make_scalar_element<std::int32_t>("b", 2));
+    CHECK(scalar_of<std::int32_t>(c.ok(add), "return") == 3);
+    f.service->shutdown();
+    CHECK(c.error(add).type == MessageErrorType::ObjectNotFound);
+}
+
 TEST_CASE("properties: stored value, handlers, direction and type errors") {
     ServiceFixture f([](ServiceFixture& f) {
         REQUIRE(f.root->set_property_value("value", Value::scalar(1.5)));

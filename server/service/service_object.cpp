@@ -51,6 +51,15 @@ struct ServiceObject::Slot {
 
 namespace {
 
+// The order of the member index: by length, then by bytes. A lookup then compares lengths, which
+// are integers, and calls memcmp only among names of the searched one's length.
+// A function object (not a function pointer), so that std::lower_bound inlines it.
+constexpr struct {
+    bool operator()(std::string_view a, std::string_view b) const noexcept {
+        return a.size() != b.size() ? a.size() < b.size() : a < b;
+    }
+} shorter_or_before;
+
 template <class F>
 std::shared_ptr<const F> share(F f) {
     if (!f) return nullptr;
@@ -131,7 +140,7 @@ Result<std::shared_ptr<ServiceObject>> ServiceObject::create(std::shared_ptr<con
         obj->slots_.push_back(std::move(slot));
     }
     std::sort(obj->slots_.begin(), obj->slots_.end(),
-              [](const auto& a, const auto& b) { return a->info->def->name < b->info->def->name; });
+              [](const auto& a, const auto& b) { return shorter_or_before(a->info->def->name, b->info->def->name); });
     obj->slot_names_.reserve(obj->slots_.size());
     for (const auto& slot : obj->slots_) obj->slot_names_.push_back(slot->info->def->name);
     return obj;
@@ -142,7 +151,7 @@ RRError ServiceObject::user_error(std::string_view exception, std::string messag
 }
 
 ServiceObject::Slot* ServiceObject::find_slot(std::string_view name) const noexcept {
-    auto it = std::lower_bound(slot_names_.begin(), slot_names_.end(), name);
+    auto it = std::lower_bound(slot_names_.begin(), slot_names_.end(), name, shorter_or_before);
     if (it == slot_names_.end() || *it != name) return nullptr;
     return slots_[static_cast<std::size_t>(it - slot_names_.begin())].get();
 }
@@ -412,7 +421,7 @@ Result<std::shared_ptr<ServiceObject>> ServiceObject::resolve_objref(const Sessi
 // Dispatch
 
 void ServiceObject::handle_entry(ObjectService& service, const SessionRef& session, MessageEntry&& entry,
-                                 Responder responder) {
+                                 Responder&& responder) {
     Slot* slot = find_slot(entry.member_name);
     const auto type = entry.entry_type;
     auto need = [&](MemberKind kind) {
@@ -463,7 +472,7 @@ void ServiceObject::handle_entry(ObjectService& service, const SessionRef& sessi
     }
 }
 
-void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, Responder responder) {
+void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, Responder&& responder) {
     const MemberInfo& info = *slot.info;
     if (info.def->direction() == robdef::MemberDirection::writeonly) {
         responder.fail(make_error(MessageErrorType::WriteOnlyMember, "Write only member"));
@@ -498,7 +507,7 @@ void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, R
     responder.respond(std::move(reply));
 }
 
-void ServiceObject::handle_property_set(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder responder) {
+void ServiceObject::handle_property_set(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder) {
     const MemberInfo& info = *slot.info;
     if (info.def->direction() == robdef::MemberDirection::readonly) {
         responder.fail(make_error(MessageErrorType::ReadOnlyMember, "Read only member"));
@@ -551,13 +560,11 @@ struct PendingCall {
             responder.fail(r.error());
             return;
         }
-        auto e = detail::pack_return(*info, *r, info->def->type);
-        if (!e) {
+        MessageEntry reply;
+        if (auto e = detail::append_return(reply, *info, *r, info->def->type); !e) {
             responder.fail(e.error());
             return;
         }
-        MessageEntry reply;
-        reply.elements.push_back(std::move(*e));
         responder.respond(std::move(reply));
     }
 };
@@ -565,7 +572,7 @@ struct PendingCall {
 }  // namespace
 
 void ServiceObject::handle_function(ObjectService& service, Slot& slot, const SessionRef& session, MessageEntry&& entry,
-                                    Responder responder) {
+                                    Responder&& responder) {
     const MemberInfo& info = *slot.info;
     const bool generator = info.def->is_generator();
     auto args = unpack_arguments(info, entry, call_parameter_count(*info.def));
@@ -577,10 +584,13 @@ void ServiceObject::handle_function(ObjectService& service, Slot& slot, const Se
     std::shared_ptr<const AsyncFunctionHandler> async_function;
     std::shared_ptr<const GeneratorFunctionHandler> generator_function;
     {
-        std::lock_guard lock(mutex_);
-        function = slot.function;
-        async_function = slot.async_function;
-        generator_function = slot.generator;
+        std::lock_guard lock(mutex_);  // only the handler this call can use is copied
+        if (generator)
+            generator_function = slot.generator;
+        else if (slot.async_function)
+            async_function = slot.async_function;
+        else
+            function = slot.function;
     }
     if (generator) {
         if (!generator_function) {
@@ -622,13 +632,11 @@ void ServiceObject::handle_function(ObjectService& service, Slot& slot, const Se
         responder.fail(r.error());
         return;
     }
-    auto e = detail::pack_return(info, *r, info.def->type);
-    if (!e) {
+    MessageEntry reply;
+    if (auto e = detail::append_return(reply, info, *r, info.def->type); !e) {
         responder.fail(e.error());
         return;
     }
-    MessageEntry reply;
-    reply.elements.push_back(std::move(*e));
     responder.respond(std::move(reply));
 }
 

@@ -166,7 +166,7 @@ public:
     Result<std::shared_ptr<ServiceObject>> resolve_objref(const SessionRef& session, std::string_view member,
                                                           std::string_view index_text, bool has_index);
     /// Dispatches one member request or packet (wire.md §6.7) at `path`. Runs on the session's strand.
-    void handle_entry(ObjectService& service, const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void handle_entry(ObjectService& service, const SessionRef& session, MessageEntry&& entry, Responder&& responder);
     /// Member info for a member name, or nullptr.
     std::shared_ptr<const detail::MemberInfo> member_info(std::string_view name) const;
 
@@ -177,16 +177,16 @@ private:
     Slot* find_slot(std::string_view name) const noexcept;
     Result<Slot*> slot_of(std::string_view name, robdef::MemberKind kind) const;
 
-    void handle_property_get(Slot& slot, const SessionRef& session, Responder responder);
-    void handle_property_set(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void handle_property_get(Slot& slot, const SessionRef& session, Responder&& responder);
+    void handle_property_set(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder);
     void handle_function(ObjectService& service, Slot& slot, const SessionRef& session, MessageEntry&& entry,
-                         Responder responder);
+                         Responder&& responder);
 
     const std::shared_ptr<const ServiceTypes> types_;
     const robdef::ServiceEntryDefinition* const def_;
     const std::string type_;
     const std::string service_name_;
-    std::vector<std::unique_ptr<Slot>> slots_;  // one per robdef member, sorted by name
+    std::vector<std::unique_ptr<Slot>> slots_;  // one per robdef member, by name length, then name
     std::vector<std::string_view> slot_names_;  // slots_[i]'s member name (the robdef's string): one flat search
     mutable std::mutex mutex_;                  // guards handlers/stored values in slots and the binding
     std::weak_ptr<ObjectService> service_;
