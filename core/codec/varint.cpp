@@ -2,10 +2,9 @@
 
 namespace rr {
 
+// Values above 252 only: write_uint_x writes the one-byte form inline.
 void detail::write_uint_x_multibyte(ByteWriter& w, std::uint32_t v) {
-    if (v <= 252) {
-        w.write_u8(static_cast<std::uint8_t>(v));
-    } else if (v <= 0xFFFF) {
+    if (v <= 0xFFFF) {
         w.write_u8(253);
         w.write_u16(static_cast<std::uint16_t>(v));
     } else {

@@ -99,19 +99,16 @@ Result<void> StreamConnection::handle_frame(SharedBytes frame, MonoTime now) {
     }
     Message message = std::move(m);  // a transport entry queues events of its own: out of the slot first
     events_.pop_back();
-    if (!decoded || message.entries.empty()) {  // an empty message is legal, with nothing to do
-        entry_vectors_.give(std::move(message.entries));
-        return decoded;
+    Result<void> handled = std::move(decoded);
+    if (!handled || message.entries.empty()) {
+        // a decoding error, or an empty message: legal, with nothing to do
+    } else if (keep) {
+        handled = fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
+    } else if (message.entries.size() != 1) {
+        handled = fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
+    } else {
+        handled = handle_transport_entry(message, message.entries.front(), now);
     }
-    if (keep) {
-        entry_vectors_.give(std::move(message.entries));
-        return fail(MessageErrorType::ProtocolError, "message received before CreateConnection completed");
-    }
-    if (message.entries.size() != 1) {
-        entry_vectors_.give(std::move(message.entries));
-        return fail(MessageErrorType::ProtocolError, "transport operation must be alone in its message");
-    }
-    auto handled = handle_transport_entry(message, message.entries.front(), now);
     entry_vectors_.give(std::move(message.entries));
     return handled;
 }
