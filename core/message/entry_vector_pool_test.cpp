@@ -56,3 +56,30 @@ TEST_CASE("entry vector pool: bounded in vectors kept and in their capacity") {
     big.give(std::vector<MessageEntry>{});  // no storage: nothing worth keeping
     CHECK(big.size() == 0);
 }
+
+TEST_CASE("entry vector pool: sent entries' element vectors come back empty with their storage, bounded") {
+    EntryVectorPool pool;
+    CHECK(pool.take_elements().capacity() == 0);
+    auto owner = std::make_shared<int>(7);
+    std::vector<MessageEntry> v(2);
+    MessageElement el;
+    el.data = SharedBytes(owner, {});
+    v[0].elements.push_back(std::move(el));
+    CHECK(owner.use_count() == 2);
+    const MessageElement* storage = v[0].elements.data();
+    v[1].elements.reserve(EntryVectorPool::kMaxElementCapacity + 1);  // too large to keep
+    pool.give(std::move(v));
+    CHECK(owner.use_count() == 1);  // the element was destroyed, only its vector's storage is kept
+    REQUIRE(pool.element_vectors() == 1);
+    auto elements = pool.take_elements();
+    CHECK(elements.empty());
+    CHECK(elements.data() == storage);
+    CHECK(pool.element_vectors() == 0);
+
+    for (std::size_t i = 0; i < EntryVectorPool::kMaxVectors + 3; ++i) {
+        std::vector<MessageEntry> one(1);
+        one[0].elements.reserve(1);
+        pool.give(std::move(one));
+    }
+    CHECK(pool.element_vectors() == EntryVectorPool::kMaxVectors);
+}

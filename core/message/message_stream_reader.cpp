@@ -30,7 +30,7 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
 #if defined(__cpp_lib_smart_ptr_for_overwrite)
             if (expected_ <= kInitialBufferBytes) {
                 // Small message: its final buffer at once, bytes and reference count in one allocation.
-                frame_ = std::make_shared_for_overwrite<std::byte[]>(expected_);
+                frame_ = small_frame(expected_);
                 std::copy(preamble_.begin(), preamble_.end(), frame_.get());
                 frame_fill_ = kMessagePreambleBytes;
             }
@@ -71,6 +71,17 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
     }
     return {};
 }
+
+#if defined(__cpp_lib_smart_ptr_for_overwrite)
+std::shared_ptr<std::byte[]> MessageStreamReader::small_frame(std::size_t size) {
+    if (size > kReusedFrameBytes) return std::make_shared_for_overwrite<std::byte[]>(size);
+    // Only this reader holds the last small buffer once everything decoded from it is released (the
+    // count cannot rise meanwhile: only a holder can copy it), so its bytes may be overwritten.
+    if (!spare_frame_ || spare_frame_.use_count() != 1)
+        spare_frame_ = std::make_shared_for_overwrite<std::byte[]>(kReusedFrameBytes);
+    return spare_frame_;
+}
+#endif
 
 std::optional<SharedBytes> MessageStreamReader::take_frame() {
     if (error_ || ready_.empty()) return std::nullopt;

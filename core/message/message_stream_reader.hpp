@@ -9,15 +9,18 @@
 // Limits: the magic is checked as soon as its bytes arrive; MessageSize is checked against
 // kMinMessageSize and Limits::max_message_size right after the preamble, before any buffer for the
 // message is allocated. A message up to 64 KiB gets its final buffer at once (one allocation with
-// its reference count). A larger one grows with the bytes that actually arrive (first 64 KiB, then
-// doubling, and to MessageSize once a quarter of it has arrived), so a peer cannot make the reader
-// allocate more than 64 KiB or 4 × what it has sent.
+// its reference count); one up to kReusedFrameBytes reuses the last such buffer when nothing decoded
+// from it is still held (a call's request and reply need no allocation for their frames). A larger
+// one grows with the bytes that actually arrive (first 64 KiB, then doubling, and to MessageSize once
+// a quarter of it has arrived), so a peer cannot make the reader allocate more than 64 KiB or 4 ×
+// what it has sent.
 // Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
 // below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
 // over the limit, or a decode limit). After the first error every call fails with that error and no
 // further frame is yielded, including frames completed before the error.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <deque>
@@ -57,13 +60,21 @@ public:
     /// Bytes of the message being assembled (0 between messages).
     std::size_t partial_bytes() const noexcept { return preamble_fill_ + (frame_ ? frame_fill_ : body_.size()); }
     /// Bytes allocated for the message being assembled (for per-connection memory accounting).
-    std::size_t partial_capacity() const noexcept { return frame_ ? expected_ : body_.capacity(); }
+    std::size_t partial_capacity() const noexcept {
+        return frame_ ? std::max(expected_, kReusedFrameBytes) : body_.capacity();
+    }
+
+    /// Messages up to this size are read into one buffer, reused from message to message.
+    static constexpr std::size_t kReusedFrameBytes = 512;
     bool failed() const noexcept { return error_.has_value(); }
     /// The error that stopped the reader, or nullptr.
     const RRError* error() const noexcept { return error_ ? &*error_ : nullptr; }
 
 private:
     Unexpected stop(RRError e);
+    /// A buffer for a message of `size` ≤ kInitialBufferBytes bytes: spare_frame_ when it fits and
+    /// nothing else holds it.
+    std::shared_ptr<std::byte[]> small_frame(std::size_t size);
 
     static constexpr std::size_t kInitialBufferBytes = 64 * 1024;
 
@@ -73,6 +84,7 @@ private:
     std::size_t expected_ = 0;        // MessageSize of the message in body_, 0 while reading a preamble
     std::vector<std::byte> body_;     // a message over kInitialBufferBytes being assembled, preamble included
     std::shared_ptr<std::byte[]> frame_;  // a message up to kInitialBufferBytes being assembled (its final buffer)
+    std::shared_ptr<std::byte[]> spare_frame_;  // the last buffer of kReusedFrameBytes, reused once released
     std::size_t frame_fill_ = 0;
     std::deque<SharedBytes> ready_;
     std::optional<RRError> error_;

@@ -188,10 +188,95 @@ TEST_CASE("message: the stream reader's buffer grows with the bytes received, no
     REQUIRE(r1.feed(piece));  // 256 KiB + 8 bytes: over a quarter
     CHECK(r1.partial_capacity() == 1024 * 1024);
     CHECK(r1.partial_capacity() <= 4 * r1.partial_bytes());
-    // Small messages get buffers of their own size.
+    // Small messages share one buffer of kReusedFrameBytes; larger ones up to 64 KiB get their own size.
     std::vector<std::byte> small = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
                                     std::byte{20},  std::byte{0},   std::byte{0},   std::byte{0}};
     MessageStreamReader r2;
     REQUIRE(r2.feed(small));
-    CHECK(r2.partial_capacity() == 20);
+    CHECK(r2.partial_capacity() == MessageStreamReader::kReusedFrameBytes);
+    std::vector<std::byte> medium = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                     std::byte{0xe8}, std::byte{0x03}, std::byte{0},  std::byte{0}};  // 1,000
+    MessageStreamReader r3;
+    REQUIRE(r3.feed(medium));
+    CHECK(r3.partial_capacity() == 1000);
+}
+
+TEST_CASE("message: the stream reader reuses a small frame's buffer only once nothing holds it") {
+    // Two different small messages (a ping and a Nop-sized call) and one over kReusedFrameBytes.
+    Message a;
+    a.entries.emplace_back().entry_type = MessageEntryType::ConnectionTest;
+    Message b;
+    b.version = 4;
+    auto& e = b.entries.emplace_back();
+    e.entry_type = MessageEntryType::FunctionCallReq;
+    e.service_path = "bench";
+    e.member_name = "Nop";
+    e.request_id = 7;
+    MessageElement value;  // decoded, its payload points into the frame
+    value.name = "value";
+    value.type = DataTypes::int32_t;
+    value.data = SharedBytes::copy_of("\x01\x02\x03\x04", 4);
+    e.elements.push_back(value);
+    Message big = b;
+    big.entries[0].metadata.assign(2 * MessageStreamReader::kReusedFrameBytes, 'm');
+    auto wire = [](const Message& m) {
+        auto f = encode_message(m);
+        REQUIRE(f);
+        return std::vector<std::byte>(f->bytes().begin(), f->bytes().end());
+    };
+    const auto wa = wire(a), wb = wire(b), wbig = wire(big);
+    REQUIRE(wa.size() <= MessageStreamReader::kReusedFrameBytes);
+    REQUIRE(wb.size() <= MessageStreamReader::kReusedFrameBytes);
+
+    MessageStreamReader reader;
+    REQUIRE(reader.feed(wa));
+    auto first = reader.take_frame();
+    REQUIRE(first);
+    const std::byte* first_buffer = first->data();
+    // Still held: the next message gets another buffer, and the held frame keeps its bytes.
+    REQUIRE(reader.feed(wb));
+    auto second = reader.take_frame();
+    REQUIRE(second);
+    CHECK(second->data() != first_buffer);
+    CHECK(bytes_of(*first) == wa);
+    CHECK(bytes_of(*second) == wb);
+    // Released (with a decoded message that pointed into it): its buffer is reused.
+    {
+        auto decoded = decode_message(*second, Limits{});
+        REQUIRE(decoded);
+        const std::byte* second_buffer = second->data();
+        second.reset();
+        REQUIRE(reader.feed(wa));
+        auto third = reader.take_frame();  // `decoded` still holds the second buffer
+        REQUIRE(third);
+        CHECK(third->data() != second_buffer);
+        CHECK(decoded->entries[0].member_name == "Nop");
+        first.reset();
+        third.reset();
+    }
+    REQUIRE(reader.feed(wb));
+    auto fourth = reader.take_frame();
+    REQUIRE(fourth);
+    CHECK(bytes_of(*fourth) == wb);
+    const std::byte* reused = fourth->data();
+    fourth.reset();
+    // Two messages in one read: the first still waits in the reader, so the second gets another buffer.
+    std::vector<std::byte> both = wa;
+    both.insert(both.end(), wb.begin(), wb.end());
+    REQUIRE(reader.feed(both));
+    auto fifth = reader.take_frame();
+    auto sixth = reader.take_frame();
+    REQUIRE(fifth);
+    REQUIRE(sixth);
+    CHECK(fifth->data() == reused);
+    CHECK(sixth->data() != reused);
+    CHECK(bytes_of(*fifth) == wa);
+    CHECK(bytes_of(*sixth) == wb);
+    // A message over kReusedFrameBytes never takes the shared buffer.
+    fifth.reset();
+    sixth.reset();
+    REQUIRE(reader.feed(wbig));
+    auto large = reader.take_frame();
+    REQUIRE(large);
+    CHECK(bytes_of(*large) == wbig);
 }

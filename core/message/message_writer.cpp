@@ -1,5 +1,6 @@
 #include "core/message/message_writer.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <string>
 
@@ -31,7 +32,8 @@ Result<void> encode_message(const Message& message, std::vector<std::byte>& out)
     auto size = encoder.measure();
     if (!size) return size.take_error();
     const std::size_t start = out.size();
-    out.reserve(start + *size);
+    // Geometric growth: `out` may be a connection's pending output that many messages are appended to.
+    if (out.capacity() - start < *size) out.reserve(std::max<std::size_t>(start + *size, 2 * out.capacity()));
     ByteWriter w(out);
     encoder.write(w);
     if (w.written() != *size) {  // measure and write disagree: a bug here, never the caller's

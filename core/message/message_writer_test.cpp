@@ -2,6 +2,8 @@
 // and the errors encode_message reports.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "core/codec/endian.hpp"
 #include "core/message/message_reader.hpp"
 #include "core/message/message_writer.hpp"
@@ -329,4 +331,24 @@ TEST_CASE("message: encode appends and reports InvalidArgument for what cannot b
     CHECK(encode_error(many).type == MessageErrorType::InvalidArgument);
     many.version = 4;
     CHECK(encode_error(many).type == MessageErrorType::InvalidArgument);
+}
+
+TEST_CASE("message: messages appended to one buffer grow it geometrically and stay intact") {
+    // A connection's pending output takes message after message while the socket is slow; growing it
+    // to the exact size each time would copy all pending bytes once per message.
+    Message m = one_entry(MessageEntryType::WirePacket);
+    m.entries[0].elements.push_back(scalar_u32("value", 7));
+    const auto one = encode(m);
+    std::vector<std::byte> out;
+    std::size_t reallocations = 0;
+    constexpr std::size_t kMessages = 2000;
+    for (std::size_t i = 0; i < kMessages; ++i) {
+        const auto capacity = out.capacity();
+        REQUIRE(encode_message(m, out));
+        if (out.capacity() != capacity) ++reallocations;
+    }
+    REQUIRE(out.size() == kMessages * one.size());
+    CHECK(reallocations <= 24);
+    for (std::size_t i = 0; i < kMessages; i += 397)
+        CHECK(std::equal(one.begin(), one.end(), out.begin() + static_cast<std::ptrdiff_t>(i * one.size())));
 }

@@ -509,6 +509,7 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
               now);
         return;
     }
+    if (e.elements.capacity() == 0) e.elements = stream_.entry_vectors().take_elements();  // room for the reply
     events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);
 }
 

@@ -63,7 +63,8 @@ struct ServiceSessionUser {
 /// PipePacketRet, WirePacket: `needs_reply` false), or, for services whose handles_locks() is true, a
 /// lock operation (ClientSessionOpReq with MemberName RequestObjectLock, RequestClientObjectLock,
 /// ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit;
-/// answer with reply()).
+/// answer with reply()). A member request without elements may carry an empty element vector with
+/// capacity, kept from an earlier reply: the service can build its reply in it.
 struct ServiceRequest {
     // A constructor, not an aggregate: the event queue builds it in place (emplace with
     // in_place_type), which clang before 16 cannot do for an aggregate.

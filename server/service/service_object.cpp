@@ -75,6 +75,16 @@ std::size_t call_parameter_count(const robdef::MemberDefinition& def) {
     return def.parameters.size() - (param_is_generator(def) ? 1 : 0);
 }
 
+// A reply built in the request's element vector, once the request's elements have been read: a
+// request without elements brings one kept from an earlier reply (ServiceRequest), so a reply of a
+// few elements allocates nothing for them (issue 14).
+MessageEntry reply_in(MessageEntry& request) {
+    MessageEntry reply;
+    reply.elements = std::move(request.elements);
+    reply.elements.clear();
+    return reply;
+}
+
 Result<std::vector<Value>> unpack_arguments(const MemberInfo& info, const MessageEntry& entry, std::size_t count) {
     std::vector<Value> args;
     args.reserve(count);
@@ -435,7 +445,7 @@ void ServiceObject::handle_entry(ObjectService& service, const SessionRef& sessi
     };
     switch (type) {
         case MessageEntryType::PropertyGetReq:
-            if (need(MemberKind::property)) handle_property_get(*slot, session, std::move(responder));
+            if (need(MemberKind::property)) handle_property_get(*slot, session, std::move(entry), std::move(responder));
             return;
         case MessageEntryType::PropertySetReq:
             if (need(MemberKind::property)) handle_property_set(*slot, session, std::move(entry), std::move(responder));
@@ -472,7 +482,7 @@ void ServiceObject::handle_entry(ObjectService& service, const SessionRef& sessi
     }
 }
 
-void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, Responder&& responder) {
+void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder) {
     const MemberInfo& info = *slot.info;
     if (info.def->direction() == robdef::MemberDirection::writeonly) {
         responder.fail(make_error(MessageErrorType::WriteOnlyMember, "Write only member"));
@@ -485,7 +495,7 @@ void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, R
         getter = slot.getter;
         stored = slot.stored;
     }
-    MessageEntry reply;
+    MessageEntry reply = reply_in(entry);
     if (getter) {
         auto v = (*getter)(session);
         if (!v) {
@@ -632,7 +642,7 @@ void ServiceObject::handle_function(ObjectService& service, Slot& slot, const Se
         responder.fail(r.error());
         return;
     }
-    MessageEntry reply;
+    MessageEntry reply = reply_in(entry);
     if (auto e = detail::append_return(reply, info, *r, info.def->type); !e) {
         responder.fail(e.error());
         return;

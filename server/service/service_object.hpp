@@ -177,7 +177,7 @@ private:
     Slot* find_slot(std::string_view name) const noexcept;
     Result<Slot*> slot_of(std::string_view name, robdef::MemberKind kind) const;
 
-    void handle_property_get(Slot& slot, const SessionRef& session, Responder&& responder);
+    void handle_property_get(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder);
     void handle_property_set(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder);
     void handle_function(ObjectService& service, Slot& slot, const SessionRef& session, MessageEntry&& entry,
                          Responder&& responder);
