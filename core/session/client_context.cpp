@@ -98,8 +98,7 @@ void ClientContext::pump_events(MonoTime now) {
         } else if (auto* r = std::get_if<ClientResponse>(&*ev)) {
             auto it = replies_.find(r->request_id);
             if (it == replies_.end()) continue;
-            Reply k = std::move(it->second);
-            replies_.erase(it);
+            Reply k = replies_.take(it);
             k(std::move(r->entry));
         } else if (auto* in = std::get_if<ClientIncoming>(&*ev)) {
             on_incoming(std::move(in->entry), now);
@@ -194,7 +193,7 @@ void ClientContext::on_incoming(MessageEntry&& e, MonoTime now) {
 
 // --- requests --------------------------------------------------------------------------------------
 
-void ClientContext::send_request(MessageEntry e, MonoTime now, Reply k) {
+void ClientContext::send_request(MessageEntry&& e, MonoTime now, Reply k) {
     now_ = now;
     auto id = session_.request(std::move(e), now);
     if (!id) {
@@ -205,10 +204,10 @@ void ClientContext::send_request(MessageEntry e, MonoTime now, Reply k) {
         }
         return;
     }
-    replies_.emplace(*id, std::move(k));
+    replies_.put(*id, std::move(k));
 }
 
-Result<void> ClientContext::send_packet(MessageEntry e, MonoTime now) {
+Result<void> ClientContext::send_packet(MessageEntry&& e, MonoTime now) {
     now_ = now;
     if (session_.is_closed()) return fail(MessageErrorType::ConnectionError, "connection closed");
     return session_.send_packet(std::move(e), now);

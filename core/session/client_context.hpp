@@ -38,6 +38,7 @@
 
 #include "core/session/client_session.hpp"
 #include "core/session/client_types.hpp"
+#include "core/session/request_map.hpp"
 #include "robdef/service_definition_set.hpp"
 
 namespace rr {
@@ -215,8 +216,8 @@ private:
     void on_connected(MonoTime now);
     void on_session_closed(const RRError& error);
     void on_incoming(MessageEntry&& e, MonoTime now);
-    void send_request(MessageEntry e, MonoTime now, Reply k);
-    Result<void> send_packet(MessageEntry e, MonoTime now);
+    void send_request(MessageEntry&& e, MonoTime now, Reply k);
+    Result<void> send_packet(MessageEntry&& e, MonoTime now);
     Result<const ObjectState*> find_object(std::string_view path) const;
     Result<const robdef::MemberDefinition*> find_member(std::string_view path, std::string_view member,
                                                          robdef::MemberKind kind, const ObjectState** obj = nullptr) const;
@@ -259,7 +260,7 @@ private:
     MonoTime now_;
     std::uint64_t next_id_ = 0;
 
-    std::map<std::uint32_t, Reply> replies_;
+    RequestMap<Reply> replies_;
     std::map<std::string, std::unique_ptr<ObjectState>, std::less<>> objects_;
     std::map<std::uint64_t, std::unique_ptr<GeneratorState>> generators_;
     std::map<std::uint64_t, std::unique_ptr<PipeState>> pipes_;

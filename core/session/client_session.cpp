@@ -142,7 +142,7 @@ void ClientSession::on_stream_event(StreamEvent&& ev, MonoTime now) {
     }
 }
 
-Result<void> ClientSession::send_special(MessageEntry entry, MonoTime now, std::uint32_t receiver_endpoint) {
+Result<void> ClientSession::send_special(MessageEntry&& entry, MonoTime now, std::uint32_t receiver_endpoint) {
     Message m;
     m.entries = stream_.entry_vectors().take();
     m.version = 2;
@@ -158,7 +158,7 @@ Result<void> ClientSession::send_special(MessageEntry entry, MonoTime now, std::
     return stream_.send(std::move(m), now);
 }
 
-Result<void> ClientSession::send_session(MessageEntry entry, MonoTime now) {
+Result<void> ClientSession::send_session(MessageEntry&& entry, MonoTime now) {
     Message m;
     m.entries = stream_.entry_vectors().take();
     m.version = 2;
@@ -343,11 +343,11 @@ void ClientSession::on_entries(Message& m, MonoTime now) {
     }
 }
 
-Result<std::uint32_t> ClientSession::request(MessageEntry entry, MonoTime now) {
+Result<std::uint32_t> ClientSession::request(MessageEntry&& entry, MonoTime now) {
     return request(std::move(entry), now, config_.request_timeout);
 }
 
-Result<std::uint32_t> ClientSession::request(MessageEntry entry, MonoTime now, std::chrono::milliseconds timeout) {
+Result<std::uint32_t> ClientSession::request(MessageEntry&& entry, MonoTime now, std::chrono::milliseconds timeout) {
     if (state_ != State::connected) return fail(MessageErrorType::InvalidState, "client session not connected");
     const std::uint32_t id = next_request_id();
     entry.request_id = id;
@@ -355,16 +355,16 @@ Result<std::uint32_t> ClientSession::request(MessageEntry entry, MonoTime now, s
     Pending p;
     p.has_deadline = timeout.count() > 0;
     p.deadline = now + timeout;
-    pending_[id] = p;
+    pending_.put(id, p);
     return id;
 }
 
-Result<void> ClientSession::send_packet(MessageEntry entry, MonoTime now) {
+Result<void> ClientSession::send_packet(MessageEntry&& entry, MonoTime now) {
     if (state_ != State::connected) return fail(MessageErrorType::InvalidState, "client session not connected");
     return send_session(std::move(entry), now);
 }
 
-Result<void> ClientSession::reply(MessageEntry entry, MonoTime now) { return send_packet(std::move(entry), now); }
+Result<void> ClientSession::reply(MessageEntry&& entry, MonoTime now) { return send_packet(std::move(entry), now); }
 
 void ClientSession::forget_request(std::uint32_t request_id) { pending_.erase(request_id); }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/session/event_queue.hpp"
+#include "core/session/request_map.hpp"
 #include "core/session/stream_connection.hpp"
 
 namespace rr {
@@ -112,13 +113,14 @@ public:
 
     /// Sends a request entry (RequestID assigned here) and returns the RequestID; the answer arrives
     /// as a ClientResponse. Errors: InvalidState when not connected; BufferLimitViolation.
-    Result<std::uint32_t> request(MessageEntry entry, MonoTime now);
+    /// The sending functions take the entry by rvalue: it is moved once, into the outgoing message.
+    Result<std::uint32_t> request(MessageEntry&& entry, MonoTime now);
     /// Like request() but with a per-request timeout (0 = none, e.g. generator Next on a long stream).
-    Result<std::uint32_t> request(MessageEntry entry, MonoTime now, std::chrono::milliseconds timeout);
+    Result<std::uint32_t> request(MessageEntry&& entry, MonoTime now, std::chrono::milliseconds timeout);
     /// Sends an entry that expects no answer (PipePacket, PipePacketRet, WirePacket).
-    Result<void> send_packet(MessageEntry entry, MonoTime now);
+    Result<void> send_packet(MessageEntry&& entry, MonoTime now);
     /// Answers a CallbackCallReq (the reply entry keeps the request's RequestID).
-    Result<void> reply(MessageEntry entry, MonoTime now);
+    Result<void> reply(MessageEntry&& entry, MonoTime now);
     /// Cancels waiting for a request: no ClientResponse will be delivered for it.
     void forget_request(std::uint32_t request_id);
 
@@ -151,8 +153,8 @@ private:
     void on_entries(Message& m, MonoTime now);
     void on_connect_reply(MessageEntry&& e, const MessageHeader& h, MonoTime now);
     void start_connect(MonoTime now);
-    Result<void> send_special(MessageEntry entry, MonoTime now, std::uint32_t receiver_endpoint = 0);
-    Result<void> send_session(MessageEntry entry, MonoTime now);
+    Result<void> send_special(MessageEntry&& entry, MonoTime now, std::uint32_t receiver_endpoint = 0);
+    Result<void> send_session(MessageEntry&& entry, MonoTime now);
     void request_missing_definitions(MonoTime now);
     void fail_connect(RRError error);
     void close(RRError error);
@@ -168,7 +170,7 @@ private:
     std::uint32_t connect_request_id_ = 0;
     std::uint16_t message_id_ = 0;
     std::vector<std::string> pending_imports_;
-    std::map<std::uint32_t, Pending> pending_;
+    RequestMap<Pending> pending_;
     EventQueue<ClientSessionEvent> events_;
     MonoTime last_send_;
     MonoTime connect_deadline_;

@@ -241,10 +241,10 @@ TEST_CASE("requests are matched by RequestID and time out after 15 s") {
     get.entry_type = MessageEntryType::PropertyGetReq;
     get.service_path = "svc";
     get.member_name = "x";
-    auto id = c.request(get, t0);
+    auto id = c.request(MessageEntry(get), t0);
     REQUIRE(id);
     get.member_name = "slow";
-    auto slow = c.request(get, t0);
+    auto slow = c.request(MessageEntry(get), t0);
     REQUIRE(slow);
     CHECK(*slow == *id + 1);
     pump(c, s, t0);

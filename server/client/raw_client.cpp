@@ -2,6 +2,7 @@
 
 #include <boost/asio/strand.hpp>
 
+#include "core/session/request_map.hpp"
 #include "server/common/connection_strand.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/transport/completion_guard.hpp"
@@ -35,16 +36,16 @@ public:
         dispatch();
     }
 
-    void request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done) {
+    void request(MessageEntry&& entry, std::chrono::milliseconds timeout, ReplyHandler done) {
         auto id = session_.request(std::move(entry), mono_now(), timeout);
         if (!id) {
             done(id.take_error());
             return;
         }
-        replies_.emplace(*id, std::move(done));
+        replies_.put(*id, std::move(done));
         if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
     }
-    void send(MessageEntry entry) {
+    void send(MessageEntry&& entry) {
         (void)session_.send_packet(std::move(entry), mono_now());
         if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
     }
@@ -74,8 +75,7 @@ private:
             } else if (auto* r = std::get_if<ClientResponse>(&*ev)) {
                 auto it = replies_.find(r->request_id);
                 if (it == replies_.end()) continue;
-                auto done = std::move(it->second);
-                replies_.erase(it);
+                auto done = replies_.take(it);
                 done(std::move(r->entry));
             } else if (auto* in = std::get_if<ClientIncoming>(&*ev)) {
                 if (on_incoming_) on_incoming_(std::move(in->entry));
@@ -94,7 +94,7 @@ private:
     }
 
     ClientSession session_;
-    std::map<std::uint32_t, ReplyHandler> replies_;
+    RequestMap<ReplyHandler> replies_;
 };
 
 void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,

@@ -393,7 +393,7 @@ TEST_CASE("RR messages travel over a WebSocket with the RR subprotocol, or none"
     get.entry_type = MessageEntryType::PropertyGetReq;
     get.service_path = "ws";
     get.member_name = "x";
-    auto id = session.request(get, now);
+    auto id = session.request(MessageEntry(get), now);
     REQUIRE(id);
     std::optional<ClientResponse> reply;
     for (int i = 0; i < 10 && !reply; ++i) {

@@ -263,7 +263,7 @@ TEST_CASE("a client that sends requests but never reads replies is throttled, ot
     get.member_name = "x";
     while (std::chrono::steady_clock::now() < give_up && written < (256u << 20)) {
         if (pending.empty()) {
-            for (int k = 0; k < 1000; ++k) REQUIRE(session.request(get, now));
+            for (int k = 0; k < 1000; ++k) REQUIRE(session.request(MessageEntry(get), now));
             auto out = session.pending_output();
             pending.assign(out.begin(), out.end());
             session.consume_output(out.size());

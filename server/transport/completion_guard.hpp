@@ -8,7 +8,6 @@
 #pragma once
 
 #include <functional>
-#include <string>
 #include <utility>
 
 #include "core/error/rr_error.hpp"
@@ -20,9 +19,10 @@ class CompletionGuard {
 public:
     using Handler = std::function<void(Result<T>)>;
 
-    /// `closed_message`: the ConnectionError's message when the guard answers.
-    explicit CompletionGuard(Handler done, std::string closed_message = "client connection closed")
-        : done_(std::move(done)), closed_message_(std::move(closed_message)) {}
+    /// `closed_message`: the ConnectionError's message when the guard answers; a string literal
+    /// (static storage: no copy per guard, one guard per request).
+    explicit CompletionGuard(Handler done, const char* closed_message = "client connection closed")
+        : done_(std::move(done)), closed_message_(closed_message) {}
     CompletionGuard(const CompletionGuard&) = delete;
     CompletionGuard& operator=(const CompletionGuard&) = delete;
     ~CompletionGuard() {
@@ -38,7 +38,7 @@ public:
 
 private:
     Handler done_;
-    std::string closed_message_;
+    const char* closed_message_;
 };
 
 }  // namespace rr::server

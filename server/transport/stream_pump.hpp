@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <type_traits>
+#include <variant>
 
 #include <boost/asio/basic_stream_socket.hpp>
 #include <boost/asio/bind_executor.hpp>
@@ -19,6 +20,7 @@
 #include <boost/asio/strand.hpp>
 #include <boost/asio/write.hpp>
 
+#include "server/common/caller_runs_executor.hpp"
 #include "server/common/read_throttle.hpp"
 #include "server/transport/connection_logic.hpp"
 
@@ -57,10 +59,18 @@ public:
     using Strand = asio::any_io_executor;
     /// The strand connection_strand() makes over an io_context's own executor.
     using IoStrand = asio::strand<asio::io_context::executor_type>;
+    /// The strand a client connection makes over a CallerRunsExecutor (server/client/client.hpp).
+    using CallerRunsStrand = asio::strand<CallerRunsExecutor>;
+    /// Beast's streams need the legacy executor interface a CallerRunsExecutor lacks: only plain
+    /// sockets read through the concrete CallerRunsStrand.
+    static constexpr bool kConcreteCallerRuns = DirectWriteSocket<Stream>;
 
     StreamPump(Stream stream, Strand strand, std::shared_ptr<ConnectionLogic> logic)
         : stream_(std::move(stream)), strand_(std::move(strand)), timer_(strand_), logic_(std::move(logic)) {
-        if (const auto* concrete = strand_.template target<IoStrand>()) io_strand_ = *concrete;
+        if (const auto* io = strand_.template target<IoStrand>())
+            read_strand_ = *io;
+        else if (const auto* caller_runs = strand_.template target<CallerRunsStrand>(); caller_runs && kConcreteCallerRuns)
+            read_strand_ = *caller_runs;
     }
 
     /// Keeps `hold` alive until the pump is destroyed (the connection's per-address slot).
@@ -148,10 +158,14 @@ private:
         };
         // One completion per message: bound to the concrete strand when there is one, Asio dispatches
         // it without the type-erased executor's copies and indirect calls (issue 14, bench/profile.sh).
-        if (io_strand_)
-            stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(*io_strand_, std::move(on_read)));
-        else
-            stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand_, std::move(on_read)));
+        std::visit(
+            [&](const auto& strand) {
+                if constexpr (std::is_same_v<std::decay_t<decltype(strand)>, CallerRunsStrand> && !kConcreteCallerRuns)
+                    stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand_, std::move(on_read)));
+                else
+                    stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand, std::move(on_read)));
+            },
+            read_strand_);
     }
 
     // Charges the bytes just read to the throttle; over the rate, reads pause (TCP back-pressure) until
@@ -269,7 +283,7 @@ private:
 
     Stream stream_;
     Strand strand_;
-    std::optional<IoStrand> io_strand_;  // strand_'s own strand, when it is an IoStrand
+    std::variant<Strand, IoStrand, CallerRunsStrand> read_strand_{strand_};  // strand_, concrete when known
     asio::steady_timer timer_;
     std::shared_ptr<ConnectionLogic> logic_;
     std::shared_ptr<const void> hold_;
