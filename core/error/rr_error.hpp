@@ -91,8 +91,9 @@ struct RRError {
 /// Builds an RRError with the standard name for `type`.
 RRError make_error(MessageErrorType type, std::string message);
 
-/// An RRError on the heap: a Result on its success path then carries one null pointer, not the
-/// three strings of an RRError (every decoder step returns a Result; errors are the rare path).
+/// An RRError on the heap: a Result's error alternative is then one pointer wide, not the three
+/// strings of an RRError, so a Result is about the size of its value (every decoder step returns a
+/// Result; errors are the rare path).
 /// Copying copies the error. A moved-from box is empty: after take_error() a Result may only be
 /// destroyed or assigned.
 class ErrorBox {
