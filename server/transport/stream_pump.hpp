@@ -61,16 +61,17 @@ public:
     using IoStrand = asio::strand<asio::io_context::executor_type>;
     /// The strand a client connection makes over a CallerRunsExecutor (server/client/client.hpp).
     using CallerRunsStrand = asio::strand<CallerRunsExecutor>;
+    /// The strand reads complete on: strand_ itself, or its concrete strand when it is one of these.
     /// Beast's streams need the legacy executor interface a CallerRunsExecutor lacks: only plain
     /// sockets read through the concrete CallerRunsStrand.
-    static constexpr bool kConcreteCallerRuns = DirectWriteSocket<Stream>;
+    using ReadStrand = std::conditional_t<DirectWriteSocket<Stream>, std::variant<Strand, IoStrand, CallerRunsStrand>,
+                                          std::variant<Strand, IoStrand>>;
 
     StreamPump(Stream stream, Strand strand, std::shared_ptr<ConnectionLogic> logic)
         : stream_(std::move(stream)), strand_(std::move(strand)), timer_(strand_), logic_(std::move(logic)) {
-        if (const auto* io = strand_.template target<IoStrand>())
-            read_strand_ = *io;
-        else if (const auto* caller_runs = strand_.template target<CallerRunsStrand>(); caller_runs && kConcreteCallerRuns)
-            read_strand_ = *caller_runs;
+        if (const auto* io = strand_.template target<IoStrand>()) read_strand_ = *io;
+        if constexpr (DirectWriteSocket<Stream>)
+            if (const auto* caller_runs = strand_.template target<CallerRunsStrand>()) read_strand_ = *caller_runs;
     }
 
     /// Keeps `hold` alive until the pump is destroyed (the connection's per-address slot).
@@ -160,10 +161,7 @@ private:
         // it without the type-erased executor's copies and indirect calls (issue 14, bench/profile.sh).
         std::visit(
             [&](const auto& strand) {
-                if constexpr (std::is_same_v<std::decay_t<decltype(strand)>, CallerRunsStrand> && !kConcreteCallerRuns)
-                    stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand_, std::move(on_read)));
-                else
-                    stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand, std::move(on_read)));
+                stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand, std::move(on_read)));
             },
             read_strand_);
     }
@@ -283,7 +281,7 @@ private:
 
     Stream stream_;
     Strand strand_;
-    std::variant<Strand, IoStrand, CallerRunsStrand> read_strand_{strand_};  // strand_, concrete when known
+    ReadStrand read_strand_{strand_};
     asio::steady_timer timer_;
     std::shared_ptr<ConnectionLogic> logic_;
     std::shared_ptr<const void> hold_;
