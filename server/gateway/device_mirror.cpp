@@ -50,7 +50,11 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
                                                                 url->scheme + "\" URLs (known: " + known + ")");
     }
     std::shared_ptr<DeviceMirror> m(new DeviceMirror(std::move(node), std::move(config), std::move(*url)));
-    m->service_ = std::make_shared<MirrorService>(m, m->config_.name, m->url_.service);
+    m->service_ = std::make_shared<MirrorService>(m, m->counters_, m->config_.name, m->url_.service);
+    // Lock holders are part of the device's status (JSON API pushes, the dashboard).
+    m->service_->set_locks_listener([weak = std::weak_ptr<DeviceMirror>(m)] {
+        if (auto self = weak.lock()) self->notify_state();
+    });
     if (m->config_.auth == DeviceAuth::passthrough) {
         auto node = m->node_.lock();
         PassthroughSessions::Settings ps;
@@ -65,7 +69,7 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
         };
         m->service_->set_passthrough(
             std::make_shared<PassthroughSessions>(node->io_context().get_executor(), std::move(ps),
-                                                  std::shared_ptr<DeviceCounters>(m, &m->counters_)));
+                                                  m->counters_));
     }
     return m;
 }
@@ -234,7 +238,7 @@ void DeviceMirror::on_disconnected(const RRError& error) {
         client_.reset();
         state_ = DeviceState::failed;
         reason_ = error.message.empty() ? std::string(error.name) : error.message;
-        if (was_connected) counters_.reconnects.fetch_add(1);
+        if (was_connected) counters_->reconnects.fetch_add(1);
     }
     service_->on_upstream_lost(error);
     notify_state();
@@ -290,6 +294,16 @@ std::string DeviceMirror::object_type() const {
     return object_type_;
 }
 
+ObjectTypeInfo DeviceMirror::root_type() const {
+    std::lock_guard lock(mutex_);
+    return {object_type_, implements_};
+}
+
+MessageElement DeviceMirror::attributes() const {
+    std::lock_guard lock(mutex_);
+    return attributes_;
+}
+
 std::shared_ptr<RawClient> DeviceMirror::upstream() const {
     std::lock_guard lock(mutex_);
     return client_;
@@ -302,13 +316,13 @@ void DeviceMirror::request(MessageEntry entry, std::function<void(Result<Message
         return;
     }
     entry.service_path = service_->to_upstream(entry.service_path);
-    counters_.requests.fetch_add(1);
+    counters_->requests.fetch_add(1);
     auto start = std::chrono::steady_clock::now();
     auto self = shared_from_this();
     c->request(std::move(entry), [self, start, done = std::move(done)](Result<MessageEntry> r) {
-        self->counters_.observe_latency(std::chrono::steady_clock::now() - start);
+        self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
         if (r) r->service_path = self->service_->to_downstream(r->service_path);
-        if (!r || r->error != MessageErrorType::None) self->counters_.request_errors.fetch_add(1);
+        if (!r || r->error != MessageErrorType::None) self->counters_->request_errors.fetch_add(1);
         done(std::move(r));
     });
 }

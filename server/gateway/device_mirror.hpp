@@ -110,10 +110,14 @@ public:
 
     DeviceStatus status() const;
     const DeviceConfig& config() const noexcept { return config_; }
-    const DeviceCounters& counters() const noexcept { return counters_; }
+    const DeviceCounters& counters() const noexcept { return *counters_; }
     /// The device's service definition texts (root first), empty before the first connect.
     std::vector<std::string> service_definitions() const;
     std::string object_type() const;
+    /// The root object's type and the types it implements, as the device said at connect; empty before.
+    ObjectTypeInfo root_type() const;
+    /// The device's service attributes (a dictionary element; of another type before the first connect).
+    MessageElement attributes() const;
     /// The upstream session when connected (for the JSON API), else nullptr.
     std::shared_ptr<RawClient> upstream() const;
 
@@ -165,14 +169,12 @@ private:
     void on_upstream_entry(MessageEntry&& entry);
     void notify_state();
 
-    friend class MirrorService;
-
     std::weak_ptr<Node> node_;
     DeviceConfig config_;
     ConnectionUrl url_;
     std::shared_ptr<MirrorService> service_;
     boost::asio::steady_timer timer_;
-    DeviceCounters counters_;
+    const std::shared_ptr<DeviceCounters> counters_ = std::make_shared<DeviceCounters>();  // shared with service_
 
     mutable std::mutex mutex_;
     DeviceState state_ = DeviceState::connecting;

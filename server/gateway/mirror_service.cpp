@@ -53,13 +53,14 @@ void set_index(MessageEntry& e, std::int32_t idx) {
 
 }  // namespace
 
-MirrorService::MirrorService(std::weak_ptr<DeviceMirror> mirror, std::string name, std::string upstream_service)
-    : mirror_(std::move(mirror)), name_(std::move(name)), upstream_service_(std::move(upstream_service)) {
-    // Lock holders are part of the device's status (JSON API pushes, the dashboard).
-    locks_->set_on_change([weak = mirror_] {
-        if (auto m = weak.lock()) m->notify_state();
-    });
-}
+MirrorService::MirrorService(std::weak_ptr<DeviceMirror> mirror, std::shared_ptr<DeviceCounters> counters, std::string name,
+                             std::string upstream_service)
+    : mirror_(std::move(mirror)),
+      counters_(std::move(counters)),
+      name_(std::move(name)),
+      upstream_service_(std::move(upstream_service)) {}
+
+void MirrorService::set_locks_listener(std::function<void()> listener) { locks_->set_on_change(std::move(listener)); }
 
 std::string MirrorService::to_upstream(std::string_view path) const { return replace_service_name(path, upstream_service_); }
 std::string MirrorService::to_downstream(std::string_view path) const { return replace_service_name(path, name_); }
@@ -84,17 +85,12 @@ std::optional<std::string> MirrorService::service_definition(std::string_view se
 
 ObjectTypeInfo MirrorService::root_type() const {
     auto m = mirror_.lock();
-    if (!m) return {};
-    std::lock_guard lock(m->mutex_);
-    return {m->object_type_, m->implements_};
+    return m ? m->root_type() : ObjectTypeInfo{};
 }
 
 MessageElement MirrorService::attributes() const {
-    auto m = mirror_.lock();
-    if (m) {
-        std::lock_guard lock(m->mutex_);
-        if (m->attributes_.type == DataTypes::dictionary_t) return m->attributes_;
-    }
+    if (auto m = mirror_.lock())
+        if (auto a = m->attributes(); a.type == DataTypes::dictionary_t) return a;
     return Service::attributes();
 }
 
@@ -397,9 +393,8 @@ std::vector<DeviceLockInfo> MirrorService::gateway_locks() const {
 }
 
 void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder) {
-    auto mirror = mirror_.lock();
     auto c = client();
-    if (!mirror || !c) {
+    if (!c) {
         if (!responder.done()) responder.fail(not_connected(name_));
         return;
     }
@@ -411,19 +406,19 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
     const auto endpoint = session.endpoint();
     const auto start = std::chrono::steady_clock::now();
     entry.service_path = to_upstream(entry.service_path);
-    mirror->counters_.requests.fetch_add(1);
+    counters_->requests.fetch_add(1);
     auto self = shared_from_this();
     auto shared = std::make_shared<Responder>(std::move(responder));
-    c->request(std::move(entry), [self, mirror, shared, type, endpoint, start](Result<MessageEntry> r) {
-        mirror->counters_.observe_latency(std::chrono::steady_clock::now() - start);
+    c->request(std::move(entry), [self, shared, type, endpoint, start](Result<MessageEntry> r) {
+        self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
         if (!r) {
             // No answer from the device (its connection dropped, the request timed out): say which device,
             // as not_connected() does for requests made while it is down.
-            mirror->counters_.request_errors.fetch_add(1);
+            self->counters_->request_errors.fetch_add(1);
             shared->fail(make_error(r.error().type, "device \"" + self->name_ + "\": " + r.error().message));
             return;
         }
-        if (r->error != MessageErrorType::None) mirror->counters_.request_errors.fetch_add(1);
+        if (r->error != MessageErrorType::None) self->counters_->request_errors.fetch_add(1);
         if (type == MessageEntryType::FunctionCallReq && r->error == MessageErrorType::None && !r->find("return")) {
             if (const auto* idx = r->find("index")) {
                 std::int32_t g = 0;
@@ -632,7 +627,7 @@ void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageE
         });
     }
     if (entry.elements.empty()) return;
-    if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
+    counters_->pipe_packets.fetch_add(1);
     entry.service_path = to_upstream(entry.service_path);
     c->send(std::move(entry));
 }
@@ -665,12 +660,11 @@ void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
             slot.second.elements.push_back(std::move(el));
         }
     }
-    auto m = mirror_.lock();
     for (auto& [ep, pair] : per_session) {
         // A session that may only send on the pipe (auth: gateway) does not receive its packets.
         if (!acks && access_.active() && !access_.may(pair.first, path, pair.second.member_name, auth::Operation::read))
             continue;
-        if (!pair.first.send(std::move(pair.second)) && m) m->counters_.pipe_drops.fetch_add(1);
+        if (!pair.first.send(std::move(pair.second))) counters_->pipe_drops.fetch_add(1);
     }
 }
 
@@ -686,11 +680,10 @@ void MirrorService::fan_out(MessageEntry&& entry) {
         auto it = event_subscribers_.find({entry.service_path, entry.member_name});
         if (it != event_subscribers_.end()) internal = it->second;
     }
-    auto m = mirror_.lock();
     const bool check = access_.active() && entry.entry_type == MessageEntryType::EventReq;
     for (const auto& s : sessions) {
         if (check && !access_.may(s, entry.service_path, entry.member_name, auth::Operation::read)) continue;
-        if (!s.send(entry) && m) m->counters_.event_drops.fetch_add(1);
+        if (!s.send(entry)) counters_->event_drops.fetch_add(1);
     }
     if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
 }
@@ -722,7 +715,7 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
         }
         return;
     }
-    if (auto m = mirror_.lock()) m->counters_.callbacks.fetch_add(1);
+    counters_->callbacks.fetch_add(1);
     entry.service_path = to_downstream(entry.service_path);
     std::weak_ptr<DeviceMirror> weak = mirror_;
     target.request(std::move(entry), [weak, reply_header](Result<MessageEntry> r) mutable {
@@ -734,16 +727,15 @@ void MirrorService::callback_from_device(MessageEntry&& entry) {
 }
 
 void MirrorService::on_upstream_entry(MessageEntry&& entry) {
-    auto m = mirror_.lock();
     switch (entry.entry_type) {
         case MessageEntryType::EventReq:
         case MessageEntryType::ServicePathReleasedReq:
-            if (m) m->counters_.events.fetch_add(1);
+            counters_->events.fetch_add(1);
             entry.service_path = to_downstream(entry.service_path);
             fan_out(std::move(entry));
             return;
         case MessageEntryType::WirePacket: {
-            if (m) m->counters_.wire_packets_in.fetch_add(1);
+            counters_->wire_packets_in.fetch_add(1);
             entry.service_path = to_downstream(entry.service_path);
             // One shared copy: the newest value for late subscribers and what internal subscribers get.
             auto shared = std::make_shared<const SharedEntry>(std::move(entry));
@@ -762,7 +754,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
                 // A session that may only set the wire's OutValue (auth: gateway) receives no InValue.
                 if (check && !access_.may(s, shared->entry().service_path, shared->entry().member_name, auth::Operation::read))
                     continue;
-                if (s.send_wire_packet(shared->entry()) && m) m->counters_.wire_packets_out.fetch_add(1);
+                if (s.send_wire_packet(shared->entry())) counters_->wire_packets_out.fetch_add(1);
             }
             deliver(internal, shared);
             return;
@@ -1076,7 +1068,7 @@ Result<std::uint32_t> MirrorService::send_internal_pipe_packet(std::uint64_t id,
         c->send(pipe_packet_entry(to_upstream(p.path), p.member, p.upstream_index, number, std::move(packet), request_ack,
                                   p.unreliable));
     }
-    if (auto m = mirror_.lock()) m->counters_.pipe_packets.fetch_add(1);
+    counters_->pipe_packets.fetch_add(1);
     return number;
 }
 

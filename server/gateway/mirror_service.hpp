@@ -18,7 +18,13 @@ namespace rr::server::gateway {
 
 class MirrorService : public Service, public std::enable_shared_from_this<MirrorService> {
 public:
-    explicit MirrorService(std::weak_ptr<DeviceMirror> mirror, std::string name, std::string upstream_service);
+    /// `counters` are the device's (DeviceMirror::counters()): this side counts requests, events, wire
+    /// and pipe packets and their drops into them.
+    MirrorService(std::weak_ptr<DeviceMirror> mirror, std::shared_ptr<DeviceCounters> counters, std::string name,
+                  std::string upstream_service);
+    /// Called (from any thread) whenever the lock holders change: they are part of the device's status.
+    /// Set once, before registration.
+    void set_locks_listener(std::function<void()> listener);
 
     // Service
     const std::string& name() const override { return name_; }
@@ -149,6 +155,7 @@ private:
     ServiceLocks::Privileges privileges(const std::string& user) const;
 
     std::weak_ptr<DeviceMirror> mirror_;
+    const std::shared_ptr<DeviceCounters> counters_;
     std::shared_ptr<PassthroughSessions> passthrough_;
     // auth: shared: the object and monitor locks of this device's gateway clients, held here (the
     // device sees one session); unused on a passthrough device.
