@@ -10,6 +10,9 @@
 #include "core/value/timespec.hpp"
 #include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/binary_push.hpp"
+#include "server/gateway/json_push.hpp"
+#include "server/gateway/json_socket_request.hpp"
+#include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
@@ -18,23 +21,14 @@ namespace rr::server::gateway {
 
 namespace {
 
-enum class SubKind : std::uint8_t { wire, event, pipe };
-
-std::string_view kind_name(SubKind k) {
-    switch (k) {
-        case SubKind::wire: return "wire";
-        case SubKind::event: return "event";
-        case SubKind::pipe: return "pipe";
-    }
-    return "?";
-}
-
 ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
 
 }  // namespace
 
-/// One JSON WebSocket: requests, subscriptions and their pushes (see json_socket.hpp). Thread-safe: the
-/// socket's strand delivers messages, device strands deliver pushes and replies.
+/// One JSON WebSocket: its requests (json_socket_request.hpp), subscriptions (json_subscriptions.hpp)
+/// and pushes (json_push.hpp) meet the socket here. Thread-safe: the socket's strand delivers
+/// messages, device strands deliver pushes and replies; mutex_ guards the registry and keeps each
+/// subscription's reply ahead of its pushes.
 class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession> {
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
@@ -43,6 +37,7 @@ public:
           socket_(std::move(socket)),
           options_(options),
           timer_(executor),
+          subs_(options.max_subscriptions),
           convert_strand_(std::move(convert_strand)),
           pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {
         // auth: gateway — the dashboard's session cookie, sent with the upgrade request, logs the socket in.
@@ -53,42 +48,32 @@ public:
     }
 
     void on_message(std::string text) {
-        if (text.size() > options_.max_message_bytes) {
-            send_reply(nullptr, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
-                                                            "message of " + std::to_string(text.size()) +
-                                                                " bytes is over the limit of " +
-                                                                std::to_string(options_.max_message_bytes))));
-            return;
-        }
-        auto msg = parse_request_json(text);
-        if (!msg) return send_reply(nullptr, ApiResult::failed(bad_request(msg.error().message)));
-        nlohmann::json id = nullptr;
+        auto parsed = parse_socket_envelope(text, options_.max_message_bytes);
+        if (auto* refused = std::get_if<SocketRejection>(&parsed))
+            return send_reply(refused->id, ApiResult::failed(std::move(refused->error)));
+        const auto& envelope = std::get<SocketEnvelope>(parsed);
         try {
-            if (!msg->is_object()) return send_reply(nullptr, ApiResult::failed(bad_request("a request is a JSON object")));
-            if (auto it = msg->find("id"); it != msg->end()) id = *it;
-            if (!id.is_number_integer() && !id.is_string())
-                return send_reply(nullptr, ApiResult::failed(bad_request("a request needs an \"id\" (integer or string)")));
-            handle(id, *msg);
+            handle(envelope);
         } catch (const std::exception& e) {
             // A nlohmann type error would be a bug here; the socket and the gateway carry on.
-            send_reply(id, ApiResult::failed(api_error(500, MessageErrorType::InternalError, e.what())));
+            send_reply(envelope.id, ApiResult::failed(api_error(500, MessageErrorType::InternalError, e.what())));
         }
     }
 
     /// Ends every subscription; nothing is sent afterwards.
     void close() {
-        std::map<std::uint64_t, Subscription> subs;
+        std::map<std::uint64_t, JsonSubscription> subs;
         std::map<std::string, DeviceLogin, std::less<>> logins;
         {
             std::lock_guard lock(mutex_);
             if (closed_) return;
             closed_ = true;
-            subs.swap(subs_);
+            subs = subs_.take_all();
             logins.swap(device_logins_);
             timer_.cancel();
         }
         for (auto& [sid, s] : subs)
-            if (s.mirror_known && !s.own) unsubscribe_upstream(s);  // those on a device_login end with its session
+            if (s.upstream_known && !s.own) unsubscribe_upstream(s);  // those on a device_login end with its session
         for (auto& [name, l] : logins) end_device_login(l);
     }
 
@@ -110,9 +95,9 @@ public:
         s.queued = socket_->queued();
         s.queued_bytes = socket_->queued_bytes();
         s.socket_dropped = socket_->dropped();
-        s.push_drops = push_drops_;
-        s.wire_coalesced = wire_coalesced_;
-        for (const auto& [sid, sub] : subs_) s.pending_wires += sub.pending_wire ? 1 : 0;
+        s.push_drops = subs_.push_drops();
+        s.wire_coalesced = subs_.wire_coalesced();
+        s.pending_wires = subs_.pending_wires();
         return s;
     }
 
@@ -123,20 +108,6 @@ private:
         std::uint32_t session = 0;
         std::string username;
         std::shared_ptr<SessionEndpoints> endpoints;  // the subscriptions made on that session
-    };
-
-    struct Subscription {
-        SubKind kind = SubKind::event;
-        bool may_write = true;  // auth: gateway allows `write` on the member
-        bool binary = false;    // "binary": true: values with numeric arrays go as binary pushes
-        std::shared_ptr<const MemberTarget> target;  // shared: every push takes it, copying no strings
-        std::shared_ptr<SessionEndpoints> own;  // made on this socket's device_login session; null: the shared one
-        std::uint64_t mirror_id = 0;  // DeviceMirror subscription id, internal pipe id, or `own`'s id
-        bool mirror_known = false;
-        bool active = false;  // subscribe answered: pushes may go
-        bool failed = false;  // subscribe failed before mirror_id was known
-        SharedEntryPtr pending_wire;  // newest value not yet sent
-        std::uint64_t dropped = 0;  // pushes dropped since the last one sent
     };
 
     // --- replies ----------------------------------------------------------------------------------
@@ -150,6 +121,7 @@ private:
             socket_->send_urgent(json_text(nlohmann::json{{"id", id}, {"result", r.value}}));
         }
     }
+    void fail(const nlohmann::json& id, ApiError e) { send_reply(id, ApiResult::failed(std::move(e))); }
 
     // An asynchronous request: counted until answered.
     bool begin_request(const nlohmann::json& id) {
@@ -160,9 +132,8 @@ private:
                 return true;
             }
         }
-        send_reply(id, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
-                                                   "more than " + std::to_string(options_.max_in_flight) +
-                                                       " requests in flight on this socket")));
+        fail(id, api_error(400, MessageErrorType::BufferLimitViolation,
+                           "more than " + std::to_string(options_.max_in_flight) + " requests in flight on this socket"));
         return false;
     }
     void end_request() {
@@ -179,103 +150,39 @@ private:
 
     // --- requests ---------------------------------------------------------------------------------
 
-    static std::optional<ApiError> read_address(const nlohmann::json& msg, MemberAddress& a) {
-        auto d = msg.find("device");
-        auto m = msg.find("member");
-        if (d == msg.end() || !d->is_string() || m == msg.end() || !m->is_string())
-            return bad_request("\"device\" and \"member\" (strings) are required");
-        a.device = d->get<std::string>();
-        a.member = m->get<std::string>();
-        if (auto o = msg.find("object"); o != msg.end() && !o->is_null()) {
-            if (!o->is_string()) return bad_request("\"object\" must be a string (a relative service path)");
-            a.object = o->get<std::string>();
-        }
-        return std::nullopt;
-    }
-
-    static std::optional<ApiError> read_subscription(const nlohmann::json& msg, std::uint64_t& sid) {
-        auto s = msg.find("subscription");
-        if (s == msg.end() || !s->is_number_unsigned()) return bad_request("\"subscription\" (a subscription id) is required");
-        sid = s->get<std::uint64_t>();
-        return std::nullopt;
-    }
-
-    void handle(const nlohmann::json& id, const nlohmann::json& msg) {
-        auto op_it = msg.find("op");
-        if (op_it == msg.end() || !op_it->is_string())
-            return send_reply(id, ApiResult::failed(bad_request("a request needs an \"op\" (string)")));
-        const std::string op = op_it->get<std::string>();
-        auto fail_with = [&](ApiError e) { send_reply(id, ApiResult::failed(std::move(e))); };
-
+    void handle(const SocketEnvelope& envelope) {
+        const auto& id = envelope.id;
+        const auto& a = api_->auth();
+        const bool logins = a && a->enabled();
         // auth: gateway — logged in by the upgrade's cookie, or by a first {"op": "login"} message.
-        if (const auto& a = api_->auth(); a && a->enabled()) {
-            if (op == "login") return login(id, msg, *a);
-            if (needs_login())
-                return fail_with(api_error(401, MessageErrorType::AuthenticationError,
-                                           "login required: send {\"op\": \"login\", \"username\", \"password\"} or "
-                                           "{\"op\": \"login\", \"token\"} first"));
-        }
+        if (logins && envelope.op != "login" && needs_login())
+            return fail(id, api_error(401, MessageErrorType::AuthenticationError,
+                                      "login required: send {\"op\": \"login\", \"username\", \"password\"} or "
+                                      "{\"op\": \"login\", \"token\"} first"));
+        auto parsed = parse_socket_request(envelope, logins);
+        if (auto* e = std::get_if<ApiError>(&parsed)) return fail(id, std::move(*e));
+        std::visit([&](auto&& request) { act(id, std::move(request)); }, std::get<SocketRequest>(std::move(parsed)));
+    }
 
-        if (op == "device_login") return device_login(id, msg);
-        if (op == "device_logout") return device_logout(id, msg);
-        if (op == "devices") return send_reply(id, ApiResult::ok(api_->device_list()));
-        if (op == "device") {
-            auto d = msg.find("device");
-            if (d == msg.end() || !d->is_string()) return fail_with(bad_request("\"device\" (string) is required"));
-            return send_reply(id, api_->device_info(d->get<std::string>()));
-        }
-        if (op == "unsubscribe") {
-            std::uint64_t sid = 0;
-            if (auto e = read_subscription(msg, sid)) return fail_with(*e);
-            return unsubscribe(id, sid);
-        }
-        if (op == "set_out_value" || op == "send") {
-            std::uint64_t sid = 0;
-            if (auto e = read_subscription(msg, sid)) return fail_with(*e);
-            auto v = msg.find("value");
-            if (v == msg.end()) return fail_with(bad_request("\"value\" is required"));
-            if (op == "set_out_value") return set_out_value(id, sid, *v);
-            bool ack = false;
-            if (auto a = msg.find("requestack"); a != msg.end()) {
-                if (!a->is_boolean()) return fail_with(bad_request("\"requestack\" must be true or false"));
-                ack = a->get<bool>();
-            }
-            return send_packet(id, sid, *v, ack);
-        }
-        if (op != "get" && op != "set" && op != "call" && op != "peek" && op != "subscribe")
-            return fail_with(bad_request("unknown op \"" + op + "\""));
-
-        MemberAddress address;
-        if (auto e = read_address(msg, address)) return fail_with(*e);
-        address.principal = principal();
-        address.device_session = device_session(address.device);
-        nlohmann::json value, args;
-        std::size_t max_items = 0;
-        if (op == "set") {
-            auto v = msg.find("value");
-            if (v == msg.end()) return fail_with(bad_request("\"value\" is required"));
-            value = *v;
-        }
-        if (op == "call") {
-            if (auto a = msg.find("args"); a != msg.end()) args = *a;
-            if (auto m = msg.find("max_items"); m != msg.end()) {
-                if (!m->is_number_unsigned()) return fail_with(bad_request("\"max_items\" must be a non-negative integer"));
-                max_items = m->get<std::size_t>();
-            }
-        }
-        bool binary = false;
-        if (op == "subscribe") {
-            if (auto b = msg.find("binary"); b != msg.end()) {
-                if (!b->is_boolean()) return fail_with(bad_request("\"binary\" must be true or false"));
-                binary = b->get<bool>();
-            }
-        }
+    void act(const nlohmann::json& id, LoginRequest r) { login(id, r, *api_->auth()); }
+    void act(const nlohmann::json& id, DeviceLoginRequest r) { device_login(id, std::move(r)); }
+    void act(const nlohmann::json& id, DeviceLogoutRequest r) { device_logout(id, r); }
+    void act(const nlohmann::json& id, DevicesRequest) { send_reply(id, ApiResult::ok(api_->device_list())); }
+    void act(const nlohmann::json& id, DeviceRequest r) { send_reply(id, api_->device_info(r.device)); }
+    void act(const nlohmann::json& id, UnsubscribeRequest r) { unsubscribe(id, r.subscription); }
+    void act(const nlohmann::json& id, SetOutValueRequest r) { set_out_value(id, r.subscription, r.value); }
+    void act(const nlohmann::json& id, SendRequest r) { send_packet(id, r.subscription, r.value, r.request_ack); }
+    void act(const nlohmann::json& id, MemberRequest r) {
+        r.address.principal = principal();
+        r.address.device_session = device_session(r.address.device);
         if (!begin_request(id)) return;
-        if (op == "get") return api_->get_property(address, replier(id));
-        if (op == "set") return api_->set_property(address, value, replier(id));
-        if (op == "call") return api_->call_function(address, args, max_items, replier(id));
-        if (op == "peek") return api_->peek_wire(address, replier(id));
-        subscribe(id, std::move(address), binary);
+        switch (r.op) {
+            case MemberOp::get: return api_->get_property(r.address, replier(id));
+            case MemberOp::set: return api_->set_property(r.address, r.value, replier(id));
+            case MemberOp::call: return api_->call_function(r.address, r.args, r.max_items, replier(id));
+            case MemberOp::peek: return api_->peek_wire(r.address, replier(id));
+            case MemberOp::subscribe: return subscribe(id, std::move(r.address), r.binary);
+        }
     }
 
     // --- subscriptions ----------------------------------------------------------------------------
@@ -284,14 +191,14 @@ private:
         // Receiving (wire values, events, pipe packets) needs `read`; sending on the subscription
         // (set_out_value, send) needs `write`, decided here once.
         if (auto denied = api_->check_access(address, auth::Operation::read)) {
-            send_reply(id, ApiResult::failed(std::move(*denied)));
+            fail(id, std::move(*denied));
             return end_request();
         }
         const bool may_write = !api_->check_access(address, auth::Operation::write).has_value();
         auto self = shared_from_this();
         api_->resolve(address, [self, id, may_write, binary](Resolved r) {
             if (auto* e = std::get_if<ApiError>(&r)) {
-                self->send_reply(id, ApiResult::failed(*e));
+                self->fail(id, *e);
                 return self->end_request();
             }
             self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write, binary);
@@ -309,19 +216,10 @@ private:
         return principal_;
     }
 
-    void login(const nlohmann::json& id, const nlohmann::json& msg, auth::GatewayAuth& a) {
-        auto u = msg.find("username");
-        auto p = msg.find("password");
-        auto t = msg.find("token");
-        Result<auth::PrincipalPtr> who = fail(MessageErrorType::AuthenticationError, "Invalid username or password");
-        if (u != msg.end() && u->is_string() && p != msg.end() && p->is_string()) {
-            who = a.login_password(u->get<std::string>(), p->get<std::string>(), socket_->peer(), auth::LoginChannel::websocket);
-        } else if (t != msg.end() && t->is_string()) {
-            who = a.login_token(t->get<std::string>(), socket_->peer(), auth::LoginChannel::websocket);
-        } else {
-            return send_reply(id, ApiResult::failed(bad_request("login takes \"username\" and \"password\", or \"token\"")));
-        }
-        if (!who) return send_reply(id, ApiResult::failed(auth::login_error(who.error())));
+    void login(const nlohmann::json& id, const LoginRequest& r, auth::GatewayAuth& a) {
+        auto who = r.by_token ? a.login_token(r.token, socket_->peer(), auth::LoginChannel::websocket)
+                              : a.login_password(r.username, r.password, socket_->peer(), auth::LoginChannel::websocket);
+        if (!who) return fail(id, auth::login_error(who.error()));
         {
             std::lock_guard lock(mutex_);
             principal_ = *who;
@@ -337,33 +235,24 @@ private:
         return it == device_logins_.end() ? 0 : it->second.session;
     }
 
-    // {"op": "device_login", "device", "username", "password"}: from now on this socket's get, set,
-    // call and peek on the device go on a session of its own, logged in to the device as that user.
-    void device_login(const nlohmann::json& id, const nlohmann::json& msg) {
-        auto d = msg.find("device");
-        auto u = msg.find("username");
-        auto p = msg.find("password");
-        if (d == msg.end() || !d->is_string() || u == msg.end() || !u->is_string() || u->get_ref<const std::string&>().empty() ||
-            (p != msg.end() && !p->is_string()))
-            return send_reply(id, ApiResult::failed(bad_request(
-                                      "device_login takes \"device\", \"username\" (non-empty strings) and \"password\" (string)")));
-        const std::string name = d->get<std::string>();
+    // From now on this socket's get, set, call and peek on the device go on a session of its own,
+    // logged in to the device as that user.
+    void device_login(const nlohmann::json& id, DeviceLoginRequest r) {
+        const std::string name = r.device;
         auto device = api_->find_device(name);
-        if (!device)
-            return send_reply(id, ApiResult::failed(api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + name + "\"")));
+        if (!device) return fail(id, api_error(404, MessageErrorType::ServiceNotFound, "no device named \"" + name + "\""));
         if (device->config().auth != DeviceAuth::passthrough)
-            return send_reply(id, ApiResult::failed(api_error(
-                                      400, MessageErrorType::InvalidOperation,
+            return fail(id, api_error(400, MessageErrorType::InvalidOperation,
                                       "device \"" + name + "\" is auth: shared: every client uses the gateway's own login to it; "
-                                      "device_login needs auth: passthrough")));
+                                      "device_login needs auth: passthrough"));
         if (!begin_request(id)) return;
-        std::string username = u->get<std::string>();
-        std::string password = p == msg.end() ? std::string() : p->get<std::string>();
         auto self = shared_from_this();
         std::weak_ptr<DeviceMirror> weak_device = device;
-        device->open_api_session(username, std::move(password), [self, id, name, username, weak_device](Result<DeviceMirror::ApiSession> r) {
+        const std::string username = r.username;
+        device->open_api_session(std::move(r.username), std::move(r.password),
+                                 [self, id, name, username, weak_device](Result<DeviceMirror::ApiSession> r) {
             if (!r) {
-                self->send_reply(id, ApiResult::failed(device_error(r.error())));
+                self->fail(id, device_error(r.error()));
                 return self->end_request();
             }
             std::optional<DeviceLogin> replaced;
@@ -387,21 +276,17 @@ private:
         });
     }
 
-    // {"op": "device_logout", "device"}: back to the gateway's shared session (the device releases this
-    // socket's client locks and monitors).
-    void device_logout(const nlohmann::json& id, const nlohmann::json& msg) {
-        auto d = msg.find("device");
-        if (d == msg.end() || !d->is_string()) return send_reply(id, ApiResult::failed(bad_request("\"device\" (string) is required")));
+    // Back to the gateway's shared session (the device releases this socket's client locks and monitors).
+    void device_logout(const nlohmann::json& id, const DeviceLogoutRequest& r) {
         std::optional<DeviceLogin> login;
         {
             std::lock_guard lock(mutex_);
-            if (auto it = device_logins_.find(d->get_ref<const std::string&>()); it != device_logins_.end()) {
+            if (auto it = device_logins_.find(r.device); it != device_logins_.end()) {
                 login = it->second;
                 device_logins_.erase(it);
             }
         }
-        if (!login)
-            return send_reply(id, ApiResult::failed(bad_request("this socket has no device_login for \"" + d->get<std::string>() + "\"")));
+        if (!login) return fail(id, bad_request("this socket has no device_login for \"" + r.device + "\""));
         end_device_login(*login, "device_logout ended the session it was made on");
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
@@ -409,20 +294,13 @@ private:
     // Closes a device login's session; its subscriptions end, each with a "closed" push naming `why`
     // (none when the socket itself is closing: `why` empty).
     void end_device_login(const DeviceLogin& login, const std::string& why = {}) {
-        std::vector<std::uint64_t> ended;
         {
             std::lock_guard lock(mutex_);
-            for (auto it = subs_.begin(); it != subs_.end();) {
-                if (it->second.own != login.endpoints) {
-                    ++it;
-                    continue;
-                }
-                if (it->second.active && !closed_ && !why.empty()) ended.push_back(it->first);
-                it = subs_.erase(it);
-            }
-            for (auto sid : ended)
-                send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"},
-                                         {"error", error_object(api_error(503, MessageErrorType::OperationAborted, why))}});
+            const auto ended = subs_.remove_own(login.endpoints);
+            if (!closed_ && !why.empty())
+                for (auto sid : ended)
+                    send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"},
+                                             {"error", error_object(api_error(503, MessageErrorType::OperationAborted, why))}});
         }
         if (login.endpoints) login.endpoints->forget();
         if (auto device = login.device.lock()) device->close_api_session(login.session);
@@ -435,24 +313,24 @@ private:
     }
 
     void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write, bool binary) {
-        SubKind kind;
+        SubscriptionKind kind;
         switch (t.member->kind) {
-            case robdef::MemberKind::wire: kind = SubKind::wire; break;
-            case robdef::MemberKind::event: kind = SubKind::event; break;
-            case robdef::MemberKind::pipe: kind = SubKind::pipe; break;
+            case robdef::MemberKind::wire: kind = SubscriptionKind::wire; break;
+            case robdef::MemberKind::event: kind = SubscriptionKind::event; break;
+            case robdef::MemberKind::pipe: kind = SubscriptionKind::pipe; break;
             default:
-                send_reply(id, ApiResult::failed(api_error(404, MessageErrorType::MemberNotFound,
-                                                           "member \"" + t.member->name + "\" is " +
-                                                               robdef::with_article(robdef::member_kind_keyword(t.member->kind)) +
-                                                               "; subscribe takes a wire, an event or a pipe")));
+                fail(id, api_error(404, MessageErrorType::MemberNotFound,
+                                   "member \"" + t.member->name + "\" is " +
+                                       robdef::with_article(robdef::member_kind_keyword(t.member->kind)) +
+                                       "; subscribe takes a wire, an event or a pipe"));
                 return end_request();
         }
         // Opening a wire connection or a pipe endpoint is a request the locks held at the gateway
         // decide; events reach every client in RR, locked or not.
-        if (kind != SubKind::event) {
-            if (auto locked = api_->check_locks(t, kind == SubKind::wire ? MessageEntryType::WireConnectReq
-                                                                        : MessageEntryType::PipeConnectReq)) {
-                send_reply(id, ApiResult::failed(std::move(*locked)));
+        if (kind != SubscriptionKind::event) {
+            if (auto locked = api_->check_locks(t, kind == SubscriptionKind::wire ? MessageEntryType::WireConnectReq
+                                                                                 : MessageEntryType::PipeConnectReq)) {
+                fail(id, std::move(*locked));
                 return end_request();
             }
         }
@@ -464,27 +342,24 @@ private:
                 if (in_flight_) --in_flight_;
                 return;
             }
-            if (subs_.size() >= options_.max_subscriptions) {
-                if (in_flight_) --in_flight_;
-                send_reply(id, ApiResult::failed(api_error(400, MessageErrorType::BufferLimitViolation,
-                                                           "more than " + std::to_string(options_.max_subscriptions) +
-                                                               " subscriptions on this socket")));
-                return;
-            }
-            sid = next_sid_++;
-            Subscription s;
+            JsonSubscription s;
             s.kind = kind;
             s.may_write = may_write;
             s.binary = binary;
             s.target = std::make_shared<const MemberTarget>(t);
             s.own = own_endpoints(t.device->config().name);
             own = s.own;
-            subs_.emplace(sid, std::move(s));
+            auto added = subs_.add(std::move(s));
+            if (auto* e = std::get_if<ApiError>(&added)) {
+                if (in_flight_) --in_flight_;
+                return fail(id, std::move(*e));
+            }
+            sid = std::get<std::uint64_t>(added);
         }
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
         if (own) return start_own_subscription(id, sid, kind, t, own);
 
-        if (kind == SubKind::pipe) {
+        if (kind == SubscriptionKind::pipe) {
             auto svc = t.device->mirror_service();
             const bool unreliable = robdef::pipe_is_unreliable(*t.object, *t.member);
             std::weak_ptr<MirrorService> weak_svc = svc;
@@ -503,8 +378,8 @@ private:
             return;
         }
 
-        const bool is_wire = kind == SubKind::wire;
-        const std::uint64_t mid = t.device->subscribe(
+        const bool is_wire = kind == SubscriptionKind::wire;
+        const std::uint64_t upstream = t.device->subscribe(
             t.path, t.member->name, is_wire, value_handler(sid, is_wire),
             [weak, sid, id](Result<void> r) {
                 if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
@@ -513,18 +388,18 @@ private:
         {
             // `subscribed` may have run already (inside subscribe), or the socket closed meanwhile.
             std::lock_guard lock(mutex_);
-            auto it = subs_.find(sid);
-            if (it == subs_.end()) {
+            auto* s = subs_.find(sid);
+            if (!s) {
                 drop = true;
-            } else if (it->second.failed) {
-                subs_.erase(it);
+            } else if (s->failed) {
+                subs_.erase(sid);
                 drop = true;
             } else {
-                it->second.mirror_id = mid;
-                it->second.mirror_known = true;
+                s->upstream_id = upstream;
+                s->upstream_known = true;
             }
         }
-        if (drop) t.device->unsubscribe(mid);
+        if (drop) t.device->unsubscribe(upstream);
     }
 
     void subscribed(std::uint64_t sid, const nlohmann::json& id, std::optional<ApiError> error) {
@@ -533,24 +408,24 @@ private:
         {
             std::lock_guard lock(mutex_);
             if (in_flight_) --in_flight_;
-            auto it = subs_.find(sid);
-            if (it == subs_.end()) {
-                if (!closed_) send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::OperationAborted, "subscription ended")));
+            auto* s = subs_.find(sid);
+            if (!s) {
+                if (!closed_) fail(id, api_error(503, MessageErrorType::OperationAborted, "subscription ended"));
                 return;
             }
             if (error) {
-                if (it->second.mirror_known) {
-                    unsubscribe.emplace(*it->second.target, it->second.mirror_id);
-                    subs_.erase(it);
+                if (s->upstream_known) {
+                    unsubscribe.emplace(*s->target, s->upstream_id);
+                    subs_.erase(sid);
                 } else {
-                    it->second.failed = true;
+                    s->failed = true;
                 }
-                send_reply(id, ApiResult::failed(*error));
+                fail(id, std::move(*error));
             } else {
                 // Under the lock: the reply is queued before any push of this subscription.
-                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(it->second.kind)}}));
-                it->second.active = true;
-                flush = it->second.pending_wire != nullptr;
+                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(s->kind)}}));
+                s->active = true;
+                flush = s->pending_wire != nullptr;
             }
         }
         if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
@@ -587,7 +462,7 @@ private:
 
     // A subscription on this socket's own session to a passthrough device (device_login): the
     // device's privileges and locks for that user apply to what it receives and sends.
-    void start_own_subscription(const nlohmann::json& id, std::uint64_t sid, SubKind kind, const MemberTarget& t,
+    void start_own_subscription(const nlohmann::json& id, std::uint64_t sid, SubscriptionKind kind, const MemberTarget& t,
                                 const std::shared_ptr<SessionEndpoints>& own) {
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
         std::weak_ptr<SessionEndpoints> weak_own = own;
@@ -595,7 +470,7 @@ private:
             auto close = [weak_own, kind](std::uint64_t x) {
                 auto o = weak_own.lock();
                 if (!o) return;
-                if (kind == SubKind::pipe)
+                if (kind == SubscriptionKind::pipe)
                     o->close_pipe(x);
                 else
                     o->unsubscribe(x);
@@ -607,17 +482,17 @@ private:
             }
             s->endpoint_opened(sid, id, std::move(r), close);
         };
-        if (kind == SubKind::pipe) {
+        if (kind == SubscriptionKind::pipe) {
             own->open_pipe(t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), pipe_handlers(sid),
                            std::move(opened));
             return;
         }
         SubscriptionHandlers h;
-        h.on_entry = value_handler(sid, kind == SubKind::wire);
+        h.on_entry = value_handler(sid, kind == SubscriptionKind::wire);
         h.on_closed = [weak, sid](const RRError& reason) {
             if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
         };
-        own->subscribe(t.path, t.member->name, kind == SubKind::wire, std::move(h), std::move(opened));
+        own->subscribe(t.path, t.member->name, kind == SubscriptionKind::wire, std::move(h), std::move(opened));
     }
 
     // A pipe endpoint (either session) or an own-session subscription answered: `close` undoes it
@@ -629,91 +504,87 @@ private:
         {
             std::lock_guard lock(mutex_);
             if (in_flight_) --in_flight_;
-            auto it = subs_.find(sid);
-            if (it == subs_.end()) {
+            auto* s = subs_.find(sid);
+            if (!s) {
                 if (r) orphan = *r;  // the socket closed while connecting
-                if (!closed_) send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::OperationAborted, "subscription ended")));
+                if (!closed_) fail(id, api_error(503, MessageErrorType::OperationAborted, "subscription ended"));
             } else if (!r) {
-                subs_.erase(it);
-                send_reply(id, ApiResult::failed(device_error(r.error())));
+                subs_.erase(sid);
+                fail(id, device_error(r.error()));
             } else {
-                it->second.mirror_id = *r;
-                it->second.mirror_known = true;
+                s->upstream_id = *r;
+                s->upstream_known = true;
                 // Under the lock: the reply is queued before any push of this subscription.
-                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(it->second.kind)}}));
-                it->second.active = true;
-                flush = it->second.pending_wire != nullptr;
+                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(s->kind)}}));
+                s->active = true;
+                flush = s->pending_wire != nullptr;
             }
         }
         if (orphan) close(*orphan);
         if (flush) flush_wires();
     }
 
-    void unsubscribe_upstream(const Subscription& s) {
+    void unsubscribe_upstream(const JsonSubscription& s) {
         if (s.own) {
-            if (s.kind == SubKind::pipe)
-                s.own->close_pipe(s.mirror_id);
+            if (s.kind == SubscriptionKind::pipe)
+                s.own->close_pipe(s.upstream_id);
             else
-                s.own->unsubscribe(s.mirror_id);
-        } else if (s.kind == SubKind::pipe) {
-            s.target->device->mirror_service()->close_internal_pipe(s.mirror_id);
+                s.own->unsubscribe(s.upstream_id);
+        } else if (s.kind == SubscriptionKind::pipe) {
+            s.target->device->mirror_service()->close_internal_pipe(s.upstream_id);
         } else {
-            s.target->device->unsubscribe(s.mirror_id);
+            s.target->device->unsubscribe(s.upstream_id);
         }
     }
 
     void unsubscribe(const nlohmann::json& id, std::uint64_t sid) {
-        std::optional<Subscription> sub;
+        std::optional<JsonSubscription> sub;
         {
             std::lock_guard lock(mutex_);
-            auto it = subs_.find(sid);
-            if (it != subs_.end() && it->second.active) {
-                sub = std::move(it->second);
-                subs_.erase(it);
-            }
+            sub = subs_.take_active(sid);
         }
-        if (!sub) return send_reply(id, ApiResult::failed(bad_request("no subscription " + std::to_string(sid))));
-        if (sub->mirror_known) unsubscribe_upstream(*sub);
+        if (!sub) return fail(id, bad_request("no subscription " + std::to_string(sid)));
+        if (sub->upstream_known) unsubscribe_upstream(*sub);
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
 
-    // Finds an active subscription of `kind` and copies its target.
-    std::optional<ApiError> find_active(std::uint64_t sid, SubKind kind, MemberTarget& t, std::uint64_t& mirror_id,
-                                        std::shared_ptr<SessionEndpoints>& own) {
-        std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        if (it == subs_.end() || !it->second.active) return bad_request("no subscription " + std::to_string(sid));
-        if (it->second.kind != kind)
-            return bad_request("subscription " + std::to_string(sid) + " is " + robdef::with_article(kind_name(it->second.kind)) +
-                               " subscription, not " + robdef::with_article(kind_name(kind)));
-        t = *it->second.target;
-        mirror_id = it->second.mirror_id;
-        own = it->second.own;
-        return std::nullopt;
-    }
+    // What set_out_value and send need of an answered subscription, copied under the lock.
+    struct Sending {
+        MemberTarget target;
+        std::uint64_t upstream_id = 0;
+        std::shared_ptr<SessionEndpoints> own;
+    };
 
-    bool may_write(std::uint64_t sid) const {
-        std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        return it != subs_.end() && it->second.may_write;
+    // The answered subscription `sid` of `kind` when this login may write on it; else the error.
+    std::variant<Sending, ApiError> sending_on(std::uint64_t sid, SubscriptionKind kind) {
+        Sending out;
+        bool may_write = false;
+        {
+            std::lock_guard lock(mutex_);
+            auto found = subs_.find_active(sid, kind);
+            if (auto* e = std::get_if<ApiError>(&found)) return std::move(*e);
+            const auto* s = std::get<const JsonSubscription*>(found);
+            out = Sending{*s->target, s->upstream_id, s->own};
+            may_write = s->may_write;
+        }
+        const auto& member = *out.target.member;
+        if (!may_write) {
+            if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
+            return api_error(403, MessageErrorType::PermissionDenied, "this login may not write " + member.name);
+        }
+        if (member.direction() == robdef::MemberDirection::readonly)
+            return api_error(405, MessageErrorType::ReadOnlyMember,
+                             std::string(kind_name(kind)) + " \"" + member.name + "\" is read-only");
+        return out;
     }
 
     void set_out_value(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value) {
-        MemberTarget t;
-        std::uint64_t mid = 0;
-        std::shared_ptr<SessionEndpoints> own;
-        if (auto e = find_active(sid, SubKind::wire, t, mid, own)) return send_reply(id, ApiResult::failed(*e));
-        if (!may_write(sid)) {
-            if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
-            return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
-                                                              "this login may not write " + t.member->name)));
-        }
-        if (t.member->direction() == robdef::MemberDirection::readonly)
-            return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
-                                                              "wire \"" + t.member->name + "\" is read-only")));
+        auto found = sending_on(sid, SubscriptionKind::wire);
+        if (auto* e = std::get_if<ApiError>(&found)) return fail(id, std::move(*e));
+        auto& [t, upstream_id, own] = std::get<Sending>(found);
         ApiError error;
         auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
-        if (!packet) return send_reply(id, ApiResult::failed(error));
+        if (!packet) return fail(id, error);
         // A client's OutValue is the device's InValue (wire.md §6.7: WirePacket, newest wins).
         MessageEntry e;
         e.entry_type = MessageEntryType::WirePacket;
@@ -724,37 +595,28 @@ private:
         if (own) {
             e.service_path = t.path;
             auto sent = own->send_wire_packet(std::move(e));
-            if (!sent) return send_reply(id, ApiResult::failed(device_error(sent.error())));
+            if (!sent) return fail(id, device_error(sent.error()));
             return send_reply(id, ApiResult::ok(nlohmann::json::object()));
         }
         auto client = t.device->upstream();
         if (!client)
-            return send_reply(id, ApiResult::failed(api_error(503, MessageErrorType::ConnectionError,
-                                                              "device \"" + t.device->config().name + "\" is not connected")));
+            return fail(id, api_error(503, MessageErrorType::ConnectionError,
+                                      "device \"" + t.device->config().name + "\" is not connected"));
         e.service_path = t.device->mirror_service()->to_upstream(t.path);
         client->send(std::move(e));
         send_reply(id, ApiResult::ok(nlohmann::json::object()));
     }
 
     void send_packet(const nlohmann::json& id, std::uint64_t sid, const nlohmann::json& value, bool request_ack) {
-        MemberTarget t;
-        std::uint64_t mid = 0;
-        std::shared_ptr<SessionEndpoints> own;
-        if (auto e = find_active(sid, SubKind::pipe, t, mid, own)) return send_reply(id, ApiResult::failed(*e));
-        if (!may_write(sid)) {
-            if (auto a = api_->auth()) a->counters().denied.fetch_add(1);
-            return send_reply(id, ApiResult::failed(api_error(403, MessageErrorType::PermissionDenied,
-                                                              "this login may not write " + t.member->name)));
-        }
-        if (t.member->direction() == robdef::MemberDirection::readonly)
-            return send_reply(id, ApiResult::failed(api_error(405, MessageErrorType::ReadOnlyMember,
-                                                              "pipe \"" + t.member->name + "\" is read-only")));
+        auto found = sending_on(sid, SubscriptionKind::pipe);
+        if (auto* e = std::get_if<ApiError>(&found)) return fail(id, std::move(*e));
+        auto& [t, upstream_id, own] = std::get<Sending>(found);
         ApiError error;
         auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
-        if (!packet) return send_reply(id, ApiResult::failed(error));
-        auto n = own ? own->send_pipe_packet(mid, std::move(*packet), request_ack)
-                     : t.device->mirror_service()->send_internal_pipe_packet(mid, std::move(*packet), request_ack);
-        if (!n) return send_reply(id, ApiResult::failed(device_error(n.error())));
+        if (!packet) return fail(id, error);
+        auto n = own ? own->send_pipe_packet(upstream_id, std::move(*packet), request_ack)
+                     : t.device->mirror_service()->send_internal_pipe_packet(upstream_id, std::move(*packet), request_ack);
+        if (!n) return fail(id, device_error(n.error()));
         send_reply(id, ApiResult::ok(nlohmann::json{{"packetnumber", *n}}));
     }
 
@@ -767,20 +629,11 @@ private:
         return socket_->queued() >= options_.wire_queue_threshold || socket_->queued_bytes() >= options_.wire_bytes_threshold;
     }
 
-    // Takes a push slot for subscription `sid`: false (and counted) when the client is too far behind.
-    bool take_push(std::uint64_t sid, std::shared_ptr<const MemberTarget>& t, std::uint64_t& dropped, bool& binary) {
+    // A push slot for subscription `sid`: none (and counted) when the client is too far behind.
+    std::optional<PushTicket> take_push(std::uint64_t sid) {
         std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        if (it == subs_.end() || !it->second.active || closed_) return false;
-        if (push_congested()) {
-            ++it->second.dropped;
-            ++push_drops_;
-            return false;
-        }
-        t = it->second.target;
-        dropped = std::exchange(it->second.dropped, 0);
-        binary = it->second.binary;
-        return true;
+        if (closed_) return std::nullopt;
+        return subs_.take_push(sid, push_congested());
     }
 
     // A push whose body (a JSON object's text, shared by all subscribers) is `r`: a binary message
@@ -793,65 +646,15 @@ private:
     }
 
     void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
-        std::shared_ptr<const MemberTarget> t;
-        std::uint64_t dropped = 0;
-        bool binary = false;
-        if (!take_push(sid, t, dropped, binary)) return;
-        if (binary)
-            return send_push(sid, "event", dropped, e->rendered_binary([&](const MessageEntry& entry) {
-                return render_binary([&](BinaryArrays* b) { return event_body(entry, *t, b); });
+        auto ticket = take_push(sid);
+        if (!ticket) return;
+        const MemberTarget& t = *ticket->target;
+        if (ticket->binary)
+            return send_push(sid, "event", ticket->dropped, e->rendered_binary([&](const MessageEntry& entry) {
+                return render_binary_body([&](BinaryArrays* b) { return event_push_body(*api_, entry, t, b); });
             }));
-        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_body(entry, *t)); });
-        socket_->send(push_text(sid, "event", dropped, body));
-    }
-
-    // A push body made with numeric arrays set aside (`body(arrays)` returns the JSON object).
-    template <class Body>
-    static SharedEntry::BinaryRendering render_binary(Body&& body) {
-        BinaryArrays arrays;
-        nlohmann::json j = body(&arrays);
-        if (j.contains("error") || arrays.blobs.empty())  // made before a later part failed: nothing refers to them
-            return SharedEntry::BinaryRendering{json_text(j), nullptr};
-        return SharedEntry::BinaryRendering{json_text(j), std::make_shared<const std::string>(binary_push_arrays(arrays.blobs))};
-    }
-
-    // {"args": {…}} or {"error": …}: the part of an event push every subscriber shares.
-    nlohmann::json event_body(const MessageEntry& e, const MemberTarget& t, BinaryArrays* binary = nullptr) const {
-        auto args = nlohmann::json::object();
-        for (const auto& p : t.member->parameters) {
-            const auto* el = e.find(p.name);
-            if (!el)
-                return {{"error", error_object(api_error(502, MessageErrorType::MessageElementNotFound,
-                                                         "event from the device has no \"" + p.name + "\" element"))}};
-            auto j = api_->element_json(*el, p, t, binary);
-            if (!j) return {{"error", error_object(*j.error)}};
-            args[p.name] = std::move(j.value);
-        }
-        return {{"args", std::move(args)}};
-    }
-
-    // {"subscription": sid, "kind": kind[, "dropped": n], …the members of `body`}; `body` is a JSON
-    // object's text, rendered once per value for all subscribers.
-    static std::string push_text(std::uint64_t sid, std::string_view kind, std::uint64_t dropped,
-                                 const std::string& body) {
-        std::string out;
-        out.reserve(body.size() + 64);
-        out += "{\"subscription\":";
-        out += std::to_string(sid);
-        out += ",\"kind\":\"";
-        out += kind;
-        out += '"';
-        if (dropped) {
-            out += ",\"dropped\":";
-            out += std::to_string(dropped);
-        }
-        if (body.size() > 2) {
-            out += ',';
-            out.append(body, 1, std::string::npos);  // the members and the closing brace
-        } else {
-            out += '}';
-        }
-        return out;
+        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_push_body(*api_, entry, t)); });
+        socket_->send(push_text(sid, "event", ticket->dropped, body));
     }
 
     // Runs on the device's strand, which must not wait for a packet's JSON (a camera frame is about
@@ -859,72 +662,51 @@ private:
     // on the server's conversion strand; while this socket's packets waiting there fill its budget
     // (max_pipe_conversions, max_pipe_conversion_bytes), newer packets are dropped and counted.
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
-        std::shared_ptr<const MemberTarget> t;
-        std::uint64_t dropped = 0;
-        bool binary = false;
-        if (!take_push(sid, t, dropped, binary)) return;
+        auto ticket = take_push(sid);
+        if (!ticket) return;
         const std::size_t bytes = payload_bytes(packet);
         if (!pipe_budget_.try_acquire(bytes)) {
             std::lock_guard lock(mutex_);
-            if (auto it = subs_.find(sid); it != subs_.end()) it->second.dropped += dropped + 1;
-            ++push_drops_;
+            subs_.return_push(sid, ticket->dropped);
             return;
         }
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, t = std::move(t), dropped, bytes, binary] {
-            self->convert_pipe_packet(sid, packet, *t, dropped, binary);
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, ticket = std::move(*ticket), bytes] {
+            self->convert_pipe_packet(sid, packet, ticket);
             self->pipe_budget_.release(bytes);
         });
     }
 
     // On the conversion strand (packets of one socket stay in order).
-    void convert_pipe_packet(std::uint64_t sid, const MessageElement& packet, const MemberTarget& t, std::uint64_t dropped,
-                             bool binary) {
+    void convert_pipe_packet(std::uint64_t sid, const MessageElement& packet, const PushTicket& ticket) {
         if (!push_allowed(sid)) return;
-        nlohmann::json msg{{"subscription", sid}, {"kind", "pipe"}};
-        BinaryArrays arrays;
-        auto j = api_->element_json(packet, t.member->type, t, binary ? &arrays : nullptr);
-        if (j)
-            msg["value"] = std::move(j.value);
-        else
-            msg["error"] = error_object(*j.error);
-        if (dropped) msg["dropped"] = dropped;
-        auto text = json_text(msg);
-        std::shared_ptr<const std::string> tail;
-        if (!arrays.blobs.empty()) {
-            text = binary_push_head(text);
-            tail = std::make_shared<const std::string>(binary_push_arrays(arrays.blobs));
-        }
+        auto push = pipe_push(*api_, sid, packet, *ticket.target, ticket.dropped, ticket.binary);
         // Under the lock: never after the subscription's "closed" push or its unsubscribe reply.
         std::lock_guard lock(mutex_);
         if (!push_allowed_locked(sid)) return;
-        if (!tail)
-            socket_->send(std::move(text));
+        if (!push.arrays)
+            socket_->send(std::move(push.body));
         else
-            socket_->send_binary(std::move(text), std::move(tail));
+            socket_->send_binary(std::move(push.body), std::move(push.arrays));
     }
 
     bool push_allowed(std::uint64_t sid) const {
         std::lock_guard lock(mutex_);
         return push_allowed_locked(sid);
     }
-    bool push_allowed_locked(std::uint64_t sid) const {
-        auto it = subs_.find(sid);
-        return !closed_ && it != subs_.end() && it->second.active;
-    }
+    bool push_allowed_locked(std::uint64_t sid) const { return !closed_ && subs_.is_active(sid); }
 
     void on_pipe_ack(std::uint64_t sid, std::uint32_t number) {
         std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        if (it == subs_.end() || !it->second.active || closed_) return;
+        if (!push_allowed_locked(sid)) return;
         send_text(nlohmann::json{{"subscription", sid}, {"kind", "pipe_ack"}, {"packetnumber", number}});
     }
 
     void on_subscription_closed(std::uint64_t sid, const RRError& reason) {
         std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        if (it == subs_.end()) return;
-        const bool active = it->second.active;
-        subs_.erase(it);
+        auto* s = subs_.find(sid);
+        if (!s) return;
+        const bool active = s->active;
+        subs_.erase(sid);
         if (active && !closed_)
             send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
     }
@@ -936,11 +718,7 @@ private:
         }
         {
             std::lock_guard lock(mutex_);
-            auto it = subs_.find(sid);
-            if (it == subs_.end()) return;
-            if (it->second.pending_wire) ++wire_coalesced_;
-            it->second.pending_wire = e;  // newest wins
-            if (!it->second.active) return;
+            if (!subs_.offer_wire(sid, e)) return;  // not open, or waits for its subscribe reply
         }
         flush_wires();
     }
@@ -956,25 +734,12 @@ private:
             }
             flushing_ = true;
         }
-        struct Item {
-            std::uint64_t sid;
-            SharedEntryPtr entry;
-            std::shared_ptr<const MemberTarget> target;
-            bool binary;
-        };
-        std::vector<Item> batch;
+        std::vector<WireToSend> batch;
         for (;;) {
-            batch.clear();
             {
                 std::lock_guard lock(mutex_);
                 flush_again_ = false;
-                if (closed_) {
-                    flushing_ = false;
-                    return;
-                }
-                bool waiting = false;
-                for (auto& [sid, sub] : subs_) waiting |= sub.active && sub.pending_wire;
-                if (!waiting) {
+                if (closed_ || !subs_.wires_waiting()) {
                     flushing_ = false;
                     return;
                 }
@@ -983,22 +748,19 @@ private:
                     flushing_ = false;
                     return;
                 }
-                for (auto& [sid, sub] : subs_) {
-                    if (!sub.active || !sub.pending_wire) continue;
-                    batch.push_back(Item{sid, std::move(sub.pending_wire), sub.target, sub.binary});
-                    sub.pending_wire = nullptr;
-                }
+                subs_.take_wires(batch);
             }
-            for (auto& item : batch) {
-                if (item.binary) {
-                    send_push(item.sid, "wire", 0, item.entry->rendered_binary([&](const MessageEntry& e) {
-                        return render_binary([&](BinaryArrays* b) { return wire_body(e, *item.target, b); });
+            for (const auto& w : batch) {
+                const MemberTarget& t = *w.target;
+                if (w.binary) {
+                    send_push(w.subscription, "wire", 0, w.value->rendered_binary([&](const MessageEntry& e) {
+                        return render_binary_body([&](BinaryArrays* b) { return wire_push_body(*api_, e, t, b); });
                     }));
                     continue;
                 }
-                const std::string& body = item.entry->rendered(
-                    [&](const MessageEntry& e) { return json_text(wire_body(e, *item.target)); });
-                socket_->send(push_text(item.sid, "wire", 0, body));
+                const std::string& body =
+                    w.value->rendered([&](const MessageEntry& e) { return json_text(wire_push_body(*api_, e, t)); });
+                socket_->send(push_text(w.subscription, "wire", 0, body));
             }
             std::lock_guard lock(mutex_);
             if (!flush_again_) {
@@ -1006,29 +768,6 @@ private:
                 return;
             }
         }
-    }
-
-    // {"value": …, "time": …} or {"error": …}: the part of a wire push every subscriber shares.
-    nlohmann::json wire_body(const MessageEntry& e, const MemberTarget& t, BinaryArrays* binary = nullptr) const {
-        nlohmann::json msg = nlohmann::json::object();
-        const auto* p = e.find("packet");
-        const auto* ts = e.find("packettime");
-        if (!p || !ts) {
-            msg["error"] = error_object(api_error(502, MessageErrorType::MessageElementNotFound,
-                                                  "WirePacket from the device without packet / packettime"));
-            return msg;
-        }
-        auto time = unpack_timespec(*ts);
-        auto j = api_->element_json(*p, t.member->type, t, binary);
-        if (!time) {
-            msg["error"] = error_object(ApiError{502, time.error().name, time.error().message});
-        } else if (!j) {
-            msg["error"] = error_object(*j.error);
-        } else {
-            msg["value"] = std::move(j.value);
-            msg["time"] = time_json(time->seconds, time->nanoseconds);
-        }
-        return msg;
     }
 
     // Under mutex_.
@@ -1054,12 +793,10 @@ private:
     mutable std::mutex mutex_;
     boost::asio::steady_timer timer_;
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
-    std::map<std::uint64_t, Subscription> subs_;
-    std::uint64_t next_sid_ = 1;
+    JsonSubscriptions subs_;
     auth::PrincipalPtr principal_;  // auth: gateway — who logged this socket in
     std::map<std::string, DeviceLogin, std::less<>> device_logins_;  // by device name
     std::size_t in_flight_ = 0;
-    std::uint64_t push_drops_ = 0, wire_coalesced_ = 0;
     ConvertStrand convert_strand_;                  // shared by the server's sockets
     ConversionBudget pipe_budget_;                  // this socket's packets posted there, not yet sent
 };

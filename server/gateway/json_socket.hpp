@@ -22,6 +22,9 @@
 //   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
 //     answered at once, and messages over `max_message_bytes` are refused.
 // Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
+//
+// The parts, each testable without a socket: json_socket_request.hpp (messages into typed requests,
+// the op table), json_subscriptions.hpp (the registry and its push policy), json_push.hpp (push bodies).
 #pragma once
 
 #include <chrono>

@@ -1,0 +1,48 @@
+// The JSON WebSocket's pushes (docs/json-api.md §WebSocket): the body of a wire value, an event or a
+// pipe packet rendered once and shared by every subscriber, and one subscriber's push around it.
+// No sockets: JsonSocketSession (json_socket.cpp) sends what these return.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "server/gateway/json_api.hpp"
+#include "server/gateway/shared_entry.hpp"
+
+namespace rr::server::gateway {
+
+/// {"subscription": sid, "kind": kind[, "dropped": n], …the members of `body`}: `body` is a JSON
+/// object's text (from json_text), so a shared body is copied, never parsed again.
+std::string push_text(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body);
+
+/// {"value": …, "time": {"seconds", "nanoseconds"}} from a WirePacket entry, or {"error": …} (502) when
+/// it lacks "packet" / "packettime" or its value does not fit the member's type. With `binary`, numeric
+/// arrays go there (binary_push.hpp).
+nlohmann::json wire_push_body(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target,
+                              BinaryArrays* binary = nullptr);
+
+/// {"args": {parameter: value, …}} from an EventReq entry, or {"error": …} (502) when an argument is
+/// missing or does not fit.
+nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,
+                               BinaryArrays* binary = nullptr);
+
+/// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; the
+/// arrays part when `binary` set any aside (then the text is already binary_push_head's).
+SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
+                                       const MemberTarget& target, std::uint64_t dropped, bool binary);
+
+/// The rendering of `body` with `arrays` set aside by it (render_binary_body).
+SharedEntry::BinaryRendering binary_rendering(const nlohmann::json& body, const BinaryArrays& arrays);
+
+/// A body rendered for binary subscribers: `body(&arrays)` returns the JSON object. The arrays part is
+/// null (a text push) when the body set none aside or is an error.
+template <class Body>
+SharedEntry::BinaryRendering render_binary_body(Body&& body) {
+    BinaryArrays arrays;
+    nlohmann::json j = body(&arrays);
+    return binary_rendering(j, arrays);
+}
+
+}  // namespace rr::server::gateway

@@ -1,0 +1,184 @@
+#include "server/gateway/json_socket_request.hpp"
+
+#include <array>
+#include <utility>
+
+namespace rr::server::gateway {
+
+namespace {
+
+ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
+
+using Parsed = std::variant<SocketRequest, ApiError>;
+using Json = nlohmann::json;
+
+// The field `name` when it is a string.
+const std::string* string_field(const Json& msg, std::string_view name) {
+    auto it = msg.find(name);
+    return it != msg.end() && it->is_string() ? &it->get_ref<const std::string&>() : nullptr;
+}
+
+std::optional<ApiError> read_subscription(const Json& msg, std::uint64_t& sid) {
+    auto s = msg.find("subscription");
+    if (s == msg.end() || !s->is_number_unsigned()) return bad_request("\"subscription\" (a subscription id) is required");
+    sid = s->get<std::uint64_t>();
+    return std::nullopt;
+}
+
+std::optional<ApiError> read_address(const Json& msg, MemberAddress& a) {
+    const auto* d = string_field(msg, "device");
+    const auto* m = string_field(msg, "member");
+    if (!d || !m) return bad_request("\"device\" and \"member\" (strings) are required");
+    a.device = *d;
+    a.member = *m;
+    if (auto o = msg.find("object"); o != msg.end() && !o->is_null()) {
+        if (!o->is_string()) return bad_request("\"object\" must be a string (a relative service path)");
+        a.object = o->get<std::string>();
+    }
+    return std::nullopt;
+}
+
+Parsed login(const Json& msg) {
+    const auto* u = string_field(msg, "username");
+    const auto* p = string_field(msg, "password");
+    const auto* t = string_field(msg, "token");
+    if (u && p) return LoginRequest{*u, *p, {}, false};
+    if (t) return LoginRequest{{}, {}, *t, true};
+    return bad_request("login takes \"username\" and \"password\", or \"token\"");
+}
+
+Parsed device_login(const Json& msg) {
+    const auto* d = string_field(msg, "device");
+    const auto* u = string_field(msg, "username");
+    auto p = msg.find("password");
+    if (!d || !u || u->empty() || (p != msg.end() && !p->is_string()))
+        return bad_request("device_login takes \"device\", \"username\" (non-empty strings) and \"password\" (string)");
+    return DeviceLoginRequest{*d, *u, p == msg.end() ? std::string() : p->get<std::string>()};
+}
+
+Parsed device_logout(const Json& msg) {
+    const auto* d = string_field(msg, "device");
+    if (!d) return bad_request("\"device\" (string) is required");
+    return DeviceLogoutRequest{*d};
+}
+
+Parsed devices(const Json&) { return DevicesRequest{}; }
+
+Parsed device(const Json& msg) {
+    const auto* d = string_field(msg, "device");
+    if (!d) return bad_request("\"device\" (string) is required");
+    return DeviceRequest{*d};
+}
+
+Parsed unsubscribe(const Json& msg) {
+    UnsubscribeRequest r;
+    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    return r;
+}
+
+Parsed set_out_value(const Json& msg) {
+    SetOutValueRequest r;
+    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    auto v = msg.find("value");
+    if (v == msg.end()) return bad_request("\"value\" is required");
+    r.value = *v;
+    return r;
+}
+
+Parsed send(const Json& msg) {
+    SendRequest r;
+    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    auto v = msg.find("value");
+    if (v == msg.end()) return bad_request("\"value\" is required");
+    r.value = *v;
+    if (auto a = msg.find("requestack"); a != msg.end()) {
+        if (!a->is_boolean()) return bad_request("\"requestack\" must be true or false");
+        r.request_ack = a->get<bool>();
+    }
+    return r;
+}
+
+template <MemberOp Op>
+Parsed member(const Json& msg) {
+    MemberRequest r;
+    r.op = Op;
+    if (auto e = read_address(msg, r.address)) return *e;
+    if constexpr (Op == MemberOp::set) {
+        auto v = msg.find("value");
+        if (v == msg.end()) return bad_request("\"value\" is required");
+        r.value = *v;
+    }
+    if constexpr (Op == MemberOp::call) {
+        if (auto a = msg.find("args"); a != msg.end()) r.args = *a;
+        if (auto m = msg.find("max_items"); m != msg.end()) {
+            if (!m->is_number_unsigned()) return bad_request("\"max_items\" must be a non-negative integer");
+            r.max_items = m->get<std::size_t>();
+        }
+    }
+    if constexpr (Op == MemberOp::subscribe) {
+        if (auto b = msg.find("binary"); b != msg.end()) {
+            if (!b->is_boolean()) return bad_request("\"binary\" must be true or false");
+            r.binary = b->get<bool>();
+        }
+    }
+    return r;
+}
+
+struct OpEntry {
+    std::string_view name;
+    Parsed (*parse)(const Json&);
+};
+
+// "login" first: without gateway users the table starts after it.
+constexpr std::array<OpEntry, 13> kOps{{
+    {"login", login},
+    {"device_login", device_login},
+    {"device_logout", device_logout},
+    {"devices", devices},
+    {"device", device},
+    {"get", member<MemberOp::get>},
+    {"set", member<MemberOp::set>},
+    {"call", member<MemberOp::call>},
+    {"peek", member<MemberOp::peek>},
+    {"subscribe", member<MemberOp::subscribe>},
+    {"unsubscribe", unsubscribe},
+    {"set_out_value", set_out_value},
+    {"send", send},
+}};
+
+constexpr auto kOpNames = [] {
+    std::array<std::string_view, kOps.size()> names{};
+    for (std::size_t i = 0; i < kOps.size(); ++i) names[i] = kOps[i].name;
+    return names;
+}();
+
+}  // namespace
+
+std::variant<SocketEnvelope, SocketRejection> parse_socket_envelope(std::string_view text, std::size_t max_bytes) {
+    if (text.size() > max_bytes)
+        return SocketRejection{nullptr, api_error(400, MessageErrorType::BufferLimitViolation,
+                                                  "message of " + std::to_string(text.size()) + " bytes is over the limit of " +
+                                                      std::to_string(max_bytes))};
+    auto msg = parse_request_json(text);
+    if (!msg) return SocketRejection{nullptr, bad_request(msg.error().message)};
+    if (!msg->is_object()) return SocketRejection{nullptr, bad_request("a request is a JSON object")};
+    nlohmann::json id = nullptr;
+    if (auto it = msg->find("id"); it != msg->end()) id = *it;
+    if (!id.is_number_integer() && !id.is_string())
+        return SocketRejection{nullptr, bad_request("a request needs an \"id\" (integer or string)")};
+    const auto* op = string_field(*msg, "op");
+    if (!op) return SocketRejection{std::move(id), bad_request("a request needs an \"op\" (string)")};
+    SocketEnvelope e{std::move(id), *op, {}};
+    e.message = std::move(*msg);
+    return e;
+}
+
+std::variant<SocketRequest, ApiError> parse_socket_request(const SocketEnvelope& envelope, bool with_logins) {
+    for (const auto& op : std::span(kOps).subspan(with_logins ? 0 : 1))
+        if (op.name == envelope.op) return op.parse(envelope.message);
+    return bad_request("unknown op \"" + envelope.op + "\"");
+}
+
+std::span<const std::string_view> socket_ops() { return kOpNames; }
+
+}  // namespace rr::server::gateway
