@@ -6,6 +6,8 @@ ApiError api_error(unsigned status, MessageErrorType type, std::string message) 
     return ApiError{status, std::string(error_name(type)), std::move(message)};
 }
 
+ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
+
 ApiError device_error(const RRError& error) {
     unsigned status = 502;
     switch (error.type) {

@@ -27,6 +27,8 @@ struct ApiError {
 
 /// An error the gateway found itself (bad input, unknown names): `type` gives the standard name.
 ApiError api_error(unsigned status, MessageErrorType type, std::string message);
+/// 400 InvalidArgument: a request the client got wrong (a missing or mistyped field, an unknown op).
+ApiError bad_request(std::string message);
 
 /// An error from the device or from the device connection, mapped to its HTTP status (see above).
 ApiError device_error(const RRError& error);

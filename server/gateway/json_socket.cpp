@@ -19,12 +19,6 @@
 
 namespace rr::server::gateway {
 
-namespace {
-
-ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
-
-}  // namespace
-
 /// One JSON WebSocket: its requests (json_socket_request.hpp), subscriptions (json_subscriptions.hpp)
 /// and pushes (json_push.hpp) meet the socket here. Thread-safe: the socket's strand delivers
 /// messages, device strands deliver pushes and replies; mutex_ guards the registry and keeps each
@@ -357,26 +351,10 @@ private:
             sid = std::get<std::uint64_t>(added);
         }
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
-        if (own) return start_own_subscription(id, sid, kind, t, own);
+        if (own) return start_endpoint_subscription(id, sid, kind, t, own);
 
-        if (kind == SubscriptionKind::pipe) {
-            auto svc = t.device->mirror_service();
-            const bool unreliable = robdef::pipe_is_unreliable(*t.object, *t.member);
-            std::weak_ptr<MirrorService> weak_svc = svc;
-            svc->open_internal_pipe(t.path, t.member->name, unreliable, pipe_handlers(sid),
-                                    [weak, sid, id, weak_svc](Result<std::uint64_t> r) {
-                                        auto close = [weak_svc](std::uint64_t pipe) {
-                                            if (auto svc = weak_svc.lock()) svc->close_internal_pipe(pipe);
-                                        };
-                                        auto s = weak.lock();
-                                        if (!s) {
-                                            if (r) close(*r);
-                                            return;
-                                        }
-                                        s->endpoint_opened(sid, id, std::move(r), close);
-                                    });
-            return;
-        }
+        if (kind == SubscriptionKind::pipe)
+            return start_endpoint_subscription(id, sid, kind, t, t.device->mirror_service()->shared_endpoints());
 
         const bool is_wire = kind == SubscriptionKind::wire;
         const std::uint64_t upstream = t.device->subscribe(
@@ -460,15 +438,16 @@ private:
         return h;
     }
 
-    // A subscription on this socket's own session to a passthrough device (device_login): the
-    // device's privileges and locks for that user apply to what it receives and sends.
-    void start_own_subscription(const nlohmann::json& id, std::uint64_t sid, SubscriptionKind kind, const MemberTarget& t,
-                                const std::shared_ptr<SessionEndpoints>& own) {
+    // A subscription through `endpoints`: this socket's own session to a passthrough device
+    // (device_login: the device's privileges and locks for that user apply to what it receives and
+    // sends), or the shared session's pipe endpoints (MirrorService::shared_endpoints).
+    void start_endpoint_subscription(const nlohmann::json& id, std::uint64_t sid, SubscriptionKind kind,
+                                     const MemberTarget& t, const std::shared_ptr<SessionEndpoints>& endpoints) {
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
-        std::weak_ptr<SessionEndpoints> weak_own = own;
-        auto opened = [weak, sid, id, weak_own, kind](Result<std::uint64_t> r) {
-            auto close = [weak_own, kind](std::uint64_t x) {
-                auto o = weak_own.lock();
+        std::weak_ptr<SessionEndpoints> weak_endpoints = endpoints;
+        auto opened = [weak, sid, id, weak_endpoints, kind](Result<std::uint64_t> r) {
+            auto close = [weak_endpoints, kind](std::uint64_t x) {
+                auto o = weak_endpoints.lock();
                 if (!o) return;
                 if (kind == SubscriptionKind::pipe)
                     o->close_pipe(x);
@@ -483,7 +462,7 @@ private:
             s->endpoint_opened(sid, id, std::move(r), close);
         };
         if (kind == SubscriptionKind::pipe) {
-            own->open_pipe(t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), pipe_handlers(sid),
+            endpoints->open_pipe(t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), pipe_handlers(sid),
                            std::move(opened));
             return;
         }
@@ -492,7 +471,7 @@ private:
         h.on_closed = [weak, sid](const RRError& reason) {
             if (auto s = weak.lock()) s->on_subscription_closed(sid, reason);
         };
-        own->subscribe(t.path, t.member->name, kind == SubscriptionKind::wire, std::move(h), std::move(opened));
+        endpoints->subscribe(t.path, t.member->name, kind == SubscriptionKind::wire, std::move(h), std::move(opened));
     }
 
     // A pipe endpoint (either session) or an own-session subscription answered: `close` undoes it
@@ -524,17 +503,18 @@ private:
         if (flush) flush_wires();
     }
 
+    // The SessionEndpoints a pipe subscription is on: the socket's device_login session, or the shared one.
+    static std::shared_ptr<SessionEndpoints> pipe_endpoints(const MemberTarget& t, const std::shared_ptr<SessionEndpoints>& own) {
+        return own ? own : t.device->mirror_service()->shared_endpoints();
+    }
+
     void unsubscribe_upstream(const JsonSubscription& s) {
-        if (s.own) {
-            if (s.kind == SubscriptionKind::pipe)
-                s.own->close_pipe(s.upstream_id);
-            else
-                s.own->unsubscribe(s.upstream_id);
-        } else if (s.kind == SubscriptionKind::pipe) {
-            s.target->device->mirror_service()->close_internal_pipe(s.upstream_id);
-        } else {
+        if (s.kind == SubscriptionKind::pipe)
+            pipe_endpoints(*s.target, s.own)->close_pipe(s.upstream_id);
+        else if (s.own)
+            s.own->unsubscribe(s.upstream_id);
+        else
             s.target->device->unsubscribe(s.upstream_id);
-        }
     }
 
     void unsubscribe(const nlohmann::json& id, std::uint64_t sid) {
@@ -614,8 +594,7 @@ private:
         ApiError error;
         auto packet = api_->element_from_json(value, t.member->type, t, "packet", error, "value");
         if (!packet) return fail(id, error);
-        auto n = own ? own->send_pipe_packet(upstream_id, std::move(*packet), request_ack)
-                     : t.device->mirror_service()->send_internal_pipe_packet(upstream_id, std::move(*packet), request_ack);
+        auto n = pipe_endpoints(t, own)->send_pipe_packet(upstream_id, std::move(*packet), request_ack);
         if (!n) return fail(id, device_error(n.error()));
         send_reply(id, ApiResult::ok(nlohmann::json{{"packetnumber", *n}}));
     }

@@ -7,27 +7,25 @@ namespace rr::server::gateway {
 
 namespace {
 
-ApiError bad_request(std::string message) { return api_error(400, MessageErrorType::InvalidArgument, std::move(message)); }
-
 using Parsed = std::variant<SocketRequest, ApiError>;
 using Json = nlohmann::json;
 
 // The field `name` when it is a string.
-const std::string* string_field(const Json& msg, std::string_view name) {
+const std::string* request_string(const Json& msg, std::string_view name) {
     auto it = msg.find(name);
     return it != msg.end() && it->is_string() ? &it->get_ref<const std::string&>() : nullptr;
 }
 
-std::optional<ApiError> read_subscription(const Json& msg, std::uint64_t& sid) {
+std::optional<ApiError> parse_subscription_id(const Json& msg, std::uint64_t& sid) {
     auto s = msg.find("subscription");
     if (s == msg.end() || !s->is_number_unsigned()) return bad_request("\"subscription\" (a subscription id) is required");
     sid = s->get<std::uint64_t>();
     return std::nullopt;
 }
 
-std::optional<ApiError> read_address(const Json& msg, MemberAddress& a) {
-    const auto* d = string_field(msg, "device");
-    const auto* m = string_field(msg, "member");
+std::optional<ApiError> parse_member_address(const Json& msg, MemberAddress& a) {
+    const auto* d = request_string(msg, "device");
+    const auto* m = request_string(msg, "member");
     if (!d || !m) return bad_request("\"device\" and \"member\" (strings) are required");
     a.device = *d;
     a.member = *m;
@@ -38,56 +36,56 @@ std::optional<ApiError> read_address(const Json& msg, MemberAddress& a) {
     return std::nullopt;
 }
 
-Parsed login(const Json& msg) {
-    const auto* u = string_field(msg, "username");
-    const auto* p = string_field(msg, "password");
-    const auto* t = string_field(msg, "token");
+Parsed parse_login(const Json& msg) {
+    const auto* u = request_string(msg, "username");
+    const auto* p = request_string(msg, "password");
+    const auto* t = request_string(msg, "token");
     if (u && p) return LoginRequest{*u, *p, {}, false};
     if (t) return LoginRequest{{}, {}, *t, true};
     return bad_request("login takes \"username\" and \"password\", or \"token\"");
 }
 
-Parsed device_login(const Json& msg) {
-    const auto* d = string_field(msg, "device");
-    const auto* u = string_field(msg, "username");
+Parsed parse_device_login(const Json& msg) {
+    const auto* d = request_string(msg, "device");
+    const auto* u = request_string(msg, "username");
     auto p = msg.find("password");
     if (!d || !u || u->empty() || (p != msg.end() && !p->is_string()))
         return bad_request("device_login takes \"device\", \"username\" (non-empty strings) and \"password\" (string)");
     return DeviceLoginRequest{*d, *u, p == msg.end() ? std::string() : p->get<std::string>()};
 }
 
-Parsed device_logout(const Json& msg) {
-    const auto* d = string_field(msg, "device");
+Parsed parse_device_logout(const Json& msg) {
+    const auto* d = request_string(msg, "device");
     if (!d) return bad_request("\"device\" (string) is required");
     return DeviceLogoutRequest{*d};
 }
 
-Parsed devices(const Json&) { return DevicesRequest{}; }
+Parsed parse_devices(const Json&) { return DevicesRequest{}; }
 
-Parsed device(const Json& msg) {
-    const auto* d = string_field(msg, "device");
+Parsed parse_device(const Json& msg) {
+    const auto* d = request_string(msg, "device");
     if (!d) return bad_request("\"device\" (string) is required");
     return DeviceRequest{*d};
 }
 
-Parsed unsubscribe(const Json& msg) {
+Parsed parse_unsubscribe(const Json& msg) {
     UnsubscribeRequest r;
-    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
     return r;
 }
 
-Parsed set_out_value(const Json& msg) {
+Parsed parse_set_out_value(const Json& msg) {
     SetOutValueRequest r;
-    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
     auto v = msg.find("value");
     if (v == msg.end()) return bad_request("\"value\" is required");
     r.value = *v;
     return r;
 }
 
-Parsed send(const Json& msg) {
+Parsed parse_send(const Json& msg) {
     SendRequest r;
-    if (auto e = read_subscription(msg, r.subscription)) return *e;
+    if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
     auto v = msg.find("value");
     if (v == msg.end()) return bad_request("\"value\" is required");
     r.value = *v;
@@ -99,10 +97,10 @@ Parsed send(const Json& msg) {
 }
 
 template <MemberOp Op>
-Parsed member(const Json& msg) {
+Parsed parse_member(const Json& msg) {
     MemberRequest r;
     r.op = Op;
-    if (auto e = read_address(msg, r.address)) return *e;
+    if (auto e = parse_member_address(msg, r.address)) return *e;
     if constexpr (Op == MemberOp::set) {
         auto v = msg.find("value");
         if (v == msg.end()) return bad_request("\"value\" is required");
@@ -131,19 +129,19 @@ struct OpEntry {
 
 // "login" first: without gateway users the table starts after it.
 constexpr std::array<OpEntry, 13> kOps{{
-    {"login", login},
-    {"device_login", device_login},
-    {"device_logout", device_logout},
-    {"devices", devices},
-    {"device", device},
-    {"get", member<MemberOp::get>},
-    {"set", member<MemberOp::set>},
-    {"call", member<MemberOp::call>},
-    {"peek", member<MemberOp::peek>},
-    {"subscribe", member<MemberOp::subscribe>},
-    {"unsubscribe", unsubscribe},
-    {"set_out_value", set_out_value},
-    {"send", send},
+    {"login", parse_login},
+    {"device_login", parse_device_login},
+    {"device_logout", parse_device_logout},
+    {"devices", parse_devices},
+    {"device", parse_device},
+    {"get", parse_member<MemberOp::get>},
+    {"set", parse_member<MemberOp::set>},
+    {"call", parse_member<MemberOp::call>},
+    {"peek", parse_member<MemberOp::peek>},
+    {"subscribe", parse_member<MemberOp::subscribe>},
+    {"unsubscribe", parse_unsubscribe},
+    {"set_out_value", parse_set_out_value},
+    {"send", parse_send},
 }};
 
 constexpr auto kOpNames = [] {
@@ -166,7 +164,7 @@ std::variant<SocketEnvelope, SocketRejection> parse_socket_envelope(std::string_
     if (auto it = msg->find("id"); it != msg->end()) id = *it;
     if (!id.is_number_integer() && !id.is_string())
         return SocketRejection{nullptr, bad_request("a request needs an \"id\" (integer or string)")};
-    const auto* op = string_field(*msg, "op");
+    const auto* op = request_string(*msg, "op");
     if (!op) return SocketRejection{std::move(id), bad_request("a request needs an \"op\" (string)")};
     SocketEnvelope e{std::move(id), *op, {}};
     e.message = std::move(*msg);

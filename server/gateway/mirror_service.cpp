@@ -58,7 +58,35 @@ MirrorService::MirrorService(std::weak_ptr<DeviceMirror> mirror, std::shared_ptr
     : mirror_(std::move(mirror)),
       counters_(std::move(counters)),
       name_(std::move(name)),
-      upstream_service_(std::move(upstream_service)) {}
+      upstream_service_(std::move(upstream_service)) {
+    // The shared session's pipe endpoints reach the device through the mirror's upstream client: no
+    // reference to this service, which they may outlive inside a completion.
+    SessionEndpoints::Upstream up;
+    auto client = [mirror = mirror_] {
+        auto m = mirror.lock();
+        return m ? m->upstream() : nullptr;
+    };
+    up.request = [client, name = name_, upstream = upstream_service_](MessageEntry e,
+                                                                       std::function<void(Result<MessageEntry>)> done) {
+        auto c = client();
+        if (!c) return done(fail(not_connected(name)));
+        e.service_path = replace_service_name(e.service_path, upstream);
+        c->request(std::move(e), std::move(done));
+    };
+    up.send = [client, name = name_, upstream = upstream_service_, counters = counters_](MessageEntry e) -> Result<void> {
+        auto c = client();
+        if (!c) return fail(not_connected(name));
+        if (e.entry_type == MessageEntryType::PipePacket) counters->pipe_packets.fetch_add(1);
+        e.service_path = replace_service_name(e.service_path, upstream);
+        c->send(std::move(e));
+        return {};
+    };
+    up.queued_bytes = [client]() -> std::size_t {
+        auto c = client();
+        return c ? c->queued_bytes() : 0;
+    };
+    shared_endpoints_ = std::make_shared<SessionEndpoints>(std::move(up));
+}
 
 void MirrorService::set_locks_listener(std::function<void()> listener) { locks_->set_on_change(std::move(listener)); }
 
@@ -633,9 +661,10 @@ void MirrorService::pipe_packets_from_client(const SessionRef& session, MessageE
 }
 
 void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
-    if (internal_pipe_packets(entry)) return;
+    const std::string path = to_downstream(entry.service_path);
+    entry.service_path = path;
+    if (shared_endpoints_->take_pipe_elements(entry)) return;  // the gateway's own endpoints' (JSON API)
     const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
-    std::string path = to_downstream(entry.service_path);
     // Regroup the elements per owning client session.
     std::map<std::uint32_t, std::pair<SessionRef, MessageEntry>> per_session;
     {
@@ -781,22 +810,8 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
         case MessageEntryType::PipeClosed: {
             std::string path = to_downstream(entry.service_path);
             const std::int32_t u = entry_pipe_index(entry);
+            if (shared_endpoints_->pipe_closed(path, entry.member_name, u)) return;
             std::optional<PipeLink> link;
-            std::shared_ptr<const InternalPipeHandlers> internal;
-            {
-                std::lock_guard lock(mutex_);
-                if (auto it = internal_pipes_by_upstream_.find({path, entry.member_name, u});
-                    it != internal_pipes_by_upstream_.end()) {
-                    internal = internal_pipes_.at(it->second).handlers;
-                    internal_pipes_.erase(it->second);
-                    internal_pipes_by_upstream_.erase(it);
-                }
-            }
-            if (internal) {
-                if (internal->on_closed)
-                    internal->on_closed(make_error(MessageErrorType::ConnectionError, "pipe endpoint closed by the device"));
-                return;
-            }
             {
                 std::lock_guard lock(mutex_);
                 auto it = pipes_by_upstream_.find({path, entry.member_name, u});
@@ -816,6 +831,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
 }
 
 void MirrorService::on_upstream_connected(const std::shared_ptr<RawClient>&) {
+    shared_endpoints_->resume();
     std::vector<MemberKey> resubscribe;
     {
         std::lock_guard lock(mutex_);
@@ -833,13 +849,8 @@ void MirrorService::on_upstream_lost(const RRError& error) {
     // to be re-subscribed when the device returns. Generators are gone with the session.
     std::vector<std::pair<SessionRef, MessageEntry>> closed;
     std::vector<std::function<void(Result<void>)>> waiting;
-    std::vector<std::shared_ptr<const InternalPipeHandlers>> internal_closed;
     {
         std::lock_guard lock(mutex_);
-        for (auto& [id, p] : internal_pipes_)
-            if (p.connected) internal_closed.push_back(p.handlers);
-        internal_pipes_.clear();  // a connect still in flight fails with the connection
-        internal_pipes_by_upstream_.clear();
         for (auto& [key, link] : pipes_by_upstream_) {
             MessageEntry e;
             e.entry_type = MessageEntryType::PipeClosed;
@@ -861,8 +872,7 @@ void MirrorService::on_upstream_lost(const RRError& error) {
     for (auto& [s, e] : closed) (void)s.send(std::move(e));
     for (auto& w : waiting)
         if (w) w(fail(not_connected(name_)));
-    for (auto& h : internal_closed)
-        if (h->on_closed) h->on_closed(not_connected(name_));
+    shared_endpoints_->lost(not_connected(name_));  // a connect still in flight fails with the connection
     (void)error;
 }
 
@@ -926,165 +936,6 @@ void MirrorService::remove_internal_subscriber(std::uint64_t id) {
             e.member_name = key.second;
             c->request(std::move(e), [](Result<MessageEntry>) {});
         }
-    }
-}
-
-// --- gateway-internal pipe endpoints (JSON API) ---------------------------------------------------
-
-bool MirrorService::internal_pipe_packets(MessageEntry& entry) {
-    const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
-    const std::string path = to_downstream(entry.service_path);
-    struct Delivery {
-        std::shared_ptr<const InternalPipeHandlers> handlers;
-        MessageElement packet;
-        std::uint32_t number = 0;
-    };
-    std::vector<Delivery> deliveries;
-    MessageEntry ack_entry;
-    {
-        std::lock_guard lock(mutex_);
-        if (internal_pipes_by_upstream_.empty()) return entry.elements.empty();
-        std::vector<MessageElement> rest;
-        for (auto& el : entry.elements) {
-            // Packets name their pipe index; acks number it (wire.md §6.7).
-            std::optional<std::int32_t> u = acks ? el.number : parse_pipe_index(el.name);
-            auto it = u ? internal_pipes_by_upstream_.find({path, entry.member_name, *u}) : internal_pipes_by_upstream_.end();
-            if (it == internal_pipes_by_upstream_.end()) {
-                rest.push_back(std::move(el));
-                continue;
-            }
-            const auto& handlers = internal_pipes_.at(it->second).handlers;
-            std::uint32_t number = 0;
-            if (acks) {
-                if (read_scalar(el, number)) deliveries.push_back(Delivery{handlers, MessageElement{}, number});
-                continue;
-            }
-            auto got = take_pipe_packet(el);
-            if (!got) continue;
-            if (got->request_ack) ack_entry.elements.push_back(pipe_ack_element(*u, got->number));
-            deliveries.push_back(Delivery{handlers, std::move(got->packet), got->number});
-        }
-        entry.elements = std::move(rest);
-    }
-    if (!ack_entry.elements.empty()) {
-        if (auto c = client()) {
-            ack_entry.entry_type = MessageEntryType::PipePacketRet;
-            ack_entry.service_path = entry.service_path;  // still the device's path here
-            ack_entry.member_name = entry.member_name;
-            c->send(std::move(ack_entry));
-        }
-    }
-    for (auto& d : deliveries) {
-        if (acks) {
-            if (d.handlers->on_ack) d.handlers->on_ack(d.number);
-        } else if (d.handlers->on_packet) {
-            d.handlers->on_packet(d.packet, d.number);
-        }
-    }
-    return entry.elements.empty();
-}
-
-void MirrorService::open_internal_pipe(std::string path, std::string member, bool unreliable,
-                                       InternalPipeHandlers handlers, std::function<void(Result<std::uint64_t>)> done) {
-    auto c = client();
-    if (!c) {
-        done(fail(not_connected(name_)));
-        return;
-    }
-    std::uint64_t id;
-    {
-        std::lock_guard lock(mutex_);
-        id = next_internal_id_++;
-        InternalPipe p;
-        p.path = path;
-        p.member = member;
-        p.unreliable = unreliable;
-        p.handlers = std::make_shared<const InternalPipeHandlers>(std::move(handlers));
-        internal_pipes_.emplace(id, std::move(p));
-    }
-    MessageEntry e = pipe_connect_request(to_upstream(path), member, unreliable);
-    auto self = shared_from_this();
-    c->request(std::move(e), [self, id, path, member, done = std::move(done)](Result<MessageEntry> r) {
-        std::optional<RRError> error;
-        std::int32_t u = -1;
-        bool reply_unreliable = false;
-        if (!r) {
-            error = r.error();
-        } else if (auto err = entry_error(*r)) {
-            error = *err;
-        } else {
-            u = entry_pipe_index(*r);
-            std::int32_t flag = 0;
-            reply_unreliable = r->find("unreliable") && read_scalar(*r->find("unreliable"), flag) && flag == 1;
-            if (u < 0) error = make_error(MessageErrorType::ProtocolError, "PipeConnectRet without an index");
-        }
-        bool orphan = false;
-        {
-            std::lock_guard lock(self->mutex_);
-            auto it = self->internal_pipes_.find(id);
-            if (it == self->internal_pipes_.end()) {
-                orphan = true;  // closed (or the device lost) while connecting
-            } else if (error) {
-                self->internal_pipes_.erase(it);
-            } else {
-                it->second.connected = true;
-                it->second.upstream_index = u;
-                it->second.unreliable = reply_unreliable;
-                self->internal_pipes_by_upstream_[{path, member, u}] = id;
-            }
-        }
-        if (error) {
-            done(fail(*error));
-            return;
-        }
-        if (orphan) {
-            if (auto c = self->client()) {
-                c->request(pipe_disconnect_request(self->to_upstream(path), member, u), [](Result<MessageEntry>) {});
-            }
-            done(fail(MessageErrorType::OperationAborted, "pipe endpoint closed while connecting"));
-            return;
-        }
-        done(id);
-    });
-}
-
-Result<std::uint32_t> MirrorService::send_internal_pipe_packet(std::uint64_t id, MessageElement packet, bool request_ack) {
-    auto c = client();
-    if (!c) return fail(not_connected(name_));
-    // The same bound as a service's pipe backlog: a device that does not read gets no more packets.
-    constexpr std::size_t kMaxBacklogBytes = 8u << 20;
-    if (c->queued_bytes() > kMaxBacklogBytes)
-        return fail(MessageErrorType::BufferLimitViolation, "device connection backlog full");
-    std::uint32_t number;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = internal_pipes_.find(id);
-        if (it == internal_pipes_.end() || !it->second.connected)
-            return fail(MessageErrorType::InvalidArgument, "pipe endpoint not open");
-        auto& p = it->second;
-        number = p.send_number == UINT32_MAX ? 0 : p.send_number + 1;
-        p.send_number = number;
-        // Sent under the lock: packet numbers reach the device in order.
-        c->send(pipe_packet_entry(to_upstream(p.path), p.member, p.upstream_index, number, std::move(packet), request_ack,
-                                  p.unreliable));
-    }
-    counters_->pipe_packets.fetch_add(1);
-    return number;
-}
-
-void MirrorService::close_internal_pipe(std::uint64_t id) {
-    std::optional<InternalPipe> p;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = internal_pipes_.find(id);
-        if (it == internal_pipes_.end()) return;
-        p = std::move(it->second);
-        internal_pipes_.erase(it);
-        if (p->connected) internal_pipes_by_upstream_.erase({p->path, p->member, p->upstream_index});
-    }
-    if (!p->connected) return;  // the connect reply disconnects it
-    if (auto c = client()) {
-        c->request(pipe_disconnect_request(to_upstream(p->path), p->member, p->upstream_index), [](Result<MessageEntry>) {});
     }
 }
 

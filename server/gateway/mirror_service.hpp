@@ -81,19 +81,11 @@ public:
                                           std::function<void(Result<void>)> done);
     void remove_internal_subscriber(std::uint64_t id);
 
-    /// What a gateway-internal pipe endpoint (JSON API) hears (on the upstream strand, without locks
-    /// held); `on_closed` also when the device connection is lost.
-    using InternalPipeHandlers = GatewayPipeHandlers;
-    /// Connects a pipe endpoint of the gateway itself (PipeConnectReq with index −1 upstream: the device
-    /// chooses). `done` gets an id for the calls below, or the device's error (ConnectionError when it is
-    /// not connected).
-    void open_internal_pipe(std::string path, std::string member, bool unreliable, InternalPipeHandlers handlers,
-                            std::function<void(Result<std::uint64_t>)> done);
-    /// Sends `packet` (an element named "packet", packed for the pipe's type) on the endpoint; returns its
-    /// packet number (1, 2, …). Errors: InvalidArgument (unknown or closed id), ConnectionError.
-    Result<std::uint32_t> send_internal_pipe_packet(std::uint64_t id, MessageElement packet, bool request_ack);
-    /// Disconnects the endpoint (PipeDisconnectReq upstream); no handler is called afterwards.
-    void close_internal_pipe(std::uint64_t id);
+    /// The gateway's own pipe endpoints on the device's shared session (the JSON API's pipe
+    /// subscriptions), paths in gateway naming: their packets and PipeClosed are taken out of the
+    /// device's traffic before the downstream clients', they close when the device connection is lost
+    /// and work again once it is back; packets sent on them count as the device's pipe_packets.
+    const std::shared_ptr<SessionEndpoints>& shared_endpoints() const noexcept { return shared_endpoints_; }
 
     std::string to_upstream(std::string_view path) const;
     std::string to_downstream(std::string_view path) const;
@@ -175,17 +167,7 @@ private:
     std::map<std::tuple<std::string, std::string, std::int32_t>, PipeLink> pipes_by_upstream_;
     std::map<std::tuple<std::uint32_t, std::string, std::string, std::int32_t>, std::int32_t> pipes_by_downstream_;
     std::set<std::pair<std::uint32_t, std::int32_t>> generators_;  // (endpoint, generator index)
-    struct InternalPipe {
-        std::string path, member;
-        bool unreliable = false;
-        bool connected = false;  // PipeConnectRet received
-        std::int32_t upstream_index = -1;
-        std::uint32_t send_number = 0;  // last packet number sent
-        std::shared_ptr<const InternalPipeHandlers> handlers;
-    };
-    std::map<std::uint64_t, InternalPipe> internal_pipes_;
-    std::map<std::tuple<std::string, std::string, std::int32_t>, std::uint64_t> internal_pipes_by_upstream_;
-    bool internal_pipe_packets(MessageEntry& entry);
+    std::shared_ptr<SessionEndpoints> shared_endpoints_;  // set once, in the constructor
     std::uint64_t next_internal_id_ = 1;
     std::shared_ptr<const DeviceTypes> types_;  // the device's definitions parsed, for member modifiers
 };

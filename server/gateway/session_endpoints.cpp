@@ -297,25 +297,27 @@ void SessionEndpoints::deliver(MessageEntry&& entry) {
             return;
         }
         case MessageEntryType::PipePacket:
-        case MessageEntryType::PipePacketRet: pipe_entry(std::move(entry)); return;
-        case MessageEntryType::PipeClosed: {
-            std::shared_ptr<const GatewayPipeHandlers> h;
-            {
-                std::lock_guard lock(mutex_);
-                auto it = pipes_by_index_.find({entry.service_path, entry.member_name, entry_pipe_index(entry)});
-                if (it == pipes_by_index_.end()) return;
-                h = pipes_.at(it->second).handlers;
-                pipes_.erase(it->second);
-                pipes_by_index_.erase(it);
-            }
-            if (h->on_closed) h->on_closed(make_error(MessageErrorType::ConnectionError, "pipe endpoint closed by the device"));
-            return;
-        }
+        case MessageEntryType::PipePacketRet: take_pipe_elements(entry); return;  // what is left is no one's
+        case MessageEntryType::PipeClosed: pipe_closed(entry.service_path, entry.member_name, entry_pipe_index(entry)); return;
         default: return;
     }
 }
 
-void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
+bool SessionEndpoints::pipe_closed(const std::string& path, const std::string& member, std::int32_t index) {
+    std::shared_ptr<const GatewayPipeHandlers> h;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = pipes_by_index_.find({path, member, index});
+        if (it == pipes_by_index_.end()) return false;
+        h = pipes_.at(it->second).handlers;
+        pipes_.erase(it->second);
+        pipes_by_index_.erase(it);
+    }
+    if (h->on_closed) h->on_closed(make_error(MessageErrorType::ConnectionError, "pipe endpoint closed by the device"));
+    return true;
+}
+
+bool SessionEndpoints::take_pipe_elements(MessageEntry& entry) {
     const bool acks = entry.entry_type == MessageEntryType::PipePacketRet;
     struct Delivery {
         std::shared_ptr<const GatewayPipeHandlers> handlers;
@@ -326,12 +328,16 @@ void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
     MessageEntry ack_entry;
     {
         std::lock_guard lock(mutex_);
+        if (pipes_by_index_.empty()) return entry.elements.empty();
+        std::vector<MessageElement> rest;
         for (auto& el : entry.elements) {
             // Packets name their pipe index; acks number it (wire.md §6.7).
             std::optional<std::int32_t> index = acks ? el.number : parse_pipe_index(el.name);
-            if (!index) continue;
-            auto it = pipes_by_index_.find({entry.service_path, entry.member_name, *index});
-            if (it == pipes_by_index_.end()) continue;
+            auto it = index ? pipes_by_index_.find({entry.service_path, entry.member_name, *index}) : pipes_by_index_.end();
+            if (it == pipes_by_index_.end()) {
+                rest.push_back(std::move(el));
+                continue;
+            }
             const auto& handlers = pipes_.at(it->second).handlers;
             if (acks) {
                 std::uint32_t number = 0;
@@ -343,6 +349,7 @@ void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
             if (got->request_ack) ack_entry.elements.push_back(pipe_ack_element(*index, got->number));
             deliveries.push_back(Delivery{handlers, std::move(got->packet), got->number});
         }
+        entry.elements = std::move(rest);
     }
     if (!ack_entry.elements.empty()) {
         ack_entry.entry_type = MessageEntryType::PipePacketRet;
@@ -357,6 +364,7 @@ void SessionEndpoints::pipe_entry(MessageEntry&& entry) {
             d.handlers->on_packet(d.packet, d.number);
         }
     }
+    return entry.elements.empty();
 }
 
 void SessionEndpoints::lost(const RRError& reason) {
@@ -386,6 +394,11 @@ void SessionEndpoints::lost(const RRError& reason) {
         if (h->on_closed) h->on_closed(reason);
     for (auto& h : pipes)
         if (h->on_closed) h->on_closed(reason);
+}
+
+void SessionEndpoints::resume() {
+    std::lock_guard lock(mutex_);
+    lost_.reset();
 }
 
 void SessionEndpoints::forget() {

@@ -1,7 +1,9 @@
 // The gateway's own event subscriptions, wire connections and pipe endpoints on one upstream session
 // to a device: the session a JSON API client opened with `device_login` (auth: passthrough;
 // docs/json-api.md "device_login"), so what that client receives and sends goes through the device's
-// own login, privileges and locks for its user instead of the gateway's shared session.
+// own login, privileges and locks for its user instead of the gateway's shared session. A device's
+// MirrorService keeps one more on that shared session for the JSON API's pipe endpoints
+// (shared_endpoints()), beside the downstream clients' pipes.
 //
 // Service paths are in gateway naming (the device's name as service name) both ways; the session's
 // owner (PassthroughSessions) translates them. One wire connection per (path, member) is made however
@@ -86,9 +88,19 @@ public:
     /// An entry the device sent on the session (gateway naming): EventReq, WirePacket, WireClosed,
     /// PipePacket, PipePacketRet, PipeClosed; others are ignored.
     void deliver(MessageEntry&& entry);
+    /// PipePacket / PipePacketRet (gateway naming) on a session other endpoints share: takes out and
+    /// delivers the elements of these endpoints (acknowledging packets that ask for it) and leaves the
+    /// rest in `entry`. Returns true when nothing is left.
+    bool take_pipe_elements(MessageEntry& entry);
+    /// PipeClosed (gateway naming) for `index` of pipe `member` at `path`: true when it closed one of
+    /// these endpoints (its `on_closed` called), false when the pipe is not one of them.
+    bool pipe_closed(const std::string& path, const std::string& member, std::int32_t index);
     /// The session ended: every subscription's and endpoint's `on_closed` gets `reason`; later calls
-    /// fail with ConnectionError.
+    /// fail with `reason` until resume().
     void lost(const RRError& reason);
+    /// A new session to the device took the lost one's place (a shared session reconnected): calls
+    /// work again. Ids stay unique across sessions.
+    void resume();
     /// The owner ends the session: forgets everything without calling handlers or sending anything.
     void forget();
 
@@ -117,7 +129,6 @@ private:
     RRError gone() const;
     void wire_connected(const MemberKey& key, Result<MessageEntry> r);
     bool pipe_connected(std::uint64_t id, Result<MessageEntry> r);  // false: closed while connecting
-    void pipe_entry(MessageEntry&& entry);
 
     const Upstream upstream_;
     mutable std::mutex mutex_;

@@ -256,3 +256,70 @@ TEST_CASE("session endpoints: a pipe closed while connecting is disconnected whe
     CHECK(fake.requests.front().request.entry_type == MessageEntryType::PipeDisconnectReq);
     CHECK(entry_pipe_index(fake.requests.front().request) == 3);
 }
+
+TEST_CASE("session endpoints: on a shared session they take their own pipe elements and leave the rest") {
+    FakeUpstreamSession fake;
+    auto ep = fake.make();
+    std::vector<std::string> packets;
+    std::vector<std::uint32_t> acks;
+    int closed = 0;
+    GatewayPipeHandlers h;
+    h.on_packet = [&](const MessageElement& p, std::uint32_t n) { packets.push_back(std::string(read_string(p)) + "#" + std::to_string(n)); };
+    h.on_ack = [&](std::uint32_t n) { acks.push_back(n); };
+    h.on_closed = [&](const RRError&) { ++closed; };
+
+    // Without endpoints the entry is left alone.
+    MessageElement packet = make_string_element("x", "to a client");
+    MessageEntry theirs = pipe_packet_entry("arm", "p", 4, 1, packet, false, false);
+    CHECK_FALSE(ep->take_pipe_elements(theirs));
+    CHECK(theirs.elements.size() == 1);
+
+    std::optional<Result<std::uint64_t>> opened;
+    ep->open_pipe("arm", "p", false, h, [&](Result<std::uint64_t> r) { opened = r; });
+    fake.answer({make_scalar_element<std::int32_t>("index", 7)});
+    REQUIRE(opened);
+    REQUIRE(opened->ok());
+    const std::uint64_t first_id = **opened;
+
+    // One entry with a packet for the gateway's endpoint (7) and one for a client's (4).
+    MessageEntry mixed = pipe_packet_entry("arm", "p", 7, 2, make_string_element("x", "ours"), true, false);
+    mixed.elements.push_back(std::move(theirs.elements.at(0)));
+    CHECK_FALSE(ep->take_pipe_elements(mixed));
+    CHECK(packets == std::vector<std::string>{"ours#2"});
+    REQUIRE(mixed.elements.size() == 1);
+    CHECK(mixed.elements[0].name == "4");  // the client's, for the caller to route
+    REQUIRE(fake.sent.size() == 1);         // the ack the device asked for
+    CHECK(fake.sent[0].entry_type == MessageEntryType::PipePacketRet);
+
+    MessageEntry only_ours;
+    only_ours.entry_type = MessageEntryType::PipePacketRet;
+    only_ours.service_path = "arm";
+    only_ours.member_name = "p";
+    only_ours.elements.push_back(pipe_ack_element(7, 9));
+    CHECK(ep->take_pipe_elements(only_ours));
+    CHECK(acks == std::vector<std::uint32_t>{9});
+
+    CHECK_FALSE(ep->pipe_closed("arm", "p", 4));  // a client's pipe: not these endpoints'
+    CHECK(closed == 0);
+
+    // The shared session drops: the endpoint closes, calls fail with the reason until it is back.
+    ep->lost(make_error(MessageErrorType::ConnectionError, "device \"arm\" is not connected"));
+    CHECK(closed == 1);
+    auto while_down = ep->send_pipe_packet(first_id, make_string_element("x", "a"), false);
+    REQUIRE_FALSE(while_down.ok());
+    CHECK(while_down.error().message == "device \"arm\" is not connected");
+    CHECK_FALSE(ep->pipe_closed("arm", "p", 7));
+
+    ep->resume();
+    opened.reset();
+    ep->open_pipe("arm", "p", false, h, [&](Result<std::uint64_t> r) { opened = r; });
+    fake.answer({make_scalar_element<std::int32_t>("index", 8)});
+    REQUIRE(opened);
+    REQUIRE(opened->ok());
+    CHECK(**opened > first_id);  // ids are not reused across sessions
+    auto stale = ep->send_pipe_packet(first_id, make_string_element("x", "a"), false);
+    REQUIRE_FALSE(stale.ok());
+    CHECK(stale.error().type == MessageErrorType::InvalidArgument);
+    CHECK(ep->pipe_closed("arm", "p", 8));
+    CHECK(closed == 2);
+}
