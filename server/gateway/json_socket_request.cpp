@@ -74,21 +74,24 @@ Parsed parse_unsubscribe(const Json& msg) {
     return r;
 }
 
-Parsed parse_set_out_value(const Json& msg) {
-    SetOutValueRequest r;
-    if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
+// "subscription" and "value": what set_out_value and send both carry.
+std::optional<ApiError> parse_subscription_value(const Json& msg, std::uint64_t& sid, Json& value) {
+    if (auto e = parse_subscription_id(msg, sid)) return e;
     auto v = msg.find("value");
     if (v == msg.end()) return bad_request("\"value\" is required");
-    r.value = *v;
+    value = *v;
+    return std::nullopt;
+}
+
+Parsed parse_set_out_value(const Json& msg) {
+    SetOutValueRequest r;
+    if (auto e = parse_subscription_value(msg, r.subscription, r.value)) return *e;
     return r;
 }
 
 Parsed parse_send(const Json& msg) {
     SendRequest r;
-    if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
-    auto v = msg.find("value");
-    if (v == msg.end()) return bad_request("\"value\" is required");
-    r.value = *v;
+    if (auto e = parse_subscription_value(msg, r.subscription, r.value)) return *e;
     if (auto a = msg.find("requestack"); a != msg.end()) {
         if (!a->is_boolean()) return bad_request("\"requestack\" must be true or false");
         r.request_ack = a->get<bool>();
