@@ -22,21 +22,21 @@ public:
     using const_iterator = typename Map::const_iterator;
     static constexpr std::size_t kSpareNodes = 8;
 
-    /// Sets `id`'s value (replacing one already there).
+    /// Sets `id`'s value (replacing one already there). One search of the tree either way.
     void put(std::uint32_t id, V value) {
-        if (auto it = map_.find(id); it != map_.end()) {
-            it->second = std::move(value);
-            return;
-        }
         if (spare_.empty()) {
-            map_.emplace(id, std::move(value));
+            map_.insert_or_assign(id, std::move(value));
             return;
         }
         auto node = std::move(spare_.back());
         spare_.pop_back();
         node.key() = id;
         node.mapped() = std::move(value);
-        map_.insert(std::move(node));
+        auto r = map_.insert(std::move(node));
+        if (r.inserted) return;
+        r.position->second = std::move(r.node.mapped());  // `id` was there: the node goes back
+        r.node.mapped() = V{};
+        spare_.push_back(std::move(r.node));
     }
 
     iterator find(std::uint32_t id) { return map_.find(id); }

@@ -64,3 +64,15 @@ TEST_CASE("request map: an erased value is released at once, spare nodes stay bo
     m.clear();
     CHECK(held.use_count() == 1);
 }
+
+TEST_CASE("request map: putting an id that is there replaces its value and keeps the spare node") {
+    RequestMap<int> m;
+    m.put(1, 10);
+    m.put(2, 20);
+    m.erase(1);
+    REQUIRE(m.spare_nodes() == 1);
+    m.put(2, 22);  // with a spare node at hand
+    CHECK(m.size() == 1);
+    CHECK(m.find(2)->second == 22);
+    CHECK(m.spare_nodes() == 1);
+}
