@@ -74,9 +74,9 @@ SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, co
     else
         msg["error"] = error_object(*j.error);
     if (dropped) msg["dropped"] = dropped;
-    auto text = json_text(msg);
-    if (arrays.blobs.empty()) return {std::move(text), nullptr};
-    return {binary_push_head(text), std::make_shared<const std::string>(binary_push_arrays(arrays.blobs))};
+    auto push = binary_rendering(msg, arrays);
+    if (push.arrays) push.body = binary_push_head(push.body);  // the whole push, not a shared body
+    return push;
 }
 
 SharedEntry::BinaryRendering binary_rendering(const nlohmann::json& body, const BinaryArrays& arrays) {

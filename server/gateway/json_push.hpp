@@ -28,8 +28,8 @@ nlohmann::json wire_push_body(const JsonApi& api, const MessageEntry& packet, co
 nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,
                                BinaryArrays* binary = nullptr);
 
-/// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; the
-/// arrays part when `binary` set any aside (then the text is already binary_push_head's).
+/// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; with the
+/// arrays part (and the text already binary_push_head's) when `binary` set any aside for a value.
 SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
                                        const MemberTarget& target, std::uint64_t dropped, bool binary);
 
