@@ -7,8 +7,10 @@
 #                 (connect and close cancel out).
 #   gateway fan-out: rr-gateway runs under callgrind while 20 JSON WebSocket clients receive a 100 Hz
 #                 device wire for 4 s: instructions and mallocs per delivered message.
+#   raw RR fan-out: the same with 20 native RR clients over rr+ws (rr_bench_rr_fanout): instructions
+#                 and mallocs per delivered value.
 # Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self)
-# and bench/results/profile_fanout.txt.
+# and bench/results/profile_fanout.txt (both fan-outs).
 # Needs valgrind (apt-get install valgrind) and a build from bench/run.sh (RR_BENCH_BUILD, default
 # build/bench).  Usage: bench/profile.sh [N]   (default 2000)
 set -euo pipefail
@@ -95,9 +97,16 @@ sleep 3
 callgrind_control -z "$gw" > /dev/null
 "$BUILD/bench/rr_bench_ws_load" --port "$gport" --clients 20 fanout --seconds 4 > "$tmp/fanout.json"
 callgrind_control -d "$gw" > /dev/null
+# Raw RR fan-out through the same gateway.
+"$BUILD/bench/rr_bench_rr_fanout" --url "rr+ws://127.0.0.1:$gport/?service=bench" --clients 20 --seconds 2 > /dev/null
+callgrind_control -z "$gw" > /dev/null
+"$BUILD/bench/rr_bench_rr_fanout" --url "rr+ws://127.0.0.1:$gport/?service=bench" --clients 20 --seconds 4 > "$tmp/rrfanout.json"
+callgrind_control -d "$gw" > /dev/null
 kill -TERM "$gw"; wait "$gw" || true
 kill -TERM "$dev"; wait "$dev" || true
-gdump=$(ls -t "$tmp"/gw.out.* | head -1)
+gdump=$(ls -v "$tmp"/gw.out.* | head -1)   # the first dump: JSON; the second: raw RR
+rdump=$(ls -v "$tmp"/gw.out.* | sed -n 2p)
+values=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" "$tmp/rrfanout.json")
 msgs=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" "$tmp/fanout.json")
 {
   echo "# callgrind of rr-gateway: a 100 Hz device wire fanned out to 20 JSON WebSocket clients for 4 s"
@@ -109,5 +118,14 @@ msgs=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); pri
   echo "## inclusive (top frames)"
   callgrind_annotate --inclusive=yes --threshold=100 "$gdump" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
     grep -E 'rr::|nlohmann|beast|malloc|free' | cut -c1-240 | sed -n 1,45p
+  echo
+  echo "# the same gateway: the wire fanned out to 20 native RR clients over rr+ws for 4 s (rr_bench_rr_fanout)"
+  echo "delivered values: $values"
+  echo "gateway instructions per delivered value: $(( $(total_ir "$rdump") / values ))"
+  bench/callgrind_calls.py "$rdump" malloc | awk -v n="$values" '{ printf "gateway malloc calls per delivered value: %.1f\n", $2 / n }'
+  echo
+  echo "## inclusive (top frames)"
+  callgrind_annotate --inclusive=yes --threshold=100 "$rdump" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
+    grep -E 'rr::|beast|malloc|free' | cut -c1-240 | sed -n 1,45p
 } > "$OUT/profile_fanout.txt"
 echo "wrote $OUT/profile_nop.txt and $OUT/profile_fanout.txt" >&2

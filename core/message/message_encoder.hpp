@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,15 @@ namespace rr::detail {
 class MessageEncoder {
 public:
     explicit MessageEncoder(const Message& message) : m_(message) {}
+    /// `message`'s header followed by one entry already encoded in `message.version` (encode_entry);
+    /// `message.entries` must be empty.
+    MessageEncoder(const Message& message, std::span<const std::byte> encoded_entry)
+        : m_(message), encoded_entry_(encoded_entry), has_encoded_entry_(true) {}
+
+    /// One entry on its own in format `version` (no local string table: a v4 code must be standard).
+    Result<std::uint32_t> measure_entry(const MessageEntry& entry, std::uint16_t version);
+    /// Writes the entry measure_entry() measured.
+    void write_entry(ByteWriter& w, const MessageEntry& entry, std::uint16_t version);
 
     /// Validates and measures; returns the total message size.
     Result<std::uint32_t> measure();
@@ -48,7 +58,12 @@ private:
     std::size_t reserve_size_slot();
     std::uint32_t next_size();
 
+    /// Entries in the message: its own, or the one already encoded.
+    std::size_t entry_count() const noexcept { return has_encoded_entry_ ? 1 : m_.entries.size(); }
+
     const Message& m_;
+    std::span<const std::byte> encoded_entry_;
+    bool has_encoded_entry_ = false;
     /// Entry and element sizes, pre-order: the first kInlineSizes in the encoder itself, so a message
     /// of a few entries and elements is encoded without allocating for them.
     static constexpr std::size_t kInlineSizes = 16;

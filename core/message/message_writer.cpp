@@ -10,10 +10,13 @@
 namespace rr {
 
 std::uint8_t default_v4_flags(const Message& message) noexcept {
-    const auto& h = message.header;
+    return default_v4_flags(message.header, message.entries.size());
+}
+
+std::uint8_t default_v4_flags(const MessageHeader& h, std::size_t entry_count) noexcept {
     std::uint8_t f = message_flags::routing_info | message_flags::endpoint_info;
     if (!h.metadata.empty() || h.message_id != 0 || h.message_res_id != 0) f |= message_flags::meta_info;
-    if (message.entries.size() != 1) f |= message_flags::multiple_entries;
+    if (entry_count != 1) f |= message_flags::multiple_entries;
     if (!h.string_table.empty()) f |= message_flags::string_table;
     if (!h.extended.empty()) f |= message_flags::extended;
     if (h.priority != 0) f |= message_flags::priority;
@@ -27,20 +30,46 @@ Result<std::size_t> encoded_size(const Message& message) {
     return std::size_t{*size};
 }
 
-Result<void> encode_message(const Message& message, std::vector<std::byte>& out) {
-    detail::MessageEncoder encoder(message);
-    auto size = encoder.measure();
+namespace {
+
+// Measures, reserves once, writes: `measure` and `write` take the ByteWriter-less / ByteWriter half.
+template <class Measure, class Write>
+Result<void> append_measured(std::vector<std::byte>& out, Measure&& measure, Write&& write) {
+    auto size = measure();
     if (!size) return size.take_error();
     const std::size_t start = out.size();
     // Geometric growth: `out` may be a connection's pending output that many messages are appended to.
     if (out.capacity() - start < *size) out.reserve(std::max<std::size_t>(start + *size, 2 * out.capacity()));
     ByteWriter w(out);
-    encoder.write(w);
+    write(w);
     if (w.written() != *size) {  // measure and write disagree: a bug here, never the caller's
         out.resize(start);
         return fail(MessageErrorType::InternalError, "message writer size mismatch");
     }
     return {};
+}
+
+}  // namespace
+
+Result<void> encode_message(const Message& message, std::vector<std::byte>& out) {
+    detail::MessageEncoder encoder(message);
+    return append_measured(out, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
+}
+
+Result<void> encode_entry(const MessageEntry& entry, std::uint16_t version, std::vector<std::byte>& out) {
+    static const Message no_header;
+    detail::MessageEncoder encoder(no_header);
+    return append_measured(
+        out, [&] { return encoder.measure_entry(entry, version); },
+        [&](ByteWriter& w) { encoder.write_entry(w, entry, version); });
+}
+
+Result<void> encode_message(const Message& message, std::span<const std::byte> encoded_entry,
+                            std::vector<std::byte>& out) {
+    if (!message.entries.empty())
+        return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
+    detail::MessageEncoder encoder(message, encoded_entry);
+    return append_measured(out, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
 }
 
 Result<SharedBytes> encode_message(const Message& message) {
@@ -66,6 +95,25 @@ Result<std::uint32_t> MessageEncoder::measure() {
     if (!total) return total.take_error();
     total_ = *total;
     return *total;
+}
+
+Result<std::uint32_t> MessageEncoder::measure_entry(const MessageEntry& entry, std::uint16_t version) {
+    size_count_ = 0;
+    more_sizes_.clear();
+    local_codes_.clear();
+    if (version != 2 && version != 4)
+        return fail(MessageErrorType::InvalidArgument, "unknown message version " + std::to_string(version));
+    auto size = version == 2 ? measure_entry_v2(entry) : measure_entry_v4(entry);
+    if (!size) return size.take_error();
+    return static_cast<std::uint32_t>(*size);
+}
+
+void MessageEncoder::write_entry(ByteWriter& w, const MessageEntry& entry, std::uint16_t version) {
+    cursor_ = 0;
+    if (version == 2)
+        write_entry_v2(w, entry);
+    else
+        write_entry_v4(w, entry);
 }
 
 void MessageEncoder::write(ByteWriter& w) {

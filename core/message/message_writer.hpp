@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/message/message.hpp"
@@ -35,6 +36,8 @@ namespace rr {
 /// (this node, peer, local endpoint, remote endpoint), except for a message made of one entry with
 /// EntryType < 500 (ASIOStreamBaseTransport.cpp); that choice belongs to the session.
 std::uint8_t default_v4_flags(const Message& message) noexcept;
+/// The same for a message of `header` and `entry_count` entries (one already encoded, see below).
+std::uint8_t default_v4_flags(const MessageHeader& header, std::size_t entry_count) noexcept;
 
 /// Exact encoded size of `message`, bytes. Errors: as encode_message.
 Result<std::size_t> encoded_size(const Message& message);
@@ -52,5 +55,18 @@ Result<void> encode_message(const Message& message, std::vector<std::byte>& out)
 
 /// Encodes into a new buffer, ready to send or to decode with views into it.
 Result<SharedBytes> encode_message(const Message& message);
+
+/// Encodes `entry` on its own in format `version` (2 or 4), appending to `out`: the bytes it has inside
+/// any message of that format (entries do not depend on their message, except for v4 string-table codes,
+/// so a code must be in the standard table). An entry sent unchanged in many messages (a wire value or
+/// event fanned out to many sessions, EncodedEntry) is encoded once this way and copied into each.
+/// Errors: as encode_message for the entry.
+Result<void> encode_entry(const MessageEntry& entry, std::uint16_t version, std::vector<std::byte>& out);
+
+/// Encodes `message` in `message.version` with one entry already encoded by encode_entry in the same
+/// format (`encoded_entry`); the result equals encode_message of the message with that entry.
+/// Errors: InvalidArgument when `message.entries` is not empty; otherwise as encode_message.
+Result<void> encode_message(const Message& message, std::span<const std::byte> encoded_entry,
+                            std::vector<std::byte>& out);
 
 }  // namespace rr

@@ -44,6 +44,8 @@ Result<std::uint32_t> MessageEncoder::measure_v2() {
         total += *n;
         if (total > kMax32) return fail(MessageErrorType::InvalidArgument, "message over 4 GiB");
     }
+    total += encoded_entry_.size();
+    if (total > kMax32) return fail(MessageErrorType::InvalidArgument, "message over 4 GiB");
     return static_cast<std::uint32_t>(total);
 }
 
@@ -108,10 +110,11 @@ void MessageEncoder::write_v2(ByteWriter& w) {
     write_string16(w, h.sender_node_name);
     write_string16(w, h.receiver_node_name);
     write_string16(w, h.metadata);
-    w.write_u16(static_cast<std::uint16_t>(m_.entries.size()));
+    w.write_u16(static_cast<std::uint16_t>(entry_count()));
     w.write_u16(h.message_id);
     w.write_u16(h.message_res_id);
     for (const auto& entry : m_.entries) write_entry_v2(w, entry);
+    w.write_bytes(encoded_entry_);
 }
 
 void MessageEncoder::write_entry_v2(ByteWriter& w, const MessageEntry& entry) {

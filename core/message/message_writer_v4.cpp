@@ -43,10 +43,9 @@ std::uint8_t element_flags_of(const MessageElement& e) noexcept {
 }
 
 // Explicit header flags may omit routing, never a field that holds data.
-Result<void> check_explicit_flags(const Message& m, std::uint8_t f) {
-    const auto& h = m.header;
+Result<void> check_explicit_flags(const MessageHeader& h, std::size_t entry_count, std::uint8_t f) {
     const char* dropped = nullptr;
-    if (!(f & message_flags::multiple_entries) && m.entries.size() != 1)
+    if (!(f & message_flags::multiple_entries) && entry_count != 1)
         dropped = "MULTIPLE_ENTRIES clear but the message has != 1 entry";
     else if (!(f & message_flags::meta_info) && (!h.metadata.empty() || h.message_id || h.message_res_id))
         dropped = "META_INFO clear but MetaData/MessageID/MessageResID set";
@@ -74,9 +73,9 @@ Result<std::uint64_t> MessageEncoder::measure_name_v4(const std::string& s, cons
 
 Result<std::uint32_t> MessageEncoder::measure_v4() {
     const auto& h = m_.header;
-    v4_flags_ = h.v4_flags ? *h.v4_flags : default_v4_flags(m_);
+    v4_flags_ = h.v4_flags ? *h.v4_flags : default_v4_flags(h, entry_count());
     if (h.v4_flags)
-        if (auto ok = check_explicit_flags(m_, v4_flags_); !ok) return ok.take_error();
+        if (auto ok = check_explicit_flags(h, entry_count(), v4_flags_); !ok) return ok.take_error();
     std::uint64_t s = 11;
     if (v4_flags_ & message_flags::routing_info)
         s += 32 + xlen_size(h.sender_node_name.size()) + xlen_size(h.receiver_node_name.size());
@@ -94,7 +93,7 @@ Result<std::uint32_t> MessageEncoder::measure_v4() {
         }
         std::sort(local_codes_.begin(), local_codes_.end());
     }
-    if (v4_flags_ & message_flags::multiple_entries) s += uint_x_size(static_cast<std::uint32_t>(m_.entries.size()));
+    if (v4_flags_ & message_flags::multiple_entries) s += uint_x_size(static_cast<std::uint32_t>(entry_count()));
     if (v4_flags_ & message_flags::extended) s += xlen_size(h.extended.size());
     const std::uint64_t header = size_plus_uint_x(s);
     if (header > kMax32) return fail(MessageErrorType::InvalidArgument, "v4 header over 4 GiB");
@@ -106,6 +105,8 @@ Result<std::uint32_t> MessageEncoder::measure_v4() {
         total += *n;
         if (total > kMax32) return fail(MessageErrorType::InvalidArgument, "message over 4 GiB");
     }
+    total += encoded_entry_.size();
+    if (total > kMax32) return fail(MessageErrorType::InvalidArgument, "message over 4 GiB");
     return static_cast<std::uint32_t>(total);
 }
 
@@ -198,9 +199,10 @@ void MessageEncoder::write_v4(ByteWriter& w) {
             write_xlen(w, text);
         }
     }
-    if (f & message_flags::multiple_entries) write_uint_x(w, static_cast<std::uint32_t>(m_.entries.size()));
+    if (f & message_flags::multiple_entries) write_uint_x(w, static_cast<std::uint32_t>(entry_count()));
     if (f & message_flags::extended) write_xlen(w, h.extended);
     for (const auto& entry : m_.entries) write_entry_v4(w, entry);
+    w.write_bytes(encoded_entry_);
 }
 
 void MessageEncoder::write_entry_v4(ByteWriter& w, const MessageEntry& entry) {

@@ -141,7 +141,7 @@ void ServiceSession::close_session() {
     username_.clear();
 }
 
-Message ServiceSession::session_message(MessageEntry&& entry) {
+Message ServiceSession::session_header(const MessageEntry& entry) {
     ++messages_out_;
     Message m;
     m.version = 2;
@@ -151,6 +151,11 @@ Message ServiceSession::session_message(MessageEntry&& entry) {
     m.header.receiver_endpoint = client_endpoint_;
     m.header.message_id = ++message_id_;
     if (entry.metadata == "unreliable\n") m.header.metadata = entry.metadata;
+    return m;
+}
+
+Message ServiceSession::session_message(MessageEntry&& entry) {
+    Message m = session_header(entry);
     m.entries = stream_.entry_vectors().take();
     m.entries.push_back(std::move(entry));
     return m;
@@ -178,21 +183,41 @@ Result<void> ServiceSession::send(MessageEntry entry, MonoTime now) {
     return stream_.send(session_message(std::move(entry)), now);
 }
 
+Result<void> ServiceSession::send(const EncodedEntry& entry, MonoTime now) {
+    if (!service_ || stream_.is_closed()) return fail(MessageErrorType::InvalidState, "client session closed");
+    return stream_.send(session_header(entry.entry()), entry, now);
+}
+
 void ServiceSession::send_wire_packet(MessageEntry entry, MonoTime now) {
     if (!service_ || stream_.is_closed()) return;
     if (stream_.pending_output_size() > config_.wire_hold_bytes) {
         WireKey key(entry.service_path, entry.member_name);
-        held_wires_.insert_or_assign(std::move(key), std::move(entry));  // newest kept until the output drains
-        return;
+        held_wires_.insert_or_assign(std::move(key), HeldWire(std::in_place_type<MessageEntry>, std::move(entry)));
+        return;  // newest kept until the output drains
     }
     (void)stream_.send(session_message(std::move(entry)), now);
+}
+
+void ServiceSession::send_wire_packet(std::shared_ptr<const EncodedEntry> entry, MonoTime now) {
+    if (!service_ || stream_.is_closed() || !entry) return;
+    if (stream_.pending_output_size() > config_.wire_hold_bytes) {
+        WireKey key(entry->entry().service_path, entry->entry().member_name);
+        held_wires_.insert_or_assign(std::move(key), HeldWire(std::move(entry)));
+        return;
+    }
+    (void)stream_.send(session_header(entry->entry()), *entry, now);
 }
 
 void ServiceSession::flush_held_wires(MonoTime now) {
     if (!service_) return;
     auto held = std::move(held_wires_);
     held_wires_.clear();
-    for (auto& [key, entry] : held) (void)stream_.send(session_message(std::move(entry)), now);
+    for (auto& [key, packet] : held) {
+        if (auto* own = std::get_if<MessageEntry>(&packet))
+            (void)stream_.send(session_message(std::move(*own)), now);
+        else if (const auto& shared = std::get<std::shared_ptr<const EncodedEntry>>(packet))
+            (void)stream_.send(session_header(shared->entry()), *shared, now);
+    }
 }
 
 Result<std::uint32_t> ServiceSession::request(MessageEntry entry, MonoTime now) {

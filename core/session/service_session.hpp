@@ -153,6 +153,11 @@ public:
     /// Sends a WirePacket now, or holds it (replacing an older held packet of the same service path
     /// and member: wires keep only the newest value) while more than wire_hold_bytes of output wait.
     void send_wire_packet(MessageEntry entry, MonoTime now);
+    /// send() and send_wire_packet() for an entry many sessions send unchanged (a wire value or event
+    /// for every client of a member): its bytes, encoded once per message format, are copied after this
+    /// session's message header. Errors: as send(); the entry's encoding error (EncodedEntry::bytes).
+    Result<void> send(const EncodedEntry& entry, MonoTime now);
+    void send_wire_packet(std::shared_ptr<const EncodedEntry> entry, MonoTime now);
     /// Sends a request to the client (CallbackCallReq); the RequestID is assigned here and returned.
     /// The answer arrives as ServiceCallbackResponse. Errors: as send().
     Result<std::uint32_t> request(MessageEntry entry, MonoTime now);
@@ -188,7 +193,11 @@ private:
                       bool authenticated, MonoTime now);
     void reply_special(const MessageHeader& request_header, MessageEntry reply, MonoTime now);
     Message session_message(MessageEntry&& entry);
+    /// session_message's header, without entries (for an EncodedEntry).
+    Message session_header(const MessageEntry& entry);
     void flush_held_wires(MonoTime now);
+    /// What a held wire value is: a packet of this session, or one shared by many (EncodedEntry).
+    using HeldWire = std::variant<MessageEntry, std::shared_ptr<const EncodedEntry>>;
 
     ServiceHost& host_;
     ServiceSessionConfig config_;
@@ -209,7 +218,7 @@ private:
     std::map<std::uint32_t, MonoTime> pending_callbacks_;  // RequestID → deadline
     std::uint64_t object_type_counter_ = 0;
     std::map<std::uint64_t, PendingObjectType> pending_object_types_;
-    std::map<WireKey, MessageEntry> held_wires_;
+    std::map<WireKey, HeldWire> held_wires_;
     struct PendingAdmission {
         std::uint64_t token = 0;
         MessageHeader header;

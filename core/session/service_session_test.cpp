@@ -499,6 +499,67 @@ TEST_CASE("service session: wire packets wait while output is backed up, only th
     CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 3}, {"w2", 9}});
 }
 
+TEST_CASE("service session: an entry shared by many sessions (EncodedEntry) arrives as one of its own") {
+    Pair p;
+    p.connect();
+    MessageEntry ev = member_request("ev", MessageEntryType::EventReq);
+    ev.elements.push_back(make_array_element<double>("a", std::vector<double>{1.5, 2.5}));
+    const auto shared_event = std::make_shared<const EncodedEntry>(ev);
+    REQUIRE(p.service.send(*shared_event, p.now));
+    MessageEntry w = member_request("w", MessageEntryType::WirePacket);
+    w.elements.push_back(make_scalar_element<std::int32_t>("value", 5));
+    p.service.send_wire_packet(std::make_shared<const EncodedEntry>(w), p.now);
+    p.pump();
+    auto incoming = p.take_client<ClientIncoming>();
+    REQUIRE(incoming.size() == 2);
+    CHECK(incoming[0].entry == ev);
+    CHECK(incoming[1].entry == w);
+
+    SECTION("held while output is backed up: the newest value, shared or not, wins") {
+        MessageEntry big = member_request("ev", MessageEntryType::EventReq);
+        big.elements.push_back(make_array_element<std::uint8_t>("p", std::vector<std::uint8_t>(4096)));
+        REQUIRE(p.service.send(big, p.now));
+        for (int i = 1; i <= 3; ++i) {
+            MessageEntry v = member_request("w", MessageEntryType::WirePacket);
+            v.elements.push_back(make_scalar_element<std::int32_t>("value", 10 + i));
+            if (i % 2)
+                p.service.send_wire_packet(std::make_shared<const EncodedEntry>(std::move(v)), p.now);
+            else
+                p.service.send_wire_packet(std::move(v), p.now);
+        }
+        MessageEntry v2 = member_request("w2", MessageEntryType::WirePacket);
+        v2.elements.push_back(make_scalar_element<std::int32_t>("value", 7));
+        p.service.send_wire_packet(std::move(v2), p.now);
+        p.pump();
+        incoming = p.take_client<ClientIncoming>();
+        REQUIRE(incoming.size() == 3);  // the event, then the newest value of each wire
+        std::vector<std::pair<std::string, std::int32_t>> wires;
+        for (std::size_t i = 1; i < incoming.size(); ++i) {
+            std::int32_t v = 0;
+            REQUIRE(read_scalar(*incoming[i].entry.find("value"), v));
+            wires.emplace_back(incoming[i].entry.member_name, v);
+        }
+        std::sort(wires.begin(), wires.end());
+        CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 13}, {"w2", 7}});
+    }
+    SECTION("an entry that cannot be encoded is an error, and the session goes on") {
+        MessageEntry bad = member_request("ev", MessageEntryType::EventReq);
+        MessageElement e;
+        e.name = "odd";
+        e.type = DataTypes::double_t;
+        e.data = SharedBytes::copy_of("abc", 3);  // not a multiple of 8 bytes
+        bad.elements.push_back(std::move(e));
+        auto r = p.service.send(EncodedEntry(std::move(bad)), p.now);
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::InvalidArgument);
+        REQUIRE(p.service.send(*shared_event, p.now));
+        p.pump();
+        incoming = p.take_client<ClientIncoming>();
+        REQUIRE(incoming.size() == 1);
+        CHECK(incoming[0].entry == ev);
+    }
+}
+
 TEST_CASE("service session: DisconnectClient ends the session and frees its endpoint, sends then fail") {
     Pair p;
     p.connect();

@@ -333,6 +333,24 @@ Result<void> StreamConnection::send(Message&& message, MonoTime now) {
     return queued;
 }
 
+Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry, MonoTime now) {
+    if (state_ != State::connected)
+        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
+    if (!header.entries.empty())
+        return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
+    const std::uint16_t version = send_version();
+    auto bytes = entry.bytes(version);
+    if (!bytes) return bytes.take_error();
+    const bool omit = omit_routing_applies(header.header, entry.entry().entry_type, version, true);
+    if (header.version != version || (omit && !header.header.v4_flags)) relabel(header, 1, version, omit);
+    const std::size_t before = output_.size();
+    if (auto ok = encode_message(header, *bytes, output_); !ok) {
+        output_.resize(before);
+        return ok;
+    }
+    return check_appended(before, now);
+}
+
 // v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this
 // session's nodes and endpoints (CORE, wire.md §2.3), except for one entry below 500.
 bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bool omit) const {
@@ -340,18 +358,26 @@ bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bo
 }
 
 bool StreamConnection::omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const {
-    return omit_routing && version == 4 && session_established_ && m.entries.size() == 1 &&
-           static_cast<std::uint16_t>(m.entries.front().entry_type) >= 500 &&
-           m.header.sender_endpoint == local_endpoint_ && m.header.receiver_endpoint == remote_endpoint_ &&
-           m.header.sender_node_name.empty() && m.header.receiver_node_name.empty() &&
-           m.header.sender_node_id == config_.local_node_id && m.header.receiver_node_id == negotiated_.remote_node_id;
+    return m.entries.size() == 1 && omit_routing_applies(m.header, m.entries.front().entry_type, version, omit_routing);
+}
+
+bool StreamConnection::omit_routing_applies(const MessageHeader& h, MessageEntryType only_entry, std::uint16_t version,
+                                            bool omit_routing) const {
+    return omit_routing && version == 4 && session_established_ && static_cast<std::uint16_t>(only_entry) >= 500 &&
+           h.sender_endpoint == local_endpoint_ && h.receiver_endpoint == remote_endpoint_ &&
+           h.sender_node_name.empty() && h.receiver_node_name.empty() && h.sender_node_id == config_.local_node_id &&
+           h.receiver_node_id == negotiated_.remote_node_id;
 }
 
 void StreamConnection::relabel(Message& m, std::uint16_t version, bool omit) const {
+    relabel(m, m.entries.size(), version, omit);
+}
+
+void StreamConnection::relabel(Message& m, std::size_t entry_count, std::uint16_t version, bool omit) const {
     m.version = version;
     if (omit && !m.header.v4_flags)
-        m.header.v4_flags =
-            static_cast<std::uint8_t>(default_v4_flags(m) & ~(message_flags::routing_info | message_flags::endpoint_info));
+        m.header.v4_flags = static_cast<std::uint8_t>(default_v4_flags(m.header, entry_count) &
+                                                      ~(message_flags::routing_info | message_flags::endpoint_info));
 }
 
 Result<void> StreamConnection::queue(const Message& m, std::uint16_t version, MonoTime now, bool omit_routing) {
@@ -375,6 +401,10 @@ Result<void> StreamConnection::append_encoded(const Message& m, MonoTime now) {
         output_.resize(before);
         return r;
     }
+    return check_appended(before, now);
+}
+
+Result<void> StreamConnection::check_appended(std::size_t before, MonoTime now) {
     if (output_.size() - before > send_limit()) {
         output_.resize(before);
         return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");

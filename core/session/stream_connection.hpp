@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/codec/limits.hpp"
+#include "core/message/encoded_entry.hpp"
 #include "core/message/message.hpp"
 #include "core/message/message_reader.hpp"
 #include "core/message/entry_vector_pool.hpp"
@@ -113,6 +114,10 @@ public:
     /// vector goes back to entry_vectors() once encoded. On an error the message keeps its entries,
     /// so the caller can still answer for them (ServiceSession::reply).
     Result<void> send(Message&& message, MonoTime now);
+    /// The same for a message of one entry that many messages carry unchanged: `header` (no entries)
+    /// gets the entry's bytes in the negotiated format, encoded once (EncodedEntry::bytes), after its
+    /// own. Errors: as send(); InvalidArgument when `header` has entries; the entry's encoding error.
+    Result<void> send(Message&& header, const EncodedEntry& entry, MonoTime now);
     /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
     Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);
 
@@ -161,10 +166,15 @@ private:
     Result<void> queue_owned(Message& m, std::uint16_t version, MonoTime now, bool omit_routing);
     /// Whether the v4 routing omission applies to `m` (asked once per message; `omit` below).
     bool omit_routing_applies(const Message& m, std::uint16_t version, bool omit_routing) const;
+    bool omit_routing_applies(const MessageHeader& h, MessageEntryType only_entry, std::uint16_t version,
+                              bool omit_routing) const;
     /// Whether `m` must be re-labelled before encoding (format `version`, or routing omitted), and how.
     bool needs_relabel(const Message& m, std::uint16_t version, bool omit) const;
     void relabel(Message& m, std::uint16_t version, bool omit) const;
+    void relabel(Message& m, std::size_t entry_count, std::uint16_t version, bool omit) const;
     Result<void> append_encoded(const Message& m, MonoTime now);
+    /// Undoes what was appended since `before` if the message is over the send limit.
+    Result<void> check_appended(std::size_t before, MonoTime now);
     void close(RRError error);
     std::size_t send_limit() const noexcept;
     std::size_t receive_limit() const noexcept;

@@ -490,7 +490,7 @@ void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry
     }
     if (ready) {
         responder.respond(MessageEntry{});
-        if (last) (void)session.send_wire_packet(last->entry());  // the newest value, at once
+        if (last) (void)session.send_wire_packet(last);  // the newest value, at once
         return;
     }
     ensure_upstream_wire(key);
@@ -709,12 +709,16 @@ void MirrorService::fan_out(MessageEntry&& entry) {
         auto it = event_subscribers_.find({entry.service_path, entry.member_name});
         if (it != event_subscribers_.end()) internal = it->second;
     }
-    const bool check = access_.active() && entry.entry_type == MessageEntryType::EventReq;
+    if (sessions.empty() && no_subscribers(internal)) return;
+    // One shared copy, encoded once per message format for the native clients.
+    const auto shared = std::make_shared<const SharedEntry>(std::move(entry));
+    const MessageEntry& e = shared->entry();
+    const bool check = access_.active() && e.entry_type == MessageEntryType::EventReq;
     for (const auto& s : sessions) {
-        if (check && !access_.may(s, entry.service_path, entry.member_name, auth::Operation::read)) continue;
-        if (!s.send(entry)) counters_->event_drops.fetch_add(1);
+        if (check && !access_.may(s, e.service_path, e.member_name, auth::Operation::read)) continue;
+        if (!s.send(shared)) counters_->event_drops.fetch_add(1);
     }
-    if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
+    deliver(internal, shared);
 }
 
 void MirrorService::callback_from_device(MessageEntry&& entry) {
@@ -783,7 +787,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
                 // A session that may only set the wire's OutValue (auth: gateway) receives no InValue.
                 if (check && !access_.may(s, shared->entry().service_path, shared->entry().member_name, auth::Operation::read))
                     continue;
-                if (s.send_wire_packet(shared->entry())) counters_->wire_packets_out.fetch_add(1);
+                if (s.send_wire_packet(shared)) counters_->wire_packets_out.fetch_add(1);
             }
             deliver(internal, shared);
             return;

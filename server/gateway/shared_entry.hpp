@@ -1,5 +1,6 @@
-// One upstream wire value or event as the gateway's own subscribers (the JSON API sockets) see it:
-// a single shared copy for all of them, plus one cached rendering (of each form: text, binary) made by
+// One upstream wire value or event as the gateway's subscribers see it: a single shared copy for all
+// of them, native clients and JSON API sockets alike. The native clients' messages copy its encoded
+// bytes (EncodedEntry: encoded once per message format); the JSON sockets share one cached rendering (of each form: text, binary) made by
 // the first subscriber that needs it, so a value fanned out to N WebSocket clients is converted to JSON
 // once, not N times.
 #pragma once
@@ -11,21 +12,20 @@
 #include <vector>
 
 #include "core/codec/shared_bytes.hpp"
+#include "core/message/encoded_entry.hpp"
 #include "core/message/message.hpp"
 
 namespace rr::server::gateway {
 
-class SharedEntry {
+class SharedEntry : public EncodedEntry {
 public:
-    explicit SharedEntry(MessageEntry entry) : entry_(std::move(entry)) {}
-
-    const MessageEntry& entry() const { return entry_; }
+    explicit SharedEntry(MessageEntry entry) : EncodedEntry(std::move(entry)) {}
 
     /// The text `render(entry())` returns, computed once; callers on other threads wait for it. Every
     /// subscriber must pass an equivalent `render` (the same conversion for the same member).
     template <class Render>
     const std::string& rendered(Render&& render) const {
-        std::call_once(once_, [&] { rendered_ = std::forward<Render>(render)(entry_); });
+        std::call_once(once_, [&] { rendered_ = std::forward<Render>(render)(entry()); });
         return rendered_;
     }
 
@@ -39,12 +39,11 @@ public:
     };
     template <class Render>
     const BinaryRendering& rendered_binary(Render&& render) const {
-        std::call_once(binary_once_, [&] { binary_ = std::forward<Render>(render)(entry_); });
+        std::call_once(binary_once_, [&] { binary_ = std::forward<Render>(render)(entry()); });
         return binary_;
     }
 
 private:
-    MessageEntry entry_;
     mutable std::once_flag once_, binary_once_;
     mutable std::string rendered_;
     mutable BinaryRendering binary_;

@@ -55,6 +55,18 @@ Result<void> SessionRef::send(MessageEntry entry) const {
     return p->send(std::move(entry));
 }
 
+Result<void> SessionRef::send(std::shared_ptr<const EncodedEntry> entry) const {
+    auto p = session_.lock();
+    if (!p) return fail(MessageErrorType::ConnectionError, "client session closed");
+    return p->send(std::move(entry));
+}
+
+Result<void> SessionRef::send_wire_packet(std::shared_ptr<const EncodedEntry> entry) const {
+    auto p = session_.lock();
+    if (!p) return fail(MessageErrorType::ConnectionError, "client session closed");
+    return p->send_wire_packet(std::move(entry));
+}
+
 Result<void> SessionRef::send_wire_packet(MessageEntry entry) const {
     auto p = session_.lock();
     if (!p) return fail(MessageErrorType::ConnectionError, "client session closed");
@@ -148,30 +160,51 @@ Result<void> ServerSession::send(MessageEntry entry) {
     return {};
 }
 
-Result<void> ServerSession::send_wire_packet(MessageEntry entry) {
+Result<void> ServerSession::send(std::shared_ptr<const EncodedEntry> entry) {
     auto pump = pump_.lock();
     if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
+    const std::size_t size = estimate_size(entry->entry());
+    if (queued_.load() + size > max_queue_) return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
+    queued_.fetch_add(size);
+    pump->dispatch([conn = connection_, entry = std::move(entry)] {
+        if (auto c = conn.lock()) c->send_session_entry(*entry);
+    });
+    return {};
+}
+
+Result<void> ServerSession::send_wire_packet(MessageEntry entry) {
     auto key = std::make_pair(entry.service_path, entry.member_name);
+    return queue_wire_packet(std::move(key), PendingWire(std::in_place_type<MessageEntry>, std::move(entry)));
+}
+
+Result<void> ServerSession::send_wire_packet(std::shared_ptr<const EncodedEntry> entry) {
+    auto key = std::make_pair(entry->entry().service_path, entry->entry().member_name);
+    return queue_wire_packet(std::move(key), PendingWire(std::move(entry)));
+}
+
+Result<void> ServerSession::queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
     bool post = false;
     {
         std::lock_guard lock(mutex_);
-        auto [it, inserted] = wire_pending_.insert_or_assign(key, std::move(entry));
+        auto [it, inserted] = wire_pending_.insert_or_assign(key, std::move(packet));
         post = inserted;  // an older packet not yet sent is replaced: wires keep only the newest value
     }
     if (post) {
         // dispatch, as send(): from the session's own strand the packet goes out before the reply.
-        pump->dispatch([conn = connection_, key] {
+        pump->dispatch([conn = connection_, key = std::move(key)] {
             if (auto c = conn.lock()) c->send_wire_entry(key);
         });
     }
     return {};
 }
 
-std::optional<MessageEntry> ServerSession::take_wire_packet(const std::pair<std::string, std::string>& key) {
+std::optional<ServerSession::PendingWire> ServerSession::take_wire_packet(const std::pair<std::string, std::string>& key) {
     std::lock_guard lock(mutex_);
     auto it = wire_pending_.find(key);
     if (it == wire_pending_.end()) return std::nullopt;
-    MessageEntry e = std::move(it->second);
+    PendingWire e = std::move(it->second);
     wire_pending_.erase(it);
     return e;
 }
@@ -381,11 +414,19 @@ void ServerConnection::send_session_entry(MessageEntry&& entry) {
     drain_events();
 }
 
+void ServerConnection::send_session_entry(const EncodedEntry& entry) {
+    (void)session_.send(entry, mono_now());
+    drain_events();
+}
+
 void ServerConnection::send_wire_entry(const std::pair<std::string, std::string>& key) {
     if (!current_) return;
     auto entry = current_->take_wire_packet(key);
     if (!entry) return;
-    session_.send_wire_packet(std::move(*entry), mono_now());
+    if (auto* own = std::get_if<MessageEntry>(&*entry))
+        session_.send_wire_packet(std::move(*own), mono_now());
+    else
+        session_.send_wire_packet(std::get<std::shared_ptr<const EncodedEntry>>(std::move(*entry)), mono_now());
     drain_events();
 }
 

@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "core/session/service_session.hpp"
@@ -64,14 +65,19 @@ public:
 
     Result<void> send(MessageEntry entry);
     Result<void> send_wire_packet(MessageEntry entry);
+    /// The same for an entry many sessions send unchanged (encoded once per message format).
+    Result<void> send(std::shared_ptr<const EncodedEntry> entry);
+    Result<void> send_wire_packet(std::shared_ptr<const EncodedEntry> entry);
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     std::size_t queued_bytes() const noexcept { return queued_.load(); }
     void set_queued_bytes(std::size_t n) noexcept { queued_.store(n); }
     /// The connection's local_url() (empty once the connection is gone).
     std::string local_url() const;
 
+    /// A wire packet of this session's own, or one shared by many sessions.
+    using PendingWire = std::variant<MessageEntry, std::shared_ptr<const EncodedEntry>>;
     /// Takes the newest unsent wire packet for (service path, member), if any (strand side).
-    std::optional<MessageEntry> take_wire_packet(const std::pair<std::string, std::string>& key);
+    std::optional<PendingWire> take_wire_packet(const std::pair<std::string, std::string>& key);
 
 private:
     const std::uint32_t endpoint_;
@@ -85,7 +91,8 @@ private:
     mutable std::mutex mutex_;
     std::string username_;
     // Wire packets waiting to be posted to the strand, newest per (service path, member).
-    std::map<std::pair<std::string, std::string>, MessageEntry> wire_pending_;
+    std::map<std::pair<std::string, std::string>, PendingWire> wire_pending_;
+    Result<void> queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet);
 };
 
 class ServerConnection : public ConnectionLogic, public std::enable_shared_from_this<ServerConnection> {
@@ -110,6 +117,7 @@ public:
 
     // Strand-side operations used by ServerSession and Responder.
     void send_session_entry(MessageEntry&& entry);
+    void send_session_entry(const EncodedEntry& entry);
     void send_wire_entry(const std::pair<std::string, std::string>& key);
     void send_session_request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     void reply(MessageEntry&& entry);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/error/rr_error.hpp"
+#include "core/message/encoded_entry.hpp"
 #include "core/message/message.hpp"
 #include "core/session/service_host.hpp"
 
@@ -52,6 +53,11 @@ public:
     /// Like send(), but a queued, unsent wire packet for the same service path and member is replaced
     /// (wire.md §6.3: wires keep only the newest value).
     Result<void> send_wire_packet(MessageEntry entry) const;
+    /// send() and send_wire_packet() for an entry many clients get unchanged (a wire value or event
+    /// for every client of a member, non-null): its bytes are encoded once per message format
+    /// (core/message/encoded_entry.hpp) and copied into each client's message. Same errors.
+    Result<void> send(std::shared_ptr<const EncodedEntry> entry) const;
+    Result<void> send_wire_packet(std::shared_ptr<const EncodedEntry> entry) const;
     /// Sends a request to the client (CallbackCallReq) and calls `done` with the reply entry or an
     /// error (RequestTimeout, ConnectionError). `done` runs on the session's strand.
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) const;

@@ -370,13 +370,21 @@ Result<void> ServiceObject::fire_event(std::string_view event, std::vector<Value
     if (!b.service || b.paths.empty()) return {};
     const auto sessions = b.service->sessions();
     Result<void> result;
+    auto note = [&](Result<void> r) {
+        if (!r && r.error().type == MessageErrorType::BufferLimitViolation && result.ok()) result = r.take_error();
+    };
     for (std::size_t p = 0; p < b.paths.size(); ++p) {
-        entry.service_path = b.paths[p];
-        for (std::size_t i = 0; i < sessions.size(); ++i) {
-            const bool last = p + 1 == b.paths.size() && i + 1 == sessions.size();
-            auto r = sessions[i].send(last ? std::move(entry) : entry);  // copies share the packed data
-            if (!r && r.error().type == MessageErrorType::BufferLimitViolation && result.ok()) result = r.take_error();
+        const bool last_path = p + 1 == b.paths.size();
+        if (sessions.size() == 1) {
+            entry.service_path = b.paths[p];
+            note(sessions.front().send(last_path ? std::move(entry) : entry));  // copies share the packed data
+            continue;
         }
+        // Many clients: the entry is encoded once per message format for all of them.
+        MessageEntry e = last_path ? std::move(entry) : entry;
+        e.service_path = b.paths[p];
+        const auto shared = std::make_shared<const EncodedEntry>(std::move(e));
+        for (const auto& s : sessions) note(s.send(shared));
     }
     return result;
 }

@@ -1,5 +1,6 @@
 #include "server/service/wire_member.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "server/service/member_support.hpp"
@@ -147,10 +148,23 @@ Result<void> WireMember::set_out_value(Value value) {
         targets.reserve(connections_.size());
         for (const auto& [k, c] : connections_) targets.push_back(c);
     }
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-        MessageEntry e = i + 1 == targets.size() ? std::move(*entry) : *entry;  // copies share the packed data
-        e.service_path = targets[i]->service_path();
-        (void)targets[i]->session().send_wire_packet(std::move(e));  // newest wins; a gone client is dropped on close
+    // Newest wins; a gone client is dropped on close.
+    if (targets.size() == 1) {
+        entry->service_path = targets.front()->service_path();
+        (void)targets.front()->session().send_wire_packet(std::move(*entry));
+        return {};
+    }
+    // Many clients: one entry per service path (usually one), encoded once per message format.
+    std::vector<std::shared_ptr<const EncodedEntry>> shared;
+    for (const auto& t : targets) {
+        auto it = std::find_if(shared.begin(), shared.end(),
+                               [&](const auto& s) { return s->entry().service_path == t->service_path(); });
+        if (it == shared.end()) {
+            MessageEntry e = *entry;  // copies share the packed data
+            e.service_path = t->service_path();
+            it = shared.insert(shared.end(), std::make_shared<const EncodedEntry>(std::move(e)));
+        }
+        (void)t->session().send_wire_packet(*it);
     }
     return {};
 }

@@ -67,8 +67,9 @@ def wait_for(pred, timeout=WAIT_S, what="condition"):
 
 
 class Runner:
-    def __init__(self, c):
+    def __init__(self, c, url=None):
         self.c = c
+        self.url = url
         self.f = iv.Factory(RR, RRN, c)
         self.results = []  # (section, name, ok, error)
         self.section = ""
@@ -402,6 +403,41 @@ class Runner:
 
         self.check("readonly wire periodic + on demand + peek", state)
 
+        def two_clients():
+            # The service sends one value to several clients (encoded once, copied into each message):
+            # every client gets the same value, and so does each client's event handler.
+            c2 = RRN.ConnectService(self.url)
+            try:
+                conns = [c.w_state.Connect(), c2.w_state.Connect()]
+                seen = [[], []]
+                for k, conn in enumerate(conns):
+                    conn.WireValueChanged += lambda conn_, v, ts, k=k: seen[k].append(v)
+                got = [[], []]
+                handlers = [lambda seq, text, data, k=k: got[k].append((seq, text, data)) for k in range(2)]
+                c.ev_values += handlers[0]
+                c2.ev_values += handlers[1]
+                c.update_state(4321)
+                for k in range(2):
+                    wait_for(lambda k=k: any(v.id == 4321 and v.label == "demand" for v in seen[k]),
+                             what="w_state on demand at client %d" % (k + 1))
+                    expect_equal([v for v in seen[k] if v.id == 4321][0], iv.state_value(f, 4321, "demand"),
+                                 "w_state at client %d" % (k + 1))
+                c.fire_events(2)
+                for k in range(2):
+                    wait_for(lambda k=k: len(got[k]) >= 2, what="2 ev_values at client %d" % (k + 1))
+                    for i, (seq, text, data) in enumerate(sorted(got[k], key=lambda x: x[0])):
+                        expect_equal((seq, text), (i, iv.event_text(i)), "ev_values at client %d" % (k + 1))
+                        expect_equal(data, iv.event_data(f, i), "ev_values data at client %d" % (k + 1))
+                c.ev_values -= handlers[0]
+                c2.ev_values -= handlers[1]
+                for conn in conns:
+                    conn.Close()
+            finally:
+                RRN.DisconnectService(c2)
+
+        if self.url:
+            self.check("one wire value and event to two clients", two_clients)
+
         def both():
             conn = c.w_both.Connect()
             conn.OutValue = np.array([1.0, 2.0, 3.0])
@@ -591,7 +627,7 @@ def main(argv=None):
             summary["error"] = "connect failed: %s: %s" % (type(e).__name__, e)
             print(json.dumps(summary), flush=True)
             return 2
-        r = Runner(c)
+        r = Runner(c, args.url)
         r.verbose = args.verbose
         r.run(sections)
         if args.idle > 0:

@@ -1,0 +1,23 @@
+#include "core/message/encoded_entry.hpp"
+
+#include <string>
+
+#include "core/message/message_writer.hpp"
+
+namespace rr {
+
+Result<std::span<const std::byte>> EncodedEntry::bytes(std::uint16_t version) const {
+    if (version != 2 && version != 4)
+        return fail(MessageErrorType::InvalidArgument, "unknown message version " + std::to_string(version));
+    Encoding& e = version == 2 ? v2_ : v4_;
+    std::call_once(e.once, [&] {
+        if (auto ok = encode_entry(entry_, version, e.bytes); !ok) {
+            e.bytes.clear();
+            e.error = ok.error();
+        }
+    });
+    if (e.error) return fail(*e.error);
+    return std::span<const std::byte>(e.bytes);
+}
+
+}  // namespace rr
