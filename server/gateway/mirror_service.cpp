@@ -9,35 +9,6 @@
 namespace rr::server::gateway {
 namespace {
 
-// The copy-on-write lists of internal subscribers (MirrorService::InternalSubs).
-template <class Subs>
-bool no_subscribers(const Subs& subs) {
-    return !subs || subs->empty();
-}
-
-template <class Sub>
-std::shared_ptr<const std::vector<Sub>> with_subscriber(const std::shared_ptr<const std::vector<Sub>>& subs, Sub sub) {
-    auto next = subs ? std::make_shared<std::vector<Sub>>(*subs) : std::make_shared<std::vector<Sub>>();
-    next->push_back(std::move(sub));
-    return next;
-}
-
-template <class Sub>
-std::shared_ptr<const std::vector<Sub>> without_subscriber(const std::shared_ptr<const std::vector<Sub>>& subs,
-                                                           std::uint64_t id) {
-    if (!subs || std::none_of(subs->begin(), subs->end(), [&](const Sub& s) { return s.id == id; })) return subs;
-    auto next = std::make_shared<std::vector<Sub>>();
-    for (const auto& s : *subs)
-        if (s.id != id) next->push_back(s);
-    return next;
-}
-
-template <class Subs>
-void deliver(const Subs& subs, const SharedEntryPtr& entry) {
-    if (subs)
-        for (const auto& s : *subs) s.on_entry(entry);
-}
-
 RRError not_connected(const std::string& device) {
     return make_error(MessageErrorType::ConnectionError, "device \"" + device + "\" is not connected");
 }
@@ -212,11 +183,10 @@ std::size_t MirrorService::session_count() const {
 
 void MirrorService::drop_session_state(std::uint32_t endpoint) {
     std::vector<MessageEntry> to_device;
+    disconnect_upstream_wires(subscriptions_.leave_all(endpoint));
     {
         std::lock_guard lock(mutex_);
         std::erase_if(sessions_, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
-        for (auto& [key, sub] : wires_)
-            std::erase_if(sub.sessions, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
         for (auto it = pipes_by_downstream_.begin(); it != pipes_by_downstream_.end();) {
             if (std::get<0>(it->first) != endpoint) {
                 ++it;
@@ -301,14 +271,7 @@ void MirrorService::dispatch_shared(const SessionRef& session, MessageEntry&& en
             // A client's OutValue is the device's InValue, passed on as it is; only on a wire this client
             // connected (the upstream connection is the gateway's, so an unconnected client's packet
             // would otherwise pass a lock taken after it).
-            bool connected;
-            {
-                std::lock_guard lock(mutex_);
-                auto it = wires_.find({entry.service_path, entry.member_name});
-                connected = it != wires_.end() &&
-                            std::find(it->second.sessions.begin(), it->second.sessions.end(), session) != it->second.sessions.end();
-            }
-            if (!connected) return;
+            if (!subscriptions_.has_session({entry.service_path, entry.member_name}, session)) return;
             if (auto c = client()) {
                 entry.service_path = to_upstream(entry.service_path);
                 c->send(std::move(entry));
@@ -468,101 +431,59 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
 
 void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     MemberKey key{entry.service_path, entry.member_name};
-    SharedEntryPtr last;
-    bool ready = false;
-    {
-        std::lock_guard lock(mutex_);
-        auto& sub = wires_[key];
-        if (std::find(sub.sessions.begin(), sub.sessions.end(), session) == sub.sessions.end())
-            sub.sessions.push_back(session);
-        ready = sub.upstream_connected;
-        if (ready) {
-            last = sub.last_packet;
-        } else {
-            auto shared = std::make_shared<Responder>(std::move(responder));
-            sub.waiting.push_back([shared](Result<void> r) {
-                if (r)
-                    shared->respond(MessageEntry{});
-                else
-                    shared->fail(r.error());
-            });
-        }
-    }
-    if (ready) {
-        responder.respond(MessageEntry{});
-        if (last) (void)session.send_wire_packet(last);  // the newest value, at once
-        return;
-    }
-    ensure_upstream_wire(key);
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    auto joined = subscriptions_.join_wire(key, session, [shared](Result<void> r) {
+        if (r)
+            shared->respond(MessageEntry{});
+        else
+            shared->fail(r.error());
+    });
+    if (!joined.ready) return ensure_upstream_wire(key);
+    shared->respond(MessageEntry{});
+    if (joined.last) (void)session.send_wire_packet(joined.last);  // the newest value, at once
 }
 
 void MirrorService::ensure_upstream_wire(const MemberKey& key) {
     auto c = client();
-    std::vector<std::function<void(Result<void>)>> fail_now;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = wires_.find(key);
-        if (it == wires_.end() || it->second.upstream_connected || it->second.connecting) return;
-        if (!c) {
-            fail_now.swap(it->second.waiting);
-        } else {
-            it->second.connecting = true;
-        }
+    if (!c) {
+        for (auto& r : subscriptions_.no_upstream(key))
+            if (r) r(fail(not_connected(name_)));
+        return;
     }
-    for (auto& f : fail_now)
-        if (f) f(fail(not_connected(name_)));
-    if (!c) return;
+    if (!subscriptions_.begin_connect(key)) return;
     MessageEntry e;
     e.entry_type = MessageEntryType::WireConnectReq;
     e.service_path = to_upstream(key.first);
     e.member_name = key.second;
     auto self = shared_from_this();
     c->request(std::move(e), [self, key](Result<MessageEntry> r) {
-        std::vector<std::function<void(Result<void>)>> waiting;
         Result<void> outcome;
         if (!r)
             outcome = r.take_error();
         else if (auto err = entry_error(*r))
             outcome = fail(*err);
-        {
-            std::lock_guard lock(self->mutex_);
-            auto it = self->wires_.find(key);
-            if (it == self->wires_.end()) return;
-            it->second.connecting = false;
-            it->second.upstream_connected = outcome.ok();
-            waiting.swap(it->second.waiting);
-            if (!outcome.ok()) {
-                // Nobody gets a connection that does not exist upstream.
-                it->second.sessions.clear();
-                if (no_subscribers(it->second.internal)) self->wires_.erase(it);
-            }
-        }
-        for (auto& w : waiting)
+        for (auto& w : self->subscriptions_.connect_done(key, outcome))
             if (w) w(outcome);
     });
 }
 
 void MirrorService::wire_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     MemberKey key{entry.service_path, entry.member_name};
-    bool last = false;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = wires_.find(key);
-        if (it != wires_.end()) {
-            std::erase(it->second.sessions, session);
-            last = it->second.sessions.empty() && no_subscribers(it->second.internal) && it->second.upstream_connected;
-            if (last) wires_.erase(it);
-        }
-    }
+    const bool last = subscriptions_.leave_wire(key, session);
     responder.respond(MessageEntry{});
-    if (last) {
-        if (auto c = client()) {
-            MessageEntry e;
-            e.entry_type = MessageEntryType::WireDisconnectReq;
-            e.service_path = to_upstream(key.first);
-            e.member_name = key.second;
-            c->request(std::move(e), [](Result<MessageEntry>) {});
-        }
+    if (last) disconnect_upstream_wires({std::move(key)});
+}
+
+void MirrorService::disconnect_upstream_wires(std::vector<MemberKey> keys) {
+    if (keys.empty()) return;
+    auto c = client();
+    if (!c) return;
+    for (auto& key : keys) {
+        MessageEntry e;
+        e.entry_type = MessageEntryType::WireDisconnectReq;
+        e.service_path = to_upstream(key.first);
+        e.member_name = std::move(key.second);
+        c->request(std::move(e), [](Result<MessageEntry>) {});
     }
 }
 
@@ -701,15 +622,13 @@ void MirrorService::pipe_packets_from_device(MessageEntry&& entry) {
 
 void MirrorService::fan_out(MessageEntry&& entry) {
     std::vector<SessionRef> sessions;
-    InternalSubs internal;
     {
         std::lock_guard lock(mutex_);
         // Passthrough clients get the device's events on their own upstream sessions.
         if (!passthrough_) sessions = sessions_;
-        auto it = event_subscribers_.find({entry.service_path, entry.member_name});
-        if (it != event_subscribers_.end()) internal = it->second;
     }
-    if (sessions.empty() && no_subscribers(internal)) return;
+    auto internal = subscriptions_.event_subscribers({entry.service_path, entry.member_name});
+    if (sessions.empty() && !internal) return;
     // One shared copy, encoded once per message format for the native clients.
     const auto shared = std::make_shared<const SharedEntry>(std::move(entry));
     const MessageEntry& e = shared->entry();
@@ -719,6 +638,11 @@ void MirrorService::fan_out(MessageEntry&& entry) {
         if (!s.send(shared)) counters_->event_drops.fetch_add(1);
     }
     deliver(internal, shared);
+}
+
+void MirrorService::deliver(const UpstreamSubscriptions::InternalSubs& subs, const SharedEntryPtr& entry) {
+    if (subs)
+        for (const auto& s : *subs) s.on_entry(entry);
 }
 
 void MirrorService::callback_from_device(MessageEntry&& entry) {
@@ -772,41 +696,25 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
             entry.service_path = to_downstream(entry.service_path);
             // One shared copy: the newest value for late subscribers and what internal subscribers get.
             auto shared = std::make_shared<const SharedEntry>(std::move(entry));
-            std::vector<SessionRef> sessions;
-            InternalSubs internal;
-            {
-                std::lock_guard lock(mutex_);
-                auto it = wires_.find({shared->entry().service_path, shared->entry().member_name});
-                if (it == wires_.end()) return;
-                it->second.last_packet = shared;
-                sessions = it->second.sessions;
-                internal = it->second.internal;
-            }
+            auto targets = subscriptions_.wire_value(shared);
+            if (!targets) return;
             const bool check = access_.active();
-            for (const auto& s : sessions) {
+            for (const auto& s : targets->sessions) {
                 // A session that may only set the wire's OutValue (auth: gateway) receives no InValue.
                 if (check && !access_.may(s, shared->entry().service_path, shared->entry().member_name, auth::Operation::read))
                     continue;
                 if (s.send_wire_packet(shared)) counters_->wire_packets_out.fetch_add(1);
             }
-            deliver(internal, shared);
+            deliver(targets->internal, shared);
             return;
         }
         case MessageEntryType::WireClosed: {
             entry.service_path = to_downstream(entry.service_path);
-            std::vector<SessionRef> sessions;
-            InternalSubs internal;
-            {
-                std::lock_guard lock(mutex_);
-                auto it = wires_.find({entry.service_path, entry.member_name});
-                if (it == wires_.end()) return;
-                sessions = std::move(it->second.sessions);
-                internal = std::move(it->second.internal);
-                wires_.erase(it);
-            }
-            for (const auto& s : sessions) (void)s.send(entry);
+            auto targets = subscriptions_.wire_closed({entry.service_path, entry.member_name});
+            if (!targets) return;
+            for (const auto& s : targets->sessions) (void)s.send(entry);
             // Internal subscribers see the WireClosed too.
-            if (!no_subscribers(internal)) deliver(internal, std::make_shared<const SharedEntry>(std::move(entry)));
+            if (targets->internal) deliver(targets->internal, std::make_shared<const SharedEntry>(std::move(entry)));
             return;
         }
         case MessageEntryType::PipePacket:
@@ -836,23 +744,13 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
 
 void MirrorService::on_upstream_connected(const std::shared_ptr<RawClient>&) {
     shared_endpoints_->resume();
-    std::vector<MemberKey> resubscribe;
-    {
-        std::lock_guard lock(mutex_);
-        for (auto& [key, sub] : wires_) {
-            sub.upstream_connected = false;
-            sub.connecting = false;
-            if (!sub.sessions.empty() || !no_subscribers(sub.internal)) resubscribe.push_back(key);
-        }
-    }
-    for (const auto& key : resubscribe) ensure_upstream_wire(key);
+    for (const auto& key : subscriptions_.upstream_back()) ensure_upstream_wire(key);
 }
 
 void MirrorService::on_upstream_lost(const RRError& error) {
     // Pipes cannot outlive the upstream session: their clients get PipeClosed. Wire connections stay,
     // to be re-subscribed when the device returns. Generators are gone with the session.
     std::vector<std::pair<SessionRef, MessageEntry>> closed;
-    std::vector<std::function<void(Result<void>)>> waiting;
     {
         std::lock_guard lock(mutex_);
         for (auto& [key, link] : pipes_by_upstream_) {
@@ -866,15 +764,9 @@ void MirrorService::on_upstream_lost(const RRError& error) {
         pipes_by_upstream_.clear();
         pipes_by_downstream_.clear();
         generators_.clear();
-        for (auto& [key, sub] : wires_) {
-            sub.upstream_connected = false;
-            sub.connecting = false;
-            for (auto& w : sub.waiting) waiting.push_back(std::move(w));
-            sub.waiting.clear();
-        }
     }
     for (auto& [s, e] : closed) (void)s.send(std::move(e));
-    for (auto& w : waiting)
+    for (auto& w : subscriptions_.upstream_lost())
         if (w) w(fail(not_connected(name_)));
     shared_endpoints_->lost(not_connected(name_));  // a connect still in flight fails with the connection
     (void)error;
@@ -883,64 +775,19 @@ void MirrorService::on_upstream_lost(const RRError& error) {
 std::uint64_t MirrorService::add_internal_subscriber(std::string path, std::string member, bool is_wire,
                                                      std::function<void(const SharedEntryPtr&)> on_entry,
                                                      std::function<void(Result<void>)> done) {
-    std::uint64_t id;
     MemberKey key{std::move(path), std::move(member)};
-    SharedEntryPtr last;
-    bool ready = false;
-    {
-        std::lock_guard lock(mutex_);
-        id = next_internal_id_++;
-        if (!is_wire) {
-            auto& subs = event_subscribers_[key];
-            subs = with_subscriber(subs, InternalSub{id, std::move(on_entry)});
-            ready = true;
-        } else {
-            auto& sub = wires_[key];
-            sub.internal = with_subscriber(sub.internal, InternalSub{id, on_entry});
-            ready = sub.upstream_connected;
-            if (ready) {
-                last = sub.last_packet;
-            } else {
-                sub.waiting.push_back(std::move(done));
-            }
-        }
-    }
-    if (ready) {
-        if (last && is_wire) on_entry(last);
-        if (done) done({});
+    auto [id, joined] = subscriptions_.add_internal(key, is_wire, on_entry, done);
+    if (!joined.ready) {
+        ensure_upstream_wire(key);
         return id;
     }
-    ensure_upstream_wire(key);
+    if (joined.last) on_entry(joined.last);
+    if (done) done({});
     return id;
 }
 
 void MirrorService::remove_internal_subscriber(std::uint64_t id) {
-    std::vector<MemberKey> disconnect;
-    {
-        std::lock_guard lock(mutex_);
-        for (auto& [key, subs] : event_subscribers_) subs = without_subscriber(subs, id);
-        for (auto it = wires_.begin(); it != wires_.end();) {
-            it->second.internal = without_subscriber(it->second.internal, id);
-            const bool unused = no_subscribers(it->second.internal) && it->second.sessions.empty();
-            if (unused && it->second.upstream_connected) {
-                disconnect.push_back(it->first);
-                it = wires_.erase(it);
-            } else if (unused && !it->second.connecting && it->second.waiting.empty()) {
-                it = wires_.erase(it);  // never connected upstream (refused, or the device was away)
-            } else {
-                ++it;
-            }
-        }
-    }
-    if (auto c = client()) {
-        for (const auto& key : disconnect) {
-            MessageEntry e;
-            e.entry_type = MessageEntryType::WireDisconnectReq;
-            e.service_path = to_upstream(key.first);
-            e.member_name = key.second;
-            c->request(std::move(e), [](Result<MessageEntry>) {});
-        }
-    }
+    disconnect_upstream_wires(subscriptions_.remove_internal(id));
 }
 
 }  // namespace rr::server::gateway

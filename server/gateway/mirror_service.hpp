@@ -12,6 +12,7 @@
 #include "server/gateway/auth/mirror_access.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
+#include "server/gateway/upstream_subscriptions.hpp"
 #include "server/service/service_locks.hpp"
 
 namespace rr::server::gateway {
@@ -100,21 +101,7 @@ public:
     std::vector<DeviceLockInfo> gateway_locks() const;
 
 private:
-    using MemberKey = std::pair<std::string, std::string>;  // downstream service path, member
-    struct InternalSub {
-        std::uint64_t id;
-        std::function<void(const SharedEntryPtr&)> on_entry;
-    };
-    // Copied on write: a value fanned out takes a reference to the list, not a copy of every handler.
-    using InternalSubs = std::shared_ptr<const std::vector<InternalSub>>;
-    struct WireSubscription {
-        std::vector<SessionRef> sessions;
-        InternalSubs internal;
-        bool upstream_connected = false;
-        bool connecting = false;
-        std::vector<std::function<void(Result<void>)>> waiting;  // connect requests waiting for upstream
-        SharedEntryPtr last_packet;                              // newest value, for late subscribers
-    };
+    using MemberKey = UpstreamSubscriptions::MemberKey;  // downstream service path, member
     struct PipeLink {
         SessionRef session;
         std::string path, member;
@@ -126,7 +113,12 @@ private:
     void forward(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void wire_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// Connects the wire upstream unless it is connected or being connected (or fails its waiting
+    /// subscriptions when the device is away).
     void ensure_upstream_wire(const MemberKey& key);
+    /// WireDisconnectReq to the device for wires nobody here subscribes to any more.
+    void disconnect_upstream_wires(std::vector<MemberKey> keys);
+    static void deliver(const UpstreamSubscriptions::InternalSubs& subs, const SharedEntryPtr& entry);
     void pipe_connect(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void pipe_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void pipe_packets_from_client(const SessionRef& session, MessageEntry&& entry);
@@ -162,13 +154,11 @@ private:
     mutable std::mutex mutex_;
     std::vector<SessionRef> sessions_;
     std::uint32_t last_caller_ = 0;  // endpoint of the client that most recently called into the device
-    std::map<MemberKey, WireSubscription> wires_;
-    std::map<MemberKey, InternalSubs> event_subscribers_;
+    UpstreamSubscriptions subscriptions_;  // wires and events: who gets what, the upstream wire connections
     std::map<std::tuple<std::string, std::string, std::int32_t>, PipeLink> pipes_by_upstream_;
     std::map<std::tuple<std::uint32_t, std::string, std::string, std::int32_t>, std::int32_t> pipes_by_downstream_;
     std::set<std::pair<std::uint32_t, std::int32_t>> generators_;  // (endpoint, generator index)
     std::shared_ptr<SessionEndpoints> shared_endpoints_;  // set once, in the constructor
-    std::uint64_t next_internal_id_ = 1;
     std::shared_ptr<const DeviceTypes> types_;  // the device's definitions parsed, for member modifiers
 };
 
