@@ -108,24 +108,21 @@ gdump=$(ls -v "$tmp"/gw.out.* | head -1)   # the first dump: JSON; the second: r
 rdump=$(ls -v "$tmp"/gw.out.* | sed -n 2p)
 values=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" "$tmp/rrfanout.json")
 msgs=$(.venv/bin/python -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" "$tmp/fanout.json")
-{
-  echo "# callgrind of rr-gateway: a 100 Hz device wire fanned out to 20 JSON WebSocket clients for 4 s"
+# fanout_report TITLE DUMP COUNT UNIT: instructions and mallocs per delivered UNIT, then the top frames.
+fanout_report() {
+  echo "# callgrind of rr-gateway: $1"
   echo "# (under valgrind the gateway is slower: counts matter, not rates)"
-  echo "delivered messages: $msgs"
-  echo "gateway instructions per delivered message: $(( $(total_ir "$gdump") / msgs ))"
-  bench/callgrind_calls.py "$gdump" malloc | awk -v n="$msgs" '{ printf "gateway malloc calls per delivered message: %.1f\n", $2 / n }'
+  echo "delivered ${4}s: $3"
+  echo "gateway instructions per delivered $4: $(( $(total_ir "$2") / $3 ))"
+  bench/callgrind_calls.py "$2" malloc | awk -v n="$3" -v u="$4" '{ printf "gateway malloc calls per delivered %s: %.1f\n", u, $2 / n }'
   echo
   echo "## inclusive (top frames)"
-  callgrind_annotate --inclusive=yes --threshold=100 "$gdump" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
+  callgrind_annotate --inclusive=yes --threshold=100 "$2" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
     grep -E 'rr::|nlohmann|beast|malloc|free' | cut -c1-240 | sed -n 1,45p
+}
+{
+  fanout_report "a 100 Hz device wire fanned out to 20 JSON WebSocket clients for 4 s" "$gdump" "$msgs" message
   echo
-  echo "# the same gateway: the wire fanned out to 20 native RR clients over rr+ws for 4 s (rr_bench_rr_fanout)"
-  echo "delivered values: $values"
-  echo "gateway instructions per delivered value: $(( $(total_ir "$rdump") / values ))"
-  bench/callgrind_calls.py "$rdump" malloc | awk -v n="$values" '{ printf "gateway malloc calls per delivered value: %.1f\n", $2 / n }'
-  echo
-  echo "## inclusive (top frames)"
-  callgrind_annotate --inclusive=yes --threshold=100 "$rdump" 2>/dev/null | grep -E '^ *[0-9,]+ \(' |
-    grep -E 'rr::|beast|malloc|free' | cut -c1-240 | sed -n 1,45p
+  fanout_report "the same wire fanned out to 20 native RR clients over rr+ws for 4 s (rr_bench_rr_fanout)" "$rdump" "$values" value
 } > "$OUT/profile_fanout.txt"
 echo "wrote $OUT/profile_nop.txt and $OUT/profile_fanout.txt" >&2

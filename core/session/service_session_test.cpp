@@ -469,6 +469,23 @@ TEST_CASE("service session: callbacks to the client are answered, time out, or f
     CHECK(p.service.is_closed());
 }
 
+namespace {
+
+// (member, int32 "value") of every incoming entry after the first, sorted.
+template <class Incoming>
+std::vector<std::pair<std::string, std::int32_t>> wire_values(const std::vector<Incoming>& incoming) {
+    std::vector<std::pair<std::string, std::int32_t>> wires;
+    for (std::size_t i = 1; i < incoming.size(); ++i) {
+        std::int32_t v = 0;
+        const MessageElement* e = incoming[i].entry.find("value");
+        if (e && read_scalar(*e, v)) wires.emplace_back(incoming[i].entry.member_name, v);
+    }
+    std::sort(wires.begin(), wires.end());
+    return wires;
+}
+
+}  // namespace
+
 TEST_CASE("service session: wire packets wait while output is backed up, only the newest per member") {
     Pair p;
     p.connect();
@@ -489,14 +506,7 @@ TEST_CASE("service session: wire packets wait while output is backed up, only th
     auto incoming = p.take_client<ClientIncoming>();
     REQUIRE(incoming.size() == 3);  // the event, then the newest value of each wire
     CHECK(incoming[0].entry.entry_type == MessageEntryType::EventReq);
-    std::vector<std::pair<std::string, std::int32_t>> wires;
-    for (std::size_t i = 1; i < incoming.size(); ++i) {
-        std::int32_t v = 0;
-        REQUIRE(read_scalar(*incoming[i].entry.find("value"), v));
-        wires.emplace_back(incoming[i].entry.member_name, v);
-    }
-    std::sort(wires.begin(), wires.end());
-    CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 3}, {"w2", 9}});
+    CHECK(wire_values(incoming) == std::vector<std::pair<std::string, std::int32_t>>{{"w", 3}, {"w2", 9}});
 }
 
 TEST_CASE("service session: an entry shared by many sessions (EncodedEntry) arrives as one of its own") {
@@ -533,14 +543,7 @@ TEST_CASE("service session: an entry shared by many sessions (EncodedEntry) arri
         p.pump();
         incoming = p.take_client<ClientIncoming>();
         REQUIRE(incoming.size() == 3);  // the event, then the newest value of each wire
-        std::vector<std::pair<std::string, std::int32_t>> wires;
-        for (std::size_t i = 1; i < incoming.size(); ++i) {
-            std::int32_t v = 0;
-            REQUIRE(read_scalar(*incoming[i].entry.find("value"), v));
-            wires.emplace_back(incoming[i].entry.member_name, v);
-        }
-        std::sort(wires.begin(), wires.end());
-        CHECK(wires == std::vector<std::pair<std::string, std::int32_t>>{{"w", 13}, {"w2", 7}});
+        CHECK(wire_values(incoming) == std::vector<std::pair<std::string, std::int32_t>>{{"w", 13}, {"w2", 7}});
     }
     SECTION("an entry that cannot be encoded is an error, and the session goes on") {
         MessageEntry bad = member_request("ev", MessageEntryType::EventReq);
