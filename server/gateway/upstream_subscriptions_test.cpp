@@ -12,9 +12,9 @@ using namespace rr::server::gateway;
 
 namespace {
 
-using Key = UpstreamSubscriptions::MemberKey;
+using SubKey = UpstreamSubscriptions::MemberKey;
 
-struct Sessions {
+struct SubscriberSessions {
     std::vector<std::shared_ptr<ServerSession>> held;
     SessionRef make(std::uint32_t endpoint) {
         held.push_back(std::make_shared<ServerSession>(endpoint, endpoint + 100, nullptr, std::weak_ptr<PumpHandle>(),
@@ -23,7 +23,7 @@ struct Sessions {
     }
 };
 
-SharedEntryPtr packet(const Key& key, std::int32_t value) {
+SharedEntryPtr wire_value_entry(const SubKey& key, std::int32_t value) {
     MessageEntry e;
     e.entry_type = MessageEntryType::WirePacket;
     e.service_path = key.first;
@@ -32,14 +32,14 @@ SharedEntryPtr packet(const Key& key, std::int32_t value) {
     return std::make_shared<const SharedEntry>(std::move(e));
 }
 
-struct Outcomes {
+struct ReadyOutcomes {
     std::vector<Result<void>> got;
     UpstreamSubscriptions::Ready ready() {
         return [this](Result<void> r) { got.push_back(std::move(r)); };
     }
 };
 
-void run(std::vector<UpstreamSubscriptions::Ready> waiting, const Result<void>& outcome) {
+void answer_all(std::vector<UpstreamSubscriptions::Ready> waiting, const Result<void>& outcome) {
     for (auto& w : waiting)
         if (w) w(outcome);
 }
@@ -49,28 +49,28 @@ void run(std::vector<UpstreamSubscriptions::Ready> waiting, const Result<void>& 
 TEST_CASE("upstream subscriptions: one upstream connect for many subscribers, then the newest value at once",
           "[gateway][subscriptions]") {
     UpstreamSubscriptions subs;
-    Sessions s;
-    const Key key{"dev", "w"};
+    SubscriberSessions s;
+    const SubKey key{"dev", "w"};
     const SessionRef a = s.make(1), b = s.make(2), late = s.make(3);
-    Outcomes outcomes;
+    ReadyOutcomes outcomes;
 
     CHECK_FALSE(subs.join_wire(key, a, outcomes.ready()).ready);
     CHECK(subs.begin_connect(key));
     CHECK_FALSE(subs.join_wire(key, b, outcomes.ready()).ready);
     CHECK_FALSE(subs.begin_connect(key));  // already being connected: one WireConnectReq
     CHECK(outcomes.got.empty());
-    run(subs.connect_done(key, {}), {});
+    answer_all(subs.connect_done(key, {}), {});
     REQUIRE(outcomes.got.size() == 2);
     CHECK(outcomes.got[0].ok());
     CHECK(outcomes.got[1].ok());
     CHECK_FALSE(subs.begin_connect(key));  // connected
 
     // Values go to every subscriber; the newest is kept for a late one.
-    CHECK_FALSE(subs.wire_value(packet({"dev", "other"}, 1)));
-    auto targets = subs.wire_value(packet(key, 7));
+    CHECK_FALSE(subs.wire_value(wire_value_entry({"dev", "other"}, 1)));
+    auto targets = subs.wire_value(wire_value_entry(key, 7));
     REQUIRE(targets);
     CHECK(targets->sessions == std::vector<SessionRef>{a, b});
-    subs.wire_value(packet(key, 8));
+    subs.wire_value(wire_value_entry(key, 8));
     auto joined = subs.join_wire(key, late, outcomes.ready());
     CHECK(joined.ready);
     REQUIRE(joined.last);
@@ -81,20 +81,20 @@ TEST_CASE("upstream subscriptions: one upstream connect for many subscribers, th
 
     // Joining twice does not deliver twice.
     subs.join_wire(key, a, outcomes.ready());
-    CHECK(subs.wire_value(packet(key, 9))->sessions.size() == 3);
+    CHECK(subs.wire_value(wire_value_entry(key, 9))->sessions.size() == 3);
 }
 
 TEST_CASE("upstream subscriptions: the last subscriber of either front end disconnects the wire upstream",
           "[gateway][subscriptions]") {
     UpstreamSubscriptions subs;
-    Sessions s;
-    const Key key{"dev", "w"};
+    SubscriberSessions s;
+    const SubKey key{"dev", "w"};
     const SessionRef a = s.make(1), b = s.make(2);
-    Outcomes outcomes;
+    ReadyOutcomes outcomes;
     subs.join_wire(key, a, outcomes.ready());
     subs.join_wire(key, b, outcomes.ready());
     REQUIRE(subs.begin_connect(key));
-    run(subs.connect_done(key, {}), {});
+    answer_all(subs.connect_done(key, {}), {});
     std::vector<SharedEntryPtr> internal_got;
     auto [id, joined] = subs.add_internal(key, true, [&](const SharedEntryPtr& e) { internal_got.push_back(e); },
                                           outcomes.ready());
@@ -102,19 +102,19 @@ TEST_CASE("upstream subscriptions: the last subscriber of either front end disco
 
     CHECK_FALSE(subs.leave_wire(key, a));
     CHECK(subs.leave_all(2).empty());  // b's session closed: the internal subscriber is left
-    auto targets = subs.wire_value(packet(key, 3));
+    auto targets = subs.wire_value(wire_value_entry(key, 3));
     REQUIRE(targets);
     CHECK(targets->sessions.empty());
     REQUIRE(targets->internal);
     CHECK(targets->internal->size() == 1);
-    CHECK(subs.remove_internal(id) == std::vector<Key>{key});
+    CHECK(subs.remove_internal(id) == std::vector<SubKey>{key});
     CHECK(subs.wire_count() == 0);
 
     SECTION("a closed session that was the last subscriber") {
         subs.join_wire(key, a, outcomes.ready());
         REQUIRE(subs.begin_connect(key));
-        run(subs.connect_done(key, {}), {});
-        CHECK(subs.leave_all(1) == std::vector<Key>{key});
+        answer_all(subs.connect_done(key, {}), {});
+        CHECK(subs.leave_all(1) == std::vector<SubKey>{key});
         CHECK(subs.wire_count() == 0);
     }
     SECTION("leaving a wire never connected upstream asks for no disconnect") {
@@ -125,10 +125,10 @@ TEST_CASE("upstream subscriptions: the last subscriber of either front end disco
 
 TEST_CASE("upstream subscriptions: a refused or impossible connect fails the waiters", "[gateway][subscriptions]") {
     UpstreamSubscriptions subs;
-    Sessions s;
-    const Key key{"dev", "w"};
+    SubscriberSessions s;
+    const SubKey key{"dev", "w"};
     const SessionRef a = s.make(1);
-    Outcomes outcomes;
+    ReadyOutcomes outcomes;
 
     SECTION("refused upstream: sessions dropped, internal subscribers kept for the device's return") {
         subs.join_wire(key, a, outcomes.ready());
@@ -136,37 +136,37 @@ TEST_CASE("upstream subscriptions: a refused or impossible connect fails the wai
         CHECK_FALSE(joined.ready);
         REQUIRE(subs.begin_connect(key));
         const Result<void> refused = fail(MessageErrorType::MemberNotFound, "no such wire");
-        run(subs.connect_done(key, refused), refused);
+        answer_all(subs.connect_done(key, refused), refused);
         REQUIRE(outcomes.got.size() == 2);
         CHECK(outcomes.got[0].error().type == MessageErrorType::MemberNotFound);
         CHECK_FALSE(subs.has_session(key, a));
-        CHECK(subs.upstream_back() == std::vector<Key>{key});
+        CHECK(subs.upstream_back() == std::vector<SubKey>{key});
         CHECK(subs.remove_internal(id).empty());  // never connected upstream: nothing to disconnect
         CHECK(subs.wire_count() == 0);
     }
     SECTION("no device connection") {
         subs.join_wire(key, a, outcomes.ready());
         const Result<void> away = fail(MessageErrorType::ConnectionError, "away");
-        run(subs.no_upstream(key), away);
+        answer_all(subs.no_upstream(key), away);
         REQUIRE(outcomes.got.size() == 1);
         CHECK(outcomes.got[0].error().type == MessageErrorType::ConnectionError);
     }
     SECTION("the device connection lost while connecting, then back") {
         subs.join_wire(key, a, outcomes.ready());
         REQUIRE(subs.begin_connect(key));
-        run(subs.upstream_lost(), fail(MessageErrorType::ConnectionError, "lost"));
+        answer_all(subs.upstream_lost(), fail(MessageErrorType::ConnectionError, "lost"));
         REQUIRE(outcomes.got.size() == 1);
         CHECK_FALSE(outcomes.got[0].ok());
         CHECK(subs.has_session(key, a));  // the subscription stays, to be connected again
-        CHECK(subs.upstream_back() == std::vector<Key>{key});
+        CHECK(subs.upstream_back() == std::vector<SubKey>{key});
         CHECK(subs.begin_connect(key));
     }
 }
 
 TEST_CASE("upstream subscriptions: events and WireClosed reach their subscribers", "[gateway][subscriptions]") {
     UpstreamSubscriptions subs;
-    Sessions s;
-    const Key ev{"dev", "ev"}, key{"dev", "w"};
+    SubscriberSessions s;
+    const SubKey ev{"dev", "ev"}, key{"dev", "w"};
     auto [id1, j1] = subs.add_internal(ev, false, [](const SharedEntryPtr&) {}, nullptr);
     auto [id2, j2] = subs.add_internal(ev, false, [](const SharedEntryPtr&) {}, nullptr);
     CHECK(j1.ready);
@@ -180,10 +180,10 @@ TEST_CASE("upstream subscriptions: events and WireClosed reach their subscribers
     subs.remove_internal(id2);
     CHECK_FALSE(subs.event_subscribers(ev));
 
-    Outcomes outcomes;
+    ReadyOutcomes outcomes;
     subs.join_wire(key, s.make(1), outcomes.ready());
     REQUIRE(subs.begin_connect(key));
-    run(subs.connect_done(key, {}), {});
+    answer_all(subs.connect_done(key, {}), {});
     auto closed = subs.wire_closed(key);
     REQUIRE(closed);
     CHECK(closed->sessions.size() == 1);
