@@ -699,7 +699,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
             auto targets = subscriptions_.wire_value(shared);
             if (!targets) return;
             const bool check = access_.active();
-            for (const auto& s : targets->sessions) {
+            for (const auto& s : *targets->sessions) {
                 // A session that may only set the wire's OutValue (auth: gateway) receives no InValue.
                 if (check && !access_.may(s, shared->entry().service_path, shared->entry().member_name, auth::Operation::read))
                     continue;
@@ -712,7 +712,7 @@ void MirrorService::on_upstream_entry(MessageEntry&& entry) {
             entry.service_path = to_downstream(entry.service_path);
             auto targets = subscriptions_.wire_closed({entry.service_path, entry.member_name});
             if (!targets) return;
-            for (const auto& s : targets->sessions) (void)s.send(entry);
+            for (const auto& s : *targets->sessions) (void)s.send(entry);
             // Internal subscribers see the WireClosed too.
             if (targets->internal) deliver(targets->internal, std::make_shared<const SharedEntry>(std::move(entry)));
             return;

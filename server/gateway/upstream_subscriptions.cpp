@@ -24,15 +24,36 @@ InternalSubs without_subscriber(const InternalSubs& subs, std::uint64_t id) {
     return next;
 }
 
+using SessionList = UpstreamSubscriptions::SessionList;
+
+// The list without the sessions `drop` selects (the same list when it selects none).
+template <class Drop>
+SessionList without_sessions(const SessionList& list, Drop&& drop) {
+    if (std::none_of(list->begin(), list->end(), drop)) return list;
+    auto next = std::make_shared<std::vector<SessionRef>>();
+    for (const auto& s : *list)
+        if (!drop(s)) next->push_back(s);
+    return next;
+}
+
 }  // namespace
 
-bool UpstreamSubscriptions::unused(const Wire& w) { return w.sessions.empty() && no_subscribers(w.internal); }
+const SessionList& UpstreamSubscriptions::empty_sessions() {
+    static const SessionList empty = std::make_shared<const std::vector<SessionRef>>();
+    return empty;
+}
+
+bool UpstreamSubscriptions::unused(const Wire& w) { return w.sessions->empty() && no_subscribers(w.internal); }
 
 UpstreamSubscriptions::Joined UpstreamSubscriptions::join_wire(const MemberKey& key, const SessionRef& session,
                                                                Ready on_ready) {
     std::lock_guard lock(mutex_);
     Wire& w = wires_[key];
-    if (std::find(w.sessions.begin(), w.sessions.end(), session) == w.sessions.end()) w.sessions.push_back(session);
+    if (std::find(w.sessions->begin(), w.sessions->end(), session) == w.sessions->end()) {
+        auto next = std::make_shared<std::vector<SessionRef>>(*w.sessions);
+        next->push_back(session);
+        w.sessions = std::move(next);
+    }
     if (w.upstream_connected) return {true, w.last};
     w.waiting.push_back(std::move(on_ready));
     return {};
@@ -42,7 +63,7 @@ bool UpstreamSubscriptions::leave_wire(const MemberKey& key, const SessionRef& s
     std::lock_guard lock(mutex_);
     auto it = wires_.find(key);
     if (it == wires_.end()) return false;
-    std::erase(it->second.sessions, session);
+    it->second.sessions = without_sessions(it->second.sessions, [&](const SessionRef& s) { return s == session; });
     if (!unused(it->second) || !it->second.upstream_connected) return false;
     wires_.erase(it);
     return true;
@@ -51,16 +72,17 @@ bool UpstreamSubscriptions::leave_wire(const MemberKey& key, const SessionRef& s
 bool UpstreamSubscriptions::has_session(const MemberKey& key, const SessionRef& session) const {
     std::lock_guard lock(mutex_);
     auto it = wires_.find(key);
-    return it != wires_.end() && std::find(it->second.sessions.begin(), it->second.sessions.end(), session) !=
-                                     it->second.sessions.end();
+    return it != wires_.end() && std::find(it->second.sessions->begin(), it->second.sessions->end(), session) !=
+                                     it->second.sessions->end();
 }
 
 std::vector<UpstreamSubscriptions::MemberKey> UpstreamSubscriptions::leave_all(std::uint32_t endpoint) {
     std::vector<MemberKey> disconnect;
     std::lock_guard lock(mutex_);
     for (auto it = wires_.begin(); it != wires_.end();) {
-        const auto removed =
-            std::erase_if(it->second.sessions, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
+        const SessionList before = it->second.sessions;
+        it->second.sessions = without_sessions(before, [&](const SessionRef& s) { return s.endpoint() == endpoint; });
+        const bool removed = it->second.sessions != before;
         if (removed && unused(it->second) && it->second.upstream_connected) {
             disconnect.push_back(it->first);
             it = wires_.erase(it);
@@ -130,7 +152,7 @@ std::vector<UpstreamSubscriptions::Ready> UpstreamSubscriptions::connect_done(co
     w.upstream_connected = outcome.ok();
     waiting.swap(w.waiting);
     if (!outcome.ok()) {
-        w.sessions.clear();
+        w.sessions = empty_sessions();
         if (no_subscribers(w.internal)) wires_.erase(it);
     }
     return waiting;
@@ -180,7 +202,7 @@ std::optional<UpstreamSubscriptions::Targets> UpstreamSubscriptions::wire_closed
     std::lock_guard lock(mutex_);
     auto it = wires_.find(key);
     if (it == wires_.end()) return std::nullopt;
-    Targets t{std::move(it->second.sessions), std::move(it->second.internal)};
+    Targets t{it->second.sessions, std::move(it->second.internal)};
     wires_.erase(it);
     return t;
 }

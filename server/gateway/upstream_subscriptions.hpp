@@ -40,9 +40,11 @@ public:
     /// Copied on write: a value fanned out takes a reference to the list, not a copy of every handler.
     using InternalSubs = std::shared_ptr<const std::vector<InternalSub>>;
 
+    /// A wire's native subscribers, copied on write like InternalSubs (never null in Targets).
+    using SessionList = std::shared_ptr<const std::vector<SessionRef>>;
     /// Who a value goes to.
     struct Targets {
-        std::vector<SessionRef> sessions;
+        SessionList sessions;
         InternalSubs internal;
     };
     /// What a subscriber found when joining a wire.
@@ -101,7 +103,7 @@ public:
 
 private:
     struct Wire {
-        std::vector<SessionRef> sessions;
+        SessionList sessions = empty_sessions();
         InternalSubs internal;
         bool upstream_connected = false;
         bool connecting = false;
@@ -109,6 +111,7 @@ private:
         SharedEntryPtr last;         // newest value, for late subscribers
     };
     static bool unused(const Wire& w);
+    static const SessionList& empty_sessions();
 
     mutable std::mutex mutex_;
     std::map<MemberKey, Wire> wires_;

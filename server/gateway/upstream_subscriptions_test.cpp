@@ -69,7 +69,8 @@ TEST_CASE("upstream subscriptions: one upstream connect for many subscribers, th
     CHECK_FALSE(subs.wire_value(wire_value_entry({"dev", "other"}, 1)));
     auto targets = subs.wire_value(wire_value_entry(key, 7));
     REQUIRE(targets);
-    CHECK(targets->sessions == std::vector<SessionRef>{a, b});
+    CHECK(*targets->sessions == std::vector<SessionRef>{a, b});
+    const auto delivering = targets->sessions;
     subs.wire_value(wire_value_entry(key, 8));
     auto joined = subs.join_wire(key, late, outcomes.ready());
     CHECK(joined.ready);
@@ -77,11 +78,12 @@ TEST_CASE("upstream subscriptions: one upstream connect for many subscribers, th
     CHECK(joined.last->entry().request_id == 8);
     CHECK(outcomes.got.size() == 2);  // a ready join keeps no waiter
     CHECK(subs.has_session(key, late));
+    CHECK(delivering->size() == 2);  // copied on write: a list being delivered is not changed under it
     CHECK_FALSE(subs.has_session({"dev", "other"}, late));
 
     // Joining twice does not deliver twice.
     subs.join_wire(key, a, outcomes.ready());
-    CHECK(subs.wire_value(wire_value_entry(key, 9))->sessions.size() == 3);
+    CHECK(subs.wire_value(wire_value_entry(key, 9))->sessions->size() == 3);
 }
 
 TEST_CASE("upstream subscriptions: the last subscriber of either front end disconnects the wire upstream",
@@ -104,7 +106,7 @@ TEST_CASE("upstream subscriptions: the last subscriber of either front end disco
     CHECK(subs.leave_all(2).empty());  // b's session closed: the internal subscriber is left
     auto targets = subs.wire_value(wire_value_entry(key, 3));
     REQUIRE(targets);
-    CHECK(targets->sessions.empty());
+    CHECK(targets->sessions->empty());
     REQUIRE(targets->internal);
     CHECK(targets->internal->size() == 1);
     CHECK(subs.remove_internal(id) == std::vector<SubKey>{key});
@@ -186,7 +188,7 @@ TEST_CASE("upstream subscriptions: events and WireClosed reach their subscribers
     answer_all(subs.connect_done(key, {}), {});
     auto closed = subs.wire_closed(key);
     REQUIRE(closed);
-    CHECK(closed->sessions.size() == 1);
+    CHECK(closed->sessions->size() == 1);
     CHECK_FALSE(subs.wire_closed(key));
     CHECK(subs.wire_count() == 0);
 }

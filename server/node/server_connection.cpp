@@ -188,8 +188,10 @@ Result<void> ServerSession::queue_wire_packet(std::pair<std::string, std::string
     bool post = false;
     {
         std::lock_guard lock(mutex_);
-        auto [it, inserted] = wire_pending_.insert_or_assign(key, std::move(packet));
-        post = inserted;  // an older packet not yet sent is replaced: wires keep only the newest value
+        auto it = wire_pending_.find(key);
+        if (it == wire_pending_.end()) it = wire_pending_.emplace(key, std::nullopt).first;
+        post = !it->second;  // an older packet not yet sent is replaced: wires keep only the newest value
+        it->second = std::move(packet);
     }
     if (post) {
         // dispatch, as send(): from the session's own strand the packet goes out before the reply.
@@ -203,9 +205,12 @@ Result<void> ServerSession::queue_wire_packet(std::pair<std::string, std::string
 std::optional<ServerSession::PendingWire> ServerSession::take_wire_packet(const std::pair<std::string, std::string>& key) {
     std::lock_guard lock(mutex_);
     auto it = wire_pending_.find(key);
-    if (it == wire_pending_.end()) return std::nullopt;
-    PendingWire e = std::move(it->second);
-    wire_pending_.erase(it);
+    if (it == wire_pending_.end() || !it->second) return std::nullopt;
+    PendingWire e = std::move(*it->second);
+    if (wire_pending_.size() > kKeptWireSlots)
+        wire_pending_.erase(it);
+    else
+        it->second.reset();
     return e;
 }
 

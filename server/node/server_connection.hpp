@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -90,8 +91,10 @@ private:
     std::atomic<std::size_t> queued_{0};
     mutable std::mutex mutex_;
     std::string username_;
-    // Wire packets waiting to be posted to the strand, newest per (service path, member).
-    std::map<std::pair<std::string, std::string>, PendingWire> wire_pending_;
+    // Wire packets waiting to be posted to the strand, newest per (service path, member). A slot stays
+    // when its packet is taken (no map node per packet), unless there are more than kKeptWireSlots.
+    static constexpr std::size_t kKeptWireSlots = 64;
+    std::map<std::pair<std::string, std::string>, std::optional<PendingWire>> wire_pending_;
     Result<void> queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet);
 };
 

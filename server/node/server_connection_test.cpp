@@ -467,3 +467,62 @@ TEST_CASE("a callback request whose work a closed pump drops is answered Connect
     CHECK(got.error().type == MessageErrorType::ConnectionError);
     CHECK(got.error().message == "client session closed");
 }
+
+namespace {
+// A pump that keeps what is handed to it, unrun: the test plays the strand.
+class KeepingPump final : public PumpHandle {
+public:
+    void post(std::function<void()> fn) override { held.push_back(std::move(fn)); }
+    void dispatch(std::function<void()> fn) override { held.push_back(std::move(fn)); }
+    void close() override {}
+    std::vector<std::function<void()>> held;
+};
+
+MessageEntry wire_packet_with(const std::string& member, std::int32_t v) {
+    MessageEntry e = request(MessageEntryType::WirePacket, member);
+    e.elements.push_back(make_scalar_element<std::int32_t>("value", v));
+    return e;
+}
+
+std::int32_t pending_value(const ServerSession::PendingWire& p) {
+    const MessageEntry& e = std::holds_alternative<MessageEntry>(p) ? std::get<MessageEntry>(p)
+                                                                     : std::get<std::shared_ptr<const EncodedEntry>>(p)->entry();
+    std::int32_t v = -1;
+    if (const auto* el = e.find("value")) (void)read_scalar(*el, v);
+    return v;
+}
+}  // namespace
+
+TEST_CASE("pending wire packets: one hand-off per member until taken, the newest wins, own or shared") {
+    auto pump = std::make_shared<KeepingPump>();
+    auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
+    const SessionRef ref(session);
+    const auto key = [](const std::string& member) { return std::make_pair(std::string("svc"), member); };
+
+    REQUIRE(ref.send_wire_packet(wire_packet_with("w", 1)));
+    REQUIRE(ref.send_wire_packet(std::make_shared<const EncodedEntry>(wire_packet_with("w", 2))));
+    CHECK(pump->held.size() == 1);  // the second replaced the first before the strand took it
+    auto taken = session->take_wire_packet(key("w"));
+    REQUIRE(taken);
+    CHECK(pending_value(*taken) == 2);
+    CHECK_FALSE(session->take_wire_packet(key("w")));
+
+    // After a take, the next value is handed off again; members do not replace each other, also
+    // beyond the slots a session keeps between values.
+    REQUIRE(ref.send_wire_packet(wire_packet_with("w", 3)));
+    CHECK(pump->held.size() == 2);
+    for (int m = 0; m < 80; ++m) REQUIRE(ref.send_wire_packet(wire_packet_with("m" + std::to_string(m), m)));
+    CHECK(pump->held.size() == 82);
+    for (int round = 0; round < 2; ++round) {
+        for (int m = 0; m < 80; ++m) {
+            auto p = session->take_wire_packet(key("m" + std::to_string(m)));
+            REQUIRE(p);
+            CHECK(pending_value(*p) == m + 100 * round);
+        }
+        for (int m = 0; m < 80; ++m) REQUIRE(ref.send_wire_packet(wire_packet_with("m" + std::to_string(m), m + 100)));
+    }
+    CHECK(pump->held.size() == 82 + 80 * 2);
+    taken = session->take_wire_packet(key("w"));
+    REQUIRE(taken);
+    CHECK(pending_value(*taken) == 3);
+}
