@@ -342,7 +342,7 @@ Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry,
     auto bytes = entry.bytes(version);
     if (!bytes) return bytes.take_error();
     const bool omit = omit_routing_applies(header.header, entry.entry().entry_type, version, true);
-    if (header.version != version || (omit && !header.header.v4_flags)) relabel(header, 1, version, omit);
+    if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
     const std::size_t before = output_.size();
     if (auto ok = encode_message(header, *bytes, output_); !ok) {
         output_.resize(before);

@@ -166,6 +166,19 @@ Result<void> ServerSession::send(std::shared_ptr<const EncodedEntry> entry) {
     const std::size_t size = estimate_size(entry->entry());
     if (queued_.load() + size > max_queue_) return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
     queued_.fetch_add(size);
+    if (pump->known_off_strand()) {
+        // From another thread (a fan-out): queued in order with the pump's one wake, no closure per
+        // entry. A wake already on its way takes it; it still precedes any later post from this thread.
+        bool wake = false;
+        {
+            std::lock_guard lock(mutex_);
+            shared_pending_.push_back(std::move(entry));
+            wake = !std::exchange(wake_pending_, true);
+        }
+        if (wake) pump->wake();
+        return {};
+    }
+    // On the session's own strand: queued at once, before the reply of the handler that sends it.
     pump->dispatch([conn = connection_, entry = std::move(entry)] {
         if (auto c = conn.lock()) c->send_session_entry(*entry);
     });
@@ -185,33 +198,39 @@ Result<void> ServerSession::send_wire_packet(std::shared_ptr<const EncodedEntry>
 Result<void> ServerSession::queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet) {
     auto pump = pump_.lock();
     if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
-    bool post = false;
+    bool wake = false;
     {
         std::lock_guard lock(mutex_);
         auto it = wire_pending_.find(key);
-        if (it == wire_pending_.end()) it = wire_pending_.emplace(key, std::nullopt).first;
-        post = !it->second;  // an older packet not yet sent is replaced: wires keep only the newest value
-        it->second = std::move(packet);
+        if (it == wire_pending_.end()) it = wire_pending_.emplace(std::move(key), std::nullopt).first;
+        it->second = std::move(packet);  // an older packet not yet sent is replaced: wires keep only the newest value
+        wake = !std::exchange(wake_pending_, true);
     }
-    if (post) {
-        // dispatch, as send(): from the session's own strand the packet goes out before the reply.
-        pump->dispatch([conn = connection_, key = std::move(key)] {
-            if (auto c = conn.lock()) c->send_wire_entry(key);
-        });
-    }
+    // At once when on the session's own strand (the packet then goes out before the reply), unless a
+    // wake from another thread is already on its way: the packet rides on that one.
+    if (wake) pump->wake();
     return {};
 }
 
-std::optional<ServerSession::PendingWire> ServerSession::take_wire_packet(const std::pair<std::string, std::string>& key) {
+void ServerSession::take_queued(std::vector<std::shared_ptr<const EncodedEntry>>& sends, std::vector<PendingWire>& wires) {
     std::lock_guard lock(mutex_);
-    auto it = wire_pending_.find(key);
-    if (it == wire_pending_.end() || !it->second) return std::nullopt;
-    PendingWire e = std::move(*it->second);
-    if (wire_pending_.size() > kKeptWireSlots)
-        wire_pending_.erase(it);
-    else
-        it->second.reset();
-    return e;
+    wake_pending_ = false;
+    if (sends.empty()) {
+        sends.swap(shared_pending_);  // both keep their capacity: no allocation per wake
+    } else {
+        for (auto& e : shared_pending_) sends.push_back(std::move(e));
+        shared_pending_.clear();
+    }
+    for (auto it = wire_pending_.begin(); it != wire_pending_.end();) {
+        if (it->second) {
+            wires.push_back(std::move(*it->second));
+            it->second.reset();
+        }
+        if (wire_pending_.size() > kKeptWireSlots && !it->second)
+            it = wire_pending_.erase(it);
+        else
+            ++it;
+    }
 }
 
 void ServerSession::request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {
@@ -424,14 +443,19 @@ void ServerConnection::send_session_entry(const EncodedEntry& entry) {
     drain_events();
 }
 
-void ServerConnection::send_wire_entry(const std::pair<std::string, std::string>& key) {
+void ServerConnection::on_wake() {
     if (!current_) return;
-    auto entry = current_->take_wire_packet(key);
-    if (!entry) return;
-    if (auto* own = std::get_if<MessageEntry>(&*entry))
-        session_.send_wire_packet(std::move(*own), mono_now());
-    else
-        session_.send_wire_packet(std::get<std::shared_ptr<const EncodedEntry>>(std::move(*entry)), mono_now());
+    current_->take_queued(woken_sends_, woken_wires_);
+    const auto now = mono_now();
+    for (const auto& entry : woken_sends_) (void)session_.send(*entry, now);
+    woken_sends_.clear();
+    for (auto& packet : woken_wires_) {
+        if (auto* own = std::get_if<MessageEntry>(&packet))
+            session_.send_wire_packet(std::move(*own), now);
+        else
+            session_.send_wire_packet(std::get<std::shared_ptr<const EncodedEntry>>(std::move(packet)), now);
+    }
+    woken_wires_.clear();
     drain_events();
 }
 

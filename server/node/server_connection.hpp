@@ -77,8 +77,10 @@ public:
 
     /// A wire packet of this session's own, or one shared by many sessions.
     using PendingWire = std::variant<MessageEntry, std::shared_ptr<const EncodedEntry>>;
-    /// Takes the newest unsent wire packet for (service path, member), if any (strand side).
-    std::optional<PendingWire> take_wire_packet(const std::pair<std::string, std::string>& key);
+    /// Strand side: moves what other threads queued for the pump's wake into `sends` (shared entries
+    /// in the order sent) and `wires` (the newest unsent packet of every (service path, member), in
+    /// key order), both appended. What is queued after this wakes the pump again.
+    void take_queued(std::vector<std::shared_ptr<const EncodedEntry>>& sends, std::vector<PendingWire>& wires);
 
 private:
     const std::uint32_t endpoint_;
@@ -91,10 +93,14 @@ private:
     std::atomic<std::size_t> queued_{0};
     mutable std::mutex mutex_;
     std::string username_;
-    // Wire packets waiting to be posted to the strand, newest per (service path, member). A slot stays
-    // when its packet is taken (no map node per packet), unless there are more than kKeptWireSlots.
+    // What other threads queued for the strand: shared entries in order (bounded by max_queue_), and
+    // wire packets, newest per (service path, member). A wire slot stays when its packet is taken (no
+    // map node per packet), unless there are more than kKeptWireSlots. `wake_pending_`: the pump was
+    // woken for them and has not taken them yet (one wake for all).
     static constexpr std::size_t kKeptWireSlots = 64;
+    std::vector<std::shared_ptr<const EncodedEntry>> shared_pending_;
     std::map<std::pair<std::string, std::string>, std::optional<PendingWire>> wire_pending_;
+    bool wake_pending_ = false;
     Result<void> queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet);
 };
 
@@ -116,12 +122,14 @@ public:
     void on_timer(MonoTime now) override;
     bool wants_close() const override { return session_.is_closed(); }
     bool wants_read() const override { return session_.pending_output_size() < config_.read_pause_bytes; }
+    /// Sends what the client session queued from other threads (ServerSession::send of a shared
+    /// entry, send_wire_packet).
+    void on_wake() override;
     void on_transport_closed(RRError error) override;
 
     // Strand-side operations used by ServerSession and Responder.
     void send_session_entry(MessageEntry&& entry);
     void send_session_entry(const EncodedEntry& entry);
-    void send_wire_entry(const std::pair<std::string, std::string>& key);
     void send_session_request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     void reply(MessageEntry&& entry);
 
@@ -146,6 +154,9 @@ private:
     std::map<std::uint32_t, std::function<void(Result<MessageEntry>)>> callbacks_;
     std::uint64_t messages_in_seen_ = 0, messages_out_seen_ = 0;
     std::vector<ServiceSessionEvent> batch_;  // drain_events' (only the outermost call uses it)
+    // on_wake's, kept for their capacity.
+    std::vector<std::shared_ptr<const EncodedEntry>> woken_sends_;
+    std::vector<ServerSession::PendingWire> woken_wires_;
     bool draining_ = false;
 };
 

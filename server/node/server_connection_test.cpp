@@ -1,6 +1,7 @@
 // Node + ServerConnection + RawClient over real loopback TCP, with a hand-written entry-level service.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <future>
@@ -447,6 +448,7 @@ class ClosedPump final : public PumpHandle {
 public:
     void post(std::function<void()> fn) override { ++dropped; }
     void dispatch(std::function<void()> fn) override { ++dropped; }
+    void wake() override { ++dropped; }
     void close() override {}
     int dropped = 0;
 };
@@ -474,14 +476,24 @@ class KeepingPump final : public PumpHandle {
 public:
     void post(std::function<void()> fn) override { held.push_back(std::move(fn)); }
     void dispatch(std::function<void()> fn) override { held.push_back(std::move(fn)); }
+    void wake() override { ++wakes; }
+    bool known_off_strand() const override { return off_strand; }
     void close() override {}
     std::vector<std::function<void()>> held;
+    int wakes = 0;
+    bool off_strand = false;
 };
 
 MessageEntry wire_packet_with(const std::string& member, std::int32_t v) {
     MessageEntry e = request(MessageEntryType::WirePacket, member);
     e.elements.push_back(make_scalar_element<std::int32_t>("value", v));
     return e;
+}
+
+std::int32_t pending_value(const std::shared_ptr<const EncodedEntry>& p) {
+    std::int32_t v = -1;
+    if (const auto* el = p->entry().find("value")) (void)read_scalar(*el, v);
+    return v;
 }
 
 std::int32_t pending_value(const ServerSession::PendingWire& p) {
@@ -493,36 +505,97 @@ std::int32_t pending_value(const ServerSession::PendingWire& p) {
 }
 }  // namespace
 
-TEST_CASE("pending wire packets: one hand-off per member until taken, the newest wins, own or shared") {
+TEST_CASE("pending wire packets: one wake per session until taken, the newest per member, own or shared") {
     auto pump = std::make_shared<KeepingPump>();
     auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
     const SessionRef ref(session);
-    const auto key = [](const std::string& member) { return std::make_pair(std::string("svc"), member); };
+    std::vector<ServerSession::PendingWire> taken;
+    std::vector<std::shared_ptr<const EncodedEntry>> sends;
+    const auto values = [&] {
+        std::vector<std::int32_t> v;
+        for (const auto& p : taken) v.push_back(pending_value(p));
+        taken.clear();
+        return v;
+    };
 
     REQUIRE(ref.send_wire_packet(wire_packet_with("w", 1)));
     REQUIRE(ref.send_wire_packet(std::make_shared<const EncodedEntry>(wire_packet_with("w", 2))));
-    CHECK(pump->held.size() == 1);  // the second replaced the first before the strand took it
-    auto taken = session->take_wire_packet(key("w"));
-    REQUIRE(taken);
-    CHECK(pending_value(*taken) == 2);
-    CHECK_FALSE(session->take_wire_packet(key("w")));
+    REQUIRE(ref.send_wire_packet(wire_packet_with("x", 7)));
+    CHECK(pump->wakes == 1);  // the later packets ride on the first wake
+    CHECK(pump->held.empty());
+    session->take_queued(sends, taken);
+    CHECK(values() == std::vector<std::int32_t>{2, 7});  // "w" replaced by its newest value, key order
+    session->take_queued(sends, taken);
+    CHECK(taken.empty());
 
-    // After a take, the next value is handed off again; members do not replace each other, also
-    // beyond the slots a session keeps between values.
+    // After a take, the next packet wakes again; members do not replace each other, also beyond the
+    // slots a session keeps between values.
     REQUIRE(ref.send_wire_packet(wire_packet_with("w", 3)));
-    CHECK(pump->held.size() == 2);
-    for (int m = 0; m < 80; ++m) REQUIRE(ref.send_wire_packet(wire_packet_with("m" + std::to_string(m), m)));
-    CHECK(pump->held.size() == 82);
-    for (int round = 0; round < 2; ++round) {
-        for (int m = 0; m < 80; ++m) {
-            auto p = session->take_wire_packet(key("m" + std::to_string(m)));
-            REQUIRE(p);
-            CHECK(pending_value(*p) == m + 100 * round);
+    CHECK(pump->wakes == 2);
+    int wakes = 2;
+    for (int round = 0; round < 3; ++round) {
+        for (int m = 0; m < 80; ++m) REQUIRE(ref.send_wire_packet(wire_packet_with("m" + std::to_string(m), m + 100 * round)));
+        if (round > 0) ++wakes;  // in round 0 the packets ride on the wake for "w"
+        CHECK(pump->wakes == wakes);
+        session->take_queued(sends, taken);
+        auto got = values();
+        REQUIRE(got.size() == (round == 0 ? 81u : 80u));
+        if (round == 0) {
+            CHECK(got.back() == 3);  // "w", last in key order
+            got.pop_back();
         }
-        for (int m = 0; m < 80; ++m) REQUIRE(ref.send_wire_packet(wire_packet_with("m" + std::to_string(m), m + 100)));
+        std::sort(got.begin(), got.end());
+        for (int m = 0; m < 80; ++m) CHECK(got[m] == m + 100 * round);
+        REQUIRE(ref.send_wire_packet(wire_packet_with("w", 4)));
+        CHECK(pump->wakes == ++wakes);
+        session->take_queued(sends, taken);
+        CHECK(values() == std::vector<std::int32_t>{4});
     }
-    CHECK(pump->held.size() == 82 + 80 * 2);
-    taken = session->take_wire_packet(key("w"));
-    REQUIRE(taken);
-    CHECK(pending_value(*taken) == 3);
+}
+
+TEST_CASE("shared entries from another thread are queued in order with one wake, on the strand sent at once") {
+    auto pump = std::make_shared<KeepingPump>();
+    auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
+    const SessionRef ref(session);
+    const auto event = [](std::int32_t v) {
+        auto e = request(MessageEntryType::EventReq, "ev");
+        e.elements.push_back(make_scalar_element<std::int32_t>("value", v));
+        return std::make_shared<const EncodedEntry>(std::move(e));
+    };
+    std::vector<std::shared_ptr<const EncodedEntry>> sends;
+    std::vector<ServerSession::PendingWire> wires;
+
+    // On the strand (or when the pump cannot tell): a dispatch per entry, as a reply's order needs.
+    REQUIRE(ref.send(event(1)));
+    CHECK(pump->held.size() == 1);
+    CHECK(pump->wakes == 0);
+
+    pump->off_strand = true;
+    REQUIRE(ref.send(event(2)));
+    REQUIRE(ref.send_wire_packet(wire_packet_with("w", 5)));
+    REQUIRE(ref.send(event(3)));
+    CHECK(pump->wakes == 1);  // one wake for the events and the wire packet
+    CHECK(pump->held.size() == 1);
+    session->take_queued(sends, wires);
+    REQUIRE(sends.size() == 2);
+    CHECK(pending_value(sends[0]) == 2);
+    CHECK(pending_value(sends[1]) == 3);
+    REQUIRE(wires.size() == 1);
+    CHECK(pending_value(wires[0]) == 5);
+
+    // Entries are never coalesced, and the next one wakes again.
+    REQUIRE(ref.send(event(4)));
+    REQUIRE(ref.send(event(4)));
+    CHECK(pump->wakes == 2);
+    session->take_queued(sends, wires);
+    CHECK(sends.size() == 4);
+
+    // The send queue bound holds for queued entries too.
+    auto small = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 256);
+    Result<void> r;
+    int accepted = 0;
+    while ((r = SessionRef(small).send(event(9))) && accepted < 100) ++accepted;
+    CHECK(accepted < 100);
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::BufferLimitViolation);
 }

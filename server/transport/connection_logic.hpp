@@ -38,6 +38,8 @@ public:
     /// False while the logic has too much output queued: the pump stops reading (TCP backpressure on
     /// a peer that sends requests but does not read the replies) and resumes once output drains.
     virtual bool wants_read() const { return true; }
+    /// Work other threads queued for this logic is waiting (PumpHandle::wake).
+    virtual void on_wake() {}
     /// The socket failed or the peer closed it; called once.
     virtual void on_transport_closed(RRError error) = 0;
 };

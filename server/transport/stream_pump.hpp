@@ -13,6 +13,7 @@
 #include <boost/asio/basic_stream_socket.hpp>
 #include <boost/asio/bind_executor.hpp>
 #include <boost/asio/socket_base.hpp>
+#include <boost/asio/bind_allocator.hpp>
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
@@ -21,6 +22,7 @@
 #include <boost/asio/write.hpp>
 
 #include "server/common/caller_runs_executor.hpp"
+#include "server/common/handler_memory.hpp"
 #include "server/common/read_throttle.hpp"
 #include "server/transport/connection_logic.hpp"
 
@@ -48,6 +50,14 @@ public:
     virtual void post(std::function<void()> fn) = 0;
     /// Like post(), but runs `fn` at once when already on the strand.
     virtual void dispatch(std::function<void()> fn) = 0;
+    /// Calls the logic's on_wake() on the strand (at once when already on it), then flushes: the
+    /// per-value hand-off of a fan-out (a wire value or event for one client session) without a
+    /// std::function, its operation in the pump's own HandlerMemory. The caller keeps what it hands
+    /// over and wakes once until on_wake() takes it; once the pump has closed, the wake is dropped.
+    virtual void wake() = 0;
+    /// True when the calling thread is known not to be running the pump's strand (a wake from it
+    /// cannot run at once). False on the strand, and when the strand cannot tell.
+    virtual bool known_off_strand() const { return false; }
     /// Closes the transport (after flushing what is pending).
     virtual void close() = 0;
 };
@@ -124,6 +134,29 @@ public:
         });
     }
 
+    void wake() override {
+        auto on_wake = [self = this->shared_from_this()] {
+            if (self->closed_) return;
+            self->logic_->on_wake();
+            self->after_work();
+        };
+        // The concrete strand when there is one, as for reads: no type-erased function wrapper, and
+        // the operation in the pump's own memory.
+        std::visit([&](const auto& strand) { asio::dispatch(strand, asio::bind_allocator(allocator(), std::move(on_wake))); },
+                   read_strand_);
+    }
+
+    bool known_off_strand() const override {
+        return std::visit(
+            [](const auto& strand) {
+                if constexpr (std::is_same_v<std::decay_t<decltype(strand)>, Strand>)
+                    return false;  // type-erased: cannot tell
+                else
+                    return !strand.running_in_this_thread();
+            },
+            read_strand_);
+    }
+
     void close() override {
         auto self = this->shared_from_this();
         asio::post(strand_, [self] {
@@ -161,7 +194,8 @@ private:
         // it without the type-erased executor's copies and indirect calls (issue 14, bench/profile.sh).
         std::visit(
             [&](const auto& strand) {
-                stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand, std::move(on_read)));
+                stream_.async_read_some(asio::buffer(buffer_),
+                                        asio::bind_allocator(allocator(), asio::bind_executor(strand, std::move(on_read))));
             },
             read_strand_);
     }
@@ -218,7 +252,7 @@ private:
         writing_ = true;
         auto self = this->shared_from_this();
         asio::async_write(stream_, asio::buffer(write_buffer_.data() + written, write_buffer_.size() - written),
-                          asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t) {
+                          asio::bind_allocator(allocator(), asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t) {
                               self->writing_ = false;
                               self->write_buffer_.clear();
                               if (self->closed_) return;
@@ -227,7 +261,7 @@ private:
                                   return;
                               }
                               self->after_work();
-                          }));
+                          })));
     }
 
     void arm_timer() {
@@ -279,6 +313,13 @@ private:
         }
     }
 
+    HandlerAllocator<void> allocator() const noexcept { return HandlerAllocator<void>(handler_memory_.get()); }
+
+    struct ReleaseMemory {
+        void operator()(HandlerMemory* m) const noexcept { m->release(); }
+    };
+    // First member: released last, after the stream's destructor has destroyed what it still held.
+    std::unique_ptr<HandlerMemory, ReleaseMemory> handler_memory_{HandlerMemory::make()};
     Stream stream_;
     Strand strand_;
     ReadStrand read_strand_{strand_};
