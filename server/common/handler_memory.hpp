@@ -1,5 +1,5 @@
-// HandlerMemory: where Asio allocates the operations of one connection (its pump's read, write and
-// wake, and the strand hand-offs of their completions) instead of the heap. Asio's own recycling cache
+// HandlerMemory: where Asio allocates the operations of one connection (its pump's write and wake,
+// and the strand hand-offs of their completions) instead of the heap. Asio's own recycling cache
 // is per thread, and a connection's operations are often made on one thread and freed on another (a
 // value fanned out by the device's strand to each client's strand), so that cache misses on every one
 // of them (issue 14, bench/profile.sh's raw RR fan-out). Here a connection has a few blocks, each kept
@@ -39,7 +39,8 @@ public:
     /// Blocks made or replaced (a slot's first use, or a larger request), since construction.
     std::uint64_t block_allocations() const noexcept { return blocks_made_.load(std::memory_order_relaxed); }
 
-    /// Slots: a pump has up to a read, a write and a wake pending, each with a strand hand-off.
+    /// Slots: a pump has up to a write and a wake pending, each with a strand hand-off, and more for
+    /// other users.
     static constexpr std::size_t kSlots = 6;
 
 private:
