@@ -33,7 +33,7 @@ namespace {
 
 using rr::testing::eventually;
 
-void write_file(const std::string& path, const std::string& text) {
+void write_entry_file(const std::string& path, const std::string& text) {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
     f << text;
@@ -167,17 +167,17 @@ TEST_CASE("local discovery: only entries a running process holds count, malforme
     const auto live = NodeID::parse("{11111111-2222-4333-8444-555555555555}").value();
     const auto stale = NodeID::parse("{21111111-2222-4333-8444-555555555555}").value();
     const std::string live_info = by_nodeid_file(dir, live, "info");
-    write_file(live_info, info_text(live, "", user, "NonceA"));
-    write_file(by_nodeid_file(dir, stale, "info"), info_text(stale, "stale.node", user, "NonceB"));  // nobody holds it
-    write_file(dir + "/by-nodeid/garbage.info", "no keys here\n");
-    write_file(dir + "/by-nodeid/noid.info", "username: " + user + "\n");
-    write_file(dir + "/by-nodeid/badid.info", "nodeid: {nope}\nusername: " + user + "\n");
-    write_file(dir + "/by-nodeid/huge.info", std::string(kMaxEntryFileSize + 10, 'x'));
-    write_file(dir + "/by-nodeid/" + live.to_string() + ".pid", "99999");  // not an .info: ignored
+    write_entry_file(live_info, info_text(live, "", user, "NonceA"));
+    write_entry_file(by_nodeid_file(dir, stale, "info"), info_text(stale, "stale.node", user, "NonceB"));  // nobody holds it
+    write_entry_file(dir + "/by-nodeid/garbage.info", "no keys here\n");
+    write_entry_file(dir + "/by-nodeid/noid.info", "username: " + user + "\n");
+    write_entry_file(dir + "/by-nodeid/badid.info", "nodeid: {nope}\nusername: " + user + "\n");
+    write_entry_file(dir + "/by-nodeid/huge.info", std::string(kMaxEntryFileSize + 10, 'x'));
+    write_entry_file(dir + "/by-nodeid/" + live.to_string() + ".pid", "99999");  // not an .info: ignored
     // The NodeName comes from by-nodename/<name>.info naming the NodeID (CORE), not from a file whose
     // name and content disagree.
-    write_file(dir + "/by-nodename/live.node.info", info_text(live, "live.node", user, "NonceA"));
-    write_file(dir + "/by-nodename/liar.info", info_text(live, "other.name", user, "NonceA"));
+    write_entry_file(dir + "/by-nodename/live.node.info", info_text(live, "live.node", user, "NonceA"));
+    write_entry_file(dir + "/by-nodename/liar.info", info_text(live, "other.name", user, "NonceA"));
 
     CHECK(find_local_nodes(tmp.dirs).empty());  // nobody holds any entry
     {
@@ -200,9 +200,9 @@ TEST_CASE("local discovery: public user directories give user@localhost URLs") {
     const std::string ann = tmp.dirs.system_run_dir + "/transport/local/ann";
     const std::string info = by_nodeid_file(ann, id, "info");
     const std::string wrong_user = by_nodeid_file(ann, other, "info");
-    write_file(info, info_text(id, "pub.node", "ann", "NonceP"));
-    write_file(wrong_user, info_text(other, "", "bob", "NonceQ"));  // in ann's directory but bob's: skipped
-    write_file(tmp.dirs.system_run_dir + "/transport/local/bad user/by-nodeid/x.info", "");  // not a user name
+    write_entry_file(info, info_text(id, "pub.node", "ann", "NonceP"));
+    write_entry_file(wrong_user, info_text(other, "", "bob", "NonceQ"));  // in ann's directory but bob's: skipped
+    write_entry_file(tmp.dirs.system_run_dir + "/transport/local/bad user/by-nodeid/x.info", "");  // not a user name
     LockHolder holder({info, wrong_user});
     auto found = find_local_nodes(tmp.dirs);
     REQUIRE(found.size() == 1);
