@@ -1,28 +1,46 @@
 #include "server/gateway/json_push.hpp"
 
+#include <algorithm>
+#include <charconv>
+#include <stdexcept>
+
 #include "core/value/timespec.hpp"
 #include "server/gateway/binary_push.hpp"
 
 namespace rr::server::gateway {
 
-std::string push_text(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body) {
-    std::string out;
-    out.reserve(body.size() + 64);
-    out += "{\"subscription\":";
-    out += std::to_string(sid);
-    out += ",\"kind\":\"";
-    out += kind;
-    out += '"';
+PushHead push_head(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body) {
+    if (kind.size() > PushHead::kMaxKind) throw std::length_error("push kind longer than PushHead::kMaxKind");
+    PushHead h;
+    char* out = h.bytes.data();
+    char* const end = out + h.bytes.size();
+    auto put = [&](std::string_view s) { out = std::copy(s.begin(), s.end(), out); };
+    put("{\"subscription\":");
+    out = std::to_chars(out, end, sid).ptr;
+    put(",\"kind\":\"");
+    put(kind);
+    put("\"");
     if (dropped) {
-        out += ",\"dropped\":";
-        out += std::to_string(dropped);
+        put(",\"dropped\":");
+        out = std::to_chars(out, end, dropped).ptr;
     }
     if (body.size() > 2) {
-        out += ',';
-        out += body.substr(1);  // the members and the closing brace
+        put(",");
+        h.body_offset = 1;  // the members and the closing brace
     } else {
-        out += '}';
+        put("}");
+        h.body_offset = body.size();
     }
+    h.size = static_cast<std::size_t>(out - h.bytes.data());
+    return h;
+}
+
+std::string push_text(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body) {
+    const PushHead head = push_head(sid, kind, dropped, body);
+    std::string out;
+    out.reserve(head.size + body.size());
+    out += head.text();
+    out += body.substr(head.body_offset);
     return out;
 }
 

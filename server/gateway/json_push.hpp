@@ -3,6 +3,8 @@
 // No sockets: JsonSocketSession (json_socket.cpp) sends what these return.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -12,6 +14,22 @@
 #include "server/gateway/shared_entry.hpp"
 
 namespace rr::server::gateway {
+
+/// The part of a push made per subscriber: push_text(sid, kind, dropped, body) is `text()` followed
+/// by `body` from `body_offset` on, so a socket can send the shared body as it is (JsonSocket::send_shared).
+struct PushHead {
+    static constexpr std::size_t kMaxKind = 16;
+    std::array<char, 96> bytes;  // the longest: {"subscription":<20 digits>,"kind":"<16>","dropped":<20 digits>,
+    std::size_t size = 0;
+    /// 1 (after the body's '{'), or the body's size when it has no members (the head closes the object).
+    std::size_t body_offset = 0;
+    std::string_view text() const noexcept { return {bytes.data(), size}; }
+};
+
+/// The head of {"subscription": sid, "kind": kind[, "dropped": n], …the members of `body`}, where `body`
+/// is a JSON object's text (from json_text). Throws std::length_error when `kind` is longer than
+/// PushHead::kMaxKind.
+PushHead push_head(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body);
 
 /// {"subscription": sid, "kind": kind[, "dropped": n], …the members of `body`}: `body` is a JSON
 /// object's text (from json_text), so a shared body is copied, never parsed again.

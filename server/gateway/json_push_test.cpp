@@ -2,6 +2,9 @@
 // renderings, and bodies for what the device sent wrong (refused before any conversion).
 #include <catch2/catch.hpp>
 
+#include <limits>
+#include <stdexcept>
+
 #include "core/session/elements.hpp"
 #include "core/value/timespec.hpp"
 #include "server/gateway/binary_push.hpp"
@@ -22,6 +25,28 @@ TEST_CASE("json push: a subscriber's push around a shared body") {
     CHECK(j.at("value") == 1.5);
     CHECK(j.at("time").at("nanoseconds") == 2);
     CHECK(text.find("\"dropped\"") < text.find("\"value\""));  // the push's own fields come first
+}
+
+TEST_CASE("json push: the head a socket writes before the shared body") {
+    const std::string body = R"({"value":2})";
+    auto head = push_head(7, "event", 0, body);
+    CHECK(head.text() == R"({"subscription":7,"kind":"event",)");
+    CHECK(std::string(head.text()) + body.substr(head.body_offset) == push_text(7, "event", 0, body));
+    // no members: the head closes the object and the body adds nothing
+    head = push_head(7, "wire", 0, "{}");
+    CHECK(head.text() == R"({"subscription":7,"kind":"wire"})");
+    CHECK(head.body_offset == 2);
+    // the longest head fits its buffer and stays valid JSON around the body
+    const auto max = std::numeric_limits<std::uint64_t>::max();
+    const std::string kind(PushHead::kMaxKind, 'k');
+    head = push_head(max, kind, max, body);
+    CHECK(head.size <= head.bytes.size());
+    auto j = json::parse(std::string(head.text()) + body.substr(head.body_offset));
+    CHECK(j.at("subscription") == max);
+    CHECK(j.at("dropped") == max);
+    CHECK(j.at("kind") == kind);
+    CHECK(j.at("value") == 2);
+    CHECK_THROWS_AS(push_head(1, kind + "k", 0, body), std::length_error);
 }
 
 TEST_CASE("json push: a binary rendering only when the body refers to arrays") {

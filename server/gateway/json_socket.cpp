@@ -624,6 +624,14 @@ private:
             socket_->send_binary(binary_push_head(push_text(sid, kind, dropped, r.body)), r.arrays);
     }
 
+    // A text push whose body is `e`'s rendering `body`: only the head is made per socket; the body is
+    // written from the entry's own string (kept alive by the message, not copied).
+    void send_text_push(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, const SharedEntryPtr& e,
+                        const std::string& body) {
+        const PushHead head = push_head(sid, kind, dropped, body);
+        socket_->send_shared(head.text(), std::shared_ptr<const std::string>(e, &body), head.body_offset);
+    }
+
     void on_event(std::uint64_t sid, const SharedEntryPtr& e) {
         auto ticket = take_push(sid);
         if (!ticket) return;
@@ -633,7 +641,7 @@ private:
                 return render_binary_body([&](BinaryArrays* b) { return event_push_body(*api_, entry, t, b); });
             }));
         const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_push_body(*api_, entry, t)); });
-        socket_->send(push_text(sid, "event", ticket->dropped, body));
+        send_text_push(sid, "event", ticket->dropped, e, body);
     }
 
     // Runs on the device's strand, which must not wait for a packet's JSON (a camera frame is about
@@ -713,7 +721,7 @@ private:
             }
             flushing_ = true;
         }
-        std::vector<WireToSend> batch;
+        std::vector<WireToSend>& batch = wire_batch_;  // the flusher's alone (flushing_)
         for (;;) {
             {
                 std::lock_guard lock(mutex_);
@@ -739,8 +747,9 @@ private:
                 }
                 const std::string& body =
                     w.value->rendered([&](const MessageEntry& e) { return json_text(wire_push_body(*api_, e, t)); });
-                socket_->send(push_text(w.subscription, "wire", 0, body));
+                send_text_push(w.subscription, "wire", 0, w.value, body);
             }
+            batch.clear();  // the values go now, the capacity stays
             std::lock_guard lock(mutex_);
             if (!flush_again_) {
                 flushing_ = false;
@@ -772,6 +781,7 @@ private:
     mutable std::mutex mutex_;
     boost::asio::steady_timer timer_;
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
+    std::vector<WireToSend> wire_batch_;  // flush_wires()' batch: used by the one flusher, outside mutex_
     JsonSubscriptions subs_;
     auth::PrincipalPtr principal_;  // auth: gateway — who logged this socket in
     std::map<std::string, DeviceLogin, std::less<>> device_logins_;  // by device name

@@ -15,12 +15,14 @@
 // `scheme://host[:port]` prefix, `scheme://` for any origin of that scheme, `scheme://*.domain`.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -67,6 +69,14 @@ public:
         head.append(*tail);
         send_binary(std::move(head));
     }
+    /// Queues one text message made of `head` and then `body` from `body_offset` on (at most its
+    /// size); `body` is shared, not copied (a push's body, the same for every subscriber of a value),
+    /// and `head` is copied (inline when short: no allocation). In order with send(). Thread-safe.
+    virtual void send_shared(std::string_view head, std::shared_ptr<const std::string> body, std::size_t body_offset) {
+        std::string text(head);
+        text.append(*body, std::min(body_offset, body->size()));
+        send(std::move(text));
+    }
     virtual void close() = 0;
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
@@ -96,7 +106,8 @@ struct HttpOptions {
     /// Time allowed for reading one request, ms.
     std::chrono::milliseconds read_timeout{30000};
     /// Text messages queued for one JSON WebSocket beyond this are dropped oldest-first (send() messages
-    /// before send_urgent() ones) and counted.
+    /// before send_urgent() ones) and counted. The limit holds for the socket's write queue and for the
+    /// messages sent but not yet taken by its strand, each: queued() is at most twice this.
     std::size_t json_socket_queue_limit = 1024;
     /// Peers whose X-Forwarded-For / X-Forwarded-Proto are believed (forwarded.hpp). Empty = none.
     std::vector<IpNetwork> trusted_proxies;

@@ -58,13 +58,18 @@ struct Fixture {
     std::shared_ptr<std::vector<std::string>> ws_log = std::make_shared<std::vector<std::string>>();
     std::shared_ptr<std::mutex> ws_log_mutex = std::make_shared<std::mutex>();
 
-    explicit Fixture(std::vector<std::string> trusted_proxies = {}) {
+    /// The last socket of "test.push.burst.v1".
+    std::shared_ptr<std::shared_ptr<http::JsonSocket>> burst_socket = std::make_shared<std::shared_ptr<http::JsonSocket>>();
+
+    explicit Fixture(std::vector<std::string> trusted_proxies = {},
+                     std::size_t queue_limit = http::HttpOptions{}.json_socket_queue_limit) {
         std::filesystem::create_directories(root / "sub");
         std::ofstream(root / "index.html") << "<h1>dash</h1>";
         std::ofstream(root / "sub" / "app.wasm") << "wasm";
         http::HttpOptions opts;
         opts.allowed_origins = {"http://localhost:8080", "http://*.example.org"};
         opts.static_root = root.string();
+        opts.json_socket_queue_limit = queue_limit;
         for (const auto& p : trusted_proxies) opts.trusted_proxies.push_back(*http::parse_ip_network(p));
         opts.on_websocket = [log = ws_log, m = ws_log_mutex](const std::string& line) {
             std::lock_guard lock(*m);
@@ -87,6 +92,43 @@ struct Fixture {
                                                          for (int i = 0; i < 200; ++i)
                                                              s->send("push " + std::to_string(i) + std::string(64 * 1024, ' '));
                                                          s->send_urgent("reply");
+                                                     },
+                                                     {}});
+        // "shared": a message, then pushes whose bodies are shared (a short head, a long one, an offset
+        // past the body's end), then one urgent reply.
+        server->add_subprotocol("test.push.shared.v1", http::JsonSocketHandler{
+                                                      {},
+                                                      [](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                          auto body = std::make_shared<const std::string>("{\"b\":2}");
+                                                          s->send("first");
+                                                          s->send_shared("{\"a\":1,", body, 1);
+                                                          s->send_shared(std::string(200, 'h'), body, 0);
+                                                          s->send_shared("only", body, 999);
+                                                          s->send_urgent("reply");
+                                                      },
+                                                      {}});
+        // "threads": 4 threads send 200 shared pushes each ("<thread>:<n>,…"), at once (800 are below
+        // the queue limit, though none is taken before the handler returns: it runs on the strand).
+        server->add_subprotocol("test.push.threads.v1", http::JsonSocketHandler{
+                                                       {},
+                                                       [](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                           auto body = std::make_shared<const std::string>(",shared");
+                                                           std::vector<std::thread> senders;
+                                                           for (int t = 0; t < 4; ++t)
+                                                               senders.emplace_back([s, body, t] {
+                                                                   for (int n = 0; n < 200; ++n)
+                                                                       s->send_shared(std::to_string(t) + ":" + std::to_string(n), body, 0);
+                                                               });
+                                                           for (auto& t : senders) t.join();
+                                                       },
+                                                       {}});
+        // "burst": 100 messages of 64 KiB at once ("burst <n> …"), with the socket kept for the test.
+        server->add_subprotocol("test.push.burst.v1", http::JsonSocketHandler{
+                                                     {},
+                                                     [kept = burst_socket](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                         *kept = s;
+                                                         for (int i = 0; i < 100; ++i)
+                                                             s->send("burst " + std::to_string(i) + std::string(64 * 1024, ' '));
                                                      },
                                                      {}});
         REQUIRE(node->register_service(std::make_shared<TinyService>()));
@@ -264,6 +306,98 @@ TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still wait
     // Only what was already written (socket buffers) comes first; without priority it would be last.
     REQUIRE(reply_at >= 0);
     CHECK(reply_at < 100);
+}
+
+TEST_CASE("a JSON WebSocket writes a shared body after each message's own head, in order with the rest") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    websocket::response_type res;
+    open_text_socket(ws, f.port, "test.push.shared.v1", res);
+    ws.write(boost::asio::buffer(std::string("go")));
+    std::vector<std::string> got;
+    for (int i = 0; i < 5; ++i) {
+        beast::flat_buffer b;
+        ws.read(b);
+        CHECK(ws.got_text());
+        got.push_back(beast::buffers_to_string(b.data()));
+    }
+    // One batch reaches the strand at once: the urgent reply goes ahead of what waits there.
+    const std::vector<std::string> rest{"first", R"({"a":1,"b":2})", std::string(200, 'h') + R"({"b":2})", "only"};
+    if (got.front() == "reply") {
+        CHECK(std::vector<std::string>(got.begin() + 1, got.end()) == rest);
+    } else {
+        REQUIRE(got.size() == 5);
+        CHECK(got[0] == "first");  // already being written when the reply came
+        CHECK(got[1] == "reply");
+        got.erase(got.begin() + 1);
+        CHECK(got == rest);
+    }
+}
+
+TEST_CASE("a JSON WebSocket keeps each sending thread's order and loses nothing below its limit") {
+    Fixture f;
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    websocket::response_type res;
+    open_text_socket(ws, f.port, "test.push.threads.v1", res);
+    ws.write(boost::asio::buffer(std::string("go")));
+    beast::get_lowest_layer(ws).expires_after(20s);  // a lost message fails the read, not the suite
+    std::array<int, 4> next{};
+    bool in_order = true;
+    for (int i = 0; i < 4 * 200; ++i) {
+        beast::flat_buffer b;
+        ws.read(b);
+        const std::string text = beast::buffers_to_string(b.data());
+        const auto colon = text.find(':'), comma = text.find(',');
+        REQUIRE(colon == 1);
+        REQUIRE(text.substr(comma) == ",shared");
+        const int t = text[0] - '0';
+        REQUIRE((t >= 0 && t < 4));
+        in_order = in_order && std::stoi(text.substr(2, comma - 2)) == next[t];
+        ++next[t];
+    }
+    CHECK(in_order);
+    CHECK(next == std::array<int, 4>{200, 200, 200, 200});
+}
+
+TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and counts them") {
+    Fixture f({}, 16);
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws(io);
+    websocket::response_type res;
+    open_text_socket(ws, f.port, "test.push.burst.v1", res);
+    ws.write(boost::asio::buffer(std::string("go")));
+    std::shared_ptr<http::JsonSocket> socket;
+    for (int i = 0; i < 100 && !socket; ++i) {
+        std::this_thread::sleep_for(10ms);
+        socket = *f.burst_socket;
+    }
+    REQUIRE(socket);
+    std::this_thread::sleep_for(200ms);  // the burst is queued while we do not read
+    CHECK(socket->queued() <= 2 * 16);
+    CHECK(socket->queued_bytes() <= 2 * 16 * (64 * 1024 + 16));
+    const auto dropped = socket->dropped();
+    CHECK(dropped >= 100 - 2 * 16);
+    // What is left arrives in order and ends with the newest.
+    beast::get_lowest_layer(ws).expires_after(20s);  // a lost message fails the read, not the suite
+    int last = -1, received = 0;
+    bool in_order = true;
+    while (last < 99) {
+        beast::flat_buffer b;
+        ws.read(b);
+        const std::string text = beast::buffers_to_string(b.data());
+        REQUIRE(text.rfind("burst ", 0) == 0);
+        const int n = std::stoi(text.substr(6));
+        in_order = in_order && n > last;
+        last = n;
+        ++received;
+    }
+    CHECK(in_order);
+    CHECK(received + dropped == 100u);
+    CHECK(socket->dropped() == dropped);
+    CHECK(socket->queued() == 0);
+    CHECK(socket->queued_bytes() == 0);
 }
 
 TEST_CASE("an unknown subprotocol is refused with 426") {

@@ -7,20 +7,23 @@
 #include <atomic>
 #include <algorithm>
 #include <cstring>
-#include <deque>
+#include <mutex>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <type_traits>
 #include <utility>
 
+#include <boost/asio/bind_allocator.hpp>
 #include <boost/asio/ssl/error.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/circular_buffer.hpp>
 
+#include "server/common/handler_memory.hpp"
 #include "server/common/read_throttle.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
@@ -121,6 +124,11 @@ private:
 };
 
 /// A JSON-subprotocol WebSocket session: text frames both ways, bounded outgoing queue.
+///
+/// Messages sent from any thread wait in `incoming_` (under a mutex) until the session's strand takes
+/// them, woken once per batch: a value fanned out to many sockets costs each one a queued message and
+/// at most one wake, not a closure per message. The wake and the asynchronous write live in the
+/// session's HandlerMemory (issue 14: Asio's per-thread cache missed on every cross-thread hand-off).
 template <class Stream>
 class JsonWebSocketSession : public JsonSocket, public std::enable_shared_from_this<JsonWebSocketSession<Stream>> {
 public:
@@ -128,8 +136,11 @@ public:
 
     JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
                          std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {})
-        : ws_(std::move(ws)), handler_(handler), limit_(limit), peer_(std::move(peer)), cookie_(std::move(cookie)),
-          pacer_(node, ws_.get_executor()) {}
+        : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), peer_(std::move(peer)),
+          cookie_(std::move(cookie)), pacer_(node, ws_.get_executor()) {
+        const auto executor = ws_.get_executor();
+        if (const auto* io = executor.template target<IoStrand>()) io_strand_ = *io;
+    }
 
     void start() {
         ws_.text(true);
@@ -138,11 +149,25 @@ public:
         read();
     }
 
-    void send(std::string text) override { enqueue(Outgoing{std::move(text), nullptr, false, false}); }
-    void send_urgent(std::string text) override { enqueue(Outgoing{std::move(text), nullptr, true, false}); }
-    void send_binary(std::string bytes) override { enqueue(Outgoing{std::move(bytes), nullptr, false, true}); }
+    void send(std::string text) override { enqueue(Outgoing::owned(std::move(text), false, false)); }
+    void send_urgent(std::string text) override { enqueue(Outgoing::owned(std::move(text), true, false)); }
+    void send_binary(std::string bytes) override { enqueue(Outgoing::owned(std::move(bytes), false, true)); }
     void send_binary(std::string head, std::shared_ptr<const std::string> tail) override {
-        enqueue(Outgoing{std::move(head), std::move(tail), false, true});
+        Outgoing out = Outgoing::owned(std::move(head), false, true);
+        out.tail = std::move(tail);
+        enqueue(std::move(out));
+    }
+    void send_shared(std::string_view head, std::shared_ptr<const std::string> body, std::size_t body_offset) override {
+        Outgoing out;
+        if (head.size() <= out.head.size()) {
+            std::memcpy(out.head.data(), head.data(), head.size());
+            out.head_size = static_cast<std::uint8_t>(head.size());
+        } else {
+            out.text.assign(head);
+        }
+        out.tail_offset = std::min(body_offset, body->size());
+        out.tail = std::move(body);
+        enqueue(std::move(out));
     }
 
     std::size_t queued() const override { return queued_count_.load(); }
@@ -164,45 +189,101 @@ public:
     std::string cookie_header() const override { return cookie_; }
 
 private:
+    using IoStrand = asio::strand<asio::io_context::executor_type>;
+
+    /// One message: `head` (inline, no allocation: a push's per-socket part), then `text`, then `tail`
+    /// from `tail_offset` on, shared by every socket it goes to (a push's body, a binary push's arrays:
+    /// written from one buffer for all subscribers, not copied per socket).
     struct Outgoing {
-        std::string text;
-        /// Bytes after `text` in the same message, shared by every socket it goes to (a binary push's
-        /// arrays: written from one buffer for all subscribers, not copied per socket).
-        std::shared_ptr<const std::string> tail;
+        std::array<char, 96> head;  // fits push_head()'s longest
+        std::uint8_t head_size = 0;
         bool urgent = false;
         bool binary = false;
-        std::size_t size() const noexcept { return text.size() + (tail ? tail->size() : 0); }
+        std::string text;
+        std::shared_ptr<const std::string> tail;
+        std::size_t tail_offset = 0;
+
+        static Outgoing owned(std::string text, bool urgent, bool binary) {
+            Outgoing o;
+            o.text = std::move(text);
+            o.urgent = urgent;
+            o.binary = binary;
+            return o;
+        }
+        std::size_t size() const noexcept { return head_size + text.size() + (tail ? tail->size() - tail_offset : 0); }
+        std::array<asio::const_buffer, 3> buffers() const noexcept {
+            return {asio::buffer(head.data(), head_size), asio::buffer(text),
+                    tail ? asio::buffer(tail->data() + tail_offset, tail->size() - tail_offset) : asio::const_buffer()};
+        }
     };
 
+    // Any thread. `incoming_` holds at most limit_ messages, like the queue (the same drop rule).
     void enqueue(Outgoing out) {
-        auto self = shared_from_this();
         queued_count_.fetch_add(1);
         queued_bytes_.fetch_add(out.size());
-        asio::post(ws_.get_executor(), [self, out = std::move(out)]() mutable {
-            if (self->closed_) {
-                self->unqueue(out);
-                return;
-            }
-            auto& q = self->queue_;
-            // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
-            if (q.size() >= self->limit_ && q.size() > (self->writing_ ? 1u : 0u)) {
-                auto victim = self->first_waiting_push();
-                if (victim == q.end()) victim = q.begin() + (self->writing_ ? 1 : 0);
-                self->unqueue(*victim);
-                q.erase(victim);
-                self->dropped_.fetch_add(1);
-            }
-            if (out.urgent)
-                q.insert(self->first_waiting_push(), std::move(out));
-            else
-                q.push_back(std::move(out));
-            self->write();
-        });
+        bool wake = false;
+        {
+            std::lock_guard lock(incoming_mutex_);
+            if (incoming_.size() >= limit_) drop_one(incoming_, 0);
+            incoming_.push_back(std::move(out));
+            wake = !wake_pending_;
+            wake_pending_ = true;
+        }
+        if (wake) post_wake();
     }
 
-    // The first push not being written: urgent messages go before it, behind earlier urgent ones.
-    typename std::deque<Outgoing>::iterator first_waiting_push() {
-        return std::find_if(queue_.begin() + (writing_ ? 1 : 0), queue_.end(), [](const Outgoing& o) { return !o.urgent; });
+    void post_wake() {
+        auto self = shared_from_this();
+        // Over the concrete strand when there is one: it queues the handler in the HandlerMemory, where
+        // the type-erased executor would wrap it in a function object from Asio's per-thread cache.
+        auto on_wake = asio::bind_allocator(allocator(), [self] { self->on_wake(); });
+        if (io_strand_)
+            asio::post(*io_strand_, std::move(on_wake));
+        else
+            asio::post(ws_.get_executor(), std::move(on_wake));
+    }
+
+    // On the strand: moves what arrived into the queue, then writes.
+    void on_wake() {
+        {
+            std::lock_guard lock(incoming_mutex_);
+            taken_.swap(incoming_);
+            wake_pending_ = false;
+        }
+        for (auto& out : taken_) accept(std::move(out));
+        taken_.clear();
+        write();
+    }
+
+    void accept(Outgoing out) {
+        if (closed_) {
+            unqueue(out);
+            return;
+        }
+        // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
+        const std::size_t busy = writing_ ? 1 : 0;
+        if (queue_.size() >= limit_ && queue_.size() > busy) drop_one(queue_, busy);
+        if (queue_.full()) queue_.set_capacity(std::min(std::max<std::size_t>(8, 2 * queue_.capacity()), limit_ + 1));
+        if (out.urgent)
+            queue_.insert(first_waiting_push(queue_, busy), std::move(out));
+        else
+            queue_.push_back(std::move(out));
+    }
+
+    // The first push from `skip` on: urgent messages go before it, behind earlier urgent ones.
+    template <class Queue>
+    static typename Queue::iterator first_waiting_push(Queue& q, std::size_t skip) {
+        return std::find_if(q.begin() + skip, q.end(), [](const Outgoing& o) { return !o.urgent; });
+    }
+
+    // Drops the oldest push from `skip` on (else the message at `skip`) and counts it.
+    template <class Queue>
+    void drop_one(Queue& q, std::size_t skip) {
+        auto victim = first_waiting_push(q, skip);
+        if (victim == q.end()) victim = q.begin() + skip;
+        unqueue(*victim);
+        q.erase(victim);
+        dropped_.fetch_add(1);
     }
 
     void read() {
@@ -247,9 +328,7 @@ private:
         auto self = shared_from_this();
         const Outgoing& next = queue_.front();
         ws_.binary(next.binary);  // the message type of the next write
-        const std::array<asio::const_buffer, 2> parts{asio::buffer(next.text),
-                                                      next.tail ? asio::buffer(*next.tail) : asio::const_buffer()};
-        ws_.async_write(parts, [self](beast::error_code ec, std::size_t) {
+        ws_.async_write(next.buffers(), asio::bind_allocator(allocator(), [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
             if (ec) {
                 self->finish();
@@ -262,7 +341,7 @@ private:
             self->unqueue(self->queue_.front());
             self->queue_.pop_front();
             self->write();
-        });
+        }));
     }
 
     void unqueue(const Outgoing& out) {
@@ -283,14 +362,26 @@ private:
         if (handler_->on_close) handler_->on_close(shared_from_this());
     }
 
+    HandlerAllocator<void> allocator() const noexcept { return HandlerAllocator<void>(handler_memory_.get()); }
+
+    struct ReleaseMemory {
+        void operator()(HandlerMemory* m) const noexcept { m->release(); }
+    };
+    // First member: released last, after the stream's destructor has destroyed what it still held.
+    std::unique_ptr<HandlerMemory, ReleaseMemory> handler_memory_{HandlerMemory::make()};
     websocket::stream<Stream> ws_;
+    std::optional<IoStrand> io_strand_;  // the socket's strand, when it is one over an io_context
     const JsonSocketHandler* handler_;
     std::size_t limit_;
     std::string peer_;
     std::shared_ptr<const void> hold_;
     std::string cookie_;
     beast::flat_buffer buffer_;
-    std::deque<Outgoing> queue_;  // front: being written while writing_
+    std::mutex incoming_mutex_;
+    std::vector<Outgoing> incoming_;  // sent, not yet taken by the strand; under incoming_mutex_
+    bool wake_pending_ = false;       // under incoming_mutex_
+    std::vector<Outgoing> taken_;     // the strand's: what the last wake took (its capacity is kept)
+    boost::circular_buffer<Outgoing> queue_;  // front: being written while writing_; grows to limit_ + 1
     std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
     std::atomic<std::uint64_t> dropped_{0};
     ReadPacer pacer_;
