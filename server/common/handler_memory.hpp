@@ -39,8 +39,8 @@ public:
     /// Blocks made or replaced (a slot's first use, or a larger request), since construction.
     std::uint64_t block_allocations() const noexcept { return blocks_made_.load(std::memory_order_relaxed); }
 
-    /// Slots: a pump has up to a write and a wake pending, each with a strand hand-off, and more for
-    /// other users.
+    /// Slots: a pump has up to a write and a wake pending, each with a strand hand-off, and usually a
+    /// post or dispatch or two (more of those at once take the heap).
     static constexpr std::size_t kSlots = 6;
 
 private:
