@@ -58,8 +58,20 @@ struct Fixture {
     std::shared_ptr<std::vector<std::string>> ws_log = std::make_shared<std::vector<std::string>>();
     std::shared_ptr<std::mutex> ws_log_mutex = std::make_shared<std::mutex>();
 
-    /// The last socket of "test.push.burst.v1".
-    std::shared_ptr<std::shared_ptr<http::JsonSocket>> burst_socket = std::make_shared<std::shared_ptr<http::JsonSocket>>();
+    /// The last socket of "test.push.burst.v1" (set on the socket's strand, read by the test).
+    struct SocketSlot {
+        std::mutex mutex;
+        std::shared_ptr<http::JsonSocket> socket;
+        void set(std::shared_ptr<http::JsonSocket> s) {
+            std::lock_guard lock(mutex);
+            socket = std::move(s);
+        }
+        std::shared_ptr<http::JsonSocket> get() {
+            std::lock_guard lock(mutex);
+            return socket;
+        }
+    };
+    std::shared_ptr<SocketSlot> burst_socket = std::make_shared<SocketSlot>();
 
     explicit Fixture(std::vector<std::string> trusted_proxies = {},
                      std::size_t queue_limit = http::HttpOptions{}.json_socket_queue_limit) {
@@ -126,7 +138,7 @@ struct Fixture {
         server->add_subprotocol("test.push.burst.v1", http::JsonSocketHandler{
                                                      {},
                                                      [kept = burst_socket](const std::shared_ptr<http::JsonSocket>& s, std::string) {
-                                                         *kept = s;
+                                                         kept->set(s);
                                                          for (int i = 0; i < 100; ++i)
                                                              s->send("burst " + std::to_string(i) + std::string(64 * 1024, ' '));
                                                      },
@@ -217,6 +229,24 @@ void open_text_socket(websocket::stream<beast::tcp_stream>& ws, std::uint16_t po
     ws.text(true);
 }
 
+/// A client of one of the fixture's JSON subprotocols that has sent its first message.
+struct SubprotocolClient {
+    boost::asio::io_context io;
+    websocket::stream<beast::tcp_stream> ws{io};
+
+    SubprotocolClient(std::uint16_t port, const char* subprotocol, const std::string& first) {
+        websocket::response_type res;
+        open_text_socket(ws, port, subprotocol, res);
+        ws.write(boost::asio::buffer(first));
+    }
+    /// The next message's text.
+    std::string read() {
+        beast::flat_buffer b;
+        ws.read(b);
+        return beast::buffers_to_string(b.data());
+    }
+};
+
 }  // namespace
 
 TEST_CASE("a JSON subprotocol WebSocket is served by its handler") {
@@ -279,18 +309,12 @@ TEST_CASE("X-Forwarded-For/-Proto are believed from a trusted proxy only") {
 
 TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still waiting") {
     Fixture f;
-    boost::asio::io_context io;
-    websocket::stream<beast::tcp_stream> ws(io);
-    websocket::response_type res;
-    open_text_socket(ws, f.port, "test.flood.v1", res);
-    ws.write(boost::asio::buffer(std::string("flood")));
+    SubprotocolClient client(f.port, "test.flood.v1", "flood");
     std::this_thread::sleep_for(300ms);  // the 13 MB backlog builds up while we do not read
     int reply_at = -1, pushes = 0, last_push = -1;
     bool in_order = true;
     for (int i = 0; i < 201; ++i) {
-        beast::flat_buffer b;
-        ws.read(b);
-        const std::string text = beast::buffers_to_string(b.data());
+        const std::string text = client.read();
         if (text == "reply") {
             reply_at = i;
             continue;
@@ -310,17 +334,11 @@ TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still wait
 
 TEST_CASE("a JSON WebSocket writes a shared body after each message's own head, in order with the rest") {
     Fixture f;
-    boost::asio::io_context io;
-    websocket::stream<beast::tcp_stream> ws(io);
-    websocket::response_type res;
-    open_text_socket(ws, f.port, "test.push.shared.v1", res);
-    ws.write(boost::asio::buffer(std::string("go")));
+    SubprotocolClient client(f.port, "test.push.shared.v1", "go");
     std::vector<std::string> got;
     for (int i = 0; i < 5; ++i) {
-        beast::flat_buffer b;
-        ws.read(b);
-        CHECK(ws.got_text());
-        got.push_back(beast::buffers_to_string(b.data()));
+        got.push_back(client.read());
+        CHECK(client.ws.got_text());
     }
     // One batch reaches the strand at once: the urgent reply goes ahead of what waits there.
     const std::vector<std::string> rest{"first", R"({"a":1,"b":2})", std::string(200, 'h') + R"({"b":2})", "only"};
@@ -337,18 +355,12 @@ TEST_CASE("a JSON WebSocket writes a shared body after each message's own head, 
 
 TEST_CASE("a JSON WebSocket keeps each sending thread's order and loses nothing below its limit") {
     Fixture f;
-    boost::asio::io_context io;
-    websocket::stream<beast::tcp_stream> ws(io);
-    websocket::response_type res;
-    open_text_socket(ws, f.port, "test.push.threads.v1", res);
-    ws.write(boost::asio::buffer(std::string("go")));
-    beast::get_lowest_layer(ws).expires_after(20s);  // a lost message fails the read, not the suite
+    SubprotocolClient client(f.port, "test.push.threads.v1", "go");
+    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
     std::array<int, 4> next{};
     bool in_order = true;
     for (int i = 0; i < 4 * 200; ++i) {
-        beast::flat_buffer b;
-        ws.read(b);
-        const std::string text = beast::buffers_to_string(b.data());
+        const std::string text = client.read();
         const auto colon = text.find(':'), comma = text.find(',');
         REQUIRE(colon == 1);
         REQUIRE(text.substr(comma) == ",shared");
@@ -363,15 +375,11 @@ TEST_CASE("a JSON WebSocket keeps each sending thread's order and loses nothing 
 
 TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and counts them") {
     Fixture f({}, 16);
-    boost::asio::io_context io;
-    websocket::stream<beast::tcp_stream> ws(io);
-    websocket::response_type res;
-    open_text_socket(ws, f.port, "test.push.burst.v1", res);
-    ws.write(boost::asio::buffer(std::string("go")));
+    SubprotocolClient client(f.port, "test.push.burst.v1", "go");
     std::shared_ptr<http::JsonSocket> socket;
     for (int i = 0; i < 100 && !socket; ++i) {
         std::this_thread::sleep_for(10ms);
-        socket = *f.burst_socket;
+        socket = f.burst_socket->get();
     }
     REQUIRE(socket);
     std::this_thread::sleep_for(200ms);  // the burst is queued while we do not read
@@ -380,13 +388,11 @@ TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and 
     const auto dropped = socket->dropped();
     CHECK(dropped >= 100 - 2 * 16);
     // What is left arrives in order and ends with the newest.
-    beast::get_lowest_layer(ws).expires_after(20s);  // a lost message fails the read, not the suite
+    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
     int last = -1, received = 0;
     bool in_order = true;
     while (last < 99) {
-        beast::flat_buffer b;
-        ws.read(b);
-        const std::string text = beast::buffers_to_string(b.data());
+        const std::string text = client.read();
         REQUIRE(text.rfind("burst ", 0) == 0);
         const int n = std::stoi(text.substr(6));
         in_order = in_order && n > last;
