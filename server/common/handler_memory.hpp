@@ -1,10 +1,11 @@
-// HandlerMemory: where Asio allocates the operations of one connection (its pump's write and wake,
-// and the strand hand-offs of their completions) instead of the heap. Asio's own recycling cache
-// is per thread, and a connection's operations are often made on one thread and freed on another (a
-// value fanned out by the device's strand to each client's strand), so that cache misses on every one
-// of them (issue 14, bench/profile.sh's raw RR fan-out). Here a connection has a few blocks, each kept
-// after its first use and handed out again while free and large enough; requests beyond them go to
-// the heap. Used through HandlerAllocator with asio::bind_allocator.
+// HandlerMemory: where Asio allocates the operations of one connection (its pump's post, dispatch,
+// wake and write, a JSON WebSocket's wake and write, and the strand hand-offs of their completions)
+// instead of the heap. Asio's own recycling cache is per thread, and a connection's operations are
+// often made on one thread and freed on another (a value fanned out by the device's strand to each
+// client's strand), so that cache misses on every one of them (issue 14, bench/profile.sh's raw RR
+// fan-out). Here a connection has a few blocks, each kept after its first use and handed out again
+// while free and large enough; requests beyond them go to the heap. Used through HandlerAllocator
+// with asio::bind_allocator.
 #pragma once
 
 #include <array>
@@ -85,6 +86,22 @@ public:
     HandlerMemory* memory() const noexcept { return memory_; }
     template <class U>
     bool operator==(const HandlerAllocator<U>& other) const noexcept { return memory_ == other.memory(); }
+
+private:
+    HandlerMemory* memory_;
+};
+
+/// A connection's own HandlerMemory: gives the owner's reference back when destroyed. Make it the
+/// connection's first member, so it goes last, after the stream has destroyed what it still held.
+class ConnectionHandlerMemory {
+public:
+    ConnectionHandlerMemory() : memory_(HandlerMemory::make()) {}
+    ~ConnectionHandlerMemory() { memory_->release(); }
+    ConnectionHandlerMemory(const ConnectionHandlerMemory&) = delete;
+    ConnectionHandlerMemory& operator=(const ConnectionHandlerMemory&) = delete;
+
+    /// For asio::bind_allocator on the connection's operations.
+    HandlerAllocator<void> allocator() const noexcept { return HandlerAllocator<void>(memory_); }
 
 private:
     HandlerMemory* memory_;

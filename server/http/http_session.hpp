@@ -362,13 +362,9 @@ private:
         if (handler_->on_close) handler_->on_close(shared_from_this());
     }
 
-    HandlerAllocator<void> allocator() const noexcept { return HandlerAllocator<void>(handler_memory_.get()); }
+    HandlerAllocator<void> allocator() const noexcept { return handler_memory_.allocator(); }
 
-    struct ReleaseMemory {
-        void operator()(HandlerMemory* m) const noexcept { m->release(); }
-    };
-    // First member: released last, after the stream's destructor has destroyed what it still held.
-    std::unique_ptr<HandlerMemory, ReleaseMemory> handler_memory_{HandlerMemory::make()};
+    ConnectionHandlerMemory handler_memory_;  // first member: see ConnectionHandlerMemory
     websocket::stream<Stream> ws_;
     std::optional<IoStrand> io_strand_;  // the socket's strand, when it is one over an io_context
     const JsonSocketHandler* handler_;
