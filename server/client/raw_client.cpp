@@ -5,7 +5,6 @@
 #include "core/session/request_map.hpp"
 #include "server/common/connection_strand.hpp"
 #include "server/common/random_ids.hpp"
-#include "server/transport/completion_guard.hpp"
 
 namespace rr::server {
 
@@ -32,8 +31,42 @@ public:
     }
     bool wants_close() const override { return session_.is_closed(); }
     void on_transport_closed(RRError error) override {
+        fail_queued();
         session_.on_transport_closed(std::move(error));
         dispatch();
+    }
+    void on_wake() override {
+        {
+            std::lock_guard lock(queue_mutex_);
+            outbox_taken_.swap(outbox_);
+            wake_pending_ = false;
+        }
+        for (auto& q : outbox_taken_) {
+            if (q.is_request)
+                request(std::move(q.entry), q.timeout.count() < 0 ? request_timeout_ : q.timeout, std::move(q.done));
+            else
+                send(std::move(q.entry));
+        }
+        outbox_taken_.clear();  // keeps its capacity: no allocation per wake
+    }
+
+    ~Logic() override { fail_queued(); }
+
+    /// From any thread: `entry` goes out on the strand, after what was queued before it, with one wake
+    /// of the pump for all that waits (no closure per entry). A request queued once the transport has
+    /// closed gets ConnectionError at once.
+    void queue(PumpHandle& pump, MessageEntry&& entry, bool is_request, std::chrono::milliseconds timeout, ReplyHandler done) {
+        bool wake = false;
+        {
+            std::lock_guard lock(queue_mutex_);
+            if (!closed_) {
+                outbox_.emplace_back(std::move(entry), is_request, timeout, std::move(done));
+                wake = !std::exchange(wake_pending_, true);
+                done = nullptr;
+            }
+        }
+        if (wake) pump.wake();
+        if (is_request && done) done(fail(MessageErrorType::ConnectionError, "client connection closed"));
     }
 
     void request(MessageEntry&& entry, std::chrono::milliseconds timeout, ReplyHandler done) {
@@ -62,6 +95,28 @@ public:
     std::chrono::milliseconds request_timeout_{15000};
 
 private:
+    struct Queued {
+        Queued(MessageEntry&& e, bool request, std::chrono::milliseconds t, ReplyHandler d)
+            : entry(std::move(e)), is_request(request), timeout(t), done(std::move(d)) {}
+        MessageEntry entry;
+        bool is_request = false;
+        std::chrono::milliseconds timeout{-1};  // < 0: the client's default
+        ReplyHandler done;                      // requests only
+    };
+
+    // What the transport's end leaves queued (its wake is dropped once the pump has closed) is
+    // answered ConnectionError, and nothing is queued after it.
+    void fail_queued() {
+        std::vector<Queued> left;
+        {
+            std::lock_guard lock(queue_mutex_);
+            closed_ = true;
+            left.swap(outbox_);
+        }
+        for (auto& q : left)
+            if (q.is_request && q.done) q.done(fail(MessageErrorType::ConnectionError, "client connection closed"));
+    }
+
     void dispatch() {
         while (auto ev = session_.poll_event()) {
             if (auto* c = std::get_if<ClientSessionConnected>(&*ev)) {
@@ -95,6 +150,11 @@ private:
 
     ClientSession session_;
     RequestMap<ReplyHandler> replies_;
+    std::mutex queue_mutex_;
+    std::vector<Queued> outbox_;        // guarded by queue_mutex_
+    bool wake_pending_ = false;         // guarded by queue_mutex_: a wake is on its way for outbox_
+    bool closed_ = false;               // guarded by queue_mutex_: the transport has closed
+    std::vector<Queued> outbox_taken_;  // on_wake's, kept for its capacity
 };
 
 void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url, RawClientOptions options,
@@ -150,28 +210,26 @@ void RawClient::connect(asio::any_io_executor executor, const ConnectionUrl& url
 }
 
 void RawClient::request(MessageEntry entry, ReplyHandler done) {
-    request(std::move(entry), std::chrono::milliseconds(-1), std::move(done));
+    queue_request(std::move(entry), std::chrono::milliseconds(-1), std::move(done));
 }
 
 void RawClient::request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done) {
+    queue_request(std::move(entry), timeout, std::move(done));
+}
+
+void RawClient::queue_request(MessageEntry&& entry, std::chrono::milliseconds timeout, ReplyHandler&& done) {
     auto pump = pump_.lock();
     if (!pump || !open_.load()) {
         done(fail(MessageErrorType::ConnectionError, "client connection closed"));
         return;
     }
-    auto logic = logic_;
-    auto guard = std::make_shared<CompletionGuard<MessageEntry>>(std::move(done));
-    pump->dispatch([logic, entry = std::move(entry), timeout, guard]() mutable {
-        auto t = timeout.count() < 0 ? logic->request_timeout_ : timeout;
-        logic->request(std::move(entry), t, guard->take());
-    });
+    logic_->queue(*pump, std::move(entry), /*is_request=*/true, timeout, std::move(done));
 }
 
 void RawClient::send(MessageEntry entry) {
     auto pump = pump_.lock();
     if (!pump) return;
-    auto logic = logic_;
-    pump->dispatch([logic, entry = std::move(entry)]() mutable { logic->send(std::move(entry)); });
+    logic_->queue(*pump, std::move(entry), /*is_request=*/false, {}, nullptr);
 }
 
 RawClient::~RawClient() { close(); }

@@ -80,6 +80,7 @@ public:
 private:
     RawClient() = default;
     friend class Logic;
+    void queue_request(MessageEntry&& entry, std::chrono::milliseconds timeout, ReplyHandler&& done);
 
     std::shared_ptr<Logic> logic_;
     std::weak_ptr<PumpHandle> pump_;

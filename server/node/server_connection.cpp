@@ -146,12 +146,31 @@ std::string ServerSession::local_url() const {
     return c ? c->local_url() : std::string();
 }
 
+// From another thread (a fan-out, a worker's reply or event): queued in order with the pump's one
+// wake, no closure per entry. A wake already on its way takes it; it still precedes any later post
+// from this thread. Every send of another thread takes this way when the pump can tell (a concrete
+// strand), and none when it cannot, so sends and replies keep their order either way.
+template <class T, class Arg>
+void ServerSession::queue_send(PumpHandle& pump, std::in_place_type_t<T> kind, Arg&& arg) {
+    bool wake = false;
+    {
+        std::lock_guard lock(mutex_);
+        send_pending_.emplace_back(kind, std::forward<Arg>(arg));
+        wake = !std::exchange(wake_pending_, true);
+    }
+    if (wake) pump.wake();
+}
+
 Result<void> ServerSession::send(MessageEntry entry) {
     auto pump = pump_.lock();
     if (!pump || !alive()) return fail(MessageErrorType::ConnectionError, "client session closed");
     const std::size_t size = estimate_size(entry);
     if (queued_.load() + size > max_queue_) return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
     queued_.fetch_add(size);
+    if (pump->known_off_strand()) {
+        queue_send(*pump, std::in_place_type<MessageEntry>, std::move(entry));
+        return {};
+    }
     // dispatch: on the session's own strand (a handler sending an event or ServicePathReleased before
     // answering) the entry is queued at once, so it reaches the client before the reply.
     pump->dispatch([conn = connection_, entry = std::move(entry)]() mutable {
@@ -167,15 +186,7 @@ Result<void> ServerSession::send(std::shared_ptr<const EncodedEntry> entry) {
     if (queued_.load() + size > max_queue_) return fail(MessageErrorType::BufferLimitViolation, "client send queue full");
     queued_.fetch_add(size);
     if (pump->known_off_strand()) {
-        // From another thread (a fan-out): queued in order with the pump's one wake, no closure per
-        // entry. A wake already on its way takes it; it still precedes any later post from this thread.
-        bool wake = false;
-        {
-            std::lock_guard lock(mutex_);
-            shared_pending_.push_back(std::move(entry));
-            wake = !std::exchange(wake_pending_, true);
-        }
-        if (wake) pump->wake();
+        queue_send(*pump, std::in_place_type<std::shared_ptr<const EncodedEntry>>, std::move(entry));
         return {};
     }
     // On the session's own strand: queued at once, before the reply of the handler that sends it.
@@ -183,6 +194,12 @@ Result<void> ServerSession::send(std::shared_ptr<const EncodedEntry> entry) {
         if (auto c = conn.lock()) c->send_session_entry(*entry);
     });
     return {};
+}
+
+void ServerSession::queue_reply(MessageEntry&& reply) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) return;  // the session or its connection is gone: nobody to answer
+    queue_send(*pump, std::in_place_type<PendingReply>, std::move(reply));
 }
 
 Result<void> ServerSession::send_wire_packet(MessageEntry entry) {
@@ -212,14 +229,14 @@ Result<void> ServerSession::queue_wire_packet(std::pair<std::string, std::string
     return {};
 }
 
-void ServerSession::take_queued(std::vector<std::shared_ptr<const EncodedEntry>>& sends, std::vector<PendingWire>& wires) {
+void ServerSession::take_queued(std::vector<PendingSend>& sends, std::vector<PendingWire>& wires) {
     std::lock_guard lock(mutex_);
     wake_pending_ = false;
     if (sends.empty()) {
-        sends.swap(shared_pending_);  // both keep their capacity: no allocation per wake
+        sends.swap(send_pending_);  // both keep their capacity: no allocation per wake
     } else {
-        for (auto& e : shared_pending_) sends.push_back(std::move(e));
-        shared_pending_.clear();
+        for (auto& e : send_pending_) sends.push_back(std::move(e));
+        send_pending_.clear();
     }
     for (auto it = wire_pending_.begin(); it != wire_pending_.end();) {
         if (it->second) {
@@ -316,6 +333,7 @@ void ServerConnection::handle_event(ServiceSessionEvent& event) {
         auto service = std::static_pointer_cast<Service>(opened->service);
         current_ = std::make_shared<ServerSession>(opened->endpoint, opened->client_endpoint, service, pump_,
                                                    weak_from_this(), config_.max_send_queue_bytes);
+        reply_sink_.reset();  // the next request makes this session's
         current_->set_username(opened->username);
         service->on_session_open(SessionRef(current_));
     } else if (auto* admission = std::get_if<ServiceAdmission>(&event)) {
@@ -336,6 +354,7 @@ void ServerConnection::handle_event(ServiceSessionEvent& event) {
         if (!current_) return;
         auto s = std::move(current_);
         current_.reset();
+        reply_sink_.reset();
         s->mark_closed();
         s->service()->on_session_close(SessionRef(s));
     }
@@ -392,11 +411,12 @@ void ServerConnection::on_object_type_query(ServiceObjectTypeQuery&& query) {
     });
 }
 
-/// One per connection, shared by its Responders (no allocation per request).
+/// One per client session, shared by its Responders (no allocation per request).
 class ServerConnection::ConnectionReplySink final : public ReplySink {
 public:
-    ConnectionReplySink(ServerConnection& owner, std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump)
-        : owner_(&owner), connection_(std::move(connection)), pump_(std::move(pump)) {}
+    ConnectionReplySink(ServerConnection& owner, std::weak_ptr<ServerConnection> connection, std::weak_ptr<PumpHandle> pump,
+                        std::weak_ptr<ServerSession> session)
+        : owner_(&owner), connection_(std::move(connection)), pump_(std::move(pump)), session_(std::move(session)) {}
 
     void send_reply(MessageEntry&& reply) override {
         // The responder may complete on any thread; on the strand, while the connection handles its
@@ -408,6 +428,11 @@ public:
         }
         auto p = pump_.lock();
         if (!p) return;
+        if (p->known_off_strand()) {
+            // In order with the session's other sends from other threads (ServerSession::queue_send).
+            if (auto s = session_.lock()) s->queue_reply(std::move(reply));
+            return;
+        }
         p->dispatch([weak = connection_, reply = std::move(reply)]() mutable {
             if (auto c = weak.lock()) c->reply(std::move(reply));
         });
@@ -417,10 +442,11 @@ private:
     ServerConnection* owner_;  // compared with tls_handling; used only while it handles (see send_reply)
     std::weak_ptr<ServerConnection> connection_;
     std::weak_ptr<PumpHandle> pump_;
+    std::weak_ptr<ServerSession> session_;
 };
 
 Responder ServerConnection::make_responder(const MessageEntry& request) {
-    if (!reply_sink_) reply_sink_ = std::make_shared<ConnectionReplySink>(*this, weak_from_this(), pump_);
+    if (!reply_sink_) reply_sink_ = std::make_shared<ConnectionReplySink>(*this, weak_from_this(), pump_, current_);
     return Responder(reply_sink_, request);
 }
 
@@ -430,12 +456,16 @@ void ServerConnection::reply(MessageEntry&& entry) {
 }
 
 void ServerConnection::send_session_entry(MessageEntry&& entry) {
+    send_entry(std::move(entry), mono_now());
+    drain_events();
+}
+
+void ServerConnection::send_entry(MessageEntry&& entry, MonoTime now) {
     // A reply sent through SessionRef::send keeps the reply rules (never lost: an error reply instead).
     if (!is_request(entry.entry_type) && entry.request_id != 0)
-        session_.reply(std::move(entry), mono_now());
+        session_.reply(std::move(entry), now);
     else
-        (void)session_.send(std::move(entry), mono_now());
-    drain_events();
+        (void)session_.send(std::move(entry), now);
 }
 
 void ServerConnection::send_session_entry(const EncodedEntry& entry) {
@@ -447,7 +477,14 @@ void ServerConnection::on_wake() {
     if (!current_) return;
     current_->take_queued(woken_sends_, woken_wires_);
     const auto now = mono_now();
-    for (const auto& entry : woken_sends_) (void)session_.send(*entry, now);
+    for (auto& send : woken_sends_) {
+        if (auto* shared = std::get_if<std::shared_ptr<const EncodedEntry>>(&send))
+            (void)session_.send(**shared, now);
+        else if (auto* own = std::get_if<MessageEntry>(&send))
+            send_entry(std::move(*own), now);
+        else
+            session_.reply(std::move(std::get<ServerSession::PendingReply>(send).entry), now);
+    }
     woken_sends_.clear();
     for (auto& packet : woken_wires_) {
         if (auto* own = std::get_if<MessageEntry>(&packet))

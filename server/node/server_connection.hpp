@@ -77,10 +77,22 @@ public:
 
     /// A wire packet of this session's own, or one shared by many sessions.
     using PendingWire = std::variant<MessageEntry, std::shared_ptr<const EncodedEntry>>;
-    /// Strand side: moves what other threads queued for the pump's wake into `sends` (shared entries
-    /// in the order sent) and `wires` (the newest unsent packet of every (service path, member), in
-    /// key order), both appended. What is queued after this wakes the pump again.
-    void take_queued(std::vector<std::shared_ptr<const EncodedEntry>>& sends, std::vector<PendingWire>& wires);
+    /// A reply to one of this session's requests (Responder::respond from another thread).
+    struct PendingReply {
+        explicit PendingReply(MessageEntry&& e) : entry(std::move(e)) {}
+        MessageEntry entry;
+    };
+    /// What other threads send, in the order they sent it: a shared entry, an entry of the session's
+    /// own (send), a reply.
+    using PendingSend = std::variant<std::shared_ptr<const EncodedEntry>, MessageEntry, PendingReply>;
+    /// A reply from another thread, queued in order with the session's sends for the pump's one wake
+    /// (no closure per reply). Only when the pump knows it is off its strand (known_off_strand);
+    /// otherwise the connection's reply sink dispatches it.
+    void queue_reply(MessageEntry&& reply);
+    /// Strand side: moves what other threads queued for the pump's wake into `sends` (in the order
+    /// sent) and `wires` (the newest unsent packet of every (service path, member), in key order),
+    /// both appended. What is queued after this wakes the pump again.
+    void take_queued(std::vector<PendingSend>& sends, std::vector<PendingWire>& wires);
 
 private:
     const std::uint32_t endpoint_;
@@ -93,15 +105,17 @@ private:
     std::atomic<std::size_t> queued_{0};
     mutable std::mutex mutex_;
     std::string username_;
-    // What other threads queued for the strand: shared entries in order (bounded by max_queue_), and
-    // wire packets, newest per (service path, member). A wire slot stays when its packet is taken (no
+    // What other threads queued for the strand: sends and replies in order (sends bounded by
+    // max_queue_, replies by the requests in flight), and wire packets, newest per (service path, member). A wire slot stays when its packet is taken (no
     // map node per packet), unless there are more than kKeptWireSlots. `wake_pending_`: the pump was
     // woken for them and has not taken them yet (one wake for all).
     static constexpr std::size_t kKeptWireSlots = 64;
-    std::vector<std::shared_ptr<const EncodedEntry>> shared_pending_;
+    std::vector<PendingSend> send_pending_;
     std::map<std::pair<std::string, std::string>, std::optional<PendingWire>> wire_pending_;
     bool wake_pending_ = false;
     Result<void> queue_wire_packet(std::pair<std::string, std::string> key, PendingWire packet);
+    template <class T, class Arg>
+    void queue_send(PumpHandle& pump, std::in_place_type_t<T> kind, Arg&& arg);  // built in place: no move
 };
 
 class ServerConnection : public ConnectionLogic, public std::enable_shared_from_this<ServerConnection> {
@@ -122,8 +136,8 @@ public:
     void on_timer(MonoTime now) override;
     bool wants_close() const override { return session_.is_closed(); }
     bool wants_read() const override { return session_.pending_output_size() < config_.read_pause_bytes; }
-    /// Sends what the client session queued from other threads (ServerSession::send of a shared
-    /// entry, send_wire_packet).
+    /// Sends what the client session queued from other threads (ServerSession::send,
+    /// send_wire_packet, queue_reply).
     void on_wake() override;
     void on_transport_closed(RRError error) override;
 
@@ -141,6 +155,7 @@ private:
     void on_object_type_query(ServiceObjectTypeQuery&& query);
     Responder make_responder(const MessageEntry& request);
     void update_queue_estimate();
+    void send_entry(MessageEntry&& entry, MonoTime now);  // send_session_entry without drain_events
     class ConnectionReplySink;
 
     std::shared_ptr<ServiceRegistry> services_;
@@ -149,13 +164,13 @@ private:
     std::string local_url_;
     ServiceSession session_;
     std::weak_ptr<PumpHandle> pump_;
-    std::shared_ptr<ReplySink> reply_sink_;    // made on the first request (needs weak_from_this)
+    std::shared_ptr<ReplySink> reply_sink_;    // the open session's; made on its first request
     std::shared_ptr<ServerSession> current_;  // the open client session's handle, if any
     std::map<std::uint32_t, std::function<void(Result<MessageEntry>)>> callbacks_;
     std::uint64_t messages_in_seen_ = 0, messages_out_seen_ = 0;
     std::vector<ServiceSessionEvent> batch_;  // drain_events' (only the outermost call uses it)
     // on_wake's, kept for their capacity.
-    std::vector<std::shared_ptr<const EncodedEntry>> woken_sends_;
+    std::vector<ServerSession::PendingSend> woken_sends_;
     std::vector<ServerSession::PendingWire> woken_wires_;
     bool draining_ = false;
 };

@@ -422,6 +422,120 @@ TEST_CASE("replies completed on another thread after the client has gone are dro
     CHECK(sum == 9);
 }
 
+namespace {
+// Answers `add` on its own thread, with an event `changed` (v = the sum) sent just before the reply
+// when `a` is even and just after it when odd: the order a client must see them in.
+class EventAndReplyService final : public RawTestService {
+public:
+    EventAndReplyService() : worker_([this] { run(); }) {}
+    ~EventAndReplyService() override {
+        {
+            std::lock_guard lock(mutex_);
+            stopping_ = true;
+            wake_.notify_all();
+        }
+        worker_.join();
+    }
+
+    void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
+        std::int32_t a = 0, b = 0;
+        const auto* ea = e.find("a");
+        const auto* eb = e.find("b");
+        if (e.entry_type != MessageEntryType::FunctionCallReq || e.member_name != "add" || !ea || !eb ||
+            !read_scalar(*ea, a) || !read_scalar(*eb, b))
+            return RawTestService::handle_entry(session, std::move(e), std::move(responder));
+        std::lock_guard lock(mutex_);
+        work_.push_back(Work{session, std::move(responder), a, b});
+        wake_.notify_all();
+    }
+
+private:
+    struct Work {
+        SessionRef session;
+        Responder responder;
+        std::int32_t a, b;
+    };
+    void run() {
+        std::unique_lock lock(mutex_);
+        for (;;) {
+            wake_.wait(lock, [&] { return stopping_ || !work_.empty(); });
+            if (work_.empty()) return;
+            auto w = std::move(work_.front());
+            work_.pop_front();
+            lock.unlock();
+            MessageEntry ev;
+            ev.entry_type = MessageEntryType::EventReq;
+            ev.service_path = "svc";
+            ev.member_name = "changed";
+            ev.elements.push_back(make_scalar_element("v", double(w.a + w.b)));
+            MessageEntry r;
+            r.elements.push_back(make_scalar_element<std::int32_t>("return", w.a + w.b));
+            if (w.a % 2 == 0) {
+                (void)w.session.send(std::move(ev));
+                w.responder.respond(std::move(r));
+            } else {
+                w.responder.respond(std::move(r));
+                (void)w.session.send(std::move(ev));
+            }
+            lock.lock();
+        }
+    }
+
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::deque<Work> work_;
+    bool stopping_ = false;
+    std::thread worker_;  // last: started once the members above exist
+};
+}  // namespace
+
+TEST_CASE("a worker thread's event and reply reach the client in the order it sent them") {
+    auto service = std::make_shared<EventAndReplyService>();
+    Fixture f(service);
+    constexpr int kCalls = 300;
+    struct Seen {
+        std::mutex mutex;
+        std::vector<std::pair<char, std::int32_t>> order;  // ('e', v) event, ('r', sum) reply
+        std::promise<void> all;
+        int replies = 0;
+    };
+    auto seen = std::make_shared<Seen>();
+    auto c = f.connect([seen](MessageEntry&& e) {
+        double v = -1;
+        if (e.entry_type == MessageEntryType::EventReq && e.find("v")) (void)read_scalar(*e.find("v"), v);
+        std::lock_guard lock(seen->mutex);
+        seen->order.emplace_back('e', static_cast<std::int32_t>(v));
+    });
+    for (int i = 0; i < kCalls; ++i) {
+        c->request(add_call(i, 1000 * i), [seen](Result<MessageEntry> r) {
+            std::int32_t sum = -1;
+            if (r && r->find("return")) (void)read_scalar(*r->find("return"), sum);
+            std::lock_guard lock(seen->mutex);
+            seen->order.emplace_back('r', sum);
+            if (++seen->replies == kCalls) seen->all.set_value();
+        });
+    }
+    REQUIRE(seen->all.get_future().wait_for(30s) == std::future_status::ready);
+    // The last call's event may follow its reply: wait for it.
+    for (int i = 0; i < 500; ++i) {
+        {
+            std::lock_guard lock(seen->mutex);
+            if (seen->order.size() == 2u * kCalls) break;
+        }
+        std::this_thread::sleep_for(10ms);
+    }
+    std::lock_guard lock(seen->mutex);
+    REQUIRE(seen->order.size() == 2u * kCalls);
+    int wrong = 0;
+    for (int i = 0; i < kCalls; ++i) {
+        const std::int32_t sum = i + 1000 * i;
+        const auto e = std::find(seen->order.begin(), seen->order.end(), std::make_pair('e', sum));
+        const auto r = std::find(seen->order.begin(), seen->order.end(), std::make_pair('r', sum));
+        if (e == seen->order.end() || r == seen->order.end() || (i % 2 == 0) != (e < r)) ++wrong;
+    }
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("a request made while the client connection closes is answered once, never lost") {
     Fixture f;
     int local_errors = 0;
@@ -490,11 +604,20 @@ MessageEntry wire_packet_with(const std::string& member, std::int32_t v) {
     return e;
 }
 
-std::int32_t pending_value(const std::shared_ptr<const EncodedEntry>& p) {
+std::int32_t value_of(const MessageEntry& e) {
     std::int32_t v = -1;
-    if (const auto* el = p->entry().find("value")) (void)read_scalar(*el, v);
+    if (const auto* el = e.find("value")) (void)read_scalar(*el, v);
     return v;
 }
+
+// What a queued send is, and its value: "shared", "own" or "reply".
+std::pair<std::string, std::int32_t> pending_send(const ServerSession::PendingSend& p) {
+    if (const auto* shared = std::get_if<std::shared_ptr<const EncodedEntry>>(&p)) return {"shared", value_of((*shared)->entry())};
+    if (const auto* own = std::get_if<MessageEntry>(&p)) return {"own", value_of(*own)};
+    return {"reply", value_of(std::get<ServerSession::PendingReply>(p).entry)};
+}
+
+std::int32_t pending_value(const ServerSession::PendingSend& p) { return pending_send(p).second; }
 
 std::int32_t pending_value(const ServerSession::PendingWire& p) {
     const MessageEntry& e = std::holds_alternative<MessageEntry>(p) ? std::get<MessageEntry>(p)
@@ -510,7 +633,7 @@ TEST_CASE("pending wire packets: one wake per session until taken, the newest pe
     auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
     const SessionRef ref(session);
     std::vector<ServerSession::PendingWire> taken;
-    std::vector<std::shared_ptr<const EncodedEntry>> sends;
+    std::vector<ServerSession::PendingSend> sends;
     const auto values = [&] {
         std::vector<std::int32_t> v;
         for (const auto& p : taken) v.push_back(pending_value(p));
@@ -553,7 +676,7 @@ TEST_CASE("pending wire packets: one wake per session until taken, the newest pe
     }
 }
 
-TEST_CASE("shared entries from another thread are queued in order with one wake, on the strand sent at once") {
+TEST_CASE("entries and replies from another thread are queued in order with one wake, on the strand sent at once") {
     auto pump = std::make_shared<KeepingPump>();
     auto session = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 1u << 20);
     const SessionRef ref(session);
@@ -562,7 +685,7 @@ TEST_CASE("shared entries from another thread are queued in order with one wake,
         e.elements.push_back(make_scalar_element<std::int32_t>("value", v));
         return std::make_shared<const EncodedEntry>(std::move(e));
     };
-    std::vector<std::shared_ptr<const EncodedEntry>> sends;
+    std::vector<ServerSession::PendingSend> sends;
     std::vector<ServerSession::PendingWire> wires;
 
     // On the strand (or when the pump cannot tell): a dispatch per entry, as a reply's order needs.
@@ -589,6 +712,32 @@ TEST_CASE("shared entries from another thread are queued in order with one wake,
     CHECK(pump->wakes == 2);
     session->take_queued(sends, wires);
     CHECK(sends.size() == 4);
+    sends.clear();
+
+    // The session's own entries and replies from other threads join the same queue, in the order sent,
+    // on the same wake: a worker's event before its reply stays before it, and after it stays after.
+    auto own = request(MessageEntryType::EventReq, "ev");
+    own.elements.push_back(make_scalar_element<std::int32_t>("value", 10));
+    REQUIRE(ref.send(std::move(own)));
+    MessageEntry reply;
+    reply.elements.push_back(make_scalar_element<std::int32_t>("value", 11));
+    session->queue_reply(std::move(reply));
+    REQUIRE(ref.send(event(12)));
+    CHECK(pump->wakes == 3);
+    CHECK(pump->held.size() == 1);  // no closure for any of them
+    session->take_queued(sends, wires);
+    REQUIRE(sends.size() == 3);
+    CHECK(pending_send(sends[0]) == std::make_pair(std::string("own"), 10));
+    CHECK(pending_send(sends[1]) == std::make_pair(std::string("reply"), 11));
+    CHECK(pending_send(sends[2]) == std::make_pair(std::string("shared"), 12));
+
+    // A reply for a session that has closed is dropped, not queued.
+    session->mark_closed();
+    MessageEntry late;
+    session->queue_reply(std::move(late));
+    sends.clear();
+    session->take_queued(sends, wires);
+    CHECK(sends.empty());
 
     // The send queue bound holds for queued entries too.
     auto small = std::make_shared<ServerSession>(1, 2, nullptr, pump, std::weak_ptr<ServerConnection>(), 256);

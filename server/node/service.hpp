@@ -74,7 +74,7 @@ private:
     std::uint32_t endpoint_ = 0;
 };
 
-/// Where the replies of one connection's requests go (ServerConnection's). Thread-safe.
+/// Where the replies of one client session's requests go (ServerConnection's). Thread-safe.
 class ReplySink {
 public:
     virtual ~ReplySink() = default;

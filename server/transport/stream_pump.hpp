@@ -51,9 +51,10 @@ public:
     /// Like post(), but runs `fn` at once when already on the strand.
     virtual void dispatch(std::function<void()> fn) = 0;
     /// Calls the logic's on_wake() on the strand (at once when already on it), then flushes: the
-    /// per-value hand-off of a fan-out (a wire value or event for one client session) without a
-    /// std::function, its operation in the pump's own HandlerMemory. The caller keeps what it hands
-    /// over and wakes once until on_wake() takes it; once the pump has closed, the wake is dropped.
+    /// hand-off from another thread (a fan-out's wire value or event, a worker's reply, a gateway's
+    /// forwarded request) without a std::function, its operation in the pump's own HandlerMemory.
+    /// The caller keeps what it hands over and wakes once until on_wake() takes it; once the pump has
+    /// closed, the wake is dropped (what waits must then be answered by on_transport_closed()).
     virtual void wake() = 0;
     /// True when the calling thread is known not to be running the pump's strand (a wake from it
     /// cannot run at once). False on the strand, and when the strand cannot tell.
