@@ -9,8 +9,11 @@
 #                 device wire for 4 s: instructions and mallocs per delivered message.
 #   raw RR fan-out: the same with 20 native RR clients over rr+ws (rr_bench_rr_fanout): instructions
 #                 and mallocs per delivered value.
-# Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self)
-# and bench/results/profile_fanout.txt (both fan-outs).
+#   gateway hop:  rr-gateway runs under callgrind while the client makes N, then 2N Nop() calls
+#                 through it (rr+tcp both sides): instructions and mallocs per forwarded call =
+#                 difference / N.
+# Writes bench/results/profile_nop.txt (per-call counts, then the top functions, inclusive and self;
+# the gateway hop at its end) and bench/results/profile_fanout.txt (both fan-outs).
 # Needs valgrind (apt-get install valgrind) and a build from bench/run.sh (RR_BENCH_BUILD, default
 # build/bench).  Usage: bench/profile.sh [N]   (default 2000)
 set -euo pipefail
@@ -125,4 +128,38 @@ fanout_report() {
   echo
   fanout_report "the same wire fanned out to 20 native RR clients over rr+ws for 4 s (rr_bench_rr_fanout)" "$rdump" "$values" value
 } > "$OUT/profile_fanout.txt"
+
+# Gateway hop: one Nop() forwarded by the gateway, a fresh gateway in front of a fresh device.
+"$BUILD/bench/rr_bench_service" --memory-mib 0.01 --threads 2 > "$tmp/hopdev" &
+dev=$!
+for _ in $(seq 1 600); do [ -s "$tmp/hopdev" ] && break; sleep 0.1; done
+durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/hopdev")
+valgrind --tool=callgrind --callgrind-out-file="$tmp/hop.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local --port 0 \
+  --log-level warning --device "bench=$durl" > "$tmp/hopgw" 2>> "$tmp/valgrind.log" &
+gw=$!
+for _ in $(seq 1 600); do [ -s "$tmp/hopgw" ] && break; sleep 0.1; done
+gport=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['port'])" "$tmp/hopgw")
+sleep 3
+hop_url="rr+tcp://127.0.0.1:$gport/?service=bench"
+"$BUILD/bench/rr_bench_client" --url "$hop_url" --count 200 --ops nop > /dev/null   # warm-up
+# N then 2N calls, each run a connection of its own: per call = difference / N (the connect cancels out).
+for c in "$N" $((2 * N)); do
+  callgrind_control -z "$gw" > /dev/null
+  "$BUILD/bench/rr_bench_client" --url "$hop_url" --count "$c" --ops nop > /dev/null
+  callgrind_control -d "$gw" > /dev/null
+done
+kill -TERM "$gw"; wait "$gw" || true
+kill -TERM "$dev"; wait "$dev" || true
+h1=$(ls -v "$tmp"/hop.out.* | head -1)
+h2=$(ls -v "$tmp"/hop.out.* | sed -n 2p)
+{
+  echo
+  echo "# callgrind of rr-gateway: Nop() calls forwarded (our client -> gateway -> rr_bench_service, rr+tcp), $N and $((2 * N)) calls"
+  echo "gateway instructions per forwarded call: $(( ($(total_ir "$h2") - $(total_ir "$h1")) / N ))"
+  paste <(bench/callgrind_calls.py "$h1" malloc) <(bench/callgrind_calls.py "$h2" malloc) |
+    awk -v n="$N" '{ printf "gateway malloc calls per forwarded call: %.1f\n", ($4 - $2) / n }'
+  echo
+  echo "## gateway hop ($((2 * N)) calls plus one connect), inclusive (top frames in rr::, asio and the allocator)"
+  annotate --inclusive=yes "$h2"
+} >> "$OUT/profile_nop.txt"
 echo "wrote $OUT/profile_nop.txt and $OUT/profile_fanout.txt" >&2
