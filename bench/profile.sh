@@ -85,17 +85,25 @@ annotate() { callgrind_annotate --threshold=100 "$@" 2>/dev/null | grep -E '^ *[
   annotate --inclusive=no "$tmp/client.$((2 * N)).out"
 } > "$OUT/profile_nop.txt"
 
+# device_and_gateway NAME SERVICE_ARGS...: a fresh rr_bench_service (SERVICE_ARGS) and a fresh
+# rr-gateway in front of it under callgrind (dumps $tmp/NAME.out.*); sets dev, gw and gport.
+device_and_gateway() {
+  local name=$1; shift
+  "$BUILD/bench/rr_bench_service" "$@" > "$tmp/$name.dev" &
+  dev=$!
+  for _ in $(seq 1 600); do [ -s "$tmp/$name.dev" ] && break; sleep 0.1; done
+  local durl
+  durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/$name.dev")
+  valgrind --tool=callgrind --callgrind-out-file="$tmp/$name.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local \
+    --port 0 --log-level warning --device "bench=$durl" > "$tmp/$name.gw" 2>> "$tmp/valgrind.log" &
+  gw=$!
+  for _ in $(seq 1 600); do [ -s "$tmp/$name.gw" ] && break; sleep 0.1; done
+  gport=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['port'])" "$tmp/$name.gw")
+  sleep 3
+}
+
 # Gateway fan-out.
-"$BUILD/bench/rr_bench_service" --tick-hz 100 --memory-mib 0.01 > "$tmp/dev" &
-dev=$!
-for _ in $(seq 1 600); do [ -s "$tmp/dev" ] && break; sleep 0.1; done
-durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/dev")
-valgrind --tool=callgrind --callgrind-out-file="$tmp/gw.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local --port 0 \
-  --log-level warning --device "bench=$durl" > "$tmp/gw" 2>> "$tmp/valgrind.log" &
-gw=$!
-for _ in $(seq 1 600); do [ -s "$tmp/gw" ] && break; sleep 0.1; done
-gport=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['port'])" "$tmp/gw")
-sleep 3
+device_and_gateway gw --tick-hz 100 --memory-mib 0.01
 "$BUILD/bench/rr_bench_ws_load" --port "$gport" --clients 20 fanout --seconds 2 > /dev/null   # warm-up
 callgrind_control -z "$gw" > /dev/null
 "$BUILD/bench/rr_bench_ws_load" --port "$gport" --clients 20 fanout --seconds 4 > "$tmp/fanout.json"
@@ -130,16 +138,7 @@ fanout_report() {
 } > "$OUT/profile_fanout.txt"
 
 # Gateway hop: one Nop() forwarded by the gateway, a fresh gateway in front of a fresh device.
-"$BUILD/bench/rr_bench_service" --memory-mib 0.01 --threads 2 > "$tmp/hopdev" &
-dev=$!
-for _ in $(seq 1 600); do [ -s "$tmp/hopdev" ] && break; sleep 0.1; done
-durl=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['url'])" "$tmp/hopdev")
-valgrind --tool=callgrind --callgrind-out-file="$tmp/hop.out" "$BUILD/server/app/rr-gateway" --no-demo --no-local --port 0 \
-  --log-level warning --device "bench=$durl" > "$tmp/hopgw" 2>> "$tmp/valgrind.log" &
-gw=$!
-for _ in $(seq 1 600); do [ -s "$tmp/hopgw" ] && break; sleep 0.1; done
-gport=$(.venv/bin/python -c "import json,sys; print(json.load(open(sys.argv[1]))['port'])" "$tmp/hopgw")
-sleep 3
+device_and_gateway hop --memory-mib 0.01 --threads 2
 hop_url="rr+tcp://127.0.0.1:$gport/?service=bench"
 "$BUILD/bench/rr_bench_client" --url "$hop_url" --count 200 --ops nop > /dev/null   # warm-up
 # N then 2N calls, each run a connection of its own: per call = difference / N (the connect cancels out).

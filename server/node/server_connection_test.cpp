@@ -9,6 +9,8 @@
 #include <thread>
 
 #include <boost/asio/connect.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
 #include <boost/asio/read.hpp>
 #include <boost/asio/write.hpp>
 
@@ -554,6 +556,65 @@ TEST_CASE("a request made while the client connection closes is answered once, n
         }
     }
     CHECK(local_errors > 0);  // the close won the race at least once
+}
+
+TEST_CASE("requests racing the end of the client's transport are each answered once, never lost") {
+    Fixture f;
+    // The client on an io_context of its own, so that the service's node can shut down under it.
+    boost::asio::io_context client_io;
+    auto work = boost::asio::make_work_guard(client_io);
+    std::vector<std::thread> io_threads;
+    for (int i = 0; i < 2; ++i) io_threads.emplace_back([&] { client_io.run(); });
+    std::shared_ptr<RawClient> c;
+    {
+        std::promise<Result<std::shared_ptr<RawClient>>> p;
+        auto url = parse_connection_url("rr+tcp://127.0.0.1:" + std::to_string(f.port) + "/?service=svc");
+        REQUIRE(url);
+        RawClient::connect(client_io.get_executor(), *url, {}, {}, {},
+                           [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
+        auto r = p.get_future().get();
+        REQUIRE(r);
+        c = *r;
+    }
+    constexpr int kRequests = 2000;
+    struct Tally {
+        std::vector<std::atomic<int>> calls = std::vector<std::atomic<int>>(kRequests);
+        std::atomic<int> answered{0}, replies{0}, errors{0};
+    };
+    auto tally = std::make_shared<Tally>();
+    std::thread sender([&] {
+        for (int i = 0; i < kRequests; ++i) {
+            c->request(add_call(i, 1), [tally, i](Result<MessageEntry> r) {
+                tally->calls[i].fetch_add(1);
+                (r ? tally->replies : tally->errors).fetch_add(1);
+                tally->answered.fetch_add(1);
+            });
+        }
+    });
+    // The device goes away while the requests are being queued.
+    while (tally->answered.load() < 50) std::this_thread::sleep_for(1ms);
+    f.node->shutdown();
+    sender.join();
+    for (int i = 0; i < 1000 && tally->answered.load() < kRequests; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(tally->answered.load() == kRequests);
+    int wrong = 0;
+    for (auto& n : tally->calls) wrong += n.load() != 1;
+    CHECK(wrong == 0);
+    CHECK(tally->replies.load() >= 50);
+    CHECK(tally->errors.load() > 0);
+    // Once the transport has ended, a request is answered ConnectionError at once.
+    for (int i = 0; i < 500 && c->is_open(); ++i) std::this_thread::sleep_for(10ms);
+    bool called = false;
+    c->request(add_call(1, 2), [&](Result<MessageEntry> r) {
+        called = true;
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::ConnectionError);
+    });
+    CHECK(called);
+    c.reset();
+    work.reset();
+    client_io.stop();
+    for (auto& t : io_threads) t.join();
 }
 
 namespace {
