@@ -393,44 +393,37 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
         std::lock_guard lock(mutex_);
         last_caller_ = session.endpoint();
     }
-    // One box for what the reply needs: the handler then holds a single shared_ptr, which std::function
-    // keeps inline (one allocation per forwarded request, not two).
-    struct Pending {
-        std::shared_ptr<MirrorService> self;
-        Responder responder;
-        MessageEntryType type;
-        std::uint32_t endpoint;
-        std::chrono::steady_clock::time_point start;
-    };
-    auto pending = std::make_shared<Pending>(
-        Pending{shared_from_this(), std::move(responder), entry.entry_type, session.endpoint(), std::chrono::steady_clock::now()});
+    const auto type = entry.entry_type;
+    const auto endpoint = session.endpoint();
+    const auto start = std::chrono::steady_clock::now();
     entry.service_path = to_upstream(entry.service_path);
     counters_->requests.fetch_add(1);
-    c->request(std::move(entry), [pending](Result<MessageEntry> r) {
-        auto& self = pending->self;
-        self->counters_->observe_latency(std::chrono::steady_clock::now() - pending->start);
+    auto self = shared_from_this();
+    auto shared = std::make_shared<Responder>(std::move(responder));
+    c->request(std::move(entry), [self, shared, type, endpoint, start](Result<MessageEntry> r) {
+        self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
         if (!r) {
             // No answer from the device (its connection dropped, the request timed out): say which device,
             // as not_connected() does for requests made while it is down.
             self->counters_->request_errors.fetch_add(1);
-            pending->responder.fail(make_error(r.error().type, "device \"" + self->name_ + "\": " + r.error().message));
+            shared->fail(make_error(r.error().type, "device \"" + self->name_ + "\": " + r.error().message));
             return;
         }
         if (r->error != MessageErrorType::None) self->counters_->request_errors.fetch_add(1);
-        if (pending->type == MessageEntryType::FunctionCallReq && r->error == MessageErrorType::None && !r->find("return")) {
+        if (type == MessageEntryType::FunctionCallReq && r->error == MessageErrorType::None && !r->find("return")) {
             if (const auto* idx = r->find("index")) {
                 std::int32_t g = 0;
                 if (read_scalar(*idx, g)) {
                     std::lock_guard lock(self->mutex_);
-                    self->generators_.insert({pending->endpoint, g});
+                    self->generators_.insert({endpoint, g});
                 }
             }
         }
-        if (pending->type == MessageEntryType::GeneratorNextReq && r->error != MessageErrorType::None) {
+        if (type == MessageEntryType::GeneratorNextReq && r->error != MessageErrorType::None) {
             // StopIteration, close and abort end the generator (the request's index is not in the reply:
             // ownership is dropped when the session closes or the device reconnects).
         }
-        pending->responder.respond(std::move(*r));
+        shared->respond(std::move(*r));
     });
 }
 

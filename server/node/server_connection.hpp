@@ -106,9 +106,10 @@ private:
     mutable std::mutex mutex_;
     std::string username_;
     // What other threads queued for the strand: sends and replies in order (sends bounded by
-    // max_queue_, replies by the requests in flight), and wire packets, newest per (service path, member). A wire slot stays when its packet is taken (no
-    // map node per packet), unless there are more than kKeptWireSlots. `wake_pending_`: the pump was
-    // woken for them and has not taken them yet (one wake for all).
+    // max_queue_, replies by the requests in flight), and wire packets, newest per (service path,
+    // member). A wire slot stays when its packet is taken (no map node per packet), unless there are
+    // more than kKeptWireSlots. `wake_pending_`: the pump was woken for them and has not taken them
+    // yet (one wake for all).
     static constexpr std::size_t kKeptWireSlots = 64;
     std::vector<PendingSend> send_pending_;
     std::map<std::pair<std::string, std::string>, std::optional<PendingWire>> wire_pending_;
