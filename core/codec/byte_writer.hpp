@@ -1,4 +1,5 @@
-// ByteWriter: appends little-endian integers and byte strings to a std::vector<std::byte>.
+// ByteWriter: appends little-endian integers and byte strings to a std::vector<std::byte>, or to a
+// GatherBuffer, where large shared payloads are spliced in instead of copied (write_shared).
 //
 // The writer never fails; callers reserve the final size first (the message writer computes every
 // size before writing) so appends do not reallocate. Not thread-safe (holds a reference to `out`).
@@ -12,15 +13,20 @@
 #include <vector>
 
 #include "core/codec/endian.hpp"
+#include "core/codec/gather_buffer.hpp"
 
 namespace rr {
 
 class ByteWriter {
 public:
     explicit ByteWriter(std::vector<std::byte>& out) noexcept : out_(out), start_(out.size()) {}
+    explicit ByteWriter(GatherBuffer& out) noexcept
+        : out_(out.owned()), start_(out.owned().size()), gather_(&out), spliced_start_(out.spliced_bytes()) {}
 
-    /// Bytes appended since this writer was made.
-    std::size_t written() const noexcept { return out_.size() - start_; }
+    /// Bytes appended since this writer was made (spliced ones included).
+    std::size_t written() const noexcept {
+        return out_.size() - start_ + (gather_ ? gather_->spliced_bytes() - spliced_start_ : 0);
+    }
     std::vector<std::byte>& buffer() noexcept { return out_; }
 
     template <class T>
@@ -39,6 +45,13 @@ public:
     void write_i64(std::int64_t v) { write(v); }
 
     void write_bytes(std::span<const std::byte> bytes) { out_.insert(out_.end(), bytes.begin(), bytes.end()); }
+    /// Like write_bytes; into a GatherBuffer, a large range with an owner is spliced, not copied.
+    void write_shared(const SharedBytes& bytes) {
+        if (gather_)
+            gather_->append(bytes);
+        else
+            write_bytes(bytes.bytes());
+    }
     void write_string(std::string_view s) {
         auto p = reinterpret_cast<const std::byte*>(s.data());
         out_.insert(out_.end(), p, p + s.size());
@@ -47,6 +60,8 @@ public:
 private:
     std::vector<std::byte>& out_;
     std::size_t start_;
+    GatherBuffer* gather_ = nullptr;
+    std::size_t spliced_start_ = 0;
 };
 
 }  // namespace rr

@@ -37,6 +37,8 @@ public:
     const std::byte* data() const noexcept { return bytes_.data(); }
     std::size_t size() const noexcept { return bytes_.size(); }
     bool empty() const noexcept { return bytes_.empty(); }
+    /// What keeps the bytes alive; null for a view of memory the caller keeps alive.
+    const std::shared_ptr<const void>& owner() const noexcept { return owner_; }
 
     /// A view of [offset, offset+n) sharing the same owner. Precondition: in range.
     SharedBytes subspan(std::size_t offset, std::size_t n) const { return SharedBytes(owner_, bytes_.subspan(offset, n)); }

@@ -1,10 +1,12 @@
 // EncodedEntry: one message entry that many messages carry unchanged (a wire value or an event sent to
 // every client session of a service, or fanned out by the gateway). Each message format's bytes of the
-// entry are made once, on first use, and copied into every message after that message's own header
-// (encode_message with an encoded entry), instead of encoding the entry's elements again per session.
+// entry are made once, on first use, and follow every message's own header (encode_message with an
+// encoded entry), instead of encoding the entry's elements again per session: copied when small,
+// spliced into the session's gathered write when large and the entry is held by a shared_ptr.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -15,7 +17,7 @@
 
 namespace rr {
 
-class EncodedEntry {
+class EncodedEntry : public std::enable_shared_from_this<EncodedEntry> {
 public:
     explicit EncodedEntry(MessageEntry entry) : entry_(std::move(entry)) {}
     EncodedEntry(const EncodedEntry&) = delete;
@@ -29,6 +31,9 @@ public:
     /// 65535 bytes, an element that cannot travel, …), the same error on every call; InvalidArgument
     /// for another version.
     Result<std::span<const std::byte>> bytes(std::uint16_t version) const;
+    /// The same bytes, kept alive by this entry when a shared_ptr owns it (else a view without owner,
+    /// valid while the entry lives). Errors: as bytes().
+    Result<SharedBytes> shared_bytes(std::uint16_t version) const;
 
 private:
     struct Encoding {

@@ -20,8 +20,8 @@ public:
     explicit MessageEncoder(const Message& message) : m_(message) {}
     /// `message`'s header followed by one entry already encoded in `message.version` (encode_entry);
     /// `message.entries` must be empty.
-    MessageEncoder(const Message& message, std::span<const std::byte> encoded_entry)
-        : m_(message), encoded_entry_(encoded_entry), has_encoded_entry_(true) {}
+    MessageEncoder(const Message& message, SharedBytes encoded_entry)
+        : m_(message), encoded_entry_(std::move(encoded_entry)), has_encoded_entry_(true) {}
 
     /// One entry on its own in format `version` (no local string table: a v4 code must be standard).
     Result<std::uint32_t> measure_entry(const MessageEntry& entry, std::uint16_t version);
@@ -32,6 +32,9 @@ public:
     Result<std::uint32_t> measure();
     /// Writes the measured message. Precondition: measure() succeeded.
     void write(ByteWriter& w);
+
+    /// Bytes of the last measured message or entry that a GatherBuffer splices instead of copying.
+    std::uint64_t spliced_bytes() const noexcept { return spliced_; }
 
 private:
     // message_writer_v2.cpp
@@ -57,13 +60,17 @@ private:
     /// Reserves a pre-order slot for a size computed after the children.
     std::size_t reserve_size_slot();
     std::uint32_t next_size();
+    void count_splice(const SharedBytes& b) noexcept {
+        if (GatherBuffer::splices(b)) spliced_ += b.size();
+    }
 
     /// Entries in the message: its own, or the one already encoded.
     std::size_t entry_count() const noexcept { return has_encoded_entry_ ? 1 : m_.entries.size(); }
 
     const Message& m_;
-    std::span<const std::byte> encoded_entry_;
+    SharedBytes encoded_entry_;
     bool has_encoded_entry_ = false;
+    std::uint64_t spliced_ = 0;
     /// Entry and element sizes, pre-order: the first kInlineSizes in the encoder itself, so a message
     /// of a few entries and elements is encoded without allocating for them.
     static constexpr std::size_t kInlineSizes = 16;

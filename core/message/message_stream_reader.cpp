@@ -36,8 +36,9 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
             }
 #endif
             if (!frame_) {
-                body_.reserve(std::min(expected_, kInitialBufferBytes));
-                body_.assign(preamble_.begin(), preamble_.end());
+                grow_large(std::min(expected_, kInitialBufferBytes));
+                std::copy(preamble_.begin(), preamble_.end(), large_.get());
+                large_fill_ = kMessagePreambleBytes;
             }
         }
         if (frame_) {
@@ -53,19 +54,24 @@ Result<void> MessageStreamReader::feed(std::span<const std::byte> bytes) {
             }
             continue;
         }
-        const std::size_t n = std::min(bytes.size(), expected_ - body_.size());
-        if (body_.size() + n > body_.capacity()) {
-            // Grow with what arrived: doubling, and the whole MessageSize once a quarter of it is here
-            // (fewer re-copies of a large message; still at most 4 × the bytes received).
-            const std::size_t arrived = body_.size() + n;
-            const std::size_t grown = 4 * arrived >= expected_ ? expected_ : std::max(arrived, 2 * body_.capacity());
-            body_.reserve(std::min(expected_, grown));
+        const std::size_t n = std::min(bytes.size(), expected_ - large_fill_);
+        if (bytes.data() != large_.get() + large_fill_) {  // else the host read them in place (read_space)
+            if (large_fill_ + n > large_capacity_) {
+                // Grow with what arrived: doubling, and the whole MessageSize once a quarter of it is
+                // here (fewer re-copies of a large message; still at most 4 × the bytes received).
+                const std::size_t arrived = large_fill_ + n;
+                const std::size_t grown = 4 * arrived >= expected_ ? expected_ : std::max(arrived, 2 * large_capacity_);
+                grow_large(std::min(expected_, grown));
+            }
+            std::copy_n(bytes.data(), n, large_.get() + large_fill_);
         }
-        body_.insert(body_.end(), bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+        large_fill_ += n;
         bytes = bytes.subspan(n);
-        if (body_.size() == expected_) {
-            ready_.push_back(SharedBytes::adopt(std::move(body_)));
-            body_ = {};
+        if (large_fill_ == expected_) {
+            std::span<const std::byte> view(large_.get(), expected_);
+            ready_.emplace_back(std::shared_ptr<const void>(std::move(large_)), view);
+            large_capacity_ = 0;
+            large_fill_ = 0;
             expected_ = 0;
         }
     }
@@ -82,6 +88,25 @@ std::shared_ptr<std::byte[]> MessageStreamReader::small_frame(std::size_t size) 
     return spare_frame_;
 }
 #endif
+
+std::span<std::byte> MessageStreamReader::read_space() {
+    if (error_ || expected_ == 0 || frame_ || !large_ || expected_ - large_fill_ < kDirectReadMinBytes) return {};
+    if (large_capacity_ - large_fill_ < kDirectReadMinBytes) {
+        // The growth rule of feed(): the whole MessageSize once a quarter has arrived, else doubling
+        // (the buffer is at least 3/4 full here, so still at most 4 × the bytes received).
+        const std::size_t grown = 4 * large_fill_ >= expected_ ? expected_ : 2 * large_capacity_;
+        grow_large(std::min(expected_, grown));
+    }
+    return {large_.get() + large_fill_, large_capacity_ - large_fill_};
+}
+
+void MessageStreamReader::grow_large(std::size_t capacity) {
+    // Not zeroed: every byte is written before it is read.
+    std::shared_ptr<std::byte[]> grown(new std::byte[capacity]);
+    if (large_fill_ != 0) std::copy_n(large_.get(), large_fill_, grown.get());
+    large_ = std::move(grown);
+    large_capacity_ = capacity;
+}
 
 std::optional<SharedBytes> MessageStreamReader::take_frame() {
     if (error_ || ready_.empty()) return std::nullopt;

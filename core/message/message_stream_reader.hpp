@@ -13,7 +13,8 @@
 // from it is still held (a call's request and reply need no allocation for their frames). A larger
 // one grows with the bytes that actually arrive (first 64 KiB, then doubling, and to MessageSize once
 // a quarter of it has arrived), so a peer cannot make the reader allocate more than 64 KiB or 4 ×
-// what it has sent.
+// what it has sent. The host may read a large message's bytes straight into that buffer
+// (read_space(), then feed() with those bytes): they are not copied again.
 // Errors (all fatal, as in CORE, which closes the connection): ProtocolError (bad magic, MessageSize
 // below a header, or a frame that does not decode in take_message), BufferLimitViolation (MessageSize
 // over the limit, or a decode limit). After the first error every call fails with that error and no
@@ -43,6 +44,13 @@ public:
     /// Errors: see above; once failed, always failed.
     Result<void> feed(std::span<const std::byte> bytes);
 
+    /// Free space in the buffer of the large message being assembled (over 64 KiB, at least
+    /// kDirectReadMinBytes of it still to come), for the host to read the message's next bytes into;
+    /// empty otherwise. The span ends at or before the message's end. Passing those bytes (the span's
+    /// start, at most its size) to feed() next adds them without a copy; any other feed() is as usual.
+    /// May grow the buffer, under the rule above.
+    std::span<std::byte> read_space();
+
     /// The next complete message, bytes exactly as received; nullopt if none is complete yet.
     std::optional<SharedBytes> take_frame();
 
@@ -58,14 +66,16 @@ public:
     /// Number of complete messages waiting.
     std::size_t ready_count() const noexcept { return ready_.size(); }
     /// Bytes of the message being assembled (0 between messages).
-    std::size_t partial_bytes() const noexcept { return preamble_fill_ + (frame_ ? frame_fill_ : body_.size()); }
+    std::size_t partial_bytes() const noexcept { return preamble_fill_ + (frame_ ? frame_fill_ : large_fill_); }
     /// Bytes allocated for the message being assembled (for per-connection memory accounting).
     std::size_t partial_capacity() const noexcept {
-        return frame_ ? std::max(expected_, kReusedFrameBytes) : body_.capacity();
+        return frame_ ? std::max(expected_, kReusedFrameBytes) : large_capacity_;
     }
 
     /// Messages up to this size are read into one buffer, reused from message to message.
     static constexpr std::size_t kReusedFrameBytes = 512;
+    /// read_space() offers no span for less than this (a smaller rest goes through the host's buffer).
+    static constexpr std::size_t kDirectReadMinBytes = 16 * 1024;
     bool failed() const noexcept { return error_.has_value(); }
     /// The error that stopped the reader, or nullptr.
     const RRError* error() const noexcept { return error_ ? &*error_ : nullptr; }
@@ -75,14 +85,18 @@ private:
     /// A buffer for a message of `size` ≤ kInitialBufferBytes bytes: spare_frame_ when it fits and
     /// nothing else holds it.
     std::shared_ptr<std::byte[]> small_frame(std::size_t size);
+    /// Moves the large message's bytes so far into a new buffer of `capacity` bytes.
+    void grow_large(std::size_t capacity);
 
     static constexpr std::size_t kInitialBufferBytes = 64 * 1024;
 
     Limits limits_;
     std::array<std::byte, kMessagePreambleBytes> preamble_{};
     std::size_t preamble_fill_ = 0;
-    std::size_t expected_ = 0;        // MessageSize of the message in body_, 0 while reading a preamble
-    std::vector<std::byte> body_;     // a message over kInitialBufferBytes being assembled, preamble included
+    std::size_t expected_ = 0;        // MessageSize of the message being assembled, 0 while reading a preamble
+    std::shared_ptr<std::byte[]> large_;  // a message over kInitialBufferBytes being assembled, preamble included
+    std::size_t large_capacity_ = 0;
+    std::size_t large_fill_ = 0;
     std::shared_ptr<std::byte[]> frame_;  // a message up to kInitialBufferBytes being assembled (its final buffer)
     std::shared_ptr<std::byte[]> spare_frame_;  // the last buffer of kReusedFrameBytes, reused once released
     std::size_t frame_fill_ = 0;

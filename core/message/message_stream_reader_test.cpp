@@ -2,6 +2,8 @@
 // failed reader that stays failed.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "core/message/for_each_split.hpp"
 #include "core/message/message_stream_reader.hpp"
 #include "core/message/message_writer.hpp"
@@ -279,4 +281,84 @@ TEST_CASE("message: the stream reader reuses a small frame's buffer only once no
     auto large = reader.take_frame();
     REQUIRE(large);
     CHECK(bytes_of(*large) == wbig);
+}
+
+TEST_CASE("message: the rest of a large message is read in place through read_space") {
+    // Two messages back to back: a 1 MiB one (its bytes a pattern) and a small one after it.
+    Message big;
+    big.version = 4;
+    auto& e = big.entries.emplace_back();
+    e.entry_type = MessageEntryType::WirePacket;
+    MessageElement value;
+    value.name = "value";
+    value.type = DataTypes::uint8_t;
+    std::vector<std::byte> payload(1 << 20);
+    for (std::size_t i = 0; i < payload.size(); ++i) payload[i] = static_cast<std::byte>(i * 7 & 0xff);
+    value.data = SharedBytes::adopt(std::move(payload));
+    e.elements.push_back(value);
+    Message small;
+    small.entries.emplace_back().entry_type = MessageEntryType::ConnectionTest;
+    std::vector<std::byte> stream;
+    REQUIRE(encode_message(big, stream));
+    const std::size_t big_size = stream.size();
+    REQUIRE(encode_message(small, stream));
+
+    MessageStreamReader reader;
+    CHECK(reader.read_space().empty());  // nothing begun: the host's own buffer
+    std::size_t at = 0;
+    std::size_t in_place = 0;
+    auto feed_normal = [&](std::size_t n) {
+        REQUIRE(reader.feed(std::span<const std::byte>(stream).subspan(at, n)));
+        at += n;
+    };
+    feed_normal(1000);  // the preamble and a first piece through the host's buffer
+    while (at < stream.size()) {
+        auto space = reader.read_space();
+        if (space.empty()) {
+            feed_normal(std::min<std::size_t>(4096, stream.size() - at));
+            continue;
+        }
+        // The span never reaches past the large message, and the buffer stays within 4 × what arrived.
+        CHECK(at + space.size() <= big_size);
+        CHECK(space.size() >= MessageStreamReader::kDirectReadMinBytes);
+        CHECK(reader.partial_capacity() <= std::max<std::size_t>(64 * 1024, 4 * reader.partial_bytes()));
+        // A socket read of up to 50,000 bytes into the span, then the same bytes fed.
+        const std::size_t n = std::min<std::size_t>(space.size(), 50'000);
+        std::copy_n(stream.begin() + static_cast<std::ptrdiff_t>(at), n, space.begin());
+        REQUIRE(reader.feed(space.first(n)));
+        at += n;
+        in_place += n;
+    }
+    CHECK(in_place > big_size / 2);
+    REQUIRE(reader.ready_count() == 2);
+    auto first = reader.take_frame();
+    REQUIRE(first);
+    CHECK(std::equal(first->bytes().begin(), first->bytes().end(), stream.begin(),
+                     stream.begin() + static_cast<std::ptrdiff_t>(big_size)));
+    auto decoded = decode_message(*first, Limits{});
+    REQUIRE(decoded);
+    CHECK(decoded->entries == big.entries);
+    auto second = reader.take_frame();
+    REQUIRE(second);
+    CHECK(second->size() == stream.size() - big_size);
+    CHECK(reader.read_space().empty());
+    CHECK(reader.partial_bytes() == 0);
+}
+
+TEST_CASE("message: read_space offers nothing for small messages or a failed reader") {
+    std::vector<std::byte> medium = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                     std::byte{0xe8}, std::byte{0x03}, std::byte{0},  std::byte{0}};  // 1,000
+    MessageStreamReader r;
+    REQUIRE(r.feed(medium));
+    CHECK(r.read_space().empty());  // in its final buffer already, through the host's reads
+    std::vector<std::byte> mib = {std::byte{'R'}, std::byte{'R'}, std::byte{'A'}, std::byte{'C'},
+                                  std::byte{0x00}, std::byte{0x00}, std::byte{0x10}, std::byte{0x00}};  // 1 MiB
+    MessageStreamReader big;
+    REQUIRE(big.feed(mib));
+    CHECK_FALSE(big.read_space().empty());
+    CHECK(big.partial_capacity() <= 64 * 1024);  // asking for space does not allocate the whole message
+    std::vector<std::byte> bad = {std::byte{'X'}};
+    MessageStreamReader failed;
+    CHECK_FALSE(failed.feed(bad));
+    CHECK(failed.read_space().empty());
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "core/codec/varint.hpp"
 #include "core/message/message_encoder.hpp"
@@ -33,43 +34,75 @@ Result<std::size_t> encoded_size(const Message& message) {
 namespace {
 
 // Measures, reserves once, writes: `measure` and `write` take the ByteWriter-less / ByteWriter half.
-template <class Measure, class Write>
-Result<void> append_measured(std::vector<std::byte>& out, Measure&& measure, Write&& write) {
+// Into a GatherBuffer only the bytes it does not splice are reserved.
+template <class Out, class Measure, class Write>
+Result<void> append_measured(Out& out, const detail::MessageEncoder& encoder, Measure&& measure, Write&& write) {
     auto size = measure();
     if (!size) return size.take_error();
-    const std::size_t start = out.size();
+    constexpr bool gathered = std::is_same_v<Out, GatherBuffer>;
+    std::vector<std::byte>& owned = [&]() -> std::vector<std::byte>& {
+        if constexpr (gathered) return out.owned(); else return out;
+    }();
+    const std::size_t copied = gathered ? static_cast<std::size_t>(*size - encoder.spliced_bytes()) : *size;
+    const std::size_t start = owned.size();
     // Geometric growth: `out` may be a connection's pending output that many messages are appended to.
-    if (out.capacity() - start < *size) out.reserve(std::max<std::size_t>(start + *size, 2 * out.capacity()));
-    ByteWriter w(out);
-    write(w);
-    if (w.written() != *size) {  // measure and write disagree: a bug here, never the caller's
-        out.resize(start);
-        return fail(MessageErrorType::InternalError, "message writer size mismatch");
+    if (owned.capacity() - start < copied) owned.reserve(std::max<std::size_t>(start + copied, 2 * owned.capacity()));
+    if constexpr (gathered) {
+        const auto mark = out.mark();
+        ByteWriter w(out);
+        write(w);
+        if (w.written() != *size) {  // measure and write disagree: a bug here, never the caller's
+            out.rollback(mark);
+            return fail(MessageErrorType::InternalError, "message writer size mismatch");
+        }
+    } else {
+        ByteWriter w(out);
+        write(w);
+        if (w.written() != *size) {
+            out.resize(start);
+            return fail(MessageErrorType::InternalError, "message writer size mismatch");
+        }
     }
     return {};
+}
+
+template <class Out>
+Result<void> encode_message_into(const Message& message, Out& out) {
+    detail::MessageEncoder encoder(message);
+    return append_measured(out, encoder, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
+}
+
+template <class Out>
+Result<void> encode_message_with_entry(const Message& message, SharedBytes encoded_entry, Out& out) {
+    if (!message.entries.empty())
+        return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
+    detail::MessageEncoder encoder(message, std::move(encoded_entry));
+    return append_measured(out, encoder, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
 }
 
 }  // namespace
 
 Result<void> encode_message(const Message& message, std::vector<std::byte>& out) {
-    detail::MessageEncoder encoder(message);
-    return append_measured(out, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
+    return encode_message_into(message, out);
 }
+
+Result<void> encode_message(const Message& message, GatherBuffer& out) { return encode_message_into(message, out); }
 
 Result<void> encode_entry(const MessageEntry& entry, std::uint16_t version, std::vector<std::byte>& out) {
     static const Message no_header;
     detail::MessageEncoder encoder(no_header);
     return append_measured(
-        out, [&] { return encoder.measure_entry(entry, version); },
+        out, encoder, [&] { return encoder.measure_entry(entry, version); },
         [&](ByteWriter& w) { encoder.write_entry(w, entry, version); });
 }
 
 Result<void> encode_message(const Message& message, std::span<const std::byte> encoded_entry,
                             std::vector<std::byte>& out) {
-    if (!message.entries.empty())
-        return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
-    detail::MessageEncoder encoder(message, encoded_entry);
-    return append_measured(out, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
+    return encode_message_with_entry(message, SharedBytes(nullptr, encoded_entry), out);
+}
+
+Result<void> encode_message(const Message& message, const SharedBytes& encoded_entry, GatherBuffer& out) {
+    return encode_message_with_entry(message, encoded_entry, out);
 }
 
 Result<SharedBytes> encode_message(const Message& message) {
@@ -89,6 +122,8 @@ Result<std::uint32_t> MessageEncoder::measure() {
         return fail(MessageErrorType::InvalidArgument, std::to_string(m_.entries.size()) + " entries (max 65535)");
     size_count_ = 0;
     more_sizes_.clear();
+    spliced_ = 0;
+    count_splice(encoded_entry_);
     if (m_.version != 2 && m_.version != 4)
         return fail(MessageErrorType::InvalidArgument, "unknown message version " + std::to_string(m_.version));
     auto total = m_.version == 2 ? measure_v2() : measure_v4();
@@ -100,6 +135,7 @@ Result<std::uint32_t> MessageEncoder::measure() {
 Result<std::uint32_t> MessageEncoder::measure_entry(const MessageEntry& entry, std::uint16_t version) {
     size_count_ = 0;
     more_sizes_.clear();
+    spliced_ = 0;
     local_codes_.clear();
     if (version != 2 && version != 4)
         return fail(MessageErrorType::InvalidArgument, "unknown message version " + std::to_string(version));

@@ -24,6 +24,7 @@
 #include <span>
 #include <vector>
 
+#include "core/codec/gather_buffer.hpp"
 #include "core/message/message.hpp"
 
 namespace rr {
@@ -53,6 +54,10 @@ Result<std::size_t> encoded_size(const Message& message);
 /// field is set). ROUTING_INFO / ENDPOINT_INFO clear is never an error: those fields are omitted.
 Result<void> encode_message(const Message& message, std::vector<std::byte>& out);
 
+/// The same into a GatherBuffer: element payloads of GatherBuffer::kSpliceMinBytes and more that have
+/// an owner are spliced in, not copied (the buffer keeps them alive until cleared).
+Result<void> encode_message(const Message& message, GatherBuffer& out);
+
 /// Encodes into a new buffer, ready to send or to decode with views into it.
 Result<SharedBytes> encode_message(const Message& message);
 
@@ -68,5 +73,8 @@ Result<void> encode_entry(const MessageEntry& entry, std::uint16_t version, std:
 /// Errors: InvalidArgument when `message.entries` is not empty; otherwise as encode_message.
 Result<void> encode_message(const Message& message, std::span<const std::byte> encoded_entry,
                             std::vector<std::byte>& out);
+/// The same into a GatherBuffer: the encoded entry is spliced in (not copied) when GatherBuffer::splices
+/// it, and so are its large element payloads.
+Result<void> encode_message(const Message& message, const SharedBytes& encoded_entry, GatherBuffer& out);
 
 }  // namespace rr

@@ -75,6 +75,7 @@ Result<std::uint64_t> MessageEncoder::measure_element_v2(const MessageElement& e
     const std::size_t slot = reserve_size_slot();
     auto payload = check_payload(e);
     if (!payload) return payload.take_error();
+    count_splice(e.data);
     std::uint64_t size = 16 + *payload;
     std::string_view name = e.name;
     ElementNumberText number(e.number.value_or(0));
@@ -114,7 +115,7 @@ void MessageEncoder::write_v2(ByteWriter& w) {
     w.write_u16(h.message_id);
     w.write_u16(h.message_res_id);
     for (const auto& entry : m_.entries) write_entry_v2(w, entry);
-    w.write_bytes(encoded_entry_);
+    w.write_shared(encoded_entry_);
 }
 
 void MessageEncoder::write_entry_v2(ByteWriter& w, const MessageEntry& entry) {
@@ -143,7 +144,7 @@ void MessageEncoder::write_element_v2(ByteWriter& w, const MessageElement& e) {
     if (is_nested(e.type))
         for (const auto& child : e.elements) write_element_v2(w, child);
     else
-        w.write_bytes(e.data.bytes());
+        w.write_shared(e.data);
 }
 
 }  // namespace rr::detail

@@ -140,6 +140,7 @@ Result<std::uint64_t> MessageEncoder::measure_element_v4(const MessageElement& e
     const std::size_t slot = reserve_size_slot();
     auto payload = check_payload(e);
     if (!payload) return payload.take_error();
+    count_splice(e.data);
     std::uint64_t s = 3 + *payload;  // flags + ElementType + raw data
     if (e.number) {
         s += int_x_size(*e.number);
@@ -202,7 +203,7 @@ void MessageEncoder::write_v4(ByteWriter& w) {
     if (f & message_flags::multiple_entries) write_uint_x(w, static_cast<std::uint32_t>(entry_count()));
     if (f & message_flags::extended) write_xlen(w, h.extended);
     for (const auto& entry : m_.entries) write_entry_v4(w, entry);
-    w.write_bytes(encoded_entry_);
+    w.write_shared(encoded_entry_);
 }
 
 void MessageEncoder::write_entry_v4(ByteWriter& w, const MessageEntry& entry) {
@@ -238,7 +239,7 @@ void MessageEncoder::write_element_v4(ByteWriter& w, const MessageElement& e) {
     if (is_nested(e.type))
         for (const auto& child : e.elements) write_element_v4(w, child);
     else
-        w.write_bytes(e.data.bytes());
+        w.write_shared(e.data);
 }
 
 }  // namespace rr::detail

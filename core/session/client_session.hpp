@@ -97,9 +97,12 @@ public:
 
     // --- I/O pump (see StreamConnection) ---
     Result<void> feed(std::span<const std::byte> bytes, MonoTime now);
+    /// See StreamConnection::read_space.
+    std::span<std::byte> read_space() { return stream_.read_space(); }
     void on_transport_closed(RRError error);
-    std::span<const std::byte> pending_output() const noexcept { return stream_.pending_output(); }
+    std::span<const std::byte> pending_output() const { return stream_.pending_output(); }
     void consume_output(std::size_t n) { stream_.consume_output(n); }
+    void take_output(GatherBuffer& out) { stream_.take_output(out); }
     void take_output(std::vector<std::byte>& out) { stream_.take_output(out); }
     std::size_t pending_output_size() const noexcept { return stream_.pending_output_size(); }
     std::optional<MonoTime> next_deadline() const;

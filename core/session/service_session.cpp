@@ -87,9 +87,14 @@ void ServiceSession::drain_stream(MonoTime now) {
     }
 }
 
-void ServiceSession::take_output(std::vector<std::byte>& out) {
+void ServiceSession::take_output(GatherBuffer& out) {
     stream_.take_output(out);
     // Held wire values go out once the backlog has been handed to the transport.
+    if (!held_wires_.empty()) flush_held_wires(MonoTime{});
+}
+
+void ServiceSession::take_output(std::vector<std::byte>& out) {
+    stream_.take_output(out);
     if (!held_wires_.empty()) flush_held_wires(MonoTime{});
 }
 

@@ -122,7 +122,11 @@ public:
     // --- I/O (see StreamConnection) ---
     /// Consumes all of `bytes`; a protocol error closes the connection (ServiceConnectionClosed).
     void feed(std::span<const std::byte> bytes, MonoTime now);
+    /// See StreamConnection::read_space.
+    std::span<std::byte> read_space() { return stream_.read_space(); }
     void on_transport_closed(RRError error);
+    /// Moves the pending output into `out`: gathered (large payloads spliced, not copied) or contiguous.
+    void take_output(GatherBuffer& out);
     void take_output(std::vector<std::byte>& out);
     std::size_t pending_output_size() const noexcept { return stream_.pending_output_size(); }
     std::optional<MonoTime> next_deadline() const;

@@ -320,7 +320,7 @@ Result<void> StreamConnection::send_frame(std::span<const std::byte> frame, Mono
         return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
     if (frame.size() > send_limit())
         return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
-    output_.insert(output_.end(), frame.begin(), frame.end());
+    output_.append(frame);
     last_send_ = now;
     return {};
 }
@@ -341,11 +341,18 @@ Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry,
     const std::uint16_t version = send_version();
     auto bytes = entry.bytes(version);
     if (!bytes) return bytes.take_error();
+    // A large entry is spliced into the gathered write, kept alive by its owner; a small one copied.
+    SharedBytes shared(nullptr, *bytes);
+    if (bytes->size() >= GatherBuffer::kSpliceMinBytes) {
+        auto owned = entry.shared_bytes(version);
+        if (!owned) return owned.take_error();
+        shared = std::move(*owned);
+    }
     const bool omit = omit_routing_applies(header.header, entry.entry().entry_type, version, true);
     if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
-    const std::size_t before = output_.size();
-    if (auto ok = encode_message(header, *bytes, output_); !ok) {
-        output_.resize(before);
+    const auto before = output_.mark();
+    if (auto ok = encode_message(header, shared, output_); !ok) {
+        output_.rollback(before);
         return ok;
     }
     return check_appended(before, now);
@@ -395,18 +402,18 @@ Result<void> StreamConnection::queue_owned(Message& m, std::uint16_t version, Mo
 }
 
 Result<void> StreamConnection::append_encoded(const Message& m, MonoTime now) {
-    const std::size_t before = output_.size();
+    const auto before = output_.mark();
     Result<void> r = encode_message(m, output_);
     if (!r) {
-        output_.resize(before);
+        output_.rollback(before);
         return r;
     }
     return check_appended(before, now);
 }
 
-Result<void> StreamConnection::check_appended(std::size_t before, MonoTime now) {
-    if (output_.size() - before > send_limit()) {
-        output_.resize(before);
+Result<void> StreamConnection::check_appended(const GatherBuffer::Mark& before, MonoTime now) {
+    if (output_.size() - (before.owned + before.spliced) > send_limit()) {
+        output_.rollback(before);
         return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
     }
     last_send_ = now;
@@ -430,28 +437,45 @@ std::size_t StreamConnection::receive_limit() const noexcept {
     return session_established_ ? config_.limits.max_message_size : config_.limits.max_pre_session_message_size;
 }
 
-std::span<const std::byte> StreamConnection::pending_output() const noexcept {
-    return std::span<const std::byte>(output_).subspan(output_offset_);
+std::span<const std::byte> StreamConnection::pending_output() const {
+    output_.flatten();
+    return std::span<const std::byte>(output_.owned()).subspan(output_offset_);
 }
 
 void StreamConnection::consume_output(std::size_t n) {
-    output_offset_ += std::min(n, output_.size() - output_offset_);
-    if (output_offset_ == output_.size()) {
+    output_.flatten();
+    auto& owned = output_.owned();
+    output_offset_ += std::min(n, owned.size() - output_offset_);
+    if (output_offset_ == owned.size()) {
         output_.clear();
         output_offset_ = 0;
-    } else if (output_offset_ > (1u << 20) && output_offset_ * 2 > output_.size()) {
-        output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(output_offset_));
+    } else if (output_offset_ > (1u << 20) && output_offset_ * 2 > owned.size()) {
+        owned.erase(owned.begin(), owned.begin() + static_cast<std::ptrdiff_t>(output_offset_));
         output_offset_ = 0;
     }
 }
 
-void StreamConnection::take_output(std::vector<std::byte>& out) {
+void StreamConnection::take_output(GatherBuffer& out) {
     out.clear();
+    if (output_offset_ != 0) {
+        // Partly consumed through consume_output() (a host that writes contiguously): drop that part.
+        output_.flatten();
+        auto& owned = output_.owned();
+        owned.erase(owned.begin(), owned.begin() + static_cast<std::ptrdiff_t>(output_offset_));
+        output_offset_ = 0;
+    }
+    out.swap(output_);
+}
+
+void StreamConnection::take_output(std::vector<std::byte>& out) {
+    output_.flatten();
+    out.clear();
+    auto& owned = output_.owned();
     if (output_offset_ == 0) {
-        std::swap(out, output_);
+        std::swap(out, owned);
     } else {
-        out.assign(output_.begin() + static_cast<std::ptrdiff_t>(output_offset_), output_.end());
-        output_.clear();
+        out.assign(owned.begin() + static_cast<std::ptrdiff_t>(output_offset_), owned.end());
+        owned.clear();
         output_offset_ = 0;
     }
 }

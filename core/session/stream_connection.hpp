@@ -4,7 +4,8 @@
 // StreamCheckCapability, GetRemoteNodeID, the 512 KiB pre-session limit, and the v4 routing omission
 // on a negotiated connection (wire.md §2.3).
 //
-// Bytes in: feed(bytes, now). Bytes out: pending_output() / consume_output(n). Events out:
+// Bytes in: feed(bytes, now). Bytes out: take_output() (gathered: large payloads are not copied), or
+// pending_output() / consume_output(n). Events out:
 // poll_event(). Time: next_deadline() / on_timer(now). The object never reads a clock.
 // Not thread-safe: one owner drives it (a strand in server/, the JS event loop in wasm-client/).
 //
@@ -23,6 +24,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/codec/gather_buffer.hpp"
 #include "core/codec/limits.hpp"
 #include "core/message/encoded_entry.hpp"
 #include "core/message/message.hpp"
@@ -102,6 +104,10 @@ public:
     /// (a Closed event is queued) and the error is returned.
     Result<void> feed(std::span<const std::byte> bytes, MonoTime now);
 
+    /// Where the host may read the next bytes to feed() without their being copied again: the rest of
+    /// a large message being received (MessageStreamReader::read_space); empty otherwise.
+    std::span<std::byte> read_space() { return state_ == State::closed ? std::span<std::byte>{} : reader_.read_space(); }
+
     /// The host reports the transport was closed by the peer or failed.
     void on_transport_closed(RRError error);
 
@@ -125,10 +131,14 @@ public:
     /// limit and enables v4 routing omission for messages matching them.
     void set_session_established(std::uint32_t local_endpoint, std::uint32_t remote_endpoint);
 
-    std::span<const std::byte> pending_output() const noexcept;
+    /// The pending output as one contiguous range (large payloads that were spliced in are copied
+    /// into it first: a host that writes gathered uses take_output(GatherBuffer&) instead).
+    std::span<const std::byte> pending_output() const;
     void consume_output(std::size_t n);
-    /// Moves all pending output into `out` (cleared first). Swaps buffers when possible, so a writer
-    /// can hold `out` while new messages are queued here without copying or reallocation hazards.
+    /// Moves all pending output into `out` (cleared first), large shared payloads as splices for one
+    /// gathered write. Swaps buffers, so a writer can hold `out` while new messages are queued here.
+    void take_output(GatherBuffer& out);
+    /// The same as one contiguous buffer (splices copied in).
     void take_output(std::vector<std::byte>& out);
     std::size_t pending_output_size() const noexcept { return output_.size() - output_offset_; }
 
@@ -174,7 +184,7 @@ private:
     void relabel(Message& m, std::size_t entry_count, std::uint16_t version, bool omit) const;
     Result<void> append_encoded(const Message& m, MonoTime now);
     /// Undoes what was appended since `before` if the message is over the send limit.
-    Result<void> check_appended(std::size_t before, MonoTime now);
+    Result<void> check_appended(const GatherBuffer::Mark& before, MonoTime now);
     void close(RRError error);
     std::size_t send_limit() const noexcept;
     std::size_t receive_limit() const noexcept;
@@ -185,7 +195,7 @@ private:
     StreamConnected negotiated_;
     MessageStreamReader reader_;
     EntryVectorPool entry_vectors_;
-    std::vector<std::byte> output_;
+    mutable GatherBuffer output_;  // mutable: pending_output() flattens it
     std::size_t output_offset_ = 0;
     EventQueue<StreamEvent> events_;
     MonoTime started_;

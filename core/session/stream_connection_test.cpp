@@ -279,3 +279,67 @@ TEST_CASE("a connection reuses the entry vectors of the messages it sends and re
     CHECK(ids == std::vector<std::uint32_t>{1, 2});
     CHECK(server.entry_vectors().size() == 2);
 }
+
+TEST_CASE("a large payload leaves a connection spliced into its output and arrives intact") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    REQUIRE(client.is_connected());
+    (void)next_event<StreamConnected>(server);
+    std::vector<double> values(25'000);
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5 * static_cast<double>(i);
+    Message m = member_message(MessageEntryType::FunctionCallReq, "Echo", 3);
+    m.entries[0].elements.push_back(make_array_element("d", std::span<const double>(values)));
+    const SharedBytes payload = m.entries[0].elements[0].data;
+    REQUIRE(client.send(m, t0));
+    CHECK(client.pending_output_size() > payload.size());
+
+    // Gathered: the payload is not copied, the pieces carry it in place.
+    GatherBuffer out;
+    client.take_output(out);
+    CHECK(client.pending_output_size() == 0);
+    REQUIRE(out.splices().size() == 1);
+    CHECK(out.splices()[0].bytes.data() == payload.data());
+    out.for_each_piece([&](std::span<const std::byte> piece) { REQUIRE(server.feed(piece, t0)); });
+    auto got = next_event<StreamMessage>(server);
+    REQUIRE(got);
+    CHECK(got->message.entries == m.entries);
+
+    // Contiguous (pending_output, as the wasm client writes): the same bytes, the splice copied in.
+    REQUIRE(client.send(m, t0));
+    const auto flat = drain(client);
+    std::vector<std::byte> gathered;
+    out.for_each_piece([&](std::span<const std::byte> piece) { gathered.insert(gathered.end(), piece.begin(), piece.end()); });
+    CHECK(flat == gathered);
+    REQUIRE(server.feed(flat, t0));
+    got = next_event<StreamMessage>(server);
+    REQUIRE(got);
+    CHECK(got->message.entries == m.entries);
+
+    // A large encoded entry held by a shared_ptr is spliced, not copied, into each message.
+    MessageEntry wire;
+    wire.entry_type = MessageEntryType::WirePacket;
+    wire.service_path = "svc";
+    wire.member_name = "frames";
+    wire.elements.push_back(make_array_element("value", std::span<const double>(values)));
+    auto entry = std::make_shared<const EncodedEntry>(wire);
+    Message header;
+    header.header.sender_node_id = kServerId;
+    header.header.receiver_node_id = kClientId;
+    REQUIRE(server.send(Message(header), *entry, t0));
+    REQUIRE(server.send(Message(header), *entry, t0));
+    GatherBuffer fan_out;
+    server.take_output(fan_out);
+    REQUIRE(fan_out.splices().size() == 2);
+    CHECK(fan_out.splices()[0].bytes.data() == fan_out.splices()[1].bytes.data());
+    const auto before = client.pending_output_size();
+    fan_out.for_each_piece([&](std::span<const std::byte> piece) { REQUIRE(client.feed(piece, t0)); });
+    CHECK(client.pending_output_size() == before);
+    for (int i = 0; i < 2; ++i) {
+        got = next_event<StreamMessage>(client);
+        REQUIRE(got);
+        REQUIRE(got->message.entries.size() == 1);
+        CHECK(got->message.entries[0] == wire);
+    }
+}

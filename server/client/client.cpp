@@ -59,7 +59,8 @@ public:
     explicit Logic(ClientContextConfig config) : ctx(std::move(config), mono_now()) {}
     void on_bytes(std::span<const std::byte> bytes, MonoTime now) override { (void)ctx.feed(bytes, now); }
     bool has_output() const override { return ctx.pending_output_size() != 0; }
-    void take_output(std::vector<std::byte>& out) override { ctx.take_output(out); }
+    void take_output(GatherBuffer& out) override { ctx.take_output(out); }
+    std::span<std::byte> read_space() override { return ctx.read_space(); }
     std::optional<MonoTime> next_deadline() const override { return ctx.next_deadline(); }
     void on_timer(MonoTime now) override { ctx.on_timer(now); }
     bool wants_close() const override { return ctx.is_closed(); }

@@ -20,7 +20,8 @@ public:
         dispatch();
     }
     bool has_output() const override { return session_.pending_output_size() != 0; }
-    void take_output(std::vector<std::byte>& out) override {
+    std::span<std::byte> read_space() override { return session_.read_space(); }
+    void take_output(GatherBuffer& out) override {
         session_.take_output(out);
         if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
     }

@@ -286,7 +286,7 @@ void ServerConnection::on_bytes(std::span<const std::byte> bytes, MonoTime now) 
     drain_events();
 }
 
-void ServerConnection::take_output(std::vector<std::byte>& out) {
+void ServerConnection::take_output(GatherBuffer& out) {
     session_.take_output(out);
     stats_->bytes_out.fetch_add(out.size(), std::memory_order_relaxed);
     update_queue_estimate();

@@ -132,7 +132,8 @@ public:
     void attach(std::weak_ptr<PumpHandle> pump) override { pump_ = std::move(pump); }
     void on_bytes(std::span<const std::byte> bytes, MonoTime now) override;
     bool has_output() const override { return session_.pending_output_size() != 0; }
-    void take_output(std::vector<std::byte>& out) override;
+    void take_output(GatherBuffer& out) override;
+    std::span<std::byte> read_space() override { return session_.read_space(); }
     std::optional<MonoTime> next_deadline() const override { return session_.next_deadline(); }
     void on_timer(MonoTime now) override;
     bool wants_close() const override { return session_.is_closed(); }

@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "core/codec/gather_buffer.hpp"
 #include "core/error/rr_error.hpp"
 #include "core/session/stream_connection.hpp"
 
@@ -26,11 +27,16 @@ public:
     virtual void attach(std::weak_ptr<PumpHandle> pump) {}
     /// Bytes arrived. Protocol errors are handled inside (they make wants_close() true).
     virtual void on_bytes(std::span<const std::byte> bytes, MonoTime now) = 0;
+    /// Where the pump may read the next bytes instead of its own buffer (the rest of a large message,
+    /// read into its final buffer: StreamConnection::read_space); it then passes them to on_bytes() as
+    /// usual. Empty: the pump's buffer.
+    virtual std::span<std::byte> read_space() { return {}; }
     /// True when bytes are waiting to be written.
     virtual bool has_output() const = 0;
-    /// Moves every pending byte into `out` (cleared first; swapping buffers keeps this copy-free).
-    /// The pump writes `out` while the logic keeps queueing into its own buffer.
-    virtual void take_output(std::vector<std::byte>& out) = 0;
+    /// Moves every pending byte into `out` (cleared first; swapping buffers keeps this copy-free), large
+    /// shared payloads as splices (GatherBuffer). The pump writes `out` with one gathered write while
+    /// the logic keeps queueing into its own buffer.
+    virtual void take_output(GatherBuffer& out) = 0;
     virtual std::optional<MonoTime> next_deadline() const = 0;
     virtual void on_timer(MonoTime now) = 0;
     /// True once the logic is finished; the pump closes the socket after flushing pending_output().

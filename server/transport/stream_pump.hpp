@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <type_traits>
 #include <variant>
 
@@ -175,16 +176,20 @@ private:
         }
         read_paused_ = false;
         reading_ = true;
-        auto on_read = [self = this->shared_from_this()](boost::system::error_code ec, std::size_t n) {
+        // The rest of a large message goes straight into its final buffer; everything else through ours.
+        std::span<std::byte> into = logic_->read_space();
+        if (into.empty()) into = buffer_;
+        auto on_read = [self = this->shared_from_this(), at = into.data()](boost::system::error_code ec, std::size_t n) {
             self->reading_ = false;
             if (self->closed_) return;
             if (ec) {
                 self->transport_failed(ec);
                 return;
             }
-            const std::span<const std::byte> got(self->buffer_.data(), n);
-            self->logic_->on_bytes(got, mono_now());
+            const std::span<const std::byte> got(at, n);
+            // Paced first: bytes read in place may be released by on_bytes (a completed message).
             if (self->throttle_) self->pace(got);
+            self->logic_->on_bytes(got, mono_now());
             self->after_work();
             if (!self->closed_ && !self->logic_->wants_close()) self->read();
         };
@@ -192,7 +197,8 @@ private:
         // it without the type-erased executor's copies and indirect calls (issue 14, bench/profile.sh).
         std::visit(
             [&](const auto& strand) {
-                stream_.async_read_some(asio::buffer(buffer_), asio::bind_executor(strand, std::move(on_read)));
+                stream_.async_read_some(asio::buffer(into.data(), into.size()),
+                                        asio::bind_executor(strand, std::move(on_read)));
             },
             read_strand_);
     }
@@ -228,11 +234,26 @@ private:
             return;
         }
         logic_->take_output(write_buffer_);
-        std::size_t written = 0;
+        if (write_buffer_.splices().empty()) {
+            const auto& owned = write_buffer_.owned();
+            write_out(asio::const_buffer(owned.data(), owned.size()));
+            return;
+        }
+        // Large payloads shared with other sessions or the received frame: one gathered write.
+        pieces_.clear();
+        write_buffer_.for_each_piece(
+            [this](std::span<const std::byte> piece) { pieces_.emplace_back(piece.data(), piece.size()); });
+        write_out(std::span<asio::const_buffer>(pieces_));
+    }
+
+    // Writes `buffers` (views of write_buffer_), directly from the strand when the socket allows, the
+    // rest asynchronously; write_buffer_ is cleared once all of it is written.
+    template <class Buffers>
+    void write_out(Buffers buffers) {
         if constexpr (DirectWriteSocket<Stream>) {
             if (direct_write_) {
                 boost::system::error_code ec;
-                written = stream_.write_some(asio::buffer(write_buffer_.data(), write_buffer_.size()), ec);
+                std::size_t written = stream_.write_some(buffers, ec);
                 if (ec == asio::error::would_block || ec == asio::error::try_again) {
                     written = 0;
                 } else if (ec) {
@@ -240,15 +261,16 @@ private:
                     transport_failed(ec);
                     return;
                 }
-                if (written == write_buffer_.size()) {
+                if (written == asio::buffer_size(buffers)) {
                     write_buffer_.clear();
                     return;
                 }
+                buffers = skip(buffers, written);
             }
         }
         writing_ = true;
         auto self = this->shared_from_this();
-        asio::async_write(stream_, asio::buffer(write_buffer_.data() + written, write_buffer_.size() - written),
+        asio::async_write(stream_, buffers,
                           asio::bind_allocator(allocator(), asio::bind_executor(strand_, [self](boost::system::error_code ec, std::size_t) {
                               self->writing_ = false;
                               self->write_buffer_.clear();
@@ -259,6 +281,16 @@ private:
                               }
                               self->after_work();
                           })));
+    }
+
+    static asio::const_buffer skip(asio::const_buffer buffer, std::size_t n) { return buffer + n; }
+    static std::span<asio::const_buffer> skip(std::span<asio::const_buffer> pieces, std::size_t n) {
+        while (!pieces.empty() && n >= pieces.front().size()) {
+            n -= pieces.front().size();
+            pieces = pieces.subspan(1);
+        }
+        if (n > 0) pieces.front() += n;
+        return pieces;
     }
 
     void arm_timer() {
@@ -342,7 +374,8 @@ private:
     std::optional<asio::steady_timer> throttle_timer_;
     bool throttled_ = false;
     std::array<std::byte, 64 * 1024> buffer_{};
-    std::vector<std::byte> write_buffer_;
+    GatherBuffer write_buffer_;
+    std::vector<asio::const_buffer> pieces_;  // write_buffer_'s pieces for a gathered write
     bool writing_ = false;
     bool direct_write_ = false;
     bool reading_ = false;
