@@ -47,8 +47,8 @@ public:
     void write_bytes(std::span<const std::byte> bytes) { out_.insert(out_.end(), bytes.begin(), bytes.end()); }
     /// Like write_bytes; into a GatherBuffer, a large range with an owner is spliced, not copied.
     void write_shared(const SharedBytes& bytes) {
-        if (gather_)
-            gather_->append(bytes);
+        if (gather_) [[unlikely]]
+            append_gathered(bytes);
         else
             write_bytes(bytes.bytes());
     }
@@ -58,6 +58,9 @@ public:
     }
 
 private:
+    // Out of line so that write_shared stays small enough to inline on the contiguous path.
+    [[gnu::noinline]] void append_gathered(const SharedBytes& bytes) { gather_->append(bytes); }
+
     std::vector<std::byte>& out_;
     std::size_t start_;
     GatherBuffer* gather_ = nullptr;

@@ -73,11 +73,14 @@ public:
     /// Empties the buffer, keeping its capacity; releases the spliced ranges.
     void clear() noexcept {
         owned_.clear();
-        splices_.clear();
-        spliced_ = 0;
+        if (!splices_.empty()) {  // the common case has none: no call into the vector's erase
+            splices_.clear();
+            spliced_ = 0;
+        }
     }
     void swap(GatherBuffer& other) noexcept {
         owned_.swap(other.owned_);
+        if (splices_.empty() && other.splices_.empty()) return;  // the common case: both keep their capacity
         splices_.swap(other.splices_);
         std::swap(spliced_, other.spliced_);
     }

@@ -89,8 +89,7 @@ std::shared_ptr<std::byte[]> MessageStreamReader::small_frame(std::size_t size) 
 }
 #endif
 
-std::span<std::byte> MessageStreamReader::read_space() {
-    if (error_ || expected_ == 0 || frame_ || !large_ || expected_ - large_fill_ < kDirectReadMinBytes) return {};
+std::span<std::byte> MessageStreamReader::large_read_space() {
     if (large_capacity_ - large_fill_ < kDirectReadMinBytes) {
         // The growth rule of feed(): the whole MessageSize once a quarter has arrived, else doubling
         // (the buffer is at least 3/4 full here, so still at most 4 × the bytes received).

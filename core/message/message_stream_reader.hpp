@@ -49,7 +49,11 @@ public:
     /// empty otherwise. The span ends at or before the message's end. Passing those bytes (the span's
     /// start, at most its size) to feed() next adds them without a copy; any other feed() is as usual.
     /// May grow the buffer, under the rule above.
-    std::span<std::byte> read_space();
+    std::span<std::byte> read_space() {
+        // Inline: the pump asks before every read, and between large messages the answer is no.
+        if (!large_ || expected_ - large_fill_ < kDirectReadMinBytes || error_) return {};
+        return large_read_space();
+    }
 
     /// The next complete message, bytes exactly as received; nullopt if none is complete yet.
     std::optional<SharedBytes> take_frame();
@@ -85,6 +89,8 @@ private:
     /// A buffer for a message of `size` ≤ kInitialBufferBytes bytes: spare_frame_ when it fits and
     /// nothing else holds it.
     std::shared_ptr<std::byte[]> small_frame(std::size_t size);
+    /// read_space() once a large message is being assembled.
+    std::span<std::byte> large_read_space();
     /// Moves the large message's bytes so far into a new buffer of `capacity` bytes.
     void grow_large(std::size_t capacity);
 

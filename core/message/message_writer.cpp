@@ -33,37 +33,46 @@ Result<std::size_t> encoded_size(const Message& message) {
 
 namespace {
 
-// Measures, reserves once, writes: `measure` and `write` take the ByteWriter-less / ByteWriter half.
-// Into a GatherBuffer only the bytes it does not splice are reserved.
+// Reserves for `copied` more bytes with geometric growth: `out` may be a connection's pending output
+// that many messages are appended to.
+void reserve_for(std::vector<std::byte>& out, std::size_t copied) {
+    const std::size_t start = out.size();
+    if (out.capacity() - start < copied) out.reserve(std::max<std::size_t>(start + copied, 2 * out.capacity()));
+}
+
+template <class Write>
+Result<void> write_contiguous(std::vector<std::byte>& out, std::size_t size, Write&& write) {
+    const std::size_t start = out.size();
+    reserve_for(out, size);
+    ByteWriter w(out);
+    write(w);
+    if (w.written() != size) {  // measure and write disagree: a bug here, never the caller's
+        out.resize(start);
+        return fail(MessageErrorType::InternalError, "message writer size mismatch");
+    }
+    return {};
+}
+
+// Measures, reserves once, writes. Into a GatherBuffer only the bytes it does not splice are reserved;
+// a message with nothing to splice (every small one) takes the contiguous path.
 template <class Out, class Measure, class Write>
 Result<void> append_measured(Out& out, const detail::MessageEncoder& encoder, Measure&& measure, Write&& write) {
     auto size = measure();
     if (!size) return size.take_error();
-    constexpr bool gathered = std::is_same_v<Out, GatherBuffer>;
-    std::vector<std::byte>& owned = [&]() -> std::vector<std::byte>& {
-        if constexpr (gathered) return out.owned(); else return out;
-    }();
-    const std::size_t copied = gathered ? static_cast<std::size_t>(*size - encoder.spliced_bytes()) : *size;
-    const std::size_t start = owned.size();
-    // Geometric growth: `out` may be a connection's pending output that many messages are appended to.
-    if (owned.capacity() - start < copied) owned.reserve(std::max<std::size_t>(start + copied, 2 * owned.capacity()));
-    if constexpr (gathered) {
+    if constexpr (std::is_same_v<Out, GatherBuffer>) {
+        if (encoder.spliced_bytes() == 0) return write_contiguous(out.owned(), *size, write);
         const auto mark = out.mark();
-        ByteWriter w(out);
-        write(w);
-        if (w.written() != *size) {  // measure and write disagree: a bug here, never the caller's
-            out.rollback(mark);
-            return fail(MessageErrorType::InternalError, "message writer size mismatch");
-        }
-    } else {
+        reserve_for(out.owned(), static_cast<std::size_t>(*size - encoder.spliced_bytes()));
         ByteWriter w(out);
         write(w);
         if (w.written() != *size) {
-            out.resize(start);
+            out.rollback(mark);
             return fail(MessageErrorType::InternalError, "message writer size mismatch");
         }
+        return {};
+    } else {
+        return write_contiguous(out, *size, write);
     }
-    return {};
 }
 
 template <class Out>

@@ -412,12 +412,15 @@ Result<void> StreamConnection::append_encoded(const Message& m, MonoTime now) {
 }
 
 Result<void> StreamConnection::check_appended(const GatherBuffer::Mark& before, MonoTime now) {
-    if (output_.size() - (before.owned + before.spliced) > send_limit()) {
-        output_.rollback(before);
-        return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
-    }
+    if (output_.size() - (before.owned + before.spliced) > send_limit()) [[unlikely]]
+        return refuse_appended(before);
     last_send_ = now;
     return {};
+}
+
+Result<void> StreamConnection::refuse_appended(const GatherBuffer::Mark& before) {
+    output_.rollback(before);
+    return fail(MessageErrorType::BufferLimitViolation, "message larger than the connection's limit");
 }
 
 void StreamConnection::set_session_established(std::uint32_t local_endpoint, std::uint32_t remote_endpoint) {

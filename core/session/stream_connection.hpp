@@ -185,6 +185,7 @@ private:
     Result<void> append_encoded(const Message& m, MonoTime now);
     /// Undoes what was appended since `before` if the message is over the send limit.
     Result<void> check_appended(const GatherBuffer::Mark& before, MonoTime now);
+    [[gnu::noinline]] Result<void> refuse_appended(const GatherBuffer::Mark& before);
     void close(RRError error);
     std::size_t send_limit() const noexcept;
     std::size_t receive_limit() const noexcept;
