@@ -1,7 +1,8 @@
 // Checks shared by the message codec fuzz targets (fuzz_message_reader, fuzz_message_structured):
-// decode arbitrary bytes as one message and as a stream split at input-dependent offsets. Whatever
-// decodes must encode again, decode to an equal model, and encode to the same bytes; a v2 message
-// must also survive conversion to v4 and back. Any violation aborts.
+// decode arbitrary bytes as one message and as a stream split at input-dependent offsets, and as a
+// stream a host reads in place (read_space). Whatever decodes must encode again, decode to an equal
+// model, and encode to the same bytes, gathered (GatherBuffer) or not; a v2 message must also survive
+// conversion to v4 and back. Any violation aborts.
 #pragma once
 
 #include <algorithm>
@@ -44,6 +45,13 @@ inline void check_round_trip(const Message& m) {
     check(*back == m);
     auto again = encode_message(*back);
     check(again.ok() && *again == *bytes);
+    // Gathered: the decoded payloads are views into `bytes`, spliced when large; the pieces in order
+    // are the same bytes.
+    GatherBuffer gathered;
+    check(encode_message(*back, gathered).ok() && gathered.size() == bytes->size());
+    std::vector<std::byte> joined;
+    gathered.for_each_piece([&](std::span<const std::byte> p) { joined.insert(joined.end(), p.begin(), p.end()); });
+    check(std::equal(joined.begin(), joined.end(), bytes->bytes().begin(), bytes->bytes().end()));
     if (m.version == 2) {  // v2 -> v4 is lossless
         Message v4 = m;
         v4.version = 4;
@@ -100,6 +108,33 @@ inline void check_message_input(const std::uint8_t* data, std::size_t size) {
         check(reader.failed());
         check(!reader.feed(input.first(std::min<std::size_t>(size, 1))).ok());
         check(!reader.take_frame());
+    }
+
+    // 3. The input as a host reads it: into read_space() when offered (a large message's own buffer),
+    // else in chunks through its own buffer. Same frames, same verdict as one feed of everything.
+    MessageStreamReader whole(limits), in_place(limits);
+    const bool whole_ok = whole.feed(input).ok();
+    bool place_ok = true;
+    for (std::size_t at = 0; at < size && place_ok;) {
+        auto space = in_place.read_space();
+        const std::size_t n = std::min(size - at, space.empty() ? std::size_t{4096} : space.size());
+        if (space.empty()) {
+            place_ok = in_place.feed(input.subspan(at, n)).ok();
+        } else {
+            check(in_place.partial_capacity() <= std::max<std::size_t>(64 * 1024, 4 * in_place.partial_bytes()));
+            std::copy_n(input.begin() + static_cast<std::ptrdiff_t>(at), n, space.begin());
+            place_ok = in_place.feed(space.first(n)).ok();
+        }
+        at += n;
+    }
+    check(place_ok == whole_ok);
+    if (whole_ok) {
+        check(in_place.partial_bytes() == whole.partial_bytes());
+        while (auto f = whole.take_frame()) {
+            auto g = in_place.take_frame();
+            check(g.has_value() && *g == *f);
+        }
+        check(!in_place.take_frame());
     }
 }
 
