@@ -11,6 +11,7 @@
 #include "server/gateway/device_mirror.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
+#include "server/node/test_node.hpp"
 #include "server/service/object_service.hpp"
 #include "server/service/wire_member.hpp"
 #include "server/transport/tcp_listener.hpp"
@@ -19,28 +20,22 @@ using namespace rr;
 using namespace rr::server;
 using namespace std::chrono_literals;
 using rr::client::Client;
+using rr::server::testing::test_node;
 
 namespace {
 
-constexpr const char* kDef =
+constexpr const char* kLargeDef =
     "service example.large\n\nstdver 0.10\n\nobject Obj\n    function double[] echo(double[] d)\n"
     "    wire uint8[] frame [readonly]\nend\n";
 
-std::shared_ptr<Node> test_node(const char* name) {
-    NodeOptions o;
-    o.node_name = name;
-    o.threads = 2;
-    return Node::create(std::move(o));
-}
-
-struct Device {
+struct LargeDevice {
     std::shared_ptr<Node> node = test_node("large.device");
     std::shared_ptr<http::HttpServer> http;  // kept alive: the listener holds it weakly
     std::shared_ptr<WireMember> frame;
     std::uint16_t port = 0;
 
-    Device() {
-        auto types = ServiceTypes::create({kDef});
+    LargeDevice() {
+        auto types = ServiceTypes::create({kLargeDef});
         REQUIRE(types);
         auto root = ServiceObject::create(*types, "example.large.Obj");
         REQUIRE(root);
@@ -60,26 +55,26 @@ struct Device {
         REQUIRE(p);
         port = *p;
     }
-    ~Device() { node->shutdown(); }
+    ~LargeDevice() { node->shutdown(); }
 };
 
 // 1 Mi doubles (8 MiB), every one distinct, so a misplaced or repeated piece shows.
-Value big_array(double offset) {
+Value large_array(double offset) {
     std::vector<double> d(1 << 20);
     for (std::size_t i = 0; i < d.size(); ++i) d[i] = offset + static_cast<double>(i) * 0.25;
     return Value::array<double>(std::span<const double>(d));
 }
 
-std::shared_ptr<Client> connect(rr::client::IoThreads& io, const std::string& url) {
+std::shared_ptr<Client> connect_client(rr::client::IoThreads& io, const std::string& url) {
     auto c = Client::connect(io.executor(), url, {});
     INFO(url << ": " << (c ? std::string() : c.error().message));
     REQUIRE(c);
     return *c;
 }
 
-void echo_twice(Client& c) {
+void echo_large_twice(Client& c) {
     for (double offset : {1.0, -7.5}) {
-        const Value sent = big_array(offset);
+        const Value sent = large_array(offset);
         auto got = c.root().call("echo", {sent});
         INFO((got ? std::string() : got.error().message));
         REQUIRE(got);
@@ -90,18 +85,18 @@ void echo_twice(Client& c) {
 }  // namespace
 
 TEST_CASE("large payloads: an 8 MiB array round-trips intact over rr+tcp and rr+ws") {
-    Device device;
+    LargeDevice device;
     rr::client::IoThreads io{2};
     for (std::string scheme : {"rr+tcp", "rr+ws"}) {
         INFO(scheme);
-        auto c = connect(io, scheme + "://127.0.0.1:" + std::to_string(device.port) + "/?service=svc");
-        echo_twice(*c);
+        auto c = connect_client(io, scheme + "://127.0.0.1:" + std::to_string(device.port) + "/?service=svc");
+        echo_large_twice(*c);
         REQUIRE(c->close_wait());
     }
 }
 
 TEST_CASE("large payloads: through the gateway, requests and replies forwarded, a wire value fanned out") {
-    Device device;
+    LargeDevice device;
     auto gateway_node = test_node("large.gateway");
     gateway::DeviceConfig cfg;
     cfg.name = "dev";
@@ -117,9 +112,9 @@ TEST_CASE("large payloads: through the gateway, requests and replies forwarded, 
 
     rr::client::IoThreads io{2};
     const std::string url = "rr+tcp://127.0.0.1:" + std::to_string(*port) + "/?service=dev";
-    auto a = connect(io, url);
-    auto b = connect(io, url);
-    echo_twice(*a);
+    auto a = connect_client(io, url);
+    auto b = connect_client(io, url);
+    echo_large_twice(*a);
 
     // One 4 MiB frame to two clients: one encoding shared by both sessions' writes.
     auto wa = a->root().wire_connect("frame");

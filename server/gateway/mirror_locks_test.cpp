@@ -10,6 +10,7 @@
 #include "server/gateway/auth/mirror_access.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/mirror_service.hpp"
+#include "server/node/test_node.hpp"
 #include "server/service/object_service_fixture.hpp"
 #include "test/support/eventually.hpp"
 
@@ -40,17 +41,10 @@ object Gripper
 end
 )";
 
-std::shared_ptr<Node> make_lock_node(const char* name) {
-    NodeOptions o;
-    o.node_name = name;
-    o.threads = 2;
-    return Node::create(std::move(o));
-}
-
 struct ArmDevice {
     std::shared_ptr<ServiceObject> root, gripper;
     std::shared_ptr<ObjectService> service;
-    std::shared_ptr<Node> node = make_lock_node("arm.node");
+    std::shared_ptr<Node> node = test_node("arm.node");
     std::uint16_t port = 0;
 
     ArmDevice() {
@@ -76,7 +70,7 @@ struct ArmDevice {
 /// The gateway in front of ArmDevice as device "dev" (auth: shared), with gateway users when `users`.
 struct LockGateway {
     ArmDevice device;
-    std::shared_ptr<Node> node = make_lock_node("gateway.node");
+    std::shared_ptr<Node> node = test_node("gateway.node");
     std::shared_ptr<DeviceMirror> mirror;
     std::uint16_t port = 0;
 

@@ -9,6 +9,7 @@
 #include "server/client/raw_client.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/node/node.hpp"
+#include "server/node/test_node.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
 
@@ -17,15 +18,9 @@ using namespace rr::server;
 using namespace rr::server::gateway;
 using namespace std::chrono_literals;
 using testing::RawTestService;
+using testing::test_node;
 
 namespace {
-
-std::shared_ptr<Node> test_node(const char* name) {
-    NodeOptions o;
-    o.node_name = name;
-    o.threads = 2;
-    return Node::create(std::move(o));
-}
 
 struct Device {
     std::shared_ptr<Node> node;

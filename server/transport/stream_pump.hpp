@@ -60,7 +60,7 @@ public:
     /// True when the calling thread is known not to be running the pump's strand (a wake from it
     /// cannot run at once). False on the strand, and when the strand cannot tell.
     virtual bool known_off_strand() const { return false; }
-    /// Closes the transport (after flushing what is pending).
+    /// Closes the transport after flushing what is pending; reads nothing more meanwhile.
     virtual void close() = 0;
 };
 
@@ -169,7 +169,9 @@ public:
 
 private:
     void read() {
-        if (reading_ || throttled_) return;
+        // Once close() is asked for, nothing more is read: a peer that keeps sending (a flood of
+        // requests) must not keep the connection from draining and closing before its node stops.
+        if (reading_ || throttled_ || close_requested_) return;
         if (!logic_->wants_read()) {
             read_paused_ = true;  // resumed by after_work() once the output has drained
             return;
