@@ -53,6 +53,11 @@ void Node::shutdown() {
     for (auto& t : threads_)
         if (t.joinable() && t.get_id() != std::this_thread::get_id()) t.join();
     threads_.clear();
+    // A connection that had not closed within the moment (still flushing to a peer that floods it,
+    // or a loaded machine) is closed now: its peer must see the end rather than wait on an open
+    // socket until its receive timeout. No thread runs the pumps any more.
+    for (auto& w : pumps)
+        if (auto p = w.lock()) p->close_now();
 }
 
 void Node::add_listener(std::shared_ptr<Listener> listener) {

@@ -576,36 +576,43 @@ TEST_CASE("requests racing the end of the client's transport are each answered o
         REQUIRE(r);
         c = *r;
     }
-    constexpr int kRequests = 2000;
+    // The sender keeps requesting until the client has seen its transport end, then a few more: the
+    // requests meet a live service, the shutdown in progress, and the ended transport.
+    constexpr int kMaxRequests = 200000;
     struct Tally {
-        std::vector<std::atomic<int>> calls = std::vector<std::atomic<int>>(kRequests);
+        std::vector<std::atomic<int>> calls = std::vector<std::atomic<int>>(kMaxRequests);
         std::atomic<int> answered{0}, replies{0}, errors{0};
     };
     auto tally = std::make_shared<Tally>();
+    std::atomic<int> sent{0};
     std::thread sender([&] {
-        for (int i = 0; i < kRequests; ++i) {
+        int after_end = 0;
+        for (int i = 0; i < kMaxRequests && after_end < 20; ++i) {
+            if (!c->is_open()) ++after_end;
             c->request(add_call(i, 1), [tally, i](Result<MessageEntry> r) {
                 tally->calls[i].fetch_add(1);
                 (r ? tally->replies : tally->errors).fetch_add(1);
                 tally->answered.fetch_add(1);
             });
+            sent.store(i + 1);
+            if (i % 64 == 63) std::this_thread::sleep_for(100us);  // a flood, not an unbounded queue
         }
     });
-    // The device goes away while the requests are being queued.
+    // The device goes away while the requests are being made.
     while (tally->answered.load() < 50) std::this_thread::sleep_for(1ms);
     f.node->shutdown();
     sender.join();
-    for (int i = 0; i < 1000 && tally->answered.load() < kRequests; ++i) std::this_thread::sleep_for(10ms);
-    CHECK(tally->answered.load() == kRequests);
+    const int requests = sent.load();
+    REQUIRE(requests < kMaxRequests);  // the client saw its transport end
+    for (int i = 0; i < 1000 && tally->answered.load() < requests; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(tally->answered.load() == requests);
     int wrong = 0;
-    for (auto& n : tally->calls) wrong += n.load() != 1;
+    for (int i = 0; i < requests; ++i) wrong += tally->calls[i].load() != 1;
     CHECK(wrong == 0);
     CHECK(tally->replies.load() >= 50);
-    // Whether some requests met the closed transport depends on timing (a loaded machine may answer
-    // all 2,000 before the close): the exactly-once checks above are the assertions, this only says.
-    if (tally->errors.load() == 0) WARN("the shutdown came after every request was answered: the race window was missed");
+    CHECK(tally->errors.load() >= 20);  // at least those made after the end
     // Once the transport has ended, a request is answered ConnectionError at once.
-    for (int i = 0; i < 500 && c->is_open(); ++i) std::this_thread::sleep_for(10ms);
+    CHECK_FALSE(c->is_open());
     bool called = false;
     c->request(add_call(1, 2), [&](Result<MessageEntry> r) {
         called = true;

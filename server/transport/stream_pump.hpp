@@ -62,6 +62,10 @@ public:
     virtual bool known_off_strand() const { return false; }
     /// Closes the transport after flushing what is pending; reads nothing more meanwhile.
     virtual void close() = 0;
+    /// Closes the transport at once, unflushed, and reports it to the logic. Only for a caller that
+    /// knows no thread runs the pump's executor: a node whose threads have stopped before a close()
+    /// could finish (a peer still flooding it, a loaded machine), so that its peer sees the end.
+    virtual void close_now() {}
 };
 
 template <class Stream>
@@ -163,6 +167,8 @@ public:
             self->after_work();
         });
     }
+
+    void close_now() override { shutdown(); }
 
     Stream& stream() { return stream_; }
     const Strand& strand() const { return strand_; }
