@@ -4,6 +4,7 @@
 #include <charconv>
 #include <stdexcept>
 
+#include "core/json/element_json_text.hpp"
 #include "core/value/timespec.hpp"
 #include "server/gateway/binary_push.hpp"
 
@@ -65,6 +66,63 @@ nlohmann::json wire_push_body(const JsonApi& api, const MessageEntry& packet, co
         msg["time"] = time_json(time->seconds, time->nanoseconds);
     }
     return msg;
+}
+
+std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target) {
+    // The direct path writes what json_text(wire_push_body(…)) would: nlohmann sorts an object's keys.
+    const auto* p = packet.find("packet");
+    const auto* ts = packet.find("packettime");
+    if (p && ts && element_json_text::renders(target.member->type)) {
+        if (auto time = unpack_timespec(*ts)) {
+            std::string out = "{\"time\":{\"nanoseconds\":";
+            char digits[24];
+            out.append(digits, std::to_chars(digits, digits + sizeof digits, time->nanoseconds).ptr);
+            out += ",\"seconds\":";
+            out.append(digits, std::to_chars(digits, digits + sizeof digits, time->seconds).ptr);
+            out += "},\"value\":";
+            if (element_json_text::append(out, *p, target.member->type)) {
+                out += '}';
+                return out;
+            }
+        }
+    }
+    return json_text(wire_push_body(api, packet, target));
+}
+
+std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target) {
+    const auto& params = target.member->parameters;
+    const bool direct = std::all_of(params.begin(), params.end(), [](const robdef::TypeDefinition& p) {
+        return element_json_text::renders(p);
+    });
+    if (direct) {
+        // In nlohmann's key order (parameter names are identifiers: nothing to escape).
+        std::vector<const robdef::TypeDefinition*> sorted;
+        sorted.reserve(params.size());
+        for (const auto& p : params) sorted.push_back(&p);
+        std::sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) { return a->name < b->name; });
+        std::string out = "{\"args\":{";
+        bool ok = true;
+        for (const auto* p : sorted) {
+            const auto* el = event.find(p->name);
+            if (!el) {
+                ok = false;
+                break;
+            }
+            if (p != sorted.front()) out += ',';
+            out += '"';
+            out += p->name;
+            out += "\":";
+            if (!element_json_text::append(out, *el, *p)) {
+                ok = false;
+                break;
+            }
+        }
+        if (ok) {
+            out += "}}";
+            return out;
+        }
+    }
+    return json_text(event_push_body(api, event, target));
 }
 
 nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,

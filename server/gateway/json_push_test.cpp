@@ -5,7 +5,10 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/message/error_entry.hpp"
 #include "core/session/elements.hpp"
+#include "core/value/numeric_array.hpp"
+#include "core/value/pack_value.hpp"
 #include "core/value/timespec.hpp"
 #include "server/gateway/binary_push.hpp"
 #include "server/gateway/json_push.hpp"
@@ -95,4 +98,149 @@ TEST_CASE("json push: what the device sent without the elements it needs becomes
     auto event = event_push_body(api, no_args, target);
     CHECK(event.at("error").at("message") == "event from the device has no \"x\" element");
     CHECK_FALSE(event.contains("args"));
+}
+
+namespace {
+
+constexpr const char* kPushDef = R"(service example.push
+
+stdver 0.10
+
+struct Pose
+    field double x
+    field string frame
+end
+
+object Sensor
+    wire double[] samples [readonly]
+    wire uint8[] frame [readonly]
+    wire int64 ticks [readonly]
+    wire cdouble[2] phasor [readonly]
+    wire bool[4-] flags [readonly]
+    wire Pose pose [readonly]
+    wire string label [readonly]
+    event moved(double y, int32[] ids, bool done)
+    event noted(string text, double at)
+    event nothing()
+end
+)";
+
+struct PushTargets {
+    std::shared_ptr<const DeviceTypes> types;
+    DeviceTypes::Object object;
+
+    PushTargets() {
+        auto t = DeviceTypes::parse({kPushDef});
+        INFO((t ? std::string() : t.error().message));
+        REQUIRE(t);
+        types = *t;
+        auto o = types->find_object("example.push.Sensor");
+        REQUIRE(o);
+        object = *o;
+    }
+    MemberTarget operator()(std::string_view member) const {
+        MemberTarget target;
+        target.types = types;
+        target.service = object.service;
+        target.object = object.entry;
+        target.member = object.entry->find_member(member);
+        REQUIRE(target.member);
+        return target;
+    }
+};
+
+template <class T>
+MessageElement array_of(std::string name, std::vector<T> items) {
+    MessageElement e;
+    e.name = std::move(name);
+    e.type = numeric_type_v<T>;
+    std::vector<std::byte> bytes(items.size() * sizeof(T));
+    for (std::size_t i = 0; i < items.size(); ++i) rr::detail::store_item<T>(bytes.data() + i * sizeof(T), items[i]);
+    e.data = SharedBytes::adopt(std::move(bytes));
+    return e;
+}
+
+MessageEntry wire_packet(MessageElement value, TimeSpec time = {1700000000, 123456789}) {
+    MessageEntry e;
+    value.name = "packet";
+    e.elements.push_back(std::move(value));
+    e.elements.push_back(pack_timespec(time, "packettime"));
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("json push: a wire value's text, written straight from its element, is the general path's") {
+    JsonApi api({});
+    PushTargets targets;
+    struct Case {
+        const char* member;
+        MessageElement packet;
+    };
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::vector<Case> cases;
+    cases.push_back({"samples", array_of<double>("", {0.0, -1.5, 0.1, 1e300, nan, 12345678.0})});
+    cases.push_back({"samples", array_of<double>("", {})});
+    cases.push_back({"frame", array_of<std::uint8_t>("", {0, 7, 255, 128})});
+    cases.push_back({"ticks", make_scalar_element<std::int64_t>("", std::int64_t{1} << 60)});
+    cases.push_back({"phasor", array_of<cdouble>("", {{1, -2}, {0.25, nan}})});
+    cases.push_back({"flags", array_of<bool>("", {true, false, true})});
+    // The general path's own types, and its errors: the same text either way.
+    Structure pose{"example.push.Pose", {{"x", Value::scalar(2.5)}, {"frame", Value(std::string("map"))}}};
+    auto pose_el = pack_value(Value(std::move(pose)), targets("pose").member->type, "packet", targets.types->set(),
+                              "example.push");
+    REQUIRE(pose_el);
+    cases.push_back({"pose", *pose_el});
+    cases.push_back({"label", make_string_element("", "tab\there \"quoted\"")});
+    cases.push_back({"samples", array_of<std::int32_t>("", {1, 2})});          // another numeric type
+    cases.push_back({"ticks", array_of<std::int64_t>("", {1, 2})});            // two items for a scalar
+    cases.push_back({"phasor", array_of<cdouble>("", {{1, 2}})});              // one for exactly two
+    cases.push_back({"flags", array_of<bool>("", {true, true, true, true, true})});  // five for at most four
+    for (auto& c : cases) {
+        const MemberTarget target = targets(c.member);
+        const MessageEntry packet = wire_packet(c.packet);
+        INFO(c.member);
+        CHECK(wire_push_text(api, packet, target) == json_text(wire_push_body(api, packet, target)));
+    }
+    // Direct text really is what the direct path wrote: a value the general path would render too.
+    const auto text = wire_push_text(api, wire_packet(array_of<double>("", {1.0, 2.5})), targets("samples"));
+    CHECK(text == R"({"time":{"nanoseconds":123456789,"seconds":1700000000},"value":[1.0,2.5]})");
+    // A packet without its time, or with a broken one, is the general path's error body.
+    MessageEntry no_time;
+    no_time.elements.push_back(make_scalar_element<double>("packet", 1.0));
+    CHECK(json::parse(wire_push_text(api, no_time, targets("samples"))).at("error").at("name") ==
+          "RobotRaconteur.MessageElementNotFound");
+    MessageEntry bad_time = wire_packet(array_of<double>("", {1.0}));
+    bad_time.elements[1] = make_scalar_element<double>("packettime", 1.0);
+    CHECK(wire_push_text(api, bad_time, targets("samples")) == json_text(wire_push_body(api, bad_time, targets("samples"))));
+    CHECK(json::parse(wire_push_text(api, bad_time, targets("samples"))).contains("error"));
+}
+
+TEST_CASE("json push: an event's text, written straight from its elements, is the general path's") {
+    JsonApi api({});
+    PushTargets targets;
+    auto event_of = [](std::vector<MessageElement> elements) {
+        MessageEntry e;
+        e.elements = std::move(elements);
+        return e;
+    };
+    std::vector<std::pair<const char*, MessageEntry>> cases;
+    cases.emplace_back("moved", event_of({make_scalar_element<double>("y", 0.5), array_of<std::int32_t>("ids", {3, -4}),
+                                          make_scalar_element<bool>("done", true)}));
+    // Elements in another order than the parameters: the same object.
+    cases.emplace_back("moved", event_of({make_scalar_element<bool>("done", false), array_of<std::int32_t>("ids", {}),
+                                          make_scalar_element<double>("y", -0.0)}));
+    cases.emplace_back("nothing", event_of({}));
+    cases.emplace_back("noted", event_of({make_string_element("text", "hi"), make_scalar_element<double>("at", 2)}));
+    cases.emplace_back("moved", event_of({make_scalar_element<double>("y", 1), make_scalar_element<bool>("done", true)}));
+    cases.emplace_back("moved", event_of({make_scalar_element<double>("y", 1), array_of<double>("ids", {1}),
+                                          make_scalar_element<bool>("done", true)}));
+    for (auto& [member, event] : cases) {
+        const MemberTarget target = targets(member);
+        INFO(member);
+        CHECK(event_push_text(api, event, target) == json_text(event_push_body(api, event, target)));
+    }
+    CHECK(event_push_text(api, cases[0].second, targets("moved")) == R"({"args":{"done":true,"ids":[3,-4],"y":0.5}})");
+    CHECK(event_push_text(api, cases[2].second, targets("nothing")) == R"({"args":{}})");
+    CHECK(json::parse(event_push_text(api, cases[4].second, targets("moved"))).contains("error"));
 }

@@ -640,7 +640,7 @@ private:
             return send_push(sid, "event", ticket->dropped, e->rendered_binary([&](const MessageEntry& entry) {
                 return render_binary_body([&](BinaryArrays* b) { return event_push_body(*api_, entry, t, b); });
             }));
-        const std::string& body = e->rendered([&](const MessageEntry& entry) { return json_text(event_push_body(*api_, entry, t)); });
+        const std::string& body = e->rendered([&](const MessageEntry& entry) { return event_push_text(*api_, entry, t); });
         send_text_push(sid, "event", ticket->dropped, e, body);
     }
 
@@ -746,7 +746,7 @@ private:
                     continue;
                 }
                 const std::string& body =
-                    w.value->rendered([&](const MessageEntry& e) { return json_text(wire_push_body(*api_, e, t)); });
+                    w.value->rendered([&](const MessageEntry& e) { return wire_push_text(*api_, e, t); });
                 send_text_push(w.subscription, "wire", 0, w.value, body);
             }
             batch.clear();  // the values go now, the capacity stays

@@ -14,8 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "core/json/element_json_text.hpp"
+#include "core/json/value_json.hpp"
 #include "core/message/string_table.hpp"
 #include "core/value/pack_value.hpp"
+#include "robdef/service_definition_set.hpp"
 #include "test/fuzz/message_checks.hpp"
 
 extern "C" std::size_t LLVMFuzzerMutate(std::uint8_t* data, std::size_t size, std::size_t max_size);
@@ -272,6 +275,29 @@ extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t s
     return bytes->size();
 }
 
+// A numeric element as JSON text: the gateway's direct path writes what the general path (unpack_value,
+// value_to_json, nlohmann's dump) does, and declines exactly what the general path refuses.
+void check_json_text(const MessageElement& el) {
+    if (!is_numeric(el.type)) return;
+    static const robdef::ServiceDefinitionSet no_types;
+    for (auto array : {robdef::ArrayKind::array, robdef::ArrayKind::none}) {
+        robdef::TypeDefinition t;
+        t.base = el.type;
+        t.array = array;
+        t.array_var_length = true;
+        std::string direct;
+        const bool rendered = element_json_text::append(direct, el, t);
+        auto v = unpack_value(el, t, no_types, "");
+        if (!v) {
+            if (rendered) __builtin_trap();
+            continue;
+        }
+        auto j = value_to_json(*v, t, no_types, "");
+        if (!j || !rendered) __builtin_trap();
+        if (direct != j->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) __builtin_trap();
+    }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     rr::fuzz::check_message_input(data, size);
     // Values from a peer, without a definition: varvalue unpacking must fail cleanly or succeed.
@@ -280,6 +306,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     auto m = decode_message(SharedBytes::copy_of(rr::fuzz::as_bytes(data, size)), rr::fuzz::fuzz_limits());
     if (m)
         for (const auto& en : m->entries)
-            for (const auto& el : en.elements) (void)unpack_value_untyped(el, limits);
+            for (const auto& el : en.elements) {
+                (void)unpack_value_untyped(el, limits);
+                check_json_text(el);
+            }
     return 0;
 }
