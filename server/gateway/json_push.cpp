@@ -142,6 +142,23 @@ nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, co
 
 SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
                                        const MemberTarget& target, std::uint64_t dropped, bool binary) {
+    if (!binary && element_json_text::renders(target.member->type)) {
+        // What json_text(msg) below gives, nlohmann's keys sorted: dropped, kind, subscription, value.
+        std::string out = "{";
+        char digits[24];
+        if (dropped) {
+            out += "\"dropped\":";
+            out.append(digits, std::to_chars(digits, digits + sizeof digits, dropped).ptr);
+            out += ',';
+        }
+        out += "\"kind\":\"pipe\",\"subscription\":";
+        out.append(digits, std::to_chars(digits, digits + sizeof digits, sid).ptr);
+        out += ",\"value\":";
+        if (element_json_text::append(out, packet, target.member->type)) {
+            out += '}';
+            return {std::move(out), nullptr};
+        }
+    }
     nlohmann::json msg{{"subscription", sid}, {"kind", "pipe"}};
     BinaryArrays arrays;
     auto j = api.element_json(packet, target.member->type, target, binary ? &arrays : nullptr);

@@ -56,7 +56,8 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
 std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target);
 
 /// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; with the
-/// arrays part (and the text already binary_push_head's) when `binary` set any aside for a value.
+/// arrays part (and the text already binary_push_head's) when `binary` set any aside for a value. A text
+/// push of a numeric type is written straight from the element (element_json_text), the same text.
 SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
                                        const MemberTarget& target, std::uint64_t dropped, bool binary);
 

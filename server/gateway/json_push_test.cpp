@@ -122,6 +122,8 @@ object Sensor
     event moved(double y, int32[] ids, bool done)
     event noted(string text, double at)
     event nothing()
+    pipe double[] stream [readonly]
+    pipe Pose poses [readonly]
 end
 )";
 
@@ -243,4 +245,34 @@ TEST_CASE("json push: an event's text, written straight from its elements, is th
     CHECK(event_push_text(api, cases[0].second, targets("moved")) == R"({"args":{"done":true,"ids":[3,-4],"y":0.5}})");
     CHECK(event_push_text(api, cases[2].second, targets("nothing")) == R"({"args":{}})");
     CHECK(json::parse(event_push_text(api, cases[4].second, targets("moved"))).contains("error"));
+}
+
+TEST_CASE("json push: a pipe packet's text, written straight from its element, is the general path's") {
+    JsonApi api({});
+    PushTargets targets;
+    auto general = [](std::uint64_t sid, std::uint64_t dropped, const json& value) {
+        json msg{{"subscription", sid}, {"kind", "pipe"}, {"value", value}};
+        if (dropped) msg["dropped"] = dropped;
+        return json_text(msg);
+    };
+    const auto samples = array_of<double>("", {1.0, -0.5, 1e-9});
+    for (std::uint64_t dropped : {0, 3}) {
+        auto push = pipe_push(api, 7, samples, targets("stream"), dropped, false);
+        CHECK(push.arrays == nullptr);
+        CHECK(push.body == general(7, dropped, json{1.0, -0.5, 1e-9}));
+    }
+    // Binary subscribers, named types and mismatched packets keep the general path.
+    auto binary = pipe_push(api, 7, samples, targets("stream"), 0, true);
+    CHECK(binary.arrays != nullptr);
+    Structure pose{"example.push.Pose", {{"x", Value::scalar(2.5)}, {"frame", Value(std::string("map"))}}};
+    auto pose_el = pack_value(Value(std::move(pose)), targets("poses").member->type, "packet", targets.types->set(),
+                              "example.push");
+    REQUIRE(pose_el);
+    auto named = pipe_push(api, 8, *pose_el, targets("poses"), 0, false);
+    CHECK(named.body == general(8, 0, json{{"frame", "map"}, {"x", 2.5}}));
+    auto wrong = pipe_push(api, 9, array_of<std::int32_t>("", {1}), targets("stream"), 2, false);
+    auto j = json::parse(wrong.body);
+    CHECK(j.at("error").at("name") == "RobotRaconteur.DataTypeMismatch");
+    CHECK(j.at("dropped") == 2);
+    CHECK_FALSE(j.contains("value"));
 }
