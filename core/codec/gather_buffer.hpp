@@ -32,6 +32,8 @@ public:
         std::size_t owned;
         std::size_t splices;
         std::size_t spliced;
+        /// The buffer's size() when the mark was taken.
+        std::size_t size() const noexcept { return owned + spliced; }
     };
 
     /// Whether append() splices `bytes` rather than copying it.

@@ -412,7 +412,7 @@ Result<void> StreamConnection::append_encoded(const Message& m, MonoTime now) {
 }
 
 Result<void> StreamConnection::check_appended(const GatherBuffer::Mark& before, MonoTime now) {
-    if (output_.size() - (before.owned + before.spliced) > send_limit()) [[unlikely]]
+    if (output_.size() - before.size() > send_limit()) [[unlikely]]
         return refuse_appended(before);
     last_send_ = now;
     return {};
