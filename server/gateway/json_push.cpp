@@ -10,6 +10,15 @@
 
 namespace rr::server::gateway {
 
+namespace {
+// The decimal text of `v`, as nlohmann writes an integer.
+template <class Integer>
+void append_integer(std::string& out, Integer v) {
+    char digits[24];
+    out.append(digits, std::to_chars(digits, digits + sizeof digits, v).ptr);
+}
+}  // namespace
+
 PushHead push_head(std::uint64_t sid, std::string_view kind, std::uint64_t dropped, std::string_view body) {
     if (kind.size() > PushHead::kMaxKind) throw std::length_error("push kind longer than PushHead::kMaxKind");
     PushHead h;
@@ -75,10 +84,9 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
     if (p && ts && element_json_text::renders(target.member->type)) {
         if (auto time = unpack_timespec(*ts)) {
             std::string out = "{\"time\":{\"nanoseconds\":";
-            char digits[24];
-            out.append(digits, std::to_chars(digits, digits + sizeof digits, time->nanoseconds).ptr);
+            append_integer(out, time->nanoseconds);
             out += ",\"seconds\":";
-            out.append(digits, std::to_chars(digits, digits + sizeof digits, time->seconds).ptr);
+            append_integer(out, time->seconds);
             out += "},\"value\":";
             if (element_json_text::append(out, *p, target.member->type)) {
                 out += '}';
@@ -145,14 +153,13 @@ SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, co
     if (!binary && element_json_text::renders(target.member->type)) {
         // What json_text(msg) below gives, nlohmann's keys sorted: dropped, kind, subscription, value.
         std::string out = "{";
-        char digits[24];
         if (dropped) {
             out += "\"dropped\":";
-            out.append(digits, std::to_chars(digits, digits + sizeof digits, dropped).ptr);
+            append_integer(out, dropped);
             out += ',';
         }
         out += "\"kind\":\"pipe\",\"subscription\":";
-        out.append(digits, std::to_chars(digits, digits + sizeof digits, sid).ptr);
+        append_integer(out, sid);
         out += ",\"value\":";
         if (element_json_text::append(out, packet, target.member->type)) {
             out += '}';
