@@ -109,4 +109,12 @@ bool append(std::string& out, const MessageElement& element, const robdef::TypeD
     return true;
 }
 
+void append_number(std::string& out, DataTypes type, const std::byte* item) {
+    dispatch_numeric(type, [&](auto tag) {
+        using T = typename decltype(tag)::type;
+        char text[64];  // put_real hands nlohmann 64 characters of room
+        out.append(text, put_item(text, detail::load_item<T>(item)));
+    });
+}
+
 }  // namespace rr::element_json_text

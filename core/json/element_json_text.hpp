@@ -24,4 +24,8 @@ bool renders(const robdef::TypeDefinition& type) noexcept;
 /// type, byte count, item count: the cases where unpack_value fails). Never throws but std::bad_alloc.
 bool append(std::string& out, const MessageElement& element, const robdef::TypeDefinition& type);
 
+/// Appends the JSON text of one item of numeric type `type` stored little-endian at `item` (any
+/// alignment), as append() writes each item. `type` must be numeric.
+void append_number(std::string& out, DataTypes type, const std::byte* item);
+
 }  // namespace rr::element_json_text

@@ -22,6 +22,17 @@ std::optional<DeviceTypes::Object> DeviceTypes::find_object(std::string_view qua
     return Object{svc, entry};
 }
 
+const element_json_text::Plan* DeviceTypes::json_text_plan(const robdef::TypeDefinition& type,
+                                                           std::string_view context_service,
+                                                           const Limits& limits) const {
+    std::lock_guard lock(plans_mutex_);
+    for (const auto& e : plans_)
+        if (e.type == &type && e.max_depth == limits.max_nesting_depth) return e.plan.get();
+    auto plan = element_json_text::Plan::compile(type, set_, context_service, limits);
+    plans_.push_back(PlanEntry{&type, limits.max_nesting_depth, plan});
+    return plan.get();
+}
+
 nlohmann::json member_summary(const robdef::ServiceEntryDefinition& object) {
     auto members = nlohmann::json::array();
     for (const auto& m : object.members) {

@@ -4,7 +4,7 @@
 #include <charconv>
 #include <stdexcept>
 
-#include "core/json/element_json_text.hpp"
+#include "core/json/element_json_plan.hpp"
 #include "core/value/timespec.hpp"
 #include "server/gateway/binary_push.hpp"
 
@@ -16,6 +16,13 @@ template <class Integer>
 void append_integer(std::string& out, Integer v) {
     char digits[24];
     out.append(digits, std::to_chars(digits, digits + sizeof digits, v).ptr);
+}
+
+// The direct JSON text plan of a member's type or parameter, from the device's types.
+const element_json_text::Plan* text_plan(const JsonApi& api, const MemberTarget& target,
+                                         const robdef::TypeDefinition& type) {
+    if (!target.types || !target.service) return nullptr;
+    return target.types->json_text_plan(type, target.context(), api.options().limits);
 }
 }  // namespace
 
@@ -81,14 +88,15 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
     // The direct path writes what json_text(wire_push_body(…)) would: nlohmann sorts an object's keys.
     const auto* p = packet.find("packet");
     const auto* ts = packet.find("packettime");
-    if (p && ts && element_json_text::renders(target.member->type)) {
+    const auto* plan = text_plan(api, target, target.member->type);
+    if (p && ts && plan) {
         if (auto time = unpack_timespec(*ts)) {
             std::string out = "{\"time\":{\"nanoseconds\":";
             append_integer(out, time->nanoseconds);
             out += ",\"seconds\":";
             append_integer(out, time->seconds);
             out += "},\"value\":";
-            if (element_json_text::append(out, *p, target.member->type)) {
+            if (plan->append(out, *p)) {
                 out += '}';
                 return out;
             }
@@ -99,38 +107,27 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
 
 std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target) {
     const auto& params = target.member->parameters;
-    const bool direct = std::all_of(params.begin(), params.end(), [](const robdef::TypeDefinition& p) {
-        return element_json_text::renders(p);
-    });
-    if (direct) {
-        // In nlohmann's key order (parameter names are identifiers: nothing to escape).
-        std::vector<const robdef::TypeDefinition*> sorted;
-        sorted.reserve(params.size());
-        for (const auto& p : params) sorted.push_back(&p);
-        std::sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) { return a->name < b->name; });
-        std::string out = "{\"args\":{";
-        bool ok = true;
-        for (const auto* p : sorted) {
-            const auto* el = event.find(p->name);
-            if (!el) {
-                ok = false;
-                break;
-            }
-            if (p != sorted.front()) out += ',';
-            out += '"';
-            out += p->name;
-            out += "\":";
-            if (!element_json_text::append(out, *el, *p)) {
-                ok = false;
-                break;
-            }
-        }
-        if (ok) {
-            out += "}}";
-            return out;
-        }
+    std::vector<std::pair<const robdef::TypeDefinition*, const element_json_text::Plan*>> sorted;
+    sorted.reserve(params.size());
+    for (const auto& p : params) {
+        const auto* plan = text_plan(api, target, p);
+        if (!plan) return json_text(event_push_body(api, event, target));
+        sorted.emplace_back(&p, plan);
     }
-    return json_text(event_push_body(api, event, target));
+    // In nlohmann's key order (parameter names are identifiers: nothing to escape).
+    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first->name < b.first->name; });
+    std::string out = "{\"args\":{";
+    for (const auto& [p, plan] : sorted) {
+        const auto* el = event.find(p->name);
+        if (!el) return json_text(event_push_body(api, event, target));
+        if (p != sorted.front().first) out += ',';
+        out += '"';
+        out += p->name;
+        out += "\":";
+        if (!plan->append(out, *el)) return json_text(event_push_body(api, event, target));
+    }
+    out += "}}";
+    return out;
 }
 
 nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,
@@ -150,7 +147,8 @@ nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, co
 
 SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
                                        const MemberTarget& target, std::uint64_t dropped, bool binary) {
-    if (!binary && element_json_text::renders(target.member->type)) {
+    const auto* plan = binary ? nullptr : text_plan(api, target, target.member->type);
+    if (plan) {
         // What json_text(msg) below gives, nlohmann's keys sorted: dropped, kind, subscription, value.
         std::string out = "{";
         if (dropped) {
@@ -161,7 +159,7 @@ SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, co
         out += "\"kind\":\"pipe\",\"subscription\":";
         append_integer(out, sid);
         out += ",\"value\":";
-        if (element_json_text::append(out, packet, target.member->type)) {
+        if (plan->append(out, packet)) {
             out += '}';
             return {std::move(out), nullptr};
         }

@@ -47,17 +47,18 @@ nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, co
                                BinaryArrays* binary = nullptr);
 
 /// json_text(wire_push_body(api, packet, target)), written straight from the packet's element when the
-/// member's type is one core/json/element_json_text.hpp renders (numeric scalars and arrays), without
-/// the Value and nlohmann::json trees; through wire_push_body otherwise and for every error.
+/// member's type is one core/json/element_json_plan.hpp covers (DeviceTypes::json_text_plan: numbers,
+/// strings, enums, structs, pods, namedarrays and containers of them), without the Value and
+/// nlohmann::json trees; through wire_push_body otherwise and for every error.
 std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target);
 
-/// json_text(event_push_body(api, event, target)), written straight from the elements when every
-/// parameter's type is one element_json_text renders; through event_push_body otherwise.
+/// json_text(event_push_body(api, event, target)), written straight from the elements when the plan
+/// covers every parameter's type; through event_push_body otherwise.
 std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target);
 
 /// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; with the
 /// arrays part (and the text already binary_push_head's) when `binary` set any aside for a value. A text
-/// push of a numeric type is written straight from the element (element_json_text), the same text.
+/// push of a type the plan covers is written straight from the element, the same text.
 SharedEntry::BinaryRendering pipe_push(const JsonApi& api, std::uint64_t sid, const MessageElement& packet,
                                        const MemberTarget& target, std::uint64_t dropped, bool binary);
 
