@@ -172,6 +172,16 @@ MessageEntry wire_packet(MessageElement value, TimeSpec time = {1700000000, 1234
 
 }  // namespace
 
+namespace {
+// The packet of the first case for `member`.
+template <class Cases>
+const MessageElement& c_value(const Cases& cases, std::string_view member) {
+    for (const auto& c : cases)
+        if (c.member == member) return c.packet;
+    throw std::logic_error("no case");
+}
+}  // namespace
+
 TEST_CASE("json push: a wire value's text, written straight from its element, is the general path's") {
     JsonApi api({});
     PushTargets targets;
@@ -187,7 +197,7 @@ TEST_CASE("json push: a wire value's text, written straight from its element, is
     cases.push_back({"ticks", make_scalar_element<std::int64_t>("", std::int64_t{1} << 60)});
     cases.push_back({"phasor", array_of<cdouble>("", {{1, -2}, {0.25, nan}})});
     cases.push_back({"flags", array_of<bool>("", {true, false, true})});
-    // The general path's own types, and its errors: the same text either way.
+    // Named types, strings and errors: the same text either way.
     Structure pose{"example.push.Pose", {{"x", Value::scalar(2.5)}, {"frame", Value(std::string("map"))}}};
     auto pose_el = pack_value(Value(std::move(pose)), targets("pose").member->type, "packet", targets.types->set(),
                               "example.push");
@@ -203,6 +213,18 @@ TEST_CASE("json push: a wire value's text, written straight from its element, is
         const MessageEntry packet = wire_packet(c.packet);
         INFO(c.member);
         CHECK(wire_push_text(api, packet, target) == json_text(wire_push_body(api, packet, target)));
+    }
+    // The struct and the string go the direct way too: DeviceTypes has a plan for them, compiled once.
+    const Limits limits = api.options().limits;
+    for (const char* member : {"pose", "label", "samples"}) {
+        const MemberTarget t = targets(member);
+        const auto* plan = targets.types->json_text_plan(t.member->type, t.context(), limits);
+        INFO(member);
+        REQUIRE(plan);
+        CHECK(targets.types->json_text_plan(t.member->type, t.context(), limits) == plan);
+        std::string direct;
+        REQUIRE(plan->append(direct, c_value(cases, member)));
+        CHECK(wire_push_text(api, wire_packet(c_value(cases, member)), t).find(direct) != std::string::npos);
     }
     // Direct text really is what the direct path wrote: a value the general path would render too.
     const auto text = wire_push_text(api, wire_packet(array_of<double>("", {1.0, 2.5})), targets("samples"));
@@ -261,7 +283,7 @@ TEST_CASE("json push: a pipe packet's text, written straight from its element, i
         CHECK(push.arrays == nullptr);
         CHECK(push.body == general(7, dropped, json{1.0, -0.5, 1e-9}));
     }
-    // Binary subscribers, named types and mismatched packets keep the general path.
+    // Binary subscribers and mismatched packets keep the general path; a struct is written directly.
     auto binary = pipe_push(api, 7, samples, targets("stream"), 0, true);
     CHECK(binary.arrays != nullptr);
     Structure pose{"example.push.Pose", {{"x", Value::scalar(2.5)}, {"frame", Value(std::string("map"))}}};

@@ -14,10 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "core/json/element_json_plan.hpp"
 #include "core/json/element_json_text.hpp"
 #include "core/json/value_json.hpp"
 #include "core/message/string_table.hpp"
 #include "core/value/pack_value.hpp"
+#include "core/value/var_type.hpp"
 #include "robdef/service_definition_set.hpp"
 #include "test/fuzz/message_checks.hpp"
 
@@ -52,7 +54,7 @@ const char* const kNames[] = {"",          "value",      "parameter", "return", 
                               "array",     "servicedef", "objecttype", "nodeid",   "nodename", "errorname",
                               "errorstring", "packet",   "x",         "svc.S",     "svc.P",    "demo.Point",
                               "RobotRaconteurServiceIndex.NodeInfo", "experimental.create.create_obj",
-                              "com.robotraconteur.geometry.Pose", "$", "a.b.c.d.e.f"};
+                              "com.robotraconteur.geometry.Pose", "$", "a.b.c.d.e.f", "svc.N"};
 
 class Mutator {
 public:
@@ -298,6 +300,76 @@ void check_json_text(const MessageElement& el) {
     }
 }
 
+// Named types for the compiled JSON text plan (element_json_plan.hpp), under names the mutator uses.
+constexpr const char* kPlanRobdef = R"(service svc
+stdver 0.10
+enum E
+    a = 1,
+    b = 2
+end
+namedarray N
+    field double x
+    field double[2] y
+end
+pod P
+    field int32 i
+    field N n
+    field uint8[2,2] m
+end
+struct S
+    field string s
+    field double[] d
+    field P p
+    field N[] ns
+    field E e
+    field S next
+    field int32{list} l
+    field string{string} m
+    field P[]{int32} pm
+    field double[*] md
+end
+)";
+
+// Any element as each of a few types through the plan: the text is the general path's, and there is no
+// text where the general path refuses the element (the plan may decline more).
+void check_json_plan(const MessageElement& el) {
+    struct Typed {
+        robdef::TypeDefinition type;
+        std::shared_ptr<const element_json_text::Plan> plan;
+    };
+    static const robdef::ServiceDefinitionSet set = [] {
+        robdef::ServiceDefinitionSet s;
+        if (!s.add_text(kPlanRobdef, "fuzz.robdef")) __builtin_trap();
+        return s;
+    }();
+    static const std::vector<Typed> typed = [] {
+        std::vector<Typed> out;
+        for (const char* text : {"S", "P", "P[]", "N[]", "N", "string", "int32{list}", "string{string}", "double[*]", "E"}) {
+            auto t = parse_type_string(text);
+            if (!t) __builtin_trap();
+            auto plan = element_json_text::Plan::compile(*t, set, "svc");
+            if (!plan) __builtin_trap();
+            out.push_back({*t, plan});
+        }
+        return out;
+    }();
+    for (const auto& [type, plan] : typed) {
+        std::string direct;
+        const bool rendered = plan->append(direct, el);
+        auto v = unpack_value(el, type, set, "svc");
+        if (!v) {
+            if (rendered) __builtin_trap();
+            continue;
+        }
+        auto j = value_to_json(*v, type, set, "svc");
+        if (!j) {
+            if (rendered) __builtin_trap();
+            continue;
+        }
+        if (rendered && direct != j->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) __builtin_trap();
+    }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     rr::fuzz::check_message_input(data, size);
     // Values from a peer, without a definition: varvalue unpacking must fail cleanly or succeed.
@@ -309,6 +381,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             for (const auto& el : en.elements) {
                 (void)unpack_value_untyped(el, limits);
                 check_json_text(el);
+                check_json_plan(el);
             }
     return 0;
 }
