@@ -22,6 +22,7 @@
 #include "core/value/var_type.hpp"
 #include "robdef/service_definition_set.hpp"
 #include "test/fuzz/message_checks.hpp"
+#include "test/fuzz/plan_types.hpp"
 
 extern "C" std::size_t LLVMFuzzerMutate(std::uint8_t* data, std::size_t size, std::size_t max_size);
 
@@ -300,36 +301,6 @@ void check_json_text(const MessageElement& el) {
     }
 }
 
-// Named types for the compiled JSON text plan (element_json_plan.hpp), under names the mutator uses.
-constexpr const char* kPlanRobdef = R"(service svc
-stdver 0.10
-enum E
-    a = 1,
-    b = 2
-end
-namedarray N
-    field double x
-    field double[2] y
-end
-pod P
-    field int32 i
-    field N n
-    field uint8[2,2] m
-end
-struct S
-    field string s
-    field double[] d
-    field P p
-    field N[] ns
-    field E e
-    field S next
-    field int32{list} l
-    field string{string} m
-    field P[]{int32} pm
-    field double[*] md
-end
-)";
-
 // Any element as each of a few types through the plan: the text is the general path's, and there is no
 // text where the general path refuses the element (the plan may decline more).
 void check_json_plan(const MessageElement& el) {
@@ -339,7 +310,7 @@ void check_json_plan(const MessageElement& el) {
     };
     static const robdef::ServiceDefinitionSet set = [] {
         robdef::ServiceDefinitionSet s;
-        if (!s.add_text(kPlanRobdef, "fuzz.robdef")) __builtin_trap();
+        if (!s.add_text(rr::fuzz::kPlanRobdef, "fuzz.robdef")) __builtin_trap();
         return s;
     }();
     static const std::vector<Typed> typed = [] {

@@ -5,14 +5,22 @@
 // Usage: gen_message_seeds <dir> [<port-seed-dir>]
 //   (the committed seeds: test/fuzz/seeds/fuzz_message_reader, test/fuzz/seeds/fuzz_gateway_port)
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/codec/endian.hpp"
+#include "core/json/value_json.hpp"
 #include "core/message/error_entry.hpp"
 #include "core/message/message_writer.hpp"
 #include "core/message/string_table.hpp"
 #include "core/session/stream_connection.hpp"
+#include "core/value/pack_value.hpp"
+#include "core/value/var_type.hpp"
+#include "robdef/service_definition_set.hpp"
+#include "test/fuzz/plan_types.hpp"
 
 namespace {
 
@@ -102,6 +110,39 @@ Message v4_extras() {
     return m;
 }
 
+// Values of the svc types (plan_types.hpp) as a reply's elements, for the JSON text plan check.
+std::optional<Message> svc_values() {
+    robdef::ServiceDefinitionSet set;
+    if (!set.add_text(rr::fuzz::kPlanRobdef, "fuzz.robdef")) return std::nullopt;
+    const nlohmann::json n = {{"x", 1.5}, {"y", {-2, 1e-300}}};
+    const nlohmann::json p = {{"i", -7}, {"n", n}, {"m", {{"dims", {2, 2}}, {"array", {0, 1, 254, 255}}}}};
+    const nlohmann::json leaf = {{"s", "a\"\n\u00e9"}, {"d", {0.5, "NaN"}}, {"p", p}, {"ns", {n, n}}, {"e", 2},
+                                 {"next", nullptr}, {"l", {1, -1}}, {"m", {{"k", "v"}, {"", ""}}},
+                                 {"pm", {{"3", nlohmann::json::array({p})}, {"-1", nlohmann::json::array()}}},
+                                 {"md", {{"dims", {1, 2}}, {"array", {1, 2}}}}};
+    nlohmann::json full = leaf;
+    full["next"] = leaf;
+    const std::pair<const char*, nlohmann::json> values[] = {
+        {"S", full}, {"P[]", {p, p}}, {"N[]", nlohmann::json::array({n})}, {"string{string}", {{"b", "x\ty"}}}, {"E", 1}};
+    Message m = base(4);
+    MessageEntry e;
+    e.entry_type = MessageEntryType::FunctionCallRes;
+    e.service_path = "svc.obj";
+    e.member_name = "f";
+    e.request_id = 1;
+    for (const auto& [type, json] : values) {
+        auto t = parse_type_string(type);
+        if (!t) return std::nullopt;
+        auto v = value_from_json(json, *t, set, "svc");
+        if (!v) return std::nullopt;
+        auto el = pack_value(*v, *t, type, set, "svc");
+        if (!el) return std::nullopt;
+        e.elements.push_back(std::move(*el));
+    }
+    m.entries.push_back(std::move(e));
+    return m;
+}
+
 bool write_bytes(const std::string& dir, const char* name, const std::vector<std::byte>& bytes) {
     std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
     if (!f) return false;
@@ -153,6 +194,10 @@ int main(int argc, char** argv) {
               write(dir, "heartbeat_v4_stripped.bin", heartbeat(4, true)) && write(dir, "call_v2.bin", call(2)) &&
               write(dir, "call_v4.bin", call(4)) && write(dir, "pipe_ack_v2.bin", pipe_ack(2)) &&
               write(dir, "pipe_ack_v4.bin", pipe_ack(4)) && write(dir, "extras_v4.bin", v4_extras());
+    if (ok) {
+        auto svc = svc_values();
+        ok = svc && write(dir, "svc_values_v4.bin", *svc);
+    }
     if (ok && argc == 3) {
         const std::string port = argv[2];
         ok = write_bytes(port, "rr_client_v2.bin", client_stream(false, "create")) &&
