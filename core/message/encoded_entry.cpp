@@ -20,9 +20,10 @@ Result<std::span<const std::byte>> EncodedEntry::bytes(std::uint16_t version) co
     return std::span<const std::byte>(e.bytes);
 }
 
-Result<SharedBytes> EncodedEntry::shared_bytes(std::uint16_t version) const {
+Result<SharedBytes> EncodedEntry::shared_bytes(std::uint16_t version, std::size_t owned_from) const {
     auto span = bytes(version);
     if (!span) return span.take_error();
+    if (span->size() < owned_from) return SharedBytes(nullptr, *span);
     return SharedBytes(weak_from_this().lock(), *span);
 }
 

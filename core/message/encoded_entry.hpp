@@ -31,9 +31,10 @@ public:
     /// 65535 bytes, an element that cannot travel, …), the same error on every call; InvalidArgument
     /// for another version.
     Result<std::span<const std::byte>> bytes(std::uint16_t version) const;
-    /// The same bytes, kept alive by this entry when a shared_ptr owns it (else a view without owner,
-    /// valid while the entry lives). Errors: as bytes().
-    Result<SharedBytes> shared_bytes(std::uint16_t version) const;
+    /// The same bytes, kept alive by this entry when a shared_ptr owns it and they are at least
+    /// `owned_from` bytes (else a view without owner, valid while the entry lives: what a caller that
+    /// copies small entries wants, without the owner's reference count). Errors: as bytes().
+    Result<SharedBytes> shared_bytes(std::uint16_t version, std::size_t owned_from = 0) const;
 
 private:
     struct Encoding {

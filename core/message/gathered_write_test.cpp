@@ -183,6 +183,12 @@ TEST_CASE("message: a large encoded entry is spliced into each message and equal
         REQUIRE(g.splices().size() == 1);
         CHECK(g.splices()[0].bytes.data() == bytes->data());
         CHECK(joined(g) == expected);
+        // Below `owned_from` bytes: a view without owner (a sender copies those).
+        auto small = shared->shared_bytes(version, bytes->size() + 1);
+        REQUIRE(small);
+        CHECK(small->owner() == nullptr);
+        CHECK(small->data() == bytes->data());
+        CHECK(shared->shared_bytes(version, bytes->size())->owner() != nullptr);
     }
     // An entry not held by a shared_ptr gives a view without owner: copied, never spliced.
     const EncodedEntry local(entry);

@@ -339,19 +339,13 @@ Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry,
     if (!header.entries.empty())
         return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
     const std::uint16_t version = send_version();
-    auto bytes = entry.bytes(version);
-    if (!bytes) return bytes.take_error();
     // A large entry is spliced into the gathered write, kept alive by its owner; a small one copied.
-    SharedBytes shared(nullptr, *bytes);
-    if (bytes->size() >= GatherBuffer::kSpliceMinBytes) {
-        auto owned = entry.shared_bytes(version);
-        if (!owned) return owned.take_error();
-        shared = std::move(*owned);
-    }
+    auto shared = entry.shared_bytes(version, GatherBuffer::kSpliceMinBytes);
+    if (!shared) return shared.take_error();
     const bool omit = omit_routing_applies(header.header, entry.entry().entry_type, version, true);
     if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
     const auto before = output_.mark();
-    if (auto ok = encode_message(header, shared, output_); !ok) {
+    if (auto ok = encode_message(header, *shared, output_); !ok) {
         output_.rollback(before);
         return ok;
     }

@@ -1,7 +1,8 @@
 // Writes a few small messages, made with our own encoder, as seed inputs for fuzz_message_reader (and
 // fuzz_message_structured), and, given a second folder, the first bytes of RR clients for
 // fuzz_gateway_port: a client's CreateConnection (made by core's StreamConnection) followed by a
-// ConnectClientCombined request for the demo device `create` and a heartbeat.
+// ConnectClientCombined request for the demo device `create` and a heartbeat. svc_values_v4.bin holds
+// values of the types fuzz_message_structured renders through the JSON text plan (plan_types.hpp).
 // Usage: gen_message_seeds <dir> [<port-seed-dir>]
 //   (the committed seeds: test/fuzz/seeds/fuzz_message_reader, test/fuzz/seeds/fuzz_gateway_port)
 #include <cstdio>
