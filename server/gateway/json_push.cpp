@@ -114,13 +114,15 @@ std::string event_push_text(const JsonApi& api, const MessageEntry& event, const
         if (!plan) return json_text(event_push_body(api, event, target));
         sorted.emplace_back(&p, plan);
     }
-    // In nlohmann's key order (parameter names are identifiers: nothing to escape).
+    // In nlohmann's key order (parameter names are identifiers: nothing to escape). Two parameters of
+    // one name (an unchecked received definition) are the general path's: it keeps one of them.
     std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first->name < b.first->name; });
     std::string out = "{\"args\":{";
-    for (const auto& [p, plan] : sorted) {
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+        const auto& [p, plan] = sorted[i];
         const auto* el = event.find(p->name);
-        if (!el) return json_text(event_push_body(api, event, target));
-        if (p != sorted.front().first) out += ',';
+        if (!el || (i && sorted[i - 1].first->name == p->name)) return json_text(event_push_body(api, event, target));
+        if (i) out += ',';
         out += '"';
         out += p->name;
         out += "\":";

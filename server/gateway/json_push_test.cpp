@@ -269,6 +269,26 @@ TEST_CASE("json push: an event's text, written straight from its elements, is th
     CHECK(json::parse(event_push_text(api, cases[4].second, targets("moved"))).contains("error"));
 }
 
+TEST_CASE("json push: an event with two parameters of one name (a received, unverified definition) is the general path's text") {
+    auto types = DeviceTypes::parse({"service example.twice\nstdver 0.10\nobject O\n    event twice(double a, double a)\nend\n"});
+    REQUIRE(types);
+    auto o = (*types)->find_object("example.twice.O");
+    REQUIRE(o);
+    MemberTarget target;
+    target.types = *types;
+    target.service = o->service;
+    target.object = o->entry;
+    target.member = o->entry->find_member("twice");
+    REQUIRE(target.member);
+    REQUIRE(target.member->parameters.size() == 2);
+    JsonApi api({});
+    MessageEntry event;
+    event.elements.push_back(make_scalar_element<double>("a", 1.5));
+    const std::string text = event_push_text(api, event, target);
+    CHECK(text == json_text(event_push_body(api, event, target)));
+    CHECK(text == R"({"args":{"a":1.5}})");
+}
+
 TEST_CASE("json push: a pipe packet's text, written straight from its element, is the general path's") {
     JsonApi api({});
     PushTargets targets;
