@@ -9,9 +9,11 @@
 
 #include "core/json/element_json_text.hpp"
 #include "core/json/namedarray_shape.hpp"
+#include "core/json/value_json.hpp"
 #include "core/json/utf8.hpp"
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
+#include "core/value/pack_value.hpp"
 
 namespace rr::element_json_text {
 
@@ -48,6 +50,9 @@ struct NamedArrayItem {
 
 /// What a struct, pod or namedarray type renders with (one per definition, shared by its uses).
 struct Body {
+    /// The definition is one the plan does not render itself (a duplicate field name, an invalid
+    /// pod, …): its uses go through the general path.
+    bool failed = false;
     std::string qualified_name;
     std::vector<Field> fields;  ///< struct, pod: sorted by name
     DataTypes element_type = DataTypes::void_t;  ///< namedarray
@@ -55,11 +60,15 @@ struct Body {
     const NamedArrayItem* item = nullptr;
 };
 
-enum class Kind { null_value, numeric, numeric_multidim, string, enumeration, structure, pod, namedarray, list, map_int32, map_string };
+enum class Kind {
+    null_value, numeric, numeric_multidim, string, enumeration, structure, pod, namedarray, list, map_int32, map_string,
+    general  ///< unpack_value → value_to_json → dump for this part alone (varvalue, multi-dim pod arrays, …)
+};
 
 struct Node {
     Kind kind = Kind::null_value;
-    TypeDefinition type;  ///< numeric, pod, namedarray: the element type and count rule
+    TypeDefinition type;  ///< numeric, pod, namedarray: the element type and count rule; general: the type
+    std::string context;  ///< where `type`'s unqualified names resolve (general, and failed bodies)
     const Body* body = nullptr;
     const Node* item = nullptr;  ///< containers
 };
@@ -71,7 +80,8 @@ struct Plan::Graph {
     std::deque<Body> bodies;
     std::deque<NamedArrayItem> items;
     const Node* root = nullptr;
-    std::size_t max_depth = 0;
+    const robdef::TypeLookup* lookup = nullptr;  ///< for the general parts
+    Limits limits;
 };
 
 void append_string(std::string& out, std::string_view s) {
@@ -109,18 +119,28 @@ class Compiler {
 public:
     Compiler(Plan::Graph& g, const robdef::TypeLookup& lookup) : g_(g), lookup_(lookup) {}
 
+    /// The node of `t`: rendered by the plan where it can, else a general node.
     const Node* node(const TypeDefinition& t, std::string_view ctx, int depth);
 
 private:
-    Node& add(Kind kind, const TypeDefinition& t) {
+    Node& add(Kind kind, const TypeDefinition& t, std::string_view ctx = {}) {
         Node& n = g_.nodes.emplace_back();
         n.kind = kind;
         n.type = t;
+        n.context = ctx;
         return n;
+    }
+    const Node* native(const TypeDefinition& t, std::string_view ctx, int depth);
+    Body& new_body(const NamedType& nt) {
+        Body& b = g_.bodies.emplace_back();
+        b.qualified_name = nt.qualified_name;
+        bodies_.emplace(nt.entry, &b);
+        return b;
     }
     const Node* named(const TypeDefinition& t, std::string_view ctx, int depth);
     const Body* structure(const NamedType& nt, int depth);
     const Body* pod(const NamedType& nt, int depth);
+    bool pod_fields(Body& b, const std::vector<PodFieldPlan>& plans, int depth);
     const Body* namedarray(const NamedType& nt);
     const NamedArrayItem* namedarray_item(const NamedArrayShape& shape);
     static bool sort_fields(std::vector<Field>& fields);
@@ -144,6 +164,11 @@ bool Compiler::sort_fields(std::vector<Field>& fields) {
 }
 
 const Node* Compiler::node(const TypeDefinition& t, std::string_view ctx, int depth) {
+    if (const Node* n = native(t, ctx, depth)) return n;
+    return &add(Kind::general, t, ctx);
+}
+
+const Node* Compiler::native(const TypeDefinition& t, std::string_view ctx, int depth) {
     if (depth > 64) return nullptr;
     if (t.container != ContainerKind::none) {
         Kind kind;
@@ -154,7 +179,6 @@ const Node* Compiler::node(const TypeDefinition& t, std::string_view ctx, int de
             default: return nullptr;  // generator
         }
         const Node* item = node(without_container(t), ctx, depth + 1);
-        if (!item) return nullptr;
         Node& n = add(kind, t);
         n.item = item;
         return &n;
@@ -176,8 +200,8 @@ const Node* Compiler::named(const TypeDefinition& t, std::string_view ctx, int d
         case NamedTypeKind::structure: {
             if (t.array != ArrayKind::none) return nullptr;
             const Body* b = structure(*nt, depth);
-            if (!b) return nullptr;
-            Node& n = add(Kind::structure, t);
+            if (b->failed) return nullptr;
+            Node& n = add(Kind::structure, t, ctx);  // a cycle may see its body fail later: ctx for that
             n.body = b;
             return &n;
         }
@@ -186,8 +210,8 @@ const Node* Compiler::named(const TypeDefinition& t, std::string_view ctx, int d
             if (t.array == ArrayKind::multidimarray) return nullptr;
             const bool is_pod = nt->kind == NamedTypeKind::pod;
             const Body* b = is_pod ? pod(*nt, depth) : namedarray(*nt);
-            if (!b) return nullptr;
-            Node& n = add(is_pod ? Kind::pod : Kind::namedarray, t);
+            if (b->failed) return nullptr;
+            Node& n = add(is_pod ? Kind::pod : Kind::namedarray, t, ctx);
             n.body = b;
             return &n;
         }
@@ -195,34 +219,36 @@ const Node* Compiler::named(const TypeDefinition& t, std::string_view ctx, int d
     }
 }
 
+// Bodies are never null: one that cannot be rendered here is marked failed (a struct in a cycle may
+// already be referred to by its own fields' nodes, which then take the general path).
 const Body* Compiler::structure(const NamedType& nt, int depth) {
     if (auto it = bodies_.find(nt.entry); it != bodies_.end()) return it->second;
-    Body& b = g_.bodies.emplace_back();
-    b.qualified_name = nt.qualified_name;
-    bodies_.emplace(nt.entry, &b);
+    Body& b = new_body(nt);
     for (const auto& m : nt.entry->members) {
         if (m.kind != robdef::MemberKind::field) continue;
-        const Node* f = node(m.type, nt.service->name, depth + 1);
-        if (!f) return nullptr;
-        b.fields.push_back(Field{m.name, {}, f, {}});
+        b.fields.push_back(Field{m.name, {}, node(m.type, nt.service->name, depth + 1), {}});
     }
-    return sort_fields(b.fields) ? &b : nullptr;
+    b.failed = !sort_fields(b.fields);
+    return &b;
 }
 
 const Body* Compiler::pod(const NamedType& nt, int depth) {
     if (auto it = bodies_.find(nt.entry); it != bodies_.end()) return it->second;
+    Body& b = new_body(nt);
     auto plans = pod_field_plans(nt, lookup_);
-    if (!plans) return nullptr;
-    Body& b = g_.bodies.emplace_back();
-    b.qualified_name = nt.qualified_name;
-    bodies_.emplace(nt.entry, &b);
-    for (const PodFieldPlan& plan : *plans) {
+    b.failed = !plans || !pod_fields(b, *plans, depth);
+    return &b;
+}
+
+// A pod's fields; false when one of them is not rendered here (then the whole pod is general).
+bool Compiler::pod_fields(Body& b, const std::vector<PodFieldPlan>& plans, int depth) {
+    for (const PodFieldPlan& plan : plans) {
         const TypeDefinition& wt = plan.wire_type;
         Field f{plan.member->name, {}, nullptr, {}};
         if (plan.multidim) {
             // Travels as a fixed 1-D array of the dims' product: pod_field_wire_type gives [0] (no
             // rule) when the dims overflow, which the general path then refuses.
-            if (wt.array_length.empty() || wt.array_length[0] <= 0 || plan.dims.empty()) return nullptr;
+            if (wt.array_length.empty() || wt.array_length[0] <= 0 || plan.dims.empty()) return false;
             f.dims_suffix = ",\"dims\":[";
             for (std::size_t i = 0; i < plan.dims.size(); ++i) {
                 if (i) f.dims_suffix += ',';
@@ -234,39 +260,38 @@ const Body* Compiler::pod(const NamedType& nt, int depth) {
             f.node = &add(Kind::numeric, wt);
         } else if (plan.named.kind == NamedTypeKind::pod) {
             const Body* inner = pod(plan.named, depth + 1);
-            if (!inner) return nullptr;
+            if (inner->failed) return false;
             Node& n = add(Kind::pod, wt);
             n.body = inner;
             f.node = &n;
         } else if (plan.named.kind == NamedTypeKind::namedarray) {
             const Body* inner = namedarray(plan.named);
-            if (!inner) return nullptr;
+            if (inner->failed) return false;
             Node& n = add(Kind::namedarray, wt);
             n.body = inner;
             f.node = &n;
         } else {
-            return nullptr;
+            return false;
         }
         b.fields.push_back(std::move(f));
     }
-    return sort_fields(b.fields) ? &b : nullptr;
+    return sort_fields(b.fields);
 }
 
 const Body* Compiler::namedarray(const NamedType& nt) {
     if (auto it = bodies_.find(nt.entry); it != bodies_.end()) return it->second;
+    Body& b = new_body(nt);
+    b.failed = true;
     auto layout = namedarray_layout(nt, lookup_);
     auto shape = namedarray_shape(nt, lookup_);
-    if (!layout || !shape) return nullptr;
+    if (!layout || !shape) return &b;
     // The general path unpacks with the layout and renders with the shape: they must agree.
-    if ((*shape)->width != layout->elements_per_item || (*shape)->element_type != layout->element_type) return nullptr;
-    const NamedArrayItem* item = namedarray_item(**shape);
-    if (!item) return nullptr;
-    Body& b = g_.bodies.emplace_back();
-    b.qualified_name = nt.qualified_name;
+    if ((*shape)->width != layout->elements_per_item || (*shape)->element_type != layout->element_type) return &b;
+    b.item = namedarray_item(**shape);
+    if (!b.item) return &b;
     b.element_type = layout->element_type;
     b.element_size = data_type_size(layout->element_type);
-    b.item = item;
-    bodies_.emplace(nt.entry, &b);
+    b.failed = false;
     return &b;
 }
 
@@ -314,7 +339,7 @@ const NamedArrayItem* Compiler::namedarray_item(const NamedArrayShape& shape) {
 
 class Renderer {
 public:
-    Renderer(std::string& out, std::size_t max_depth) : out_(out), max_depth_(max_depth) {}
+    Renderer(std::string& out, const Plan::Graph& g) : out_(out), g_(g), max_depth_(g.limits.max_nesting_depth) {}
 
     bool render(const Node& n, const MessageElement& e);
 
@@ -325,6 +350,7 @@ private:
         std::size_t& d_;
     };
 
+    bool general(const Node& n, const MessageElement& e);
     bool numeric_multidim(const Node& n, const MessageElement& e);
     bool structure(const Node& n, const MessageElement& e);
     bool pod(const Node& n, const MessageElement& e);
@@ -336,6 +362,7 @@ private:
     bool map_string(const Node& n, const MessageElement& e);
 
     std::string& out_;
+    const Plan::Graph& g_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
 };
@@ -345,7 +372,9 @@ bool Renderer::render(const Node& n, const MessageElement& e) {
     // Limits::max_nesting_depth), so a value rendered here never meets their depth error.
     Depth d(depth_);
     if (depth_ > max_depth_) return false;
+    if (n.body && n.body->failed) return general(n, e);
     switch (n.kind) {
+        case Kind::general: return general(n, e);
         case Kind::null_value: out_ += "null"; return true;
         case Kind::numeric: return append(out_, e, n.type);
         case Kind::numeric_multidim: return numeric_multidim(n, e);
@@ -369,6 +398,19 @@ bool Renderer::render(const Node& n, const MessageElement& e) {
         case Kind::map_string: return map_string(n, e);
     }
     return false;
+}
+
+// This part alone the general way. Its own depth count starts at this node, so it gets the levels left
+// (at most what the general path over the whole value would leave it: depth_ counts at least as many).
+bool Renderer::general(const Node& n, const MessageElement& e) {
+    Limits limits = g_.limits;
+    limits.max_nesting_depth = max_depth_ - (depth_ - 1);
+    auto v = unpack_value(e, n.type, *g_.lookup, n.context, limits);
+    if (!v) return false;
+    auto j = value_to_json(*v, n.type, *g_.lookup, n.context, limits);
+    if (!j) return false;
+    out_ += j->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    return true;
 }
 
 bool Renderer::numeric_multidim(const Node& n, const MessageElement& e) {
@@ -576,16 +618,18 @@ Plan::~Plan() = default;
 std::shared_ptr<const Plan> Plan::compile(const TypeDefinition& type, const robdef::TypeLookup& lookup,
                                           std::string_view context_service, const Limits& limits) {
     auto g = std::make_unique<Graph>();
-    g->max_depth = limits.max_nesting_depth;
+    g->lookup = &lookup;
+    g->limits = limits;
     Compiler c(*g, lookup);
     g->root = c.node(type, context_service, 0);
-    if (!g->root) return nullptr;
+    if (g->root->kind == Kind::general || (g->root->body && g->root->body->failed))
+        return nullptr;  // nothing here to do better than the caller's own general path
     return std::make_shared<const Plan>(std::move(g));
 }
 
 bool Plan::append(std::string& out, const MessageElement& element) const {
     const std::size_t at = out.size();
-    Renderer r(out, graph_->max_depth);
+    Renderer r(out, *graph_);
     if (r.render(*graph_->root, element)) return true;
     out.resize(at);
     return false;

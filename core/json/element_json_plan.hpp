@@ -3,18 +3,20 @@
 // its sorted order), without the Value and nlohmann::json trees in between (issue 14).
 //
 // A Plan is compiled once per type (named types resolved, fields sorted as nlohmann sorts them, pod
-// plans and namedarray offsets worked out) and then renders any number of elements. It covers:
+// plans and namedarray offsets worked out) and then renders any number of elements. It writes itself:
 //   numeric scalars, T[], T[N], T[N-], T[*] and T[N,M] (element_json_text.hpp for the numbers)
 //   string, enum, void
 //   struct (recursive ones included), pod and namedarray scalars and 1-D arrays, pod fields of
 //   every kind (multi-dim ones too)
-//   T{list}, T{int32}, T{string} of any covered T
-// It declines (compile() gives nullptr) varvalue, multi-dim pod and namedarray arrays, generators and
-// any definition the general path would refuse; and append() declines any element that does not
-// match its type in a way the general path would refuse (wrong element type or type name, missing
-// field, wrong count, misnumbered item, duplicate map key, invalid UTF-8, nesting deeper than
-// Limits::max_nesting_depth). The general path then renders it or words the error: the direct text
-// never differs from it, and never stands where the general path reports an error.
+//   T{list}, T{int32}, T{string}
+// and hands any other part (varvalue, multi-dim pod and namedarray arrays, a definition it does not
+// take, such as one with two fields of one name) to the general path for that part alone, so that a
+// struct with a `varvalue{string} extended` field still has its other fields written directly. A type
+// with nothing to write directly gets no plan (compile() gives nullptr). append() declines any element
+// the general path would refuse (wrong element type or type name, missing field, wrong count,
+// misnumbered item, duplicate map key, invalid UTF-8, nesting deeper than Limits::max_nesting_depth):
+// the caller's general path then words the error. The direct text never differs from the general
+// path's, and never stands where the general path reports an error.
 #pragma once
 
 #include <memory>
@@ -31,9 +33,8 @@ namespace rr::element_json_text {
 class Plan {
 public:
     /// The plan of robdef type `type` (named types through `lookup`, unqualified ones in
-    /// `context_service`), or nullptr when the type is not covered (above). `lookup` must outlive the
-    /// plan only during compile(): the plan keeps names and shapes, not references into the lookup,
-    /// except the definitions' own member names (so the definitions must outlive the plan).
+    /// `context_service`), or nullptr when it would write nothing directly (above). `lookup` (and so
+    /// the definitions) must outlive the plan: the general parts use it when rendering.
     static std::shared_ptr<const Plan> compile(const robdef::TypeDefinition& type, const robdef::TypeLookup& lookup,
                                                std::string_view context_service, const Limits& limits = {});
 

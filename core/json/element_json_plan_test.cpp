@@ -247,14 +247,30 @@ TEST_CASE("element JSON plan: every byte of a string and of a map key is escaped
     check_same(map, "string{string}");
 }
 
-TEST_CASE("element JSON plan: types it does not cover get no plan") {
-    for (const char* type : {"varvalue", "Loose", "example.test.Outer", "example.test.Holder", "example.test.Vec3[*]",
-                             "example.test.Sample[*]", "example.test.Nope", "varvalue{list}"}) {
+TEST_CASE("element JSON plan: a type with nothing to write directly gets no plan, others hand such parts to the general path") {
+    for (const char* type : {"varvalue", "example.test.Vec3[*]", "example.test.Sample[*]", "example.test.Nope", "Mode[]"}) {
         INFO(type);
         CHECK_FALSE(plan_of(type_of(type)));
     }
-    CHECK(plan_of(type_of("State")));
-    CHECK(plan_of(type_of("void")));
+    for (const char* type : {"State", "void", "Loose", "example.test.Outer", "example.test.Holder", "varvalue{list}"}) {
+        INFO(type);
+        CHECK(plan_of(type_of(type)));
+    }
+    // The test values touching every kind: a recursive struct with varvalue, multi-dim and container
+    // fields, pods with multi-dim pod fields, a varvalue map of named values.
+    for (const auto& [value, type] : rich_values()) {
+        const std::string qualified = type.rfind("varvalue", 0) == 0 ? type : "example.test." + type;
+        auto e = pack_value(value, type_of(qualified), "value", plan_lookup(), kPlanSvc);
+        INFO(qualified);
+        REQUIRE(e);
+        check_same(*e, qualified);
+    }
+    Structure loose{"example.plan.Loose", {{"anything", Value(samples({1, 2}))}}};
+    auto e = pack_value(Value(loose), type_of("Loose"), "value", plan_lookup(), kPlanSvc);
+    REQUIRE(e);
+    check_same(*e, "Loose");
+    check_same(element_from_json(nlohmann::json::array({nullptr, {{"type", "string"}, {"value", "x"}}}), type_of("varvalue{list}")),
+               "varvalue{list}");
 }
 
 TEST_CASE("element JSON plan: broken element trees render as the general path or are declined, never otherwise") {
@@ -272,6 +288,12 @@ TEST_CASE("element JSON plan: broken element trees render as the general path or
     cases.push_back({"string{string}", element_from_json({{"a", "x"}, {"b", "y"}}, type_of("string{string}"))});
     cases.push_back({"double[]{int32}", element_from_json({{"1", {1.0}}, {"2", {2.0}}}, type_of("double[]{int32}"))});
     cases.push_back({"int32[*]", element_from_json({{"dims", {2}}, {"array", {1, 2}}}, type_of("int32[*]"))});
+    for (const auto& [value, type] : rich_values()) {  // with general parts: varvalue, multi-dim pods
+        const std::string qualified = type.rfind("varvalue", 0) == 0 ? type : "example.test." + type;
+        auto e = pack_value(value, type_of(qualified), "value", plan_lookup(), kPlanSvc);
+        REQUIRE(e);
+        cases.push_back({qualified, *e});
+    }
     std::size_t rendered = 0, refused = 0, declined_only = 0;
     for (const auto& c : cases) {
         const auto t = type_of(c.type);
