@@ -55,7 +55,7 @@ const char* const kNames[] = {"",          "value",      "parameter", "return", 
                               "array",     "servicedef", "objecttype", "nodeid",   "nodename", "errorname",
                               "errorstring", "packet",   "x",         "svc.S",     "svc.P",    "demo.Point",
                               "RobotRaconteurServiceIndex.NodeInfo", "experimental.create.create_obj",
-                              "com.robotraconteur.geometry.Pose", "$", "a.b.c.d.e.f", "svc.N"};
+                              "com.robotraconteur.geometry.Pose", "$", "a.b.c.d.e.f", "svc.N", "svc.W"};
 
 class Mutator {
 public:
@@ -315,7 +315,7 @@ void check_json_plan(const MessageElement& el) {
     }();
     static const std::vector<Typed> typed = [] {
         std::vector<Typed> out;
-        for (const char* text : {"S", "P", "P[]", "N[]", "N", "string", "int32{list}", "string{string}", "double[*]", "E"}) {
+        for (const char* text : {"S", "W", "P[]", "N[]", "N", "string", "int32{list}", "string{string}", "double[*]", "E", "P"}) {
             auto t = parse_type_string(text);
             if (!t) __builtin_trap();
             auto plan = element_json_text::Plan::compile(*t, set, "svc");

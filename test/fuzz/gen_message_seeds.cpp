@@ -123,8 +123,11 @@ std::optional<Message> svc_values() {
                                  {"md", {{"dims", {1, 2}}, {"array", {1, 2}}}}};
     nlohmann::json full = leaf;
     full["next"] = leaf;
+    const nlohmann::json w = {{"any", {{"type", "svc.P[]"}, {"value", nlohmann::json::array({p})}}},
+                               {"grid", {{"dims", {1, 2}}, {"array", {p, p}}}},
+                               {"x", -0.5}};
     const std::pair<const char*, nlohmann::json> values[] = {
-        {"S", full}, {"P[]", {p, p}}, {"N[]", nlohmann::json::array({n})}, {"string{string}", {{"b", "x\ty"}}}, {"E", 1}};
+        {"S", full}, {"W", w}, {"P[]", {p, p}}, {"N[]", nlohmann::json::array({n})}, {"string{string}", {{"b", "x\ty"}}}, {"E", 1}};
     Message m = base(4);
     MessageEntry e;
     e.entry_type = MessageEntryType::FunctionCallRes;

@@ -31,6 +31,11 @@ struct S
     field P[]{int32} pm
     field double[*] md
 end
+struct W
+    field varvalue any
+    field P[*] grid
+    field double x
+end
 )";
 
 }  // namespace rr::fuzz
