@@ -373,6 +373,12 @@ bool Renderer::render(const Node& n, const MessageElement& e) {
     Depth d(depth_);
     if (depth_ > max_depth_) return false;
     if (n.body && n.body->failed) return general(n, e);
+    const bool nullable = n.kind == Kind::structure || n.kind == Kind::list || n.kind == Kind::map_int32 ||
+                          n.kind == Kind::map_string;
+    if (nullable && e.type == DataTypes::void_t) {
+        out_ += "null";
+        return true;
+    }
     switch (n.kind) {
         case Kind::general: return general(n, e);
         case Kind::null_value: out_ += "null"; return true;
@@ -440,10 +446,6 @@ bool Renderer::numeric_multidim(const Node& n, const MessageElement& e) {
 }
 
 bool Renderer::structure(const Node& n, const MessageElement& e) {
-    if (e.type == DataTypes::void_t) {
-        out_ += "null";
-        return true;
-    }
     const Body& b = *n.body;
     if (e.type != DataTypes::structure_t || e.type_name != b.qualified_name) return false;
     out_ += '{';
@@ -535,10 +537,6 @@ void Renderer::namedarray_object(const NamedArrayItem& item, const std::byte* da
 }
 
 bool Renderer::list(const Node& n, const MessageElement& e) {
-    if (e.type == DataTypes::void_t) {
-        out_ += "null";
-        return true;
-    }
     if (e.type != DataTypes::list_t) return false;
     out_ += '[';
     for (std::size_t i = 0; i < e.elements.size(); ++i) {
@@ -552,10 +550,6 @@ bool Renderer::list(const Node& n, const MessageElement& e) {
 }
 
 bool Renderer::map_int32(const Node& n, const MessageElement& e) {
-    if (e.type == DataTypes::void_t) {
-        out_ += "null";
-        return true;
-    }
     if (e.type != DataTypes::vector_t) return false;
     struct Key {
         char text[12];
@@ -586,10 +580,6 @@ bool Renderer::map_int32(const Node& n, const MessageElement& e) {
 }
 
 bool Renderer::map_string(const Node& n, const MessageElement& e) {
-    if (e.type == DataTypes::void_t) {
-        out_ += "null";
-        return true;
-    }
     if (e.type != DataTypes::dictionary_t) return false;
     std::vector<const MessageElement*> items(e.elements.size());
     for (std::size_t i = 0; i < items.size(); ++i) {
