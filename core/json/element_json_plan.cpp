@@ -354,7 +354,8 @@ private:
     bool numeric_multidim(const Node& n, const MessageElement& e);
     bool structure(const Node& n, const MessageElement& e);
     bool pod(const Node& n, const MessageElement& e);
-    bool pod_field(const Field& f, const MessageElement& e);
+    bool object(const Body& b, const MessageElement& e);
+    bool field(const Field& f, const MessageElement& e);
     bool namedarray(const Node& n, const MessageElement& e);
     void namedarray_object(const NamedArrayItem& item, const std::byte* data, DataTypes type, std::size_t size);
     bool list(const Node& n, const MessageElement& e);
@@ -448,6 +449,11 @@ bool Renderer::numeric_multidim(const Node& n, const MessageElement& e) {
 bool Renderer::structure(const Node& n, const MessageElement& e) {
     const Body& b = *n.body;
     if (e.type != DataTypes::structure_t || e.type_name != b.qualified_name) return false;
+    return object(b, e);
+}
+
+// `{"field":value,…}` of a struct or pod item: each field is the first child of its name.
+bool Renderer::object(const Body& b, const MessageElement& e) {
     out_ += '{';
     for (std::size_t i = 0; i < b.fields.size(); ++i) {
         const Field& f = b.fields[i];
@@ -455,7 +461,7 @@ bool Renderer::structure(const Node& n, const MessageElement& e) {
         if (!c) return false;
         if (i) out_ += ',';
         out_ += f.key;
-        if (!render(*f.node, *c)) return false;
+        if (!field(f, *c)) return false;
     }
     out_ += '}';
     return true;
@@ -472,22 +478,14 @@ bool Renderer::pod(const Node& n, const MessageElement& e) {
         auto number = element_number(item);
         if (!number || static_cast<std::size_t>(*number) != i || item.type != DataTypes::pod_t) return false;
         if (i) out_ += ',';
-        out_ += '{';
-        for (std::size_t k = 0; k < b.fields.size(); ++k) {
-            const Field& f = b.fields[k];
-            const MessageElement* c = item.find(f.name);
-            if (!c) return false;
-            if (k) out_ += ',';
-            out_ += f.key;
-            if (!pod_field(f, *c)) return false;
-        }
-        out_ += '}';
+        if (!object(b, item)) return false;
     }
     if (!scalar) out_ += ']';
     return true;
 }
 
-bool Renderer::pod_field(const Field& f, const MessageElement& e) {
+// A pod field declared multi-dim is {"array": items, "dims": declared}; every other field is its node.
+bool Renderer::field(const Field& f, const MessageElement& e) {
     if (f.dims_suffix.empty()) return render(*f.node, e);
     out_ += "{\"array\":";
     if (!render(*f.node, e)) return false;
