@@ -213,26 +213,9 @@ void ServiceLocks::shutdown() {
 void ServiceLocks::park(const std::string& path, std::uint32_t endpoint, Responder responder, std::chrono::milliseconds wait) {
     auto parked = std::make_shared<Parked>();
     parked->responder = std::move(responder);
-    std::shared_ptr<Parked> replaced;
-    bool granted_meanwhile = false;
-    {
-        std::lock_guard lock(mutex_);
-        // Handed over between monitor_enter/continue and now (its event found nothing parked).
-        granted_meanwhile = locks_.monitor_holder(path) == endpoint;
-        if (io_ && !shut_down_ && !granted_meanwhile) {
-            parked->timer = std::make_unique<boost::asio::steady_timer>(*io_, wait);
-            replaced = std::move(parked_[{path, endpoint}]);
-            parked_[{path, endpoint}] = parked;
-        }
-    }
-    if (replaced && !replaced->responder.done()) answer(replaced->responder, "Continue");
-    if (!parked->timer) {  // no io_context: the client asks again at once
-        answer(parked->responder, granted_meanwhile ? "OK" : "Continue");
-        return;
-    }
     std::weak_ptr<ServiceLocks> weak = weak_from_this();
     std::weak_ptr<Parked> weak_parked = parked;
-    parked->timer->async_wait([weak, weak_parked, path, endpoint](const boost::system::error_code& ec) {
+    auto on_timeout = [weak, weak_parked, path, endpoint](const boost::system::error_code& ec) {
         if (ec) return;
         auto self = weak.lock();
         if (!self) return;
@@ -253,7 +236,24 @@ void ServiceLocks::park(const std::string& path, std::uint32_t endpoint, Respond
             }
         }
         if (mine && !mine->responder.done()) answer(mine->responder, "Continue");
-    });
+    };
+    std::shared_ptr<Parked> replaced;
+    bool granted_meanwhile = false;
+    {
+        std::lock_guard lock(mutex_);
+        // Handed over between monitor_enter/continue and now (its event found nothing parked).
+        granted_meanwhile = locks_.monitor_holder(path) == endpoint;
+        if (io_ && !shut_down_ && !granted_meanwhile) {
+            parked->timer = std::make_unique<boost::asio::steady_timer>(*io_, wait);
+            // Armed before it is published: once in parked_, another connection's thread may take it
+            // and cancel the timer (a timer is not safe for two threads at once).
+            parked->timer->async_wait(std::move(on_timeout));
+            replaced = std::move(parked_[{path, endpoint}]);
+            parked_[{path, endpoint}] = parked;
+        }
+    }
+    if (replaced && !replaced->responder.done()) answer(replaced->responder, "Continue");
+    if (!parked->timer) answer(parked->responder, granted_meanwhile ? "OK" : "Continue");  // no io_context: the client asks again at once
 }
 
 void ServiceLocks::deliver(std::vector<ObjectLocks::MonitorEvent>& events) {
