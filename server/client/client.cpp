@@ -42,6 +42,8 @@ TimeSpec wall_clock_now() {
 // --- IoThreads -------------------------------------------------------------------------------------
 
 IoThreads::IoThreads(unsigned threads) : work_(io_.get_executor()) {
+    // Callers waiting with caller_runs_io must not sleep untimed while workers run the io_context too.
+    asio::use_service<detail::CallerIoRunners>(io_).workers.store(static_cast<int>(threads));
     for (unsigned i = 0; i < threads; ++i) threads_.emplace_back([this] { io_.run(); });
 }
 
@@ -132,6 +134,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     std::shared_ptr<Client> client(new Client());
     client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(*io)));
     client->caller_runs_io_ = options.caller_runs_io;
+    client->untimed_waits_ = options.caller_runs_io && options.request_timeout.count() > 0;
     client->wait_limit_ = options.request_timeout + 5s;
     auto logic = std::make_shared<Logic>(std::move(cfg));
     client->logic_ = logic;

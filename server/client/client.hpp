@@ -38,6 +38,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "core/session/client_context.hpp"
+#include "server/client/caller_io.hpp"
 #include "server/common/caller_runs_executor.hpp"
 #include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"
@@ -80,10 +81,13 @@ struct ClientOptions {
     /// The calling thread runs the connection's I/O while it waits: for a program whose io_context
     /// no other thread runs (IoThreads(0)) and that calls from one thread. A blocking call then
     /// sleeps once per reply, in the socket wait itself, instead of a worker thread waking for the
-    /// reply and then waking the caller (issue 14: one context switch per call, not two). Events,
-    /// wire values, callbacks and heartbeats are handled only while a blocking call, close_wait() or
-    /// poll() runs: call poll() at least every heartbeat_period when idle. Other threads calling at
-    /// the same time still complete, up to 1 ms later.
+    /// reply and then waking the caller (issue 14: one context switch per call, not two); alone, it
+    /// sleeps there without a timeout (server/client/caller_io.hpp: a timeout re-armed per call cost
+    /// more CPU than the call), bounded by request_timeout. Events, wire values, callbacks and
+    /// heartbeats are handled only while a blocking call, close_wait() or poll() runs: call poll() at
+    /// least every heartbeat_period when idle. Other threads calling at the same time still complete,
+    /// up to 1 ms later. A thread of the program's own that runs the io_context (io_context::run)
+    /// would leave a caller asleep: use IoThreads(0), or no caller_runs_io.
     bool caller_runs_io = false;
 };
 
@@ -176,6 +180,9 @@ private:
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
     bool caller_runs_io_ = false;
+    /// caller_runs_io: a lone caller waits for its answer without a timeout (caller_io.hpp), which
+    /// needs the request timeout to bound the wait.
+    bool untimed_waits_ = false;
     /// The io_context under the connection's strand (run by the caller with caller_runs_io).
     boost::asio::io_context& io_context() const { return strand_->get_inner_executor().inner().context(); }
     std::chrono::milliseconds wait_limit_{20000};
@@ -340,11 +347,12 @@ public:
             std::lock_guard lock(mutex_);
             if (result_) return;
             result_.emplace(std::move(r));
-            answered_.store(true, std::memory_order_release);
+            answered_.store(true);  // sequentially consistent: paired with UntimedWait (caller_io.hpp)
         }
         ready_.notify_one();
+        untimed_wait.kick();
     }
-    bool answered() const noexcept { return answered_.load(std::memory_order_acquire); }
+    bool answered() const noexcept { return answered_.load(); }
     /// The result, or nullopt when none came within `limit`.
     std::optional<Result<T>> wait_for(std::chrono::steady_clock::duration limit) {
         std::unique_lock lock(mutex_);
@@ -352,6 +360,7 @@ public:
         return std::move(result_);
     }
     std::atomic<int> completions{0};  // live SyncCompletion copies
+    UntimedWait untimed_wait;         // the waiting thread's, when it runs the io_context (caller_runs_io)
 
 private:
     std::mutex mutex_;
@@ -359,22 +368,6 @@ private:
     std::optional<Result<T>> result_;
     std::atomic<bool> answered_{false};
 };
-
-/// Runs `io` on this thread until `done()` or `deadline`, in slices of at most 1 ms (another thread
-/// may complete what this one waits for). True when done.
-template <class Done>
-bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline) {
-    while (!done()) {
-        const auto now = std::chrono::steady_clock::now();
-        if (now >= deadline) return false;
-        const auto slice = std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(1));
-        if (io.run_one_for(slice) == 0 && io.stopped()) {
-            io.restart();  // out of work (no worker guard): nothing here can finish it, so do not spin
-            std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(slice, std::chrono::microseconds(100)));
-        }
-    }
-    return true;
-}
 
 /// The completion a blocking call hands to the strand. When its last copy is dropped unanswered
 /// (the connection closed first), the call fails with ConnectionError.
@@ -407,9 +400,14 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
             start(ctx, now, done);
         });
     }
-    if (caller_runs_io_)
-        detail::run_io_until(io_context(), [&] { return waiter->answered(); },
-                             std::chrono::steady_clock::now() + wait_limit_);
+    if (caller_runs_io_) {
+        const auto deadline = std::chrono::steady_clock::now() + wait_limit_;
+        const auto answered = [&] { return waiter->answered(); };
+        if (untimed_waits_)
+            detail::run_io_until_answered(io_context(), answered, waiter->untimed_wait, deadline);
+        else
+            detail::run_io_until(io_context(), answered, deadline);
+    }
     auto r = waiter->wait_for(caller_runs_io_ ? std::chrono::steady_clock::duration::zero()
                                               : std::chrono::steady_clock::duration(wait_limit_));
     if (!r) return fail(MessageErrorType::RequestTimeout, "no answer from the client connection in time");
