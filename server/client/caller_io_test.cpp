@@ -21,11 +21,12 @@
 
 using namespace rr;
 using namespace std::chrono_literals;
+
+// Named, not anonymous: in the unity build (preset tsan) other test files' helpers share the batch.
+namespace caller_io_test {
+
 using rr::client::detail::CallerIoRunners;
 using rr::client::detail::SyncWaiter;
-
-namespace {
-
 using Clock = std::chrono::steady_clock;
 
 // A thread waiting for `waiter`'s answer with run_io_until_answered on `io`; ended() tells whether it
@@ -70,33 +71,35 @@ bool eventually(Pred pred, std::chrono::milliseconds limit = 5s) {
     return true;
 }
 
-}  // namespace
+}  // namespace caller_io_test
+
+namespace cit = caller_io_test;
 
 TEST_CASE("caller io: a lone caller's untimed wait ends when a thread that does not run the io_context answers") {
     boost::asio::io_context io;
     auto guard = boost::asio::make_work_guard(io);
     for (int i = 0; i < 50; ++i) {
-        UntimedWaiter a(io);
-        REQUIRE(eventually([&] { return runners_of(io) == 1; }));
+        cit::UntimedWaiter a(io);
+        REQUIRE(cit::eventually([&] { return cit::runners_of(io) == 1; }));
         std::this_thread::sleep_for(std::chrono::microseconds(200 * (i % 5)));  // asleep, or about to be
         a.waiter->set(5);  // this thread never runs `io`: the set must wake the waiter
         INFO("iteration " << i);
         REQUIRE(a.ended(2s));
     }
-    CHECK(runners_of(io) == 0);
+    CHECK(cit::runners_of(io) == 0);
 }
 
 TEST_CASE("caller io: a second thread running the io_context wakes the untimed waiter, whoever runs its answer") {
     boost::asio::io_context io;
     auto guard = boost::asio::make_work_guard(io);
     for (int i = 0; i < 100; ++i) {
-        UntimedWaiter a(io);
-        REQUIRE(eventually([&] { return runners_of(io) == 1; }));
+        cit::UntimedWaiter a(io);
+        REQUIRE(cit::eventually([&] { return cit::runners_of(io) == 1; }));
         std::atomic<bool> b_done{false};
         std::thread b([&] {
-            rr::client::detail::run_io_until(io, [&] { return b_done.load(); }, Clock::now() + 60s);
+            rr::client::detail::run_io_until(io, [&] { return b_done.load(); }, cit::Clock::now() + 60s);
         });
-        REQUIRE(eventually([&] { return runners_of(io) == 2; }));
+        REQUIRE(cit::eventually([&] { return cit::runners_of(io) == 2; }));
         // The answer is a handler: either thread may run it. If `a` were still asleep without a
         // timeout while `b` ran it, nothing would wake `a`.
         boost::asio::post(io, [w = a.waiter] { w->set(7); });
@@ -106,24 +109,24 @@ TEST_CASE("caller io: a second thread running the io_context wakes the untimed w
         boost::asio::post(io, [] {});
         b.join();
     }
-    CHECK(runners_of(io) == 0);
+    CHECK(cit::runners_of(io) == 0);
 }
 
 TEST_CASE("caller io: while worker threads run the io_context nobody waits untimed") {
     rr::client::IoThreads workers(1);
     auto* io = &boost::asio::query(workers.executor(), boost::asio::execution::context);
     auto& context = static_cast<boost::asio::io_context&>(*io);
-    CHECK(boost::asio::use_service<CallerIoRunners>(context).workers.load() == 1);
+    CHECK(boost::asio::use_service<cit::CallerIoRunners>(context).workers.load() == 1);
     for (int i = 0; i < 100; ++i) {
-        UntimedWaiter a(context);
-        REQUIRE(eventually([&] { return runners_of(context) == 1; }));
+        cit::UntimedWaiter a(context);
+        REQUIRE(cit::eventually([&] { return cit::runners_of(context) == 1; }));
         boost::asio::post(context, [w = a.waiter] { w->set(1); });  // the worker may run it
         INFO("iteration " << i);
         REQUIRE(a.ended(2s));
     }
 }
 
-namespace {
+namespace caller_io_test {
 
 // RawTestService whose `add` is never answered (its responders are kept until the service goes).
 class SilentAddService : public server::testing::RawTestService {
@@ -166,10 +169,10 @@ struct CallerIoFixture {
     }
 };
 
-}  // namespace
+}  // namespace caller_io_test
 
 TEST_CASE("caller io: a client with caller_runs_io answers calls from one and from three threads") {
-    CallerIoFixture f;
+    cit::CallerIoFixture f;
     auto c = f.connect();
     auto root = c->root();
     for (int i = 0; i < 500; ++i) {
@@ -194,16 +197,16 @@ TEST_CASE("caller io: a client with caller_runs_io answers calls from one and fr
     for (auto& t : threads) t.join();
     CHECK(done == 3);
     CHECK(wrong == 0);
-    CHECK(runners_of(static_cast<boost::asio::io_context&>(boost::asio::query(f.none.executor(), boost::asio::execution::context))) == 0);
+    CHECK(cit::runners_of(static_cast<boost::asio::io_context&>(boost::asio::query(f.none.executor(), boost::asio::execution::context))) == 0);
 }
 
 TEST_CASE("caller io: an unanswered call ends with the request timeout, not later") {
-    CallerIoFixture f;
+    cit::CallerIoFixture f;
     auto c = f.connect(300ms);
     auto root = c->root();
-    const auto t0 = Clock::now();
+    const auto t0 = cit::Clock::now();
     auto r = root.call("add", {Value::scalar<std::int32_t>(1), Value::scalar<std::int32_t>(2)});
-    const auto took = Clock::now() - t0;
+    const auto took = cit::Clock::now() - t0;
     REQUIRE_FALSE(r);
     CHECK(r.error().type == MessageErrorType::RequestTimeout);
     CHECK(took >= 250ms);
