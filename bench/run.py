@@ -180,7 +180,7 @@ class Sampler(threading.Thread):
                 "vcsw_per_s": (s[-1][3] - s[0][3]) / dt}
 
 
-SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser")
+SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs")
 # Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
 # allows by default (256); 0 lifts the limit.
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
@@ -343,6 +343,97 @@ def browser_section(exe, args, rounds, procs):
     return raw
 
 
+# The pairs section's figures: (key, what, how it is made from one block's rows, unit).
+PAIR_FIGURES = [
+    ("blocking_vs_async_p50", "Nop p50, blocking / async (same process, back to back)",
+     lambda b: ratio(b, ("ours", "nop", "p50_us"), ("ours", "nop_async", "p50_us")), "×"),
+    ("blocking_vs_async_cpu", "client CPU per Nop, blocking / async",
+     lambda b: ratio(b, ("ours", "nop", "client_cpu_us_per_op"), ("ours", "nop_async", "client_cpu_us_per_op")), "×"),
+    ("blocking_vcsw", "context switches per blocking Nop", lambda b: field(b, ("ours", "nop", "client_vcsw_per_op")), ""),
+    ("async_vcsw", "context switches per async Nop", lambda b: field(b, ("ours", "nop_async", "client_vcsw_per_op")), ""),
+    ("caller_io_vs_async_p50", "Nop p50, blocking with caller_runs_io / async",
+     lambda b: ratio(b, ("caller-io", "nop", "p50_us"), ("ours", "nop_async", "p50_us")), "×"),
+    ("caller_io_vs_async_cpu", "client CPU per Nop, caller_runs_io / async",
+     lambda b: ratio(b, ("caller-io", "nop", "client_cpu_us_per_op"), ("ours", "nop_async", "client_cpu_us_per_op")), "×"),
+    ("caller_io_vcsw", "context switches per blocking Nop with caller_runs_io",
+     lambda b: field(b, ("caller-io", "nop", "client_vcsw_per_op")), ""),
+    ("get_vs_official", "property get, official client's p50 / ours (blocking)",
+     lambda b: ratio(b, ("official", "get", "p50_us"), ("ours", "get", "p50_us")), "×"),
+    ("get_caller_io_vs_official", "property get, official client's p50 / ours (caller_runs_io)",
+     lambda b: ratio(b, ("official", "get", "p50_us"), ("caller-io", "get", "p50_us")), "×"),
+    ("gateway_hop_async", "gateway hop, async Nop (through − direct) / TCP floor",
+     lambda b: hop(b, "nop_async"), "× floor"),
+    ("gateway_hop_blocking", "gateway hop, blocking Nop (through − direct) / TCP floor",
+     lambda b: hop(b, "nop"), "× floor"),
+]
+
+
+def field(block, key):
+    name, op, k = key
+    row = block.get((name, op))
+    return row.get(k) if row else None
+
+
+def ratio(block, a, b):
+    x, y = field(block, a), field(block, b)
+    return x / y if x is not None and y else None
+
+
+def hop(block, op):
+    through, direct, floor = field(block, ("gateway", op, "p50_us")), field(block, ("ours", op, "p50_us")), \
+        field(block, ("floor", "tcp_64", "p50_us"))
+    return (through - direct) / floor if None not in (through, direct) and floor else None
+
+
+def pairs_section(exe, args, procs):
+    """Issue 14's ratios from many short blocks, each pair measured within one block: on these vCPUs a
+    thread's wake-up flips between ~5 µs and ~45 µs for seconds at a time, so two rows run minutes apart
+    in the suite can land in different modes and their ratio mislead by 3-4x (../shared/BENCHMARKING.md).
+    A block runs, back to back: the TCP floor; our client's blocking Nop, async Nop and blocking get in
+    one process; the same blocking calls with caller_runs_io; the same client through the gateway; the
+    official client's Nop and get on the official service. Blocks alternate their order (forward, then
+    backward). Each figure is taken within each block, then the median over blocks is reported with
+    every block's value."""
+    ours = Proc([exe["rr_bench_service"]], "bench_service")
+    procs.append(ours)
+    official = Proc([PY, os.path.join(HERE, "py", "official_service.py")], "official_service")
+    procs.append(official)
+    gw = gateway_proc(exe, ours.ready["url"])
+    procs.append(gw)
+    gw_url = "rr+tcp://127.0.0.1:%d/?service=bench" % gw.ready["port"]
+    time.sleep(1.0)
+    n = str(args.pair_count)
+    client = lambda url, label, ops, *extra: [exe["rr_bench_client"], "--url", url, "--label", label, "--count", n,
+                                              "--ops", ops, *extra]
+    plan = [("floor", [exe["rr_bench_floor"], "--count", n]),
+            ("ours", client(ours.ready["url"], "ours->ours rr+tcp", "nop,nop_async,get")),
+            ("caller-io", client(ours.ready["url"], "ours->ours rr+tcp caller-io", "nop,get", "--caller-io", "1")),
+            ("gateway", client(gw_url, "ours->gateway->ours rr+tcp", "nop,nop_async")),
+            ("official", [PY, os.path.join(HERE, "py", "official_client.py"), "--url", official.ready["url"], "--label",
+                          "official->official rr+tcp", "--count", n, "--ops", "nop,get"])]
+    blocks = []
+    for i in range(args.pair_blocks):
+        log("pairs: block %d/%d" % (i + 1, args.pair_blocks))
+        block = {}
+        for name, argv in (plan if i % 2 == 0 else list(reversed(plan))):
+            for row in run_rows(argv):
+                block[(name, row["op"])] = row
+        blocks.append(block)
+    for p in (gw, official, ours):
+        p.stop()
+        procs.remove(p)
+    out = []
+    for key, what, make, unit in PAIR_FIGURES:
+        values = [make(b) for b in blocks]
+        values = [v for v in values if v is not None]
+        if values:
+            out.append({"figure": key, "what": what, "unit": unit, "median": statistics.median(values),
+                        "min": min(values), "max": max(values), "blocks": [round(v, 2) for v in values]})
+    raw = [dict(row, block=i, name=name) for i, b in enumerate(blocks) for (name, _), row in b.items()]
+    return {"figures": out, "raw": raw}
+
+
+
 def summarize_browser(raw):
     """One row per (path, op): medians over rounds, the ratio to the native client's p50 and to the TCP
     floor of the same round (every round listed)."""
@@ -395,6 +486,9 @@ def main(argv=None):
     ap.add_argument("--camera", action="store_true", help="also: 640x480 RGB at 30 Hz to N JSON clients (binary pushes)")
     ap.add_argument("--browser", action="store_true", help="also: the wasm client in node and Chromium, with the native client")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
+    ap.add_argument("--pairs", action="store_true", help="also: issue 14's ratios from short interleaved blocks")
+    ap.add_argument("--pair-blocks", type=int, default=12, help="blocks of the pairs section (default 12)")
+    ap.add_argument("--pair-count", type=int, default=1000, help="calls per op and block in the pairs section")
     ap.add_argument("--only", help="run only these sections (comma-separated): " + ",".join(SECTIONS) +
                     "; results go to latest-SECTIONS.json/.md")
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
@@ -412,6 +506,7 @@ def main(argv=None):
             ap.error("--only: unknown section(s) %s (sections: %s)" % (", ".join(bad), ", ".join(SECTIONS)))
         args.skip_calls, args.skip_fanout, args.skip_scale = "calls" not in only, "fanout" not in only, "scale" not in only
         args.rr_fanout, args.camera, args.browser = "rr-fanout" in only, "camera" in only, "browser" in only
+        args.pairs = "pairs" in only
         stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
     browser_rounds = args.rounds
 
@@ -425,7 +520,7 @@ def main(argv=None):
     started = time.time()
     result = {"started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
               "machine": machine_info(), "load_average_start": list(os.getloadavg()),
-              "busy_loops": not args.no_busy, "rounds": args.rounds, "count": args.count}
+              "busy_loops": not args.no_busy, "rounds": args.rounds, "count": args.count, "pair_count": args.pair_count}
     busy = [] if args.no_busy else start_busy_loops()
     if busy:
         log("two nice-19 busy loops run for the duration (busy latency regime, ../shared/BENCHMARKING.md)")
@@ -549,6 +644,7 @@ def main(argv=None):
         rr_fanout = rr_fanout_section(exe, args, procs) if args.rr_fanout else []
         camera = camera_section(exe, args, procs) if args.camera else []
         browser = browser_section(exe, args, browser_rounds, procs) if args.browser else []
+        pairs = pairs_section(exe, args, procs) if args.pairs else {}
     finally:
         for p in reversed(procs):
             p.stop()
@@ -557,7 +653,8 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
-    result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser})
+    result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser,
+                   "pairs": pairs.get("figures", []), "pairs_raw": pairs.get("raw", [])})
     result["load_average_end"] = list(os.getloadavg())
     result["duration_s"] = round(time.time() - started, 1)
     result["raw"] = raw
@@ -788,6 +885,16 @@ def markdown(res):
                 fmt(e.get("gateway_cpu_us_per_op")) if e["label"] != "floor" else "",
                 (fmt(e["x_native"], 2) + rounds("x_native")) if "x_native" in e else "",
                 (fmt(e["x_tcp_floor"], 2) + rounds("x_tcp_floor")) if "x_tcp_floor" in e else ""))
+    if res.get("pairs"):
+        out += ["", "Pairs: issue 14's ratios, each taken within one short block (the TCP floor, our client's blocking and async "
+                "Nop and blocking get in one process, the same blocking calls with caller_runs_io, the same client through the "
+                "gateway, the official client's Nop and get; %d calls per op, blocks in alternating order), then the median "
+                "over blocks, with every block's value:" % res["pair_count"], "",
+                "| figure | median | min – max | every block |", "|---|---|---|---|"]
+        for f in res["pairs"]:
+            out.append("| %s | **%s%s** | %s – %s | %s |" % (
+                f["what"], fmt(f["median"], 2), f["unit"] and " " + f["unit"], fmt(f["min"], 2), fmt(f["max"], 2),
+                ", ".join("%.2f" % x for x in f["blocks"])))
     return "\n".join(out) + "\n"
 
 
