@@ -186,8 +186,8 @@ SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
 
 
-def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False):
-    argv = [exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning", "--device",
+def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=()):
+    argv = [*prefix, exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning", "--device",
             "bench=" + device_url]
     if unlimited:
         path = os.path.join(tempfile.gettempdir(), "rr-bench-gateway-%d.yaml" % os.getpid())
@@ -344,23 +344,25 @@ def browser_section(exe, args, rounds, procs):
 
 
 # The pairs section's figures: (key, what, how it is made from one block's rows, unit).
+NOP, ASYNC, GET = ("ours", "nop"), ("ours", "nop_async"), ("ours", "get")
+CIO_NOP, CIO_GET, OFF_GET, FLOOR = ("caller-io", "nop"), ("caller-io", "get"), ("official", "get"), ("floor", "tcp_64")
 PAIR_FIGURES = [
     ("blocking_vs_async_p50", "Nop p50, blocking / async (same process, back to back)",
-     lambda b: ratio(b, ("ours", "nop", "p50_us"), ("ours", "nop_async", "p50_us")), "×"),
+     lambda b: ratio(b, NOP + ("p50_us",), ASYNC + ("p50_us",)), "×"),
     ("blocking_vs_async_cpu", "client CPU per Nop, blocking / async",
-     lambda b: ratio(b, ("ours", "nop", "client_cpu_us_per_op"), ("ours", "nop_async", "client_cpu_us_per_op")), "×"),
-    ("blocking_vcsw", "context switches per blocking Nop", lambda b: field(b, ("ours", "nop", "client_vcsw_per_op")), ""),
-    ("async_vcsw", "context switches per async Nop", lambda b: field(b, ("ours", "nop_async", "client_vcsw_per_op")), ""),
+     lambda b: ratio(b, NOP + ("client_cpu_us_per_op",), ASYNC + ("client_cpu_us_per_op",)), "×"),
+    ("blocking_vcsw", "context switches per blocking Nop", lambda b: field(b, NOP + ("client_vcsw_per_op",)), ""),
+    ("async_vcsw", "context switches per async Nop", lambda b: field(b, ASYNC + ("client_vcsw_per_op",)), ""),
     ("caller_io_vs_async_p50", "Nop p50, blocking with caller_runs_io / async",
-     lambda b: ratio(b, ("caller-io", "nop", "p50_us"), ("ours", "nop_async", "p50_us")), "×"),
+     lambda b: ratio(b, CIO_NOP + ("p50_us",), ASYNC + ("p50_us",)), "×"),
     ("caller_io_vs_async_cpu", "client CPU per Nop, caller_runs_io / async",
-     lambda b: ratio(b, ("caller-io", "nop", "client_cpu_us_per_op"), ("ours", "nop_async", "client_cpu_us_per_op")), "×"),
+     lambda b: ratio(b, CIO_NOP + ("client_cpu_us_per_op",), ASYNC + ("client_cpu_us_per_op",)), "×"),
     ("caller_io_vcsw", "context switches per blocking Nop with caller_runs_io",
-     lambda b: field(b, ("caller-io", "nop", "client_vcsw_per_op")), ""),
+     lambda b: field(b, CIO_NOP + ("client_vcsw_per_op",)), ""),
     ("get_vs_official", "property get, official client's p50 / ours (blocking)",
-     lambda b: ratio(b, ("official", "get", "p50_us"), ("ours", "get", "p50_us")), "×"),
+     lambda b: ratio(b, OFF_GET + ("p50_us",), GET + ("p50_us",)), "×"),
     ("get_caller_io_vs_official", "property get, official client's p50 / ours (caller_runs_io)",
-     lambda b: ratio(b, ("official", "get", "p50_us"), ("caller-io", "get", "p50_us")), "×"),
+     lambda b: ratio(b, OFF_GET + ("p50_us",), CIO_GET + ("p50_us",)), "×"),
     ("gateway_hop_async", "gateway hop, async Nop (through − direct) / TCP floor",
      lambda b: hop(b, "nop_async"), "× floor"),
     ("gateway_hop_blocking", "gateway hop, blocking Nop (through − direct) / TCP floor",
@@ -386,30 +388,34 @@ def hop(block, op):
 
 
 def pairs_section(exe, args, procs):
-    """Issue 14's ratios from many short blocks, each pair measured within one block: on these vCPUs a
-    thread's wake-up flips between ~5 µs and ~45 µs for seconds at a time, so two rows run minutes apart
-    in the suite can land in different modes and their ratio mislead by 3-4x (../shared/BENCHMARKING.md).
-    A block runs, back to back: the TCP floor; our client's blocking Nop, async Nop and blocking get in
-    one process; the same blocking calls with caller_runs_io; the same client through the gateway; the
-    official client's Nop and get on the official service. Blocks alternate their order (forward, then
-    backward). Each figure is taken within each block, then the median over blocks is reported with
-    every block's value."""
-    ours = Proc([exe["rr_bench_service"]], "bench_service")
+    """Issue 14's ratios from many short blocks, each pair measured within one block. A block runs, back to
+    back: the TCP floor; our client's blocking Nop, async Nop and blocking get in one process; the same
+    blocking calls with caller_runs_io; the same client through the gateway; the official client's Nop and
+    get on the official service. Blocks alternate their order (forward, then backward); each figure is
+    taken within each block, then the median over blocks is reported with every block's value.
+
+    Every process of this section runs on one vCPU (`--pairs-cpu`, default 0; empty: anywhere). On these
+    VMs a wake-up of a thread on the other vCPU costs ~40 µs of CPU (an inter-processor interrupt under
+    the hypervisor), and the scheduler moves peers between "same vCPU" and "other vCPU" every few tenths of
+    a second: unpinned, a row's p50 flips between ~12 and ~55 µs for reasons that have nothing to do with
+    the code, and two rows run one after the other can land in different modes (docs/benchmarks.md)."""
+    pin = ["taskset", "-c", args.pairs_cpu] if args.pairs_cpu else []
+    ours = Proc(pin + [exe["rr_bench_service"]], "bench_service")
     procs.append(ours)
-    official = Proc([PY, os.path.join(HERE, "py", "official_service.py")], "official_service")
+    official = Proc(pin + [PY, os.path.join(HERE, "py", "official_service.py")], "official_service")
     procs.append(official)
-    gw = gateway_proc(exe, ours.ready["url"])
+    gw = gateway_proc(exe, ours.ready["url"], prefix=pin)
     procs.append(gw)
     gw_url = "rr+tcp://127.0.0.1:%d/?service=bench" % gw.ready["port"]
     time.sleep(1.0)
     n = str(args.pair_count)
-    client = lambda url, label, ops, *extra: [exe["rr_bench_client"], "--url", url, "--label", label, "--count", n,
-                                              "--ops", ops, *extra]
-    plan = [("floor", [exe["rr_bench_floor"], "--count", n]),
+    client = lambda url, label, ops, *extra: pin + [exe["rr_bench_client"], "--url", url, "--label", label, "--count", n,
+                                                    "--ops", ops, *extra]
+    plan = [("floor", pin + [exe["rr_bench_floor"], "--count", n]),
             ("ours", client(ours.ready["url"], "ours->ours rr+tcp", "nop,nop_async,get")),
             ("caller-io", client(ours.ready["url"], "ours->ours rr+tcp caller-io", "nop,get", "--caller-io", "1")),
             ("gateway", client(gw_url, "ours->gateway->ours rr+tcp", "nop,nop_async")),
-            ("official", [PY, os.path.join(HERE, "py", "official_client.py"), "--url", official.ready["url"], "--label",
+            ("official", pin + [PY, os.path.join(HERE, "py", "official_client.py"), "--url", official.ready["url"], "--label",
                           "official->official rr+tcp", "--count", n, "--ops", "nop,get"])]
     blocks = []
     for i in range(args.pair_blocks):
@@ -487,8 +493,9 @@ def main(argv=None):
     ap.add_argument("--browser", action="store_true", help="also: the wasm client in node and Chromium, with the native client")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
     ap.add_argument("--pairs", action="store_true", help="also: issue 14's ratios from short interleaved blocks")
-    ap.add_argument("--pair-blocks", type=int, default=12, help="blocks of the pairs section (default 12)")
-    ap.add_argument("--pair-count", type=int, default=1000, help="calls per op and block in the pairs section")
+    ap.add_argument("--pair-blocks", type=int, default=24, help="blocks of the pairs section (default 24)")
+    ap.add_argument("--pair-count", type=int, default=500, help="calls per op and block in the pairs section")
+    ap.add_argument("--pairs-cpu", default="0", help="the vCPU every process of the pairs section runs on ('' = any)")
     ap.add_argument("--only", help="run only these sections (comma-separated): " + ",".join(SECTIONS) +
                     "; results go to latest-SECTIONS.json/.md")
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
@@ -520,7 +527,8 @@ def main(argv=None):
     started = time.time()
     result = {"started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
               "machine": machine_info(), "load_average_start": list(os.getloadavg()),
-              "busy_loops": not args.no_busy, "rounds": args.rounds, "count": args.count, "pair_count": args.pair_count}
+              "busy_loops": not args.no_busy, "rounds": args.rounds, "count": args.count, "pair_count": args.pair_count,
+              "pairs_cpu": args.pairs_cpu}
     busy = [] if args.no_busy else start_busy_loops()
     if busy:
         log("two nice-19 busy loops run for the duration (busy latency regime, ../shared/BENCHMARKING.md)")
@@ -888,8 +896,9 @@ def markdown(res):
     if res.get("pairs"):
         out += ["", "Pairs: issue 14's ratios, each taken within one short block (the TCP floor, our client's blocking and async "
                 "Nop and blocking get in one process, the same blocking calls with caller_runs_io, the same client through the "
-                "gateway, the official client's Nop and get; %d calls per op, blocks in alternating order), then the median "
-                "over blocks, with every block's value:" % res["pair_count"], "",
+                "gateway, the official client's Nop and get; %d calls per op, blocks in alternating order; %s), then the median "
+                "over blocks, with every block's value:" % (
+                    res["pair_count"], "every process on vCPU %s" % res["pairs_cpu"] if res.get("pairs_cpu") else "unpinned"), "",
                 "| figure | median | min – max | every block |", "|---|---|---|---|"]
         for f in res["pairs"]:
             out.append("| %s | **%s%s** | %s – %s | %s |" % (
