@@ -88,10 +88,14 @@ inline void run_slice(boost::asio::io_context& io, std::chrono::steady_clock::du
     }
 }
 
-/// Runs `io` on this thread until `done()` or `deadline`, in slices of at most 1 ms (another thread
-/// may complete what this one waits for). True when done.
+/// Runs `io` on this thread until `done()` or `deadline`. In slices of at most 1 ms (another thread
+/// may complete what this one waits for), unless `untimed` is given (one blocking call's answer, whose
+/// setter kicks it) and this is the only thread running `io`: then without a timeout, and `deadline`
+/// is checked whenever a handler ran (the connection's own timers, heartbeat and request timeout, run
+/// at least that often). True when done.
 template <class Done>
-bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline) {
+bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline,
+                  UntimedWait* untimed = nullptr) {
     auto& runners = join_runners(io);
     bool ok = true;
     while (!done()) {
@@ -100,40 +104,21 @@ bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_cl
             ok = false;
             break;
         }
-        run_slice(io, std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(1)));
-    }
-    runners.runners.fetch_sub(1);
-    return ok;
-}
-
-/// For one blocking call's answer: runs `io` on this thread until `answered()`, without a timeout
-/// while this is the only thread running it (then `deadline` is checked whenever a handler ran: the
-/// connection's own timers, heartbeat and request timeout, run at least that often), in 1 ms slices
-/// otherwise. `wait` is the waiter's UntimedWait (its result's setter kicks it). True when answered.
-template <class Answered>
-bool run_io_until_answered(boost::asio::io_context& io, Answered answered, UntimedWait& wait,
-                           std::chrono::steady_clock::time_point deadline) {
-    auto& runners = join_runners(io);
-    bool ok = true;
-    while (!answered()) {
-        const auto now = std::chrono::steady_clock::now();
-        if (now >= deadline) {
-            ok = false;
-            break;
+        bool alone = false;
+        if (untimed) {
+            // Announce, then look; the arriving thread and the result's setter do the reverse: one of
+            // the two sees the other, so nobody is left asleep (sequentially consistent atomics).
+            runners.untimed.store(true);
+            untimed->enter(io);
+            alone = runners.runners.load() == 1 && runners.workers.load() == 0;
+            std::size_t ran = 1;
+            if (alone && !done()) ran = io.run_one();
+            untimed->leave();
+            runners.untimed.store(false);
+            if (alone && ran == 0 && io.stopped()) run_slice(io, std::chrono::milliseconds(1));  // restarts it, no spin
         }
-        // Announce, then look; the arriving thread and the result's setter do the reverse: one of the
-        // two sees the other, so nobody is left asleep (sequentially consistent atomics).
-        runners.untimed.store(true);
-        wait.enter(io);
-        const bool alone = runners.runners.load() == 1 && runners.workers.load() == 0;
-        std::size_t ran = 1;
-        if (alone && !answered()) ran = io.run_one();
-        wait.leave();
-        runners.untimed.store(false);
         if (!alone)
             run_slice(io, std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(1)));
-        else if (ran == 0 && io.stopped())
-            run_slice(io, std::chrono::milliseconds(1));  // stopped: restarts it, without a spin
     }
     runners.runners.fetch_sub(1);
     return ok;

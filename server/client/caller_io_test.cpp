@@ -16,6 +16,7 @@
 
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
+#include "server/node/test_node.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
 
@@ -29,7 +30,7 @@ using rr::client::detail::CallerIoRunners;
 using rr::client::detail::SyncWaiter;
 using Clock = std::chrono::steady_clock;
 
-// A thread waiting for `waiter`'s answer with run_io_until_answered on `io`; ended() tells whether it
+// A thread waiting for `waiter`'s answer with run_io_until on `io`, untimed when alone; ended() tells whether it
 // returned within `limit`. A waiter left asleep is woken by the test itself (so a failure does not
 // hang the run) and reported.
 struct UntimedWaiter {
@@ -46,8 +47,8 @@ struct UntimedWaiter {
         thread = std::thread([this, &made] {
             waiter = std::make_shared<SyncWaiter<int>>();
             made.set_value();
-            done.set_value(rr::client::detail::run_io_until_answered(
-                io, [w = waiter] { return w->answered(); }, waiter->untimed_wait, Clock::now() + 60s));
+            done.set_value(rr::client::detail::run_io_until(
+                io, [w = waiter] { return w->answered(); }, Clock::now() + 60s, &waiter->untimed_wait));
         });
         ready.wait();
     }
@@ -144,8 +145,7 @@ public:
 };
 
 struct CallerIoFixture {
-    std::shared_ptr<server::Node> node =
-        server::Node::create(server::NodeOptions{NodeID(), "calleriotest.node", 2, {}, 0, 5000ms});
+    std::shared_ptr<server::Node> node = server::testing::test_node("calleriotest.node");
     std::shared_ptr<SilentAddService> service = std::make_shared<SilentAddService>();
     std::uint16_t port = 0;
     rr::client::IoThreads none{0};

@@ -401,12 +401,8 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
         });
     }
     if (caller_runs_io_) {
-        const auto deadline = std::chrono::steady_clock::now() + wait_limit_;
-        const auto answered = [&] { return waiter->answered(); };
-        if (untimed_waits_)
-            detail::run_io_until_answered(io_context(), answered, waiter->untimed_wait, deadline);
-        else
-            detail::run_io_until(io_context(), answered, deadline);
+        detail::run_io_until(io_context(), [&] { return waiter->answered(); }, std::chrono::steady_clock::now() + wait_limit_,
+                             untimed_waits_ ? &waiter->untimed_wait : nullptr);
     }
     auto r = waiter->wait_for(caller_runs_io_ ? std::chrono::steady_clock::duration::zero()
                                               : std::chrono::steady_clock::duration(wait_limit_));
