@@ -20,6 +20,7 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <utility>
 
 #include <boost/asio/execution_context.hpp>
 #include <boost/asio/io_context.hpp>
@@ -34,6 +35,8 @@ public:
     using key_type = CallerIoRunners;
     inline static boost::asio::execution_context::id id;
     explicit CallerIoRunners(boost::asio::execution_context& context) : service(context) {}
+    /// The io_context it belongs to (made only by use_service on an io_context).
+    boost::asio::io_context& io() noexcept { return static_cast<boost::asio::io_context&>(context()); }
 
     std::atomic<int> runners{0};
     std::atomic<bool> untimed{false};
@@ -68,15 +71,16 @@ private:
     std::atomic<boost::asio::io_context*> io_{nullptr};
 };
 
-/// Counts this thread among the runners of `io`; when a thread waits there untimed, wakes it and waits
-/// until it has left that wait (header comment).
-inline CallerIoRunners& join_runners(boost::asio::io_context& io) {
-    auto& runners = boost::asio::use_service<CallerIoRunners>(io);
+/// The runners of `io` (a lookup under Asio's service registry lock: a client keeps the answer).
+inline CallerIoRunners& caller_io_runners(boost::asio::io_context& io) { return boost::asio::use_service<CallerIoRunners>(io); }
+
+/// Counts this thread among `runners`; when a thread waits there untimed, wakes it and waits until it
+/// has left that wait (header comment).
+inline void join_runners(CallerIoRunners& runners) {
     if (runners.runners.fetch_add(1) > 0 && runners.untimed.load()) {
-        boost::asio::post(io, [] {});
+        boost::asio::post(runners.io(), [] {});
         while (runners.untimed.load()) std::this_thread::sleep_for(std::chrono::microseconds(20));
     }
-    return runners;
 }
 
 /// One run of `io` of at most `slice`. When it is out of work (no worker guard) nothing here can
@@ -88,15 +92,16 @@ inline void run_slice(boost::asio::io_context& io, std::chrono::steady_clock::du
     }
 }
 
-/// Runs `io` on this thread until `done()` or `deadline`. In slices of at most 1 ms (another thread
+/// Runs the io_context of `runners` on this thread until `done()` or `deadline`. In slices of at most 1 ms (another thread
 /// may complete what this one waits for), unless `untimed` is given (one blocking call's answer, whose
 /// setter kicks it) and this is the only thread running `io`: then without a timeout, and `deadline`
 /// is checked whenever a handler ran (the connection's own timers, heartbeat and request timeout, run
 /// at least that often). True when done.
 template <class Done>
-bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline,
+bool run_io_until(CallerIoRunners& runners, Done done, std::chrono::steady_clock::time_point deadline,
                   UntimedWait* untimed = nullptr) {
-    auto& runners = join_runners(io);
+    boost::asio::io_context& io = runners.io();
+    join_runners(runners);
     bool ok = true;
     while (!done()) {
         const auto now = std::chrono::steady_clock::now();
@@ -122,6 +127,13 @@ bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_cl
     }
     runners.runners.fetch_sub(1);
     return ok;
+}
+
+/// The same for `io` (looks its runners up).
+template <class Done>
+bool run_io_until(boost::asio::io_context& io, Done done, std::chrono::steady_clock::time_point deadline,
+                  UntimedWait* untimed = nullptr) {
+    return run_io_until(caller_io_runners(io), std::move(done), deadline, untimed);
 }
 
 }  // namespace rr::client::detail

@@ -26,7 +26,6 @@ using namespace std::chrono_literals;
 // Named, not anonymous: in the unity build (preset tsan) other test files' helpers share the batch.
 namespace caller_io_test {
 
-using rr::client::detail::CallerIoRunners;
 using rr::client::detail::SyncWaiter;
 using Clock = std::chrono::steady_clock;
 
@@ -60,7 +59,7 @@ struct UntimedWaiter {
     }
 };
 
-int runners_of(boost::asio::io_context& io) { return boost::asio::use_service<CallerIoRunners>(io).runners.load(); }
+int runners_of(boost::asio::io_context& io) { return rr::client::detail::caller_io_runners(io).runners.load(); }
 
 template <class Pred>
 bool eventually(Pred pred, std::chrono::milliseconds limit = 5s) {
@@ -117,7 +116,7 @@ TEST_CASE("caller io: while worker threads run the io_context nobody waits untim
     rr::client::IoThreads workers(1);
     auto* io = &boost::asio::query(workers.executor(), boost::asio::execution::context);
     auto& context = static_cast<boost::asio::io_context&>(*io);
-    CHECK(boost::asio::use_service<cit::CallerIoRunners>(context).workers.load() == 1);
+    CHECK(rr::client::detail::caller_io_runners(context).workers.load() == 1);
     for (int i = 0; i < 100; ++i) {
         cit::UntimedWaiter a(context);
         REQUIRE(cit::eventually([&] { return cit::runners_of(context) == 1; }));

@@ -43,7 +43,7 @@ TimeSpec wall_clock_now() {
 
 IoThreads::IoThreads(unsigned threads) : work_(io_.get_executor()) {
     // Callers waiting with caller_runs_io must not sleep untimed while workers run the io_context too.
-    asio::use_service<detail::CallerIoRunners>(io_).workers.store(static_cast<int>(threads));
+    detail::caller_io_runners(io_).workers.store(static_cast<int>(threads));
     for (unsigned i = 0; i < threads; ++i) threads_.emplace_back([this] { io_.run(); });
 }
 
@@ -135,6 +135,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     client->strand_.emplace(asio::make_strand(server::CallerRunsExecutor(*io)));
     client->caller_runs_io_ = options.caller_runs_io;
     client->untimed_waits_ = options.caller_runs_io && options.request_timeout.count() > 0;
+    if (options.caller_runs_io) client->io_runners_ = &detail::caller_io_runners(io->context());
     client->wait_limit_ = options.request_timeout + 5s;
     auto logic = std::make_shared<Logic>(std::move(cfg));
     client->logic_ = logic;
@@ -194,7 +195,7 @@ Client::~Client() {
             // No worker thread writes the DisconnectClient: give it a moment on this one.
             std::weak_ptr<PumpHandle> weak = pump;
             pump.reset();
-            detail::run_io_until(io_context(), [&] { return weak.expired(); },
+            detail::run_io_until(*io_runners_, [&] { return weak.expired(); },
                                  std::chrono::steady_clock::now() + std::chrono::milliseconds(200));
         }
     }
@@ -220,7 +221,7 @@ Result<void> Client::close_wait(std::chrono::milliseconds timeout) {
     if (!pump_.lock() && !open_.load()) return {};
     if (caller_runs_io_) {
         const auto closed = [this] { return closed_future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; };
-        detail::run_io_until(io_context(), closed,
+        detail::run_io_until(*io_runners_, closed,
                              std::chrono::steady_clock::now() + timeout);
         timeout = {};
     }
@@ -233,7 +234,7 @@ void Client::poll(std::chrono::milliseconds duration) {
     if (on_strand()) return;
     const auto until = std::chrono::steady_clock::now() + duration;
     if (caller_runs_io_) {
-        detail::run_io_until(io_context(), [] { return false; }, until);
+        detail::run_io_until(*io_runners_, [] { return false; }, until);
         return;
     }
     std::this_thread::sleep_until(until);

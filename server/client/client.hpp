@@ -183,8 +183,8 @@ private:
     /// caller_runs_io: a lone caller waits for its answer without a timeout (caller_io.hpp), which
     /// needs the request timeout to bound the wait.
     bool untimed_waits_ = false;
-    /// The io_context under the connection's strand (run by the caller with caller_runs_io).
-    boost::asio::io_context& io_context() const { return strand_->get_inner_executor().inner().context(); }
+    /// caller_runs_io: the io_context's runners, looked up once (not per call).
+    detail::CallerIoRunners* io_runners_ = nullptr;
     std::chrono::milliseconds wait_limit_{20000};
     std::shared_ptr<std::promise<void>> closed_promise_ = std::make_shared<std::promise<void>>();
     std::shared_future<void> closed_future_ = closed_promise_->get_future().share();
@@ -401,7 +401,7 @@ Result<T> Client::wait(std::function<void(ClientContext&, MonoTime, Completion<T
         });
     }
     if (caller_runs_io_) {
-        detail::run_io_until(io_context(), [&] { return waiter->answered(); }, std::chrono::steady_clock::now() + wait_limit_,
+        detail::run_io_until(*io_runners_, [&] { return waiter->answered(); }, std::chrono::steady_clock::now() + wait_limit_,
                              untimed_waits_ ? &waiter->untimed_wait : nullptr);
     }
     auto r = waiter->wait_for(caller_runs_io_ ? std::chrono::steady_clock::duration::zero()
