@@ -49,6 +49,9 @@ public:
         spare_[count_++] = std::move(entries);
     }
 
+    /// Keeps the storage of a sent entry's element vector (emptied here) when there is room and it is small.
+    void give_elements(std::vector<MessageElement>&& elements) noexcept { keep_elements(elements); }
+
     /// Entry vectors kept now.
     std::size_t size() const noexcept { return count_; }
     /// Element vectors kept now.

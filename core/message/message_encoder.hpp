@@ -17,7 +17,9 @@ namespace rr::detail {
 
 class MessageEncoder {
 public:
-    explicit MessageEncoder(const Message& message) : m_(message) {}
+    explicit MessageEncoder(const Message& message) : m_(message), entries_(message.entries) {}
+    /// `header`'s header followed by `entries`, which live elsewhere (`header.entries` is not read).
+    MessageEncoder(const Message& header, std::span<const MessageEntry> entries) : m_(header), entries_(entries) {}
     /// `message`'s header followed by one entry already encoded in `message.version` (encode_entry);
     /// `message.entries` must be empty.
     MessageEncoder(const Message& message, SharedBytes encoded_entry)
@@ -65,9 +67,10 @@ private:
     }
 
     /// Entries in the message: its own, or the one already encoded.
-    std::size_t entry_count() const noexcept { return has_encoded_entry_ ? 1 : m_.entries.size(); }
+    std::size_t entry_count() const noexcept { return has_encoded_entry_ ? 1 : entries_.size(); }
 
     const Message& m_;
+    std::span<const MessageEntry> entries_;  ///< the entries encoded (m_.entries unless given apart)
     SharedBytes encoded_entry_;
     bool has_encoded_entry_ = false;
     std::uint64_t spliced_ = 0;

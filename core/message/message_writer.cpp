@@ -114,6 +114,13 @@ Result<void> encode_message(const Message& message, const SharedBytes& encoded_e
     return encode_message_with_entry(message, encoded_entry, out);
 }
 
+Result<void> encode_message(const Message& header, std::span<const MessageEntry> entries, GatherBuffer& out) {
+    if (!header.entries.empty())
+        return fail(MessageErrorType::InvalidArgument, "a message with entries given apart has no entries of its own");
+    detail::MessageEncoder encoder(header, entries);
+    return append_measured(out, encoder, [&] { return encoder.measure(); }, [&](ByteWriter& w) { encoder.write(w); });
+}
+
 Result<SharedBytes> encode_message(const Message& message) {
     std::vector<std::byte> out;
     if (auto ok = encode_message(message, out); !ok) return ok.take_error();
@@ -127,8 +134,8 @@ std::uint64_t xlen_size(std::size_t n) noexcept {
 }
 
 Result<std::uint32_t> MessageEncoder::measure() {
-    if (m_.entries.size() > 0xFFFF)
-        return fail(MessageErrorType::InvalidArgument, std::to_string(m_.entries.size()) + " entries (max 65535)");
+    if (entries_.size() > 0xFFFF)
+        return fail(MessageErrorType::InvalidArgument, std::to_string(entries_.size()) + " entries (max 65535)");
     size_count_ = 0;
     more_sizes_.clear();
     spliced_ = 0;

@@ -77,4 +77,9 @@ Result<void> encode_message(const Message& message, std::span<const std::byte> e
 /// it, and so are its large element payloads.
 Result<void> encode_message(const Message& message, const SharedBytes& encoded_entry, GatherBuffer& out);
 
+/// Encodes the message of `header`'s header and `entries` (kept where they are: a session's reply is
+/// not moved into a Message to be sent); the result equals encode_message of the message with them.
+/// Errors: InvalidArgument when `header.entries` is not empty; otherwise as encode_message.
+Result<void> encode_message(const Message& header, std::span<const MessageEntry> entries, GatherBuffer& out);
+
 }  // namespace rr

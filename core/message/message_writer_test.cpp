@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <span>
 
 #include "core/codec/endian.hpp"
 #include "core/message/message_reader.hpp"
@@ -81,6 +83,32 @@ TEST_CASE("message: every shared vector re-encodes byte-identical", "[shared]") 
         Message m = decode(*bytes);
         CHECK(encode(m) == *bytes);
     }
+}
+
+TEST_CASE("message: a header with its entries given apart encodes as the whole message", "[shared]") {
+    for (const auto& name : rr::test::vector_names())
+        if (!rr::test::load_vector(name)) RR_SKIP("shared vector " << rr::test::vector_path(name) << " not found");
+    for (const auto& name : rr::test::vector_names()) {
+        INFO(name);
+        auto bytes = rr::test::load_vector(name);
+        REQUIRE(bytes);
+        Message whole = decode(*bytes);
+        Message header = whole;
+        header.entries.clear();
+        GatherBuffer out;
+        out.append(std::span<const std::byte>(std::array<std::byte, 1>{std::byte{0xEE}}));  // appended after it
+        REQUIRE(encode_message(header, std::span<const MessageEntry>(whole.entries), out));
+        out.flatten();
+        REQUIRE(out.owned().front() == std::byte{0xEE});
+        CHECK(std::vector<std::byte>(out.owned().begin() + 1, out.owned().end()) == *bytes);
+    }
+    // The header must not carry entries of its own.
+    Message both = one_entry(MessageEntryType::FunctionCallReq);
+    GatherBuffer out;
+    auto refused = encode_message(both, std::span<const MessageEntry>(both.entries), out);
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().type == MessageErrorType::InvalidArgument);
+    CHECK(out.empty());
 }
 
 TEST_CASE("message: LITE message converts v2 -> v4 and v4 -> v2 byte-identical", "[shared]") {

@@ -38,7 +38,7 @@ Result<std::uint32_t> MessageEncoder::measure_v2() {
     if (header > 0xFFFF) return fail(MessageErrorType::InvalidArgument, "v2 header over 65535 bytes");
     header_size_ = static_cast<std::uint32_t>(header);
     std::uint64_t total = header;
-    for (const auto& entry : m_.entries) {
+    for (const auto& entry : entries_) {
         auto n = measure_entry_v2(entry);
         if (!n) return n.take_error();
         total += *n;
@@ -114,7 +114,7 @@ void MessageEncoder::write_v2(ByteWriter& w) {
     w.write_u16(static_cast<std::uint16_t>(entry_count()));
     w.write_u16(h.message_id);
     w.write_u16(h.message_res_id);
-    for (const auto& entry : m_.entries) write_entry_v2(w, entry);
+    for (const auto& entry : entries_) write_entry_v2(w, entry);
     w.write_shared(encoded_entry_);
 }
 

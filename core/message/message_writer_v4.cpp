@@ -99,7 +99,7 @@ Result<std::uint32_t> MessageEncoder::measure_v4() {
     if (header > kMax32) return fail(MessageErrorType::InvalidArgument, "v4 header over 4 GiB");
     header_size_ = static_cast<std::uint32_t>(header);
     std::uint64_t total = header;
-    for (const auto& entry : m_.entries) {
+    for (const auto& entry : entries_) {
         auto n = measure_entry_v4(entry);
         if (!n) return n.take_error();
         total += *n;
@@ -202,7 +202,7 @@ void MessageEncoder::write_v4(ByteWriter& w) {
     }
     if (f & message_flags::multiple_entries) write_uint_x(w, static_cast<std::uint32_t>(entry_count()));
     if (f & message_flags::extended) write_xlen(w, h.extended);
-    for (const auto& entry : m_.entries) write_entry_v4(w, entry);
+    for (const auto& entry : entries_) write_entry_v4(w, entry);
     w.write_shared(encoded_entry_);
 }
 

@@ -1,5 +1,7 @@
 #include "core/session/service_session.hpp"
 
+#include <utility>
+
 #include "core/message/error_entry.hpp"
 #include "core/names/service_path.hpp"
 #include "core/session/elements.hpp"
@@ -168,12 +170,14 @@ Message ServiceSession::session_message(MessageEntry&& entry) {
 
 void ServiceSession::reply(MessageEntry&& entry, MonoTime now) {
     if (!service_ || stream_.is_closed()) return;
-    Message m = session_message(std::move(entry));
-    auto sent = stream_.send(std::move(m), now);
-    if (sent) return;
-    // A reply must not vanish: answer with the error instead (e.g. over the size limit). A failed
-    // send leaves the message as it was, so the header fields come from the unsent reply.
-    MessageEntry& unsent = m.entries.front();
+    // Encoded where it is (not moved into a Message); its element vector is kept for a later reply.
+    auto sent = stream_.send(session_header(entry), entry, now);
+    if (sent) {
+        stream_.entry_vectors().give_elements(std::move(entry.elements));
+        return;
+    }
+    // A reply must not vanish: answer with the error instead (e.g. over the size limit).
+    MessageEntry& unsent = entry;
     MessageEntry header;
     header.entry_type = unsent.entry_type;
     header.service_path = std::move(unsent.service_path);
@@ -272,6 +276,11 @@ void ServiceSession::on_message(Message&& m, MonoTime now) {
 }
 
 void ServiceSession::on_entries(Message& m, MonoTime now) {
+    lone_entry_ = m.entries.size() == 1 ? &m.entries : nullptr;
+    struct Forget {
+        std::vector<MessageEntry>*& p;
+        ~Forget() { p = nullptr; }
+    } forget{lone_entry_};
     for (auto& e : m.entries) {
         if (stream_.is_closed()) return;
         const auto type = e.entry_type;
@@ -522,7 +531,7 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
         }
         case MessageEntryType::PipePacket:
         case MessageEntryType::PipePacketRet:
-        case MessageEntryType::WirePacket: events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), false); return;
+        case MessageEntryType::WirePacket: queue_request(std::move(e), false); return;
         default: break;
     }
     if (!request) return;
@@ -540,14 +549,26 @@ void ServiceSession::handle_session_entry(const MessageHeader& h, MessageEntry&&
         return;
     }
     if (e.elements.capacity() == 0) e.elements = stream_.entry_vectors().take_elements();  // room for the reply
-    events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);
+    queue_request(std::move(e), true);
+}
+
+void ServiceSession::queue_request(MessageEntry&& e, bool needs_reply) {
+    if (lone_entry_ && lone_entry_->size() == 1 && &lone_entry_->front() == &e) {
+        // The message's own vector goes with the request (on_entries' loop has no entry after this one).
+        auto* holder = std::exchange(lone_entry_, nullptr);
+        events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(*holder), needs_reply);
+        return;
+    }
+    auto holder = stream_.entry_vectors().take();
+    holder.push_back(std::move(e));
+    events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(holder), needs_reply);
 }
 
 void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
     MessageEntry r = reply_to(e);
     const std::string& op = e.member_name;
     if ((op == "AuthenticateUser" || op == "LogoutUser") && service_->admits_sessions()) {
-        events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);  // the service's own login (passthrough)
+        queue_request(std::move(e), true);  // the service's own login (passthrough)
         return;
     }
     if (op == "AuthenticateUser") {
@@ -582,7 +603,7 @@ void ServiceSession::handle_session_op(MessageEntry&& e, MonoTime now) {
                          op == "ReleaseClientObjectLock";
     if ((monitor_op || lock_op) && service_->handles_locks()) {
         // CORE ServerContext::ClientLockOp: the service owns the objects and their locks.
-        events_.emplace_back(std::in_place_type<ServiceRequest>, std::move(e), true);
+        queue_request(std::move(e), true);
         return;
     }
     if (monitor_op) {

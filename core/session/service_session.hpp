@@ -65,11 +65,17 @@ struct ServiceSessionUser {
 /// ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit;
 /// answer with reply()). A member request without elements may carry an empty element vector with
 /// capacity, kept from an earlier reply: the service can build its reply in it.
+/// The entry lives in an entry vector of its own: the received message's, when the request came alone
+/// (the usual case: the entry stays where it was decoded), so the event costs no entry move. A host
+/// hands the request back with ServiceSession::recycle once handled, so the next message reuses it.
 struct ServiceRequest {
     // A constructor, not an aggregate: the event queue builds it in place (emplace with
     // in_place_type), which clang before 16 cannot do for an aggregate.
-    ServiceRequest(MessageEntry&& e, bool reply) : entry(std::move(e)), needs_reply(reply) {}
-    MessageEntry entry;
+    /// `holder` has exactly one entry: the request.
+    ServiceRequest(std::vector<MessageEntry>&& holder, bool reply) : entries(std::move(holder)), needs_reply(reply) {}
+    MessageEntry& entry() noexcept { return entries.front(); }
+    const MessageEntry& entry() const noexcept { return entries.front(); }
+    std::vector<MessageEntry> entries;  ///< the request alone (empty once recycled)
     bool needs_reply = true;
 };
 /// ObjectTypeName for `path` in the session's service: answer with answer_object_type(token, …).
@@ -151,6 +157,9 @@ public:
     /// host's Responder sets them). A reply that cannot be sent (over the size limit) is replaced by
     /// an error reply with the same RequestID. Ignored without a session.
     void reply(MessageEntry&& entry, MonoTime now);
+    /// Takes back a handled request's entry vector (the request entry is destroyed now) for the next
+    /// message. Optional: a request not handed back is only freed.
+    void recycle(ServiceRequest&& request) noexcept { stream_.entry_vectors().give(std::move(request.entries)); }
     /// Sends an entry the client did not ask for (EventReq, PipePacket, PipeClosed, WireClosed, …).
     /// Errors: InvalidState without a session or after close; BufferLimitViolation over the size limit.
     Result<void> send(MessageEntry entry, MonoTime now);
@@ -185,6 +194,8 @@ private:
     void drain_stream(MonoTime now);
     void on_message(Message&& m, MonoTime now);
     void on_entries(Message& m, MonoTime now);
+    /// Queues a ServiceRequest for `e`: in the received message's vector when `e` is its only entry.
+    void queue_request(MessageEntry&& e, bool needs_reply);
     void handle_special(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void handle_session_entry(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void handle_session_op(MessageEntry&& e, MonoTime now);
@@ -208,6 +219,7 @@ private:
     StreamConnection stream_;
     EventQueue<ServiceSessionEvent> events_;
     std::vector<StreamEvent> stream_batch_;  // drain_stream's
+    std::vector<MessageEntry>* lone_entry_ = nullptr;  // while on_entries handles a message of one entry: its vector
     bool closed_reported_ = false;
 
     std::shared_ptr<HostedService> service_;

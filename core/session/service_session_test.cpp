@@ -180,14 +180,14 @@ TEST_CASE("service session: member requests go to the host in order and the repl
     p.pump();
     auto requests = p.take<ServiceRequest>(p.service_events);
     REQUIRE(requests.size() == 2);
-    CHECK(requests[0].entry.member_name == "a");
-    CHECK(requests[1].entry.member_name == "b");
+    CHECK(requests[0].entry().member_name == "a");
+    CHECK(requests[1].entry().member_name == "b");
     CHECK(requests[0].needs_reply);
     // Answer the second first: each reply finds its request by RequestID.
-    MessageEntry r2 = reply_to(requests[1].entry);
+    MessageEntry r2 = reply_to(requests[1].entry());
     r2.elements.push_back(make_scalar_element<std::int32_t>("return", 7));
     p.service.reply(std::move(r2), p.now);
-    p.service.reply(reply_to(requests[0].entry), p.now);
+    p.service.reply(reply_to(requests[0].entry()), p.now);
     p.pump();
     auto responses = p.take_client<ClientResponse>();
     REQUIRE(responses.size() == 2);
@@ -200,6 +200,44 @@ TEST_CASE("service session: member requests go to the host in order and the repl
     CHECK(responses[1].request_id == *id1);
 }
 
+TEST_CASE("service session: a lone request travels in its message's entry vector, recycled for the next message; "
+          "a sent reply's element vector comes back with the next request") {
+    Pair p;
+    p.connect();
+    REQUIRE(p.client.request(member_request("a"), p.now));
+    p.pump();
+    auto first = p.take<ServiceRequest>(p.service_events);
+    REQUIRE(first.size() == 1);
+    REQUIRE(first[0].entries.size() == 1);
+    const MessageEntry* slot = first[0].entries.data();
+    MessageEntry r = reply_to(first[0].entry());
+    // Built in the request's element vector, as the service does (service_object.cpp, reply_in).
+    r.elements = std::move(first[0].entry().elements);
+    r.elements.clear();
+    r.elements.push_back(make_scalar_element<std::int32_t>("return", 1));
+    const MessageElement* reply_elements = r.elements.data();
+    p.service.reply(std::move(r), p.now);
+    p.service.recycle(std::move(first[0]));
+    CHECK(first[0].entries.empty());
+    p.pump();
+    auto answered = p.take_client<ClientResponse>();
+    REQUIRE(answered.size() == 1);
+    REQUIRE(answered[0].entry);
+    std::int32_t v = 0;
+    REQUIRE(answered[0].entry->find("return"));
+    CHECK(read_scalar(*answered[0].entry->find("return"), v));
+    CHECK(v == 1);
+
+    REQUIRE(p.client.request(member_request("b"), p.now));
+    p.pump();
+    auto second = p.take<ServiceRequest>(p.service_events);
+    REQUIRE(second.size() == 1);
+    CHECK(second[0].entry().member_name == "b");
+    CHECK(second[0].entries.data() == slot);                           // decoded into the recycled vector
+    CHECK(second[0].entry().elements.data() == reply_elements);        // room for its reply: the last reply's
+    CHECK(second[0].entry().elements.empty());
+}
+
 TEST_CASE("service session: a reply over the size limit becomes an error reply with the same RequestID") {
     Pair p;
     p.connect();
@@ -208,7 +246,7 @@ TEST_CASE("service session: a reply over the size limit becomes an error reply w
     p.pump();
     auto requests = p.take<ServiceRequest>(p.service_events);
     REQUIRE(requests.size() == 1);
-    MessageEntry r = reply_to(requests[0].entry);
+    MessageEntry r = reply_to(requests[0].entry());
     std::vector<std::uint8_t> huge(13u * 1024u * 1024u);
     r.elements.push_back(make_array_element<std::uint8_t>("return", huge));
     const auto reply_type = r.entry_type;
@@ -295,7 +333,7 @@ TEST_CASE("service session: lock operations reach a service that handles locks, 
         auto requests = p.take<ServiceRequest>(p.service_events);
         REQUIRE(requests.size() == std::size(ops));
         for (std::size_t i = 0; i < std::size(ops); ++i) {
-            CHECK(requests[i].entry.member_name == ops[i]);
+            CHECK(requests[i].entry().member_name == ops[i]);
             CHECK(requests[i].needs_reply);
         }
         CHECK(p.take_client<ClientResponse>().empty());  // the service answers
@@ -366,8 +404,8 @@ TEST_CASE("service session: a service that admits sessions itself answers the co
         p.pump();
         auto requests = p.take<ServiceRequest>(p.service_events);
         REQUIRE(requests.size() == 2);
-        CHECK(requests[0].entry.member_name == "AuthenticateUser");
-        CHECK(requests[1].entry.member_name == "a");
+        CHECK(requests[0].entry().member_name == "AuthenticateUser");
+        CHECK(requests[1].entry().member_name == "a");
     }
     SECTION("refused: the client gets the service's error, the endpoint is freed") {
         Pair p("svc", false, "alice", "wrong");

@@ -352,6 +352,22 @@ Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry,
     return check_appended(before, now);
 }
 
+Result<void> StreamConnection::send(Message&& header, const MessageEntry& entry, MonoTime now) {
+    if (state_ != State::connected)
+        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
+    if (!header.entries.empty())
+        return fail(MessageErrorType::InvalidArgument, "a message with an entry given apart has no other entries");
+    const std::uint16_t version = send_version();
+    const bool omit = omit_routing_applies(header.header, entry.entry_type, version, true);
+    if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
+    const auto before = output_.mark();
+    if (auto ok = encode_message(header, std::span<const MessageEntry>(&entry, 1), output_); !ok) {
+        output_.rollback(before);
+        return ok;
+    }
+    return check_appended(before, now);
+}
+
 // v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this
 // session's nodes and endpoints (CORE, wire.md §2.3), except for one entry below 500.
 bool StreamConnection::needs_relabel(const Message& m, std::uint16_t version, bool omit) const {

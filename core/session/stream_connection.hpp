@@ -124,6 +124,10 @@ public:
     /// gets the entry's bytes in the negotiated format, encoded once (EncodedEntry::bytes), after its
     /// own. Errors: as send(); InvalidArgument when `header` has entries; the entry's encoding error.
     Result<void> send(Message&& header, const EncodedEntry& entry, MonoTime now);
+    /// The same for a message of `header` (no entries) and `entry`, which stays the caller's: a reply
+    /// is encoded where the service built it, not moved into a Message first. Errors: as send();
+    /// InvalidArgument when `header` has entries.
+    Result<void> send(Message&& header, const MessageEntry& entry, MonoTime now);
     /// Queues an already-encoded frame (used by forwarding when the bytes can be sent as they are).
     Result<void> send_frame(std::span<const std::byte> frame, MonoTime now);
 

@@ -341,7 +341,7 @@ void ServerConnection::handle_event(ServiceSessionEvent& event) {
     } else if (auto* user = std::get_if<ServiceSessionUser>(&event)) {
         if (current_) current_->set_username(std::move(user->username));
     } else if (auto* request = std::get_if<ServiceRequest>(&event)) {
-        on_request(std::move(*request));
+        on_request(*request);
     } else if (auto* query = std::get_if<ServiceObjectTypeQuery>(&event)) {
         on_object_type_query(std::move(*query));
     } else if (auto* response = std::get_if<ServiceCallbackResponse>(&event)) {
@@ -361,16 +361,17 @@ void ServerConnection::handle_event(ServiceSessionEvent& event) {
     // ServiceConnectionClosed: the pump closes the transport (wants_close()).
 }
 
-void ServerConnection::on_request(ServiceRequest&& request) {
+void ServerConnection::on_request(ServiceRequest& request) {
     if (!current_) return;
     auto service = current_->service();
     if (!request.needs_reply) {
-        service->handle_entry(SessionRef(current_), std::move(request.entry), Responder());
-        return;
+        service->handle_entry(SessionRef(current_), std::move(request.entry()), Responder());
+    } else {
+        // The Responder is built in the parameter's place; std::move only names the entry, which the
+        // callee takes by reference, so make_responder reads it intact whatever the argument order.
+        service->handle_entry(SessionRef(current_), std::move(request.entry()), make_responder(request.entry()));
     }
-    // The Responder is built in the parameter's place; std::move only names the entry, which the
-    // callee takes by reference, so make_responder reads it intact whatever the argument order.
-    service->handle_entry(SessionRef(current_), std::move(request.entry), make_responder(request.entry));
+    session_.recycle(std::move(request));  // its entry vector, for the next message
 }
 
 void ServerConnection::on_admission(ServiceAdmission&& admission) {

@@ -152,7 +152,7 @@ public:
 private:
     void drain_events();
     void handle_event(ServiceSessionEvent& event);
-    void on_request(ServiceRequest&& request);
+    void on_request(ServiceRequest& request);
     void on_admission(ServiceAdmission&& admission);
     void on_object_type_query(ServiceObjectTypeQuery&& query);
     Responder make_responder(const MessageEntry& request);
