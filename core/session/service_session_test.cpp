@@ -200,8 +200,8 @@ TEST_CASE("service session: member requests go to the host in order and the repl
     CHECK(responses[1].request_id == *id1);
 }
 
-TEST_CASE("service session: a lone request travels in its message's entry vector, recycled for the next message; "
-          "a sent reply's element vector comes back with the next request") {
+TEST_CASE("service session: a lone request travels in its message's entry vector, recycled for the next message, "
+          "and a sent reply's element vector comes back with the next request") {
     Pair p;
     p.connect();
     REQUIRE(p.client.request(member_request("a"), p.now));

@@ -333,39 +333,37 @@ Result<void> StreamConnection::send(Message&& message, MonoTime now) {
     return queued;
 }
 
-Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry, MonoTime now) {
+template <class Encode>
+Result<void> StreamConnection::send_with_entry(Message& header, MessageEntryType entry_type, MonoTime now,
+                                               Encode&& encode) {
     if (state_ != State::connected)
         return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
     if (!header.entries.empty())
-        return fail(MessageErrorType::InvalidArgument, "a message with an encoded entry has no other entries");
+        return fail(MessageErrorType::InvalidArgument, "a message with an entry given apart has no other entries");
     const std::uint16_t version = send_version();
-    // A large entry is spliced into the gathered write, kept alive by its owner; a small one copied.
-    auto shared = entry.shared_bytes(version, GatherBuffer::kSpliceMinBytes);
-    if (!shared) return shared.take_error();
-    const bool omit = omit_routing_applies(header.header, entry.entry().entry_type, version, true);
+    const bool omit = omit_routing_applies(header.header, entry_type, version, true);
     if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
     const auto before = output_.mark();
-    if (auto ok = encode_message(header, *shared, output_); !ok) {
+    if (auto ok = encode(version); !ok) {
         output_.rollback(before);
         return ok;
     }
     return check_appended(before, now);
 }
 
+Result<void> StreamConnection::send(Message&& header, const EncodedEntry& entry, MonoTime now) {
+    return send_with_entry(header, entry.entry().entry_type, now, [&](std::uint16_t version) -> Result<void> {
+        // A large entry is spliced into the gathered write, kept alive by its owner; a small one copied.
+        auto shared = entry.shared_bytes(version, GatherBuffer::kSpliceMinBytes);
+        if (!shared) return shared.take_error();
+        return encode_message(header, *shared, output_);
+    });
+}
+
 Result<void> StreamConnection::send(Message&& header, const MessageEntry& entry, MonoTime now) {
-    if (state_ != State::connected)
-        return fail(MessageErrorType::InvalidState, state_ == State::closed ? "connection closed" : "connection not ready");
-    if (!header.entries.empty())
-        return fail(MessageErrorType::InvalidArgument, "a message with an entry given apart has no other entries");
-    const std::uint16_t version = send_version();
-    const bool omit = omit_routing_applies(header.header, entry.entry_type, version, true);
-    if (needs_relabel(header, version, omit)) relabel(header, 1, version, omit);
-    const auto before = output_.mark();
-    if (auto ok = encode_message(header, std::span<const MessageEntry>(&entry, 1), output_); !ok) {
-        output_.rollback(before);
-        return ok;
-    }
-    return check_appended(before, now);
+    return send_with_entry(header, entry.entry_type, now, [&](std::uint16_t) {
+        return encode_message(header, std::span<const MessageEntry>(&entry, 1), output_);
+    });
 }
 
 // v4 on a negotiated connection omits ROUTING_INFO / ENDPOINT_INFO when the header names exactly this

@@ -187,6 +187,10 @@ private:
     void relabel(Message& m, std::uint16_t version, bool omit) const;
     void relabel(Message& m, std::size_t entry_count, std::uint16_t version, bool omit) const;
     Result<void> append_encoded(const Message& m, MonoTime now);
+    /// The message of `header` (no entries) and one entry of `entry_type` given apart:
+    /// `encode(version)` appends it to output_ once the header is labelled.
+    template <class Encode>
+    Result<void> send_with_entry(Message& header, MessageEntryType entry_type, MonoTime now, Encode&& encode);
     /// Undoes what was appended since `before` if the message is over the send limit.
     Result<void> check_appended(const GatherBuffer::Mark& before, MonoTime now);
     [[gnu::noinline]] Result<void> refuse_appended(const GatherBuffer::Mark& before);
