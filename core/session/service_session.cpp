@@ -177,12 +177,11 @@ void ServiceSession::reply(MessageEntry&& entry, MonoTime now) {
         return;
     }
     // A reply must not vanish: answer with the error instead (e.g. over the size limit).
-    MessageEntry& unsent = entry;
     MessageEntry header;
-    header.entry_type = unsent.entry_type;
-    header.service_path = std::move(unsent.service_path);
-    header.member_name = std::move(unsent.member_name);
-    header.request_id = unsent.request_id;
+    header.entry_type = entry.entry_type;
+    header.service_path = std::move(entry.service_path);
+    header.member_name = std::move(entry.member_name);
+    header.request_id = entry.request_id;
     set_entry_error(header, sent.error());
     (void)stream_.send(session_message(std::move(header)), now);
 }
@@ -271,16 +270,14 @@ void ServiceSession::reply_special(const MessageHeader& request_header, MessageE
 
 void ServiceSession::on_message(Message&& m, MonoTime now) {
     ++messages_in_;
+    // A request alone in its message takes the message's vector with it (queue_request).
+    lone_entry_ = m.entries.size() == 1 ? &m.entries : nullptr;
     on_entries(m, now);
+    lone_entry_ = nullptr;
     stream_.entry_vectors().give(std::move(m.entries));
 }
 
 void ServiceSession::on_entries(Message& m, MonoTime now) {
-    lone_entry_ = m.entries.size() == 1 ? &m.entries : nullptr;
-    struct Forget {
-        std::vector<MessageEntry>*& p;
-        ~Forget() { p = nullptr; }
-    } forget{lone_entry_};
     for (auto& e : m.entries) {
         if (stream_.is_closed()) return;
         const auto type = e.entry_type;

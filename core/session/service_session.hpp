@@ -219,7 +219,7 @@ private:
     StreamConnection stream_;
     EventQueue<ServiceSessionEvent> events_;
     std::vector<StreamEvent> stream_batch_;  // drain_stream's
-    std::vector<MessageEntry>* lone_entry_ = nullptr;  // while on_entries handles a message of one entry: its vector
+    std::vector<MessageEntry>* lone_entry_ = nullptr;  // while on_message handles a message of one entry: its vector
     bool closed_reported_ = false;
 
     std::shared_ptr<HostedService> service_;
