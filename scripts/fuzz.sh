@@ -1,29 +1,36 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (preset fuzz: clang-14, ASan + UBSan, the server included) and runs each
-# one (docs/fuzzing.md).
+# Runs the libFuzzer targets (docs/fuzzing.md).
 #
-#   scripts/fuzz.sh            CI: every target briefly (the times below: about 3 minutes in all),
-#                              from the seeds and regressions (a fresh corpus in build/fuzz/ci-corpus)
+#   scripts/fuzz.sh            CI: every target briefly (the times below, two targets at a time: about
+#                              3 minutes in all), from the seeds and regressions (a fresh corpus in
+#                              BUILD/ci-corpus), on the targets of the debug build (preset debug:
+#                              clang-14 -O0, ASan + UBSan, linked from the objects the tests use, so CI
+#                              compiles the project once); builds them there if needed
 #   scripts/fuzz.sh N          every target for N seconds
 #   scripts/fuzz.sh --long     every target to 10^7 executions or RR_FUZZ_LONG_SECONDS (default 1800)
 #                              seconds, whichever comes first; one worker, nice -n 10; the corpus grows
-#                              in build/fuzz/corpus/<target>
+#                              in build/fuzz/corpus/<target>. Builds preset fuzz (-O1: about twice the
+#                              executions per second of -O0, for a campaign that runs long)
 #   scripts/fuzz.sh ... TARGET...   only these targets
 #
+# RR_FUZZ_PRESET=fuzz|debug picks the build either way; RR_FUZZ_JOBS=N runs N targets at a time (CI: 2).
 # Inputs: test/fuzz/seeds/<target> and test/fuzz/regressions/<target> (past crashes, kept as tests and
 # replayed by ctest in the debug build). RR_FUZZ_SEED fixes libFuzzer's random seed (default 1) so that
 # a CI run from an empty corpus is reproducible: a slower machine explores a prefix of what a faster
 # one does. RR_FUZZ_SEED=0 picks a new seed each run, which is what a longer campaign wants.
-# A crash leaves its input in build/fuzz/<target>-crash-*; the log is build/fuzz/<target>.log.
+# A crash leaves its input in BUILD/<target>-crash-*; the log is BUILD/<target>.log (BUILD: build/fuzz
+# or build/debug/test/fuzz).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # Seconds per target in CI: the pure parsers saturate quickly; the gateway targets need a few seconds
 # to start the gateway and run slower (every input goes through the gateway's threads and sockets).
+# Twice what the -O1 build of earlier sessions had, as -O0 runs about half as many inputs per second;
+# with two targets at a time the phase takes as long as it did.
 declare -A CI_SECONDS=(
-  [fuzz_robdef_parser]=15 [fuzz_message_reader]=15 [fuzz_message_structured]=20 [fuzz_connection_url]=10
-  [fuzz_service_path]=10 [fuzz_gateway_config]=15 [fuzz_discovery_packet]=10 [fuzz_usb_descriptors]=10
-  [fuzz_usb_packets]=10 [fuzz_json_socket]=20 [fuzz_json_rest]=20 [fuzz_gateway_port]=25
+  [fuzz_robdef_parser]=30 [fuzz_message_reader]=30 [fuzz_message_structured]=40 [fuzz_connection_url]=20
+  [fuzz_service_path]=20 [fuzz_gateway_config]=30 [fuzz_discovery_packet]=20 [fuzz_usb_descriptors]=20
+  [fuzz_usb_packets]=20 [fuzz_json_socket]=40 [fuzz_json_rest]=40 [fuzz_gateway_port]=50
 )
 
 mode=ci
@@ -39,23 +46,34 @@ done
 seed=${RR_FUZZ_SEED:-1}
 long_seconds=${RR_FUZZ_LONG_SECONDS:-1800}
 
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target rr_fuzz_targets -j "${RR_JOBS:-$(nproc)}"
+preset=${RR_FUZZ_PRESET:-}
+[ -n "$preset" ] || { if [ "$mode" = long ]; then preset=fuzz; else preset=debug; fi; }
+case "$preset" in
+  fuzz) bin=build/fuzz/test/fuzz; out=build/fuzz ;;
+  debug) bin=build/debug/test/fuzz; out=build/debug/test/fuzz ;;
+  *) echo "fuzz: RR_FUZZ_PRESET is fuzz or debug, not $preset"; exit 2 ;;
+esac
+cmake --preset "$preset" >/dev/null
+cmake --build --preset "$preset" --target rr_fuzz_targets -j "${RR_JOBS:-$(nproc)}"
+parallel=${RR_FUZZ_JOBS:-}
+[ -n "$parallel" ] || { if [ "$mode" = long ]; then parallel=1; else parallel=2; fi; }
 
 shopt -s nullglob
 targets=()
 if ((${#only[@]})); then
-  for t in "${only[@]}"; do targets+=("build/fuzz/test/fuzz/$t"); done
+  for t in "${only[@]}"; do targets+=("$bin/$t"); done
 else
-  targets=(build/fuzz/test/fuzz/fuzz_*)
+  targets=("$bin"/fuzz_*)
 fi
 if ((${#targets[@]} == 0)); then echo "fuzz: no targets"; exit 0; fi
-for t in "${targets[@]}"; do
-  [ -x "$t" ] || { echo "fuzz: no target $t"; exit 1; }
+
+# One target: its log in $out/<name>.log, a summary line on stdout when it ends.
+run_target() {
+  local t=$1 name corpus inputs dict limits runner s start runs last d
   name=$(basename "$t")
   # libFuzzer runs its whole starting corpus before it looks at the clock: a CI run starts from the
   # seeds and regressions only (a fresh folder), so its time stays bounded; --long keeps a corpus.
-  if [ "$mode" = long ]; then corpus=build/fuzz/corpus/$name; else corpus=build/fuzz/ci-corpus/$name; rm -rf "$corpus"; fi
+  if [ "$mode" = long ]; then corpus=$out/corpus/$name; else corpus=$out/ci-corpus/$name; rm -rf "$corpus"; fi
   mkdir -p "$corpus"
   inputs=()
   for d in test/fuzz/seeds/$name test/fuzz/regressions/$name; do [ -d "$d" ] && inputs+=("$d"); done
@@ -64,19 +82,42 @@ for t in "${targets[@]}"; do
   if [ "$mode" = long ]; then
     limits=(-runs=10000000 -max_total_time="$long_seconds")
     runner=(nice -n 10)
-    echo "fuzz: $name to 10^7 runs or ${long_seconds}s (seed $seed)"
   else
     s=${seconds:-${CI_SECONDS[$name]:-30}}
     limits=(-max_total_time="$s")
     runner=()
-    echo "fuzz: $name for ${s}s (seed $seed)"
   fi
   start=$(date +%s)
-  "${runner[@]}" "$t" -seed="$seed" "${limits[@]}" "${dict[@]}" -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 \
-       -artifact_prefix="build/fuzz/$name-" "$corpus" "${inputs[@]}" >"build/fuzz/$name.log" 2>&1 \
-    || { tail -60 "build/fuzz/$name.log"; echo "fuzz: $name FAILED (input in build/fuzz/$name-*)"; exit 1; }
-  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "build/fuzz/$name.log" | tail -1)
-  last=$(grep -E '^#[0-9]+' "build/fuzz/$name.log" | tail -1 | sed -E 's/^#[0-9]+[[:space:]]+[A-Z]+[[:space:]]+//')
-  echo "  $((($(date +%s) - start)))s, ${runs:-?} runs; $last"
+  if ! "${runner[@]}" "$t" -seed="$seed" "${limits[@]}" "${dict[@]}" -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 \
+       -artifact_prefix="$out/$name-" "$corpus" "${inputs[@]}" >"$out/$name.log" 2>&1; then
+    tail -60 "$out/$name.log"
+    echo "fuzz: $name FAILED (input in $out/$name-*)"
+    return 1
+  fi
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$name.log" | tail -1)
+  last=$(grep -E '^#[0-9]+' "$out/$name.log" | tail -1 | sed -E 's/^#[0-9]+[[:space:]]+[A-Z]+[[:space:]]+//')
+  echo "fuzz: $name $((($(date +%s) - start)))s, ${runs:-?} runs; $last"
+}
+
+for t in "${targets[@]}"; do [ -x "$t" ] || { echo "fuzz: no target $t"; exit 1; }; done
+if [ "$mode" = long ]; then
+  echo "fuzz: ${#targets[@]} targets ($preset build), each to 10^7 runs or ${long_seconds}s, $parallel at a time (seed $seed)"
+else
+  echo "fuzz: ${#targets[@]} targets ($preset build), $parallel at a time (seed $seed)"
+fi
+# At most $parallel targets at once; the first failure stops the others.
+pids=()
+failed=0
+for t in "${targets[@]}"; do
+  while (($(jobs -rp | wc -l) >= parallel)); do wait -n || failed=1; ((failed)) && break; done
+  ((failed)) && break
+  run_target "$t" &
+  pids+=($!)
 done
+while (($(jobs -rp | wc -l) > 0)); do wait -n || failed=1; done
+if ((failed)); then
+  kill "${pids[@]}" 2>/dev/null || true
+  echo "fuzz: FAILED"
+  exit 1
+fi
 echo "fuzz: ok"

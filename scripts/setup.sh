@@ -25,17 +25,18 @@ RUN_PACKAGES=(
   emscripten node-acorn
 )
 PYTHON_PACKAGES=(python3-venv)
-# Testing only: Catch2, the USB device emulator, clang for the fuzz targets, Chromium for the browser
-# tests, nginx/openssl/htpasswd for the reverse-proxy tests, podman & co. for the container image
-# (docker/build.sh: no Docker daemon, the base made with mmdebstrap).
+# Testing only: Catch2, the USB device emulator, clang and lld for the debug preset (its sanitizer
+# build is also the fuzz targets' build), Chromium for the browser tests, nginx/openssl/htpasswd for
+# the reverse-proxy tests, podman & co. for the container image (docker/build.sh: no Docker daemon, the
+# base made with mmdebstrap; busybox-static for the image made from a build on this machine).
 TEST_PACKAGES=(
   catch2
   umockdev libumockdev-dev
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev lld
   chromium fonts-liberation
   nginx openssl apache2-utils haproxy
   testssl.sh
-  podman buildah runc mmdebstrap fuse-overlayfs slirp4netns uidmap
+  podman buildah runc mmdebstrap fuse-overlayfs slirp4netns uidmap busybox-static
 )
 APT_PACKAGES=()
 wants run && APT_PACKAGES+=("${RUN_PACKAGES[@]}")

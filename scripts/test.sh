@@ -1,45 +1,53 @@
 #!/usr/bin/env bash
-# The test command: installs what is missing (scripts/setup.sh: the run packages and the test tools:
-# Catch2, Chromium, nginx, clang, umockdev, podman, the Python venv), builds the WebAssembly client and
-# the dashboard, starts the container image's build in the background (nice 19: it takes the CPU the
-# tests leave idle), builds the debug preset (ASan + UBSan), runs every test (unit, interop against the
-# official library), the server tests again under ThreadSanitizer (built meanwhile at nice 19;
-# RR_TSAN=0 leaves them out), then builds the libFuzzer targets and runs each briefly (scripts/fuzz.sh; RR_FUZZ_SECONDS=N for N seconds each, 0 for
-# none) while the Debian package is installed on a fresh Debian 12 root (RR_FRESH_DEBIAN=0 leaves it
-# out), and last the container test on the image built meanwhile (RR_CONTAINER=0 leaves it out).
-# Exits non-zero on any failure; prints how long each phase took.
+# The test command (docs/development.md "CI time" has the phases, their order and a measured run):
+#   setup            scripts/setup.sh: the run packages and the test tools, the Python venv
+#   wasm+dashboard   the WebAssembly client and the dashboard (the browser tests need them)
+#   build            preset debug: clang-14 -O0, ASan + UBSan, every test program and the libFuzzer
+#                    targets linked from the same objects
+#   ctest            every test but the timing ones, RR_CTEST_JOBS at a time (default 4 per CPU: most
+#                    tests wait on sockets, timers and child processes); then the tests labelled
+#                    `timing` (they assert rates and latencies a crowded CPU blurs), two at a time
+#   tsan             the server tests under ThreadSanitizer (preset tsan, built meanwhile)
+#   fuzz             every libFuzzer target briefly, two at a time (scripts/fuzz.sh)
+#   package          (meanwhile) preset package: the Release binaries and the Debian package, installed
+#                    on a fresh Debian 12 root; the container image made from those binaries (no
+#                    second compile) and its test; the Containerfile's from-source build only when
+#                    its inputs changed (docker/from-source.verified)
+# Meanwhile = in the background at nice 19, one chain: the tsan build, then the package build, then
+# the fresh-Debian, container and from-source steps, so they take the CPU the tests leave idle.
+# Exits non-zero on any failure; prints how long each phase took, and warns, naming the slowest
+# phases and tests, when the whole run passes RR_CI_BUDGET_MINUTES (45).
+#   RR_TSAN=0, RR_FRESH_DEBIAN=0, RR_CONTAINER=0 leave those steps out; RR_FUZZ_SECONDS=N fuzzes each
+#   target N seconds (0: no fuzzing); RR_FROM_SOURCE=1|0 forces the from-source image build on or off.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+budget_min=${RR_CI_BUDGET_MINUTES:-45}
 t_phase=$SECONDS
 phases=()
 phase_done() { phases+=("$1 $((SECONDS - t_phase)) s"); t_phase=$SECONDS; }
-container_pid=
-tsan_pid=
-fresh_pid=
+bg_pid=
 finish() {
   local rc=$?
-  if [ -n "$container_pid" ]; then kill -- -"$container_pid" 2>/dev/null || true; fi
-  if [ -n "$tsan_pid" ]; then kill -- -"$tsan_pid" 2>/dev/null || true; fi
-  if [ -n "$fresh_pid" ]; then kill "$fresh_pid" 2>/dev/null || true; fi
+  if [ -n "$bg_pid" ]; then kill -- -"$bg_pid" 2>/dev/null || true; fi
   echo "test: phases: ${phases[*]/%/,} total $SECONDS s"
+  if ((SECONDS > budget_min * 60)); then
+    echo "test: WARNING: the run took $((SECONDS / 60)) min, over the budget of $budget_min min (CI allows 90 on a"
+    echo "test: fresh clone with an empty compiler cache; docs/development.md \"CI time\"). Slowest phases:"
+    printf '%s\n' "${phases[@]}" | sort -k2 -rn | head -3 | sed 's/^/test:   /'
+    echo "test: slowest tests:"
+    cat build/ctest-*.log 2>/dev/null |
+      sed -nE 's/^ *[0-9]+\/[0-9]+ Test +#[0-9]+: (.*[^ .]) \.+.* ([0-9.]+) sec$/\2 s  \1/p' |
+      sort -rn | head -10 | sed 's/^/test:   /'
+  fi
   exit $rc
 }
 trap finish EXIT
-# Waits for a background job (its pid variable already cleared, so the EXIT trap leaves it alone); when
-# it failed, prints the end of its log and what failed, and stops the run.
-await_job() {
-  local pid=$1 log=$2 lines=$3 what=$4
-  if ! wait "$pid"; then
-    tail -n "$lines" "$log"
-    echo "test: FAILED: $what (log $log)"
-    exit 1
-  fi
-}
 
 ./scripts/setup.sh
 phase_done setup
 jobs=${RR_JOBS:-$(nproc)}
+ctest_jobs=${RR_CTEST_JOBS:-$((4 * $(nproc)))}
 
 # The WebAssembly client package (wasm-client/dist; build folder build/wasm), tested by ctest.
 ./wasm-client/build.sh
@@ -51,30 +59,96 @@ else
 fi
 phase_done wasm+dashboard
 
-# The container image (issue 13): docker/build.sh from the committed tree plus web/dist, in its own
-# process group at nice 19, so the builds and tests below keep the CPU and the image's compile takes
-# what they leave idle (ctest waits on sockets and timers much of the time). The container test at
-# the end runs on this image (same inputs key) and skips, with the reason, where podman cannot run.
-mkdir -p build
-if [ "${RR_CONTAINER:-1}" != 0 ] && command -v podman >/dev/null && podman info >/dev/null 2>&1; then
-  setsid nice -n 19 ./docker/build.sh --tag localhost/rr-gateway:ci >build/container-build.log 2>&1 &
-  container_pid=$!
-  echo "test: building the container image in the background (build/container-build.log)"
-fi
+cmake --preset debug >/dev/null
+cmake --build --preset debug -j "$jobs"
+phase_done build
 
-# ThreadSanitizer (issue 16): the threaded server tests (node, client, gateway, transports: the
-# "server: " tests of rr_server_tests) built with -fsanitize=thread in build/tsan (preset tsan: only
-# rr_server_tests, a unity build: about 9 CPU-minutes cold) and run; a data race fails the run
-# (halt_on_error; test/support/tsan.supp holds only explained third-party false positives). The build
-# starts in the background at nice 19 once the debug build is done, so it takes the CPU that ctest
-# leaves idle; RR_TSAN=0 leaves the step out. On a failure it names this step and the failed tests and
-# prints each ThreadSanitizer report from the full log (build/tsan/ctest.log).
-tsan_step() {
-  local pid=$tsan_pid
-  tsan_pid=
-  await_job "$pid" build/tsan-build.log 40 "the ThreadSanitizer build (preset tsan, build/tsan) did not compile"
+# The background chain (its own process group, nice 19; its steps' logs in build/bg-*.log, their
+# outcomes in build/bg-status/<step>: "ok", "skipped: why" or "failed").
+mkdir -p build/bg-status
+rm -f build/bg-status/*
+container_ok=
+if [ "${RR_CONTAINER:-1}" != 0 ] && command -v podman >/dev/null && podman info >/dev/null 2>&1; then container_ok=1; fi
+# The from-source image build: only when its inputs differ from the last verified ones.
+from_source=${RR_FROM_SOURCE:-}
+if [ -z "$from_source" ]; then
+  if [ "$(./docker/build.sh --print-from-source-key)" = "$(sed -n 's/^key //p' docker/from-source.verified 2>/dev/null)" ]; then
+    from_source=0
+    echo "test: the Containerfile's from-source build is skipped: its inputs (docker/, packaging/, cmake/,"
+    echo "test:   CMakePresets.json, every CMakeLists.txt) are those verified at $(sed -n 's/^commit //p' docker/from-source.verified)"
+  else
+    from_source=1
+    echo "test: the Containerfile's from-source build runs: its inputs changed since docker/from-source.verified"
+  fi
+fi
+background_chain() {
+  step() {  # step NAME COMMAND...: runs it, logs to build/bg-NAME.log, records its outcome (77: skipped)
+    local name=$1; shift
+    local t0=$SECONDS rc=0
+    "$@" >"build/bg-$name.log" 2>&1 || rc=$?
+    case $rc in
+      0) echo "ok $((SECONDS - t0)) s" ;;
+      77) echo "ok (skipped: $(grep -m1 -o 'SKIP.*' "build/bg-$name.log"))" ;;
+      *) echo "failed $((SECONDS - t0)) s" ;;
+    esac >"build/bg-status/$name"
+  }
+  if [ "${RR_TSAN:-1}" != 0 ]; then
+    step tsan-build sh -c 'cmake --preset tsan >/dev/null && cmake --build --preset tsan -j "$1"' sh "$jobs"
+  fi
+  step package-build sh -c 'cmake --preset package >/dev/null && cmake --build --preset package -j "$1"' sh "$jobs"
+  if [ "${RR_FRESH_DEBIAN:-1}" != 0 ] && grep -q '^ok' build/bg-status/package-build; then
+    # (the ctest test "install: the package on a fresh Debian 12 root", called directly: a second
+    # ctest in build/debug while the main one runs would write over its logs)
+    step fresh-debian env RR_FRESH_DEBIAN=1 test/gateway/fresh_debian_test.sh build/package docs/deployment.md cpack &
+  fi
+  if [ -n "$container_ok" ] && grep -q '^ok' build/bg-status/package-build; then
+    step container-image ./docker/build.sh --from-build build/package --tag localhost/rr-gateway:ci
+  fi
+  if [ -n "$container_ok" ] && [ "$from_source" = 1 ]; then
+    step from-source ./docker/build.sh --tag localhost/rr-gateway:from-source --smoke --record-verified
+  fi
+  wait
+}
+setsid nice -n 19 bash -c "$(declare -f background_chain); jobs=$jobs container_ok=$container_ok from_source=$from_source background_chain" \
+  >build/bg-chain.log 2>&1 &
+bg_pid=$!
+# Waits until the background step NAME has an outcome; fails the run (with its log's end) if it failed.
+await_step() {
+  local name=$1 what=$2
+  while [ ! -f "build/bg-status/$name" ]; do
+    if ! kill -0 "$bg_pid" 2>/dev/null; then
+      [ -f "build/bg-status/$name" ] && break
+      echo "test: FAILED: the background chain ended before $what (build/bg-chain.log)"; tail -n 20 build/bg-chain.log; exit 1
+    fi
+    sleep 2
+  done
+  if ! grep -q '^ok' "build/bg-status/$name"; then
+    tail -n 60 "build/bg-$name.log"
+    echo "test: FAILED: $what (log build/bg-$name.log)"
+    exit 1
+  fi
+}
+
+# ctest: a test run starts the longest tests first when it has their times; a fresh build has none,
+# so it takes them from test/ctest-costs.txt (a scheduling hint; a test not listed just starts later).
+costs=build/debug/Testing/Temporary/CTestCostData.txt
+[ -f "$costs" ] || { mkdir -p "$(dirname "$costs")"; cp test/ctest-costs.txt "$costs"; }
+excluded='^(docker: the image|install: the package on a fresh Debian 12 root)'
+status=0
+ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" 2>&1 | tee build/ctest-main.log || status=1
+ctest --preset debug -j 2 -L timing -E "$excluded" 2>&1 | tee build/ctest-timing.log || status=1
+((status == 0)) || { echo "test: FAILED: ctest (build/ctest-main.log, build/ctest-timing.log)"; exit 1; }
+phase_done ctest
+
+# ThreadSanitizer (issue 16): the threaded server tests ("server: " tests of rr_server_tests) built with
+# -fsanitize=thread in build/tsan (preset tsan: a unity build of rr_server_tests only) and run; a data
+# race fails the run (halt_on_error; test/support/tsan.supp holds only explained third-party false
+# positives). On a failure it names the failed tests and prints each report (build/tsan/ctest.log).
+if [ "${RR_TSAN:-1}" != 0 ]; then
+  await_step tsan-build "the ThreadSanitizer build (preset tsan, build/tsan) did not compile"
   phase_done tsan-build-wait
-  if ! ctest --preset tsan -j "$jobs" --output-log build/tsan/ctest.log; then
+  if ! ctest --preset tsan -j "$ctest_jobs" --output-log build/tsan/ctest.log >build/ctest-tsan.log 2>&1; then
+    tail -n 5 build/ctest-tsan.log
     echo "test: FAILED: the ThreadSanitizer step (ctest --preset tsan; full log build/tsan/ctest.log)"
     echo "test: failed TSan tests (re-run one: ctest --preset tsan -R '<name>'):"
     sed 's/^[0-9]*:/  /' build/tsan/Testing/Temporary/LastTestsFailed.log 2>/dev/null || true
@@ -82,54 +156,37 @@ tsan_step() {
     awk '/WARNING: ThreadSanitizer|ERROR: ThreadSanitizer/,/SUMMARY: ThreadSanitizer/' build/tsan/ctest.log | head -n 400
     exit 1
   fi
+  grep -E 'tests passed|Total Test time' build/ctest-tsan.log || true
   phase_done tsan
-}
-
-cmake --preset debug >/dev/null
-cmake --build --preset debug -j "$jobs"
-phase_done build
-if [ "${RR_TSAN:-1}" != 0 ]; then
-  cmake --preset tsan >/dev/null
-  setsid nice -n 19 cmake --build --preset tsan -j "$jobs" >build/tsan-build.log 2>&1 &
-  tsan_pid=$!
-fi
-ctest --preset debug -j "$jobs" -E '^docker: the image'
-phase_done ctest
-if [ -n "$tsan_pid" ]; then tsan_step; fi
-
-# The Debian package installed on a fresh Debian 12 root (issue 15; test/gateway/fresh_debian_test.sh:
-# mmdebstrap, the page's apt-get install, the gateway run as the unit runs it, purge). About 2 minutes,
-# mostly downloads from the Debian mirror: it runs beside the fuzz phase, whose single worker leaves a
-# CPU idle. RR_FRESH_DEBIAN=0 leaves it out; it reports skipped (77) without root or mmdebstrap.
-if [ "${RR_FRESH_DEBIAN:-1}" != 0 ]; then
-  RR_FRESH_DEBIAN=1 ctest --preset debug -R '^install: the package on a fresh Debian 12 root' --output-on-failure \
-    >build/fresh-debian.log 2>&1 &
-  fresh_pid=$!
 fi
 
-# RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times (~3 min).
+# RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times.
 fuzz_seconds=${RR_FUZZ_SECONDS:-}
 if [ "$fuzz_seconds" != 0 ]; then
   ./scripts/fuzz.sh $fuzz_seconds
   phase_done fuzz
 fi
-if [ -n "$fresh_pid" ]; then
-  pid=$fresh_pid
-  fresh_pid=
-  await_job "$pid" build/fresh-debian.log 40 "the package on a fresh Debian 12 root"
-  grep -E 'Test #.*(Passed|Skipped)' build/fresh-debian.log || true
-  phase_done fresh-debian-wait
-fi
 
-if [ "${RR_CONTAINER:-1}" != 0 ]; then
-  if [ -n "$container_pid" ]; then
-    pid=$container_pid
-    container_pid=
-    await_job "$pid" build/container-build.log 60 "docker/build.sh"
-    grep -E '^build: ' build/container-build.log || true
-    phase_done container-build-wait
-  fi
-  ctest --preset debug -R '^docker: the image' --output-on-failure
-  phase_done container
+# What the background chain still does: the package, installed on a fresh Debian root; the image from
+# it and its test; the from-source image build.
+await_step package-build "the Release package build (preset package, build/package)"
+if [ "${RR_FRESH_DEBIAN:-1}" != 0 ]; then
+  await_step fresh-debian "the package on a fresh Debian 12 root"
+  cat build/bg-status/fresh-debian
 fi
+if [ "${RR_CONTAINER:-1}" != 0 ]; then
+  if [ -n "$container_ok" ]; then
+    await_step container-image "docker/build.sh --from-build build/package"
+    grep -E '^build: ' build/bg-container-image.log || true
+  fi
+  # The container test on that image (reports skipped, with the reason, where podman cannot run).
+  RR_CONTAINER_PREBUILT=1 ctest --preset debug -R '^docker: the image' --output-on-failure 2>&1 |
+    tee build/ctest-container.log || { echo "test: FAILED: the container test"; exit 1; }
+  if [ -n "$container_ok" ] && [ "$from_source" = 1 ]; then
+    await_step from-source "the Containerfile's from-source build (docker/build.sh --smoke)"
+    grep -E '^build: ' build/bg-from-source.log || true
+    echo "test: the from-source build passed; docker/from-source.verified now holds its inputs (commit it)"
+  fi
+fi
+phase_done package+container-wait
 echo "test: all passed"

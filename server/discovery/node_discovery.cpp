@@ -661,13 +661,22 @@ void NodeDiscovery::interrogate(NodeID id, std::vector<std::string> urls, std::s
 
 void NodeDiscovery::emit(std::vector<DiscoveryEvent> events) {
     if (events.empty()) return;
-    std::vector<Listener> listeners;
+    std::vector<std::uint64_t> ids;
     {
         std::lock_guard lock(mutex_);
-        for (const auto& [id, l] : listeners_) listeners.push_back(l);
+        for (const auto& [id, l] : listeners_) ids.push_back(id);
     }
-    if (listeners.empty()) return;
-    asio::post(strand_, [events = std::move(events), listeners = std::move(listeners)] {
+    if (ids.empty()) return;
+    // The listeners registered now, called only if still registered when the events are delivered: one
+    // removed in between (remove_listener, stop) is not called, so its owner may go away once that
+    // returned.
+    asio::post(strand_, [self = shared_from_this(), events = std::move(events), ids = std::move(ids)] {
+        std::vector<Listener> listeners;
+        {
+            std::lock_guard lock(self->mutex_);
+            for (auto id : ids)
+                if (auto it = self->listeners_.find(id); it != self->listeners_.end()) listeners.push_back(it->second);
+        }
         for (const auto& e : events)
             for (const auto& l : listeners) l(e);
     });

@@ -134,6 +134,8 @@ public:
     /// URLs to connect to `url` with: the zone of a link-local host added (see header comment).
     std::vector<std::string> connectable_urls(const std::string& url) const;
 
+    /// Listeners run on the discovery's strand. One removed (remove_listener, or all by stop) is not
+    /// called for events delivered after that, even ones made before; a call already running finishes.
     using Listener = std::function<void(const DiscoveryEvent&)>;
     std::uint64_t add_listener(Listener listener);
     void remove_listener(std::uint64_t id);

@@ -264,7 +264,7 @@ TEST_CASE("json socket: subscribers of one wire and one event each get every val
     CHECK(a.request(member("call", "update_state", {{"args", {515151}}}))["result"] == json{{"return", nullptr}});
     const json expected{{"id", 515151}, {"label", "demand"}, {"values", {128787.75}}};
     for (auto [ws, sid] : {std::pair{&a, wire_a}, std::pair{&b, wire_b1}, std::pair{&b, wire_b2}}) {
-        auto push = ws->wait_push([&](const json& j) { return push_of(sid, "wire")(j) && j["value"]["id"] == 515151; });
+        auto push = ws->wait_push([&, sid = sid](const json& j) { return push_of(sid, "wire")(j) && j["value"]["id"] == 515151; });
         REQUIRE(push);
         CHECK((*push)["value"] == expected);
         CHECK((*push)["time"]["seconds"].get<std::int64_t>() > 1600000000);
@@ -274,7 +274,7 @@ TEST_CASE("json socket: subscribers of one wire and one event each get every val
     CHECK(b.request(member("call", "fire_events", {{"args", {2}}}))["result"] == json{{"return", nullptr}});
     for (int seq = 0; seq < 2; ++seq) {
         for (auto [ws, sid] : {std::pair{&a, ev_a}, std::pair{&b, ev_b}}) {
-            auto ev = ws->wait_push([&](const json& j) { return push_of(sid, "event")(j) && j["args"]["seq"] == seq; });
+            auto ev = ws->wait_push([&, sid = sid](const json& j) { return push_of(sid, "event")(j) && j["args"]["seq"] == seq; });
             REQUIRE(ev);
             CHECK((*ev)["args"]["text"] == "event " + std::to_string(seq) + " \u2713");
             CHECK((*ev)["args"]["data"] == json{{"id", seq}, {"label", "event"}, {"values", {seq * 1.5}}});

@@ -14,7 +14,7 @@ log lines with device / client / request), the process runs as uid 10001, the im
 probes /livez and passes. Prints the image size.
 
 Exit 77 (skipped, with the reason) where podman is missing or cannot run containers here.
-Usage: container_test.py [--image localhost/rr-gateway:ci]
+Usage: container_test.py [--image localhost/rr-gateway:ci] [--prebuilt]
 """
 import argparse
 import json
@@ -53,7 +53,14 @@ def free_port():
         return s.getsockname()[1]
 
 
-def ensure_image(image):
+def ensure_image(image, prebuilt):
+    if prebuilt:
+        # scripts/test.sh made it from its Release build (docker/build.sh --from-build): test that one.
+        found = podman("images", "--format", "{{.ID}}", image).stdout.split()
+        expect(bool(found), "--prebuilt: no image %s" % image)
+        label = podman("image", "inspect", "--format", "{{index .Labels \"rr.inputs\"}}", image).stdout.strip()
+        print("image: %s as given (rr.inputs=%s)" % (image, label[:21]))
+        return
     key = subprocess.run([os.path.join(ROOT, "docker", "build.sh"), "--print-key"], cwd=ROOT, capture_output=True,
                          text=True, check=True).stdout.strip()
     found = podman("images", "--filter", "label=rr.inputs=" + key, "--format", "{{.ID}}").stdout.split()
@@ -71,6 +78,9 @@ def ensure_image(image):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--image", default="localhost/rr-gateway:ci")
+    ap.add_argument("--prebuilt", action="store_true",
+                    help="test --image as it is (built by docker/build.sh --from-build), never build it here "
+                         "(also RR_CONTAINER_PREBUILT=1: scripts/test.sh)")
     a = ap.parse_args()
 
     if subprocess.run(["sh", "-c", "command -v podman"], capture_output=True).returncode != 0:
@@ -80,7 +90,7 @@ def main():
         skip("podman cannot run here: " + info.stderr.strip()[-300:])
     checks = gwproc.Checks()
     try:
-        ensure_image(a.image)
+        ensure_image(a.image, a.prebuilt or os.environ.get("RR_CONTAINER_PREBUILT") == "1")
     except Exception as e:
         # The build's RUN steps need a working runtime: tell "cannot run containers here" from a broken build.
         base = "localhost/debian:bookworm-local"

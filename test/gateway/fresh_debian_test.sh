@@ -5,12 +5,16 @@
 # rr-gateway user, /etc/rr-gateway/gateway.yaml 0640 root:rr-gateway, the unit, the gateway started as
 # that user with that file and answering /readyz, and `apt-get purge` removing it all.
 #
-#   fresh_debian_test.sh BUILD_DIR DOC CPACK
+#   fresh_debian_test.sh BUILD_DIR DOC CPACK     (RR_PACKAGE_BUILD=DIR overrides BUILD_DIR)
 #
 # Downloads about 100 MB and takes minutes, so it runs only with RR_FRESH_DEBIAN=1 (and as root, with
 # mmdebstrap installed); otherwise it reports skipped (77) with the reason.
 set -euo pipefail
 build=$1 doc=$2 cpack=$3
+# RR_PACKAGE_BUILD: pack that build folder instead (scripts/test.sh: its Release package build, so that
+# what is installed is the package a user gets, not the sanitizer build the tests ran).
+build=${RR_PACKAGE_BUILD:-$build}
+echo "packing $build"
 
 [ "${RR_FRESH_DEBIAN:-}" = 1 ] || { echo "SKIP: set RR_FRESH_DEBIAN=1 to run (downloads ~100 MB from the Debian mirror, several minutes)"; exit 77; }
 [ "$(id -u)" = 0 ] || { echo "SKIP: needs root (chroot)"; exit 77; }

@@ -637,7 +637,9 @@ private:
 
     void properties() {
         for (auto& [name, ab] : property_values()) {
-            const auto& [a, b] = ab;
+            // (not a structured binding: clang 14 cannot capture one in a lambda)
+            const auto& a = std::get<0>(ab);
+            const auto& b = std::get<1>(ab);
             check(name + " get", [&, name = name] { expect_equal(unwrap(c_.get(name), name), a, name + " (A)"); });
             check(name + " set/get", [&, name = name] {
                 unwrap(c_.set(name, b), "set " + name);
@@ -699,7 +701,8 @@ private:
             expect(e.message == "standard error from throw_standard", "error message " + e.message);
         });
         for (auto& [kind, sb] : varvalue_catalog()) {
-            const auto& [sent, back] = sb;
+            const auto& sent = std::get<0>(sb);
+            const auto& back = std::get<1>(sb);
             check("echo varvalue " + kind, [&, kind = kind] { expect_equal(unwrap(c_.call("echo", {sent}), kind), back, kind); });
             check("catalog varvalue " + kind,
                   [&, kind = kind] { expect_equal(unwrap(c_.call("catalog", {Str(kind)}), kind), back, kind); });

@@ -613,9 +613,9 @@ TEST_CASE("usb emulated: USB devices feed the discovery table, their services ar
     }());
     REQUIRE(d->start());
     d->want_services(true);
-    std::atomic<int> lost{0};
-    d->add_listener([&](const server::discovery::DiscoveryEvent& e) {
-        if (e.kind == server::discovery::DiscoveryEvent::Kind::node_lost && e.node.node_id == device_node_id()) ++lost;
+    auto lost = std::make_shared<std::atomic<int>>(0);  // the listener may outlive a failed REQUIRE
+    d->add_listener([lost](const server::discovery::DiscoveryEvent& e) {
+        if (e.kind == server::discovery::DiscoveryEvent::Kind::node_lost && e.node.node_id == device_node_id()) ++*lost;
     });
     auto source = server::usb::UsbDiscoverySource::start(w->io.executor(), w->host, d);
     CHECK_FALSE(d->node(device_node_id()));
@@ -638,7 +638,7 @@ TEST_CASE("usb emulated: USB devices feed the discovery table, their services ar
     CHECK(s->connection_urls == std::vector<std::string>{"rr+usb:///?nodeid=" + device_node_id().to_string() + "&service=usbtest"});
 
     w->emulator->unplug(dev);  // unplugged: lost at once, not after the 60 s expiry
-    CHECK(eventually([&] { return lost.load() == 1; }, 5s));
+    CHECK(eventually([&] { return lost->load() == 1; }, 5s));
     CHECK_FALSE(d->node(device_node_id()));
     plug(*w, UsbWorld::device_options(5));  // re-plugged at another address: back
     CHECK(eventually([&] { return d->node(device_node_id()).has_value(); }, 5s));
