@@ -126,7 +126,7 @@ std::optional<ServiceSessionEvent> ServiceSession::poll_event() {
 
 void ServiceSession::take_events(std::vector<ServiceSessionEvent>& batch) { events_.take_all(batch); }
 
-void ServiceSession::close_session() {
+void ServiceSession::close_session(std::uint64_t disconnect_token) {
     for (auto& [id, deadline] : pending_callbacks_)
         events_.emplace_back(std::in_place_type<ServiceCallbackResponse>, id,
                              fail(MessageErrorType::ConnectionError, "client disconnected"));
@@ -141,7 +141,7 @@ void ServiceSession::close_session() {
     auto service = std::move(service_);
     service_.reset();
     host_.release_endpoint(endpoint_);
-    events_.emplace_back(ServiceSessionClosed{std::move(service), endpoint_});
+    events_.emplace_back(ServiceSessionClosed{std::move(service), endpoint_, disconnect_token});
     endpoint_ = 0;
     client_endpoint_ = 0;
     authenticated_ = false;
@@ -304,6 +304,14 @@ void ServiceSession::handle_special(const MessageHeader& h, MessageEntry&& e, Mo
         case MessageEntryType::ConnectClientCombined: connect_client(h, std::move(e), true, now); return;
         case MessageEntryType::DisconnectClient: {
             MessageEntry r = reply_to(e);
+            if (service_ && service_->admits_sessions()) {
+                // The service ends the session itself (the gateway's passthrough mirror closes the
+                // device's session first): CORE answers DisconnectClient only after RemoveClient, so
+                // a client whose DisconnectService returned finds the session's locks gone.
+                disconnect_ = PendingDisconnect{++disconnect_counter_, h, std::move(r)};
+                close_session(disconnect_->token);
+                return;
+            }
             close_session();
             reply_special(h, std::move(r), now);
             return;
@@ -473,6 +481,14 @@ bool ServiceSession::answer_admission(std::uint64_t token, Result<void> outcome,
     }
     open_session(p.header, std::move(p.reply), p.combined, p.return_defs, std::move(p.service), p.endpoint,
                  std::move(p.username), true, now);
+    return true;
+}
+
+bool ServiceSession::answer_disconnect(std::uint64_t token, MonoTime now) {
+    if (!disconnect_ || disconnect_->token != token || stream_.is_closed()) return false;
+    PendingDisconnect p = std::move(*disconnect_);
+    disconnect_.reset();
+    reply_special(p.header, std::move(p.reply), now);
     return true;
 }
 

@@ -104,9 +104,13 @@ struct ServiceAdmission {
     std::optional<MessageElement> credentials;
 };
 /// The client session ended (DisconnectClient or the connection closed). No further session events.
+/// `disconnect_token` is non-zero when the client's DisconnectClient ended a session of a service whose
+/// admits_sessions() is true: its DisconnectClientRet is held until the host calls
+/// answer_disconnect(disconnect_token, …), once the service has ended its side of the session.
 struct ServiceSessionClosed {
     std::shared_ptr<HostedService> service;
     std::uint32_t endpoint = 0;
+    std::uint64_t disconnect_token = 0;
 };
 /// The connection is closed: no further events.
 struct ServiceConnectionClosed {
@@ -181,6 +185,9 @@ public:
     /// the token is unknown or the connection closed meanwhile: the service must then drop what it
     /// prepared for that endpoint.
     bool answer_admission(std::uint64_t token, Result<void> outcome, MonoTime now);
+    /// Sends the DisconnectClientRet held for a ServiceSessionClosed's `disconnect_token`. Returns false
+    /// (nothing sent) when the token is unknown or answered already, or the connection closed meanwhile.
+    bool answer_disconnect(std::uint64_t token, MonoTime now);
     /// Ends the connection after the pending output (the host's close()).
     void close(RRError error);
 
@@ -202,7 +209,8 @@ private:
     void connect_client(const MessageHeader& h, MessageEntry&& e, bool combined, MonoTime now);
     void get_service_desc(const MessageHeader& h, MessageEntry&& e, MonoTime now);
     void object_type_name(const MessageHeader& h, MessageEntry&& e, MonoTime now);
-    void close_session();
+    /// `disconnect_token`: ServiceSessionClosed's (0: the reply of a DisconnectClient is not held).
+    void close_session(std::uint64_t disconnect_token = 0);
     void open_session(const MessageHeader& h, MessageEntry reply, bool combined, bool return_defs,
                       std::shared_ptr<HostedService> service, std::uint32_t endpoint, std::string username,
                       bool authenticated, MonoTime now);
@@ -246,6 +254,13 @@ private:
     };
     std::optional<PendingAdmission> admission_;  // at most one: a connection carries one session
     std::uint64_t admission_counter_ = 0;
+    struct PendingDisconnect {
+        std::uint64_t token = 0;
+        MessageHeader header;
+        MessageEntry reply;
+    };
+    std::optional<PendingDisconnect> disconnect_;  // a DisconnectClientRet waiting for answer_disconnect()
+    std::uint64_t disconnect_counter_ = 0;
 };
 
 }  // namespace rr

@@ -437,6 +437,51 @@ TEST_CASE("service session: a service that admits sessions itself answers the co
     }
 }
 
+TEST_CASE("service session: a service that admits sessions ends them itself: DisconnectClientRet waits for it") {
+    Pair p;
+    p.host.service->admits = true;
+    p.pump();
+    auto asks = p.take<ServiceAdmission>(p.service_events);
+    REQUIRE(asks.size() == 1);
+    REQUIRE(p.service.answer_admission(asks[0].token, {}, p.now));
+    p.pump();
+    REQUIRE(p.take_client<ClientSessionConnected>().size() == 1);
+    REQUIRE(p.take<ServiceSessionOpened>(p.service_events).size() == 1);
+
+    p.client.disconnect(p.now);
+    p.pump();
+    auto closed = p.take<ServiceSessionClosed>(p.service_events);
+    REQUIRE(closed.size() == 1);
+    CHECK(closed[0].endpoint == asks[0].endpoint);
+    REQUIRE(closed[0].disconnect_token != 0);
+    CHECK_FALSE(p.service.has_session());
+    CHECK(p.host.live.empty());
+    CHECK(p.service.pending_output_size() == 0);  // no DisconnectClientRet yet
+    CHECK(p.take_client<ClientSessionClosed>().empty());  // the client still waits for it
+
+    CHECK_FALSE(p.service.answer_disconnect(closed[0].disconnect_token + 1, p.now));  // unknown token
+    REQUIRE(p.service.answer_disconnect(closed[0].disconnect_token, p.now));
+    CHECK_FALSE(p.service.answer_disconnect(closed[0].disconnect_token, p.now));  // answered once
+    p.pump();
+    CHECK(p.take_client<ClientSessionClosed>().size() == 1);  // the reply closed it, not the 500 ms wait
+
+    {  // the connection closes before the service has ended its side: nothing to answer
+        Pair q;
+        q.host.service->admits = true;
+        q.pump();
+        auto a = q.take<ServiceAdmission>(q.service_events);
+        REQUIRE(a.size() == 1);
+        REQUIRE(q.service.answer_admission(a[0].token, {}, q.now));
+        q.pump();
+        q.client.disconnect(q.now);
+        q.pump();
+        auto c = q.take<ServiceSessionClosed>(q.service_events);
+        REQUIRE(c.size() == 1);
+        q.service.on_transport_closed(make_error(MessageErrorType::ConnectionError, "gone"));
+        CHECK_FALSE(q.service.answer_disconnect(c[0].disconnect_token, q.now));
+    }
+}
+
 TEST_CASE("service session: ObjectTypeName is asked of the host and answered later") {
     Pair p;
     p.connect();
@@ -610,6 +655,8 @@ TEST_CASE("service session: DisconnectClient ends the session and frees its endp
     auto closed = p.take<ServiceSessionClosed>(p.service_events);
     REQUIRE(closed.size() == 1);
     CHECK(closed[0].endpoint == endpoint);
+    CHECK(closed[0].disconnect_token == 0);  // answered at once
+    CHECK(p.take_client<ClientSessionClosed>().size() == 1);
     CHECK(p.host.live.empty());
     CHECK_FALSE(p.service.has_session());
     auto r = p.service.send(member_request("ev", MessageEntryType::EventReq), p.now);

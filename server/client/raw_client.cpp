@@ -5,6 +5,7 @@
 #include "core/session/request_map.hpp"
 #include "server/common/connection_strand.hpp"
 #include "server/common/random_ids.hpp"
+#include "server/transport/completion_guard.hpp"
 
 namespace rr::server {
 
@@ -51,7 +52,10 @@ public:
         outbox_taken_.clear();  // keeps its capacity: no allocation per wake
     }
 
-    ~Logic() override { fail_queued(); }
+    ~Logic() override {
+        fail_queued();
+        run_close_waiters();
+    }
 
     /// From any thread: `entry` goes out on the strand, after what was queued before it, with one wake
     /// of the pump for all that waits (no closure per entry). A request queued once the transport has
@@ -83,9 +87,11 @@ public:
         (void)session_.send_packet(std::move(entry), mono_now());
         if (auto c = client_.lock()) c->queued_.store(session_.pending_output_size());
     }
-    void close() {
+    void close(std::function<void()> closed) {
+        if (closed) close_waiters_.push_back(std::move(closed));
         session_.disconnect(mono_now());
         dispatch();
+        if (session_.is_closed()) run_close_waiters();  // ended before: no ClientSessionClosed comes
     }
 
     std::weak_ptr<RawClient> client_;
@@ -145,12 +151,20 @@ private:
                 }
                 if (auto c = client_.lock()) c->open_.store(false);
                 if (auto h = std::move(on_closed_)) h(closed->error);
+                run_close_waiters();
             }
         }
     }
 
+    void run_close_waiters() {
+        auto waiters = std::move(close_waiters_);
+        close_waiters_.clear();
+        for (auto& w : waiters) w();
+    }
+
     ClientSession session_;
     RequestMap<ReplyHandler> replies_;
+    std::vector<std::function<void()>> close_waiters_;  // close()'s `closed`, run when the session ends
     std::mutex queue_mutex_;
     std::vector<Queued> outbox_;        // guarded by queue_mutex_
     bool wake_pending_ = false;         // guarded by queue_mutex_: a wake is on its way for outbox_
@@ -235,11 +249,21 @@ void RawClient::send(MessageEntry entry) {
 
 RawClient::~RawClient() { close(); }
 
-void RawClient::close() {
+void RawClient::close(std::function<void()> closed) {
     auto pump = pump_.lock();
-    if (!pump) return;
-    auto logic = logic_;
-    pump->dispatch([logic] { logic->close(); });
+    if (!pump) {
+        if (closed) closed();
+        return;
+    }
+    if (!closed) {
+        pump->dispatch([logic = logic_] { logic->close(nullptr); });
+        return;
+    }
+    // The guard calls `closed` if the pump drops this work unrun (it has closed meanwhile).
+    auto guard = std::make_shared<CompletionGuard<void>>([closed = std::move(closed)](Result<void>) { closed(); });
+    pump->dispatch([logic = logic_, guard] {
+        logic->close([done = guard->take()] { done({}); });
+    });
 }
 
 }  // namespace rr::server

@@ -64,8 +64,11 @@ public:
     void request(MessageEntry entry, std::chrono::milliseconds timeout, ReplyHandler done);
     /// Sends an entry that gets no reply (pipe/wire packets, callback replies).
     void send(MessageEntry entry);
-    /// DisconnectClient, then close. Also done when the last reference goes.
-    void close();
+    /// DisconnectClient, then close. Also done when the last reference goes. `closed` (optional) is
+    /// called once, on the connection's strand or at once, when the session has ended: the service
+    /// answered DisconnectClient, or 500 ms passed without an answer (wire.md §6.6), or the connection
+    /// closed, or it had ended before.
+    void close(std::function<void()> closed = {});
     ~RawClient();
 
     const ClientSessionInfo& info() const noexcept { return info_; }

@@ -134,11 +134,11 @@ void MirrorService::on_session_open(const SessionRef& session) {
 }
 
 void MirrorService::on_session_close(const SessionRef& session) {
-    drop_session_state(session.endpoint());
     if (passthrough_) {
-        passthrough_->close(session.endpoint());
+        end_session(session, {});
         return;
     }
+    drop_session_state(session.endpoint());
     // Its client locks and monitors go; its user's user locks with the user's last session here.
     const std::string user = session.username();
     bool last_of_user = true;
@@ -148,6 +148,15 @@ void MirrorService::on_session_close(const SessionRef& session) {
             if (!user.empty() && s.username() == user) last_of_user = false;
     }
     locks_->session_closed(session.endpoint(), user, last_of_user);
+}
+
+void MirrorService::end_session(const SessionRef& session, std::function<void()> ended) {
+    if (!passthrough_) {
+        Service::end_session(session, std::move(ended));  // the gateway's own locks: gone at once
+        return;
+    }
+    drop_session_state(session.endpoint());
+    passthrough_->close(session.endpoint(), std::move(ended));
 }
 
 void MirrorService::admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,

@@ -37,6 +37,9 @@ public:
                      std::function<void(Result<ObjectTypeInfo>)> done) override;
     void on_session_open(const SessionRef& session) override;
     void on_session_close(const SessionRef& session) override;
+    /// auth: passthrough: the client's DisconnectClient is answered once the device has answered the
+    /// DisconnectClient of the client's upstream session (its locks are gone there by then).
+    void end_session(const SessionRef& session, std::function<void()> ended) override;
     void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override;
     /// Lock operations reach the mirror: forwarded on the client's own session (passthrough), or
     /// decided by the gateway's own lock table (shared; docs/security.md "auth: shared").

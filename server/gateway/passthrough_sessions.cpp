@@ -169,21 +169,27 @@ std::size_t PassthroughSessions::queued_bytes(std::uint32_t endpoint) const {
     return client ? client->queued_bytes() : 0;
 }
 
-void PassthroughSessions::close(std::uint32_t endpoint) {
+void PassthroughSessions::close(std::uint32_t endpoint, std::function<void()> ended) {
     std::shared_ptr<RawClient> client;
     std::string username;
+    bool found = false;
     {
         std::lock_guard lock(mutex_);
         auto it = links_.find(endpoint);
-        if (it == links_.end()) return;
-        client = std::move(it->second.client);
-        username = it->second.username;
-        if (!client) gone_[endpoint];  // still connecting: the connect's answer closes it
-        else links_.erase(it);
-        forget_locks_of(endpoint, username);
+        if (it != links_.end()) {
+            found = true;
+            client = std::move(it->second.client);
+            username = it->second.username;
+            if (!client) gone_[endpoint];  // still connecting: the connect's answer closes it
+            else links_.erase(it);
+            forget_locks_of(endpoint, username);
+        }
     }
-    if (client) client->close();
-    changed();
+    if (client)
+        client->close(std::move(ended));  // `ended` once the device answered (or the session ended otherwise)
+    else if (ended)
+        ended();
+    if (found) changed();
 }
 
 void PassthroughSessions::close_all() {

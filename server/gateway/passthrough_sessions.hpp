@@ -3,7 +3,10 @@
 // its own, opened with the username and `credentials` element the client sent (or none), so the
 // device's own users, privileges, object locks and monitor locks apply exactly as if the client had
 // connected directly. The upstream session is opened when the client connects (its connect waits for
-// the device's answer, and gets the device's own error when refused) and closed when the client goes.
+// the device's answer, and gets the device's own error when refused) and closed when the client goes;
+// a client's DisconnectClient is answered once the device has answered the upstream session's own
+// (MirrorService::end_session), so the locks of the session are gone on the device when the client's
+// disconnect returns, as with a direct connection.
 //
 // Forwarding is one to one: every member request, session operation (AuthenticateUser, LogoutUser,
 // RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock, ReleaseClientObjectLock, MonitorEnter,
@@ -92,8 +95,11 @@ public:
     /// gone (closed by the device or never admitted), and the device's own.
     void request(std::uint32_t endpoint, MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     /// The client went (or never took its admission): closes its upstream session (DisconnectClient;
-    /// the device drops its client locks and monitors) and forgets its locks.
-    void close(std::uint32_t endpoint);
+    /// the device drops its client locks and monitors) and forgets its locks. `ended` (optional) is
+    /// called once, from any thread or at once, when the upstream session has ended: the device answered
+    /// the DisconnectClient (its locks are released by then), or 500 ms passed without an answer, or the
+    /// connection closed; at once when the client had no upstream session (any more).
+    void close(std::uint32_t endpoint, std::function<void()> ended = {});
     /// Closes every upstream session (the device mirror stops); admissions are refused until reopen().
     void close_all();
     void reopen();

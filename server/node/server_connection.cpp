@@ -350,13 +350,30 @@ void ServerConnection::handle_event(ServiceSessionEvent& event) {
         auto done = std::move(it->second);
         callbacks_.erase(it);
         done(std::move(response->entry));
-    } else if (std::holds_alternative<ServiceSessionClosed>(event)) {
-        if (!current_) return;
+    } else if (auto* closed = std::get_if<ServiceSessionClosed>(&event)) {
+        const std::uint64_t token = closed->disconnect_token;
+        if (!current_) {
+            if (token != 0) session_.answer_disconnect(token, mono_now());
+            return;
+        }
         auto s = std::move(current_);
         current_.reset();
         reply_sink_.reset();
         s->mark_closed();
-        s->service()->on_session_close(SessionRef(s));
+        if (token == 0) {
+            s->service()->on_session_close(SessionRef(s));
+            return;
+        }
+        s->service()->end_session(SessionRef(s), [weak = weak_from_this(), pump = pump_, token] {
+            auto p = pump.lock();
+            if (!p) return;
+            p->post([weak, token] {
+                if (auto c = weak.lock()) {
+                    c->session_.answer_disconnect(token, mono_now());
+                    c->drain_events();
+                }
+            });
+        });
     }
     // ServiceConnectionClosed: the pump closes the transport (wants_close()).
 }

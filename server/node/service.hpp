@@ -131,7 +131,18 @@ public:
     virtual void abandon_admission(std::uint32_t endpoint) {}
 
     virtual void on_session_open(const SessionRef& session) {}
+    /// The client's session ended: DisconnectClient, or its connection closed.
     virtual void on_session_close(const SessionRef& session) {}
+    /// For services whose admits_sessions() is true, instead of on_session_close when the client sent
+    /// DisconnectClient: end the session and call `ended` once, from any thread, when the service's
+    /// own side of it has ended (the gateway's passthrough mirror: the device answered its
+    /// DisconnectClient). The client's DisconnectClientRet waits for it, as CORE answers DisconnectClient
+    /// only after its RemoveClient: a client whose disconnect returned finds the session's locks gone.
+    /// The default is on_session_close, then `ended`.
+    virtual void end_session(const SessionRef& session, std::function<void()> ended) {
+        on_session_close(session);
+        ended();
+    }
 
     /// A member request from a client (EntryType ≥ 1111, odd), or a client-sent packet that needs no
     /// answer (PipePacket, PipePacketRet, WirePacket: `responder` is then empty and must be ignored).
