@@ -20,12 +20,6 @@ std::optional<std::int32_t> element_index(const MessageElement& e) {
     return v;
 }
 
-template <class F>
-std::shared_ptr<const F> share(F f) {
-    if (!f) return nullptr;
-    return std::make_shared<const F>(std::move(f));
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -33,7 +27,7 @@ std::shared_ptr<const F> share(F f) {
 
 PipeEndpoint::PipeEndpoint(std::weak_ptr<PipeMember> member, std::shared_ptr<const detail::MemberInfo> info,
                            SessionRef session, std::string path, std::int32_t index, bool unreliable)
-    : member_(std::move(member)), info_(std::move(info)), session_(std::move(session)), path_(std::move(path)),
+    : MemberConnection(std::move(session), std::move(path)), member_(std::move(member)), info_(std::move(info)),
       index_(index), unreliable_(unreliable) {}
 
 Result<std::uint32_t> PipeEndpoint::send(const Value& packet, bool request_ack) {
@@ -81,7 +75,7 @@ Result<std::uint32_t> PipeEndpoint::send(const Value& packet, bool request_ack) 
 
 void PipeEndpoint::close() {
     if (!open_.load()) return;
-    if (auto member = member_.lock()) member->remove_endpoint(shared_from_this(), true);
+    if (auto member = member_.lock()) member->close_endpoint(shared_from_this());
     open_.store(false);
 }
 
@@ -93,46 +87,13 @@ PipeMember::PipeMember(std::shared_ptr<const detail::MemberInfo> info, bool unre
 
 const std::string& PipeMember::name() const noexcept { return info_->def->name; }
 
-void PipeMember::on_connect(ConnectHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_connect_ = std::move(h);
-}
+void PipeMember::on_packet(PacketHandler handler) { set_handler(on_packet_, std::move(handler)); }
 
-void PipeMember::on_packet(PacketHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_packet_ = std::move(h);
-}
+void PipeMember::on_ack(AckHandler handler) { set_handler(on_ack_, std::move(handler)); }
 
-void PipeMember::on_ack(AckHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_ack_ = std::move(h);
-}
+void PipeMember::clear_handlers() { clear_handler_slots(on_packet_, on_ack_); }
 
-void PipeMember::on_close(CloseHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_close_ = std::move(h);
-}
-
-void PipeMember::clear_handlers() {
-    std::shared_ptr<const void> a, b, c, d;
-    std::lock_guard lock(mutex_);
-    a = std::move(on_connect_);
-    b = std::move(on_packet_);
-    c = std::move(on_ack_);
-    d = std::move(on_close_);
-}
-
-std::vector<std::shared_ptr<PipeEndpoint>> PipeMember::endpoints() const {
-    std::lock_guard lock(mutex_);
-    std::vector<std::shared_ptr<PipeEndpoint>> out;
-    out.reserve(endpoints_.size());
-    for (const auto& [k, ep] : endpoints_) out.push_back(ep);
-    return out;
-}
+std::vector<std::shared_ptr<PipeEndpoint>> PipeMember::endpoints() const { return snapshot(); }
 
 std::size_t PipeMember::broadcast(const Value& packet) {
     std::size_t n = 0;
@@ -141,40 +102,10 @@ std::size_t PipeMember::broadcast(const Value& packet) {
     return n;
 }
 
-void PipeMember::remove_endpoint(const std::shared_ptr<PipeEndpoint>& endpoint, bool notify_client) {
-    std::shared_ptr<const CloseHandler> on_close;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = endpoints_.find(Key{endpoint->session().endpoint(), endpoint->index()});
-        if (it == endpoints_.end() || it->second != endpoint) return;  // already removed: on_close ran
-        endpoints_.erase(it);
-        on_close = on_close_;
-    }
-    endpoint->open_.store(false);
-    if (notify_client) {
-        MessageEntry closed = detail::member_entry(MessageEntryType::PipeClosed, endpoint->service_path(), name());
-        closed.elements.push_back(make_scalar_element<std::int32_t>("index", endpoint->index()));
-        (void)endpoint->session().send(std::move(closed));
-    }
-    if (on_close) (*on_close)(endpoint);
-}
-
-void PipeMember::drop_if(const std::function<bool(const PipeEndpoint&)>& pred) {
-    std::vector<std::shared_ptr<PipeEndpoint>> dropped;
-    {
-        std::lock_guard lock(mutex_);
-        for (const auto& [k, ep] : endpoints_)
-            if (pred(*ep)) dropped.push_back(ep);
-    }
-    for (const auto& ep : dropped) remove_endpoint(ep, false);
-}
-
-void PipeMember::drop_session(const SessionRef& session) {
-    drop_if([e = session.endpoint()](const PipeEndpoint& ep) { return ep.session().endpoint() == e; });
-}
-
-void PipeMember::drop_path(const std::string& path) {
-    drop_if([&](const PipeEndpoint& ep) { return ep.service_path() == path; });
+void PipeMember::close_endpoint(const std::shared_ptr<PipeEndpoint>& endpoint) {
+    MessageEntry closed = detail::member_entry(MessageEntryType::PipeClosed, endpoint->service_path(), name());
+    closed.elements.push_back(make_scalar_element<std::int32_t>("index", endpoint->index()));
+    remove(Key{endpoint->session().endpoint(), endpoint->index()}, endpoint, std::move(closed));
 }
 
 void PipeMember::handle_request(const SessionRef& session, MessageEntry&& entry, Responder responder) {
@@ -184,18 +115,7 @@ void PipeMember::handle_request(const SessionRef& session, MessageEntry&& entry,
         return;
     }
     if (entry.entry_type == MessageEntryType::PipeDisconnectReq) {
-        std::shared_ptr<PipeEndpoint> ep;
-        {
-            std::lock_guard lock(mutex_);
-            auto it = endpoints_.find(Key{session.endpoint(), *index});
-            if (it != endpoints_.end()) ep = it->second;
-        }
-        if (!ep) {
-            responder.fail(make_error(MessageErrorType::InvalidArgument, "Invalid pipe"));
-            return;
-        }
-        remove_endpoint(ep, false);
-        responder.respond(MessageEntry{});
+        disconnect(Key{session.endpoint(), *index}, responder, make_error(MessageErrorType::InvalidArgument, "Invalid pipe"));
         return;
     }
 
@@ -213,7 +133,7 @@ void PipeMember::handle_request(const SessionRef& session, MessageEntry&& entry,
         // gets one more than its highest; −1 with none gives 1. So an index in use is never refused.
         std::int32_t i = *index;
         std::optional<std::int32_t> highest;
-        for (const auto& [k, e] : endpoints_)
+        for (const auto& [k, e] : connections_)
             if (k.first == session.endpoint() && (!highest || k.second > *highest)) highest = k.second;
         if (highest && *highest >= i) {
             if (*highest == std::numeric_limits<std::int32_t>::max()) {
@@ -224,19 +144,12 @@ void PipeMember::handle_request(const SessionRef& session, MessageEntry&& entry,
         }
         if (i == -1) i = 1;
         ep.reset(new PipeEndpoint(weak_from_this(), info_, session, entry.service_path, i, unreliable));
-        endpoints_.emplace(Key{session.endpoint(), i}, ep);
+        connections_.emplace(Key{session.endpoint(), i}, ep);
         on_connect = on_connect_;
     }
-    if (on_connect) {
-        if (auto r = (*on_connect)(ep); !r) {
-            {
-                std::lock_guard lock(mutex_);
-                endpoints_.erase(Key{session.endpoint(), ep->index()});
-            }
-            ep->open_.store(false);
-            responder.fail(r.error());
-            return;
-        }
+    if (auto r = run_on_connect(on_connect, Key{session.endpoint(), ep->index()}, ep, true); !r) {
+        responder.fail(r.error());
+        return;
     }
     MessageEntry reply;
     reply.elements.push_back(make_scalar_element<std::int32_t>("index", ep->index()));
@@ -252,18 +165,14 @@ void PipeMember::handle_packet(const SessionRef& session, MessageEntry&& entry) 
         on_packet = on_packet_;
         on_ack = on_ack_;
     }
-    auto find = [&](std::int32_t index) {
-        std::lock_guard lock(mutex_);
-        auto it = endpoints_.find(Key{session.endpoint(), index});
-        return it == endpoints_.end() ? nullptr : it->second;
-    };
+    auto endpoint_at = [&](std::int32_t index) { return find(Key{session.endpoint(), index}); };
 
     if (entry.entry_type == MessageEntryType::PipePacketRet) {
         for (const auto& e : entry.elements) {
             auto index = element_index(e);
             std::uint32_t number = 0;
             if (!index || !read_scalar(e, number)) continue;
-            auto ep = find(*index);
+            auto ep = endpoint_at(*index);
             if (ep && on_ack) (*on_ack)(ep, number);
         }
         return;
@@ -274,7 +183,7 @@ void PipeMember::handle_packet(const SessionRef& session, MessageEntry&& entry) 
     for (const auto& e : entry.elements) {
         auto index = element_index(e);
         if (!index || e.type != DataTypes::dictionary_t) continue;
-        auto ep = find(*index);
+        auto ep = endpoint_at(*index);
         if (!ep) continue;
         const MessageElement* num = e.find("packetnumber");
         const MessageElement* data = e.find("packet");

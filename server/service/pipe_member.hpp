@@ -30,19 +30,18 @@
 #include <thread>
 #include <vector>
 
+#include "server/service/member_connections.hpp"
 #include "server/service/service_object.hpp"
 
 namespace rr::server {
 
 class PipeMember;
 
-class PipeEndpoint : public std::enable_shared_from_this<PipeEndpoint> {
+/// One client's end of a pipe; session(), service_path() and is_open() are MemberConnection's.
+class PipeEndpoint : public std::enable_shared_from_this<PipeEndpoint>, public detail::MemberConnection {
 public:
     std::int32_t index() const noexcept { return index_; }
-    const SessionRef& session() const noexcept { return session_; }
-    const std::string& service_path() const noexcept { return path_; }
     bool unreliable() const noexcept { return unreliable_; }
-    bool is_open() const noexcept { return open_.load(); }
 
     /// Sends one packet (packed once, checked against the pipe type) from any thread; returns its packet
     /// number. `request_ack` asks the client for a PipePacketRet (delivered to PipeMember::on_ack).
@@ -60,28 +59,24 @@ private:
 
     const std::weak_ptr<PipeMember> member_;
     const std::shared_ptr<const detail::MemberInfo> info_;
-    const SessionRef session_;
-    const std::string path_;
     const std::int32_t index_;
     const bool unreliable_;
-    std::atomic<bool> open_{true};
     std::mutex send_mutex_;  // packet numbers are assigned and queued in one step
     std::atomic<std::thread::id> send_owner_{};
     std::uint32_t send_number_ = 0;
 };
 
-class PipeMember : public std::enable_shared_from_this<PipeMember> {
+/// Endpoints by (session endpoint, pipe index). on_connect (runs before the PipeConnectRet; an error
+/// refuses the connection and is the reply), on_close, drop_session and drop_path are
+/// MemberConnections'.
+class PipeMember : public std::enable_shared_from_this<PipeMember>,
+                   public detail::MemberConnections<PipeEndpoint, std::pair<std::uint32_t, std::int32_t>> {
 public:
-    /// Runs before the PipeConnectRet; an error refuses the connection (and is the reply).
-    using ConnectHandler = std::function<Result<void>(const std::shared_ptr<PipeEndpoint>& endpoint)>;
     using PacketHandler = std::function<void(const std::shared_ptr<PipeEndpoint>& endpoint, Value packet)>;
     using AckHandler = std::function<void(const std::shared_ptr<PipeEndpoint>& endpoint, std::uint32_t packet_number)>;
-    using CloseHandler = std::function<void(const std::shared_ptr<PipeEndpoint>& endpoint)>;
 
-    void on_connect(ConnectHandler handler);
     void on_packet(PacketHandler handler);
     void on_ack(AckHandler handler);
-    void on_close(CloseHandler handler);
 
     const std::string& name() const noexcept;
     bool unreliable() const noexcept { return unreliable_; }
@@ -98,25 +93,19 @@ public:
     PipeMember(std::shared_ptr<const detail::MemberInfo> info, bool unreliable);
     void handle_request(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void handle_packet(const SessionRef& session, MessageEntry&& entry);
-    void drop_session(const SessionRef& session);
-    void drop_path(const std::string& path);
     void clear_handlers();
 
 private:
     friend class PipeEndpoint;
     using Key = std::pair<std::uint32_t, std::int32_t>;  // session endpoint, pipe index
-    void remove_endpoint(const std::shared_ptr<PipeEndpoint>& endpoint, bool notify_client);
-    void drop_if(const std::function<bool(const PipeEndpoint&)>& pred);
+    /// PipeEndpoint::close: removed, with PipeClosed to the client.
+    void close_endpoint(const std::shared_ptr<PipeEndpoint>& endpoint);
 
     const std::shared_ptr<const detail::MemberInfo> info_;
     const bool unreliable_;
     std::atomic<std::size_t> max_backlog_{1024 * 1024};
-    mutable std::mutex mutex_;
-    std::map<Key, std::shared_ptr<PipeEndpoint>> endpoints_;
-    std::shared_ptr<const ConnectHandler> on_connect_;
-    std::shared_ptr<const PacketHandler> on_packet_;
-    std::shared_ptr<const AckHandler> on_ack_;
-    std::shared_ptr<const CloseHandler> on_close_;
+    std::shared_ptr<const PacketHandler> on_packet_;  // guarded by mutex_
+    std::shared_ptr<const AckHandler> on_ack_;        // guarded by mutex_
 };
 
 }  // namespace rr::server

@@ -9,12 +9,6 @@ namespace rr::server {
 
 namespace {
 
-template <class F>
-std::shared_ptr<const F> share(F f) {
-    if (!f) return nullptr;
-    return std::make_shared<const F>(std::move(f));
-}
-
 TimeSpec add_ns(TimeSpec t, std::int64_t ns) {
     std::int64_t total = t.nanoseconds + ns;
     t.seconds += total / 1'000'000'000;
@@ -57,7 +51,7 @@ Result<void> WireConnection::set_out_value(const Value& value) {
 
 void WireConnection::close() {
     if (!open_.load()) return;
-    if (auto member = member_.lock()) member->remove(shared_from_this(), true);
+    if (auto member = member_.lock()) member->close_connection(shared_from_this());
     open_.store(false);
 }
 
@@ -69,52 +63,15 @@ WireMember::WireMember(std::shared_ptr<const detail::MemberInfo> info) : info_(s
 const std::string& WireMember::name() const noexcept { return info_->def->name; }
 robdef::MemberDirection WireMember::direction() const noexcept { return info_->def->direction(); }
 
-void WireMember::on_connect(ConnectHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_connect_ = std::move(h);
-}
+void WireMember::on_value(ValueHandler handler) { set_handler(on_value_, std::move(handler)); }
 
-void WireMember::on_value(ValueHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_value_ = std::move(h);
-}
+void WireMember::set_peek_in_handler(PeekHandler handler) { set_handler(peek_in_, std::move(handler)); }
 
-void WireMember::on_close(CloseHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    on_close_ = std::move(h);
-}
+void WireMember::set_peek_out_handler(PeekHandler handler) { set_handler(peek_out_, std::move(handler)); }
 
-void WireMember::set_peek_in_handler(PeekHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    peek_in_ = std::move(h);
-}
+void WireMember::set_poke_handler(PokeHandler handler) { set_handler(poke_, std::move(handler)); }
 
-void WireMember::set_peek_out_handler(PeekHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    peek_out_ = std::move(h);
-}
-
-void WireMember::set_poke_handler(PokeHandler handler) {
-    auto h = share(std::move(handler));
-    std::lock_guard lock(mutex_);
-    poke_ = std::move(h);
-}
-
-void WireMember::clear_handlers() {
-    std::shared_ptr<const void> a, b, c, d, e, f;
-    std::lock_guard lock(mutex_);
-    a = std::move(on_connect_);
-    b = std::move(on_value_);
-    c = std::move(on_close_);
-    d = std::move(peek_in_);
-    e = std::move(peek_out_);
-    f = std::move(poke_);
-}
+void WireMember::clear_handlers() { clear_handler_slots(on_value_, peek_in_, peek_out_, poke_); }
 
 TimeSpec WireMember::next_time() {
     TimeSpec t = wall_clock_timespec();
@@ -190,45 +147,11 @@ Result<TimedValue> WireMember::in_value() const {
     return *in_;
 }
 
-std::vector<std::shared_ptr<WireConnection>> WireMember::connections() const {
-    std::lock_guard lock(mutex_);
-    std::vector<std::shared_ptr<WireConnection>> out;
-    for (const auto& [k, c] : connections_) out.push_back(c);
-    return out;
-}
+std::vector<std::shared_ptr<WireConnection>> WireMember::connections() const { return snapshot(); }
 
-void WireMember::remove(const std::shared_ptr<WireConnection>& connection, bool notify_client) {
-    std::shared_ptr<const CloseHandler> on_close;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = connections_.find(Key{connection->session().endpoint(), connection->service_path()});
-        if (it == connections_.end() || it->second != connection) return;
-        connections_.erase(it);
-        on_close = on_close_;
-    }
-    connection->open_.store(false);
-    if (notify_client)
-        (void)connection->session().send(
-            detail::member_entry(MessageEntryType::WireClosed, connection->service_path(), name()));
-    if (on_close) (*on_close)(connection);
-}
-
-void WireMember::drop_if(const std::function<bool(const WireConnection&)>& pred) {
-    std::vector<std::shared_ptr<WireConnection>> dropped;
-    {
-        std::lock_guard lock(mutex_);
-        for (const auto& [k, c] : connections_)
-            if (pred(*c)) dropped.push_back(c);
-    }
-    for (const auto& c : dropped) remove(c, false);
-}
-
-void WireMember::drop_session(const SessionRef& session) {
-    drop_if([e = session.endpoint()](const WireConnection& c) { return c.session().endpoint() == e; });
-}
-
-void WireMember::drop_path(const std::string& path) {
-    drop_if([&](const WireConnection& c) { return c.service_path() == path; });
+void WireMember::close_connection(const std::shared_ptr<WireConnection>& connection) {
+    remove(Key{connection->session().endpoint(), connection->service_path()}, connection,
+           detail::member_entry(MessageEntryType::WireClosed, connection->service_path(), name()));
 }
 
 void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry, Responder responder) {
@@ -250,17 +173,9 @@ void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry,
                 on_connect = on_connect_;
                 if (dir != robdef::MemberDirection::writeonly) current = out_;
             }
-            if (on_connect) {
-                if (auto r = (*on_connect)(conn); !r) {
-                    if (created) {
-                        std::lock_guard lock(mutex_);
-                        auto it = connections_.find(Key{session.endpoint(), entry.service_path});
-                        if (it != connections_.end() && it->second == conn) connections_.erase(it);
-                        conn->open_.store(false);
-                    }
-                    responder.fail(r.error());
-                    return;
-                }
+            if (auto r = run_on_connect(on_connect, Key{session.endpoint(), entry.service_path}, conn, created); !r) {
+                responder.fail(r.error());
+                return;
             }
             if (current) {
                 if (auto e = pack_packet(current->value, current->time, MessageEntryType::WirePacket)) {
@@ -271,21 +186,10 @@ void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry,
             responder.respond(MessageEntry{});
             return;
         }
-        case MessageEntryType::WireDisconnectReq: {
-            std::shared_ptr<WireConnection> conn;
-            {
-                std::lock_guard lock(mutex_);
-                auto it = connections_.find(Key{session.endpoint(), entry.service_path});
-                if (it != connections_.end()) conn = it->second;
-            }
-            if (!conn) {
-                responder.fail(make_error(MessageErrorType::ServiceError, "Invalid wire connection"));
-                return;
-            }
-            remove(conn, false);
-            responder.respond(MessageEntry{});
+        case MessageEntryType::WireDisconnectReq:
+            disconnect(Key{session.endpoint(), entry.service_path}, responder,
+                       make_error(MessageErrorType::ServiceError, "Invalid wire connection"));
             return;
-        }
         case MessageEntryType::WirePeekInValueReq:
         case MessageEntryType::WirePeekOutValueReq: {
             const bool in = entry.entry_type == MessageEntryType::WirePeekInValueReq;

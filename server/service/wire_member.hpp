@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "core/value/timespec.hpp"
+#include "server/service/member_connections.hpp"
 #include "server/service/service_object.hpp"
 
 namespace rr::server {
@@ -48,11 +49,9 @@ struct TimedValue {
 /// The current wall-clock time as a TimeSpec (seconds and nanoseconds since 1970-01-01 UTC).
 TimeSpec wall_clock_timespec();
 
-class WireConnection : public std::enable_shared_from_this<WireConnection> {
+/// One client's connection of a wire; session(), service_path() and is_open() are MemberConnection's.
+class WireConnection : public std::enable_shared_from_this<WireConnection>, public detail::MemberConnection {
 public:
-    const SessionRef& session() const noexcept { return session_; }
-    const std::string& service_path() const noexcept { return path_; }
-    bool is_open() const noexcept { return open_.load(); }
     /// Last value accepted from this client, if any.
     std::optional<TimedValue> in_value() const;
     /// Sends `value` to this client only (time stamp from the wall clock). Errors: InvalidOperation
@@ -64,30 +63,26 @@ public:
 private:
     friend class WireMember;
     WireConnection(std::weak_ptr<WireMember> member, SessionRef session, std::string path)
-        : member_(std::move(member)), session_(std::move(session)), path_(std::move(path)) {}
+        : MemberConnection(std::move(session), std::move(path)), member_(std::move(member)) {}
 
     const std::weak_ptr<WireMember> member_;
-    const SessionRef session_;
-    const std::string path_;
-    std::atomic<bool> open_{true};
     mutable std::mutex mutex_;
     std::optional<TimedValue> in_;
 };
 
-class WireMember : public std::enable_shared_from_this<WireMember> {
+/// Connections by (session endpoint, service path). on_connect (runs before the WireConnectRet; an
+/// error refuses the connection and is the reply), on_close, drop_session and drop_path are
+/// MemberConnections'.
+class WireMember : public std::enable_shared_from_this<WireMember>,
+                   public detail::MemberConnections<WireConnection, std::pair<std::uint32_t, std::string>> {
 public:
-    using ConnectHandler = std::function<Result<void>(const std::shared_ptr<WireConnection>& connection)>;
     /// `connection` is null for a PokeOutValue.
     using ValueHandler =
         std::function<void(const std::shared_ptr<WireConnection>& connection, const Value& value, TimeSpec time)>;
-    using CloseHandler = std::function<void(const std::shared_ptr<WireConnection>& connection)>;
     using PeekHandler = std::function<Result<TimedValue>(const SessionRef& session)>;
     using PokeHandler = std::function<Result<void>(const SessionRef& session, Value value, TimeSpec time)>;
 
-    /// Runs before the WireConnectRet (an error refuses the connection and is the reply).
-    void on_connect(ConnectHandler handler);
     void on_value(ValueHandler handler);
-    void on_close(CloseHandler handler);
     void set_peek_in_handler(PeekHandler handler);
     void set_peek_out_handler(PeekHandler handler);
     void set_poke_handler(PokeHandler handler);
@@ -108,8 +103,6 @@ public:
     WireMember(std::shared_ptr<const detail::MemberInfo> info);
     void handle_request(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void handle_packet(const SessionRef& session, MessageEntry&& entry);
-    void drop_session(const SessionRef& session);
-    void drop_path(const std::string& path);
     void clear_handlers();
 
 private:
@@ -118,18 +111,15 @@ private:
     Result<MessageEntry> pack_packet(const Value& value, TimeSpec time, MessageEntryType type) const;
     Result<void> send_to(const WireConnection& connection, const Value& value);
     TimeSpec next_time();
-    void remove(const std::shared_ptr<WireConnection>& connection, bool notify_client);
-    void drop_if(const std::function<bool(const WireConnection&)>& pred);
+    /// WireConnection::close: removed, with WireClosed to the client.
+    void close_connection(const std::shared_ptr<WireConnection>& connection);
 
     const std::shared_ptr<const detail::MemberInfo> info_;
-    mutable std::mutex mutex_;
-    std::map<Key, std::shared_ptr<WireConnection>> connections_;
+    // Guarded by mutex_ (MemberConnections'):
     std::optional<TimedValue> out_;
     std::optional<TimedValue> in_;
     TimeSpec last_time_{};
-    std::shared_ptr<const ConnectHandler> on_connect_;
     std::shared_ptr<const ValueHandler> on_value_;
-    std::shared_ptr<const CloseHandler> on_close_;
     std::shared_ptr<const PeekHandler> peek_in_, peek_out_;
     std::shared_ptr<const PokeHandler> poke_;
 };
