@@ -13,9 +13,10 @@
 #   --print-key    print the inputs key (below) and exit
 #   --record-verified  after a from-source build (and --smoke) passed, write docker/from-source.verified:
 #                  the key of what that build's success depends on beyond the sources the package build
-#                  compiles too (docker/, packaging/, cmake/, CMakePresets.json, every CMakeLists.txt:
-#                  the Containerfile's packages, its CMake flow), and the commit. scripts/test.sh skips the
-#                  from-source build while that key is unchanged
+#                  compiles too (docker/, packaging/, cmake/, CMakePresets.json, the top CMakeLists.txt,
+#                  and what any CMakeLists.txt looks for on the system: find_package and the like, as a
+#                  new dependency must reach the Containerfile's package list), and the commit.
+#                  scripts/test.sh skips the from-source build while that key is unchanged
 #   --print-from-source-key  print that key and exit
 #   --from-build DIR  no compile: the runtime image from the Release binaries of build folder DIR
 #                  (e.g. build/package, which scripts/test.sh has built anyway), its root file system
@@ -65,8 +66,11 @@ key() {
 if [ -n "$print_key" ] && [ -z "$from_build" ]; then key; exit 0; fi
 verified=docker/from-source.verified
 from_source_key() {
-  git ls-tree -r HEAD -- docker packaging cmake CMakePresets.json $(git ls-files -- '*CMakeLists.txt') |
-    grep -v "	$verified\$" | sha256sum | cut -d' ' -f1
+  {
+    git ls-tree -r HEAD -- docker packaging cmake CMakePresets.json CMakeLists.txt | grep -v "	$verified\$"
+    # What every other CMakeLists.txt asks of the system: a new dependency must reach the Containerfile.
+    git grep -h -E 'find_package|pkg_check_modules|find_library|find_program|find_path' HEAD -- '*CMakeLists.txt' | sort
+  } | sha256sum | cut -d' ' -f1
 }
 if [ -n "$print_fs_key" ]; then from_source_key; exit 0; fi
 
