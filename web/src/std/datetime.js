@@ -64,9 +64,10 @@ export function durationText(seconds) {
   return `${sign}${(a / 86400).toFixed(1)} d`;
 }
 
-/** "3.2 s ago" for a time `ageSeconds` in the past, "in 1.0 s" for one ahead of the page's clock. */
+/** "3.2 s ago" for a time `ageSeconds` in the past, "in 1.0 s" for one ahead of the page's clock
+ * (less than half a millisecond ahead is "0 ms ago"). */
 export function ageText(ageSeconds) {
-  return ageSeconds >= 0 ? `${durationText(ageSeconds)} ago` : `in ${durationText(-ageSeconds)}`;
+  return ageSeconds > -0.0005 ? `${durationText(Math.max(ageSeconds, 0))} ago` : `in ${durationText(-ageSeconds)}`;
 }
 
 /**
