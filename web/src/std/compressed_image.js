@@ -47,7 +47,9 @@ export function checkCompressedImage(value) {
     return { ok: false, error: { code: "not_an_image", message: "not a CompressedImage: data expected" } };
   }
   const data = value.data;
-  if (!(data instanceof Uint8Array || data instanceof Uint8ClampedArray)) return { ok: false, error: { code: "bad_data", message: "data must be bytes (uint8[])" } };
+  if (!(data instanceof Uint8Array || data instanceof Uint8ClampedArray)) {
+    return { ok: false, error: { code: "bad_data", message: "data must be bytes (uint8[])" } };
+  }
   if (!data.length) return { ok: false, error: { code: "empty", message: "the compressed image has no bytes" } };
   const format = compressedFormat(data);
   if (!format) {

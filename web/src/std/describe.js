@@ -101,13 +101,15 @@ export class TypeDescriber {
     return this.describeNamed(def);
   }
 
-  /** The descriptor of member `name` of object type `objectQualified` (its type annotated as a field
-   * of the object, e.g. Camera's uint32 `capabilities` property with its flags), or null. */
+  /** The field-like descriptor { name, type, ...annotations } of member `member` ({name, type} as
+   * the client package's $members give it) of object type `objectQualified`: its type annotated as a
+   * field of the object would be, e.g. Camera's uint32 `capabilities` property with its flags. */
   describeMember(objectQualified, member) {
     const owner = this.outline?.types.get(objectQualified);
     const scope = owner?.service ?? String(objectQualified).split(".").slice(0, -1).join(".");
     const type = this.describe(member.type, scope);
-    return owner ? { name: member.name, type, ...this.annotate(owner, { name: member.name, type: member.type }) } : { name: member.name, type };
+    const annotations = owner ? this.annotate(owner, { name: member.name, type: member.type }) : {};
+    return { name: member.name, type, ...annotations };
   }
 
   describeNamed(def) {

@@ -48,7 +48,9 @@ export async function imageToBitmap(value, options = {}) {
   if (typeof ImageDataCtor !== "function") return fail("no_browser", "ImageData is not available here");
   try {
     const bitmap = await create(new ImageDataCtor(d.data, d.width, d.height));
-    return { ok: true, bitmap, width: d.width, height: d.height, encoding: d.encoding, ...(d.range !== undefined ? { range: d.range } : {}) };
+    const out = { ok: true, bitmap, width: d.width, height: d.height, encoding: d.encoding };
+    if (d.range !== undefined) out.range = d.range;
+    return out;
   } catch (e) {
     return fail("decode_failed", `the image could not be made a bitmap: ${e?.message || e}`);
   }

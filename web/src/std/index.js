@@ -10,7 +10,7 @@
 export { RendererRegistry } from "./registry.js";
 export { TypeDescriber, resolveName, findNamed, qualifyType, fieldAt } from "./describe.js";
 export { standardRegistry, standardDescriber, STANDARD_ANNOTATORS } from "./standard.js";
-export { typedText, fieldText } from "./typed_text.js";
+export { typedText, fieldText, memberText } from "./typed_text.js";
 export { decodeImage, checkImage } from "./image_decode.js";
 export { compressedFormat, checkCompressedImage, COMPRESSED_FORMATS } from "./compressed_image.js";
 export { imageToBitmap, isCompressedEncoding } from "./image_bitmap.js";

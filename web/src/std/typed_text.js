@@ -43,6 +43,12 @@ export function fieldText(owner, field, ownerDescriptor, ctx = {}, maxItems = 16
   return text;
 }
 
+/** Text of a member's value, with the member's annotations (describeMember: e.g. Camera's
+ * `capabilities` property as flag names). */
+export function memberText(value, member, ctx = {}, maxItems = 16) {
+  return fieldText({ [member.name]: value }, member, null, ctx, maxItems);
+}
+
 function itemsText(value, d, ctx, maxItems) {
   const element = d.element;
   if (value instanceof Map) {
