@@ -281,6 +281,24 @@ test("bad frames, one by one: an error result from the header, no exception, no 
   assert.match(decodeImage(narrow).error.message, /step 11 is less than a row of 4 rgb888 pixels \(12 bytes\)/);
 });
 
+test("a step in pixels (what a FLIR-style mono16 driver sends): read as rows of whole pixels, with a note", () => {
+  // mono16, 5×3, step = width = 5 (in pixels), data exactly 3 rows of 5 two-byte samples
+  const width = 5, height = 3;
+  const data = new Uint8Array(width * height * 2);
+  for (let i = 0; i < width * height; i++) { data[2 * i] = 0x11; data[2 * i + 1] = 10 * i; }
+  const v = { image_info: { width, height, step: width, encoding: E.mono16 }, data };
+  const r = decodeImage(v);
+  assert.equal(r.ok, true, r.error?.message);
+  assert.match(r.note, /step 5 read as pixels: rows of 10 bytes/);
+  for (let i = 0; i < width * height; i++) assert.equal(r.data[4 * i], 10 * i, `pixel ${i}: its high byte`);
+  // the same step with data for a real step of 5 bytes (too short for whole rows) is still refused
+  assert.equal(decodeImage({ ...v, data: data.subarray(0, 15) }).error.code, "step_too_small");
+  // one byte more than whole rows: not a step in pixels either
+  assert.equal(decodeImage({ ...v, data: new Uint8Array(31) }).error.code, "step_too_small");
+  // one-byte encodings never need it: step = width is a whole row there
+  assert.equal(decodeImage({ image_info: { width, height, step: width, encoding: E.mono8 }, data: new Uint8Array(15) }).note, undefined);
+});
+
 const JPEG = Uint8Array.of(0xff, 0xd8, 0xff, 0xe0, 0, 0x10, 0x4a, 0x46, 0x49, 0x46);
 const PNG = Uint8Array.of(0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13);
 const bytes = (s, ...more) => Uint8Array.from([...Array.from(s, (ch) => ch.charCodeAt(0)), ...more]);

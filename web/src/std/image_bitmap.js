@@ -23,7 +23,7 @@ import { encodingNames } from "./image_encodings.js";
  * @param {Function} [options.createImageBitmap]  defaults to the global one
  * @param {Function} [options.ImageData]  defaults to the global one
  * @returns {Promise<{ok: true, bitmap: ImageBitmap, width: number, height: number, encoding?: string,
- *   format?: object, range?: object} | {ok: false, error: {code: string, message: string}}>}
+ *   format?: object, range?: object, note?: string} | {ok: false, error: {code: string, message: string}}>}
  *   error codes: those of checkImage (image_decode.js) and checkCompressedImage (compressed_image.js),
  *   decode_failed (the browser could not decode the compressed bytes, e.g. a corrupt JPEG),
  *   no_browser (no createImageBitmap here)
@@ -50,6 +50,7 @@ export async function imageToBitmap(value, options = {}) {
     const bitmap = await create(new ImageDataCtor(d.data, d.width, d.height));
     const out = { ok: true, bitmap, width: d.width, height: d.height, encoding: d.encoding };
     if (d.range !== undefined) out.range = d.range;
+    if (d.note) out.note = d.note;
     return out;
   } catch (e) {
     return fail("decode_failed", `the image could not be made a bitmap: ${e?.message || e}`);

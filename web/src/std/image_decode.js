@@ -21,7 +21,9 @@ function fail(code, message) { return { ok: false, error: { code, message } }; }
  * Checks an Image value's header against its data without reading pixels.
  * @param {{image_info: {width, height, step, encoding}, data: Uint8Array}} value
  * @param {Array<{name: string, value: number}>} [encodings]  the device's ImageEncoding enum values
- * @returns {{ok: true, width, height, step, encoding: string, format: object} | {ok: false, error: {code, message}}}
+ * A step equal to the width of a multi-byte encoding, with data of exactly height rows of whole
+ * pixels, is read as a step in pixels (what some drivers send) and reported in `note`.
+ * @returns {{ok: true, width, height, step, encoding: string, format: object, note?: string} | {ok: false, error: {code, message}}}
  *   error codes: not_an_image, zero_size, unknown_encoding, not_raw (compressed, freeform, other,
  *   unknown: no pixel layout), bad_data (data not bytes), step_too_small, data_too_short
  */
@@ -49,6 +51,12 @@ export function checkImage(value, encodings) {
   if (!(data instanceof Uint8Array || data instanceof Uint8ClampedArray)) return fail("bad_data", "data must be bytes (uint8[])");
   const rowBytes = width * format.bytes;
   if (step < rowBytes) {
+    // Some drivers write the step in pixels (a FLIR-style mono16 driver sends step = width): when the
+    // data holds exactly rows of whole pixels, read them so and say so in `note`.
+    if (step === width && format.bytes > 1 && data.length === height * rowBytes) {
+      return { ok: true, width, height, step: rowBytes, encoding, format,
+        note: `step ${step} read as pixels: rows of ${rowBytes} bytes` };
+    }
     return fail("step_too_small", `step ${step} is less than a row of ${width} ${encoding} pixels (${rowBytes} bytes)`);
   }
   if (data.length < height * step) {
@@ -66,8 +74,8 @@ export function checkImage(value, encodings) {
  * @param {Uint8ClampedArray} [options.out]  a buffer to reuse when it has width·height·4 bytes
  * @param {{min: number, max: number}} [options.depthRange]  a fixed range for depth images
  * @param {{min: number, max: number}} [options.floatRange]  the range of mono_f16/f32/f64 (default 0..1)
- * @returns {{ok: true, width, height, data: Uint8ClampedArray, encoding: string, range?: {min, max}|null}
- *   | {ok: false, error: {code, message}}}  (codes of checkImage)
+ * @returns {{ok: true, width, height, data: Uint8ClampedArray, encoding: string, range?: {min, max}|null,
+ *   note?: string} | {ok: false, error: {code, message}}}  (codes of checkImage)
  */
 export function decodeImage(value, options = {}) {
   const head = checkImage(value, options.encodings);
@@ -77,6 +85,7 @@ export function decodeImage(value, options = {}) {
   const out = options.out instanceof Uint8ClampedArray && options.out.length === size ? options.out : new Uint8ClampedArray(size);
   const data = value.data;
   const result = { ok: true, width, height, data: out, encoding };
+  if (head.note) result.note = head.note;
   if (format.kind === "color") decodeColor(data, width, height, step, format, out);
   else if (format.kind === "mono") decodeMono(data, width, height, step, format, out, options.floatRange);
   else if (format.kind === "bayer") demosaicBilinear(data, width, height, step, format.pattern, out);

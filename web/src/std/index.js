@@ -1,8 +1,7 @@
 // The standard Robot Raconteur types (com.robotraconteur.*) in a page: one import for the dashboard
 // and for pages that use the client package directly. See docs/dashboard.md "Standard types".
 //
-//   import { RobdefOutline } from "../robdef_outline.js";
-//   import { standardDescriber, typedText, imageToBitmap } from "./std/index.js";
+//   import { RobdefOutline, standardDescriber, typedText, imageToBitmap } from "./std/index.js";
 //   const types = standardDescriber(new RobdefOutline(camera.$definitions));
 //   const d = types.describe("RobotState", "com.robotraconteur.robotics.robot");
 //   typedText(state, d);            // "{ts: 2024-05-01T12:00:00.25Z (0.1 s ago), ..., robot_state_flags: enabled | ready, ...}"
@@ -22,3 +21,6 @@ export { formatPose, formatTransform, formatRotation, quaternionToRpy } from "./
 export { enumName, formatEnum, flagNames, formatFlags, isFlagEnum, flagEnumFor } from "./enums.js";
 export { siUnitText, unitsOf, unitsFieldFor } from "./units.js";
 export { plotRole, leaveOutOfPlot, typedNumericFields, sensorTimestamp } from "./plot_fields.js";
+export { deviceInfoRows } from "./device_info.js";
+export { FrameDecoder } from "./frame_decoder.js";
+export { RobdefOutline } from "../robdef_outline.js";

@@ -11,10 +11,11 @@ import { renderers as datetime } from "./datetime.js";
 import { renderers as geometry } from "./geometry.js";
 import { renderers as units } from "./units.js";
 import { renderers as image } from "./image_renderers.js";
+import { renderers as deviceInfo } from "./device_info.js";
 
 /** A new registry holding the standard renderers (add your own with register()). */
 export function standardRegistry() {
-  return new RendererRegistry().register(uuid, identifier, datetime, geometry, units, image);
+  return new RendererRegistry().register(uuid, identifier, datetime, geometry, units, image, deviceInfo);
 }
 
 /** The field annotators of the standard types: flag enums, units. */
