@@ -8,22 +8,10 @@
 import { h } from "../dom.js";
 import { formatValue } from "../value_codec.js";
 import { asImage, drawImage } from "../image_view.js";
-import { numericFields } from "../numeric_fields.js";
-import { decodeKnown } from "../packet_layouts.js";
 import { LivePlot } from "../live_plot.js";
 import { typedText } from "../std/typed_text.js";
-import { typedNumericFields, sensorTimestamp } from "../std/plot_fields.js";
+import { plotSample } from "../views/plot_sample.js";
 import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
-
-/** The numbers of `value` to plot ([[name, number, hidden?], ...]) and its own time (seconds) or null. */
-export function plotSample(value, d, qualifiedType) {
-  const known = decodeKnown(qualifiedType, value);
-  if (known) return { pairs: known, t: null };
-  if (!d || d.kind === "unknown" || d.kind === "object") return { pairs: numericFields(value, null), t: null };
-  let t = null;
-  try { t = sensorTimestamp(value, d)?.seconds ?? null; } catch { t = null; }
-  return { pairs: typedNumericFields(value, d), t };
-}
 
 export class StreamDisplay {
   /**
