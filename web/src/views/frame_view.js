@@ -8,7 +8,7 @@
 // newer good frame comes.
 //
 // For tests and tools the figure carries data-received, data-drawn, data-errors, data-error-code,
-// data-width, data-height, data-encoding and data-dropped.
+// data-width, data-height, data-encoding, data-dropped and data-age-ms.
 
 import { h } from "../dom.js";
 import { FrameDecoder } from "../std/frame_decoder.js";
@@ -151,7 +151,9 @@ export class FrameView {
       if (l.range) parts.push(`depth ${fmt(l.range.min)}–${fmt(l.range.max)}`);
       parts.push(`${this.rate().toFixed(1)} fps`);
       if (l.ts) {
-        parts.push(l.ts.comparable ? ageWords(Date.now() / 1000 - l.ts.seconds) : "age unknown (device clock)");
+        const age = Date.now() / 1000 - l.ts.seconds;
+        parts.push(l.ts.comparable ? ageWords(age) : "age unknown (device clock)");
+        if (l.ts.comparable) this.el.dataset.ageMs = String(Math.round(age * 1000));
       }
       if (l.note) parts.push(l.note);
     }
