@@ -44,8 +44,9 @@ export function propertyView(ctx, member, _ObjectPanel, described = null) {
       const v = await prop.get();
       if (disposed) return undefined;
       const text = wantsText ? editorText(member.type, v) : "";  // before the pictures' bytes go to their decoder
-      plot?.push(plotPairs(v));
+      const pairs = plot ? plotPairs(v) : null;
       show(v, text);
+      if (pairs) plot?.push(pairs);
       out.dataset.reads = String(++reads);
       card.clearError();
       return { v, text };

@@ -133,12 +133,12 @@ export class FrameView {
     this.updateStatus();
   }
 
-  /** Frames drawn per second over the last two seconds. */
+  /** Frames drawn per second over the last two seconds: 0 when none, null when one (no rate yet). */
   rate() {
     const now = performance.now();
     const recent = this.drawTimes.filter((t) => t >= now - RATE_WINDOW_MS);
-    if (recent.length < 2) return recent.length ? 0.5 : 0;
-    return (recent.length - 1) * 1000 / Math.max(1, recent[recent.length - 1] - recent[0]);
+    if (recent.length < 2) return recent.length ? null : 0;
+    return (recent.length - 1) * 1000 / Math.max(1, now - recent[0]);
   }
 
   updateStatus() {
@@ -149,7 +149,8 @@ export class FrameView {
     } else {
       parts.push(`${l.width}×${l.height} ${l.what}`.trim());
       if (l.range) parts.push(`depth ${fmt(l.range.min)}–${fmt(l.range.max)}`);
-      parts.push(`${this.rate().toFixed(1)} fps`);
+      const rate = this.rate();
+      if (rate !== null) parts.push(`${rate.toFixed(1)} fps`);
       if (l.ts) {
         const age = Date.now() / 1000 - l.ts.seconds;
         parts.push(l.ts.comparable ? ageWords(age) : "age unknown (device clock)");
