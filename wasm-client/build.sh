@@ -39,7 +39,7 @@ copy_if_changed "$here/README.md" "$dist/README.md"
 web="$root/web/src"
 mkdir -p "$dist/dashboard/std"
 for f in rr_types.js value_codec.js robdef_outline.js; do copy_if_changed "$web/$f" "$dist/dashboard/$f"; done
-for f in "$web"/std/*.js; do copy_if_changed "$f" "$dist/dashboard/std/$(basename "$f")"; done
+for f in "$web"/std/*.js "$web"/std/index.d.ts; do copy_if_changed "$f" "$dist/dashboard/std/$(basename "$f")"; done
 for f in "$dist"/dashboard/std/*.js; do [ -f "$web/std/$(basename "$f")" ] || rm -f "$f"; done
 copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
 echo "wasm-client: package in $dist"
