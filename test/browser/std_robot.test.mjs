@@ -1,8 +1,8 @@
 // A robot on the official abstract robot base (PyPI robotraconteur-abstract-robot) behind rr-gateway,
 // in headless Chromium (issue 41): test/browser/devices/sim_robot.py, a simulated three-joint arm
 // whose RobotInfo comes from an info file through the companion library's InfoFileLoader. The page
-// shows its device card, robot_state_flags by name (enable() from the page turns "none" into
-// "enabled | ready"), UUIDs as 8-4-4-4-12 text, times as dates, enums by name, capabilities by flag
+// shows its device card and robot panel, robot_state_flags by name (Enable in the panel turns "none"
+// into "enabled | ready"), the joints named from the RobotInfo, UUIDs as 8-4-4-4-12 text, times as dates, enums by name, capabilities by flag
 // name; its plots have no series for UUID bytes or clock fields. Screenshots go to $RR_ARTIFACTS
 // (docs/img with RR_DOCS_SCREENSHOTS=1).
 
@@ -58,12 +58,21 @@ test("device card: name, UUID as text, manufacturer, model, serial, implemented 
   assert.equal(await view().locator('[data-panel="camera"]').count(), 0);
 });
 
-test("flags by name: enable() from the page turns 'none' into 'enabled | ready'", async () => {
+test("flags by name: Enable in the robot panel turns 'none' into 'enabled | ready'", async () => {
   const text = () => card("robot_state").locator(".stream output.value").textContent();
+  const robotPanel = view().locator('[data-panel="robot"]');
   await waitFor(async () => /robot_state_flags: /.test(await text()), "robot_state shown");
   assert.match(await text(), /robot_state_flags: none[,}]/);
-  await card("enable").locator("button", { hasText: /^Call$/ }).click();
+  await waitFor(async () => (await robotPanel.getAttribute("data-flags")) === "none", "the panel's flags");
+  await robotPanel.locator('button[data-action="enable"]').click();
   await waitFor(async () => /robot_state_flags: enabled \| ready[,}]/.test(await text()), "enabled | ready", 15000);
+  await waitFor(async () => (await robotPanel.getAttribute("data-flags")) === "enabled | ready", "the panel's flags enabled | ready");
+  assert.equal(await robotPanel.locator('dd[data-row="controller_state"]').textContent(), "motor_on");
+  assert.match(await robotPanel.locator('dd[data-row="ts"]').textContent(), ISO);
+  assert.deepEqual(await robotPanel.locator("table.robot-joints tbody tr").evaluateAll((rows) => rows.map((r) => r.dataset.joint)),
+    robot.info.joint_names);
+  assert.match(await robotPanel.locator('tr[data-joint="shoulder"]').textContent(), /shoulder0\.0000 rad/);
+  assert.equal(await robotPanel.locator(".robot-tool").textContent(), "tool: position (0.7, 0, 0.3) m, rpy (0, 0, 0)°");
   const t = await text();
   assert.match(t, new RegExp(`^\\{ts: ${ISO.source} \\([\\d.]+ m?s ago\\), seqno: \\d+, command_mode: [a-z_]+, operational_mode: [a-z_]+, controller_state: motor_on,`));
   assert.match(t, /kin_chain_tcp: \[position \(0\.7, 0, 0\.3\) m, rpy \(0, 0, 0\)°\]/);
