@@ -128,8 +128,8 @@ test("bad frames, one by one: what is wrong is shown, the last good frame stays,
 });
 
 test("pictures in a property, a function result and a map of images", async () => {
-  const good = await showGood("rgb888");
   const mono = await send("mono8");
+  const good = await showGood("rgb888");  // the service's last raw frame (still, capture, capture_pair[0])
   // property: read (again) after the frame was set
   const still = card("still");
   const reads = await num(still.locator("output.value"), "data-reads");
