@@ -335,6 +335,10 @@ TEST_CASE("gateway: with gateway.auth the demo node requires a login only the ga
         INFO(name);
         CHECK((*gw)->demo_node()->find_service(name)->requires_authentication());
     }
+    // GET /api/features needs no login (the dashboard asks it first) and says logins are on.
+    auto features = gateway_http_get((*gw)->port(), "/api/features");
+    CHECK(features.result() == bhttp::status::ok);
+    CHECK(features.body() == "{\"auth\":true,\"discovery\":true}\n");  // JSON answers end with a newline
     CHECK_FALSE((*gw)->demo_discovery());  // the demo node stays quiet while logins are on
 
     client::IoThreads io(1);

@@ -182,6 +182,9 @@ def main():
         res = find(net, args.python, official_py, call=False)
         if any(s["nodename"] == NAME for s in res["services"]) or res["nodes"] or res["nodes2"]:
             raise Failed("--no-discovery: the official client still found the gateway: %s" % res)
+        features = json.loads(http(net, args.python, "http://127.0.0.1:8080/api/features")["body"])
+        if features != {"discovery": False, "auth": False}:
+            raise Failed("--no-discovery: /api/features %r" % features)
         log("--no-discovery: not found: ok")
         stop(gw)
 
