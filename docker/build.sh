@@ -20,7 +20,8 @@
 #   --print-from-source-key  print that key and exit
 #   --from-build DIR  no compile: the runtime image from the Release binaries of build folder DIR
 #                  (e.g. build/package, which scripts/test.sh has built anyway), its root file system
-#                  gathered here by docker/rootfs.sh (Containerfile ROOTFS=prebuilt). This host's
+#                  gathered here by docker/rootfs.sh and given as the build context named
+#                  "build", which replaces the Containerfile's build stage. This host's
 #                  libraries go into the image, so DIR must come from a Debian 12 host like the base
 #                  image's. Label rr.inputs=prebuilt-<sha256 of the root file system>
 #
@@ -112,7 +113,7 @@ if [ -n "$from_build" ]; then
   sh docker/rootfs.sh "$from_build" . "$ctx/rootfs/out" >/dev/null
   k=prebuilt-$( (cd "$ctx/rootfs" && find . -type f -print0 | sort -z | xargs -0 sha256sum) | sha256sum | cut -d' ' -f1)
   if [ -n "$print_key" ]; then echo "$k"; exit 0; fi
-  build_image --pull=never --build-arg ROOTFS=prebuilt --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
+  build_image --pull=never --build-context "build=$ctx/rootfs" --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
   echo "build: from $from_build, no compile"
 else
   pull=(--pull=never)
