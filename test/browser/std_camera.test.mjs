@@ -88,6 +88,11 @@ test("start streaming from the panel: preview, raw and compressed streams show t
   const state = panel().locator("output.camera-state");
   await waitFor(async () => /\bstreaming\b/.test((await state.getAttribute("data-flags")) || ""), "camera_state streaming", 15000);
   assert.match(await state.getAttribute("data-flags"), /^ready \| streaming$/);
+  // the camera_state card below shares the panel's wire connection (one per wire): its value, no error
+  const stateCard = view().locator('.member[data-member="camera_state"]');
+  await waitFor(async () => /state_flags: ready \| streaming[,}]/.test(await stateCard.locator(".stream output.value").textContent()),
+    "the camera_state card's value");
+  assert.ok(await stateCard.locator(".member-error").isHidden(), `camera_state card: ${await stateCard.locator(".member-error").textContent()}`);
 
   // preview_stream: JPEG quality 70
   const preview = await framesMatch(live(), 3, 8, "preview");

@@ -18,8 +18,9 @@ const pageErrors = [];
 
 const card = (name) => page.locator(`.member[data-member="${name}"]`).first();
 const frameOf = (name) => card(name).locator(".frame-view").first();
-const attr = async (loc, name) => (await loc.getAttribute(name)) ?? "";
-const num = async (loc, name) => Number((await loc.getAttribute(name)) || 0);
+// a wire's picture appears with its first frame: before it, no attribute ("" and 0)
+const attr = async (loc, name) => ((await loc.count()) ? (await loc.getAttribute(name)) ?? "" : "");
+const num = async (loc, name) => Number((await attr(loc, name)) || 0);
 
 /** Sends a case to the service (stdin) and resolves with its answer (reference picture and all). */
 async function send(name) {

@@ -63,6 +63,8 @@ test("flags by name: Enable in the robot panel turns 'none' into 'enabled | read
   const robotPanel = view().locator('[data-panel="robot"]');
   await waitFor(async () => /robot_state_flags: /.test(await text()), "robot_state shown");
   assert.match(await text(), /robot_state_flags: none[,}]/);
+  // the robot panel and the robot_state card share one wire connection: no error on either
+  assert.ok(await card("robot_state").locator(".member-error").isHidden(), await card("robot_state").locator(".member-error").textContent());
   await waitFor(async () => (await robotPanel.getAttribute("data-flags")) === "none", "the panel's flags");
   await robotPanel.locator('button[data-action="enable"]').click();
   await waitFor(async () => /robot_state_flags: enabled \| ready[,}]/.test(await text()), "enabled | ready", 15000);

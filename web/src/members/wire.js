@@ -1,6 +1,7 @@
 // A wire: connected while the device page is open (readonly and read-write wires), newest in-value
 // shown and plotted; writable wires get an out-value editor. Peek reads the value without connecting.
-// A wire connection that closes while the page is open is connected again after REOPEN_MS.
+// A wire connection that closes while the page is open is connected again after REOPEN_MS. The
+// connection is shared with the panels that show the same wire (views/shared_wire.js).
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
@@ -8,6 +9,7 @@ import { formatValue, parseInput } from "../value_codec.js";
 import { parseType } from "../rr_types.js";
 import { memberText } from "../std/typed_text.js";
 import { StreamDisplay } from "./stream_display.js";
+import { connectShared } from "../views/shared_wire.js";
 
 const REOPEN_MS = 2000;
 
@@ -19,7 +21,7 @@ export function wireView(ctx, member, _ObjectPanel, described = null) {
 
   async function open() {
     try {
-      conn = await wire.connect();
+      conn = await connectShared(ctx.obj, member.name);
       if (disposed) { await conn.close(); return; }
       card.clearError();
       display ??= new StreamDisplay(card.body, { qualifiedType: qualified, type: described?.type, view: ctx.view, label: member.name });

@@ -10,6 +10,7 @@ import { describeMember } from "../views/context.js";
 import { FrameView } from "../views/frame_view.js";
 import { imageKind } from "../views/image_set.js";
 import { PictureStream } from "../views/picture_stream.js";
+import { followWire } from "../views/shared_wire.js";
 import { typedText, fieldText, memberText } from "../std/typed_text.js";
 
 export const CAMERA = "com.robotraconteur.imaging.Camera";
@@ -105,17 +106,19 @@ export function createCameraPanel(parent, ctx) {
   const stateDesc = described(stateMember)?.type;
   const flagsField = stateDesc?.fields?.find((f) => f.name === "state_flags");
   if (stateMember && !stateMember.writeonly) {
-    let conn = null;
-    obj[stateMember.name].connect().then((c) => {
-      if (disposed) { c.close().catch(() => {}); return; }
-      conn = c;
-      c.onChange((v) => {
+    // shared with the camera_state card below (one connection per wire), reconnected after a close
+    const follow = followWire(obj, stateMember.name, {
+      onValue: (v) => {
         const text = flagsField ? fieldText(v, flagsField, stateDesc, view?.text) : typedText(v, stateDesc, view?.text);
         state.textContent = `state: ${text}`;
         state.dataset.flags = text;
-      });
-    }).catch(fail("camera_state"));
-    disposers.push(() => conn?.close().catch(() => {}));
+      },
+      onError: (e) => {
+        if (e) fail("camera_state")(e);
+        else if (!disposed && error.textContent.startsWith("camera_state:")) showError(null);
+      },
+    });
+    disposers.push(() => follow.dispose());
   }
 
   // readable information: capabilities, camera_info, param_info

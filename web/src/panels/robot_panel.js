@@ -9,6 +9,7 @@ import { h, errorText } from "../dom.js";
 import { describeMember } from "../views/context.js";
 import { fieldText, typedText } from "../std/typed_text.js";
 import { formatPose } from "../std/geometry.js";
+import { followWire } from "../views/shared_wire.js";
 
 export const ROBOT = "com.robotraconteur.robotics.robot.Robot";
 const UNITS = { radian: "rad", degree: "°", meter: "m" };
@@ -75,7 +76,7 @@ export function createRobotPanel(parent, ctx) {
 
   const stateMember = find("robot_state", "wire");
   const stateType = described(stateMember)?.type;
-  let conn = null, latest = null, frame = 0;
+  let follow = null, latest = null, frame = 0;
   const field = (name) => stateType?.fields?.find((f) => f.name === name);
   function draw() {
     frame = 0;
@@ -94,12 +95,16 @@ export function createRobotPanel(parent, ctx) {
       `${tcp.length > 1 ? `tool ${i}` : "tool"}: ${formatPose(p) ?? typedText(p, null)}`)));
     el.dataset.flags = rows.find(([, , key]) => key === "robot_state_flags")?.[1] ?? "";
   }
-  if (stateMember && stateType?.fields) {
-    obj.robot_state.connect().then((c) => {
-      if (disposed) { c.close().catch(() => {}); return; }
-      conn = c;
-      c.onChange((v) => { latest = v; if (!frame) frame = requestAnimationFrame(draw); });
-    }).catch((e) => { if (!disposed) showError(`robot_state: ${errorText(e)}`); });
+  if (stateMember && stateType?.fields && !stateMember.writeonly) {
+    // shared with the robot_state card below (one connection per wire), reconnected after a close
+    follow = followWire(obj, stateMember.name, {
+      onValue: (v) => { latest = v; if (!frame) frame = requestAnimationFrame(draw); },
+      onError: (e) => {
+        if (disposed) return;
+        if (e) showError(`robot_state: ${errorText(e)}`);
+        else if (error.textContent.startsWith("robot_state:")) showError(null);
+      },
+    });
   }
 
   return {
@@ -107,7 +112,7 @@ export function createRobotPanel(parent, ctx) {
     dispose() {
       disposed = true;
       if (frame) cancelAnimationFrame(frame);
-      conn?.close().catch(() => {});
+      follow?.dispose();
       el.remove();
     },
   };
