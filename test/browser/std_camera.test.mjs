@@ -80,7 +80,9 @@ test("camera panel: capabilities, camera_info and param_info readable", async ()
   assert.match(await dd("calibration.K").textContent(), /300/);
   const params = panel().locator("table.param-info tbody tr");
   await waitFor(async () => (await params.count()) === 6, "six parameters");
-  assert.match(await panel().locator('tr[data-param="focus"]').textContent(), /focus.*CAP_PROP_FOCUS/);
+  // parameter, its DataType as type text, description
+  assert.deepEqual(await panel().locator('tr[data-param="focus"] td').allTextContents(),
+    ["focus", "double", "Focus of the camera (CAP_PROP_FOCUS property)"]);
 });
 
 test("start streaming from the panel: preview, raw and compressed streams show the frames sent", async () => {

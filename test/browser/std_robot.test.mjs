@@ -78,6 +78,10 @@ test("flags by name: Enable in the robot panel turns 'none' into 'enabled | read
   const t = await text();
   assert.match(t, new RegExp(`^\\{ts: ${ISO.source} \\([\\d.]+ m?s ago\\), seqno: \\d+, command_mode: [a-z_]+, operational_mode: [a-z_]+, controller_state: motor_on,`));
   assert.match(t, /kin_chain_tcp: \[position \(0\.7, 0, 0\.3\) m, rpy \(0, 0, 0\)°\]/);
+  // advanced_robot_state: the units codes by name (uint8[] of JointPositionUnits), and as units of the positions
+  const adv = card("advanced_robot_state").locator(".stream output.value");
+  await waitFor(async () => /joint_position_units: /.test(await adv.textContent()), "advanced_robot_state shown");
+  assert.match(await adv.textContent(), /joint_position: \[[-\d., ]+\] radian, .*joint_position_units: \[radian, radian, radian\]/);
   // enums by name in properties; capabilities by flag name in robot_info; joint UUIDs as text
   await waitFor(async () => /^[a-z_]+$/.test(await card("command_mode").locator("output.value").textContent()), "command_mode by name");
   const info = card("robot_info").locator("output.value");

@@ -9,6 +9,8 @@ import { formatTime, formatDuration, timeParts, isoTime, ageText, timeSeconds } 
 import { quaternionToRpy, formatPose, formatTransform, formatRotation } from "../src/std/geometry.js";
 import { enumName, formatEnum, flagNames, formatFlags, isFlagEnum } from "../src/std/enums.js";
 import { siUnitText, unitsOf, unitsFieldFor } from "../src/std/units.js";
+import { standardDescriber } from "../src/std/standard.js";
+import { typedText } from "../src/std/typed_text.js";
 import { standardDefinitions, SKIP_REASON } from "./std_fixtures.mjs";
 
 const seq = Uint8Array.from({ length: 16 }, (_, i) => i);
@@ -160,4 +162,25 @@ test("units: SIUnit display text; the sibling field that names a field's units",
   const codes = { joint_position: Float64Array.of(1), joint_position_units: Uint8Array.of(2) };
   assert.deepEqual(unitsOf(codes, { name: "joint_position", units: { field: "joint_position_units", enumValues: [{ name: "radian", value: 2 }] } }), ["radian"]);
   assert.equal(unitsOf({ data: [1], data_units: [] }, { name: "data", units: { field: "data_units" } }), null);
+});
+
+test("DataType as the type text it stands for, with the device's enum numbers", (t) => {
+  const defs = standardDefinitions();
+  if (!defs) return t.skip(SKIP_REASON);
+  const d = standardDescriber(new RobdefOutline(defs)).describe("DataType", "com.robotraconteur.datatype");
+  assert.ok(d.renderer, d.mismatch);
+  // DataTypeCode: double_c 1, uint8_c 4, string_c 11, structure_c 101; ArrayTypeCode: array_c 1,
+  // multidimarray_c 2; ContainerTypeCode: list_c 1, map_string_c 3 (numbers of the standard definition)
+  const dt = (o) => typedText({ name: "", type_string: "", array_var_len: false, array_len: new Uint32Array(0),
+    array_type_code: 0, container_type_code: 0, ...o }, d);
+  assert.equal(dt({ type_code: 1 }), "double");
+  assert.equal(dt({ type_code: 1, name: "focus" }), "double focus");
+  assert.equal(dt({ type_code: 4, array_type_code: 1, array_var_len: true }), "uint8[]");
+  assert.equal(dt({ type_code: 4, array_type_code: 1, array_len: Uint32Array.of(3) }), "uint8[3]");
+  assert.equal(dt({ type_code: 4, array_type_code: 1, array_var_len: true, array_len: Uint32Array.of(8) }), "uint8[8-]");
+  assert.equal(dt({ type_code: 1, array_type_code: 2, array_len: Uint32Array.of(2, 3) }), "double[2,3]");
+  assert.equal(dt({ type_code: 1, array_type_code: 2, array_var_len: true }), "double[*]");
+  assert.equal(dt({ type_code: 11, container_type_code: 1 }), "string{list}");
+  assert.equal(dt({ type_code: 101, type_string: "com.robotraconteur.geometry.Pose", container_type_code: 3 }),
+    "com.robotraconteur.geometry.Pose{string}");
 });

@@ -206,6 +206,13 @@ test("a robot state reads as text: time, enums by name, flags by name, poses", (
   const adv = standardDescriber(outline).describe("AdvancedRobotState", R);
   const state = { ...robotState(now), joint_position_units: Uint8Array.of(2, 3), joint_effort_units: new Uint8Array(0) };
   assert.match(typedText(state, adv, { now }), /joint_position: \[0\.1, -0\.2\] \(radian, degree\)/);
+  // the codes themselves by name too (uint8[] of JointPositionUnits values), an unknown code said so
+  assert.match(typedText(state, adv, { now }), /joint_position_units: \[radian, degree\], joint_effort_units: \[\],/);
+  const odd = { ...state, joint_position_units: Uint8Array.of(1, 99) };
+  assert.match(typedText(odd, adv, { now }), /joint_position_units: \[meter, 99 \(not a value of the enum\)\]/);
+  // RobotJointCommand's `units` names no enum of its own: plain numbers
+  const cmd = standardDescriber(outline).describe("RobotJointCommand", R);
+  assert.match(typedText({ seqno: 1, state_seqno: 2, command: Float64Array.of(0), units: Uint8Array.of(2) }, cmd), /units: \[2\]\}$/);
 });
 
 test("plots leave out identifiers, UUIDs, byte arrays and clock fields; flags and sequence numbers start hidden", (t) => {

@@ -85,3 +85,28 @@ export function flagAnnotator(owner, field, outline) {
   const flags = flagEnumFor(outline, owner, field);
   return flags ? { flags } : null;
 }
+
+/**
+ * The enum values of integer code field `field` of `owner`, for fields that hold enum values without
+ * being typed as the enum: AdvancedRobotState's `uint8[] joint_position_units` holds
+ * JointPositionUnits values, `joint_effort_units` JointEffortUnits ones. Found as flag enums are (the
+ * field name in CamelCase); only for names ending in `_units` and for enums that are not flags.
+ */
+export function codeEnumFor(outline, owner, field) {
+  const name = field?.name || "";
+  if (!/_units$/.test(name) || !/^u?int(8|16|32|64)(\[\])?$/.test(String(field.type).replace(/\s+/g, ""))) return null;
+  const t = findNamed(outline, camel(name), owner?.service);
+  return t?.kind === "enum" && !isFlagEnum(t.values) ? t.values : null;
+}
+
+/** Field annotator for TypeDescriber: { codes: enum values } on integer fields holding enum codes. */
+export function codeAnnotator(owner, field, outline) {
+  const codes = codeEnumFor(outline, owner, field);
+  return codes ? { codes } : null;
+}
+
+/** "radian" for one code, "[radian, radian, meter]" for an array of codes. */
+export function formatCodes(values, v) {
+  if (typeof v === "number" || typeof v === "bigint") return formatEnum(values, v);
+  return `[${Array.from(v, (x) => formatEnum(values, x)).join(", ")}]`;
+}

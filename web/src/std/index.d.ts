@@ -172,6 +172,10 @@ export function isFlagEnum(values: EnumValue[] | null | undefined): boolean;
 export function flagNames(values: EnumValue[] | null | undefined, n: unknown): string[];
 export function formatFlags(values: EnumValue[] | null | undefined, n: unknown): string;
 export function flagEnumFor(outline: RobdefOutline, owner: OutlineEntry, field: { name: string; type: string }): EnumValue[] | null;
+/** Enum values of an integer field that holds enum codes (AdvancedRobotState's joint_position_units → JointPositionUnits). */
+export function codeEnumFor(outline: RobdefOutline, owner: OutlineEntry, field: { name: string; type: string }): EnumValue[] | null;
+/** "radian" for one code, "[radian, meter]" for an array of codes. */
+export function formatCodes(values: EnumValue[] | null | undefined, v: number | bigint | ArrayLike<number>): string;
 export function siUnitText(unit: unknown): string | null;
 export function unitsOf(owner: unknown, field: FieldDescriptor, siblingField?: FieldDescriptor): string[] | null;
 export function unitsFieldFor(owner: OutlineEntry, name: string): string | null;
@@ -180,3 +184,5 @@ export function leaveOutOfPlot(field: FieldDescriptor): boolean;
 export function typedNumericFields(value: unknown, d: TypeDescriptor | null | undefined, prefix?: string): Array<[string, number, boolean]>;
 export function sensorTimestamp(value: unknown, d: TypeDescriptor | null | undefined): { seconds: number; path: string; type: string } | null;
 export function deviceInfoRows(info: unknown, extraTypes?: string[]): Array<{ key: string; label: string; text: string }>;
+/** The robdef type text a com.robotraconteur.datatype.DataType value stands for ("double[3]", "string{list}"); `descriptor` gives the device's enum values. */
+export function formatDataType(value: unknown, descriptor?: TypeDescriptor | null): string | null;

@@ -1,11 +1,11 @@
 // Readable one-line text of a value typed by its descriptor (describe.js): registered renderers'
 // text (UUIDs, identifiers, times, poses, images, ...), enums by name, flag fields by the names of
-// their set flags, units after numbers whose structure names them; everything else as the generic
+// their set flags, enum codes in integer fields by name, units after numbers whose structure names them; everything else as the generic
 // view writes it (value_codec.js formatValue). Never throws: a renderer that fails gives the
 // generic text.
 
 import { formatValue } from "../value_codec.js";
-import { formatEnum, formatFlags } from "./enums.js";
+import { formatEnum, formatFlags, formatCodes } from "./enums.js";
 import { unitsOf } from "./units.js";
 
 /**
@@ -34,6 +34,9 @@ export function fieldText(owner, field, ownerDescriptor, ctx = {}, maxItems = 16
   const v = owner?.[field.name];
   let text;
   if (field.flags && (typeof v === "number" || typeof v === "bigint")) text = formatFlags(field.flags, v);
+  else if (field.codes && (typeof v === "number" || typeof v === "bigint" || ArrayBuffer.isView(v) || Array.isArray(v))) {
+    text = formatCodes(field.codes, v);
+  }
   else text = typedText(v, field.type, ctx, maxItems);
   if (field.units) {
     const sibling = ownerDescriptor?.fields?.find((f) => f.name === field.units.field);
