@@ -44,7 +44,7 @@ try {
   console.log(`[bench] camera ${width}×${height} at ${fps} fps, ${stream}, ${tabs} tabs, ${seconds} s`);
   camera = await startDevice("camera_synthetic.py", ["--camera-info", path.join(DEVICES, "synthetic_camera_info.yml"),
     "--width", String(width), "--height", String(height), "--fps", String(fps), "--max-lifetime", String(seconds + 180)]);
-  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-demo"]);
+  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-demo", "--no-discovery"]);
   await waitFor(async () => (await apiDevices(gateway.base)).find((d) => d.name === "camera")?.state === "connected", "camera connected", 30000);
   browser = await launchChromium();
   const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });

@@ -36,7 +36,7 @@ before(async () => {
   camera = await startDevice("camera_synthetic.py",
     ["--camera-info", path.join(DEVICES, "synthetic_camera_info.yml"), "--width", "320", "--height", "240", "--fps", "15",
       "--max-lifetime", "240"]);
-  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-demo"]);
+  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-demo", "--no-discovery"]);
   await waitFor(async () => (await apiDevices(gateway.base)).find((d) => d.name === "camera")?.state === "connected",
     "camera connected", 30000);
   browser = await launchChromium();
@@ -47,7 +47,7 @@ before(async () => {
 });
 
 after(async () => {
-  if (page) await screenshot(page, "std-camera-end.png").catch(() => {});
+  if (page) await screenshot(page, "std-camera-end.png", { docs: false }).catch(() => {});
   await browser?.close();
   await gateway?.child.stop();
   await camera?.child.stop();

@@ -54,7 +54,7 @@ async function assertPicture(fig, a, what) {
 before(async () => {
   assert.ok(s.gateway, "RR_GATEWAY must be set");
   service = await startDevice("image_service.py", ["--max-lifetime", "240"], { stdin: "pipe" });
-  gateway = await startGateway(s, { images: service.info.url }, 0, ["--no-demo"]);
+  gateway = await startGateway(s, { images: service.info.url }, 0, ["--no-demo", "--no-discovery"]);
   await waitFor(async () => (await apiDevices(gateway.base)).find((d) => d.name === "images")?.state === "connected",
     "images connected", 30000);
   browser = await launchChromium();
@@ -66,7 +66,7 @@ before(async () => {
 });
 
 after(async () => {
-  if (page) await screenshot(page, "std-images-end.png").catch(() => {});
+  if (page) await screenshot(page, "std-images-end.png", { docs: false }).catch(() => {});
   await browser?.close();
   await gateway?.child.stop();
   service?.child.proc.stdin.end();

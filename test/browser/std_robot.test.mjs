@@ -26,7 +26,7 @@ const seriesOf = (c) => c.locator(".plot-readout .readout-item").evaluateAll((el
 before(async () => {
   assert.ok(s.gateway, "RR_GATEWAY must be set");
   robot = await startDevice("sim_robot.py", ["--max-lifetime", "240"]);
-  gateway = await startGateway(s, { robot: robot.info.url }, 0, ["--no-demo"]);
+  gateway = await startGateway(s, { robot: robot.info.url }, 0, ["--no-demo", "--no-discovery"]);
   await waitFor(async () => (await apiDevices(gateway.base)).find((d) => d.name === "robot")?.state === "connected",
     "robot connected", 30000);
   browser = await launchChromium();
@@ -37,7 +37,7 @@ before(async () => {
 });
 
 after(async () => {
-  if (page) await screenshot(page, "std-robot-end.png").catch(() => {});
+  if (page) await screenshot(page, "std-robot-end.png", { docs: false }).catch(() => {});
   await browser?.close();
   await gateway?.child.stop();
   await robot?.child.stop();

@@ -16,13 +16,13 @@ export function startDevice(script, args = [], options = {}) {
 
 /**
  * A screenshot of `target` (a page or locator) to $RR_ARTIFACTS/<name>; with RR_DOCS_SCREENSHOTS=1
- * also to docs/img/<name> (the pictures of docs/dashboard.md).
+ * also to docs/img/<name> (the pictures of docs/dashboard.md), unless `docs` is false.
  */
-export async function screenshot(target, name, options = {}) {
+export async function screenshot(target, name, { docs = true, ...options } = {}) {
   const s = settings();
   fs.mkdirSync(s.artifacts, { recursive: true });
   await target.screenshot({ path: path.join(s.artifacts, name), ...options });
-  if (process.env.RR_DOCS_SCREENSHOTS === "1") {
+  if (docs && process.env.RR_DOCS_SCREENSHOTS === "1") {
     fs.mkdirSync(path.join(ROOT, "docs/img"), { recursive: true });
     fs.copyFileSync(path.join(s.artifacts, name), path.join(ROOT, "docs/img", name));
   }
