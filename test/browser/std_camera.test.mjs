@@ -118,6 +118,16 @@ test("start streaming from the panel: preview, raw and compressed streams show t
   await waitFor(async () => (await live().getAttribute("data-encoding")) === "jpeg", "compressed frames drawn", 15000);
   const jpeg = await framesMatch(live(), 2, 8, "compressed");
   assert.ok(jpeg.max <= 16 && jpeg.mean <= 2, `compressed within JPEG's error: ${JSON.stringify(jpeg)}`);
+
+  // the generic pipe card below draws the same pictures (an endpoint of its own beside the panel's)
+  const pipeCard = view().locator('.member[data-member="frame_stream"]');
+  await pipeCard.locator("button", { hasText: /^Connect$/ }).click();
+  const pipeFig = pipeCard.locator(".frame-view").first();
+  await pipeFig.waitFor({ timeout: 15000 });
+  const fromCard = await framesMatch(pipeFig, 2, 0, "frame_stream card");
+  assert.equal(fromCard.max, 0, `the pipe card's frame ${fromCard.k} equal to the frame sent`);
+  assert.equal(await pipeFig.getAttribute("data-encoding"), "bgr888");
+  await pipeCard.locator("button", { hasText: /^Disconnect$/ }).click();
   assert.deepEqual(pageErrors.map(String), []);
 });
 
