@@ -13,13 +13,15 @@
 #   --print-key    print the inputs key (below) and exit
 #   --record-verified  after a from-source build (and --smoke) passed, write docker/from-source.verified:
 #                  the key of what that build's success depends on beyond the sources the package build
-#                  compiles too (docker/, packaging/, cmake/, CMakePresets.json, every CMakeLists.txt:
-#                  the Containerfile's packages, its CMake flow), and the commit. scripts/test.sh skips the
-#                  from-source build while that key is unchanged
+#                  compiles too (docker/, packaging/, cmake/, CMakePresets.json, the top CMakeLists.txt,
+#                  and what any CMakeLists.txt looks for on the system: find_package and the like, as a
+#                  new dependency must reach the Containerfile's package list), and the commit.
+#                  scripts/test.sh skips the from-source build while that key is unchanged
 #   --print-from-source-key  print that key and exit
 #   --from-build DIR  no compile: the runtime image from the Release binaries of build folder DIR
 #                  (e.g. build/package, which scripts/test.sh has built anyway), its root file system
-#                  gathered here by docker/rootfs.sh (Containerfile ROOTFS=prebuilt). This host's
+#                  gathered here by docker/rootfs.sh and given as the build context named
+#                  "build", which replaces the Containerfile's build stage. This host's
 #                  libraries go into the image, so DIR must come from a Debian 12 host like the base
 #                  image's. Label rr.inputs=prebuilt-<sha256 of the root file system>
 #
@@ -65,8 +67,11 @@ key() {
 if [ -n "$print_key" ] && [ -z "$from_build" ]; then key; exit 0; fi
 verified=docker/from-source.verified
 from_source_key() {
-  git ls-tree -r HEAD -- docker packaging cmake CMakePresets.json $(git ls-files -- '*CMakeLists.txt') |
-    grep -v "	$verified\$" | sha256sum | cut -d' ' -f1
+  {
+    git ls-tree -r HEAD -- docker packaging cmake CMakePresets.json CMakeLists.txt | grep -v "	$verified\$"
+    # What every other CMakeLists.txt asks of the system: a new dependency must reach the Containerfile.
+    git grep -h -E 'find_package|pkg_check_modules|find_library|find_program|find_path' HEAD -- '*CMakeLists.txt' | sort
+  } | sha256sum | cut -d' ' -f1
 }
 if [ -n "$print_fs_key" ]; then from_source_key; exit 0; fi
 
@@ -108,7 +113,7 @@ if [ -n "$from_build" ]; then
   sh docker/rootfs.sh "$from_build" . "$ctx/rootfs/out" >/dev/null
   k=prebuilt-$( (cd "$ctx/rootfs" && find . -type f -print0 | sort -z | xargs -0 sha256sum) | sha256sum | cut -d' ' -f1)
   if [ -n "$print_key" ]; then echo "$k"; exit 0; fi
-  build_image --pull=never --build-arg ROOTFS=prebuilt --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
+  build_image --pull=never --build-context "build=$ctx/rootfs" --label "rr.inputs=$k" -f "$ctx/docker/Containerfile" -t "$image" "$ctx"
   echo "build: from $from_build, no compile"
 else
   pull=(--pull=never)

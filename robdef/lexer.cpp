@@ -1,5 +1,7 @@
 #include "robdef/lexer.hpp"
 
+#include "robdef/parser.hpp"
+
 namespace rr::robdef::lex {
 
 std::string_view trim_left(std::string_view s) noexcept {
@@ -145,9 +147,14 @@ bool LineReader::check_chars(std::string_view l) {
         error_.emplace(line_, "Service definition must not contain null characters");
         return false;
     }
-    for (char c : l) {
-        if (!is_valid_char(c)) {
-            error_.emplace(line_, "Service definition must contain only ASCII characters");
+    for (std::size_t i = 0; i < l.size(); ++i) {
+        if (!is_valid_char(l[i])) {
+            std::string message = "Service definition must contain only ASCII characters";
+            // The official message, and what the bytes are when they are a byte-order mark: editors
+            // add it unseen, and the official parser refuses text that starts with one too.
+            if (l.substr(i, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark)
+                message += " (a UTF-8 byte-order mark, bytes EF BB BF, at column " + std::to_string(i + 1) + ")";
+            error_.emplace(line_, std::move(message));
             return false;
         }
     }

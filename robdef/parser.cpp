@@ -12,6 +12,20 @@
 
 namespace rr::robdef {
 
+FileText definition_file_text(std::string bytes, std::string_view file_name) {
+    FileText out;
+    if (std::string_view(bytes).substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark) {
+        bytes.erase(0, kUtf8ByteOrderMark.size());
+        out.diagnostics.push_back(Diagnostic{
+            Severity::warning, DiagnosticKind::syntax, std::string(file_name), 1,
+            "the file starts with a UTF-8 byte-order mark (bytes EF BB BF): dropped here and by the official "
+            "file readers (RobotRaconteurGen, RegisterServiceTypeFromFile), but the official parser refuses the "
+            "text with it (RegisterServiceType, a definition sent by a service); save the file without it"});
+    }
+    out.text = std::move(bytes);
+    return out;
+}
+
 using lex::is_alpha;
 using lex::is_blank;
 using lex::is_digit;

@@ -1,5 +1,6 @@
 // Parser for service definition text (robdef.md §1–§9): one `.robdef` text in, one
-// ServiceDefinition out. Sans-IO: the caller reads files (and strips a UTF-8 BOM, robdef.md §1.1).
+// ServiceDefinition out. Sans-IO: the caller reads files and hands their bytes to
+// definition_file_text() (a leading UTF-8 BOM dropped with a warning, robdef.md §1.1).
 //
 // Accepts stdver 0.9 / 0.10 files and the legacy forms without stdver (`option`, `option version`,
 // `option constant`, `option pipe X unreliable`, `end struct` / `end object`), LF and CRLF, line
@@ -16,6 +17,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -24,6 +26,23 @@
 #include "robdef/service_definition.hpp"
 
 namespace rr::robdef {
+
+/// The UTF-8 byte-order mark, EF BB BF. Not ASCII: the parser refuses it anywhere in a text, naming it
+/// (as the official ServiceDefinition::FromString refuses it, with the same message before the name).
+inline constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
+
+/// The text of a definition file, and what reading it noticed.
+struct FileText {
+    std::string text;
+    std::vector<Diagnostic> diagnostics;  ///< at most a warning about a dropped byte-order mark
+};
+
+/// The bytes of a `.robdef` file as the official file readers take them (robdef.md §1.1): one leading
+/// UTF-8 byte-order mark is dropped, as RobotRaconteurGen's reader and the Python library's
+/// ReadServiceDefinitionFile (utf-8-sig) drop it, with a warning (line 1) that names it, because the
+/// same text registered as text (RegisterServiceType) or sent by a service is refused. Anything else
+/// (a second mark, one after a blank line) stays and is refused by the parser.
+FileText definition_file_text(std::string bytes, std::string_view file_name);
 
 struct ParseOutput {
     ServiceDefinition definition;

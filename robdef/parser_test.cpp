@@ -23,6 +23,10 @@ struct ParseCase {
     int line;
 };
 
+// The parser's message for a byte-order mark in text, up to the column.
+const std::string kBomInText =
+    "Service definition must contain only ASCII characters (a UTF-8 byte-order mark, bytes EF BB BF, at column ";
+
 ServiceDefinition parse_ok(std::string_view text) {
     auto r = parse_service_definition_report(text, "t.robdef");
     INFO(dump(r.diagnostics));
@@ -544,7 +548,61 @@ TEST_CASE("official behaviour followed: option above stdver, objref array with c
     SECTION("a byte-order mark in text is not ASCII (the file readers strip it, the parser does not)") {
         auto r = parse_service_definition_report("\xEF\xBB\xBFservice a.b\nstdver 0.10\n", "t.robdef");
         REQUIRE_FALSE(r.ok());
-        CHECK(r.diagnostics.back().message == "Service definition must contain only ASCII characters");
+        CHECK(r.diagnostics.back().message == kBomInText + "1)");
         CHECK(r.diagnostics.back().line == 1);
+    }
+}
+
+// Issue 40: a robdef with a UTF-8 byte-order mark. The official verdict, run with robotraconteur 1.2.9
+// (the .venv, Python) on "\xEF\xBB\xBFservice t.bom\nstdver 0.10\nstruct S\n    field int32 x\nend\n":
+//   ServiceDefinition.FromString(text), RegisterServiceType(open(path).read()) -> refused,
+//     "Parse error: Service definition must contain only ASCII characters" (the mark is not named);
+//   RegisterServiceTypeFromFile(path), RegisterServiceTypesFromFiles([path]),
+//     RegisterServiceType(ReadServiceDefinitionFile(path)) -> accepted (utf-8-sig drops the mark);
+//   RobotRaconteurGen --verify-robdef reads files with ReadFile, which skips a leading EF BB BF (source).
+// So the official *text* parser refuses it and the official *file* readers and verifier accept it. We
+// agree with both: the parser refuses it in text with the official message plus what the bytes are;
+// reading a file (rr-robdef check) drops one leading mark, as the official file readers do, and warns
+// that the text itself would be refused (RegisterServiceType), which is how a user meets the problem.
+TEST_CASE("a byte-order mark: refused in text naming it, dropped from the start of a file with a warning") {
+    SECTION("in text: the official message, then what the bytes are and where") {
+        auto r = parse_service_definition_report("service a.b\nstdver 0.10\n# a \xEF\xBB\xBF\n", "t.robdef");
+        REQUIRE_FALSE(r.ok());
+        CHECK(r.diagnostics.back().message == kBomInText + "5)");
+        CHECK(r.diagnostics.back().line == 3);
+        // Other non-ASCII bytes keep the official message alone.
+        auto utf8 = parse_service_definition_report("service a.b\n# caf\xC3\xA9\n", "t.robdef");
+        REQUIRE_FALSE(utf8.ok());
+        CHECK(utf8.diagnostics.back().message == "Service definition must contain only ASCII characters");
+    }
+    SECTION("a file: one leading mark dropped with a warning that names it; the text parses") {
+        auto f = definition_file_text("\xEF\xBB\xBFservice a.b\nstdver 0.10\n", "t.robdef");
+        CHECK(f.text == "service a.b\nstdver 0.10\n");
+        REQUIRE(f.diagnostics.size() == 1);
+        const auto& w = f.diagnostics[0];
+        CHECK(w.severity == Severity::warning);
+        CHECK(w.file == "t.robdef");
+        CHECK(w.line == 1);
+        CHECK_THAT(w.message, Catch::Contains("UTF-8 byte-order mark (bytes EF BB BF)"));
+        CHECK_THAT(w.message, Catch::Contains("RegisterServiceType"));
+        CHECK(format_diagnostic(w).rfind("t.robdef:1: warning: the file starts with a UTF-8 byte-order mark", 0) == 0);
+        CHECK(parse_service_definition_report(f.text, "t.robdef").ok());
+    }
+    SECTION("a file: nothing else is dropped; a second mark, or one after a blank line, is refused") {
+        auto plain = definition_file_text("service a.b\n", "t.robdef");
+        CHECK(plain.text == "service a.b\n");
+        CHECK(plain.diagnostics.empty());
+        auto twice = definition_file_text("\xEF\xBB\xBF\xEF\xBB\xBFservice a.b\n", "t.robdef");
+        CHECK(twice.diagnostics.size() == 1);
+        auto r = parse_service_definition_report(twice.text, "t.robdef");
+        REQUIRE_FALSE(r.ok());
+        CHECK(r.diagnostics.back().message == kBomInText + "1)");
+        auto later = definition_file_text("\n\xEF\xBB\xBFservice a.b\n", "t.robdef");
+        CHECK(later.diagnostics.empty());
+        auto r2 = parse_service_definition_report(later.text, "t.robdef");
+        REQUIRE_FALSE(r2.ok());
+        CHECK(r2.diagnostics.back().line == 2);
+        CHECK(definition_file_text("", "t.robdef").text.empty());
+        CHECK(definition_file_text("\xEF\xBB", "t.robdef").text == "\xEF\xBB");  // half a mark stays
     }
 }

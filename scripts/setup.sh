@@ -28,12 +28,14 @@ PYTHON_PACKAGES=(python3-venv)
 # Testing only: Catch2, the USB device emulator, clang and lld for the debug preset (its sanitizer
 # build is also the fuzz targets' build), Chromium for the browser tests, nginx/openssl/htpasswd for
 # the reverse-proxy tests, podman & co. for the container image (docker/build.sh: no Docker daemon, the
-# base made with mmdebstrap; busybox-static for the image made from a build on this machine).
+# base made with mmdebstrap; busybox-static for the image made from a build on this machine); libgl1
+# and libglib2.0-0, which the OpenCV wheel of the camera driver's browser test links (Chromium pulls
+# them in too; named here so they do not depend on that).
 TEST_PACKAGES=(
   catch2
   umockdev libumockdev-dev
   clang-14 libclang-rt-14-dev lld
-  chromium fonts-liberation
+  chromium fonts-liberation libgl1 libglib2.0-0
   nginx openssl apache2-utils haproxy
   testssl.sh
   podman buildah runc mmdebstrap fuse-overlayfs slirp4netns uidmap busybox-static

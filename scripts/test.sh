@@ -75,7 +75,8 @@ if [ -z "$from_source" ]; then
   if [ "$(./docker/build.sh --print-from-source-key)" = "$(sed -n 's/^key //p' docker/from-source.verified 2>/dev/null)" ]; then
     from_source=0
     echo "test: the Containerfile's from-source build is skipped: its inputs (docker/, packaging/, cmake/,"
-    echo "test:   CMakePresets.json, every CMakeLists.txt) are those verified at $(sed -n 's/^commit //p' docker/from-source.verified)"
+    echo "test:   CMakePresets.json, the top CMakeLists.txt, the dependencies any CMakeLists.txt looks for)"
+    echo "test:   are those verified at $(sed -n 's/^commit //p' docker/from-source.verified)"
   else
     from_source=1
     echo "test: the Containerfile's from-source build runs: its inputs changed since docker/from-source.verified"
@@ -129,10 +130,8 @@ await_step() {
   fi
 }
 
-# ctest: a test run starts the longest tests first when it has their times; a fresh build has none,
-# so it takes them from test/ctest-costs.txt (a scheduling hint; a test not listed just starts later).
-costs=build/debug/Testing/Temporary/CTestCostData.txt
-[ -f "$costs" ] || { mkdir -p "$(dirname "$costs")"; cp test/ctest-costs.txt "$costs"; }
+# ctest starts the longest tests first (their COST from test/schedule/costs.cmake; regenerate it from
+# build/ctest-main.log and build/ctest-timing.log with test/schedule/ctest_costs.py when tests change).
 excluded='^(docker: the image|install: the package on a fresh Debian 12 root)'
 status=0
 ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" 2>&1 | tee build/ctest-main.log || status=1

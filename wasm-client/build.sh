@@ -33,5 +33,13 @@ copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
 copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
 for f in robotraconteur.mjs errors.mjs proxy.mjs index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
 copy_if_changed "$here/README.md" "$dist/README.md"
+# The dashboard's standard-type modules (web/src/std: renderers, image decoding, readable text) for
+# the package's users, with the three page modules they import, in the same layout:
+# import { ... } from "robotraconteur-wasm/std" (dist/dashboard/std/index.js).
+web="$root/web/src"
+mkdir -p "$dist/dashboard/std"
+for f in rr_types.js value_codec.js robdef_outline.js; do copy_if_changed "$web/$f" "$dist/dashboard/$f"; done
+for f in "$web"/std/*.js "$web"/std/index.d.ts; do copy_if_changed "$f" "$dist/dashboard/std/$(basename "$f")"; done
+for f in "$dist"/dashboard/std/*.js; do [ -f "$web/std/$(basename "$f")" ] || rm -f "$f"; done
 copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
 echo "wasm-client: package in $dist"

@@ -20,6 +20,7 @@ mkdir -p "$tmp/vendor/rr" "$tmp/vendor/uplot"
 cp index.html login.html style.css "$tmp/"
 cp -R src "$tmp/src"
 cp -R "$rr"/. "$tmp/vendor/rr/"
+rm -rf "$tmp/vendor/rr/dashboard"   # the package's copy of src/std: the page has its own
 cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css node_modules/uplot/LICENSE "$tmp/vendor/uplot/"
 rm -rf "$out"
 mv "$tmp" "$out"

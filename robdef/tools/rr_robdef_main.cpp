@@ -6,7 +6,8 @@
 //                             exit status 1 on any error, else 0.
 //   rr-robdef format FILE     print the canonical text form (robdef.md §12).
 //
-// The only robdef code that reads files (a leading UTF-8 BOM is stripped, robdef.md §1.1).
+// The only robdef code that reads files; their bytes go through definition_file_text (a leading UTF-8
+// byte-order mark is dropped with a warning, as the official file readers drop it: robdef.md §1.1).
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -25,13 +26,15 @@ int usage() {
     return 2;
 }
 
-bool read_file(const std::string& path, std::string& out) {
+// The file's text, its warnings printed to `warnings`; false when it cannot be read.
+bool read_file(const std::string& path, std::string& out, std::ostream& warnings) {
     std::ifstream f(path, std::ios::binary);
     if (!f) return false;
     std::ostringstream ss;
     ss << f.rdbuf();
-    out = ss.str();
-    if (out.size() >= 3 && out.compare(0, 3, "\xEF\xBB\xBF") == 0) out.erase(0, 3);
+    auto file = rr::robdef::definition_file_text(ss.str(), path);
+    for (const auto& d : file.diagnostics) warnings << rr::robdef::format_diagnostic(d) << '\n';
+    out = std::move(file.text);
     return true;
 }
 
@@ -41,7 +44,7 @@ int check(const std::vector<std::string>& files) {
     std::vector<std::string> names;
     for (const auto& path : files) {
         std::string text;
-        if (!read_file(path, text)) {
+        if (!read_file(path, text, std::cout)) {
             std::cout << path << ": error: cannot read file\n";
             failed = true;
             continue;
@@ -69,7 +72,7 @@ int check(const std::vector<std::string>& files) {
 
 int format(const std::string& path) {
     std::string text;
-    if (!read_file(path, text)) {
+    if (!read_file(path, text, std::cerr)) {
         std::cerr << path << ": error: cannot read file\n";
         return 1;
     }

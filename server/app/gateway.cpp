@@ -71,6 +71,39 @@ Result<void> serve_local(const std::shared_ptr<Node>& node, std::optional<local:
     return {};
 }
 
+// Whether `listen` is a wildcard address (`::`, `0.0.0.0`): the node is reachable from the network.
+bool listens_everywhere(const std::string& listen) {
+    boost::system::error_code ec;
+    const auto a = boost::asio::ip::make_address(listen, ec);
+    return !ec && a.is_unspecified();
+}
+
+// Node discovery settings shared by the gateway's node and its demo node (docs/discovery.md).
+discovery::DiscoveryOptions discovery_options(const DiscoverySettings& s, const std::shared_ptr<Node>& node,
+                                              std::shared_ptr<boost::asio::ip::tcp::endpoint> bound) {
+    discovery::DiscoveryOptions o;
+    o.node_id = node->node_id();
+    o.node_name = node->node_name();
+    o.announce = s.announce;
+    o.flags = rr::discovery::kLinkLocal | (s.ipv4_broadcast ? rr::discovery::kIpv4Broadcast : 0u);
+    o.interfaces = s.interfaces;
+    o.limits.max_nodes = s.max_nodes;
+    o.limits.url_expiry = s.node_expiry;
+    std::weak_ptr<Node> weak_node = node;
+    // One ServiceStateNonce per node: the announces carry the node's, as its rr+local entries do.
+    o.service_state_nonce = [weak_node] {
+        auto n = weak_node.lock();
+        return n ? n->service_state_nonce() : std::string();
+    };
+    // What the announces carry: the node's TCP port as bound (set before discovery starts).
+    o.listen_endpoints = [bound = std::move(bound)] {
+        std::vector<boost::asio::ip::tcp::endpoint> out;
+        if (bound->port() != 0) out.push_back(*bound);
+        return out;
+    };
+    return o;
+}
+
 // The demo node's one user while gateway.auth is on (docs/security.md "The demo node").
 constexpr std::string_view kDemoUser = "rr-gateway-demo";
 
@@ -193,9 +226,26 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         auto demo_reservation = reserve_local_name(c.local, dopts.node_name, NodeID{});
         if (!demo_reservation) return demo_reservation.take_error();
         if (*demo_reservation) dopts.node_id = (*demo_reservation)->node_id;
+        // The demo node is a node like the gateway's: where the gateway listens on every address (the
+        // default `::`), so does it, with the gateway's limits, and it announces itself when discovery
+        // is on. While gateway.auth is on it stays on loopback and quiet: its services then require a
+        // login only this process knows (docs/security.md "The demo node"), so announcing them would
+        // only offer services nobody else can use.
+        g->demo_public_ = !g->auth_ && listens_everywhere(c.listen);
+        if (g->demo_public_) {
+            // The gateway's own sessions to the demo devices (create, webcam) come from 127.0.0.1 too.
+            if (c.limits.connections_per_address) {
+                dopts.address_limiter = AddressLimiter::create(c.limits.connections_per_address + 2);
+                dopts.on_limited = [limit_log](const std::string&, const std::string& reason) {
+                    limit_log->warn("demo node: connection refused: " + reason + " (gateway.limits.connections_per_address)");
+                };
+            }
+            dopts.read_rates = opts.read_rates;
+        }
         g->demo_node_ = Node::create(dopts);
-        auto port = listen_tcp(g->demo_node_, "127.0.0.1", c.demo_port);
-        if (!port) return port.take_error();
+        auto demo_listener = open_tcp_listener(g->demo_node_, g->demo_public_ ? c.listen : std::string("127.0.0.1"), c.demo_port);
+        if (!demo_listener) return demo_listener.take_error();
+        *g->demo_bound_ = (*demo_listener)->local_endpoint();
         if (c.local) {
             if (auto r = serve_local(g->demo_node_, std::move(*demo_reservation)); !r) return r.take_error();
         }
@@ -208,7 +258,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             if (!password) return password.take_error();
             login = DemoLogin{std::string(kDemoUser), std::move(*password)};
         }
-        auto demo_devices = demo(g->demo_node_, *port, login);
+        auto demo_devices = demo(g->demo_node_, (*demo_listener)->port(), login);
         if (!demo_devices) return demo_devices.take_error();
         if (login.required()) {
             for (const auto& name : g->demo_node_->service_names()) {
@@ -286,29 +336,12 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the
     // services that `discover:` filters select into devices.
     if (c.discovery.enabled) {
-        discovery::DiscoveryOptions dopts;
-        dopts.node_id = g->node_->node_id();
-        dopts.node_name = g->node_->node_name();
+        auto dopts = discovery_options(c.discovery, g->node_, g->tcp_bound_);
         dopts.listen = true;
-        dopts.announce = c.discovery.announce;
-        dopts.flags = rr::discovery::kLinkLocal | (c.discovery.ipv4_broadcast ? rr::discovery::kIpv4Broadcast : 0u);
-        dopts.interfaces = c.discovery.interfaces;
-        dopts.limits.max_nodes = c.discovery.max_nodes;
-        dopts.limits.url_expiry = c.discovery.node_expiry;
         // Services are read over the node's transports (rr+tcp, rr+local, and rr+usb when on).
         dopts.transports = &g->node_->transports();
-        std::weak_ptr<Node> weak_node = g->node_;
-        // One ServiceStateNonce per node: the announces carry the node's, as its rr+local entries do.
-        dopts.service_state_nonce = [weak_node] {
-            auto n = weak_node.lock();
-            return n ? n->service_state_nonce() : std::string();
-        };
-        // What the announces carry: the gateway's TCP port as bound (set below, before discovery starts).
-        dopts.listen_endpoints = [bound = g->tcp_bound_] {
-            std::vector<boost::asio::ip::tcp::endpoint> out;
-            if (bound->port() != 0) out.push_back(*bound);
-            return out;
-        };
+        // The demo node is part of the gateway, not a node it found (its devices are already served).
+        if (g->demo_node_) dopts.ignored_nodes.push_back(g->demo_node_->node_id());
         g->discovery_ = discovery::NodeDiscovery::create(g->node_->io_context().get_executor(), dopts);
         std::weak_ptr<discovery::NodeDiscovery> weak_discovery = g->discovery_;
         g->node_->on_services_changed([weak_discovery] {
@@ -347,6 +380,16 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             json_api->set_discovery_hooks(std::move(hooks));
         }
         g->discovered_->start();
+        // The demo node announces itself too (and answers requests), as a node of its own would.
+        if (g->demo_node_ && g->demo_public_ && c.discovery.announce) {
+            auto demo_opts = discovery_options(c.discovery, g->demo_node_, g->demo_bound_);
+            demo_opts.listen = false;  // no table of its own: the gateway keeps one
+            g->demo_discovery_ = discovery::NodeDiscovery::create(g->demo_node_->io_context().get_executor(), demo_opts);
+            std::weak_ptr<discovery::NodeDiscovery> weak_demo = g->demo_discovery_;
+            g->demo_node_->on_services_changed([weak_demo] {
+                if (auto d = weak_demo.lock()) d->services_changed();
+            });
+        }
     }
     for (auto& d : g->devices_) {
         d->set_state_listener([](const gateway::DeviceStatus& s) {
@@ -375,15 +418,22 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         };
         tcp_opts.tls = std::move(tls);
     }
-    auto port = listen_tcp(g->node_, c.listen, c.port, std::move(tcp_opts));
-    if (!port) return port.take_error();
-    g->port_ = *port;
-    *g->tcp_bound_ = boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address(c.listen), *port);
+    auto listener = open_tcp_listener(g->node_, c.listen, c.port, std::move(tcp_opts));
+    if (!listener) return listener.take_error();
+    if (!(*listener)->fallback_note().empty()) log(LogLevel::warning, "gateway port: " + (*listener)->fallback_note());
+    g->port_ = (*listener)->port();
+    *g->tcp_bound_ = (*listener)->local_endpoint();
     if (c.local) {
         if (auto r = serve_local(g->node_, std::move(*reservation)); !r) return r.take_error();
     }
+    if (g->demo_discovery_) {
+        if (auto r = g->demo_discovery_->start(); !r) return r.take_error();
+    }
     if (g->discovery_) {
         if (auto r = g->discovery_->start(); !r) return r.take_error();
+        if (c.discovery.announce && g->tcp_bound_->address().is_unspecified())
+            log(LogLevel::info, "node discovery: announcing " + c.node_name + (g->demo_discovery_ ? " and " + c.node_name + ".demo" : "") +
+                                    " on the local network, as an official node does (off: --no-discovery, discovery.enabled: false)");
         // Other sources of the table: this computer's rr+local nodes and the USB devices.
         if (c.discovery.local) {
             discovery::LocalSourceOptions lo;
@@ -437,6 +487,7 @@ void Gateway::stop() {
 #ifdef RR_HAVE_USB
     if (usb_source_) usb_source_->stop();
 #endif
+    if (demo_discovery_) demo_discovery_->stop();
     if (discovery_) discovery_->stop(std::chrono::milliseconds(6000));  // before the node's threads stop
     for (auto& d : devices_) d->stop();
 #ifdef RR_HAVE_USB

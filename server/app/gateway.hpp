@@ -3,7 +3,9 @@
 // the default path is the real path; behind a per-process login while gateway.auth is on), health
 // endpoints and the JSON API. Transports for the devices: the node's TransportRegistry, plus rr+usb
 // (a UsbHost) when the configuration needs it (usb_wanted).
-// Discovery (when on) is fed by UDP, by the rr+local node directories and by the USB devices.
+// Discovery (on by default, as on an official server node) is fed by UDP, by the rr+local node
+// directories and by the USB devices; the gateway and, unless gateway.auth is on, its demo node
+// announce themselves.
 #pragma once
 
 #include <atomic>
@@ -72,6 +74,9 @@ public:
     std::shared_ptr<gateway::DeviceMirror> device(std::string_view name) const;
     /// Node discovery (docs/discovery.md), nullptr when `discovery.enabled` is off.
     const std::shared_ptr<discovery::NodeDiscovery>& discovery() const noexcept { return discovery_; }
+    /// The demo node's announces: nullptr unless discovery is on and the demo node is reachable from the
+    /// network (the gateway listens on a wildcard address and gateway.auth is off).
+    const std::shared_ptr<discovery::NodeDiscovery>& demo_discovery() const noexcept { return demo_discovery_; }
     /// Devices found by `discover:` filters or added from the JSON API, now.
     std::vector<std::shared_ptr<gateway::DeviceMirror>> discovered_devices() const;
     /// The rr+usb host transport, nullptr unless the configuration needs it (usb_wanted()).
@@ -108,6 +113,11 @@ private:
     /// The TCP port as bound (discovery announces it); written once before discovery starts.
     std::shared_ptr<boost::asio::ip::tcp::endpoint> tcp_bound_ = std::make_shared<boost::asio::ip::tcp::endpoint>();
     std::shared_ptr<discovery::NodeDiscovery> discovery_;
+    /// The demo node's TCP port as bound, and its announces (null unless it is public and discovery on).
+    std::shared_ptr<boost::asio::ip::tcp::endpoint> demo_bound_ = std::make_shared<boost::asio::ip::tcp::endpoint>();
+    std::shared_ptr<discovery::NodeDiscovery> demo_discovery_;
+    /// The demo node listens where the gateway does (a wildcard address) rather than on loopback only.
+    bool demo_public_ = false;
     std::shared_ptr<DiscoveredDevices> discovered_;
     std::shared_ptr<usb::UsbHost> usb_host_;
     std::shared_ptr<discovery::LocalDiscoverySource> local_source_;

@@ -105,6 +105,8 @@ bool names_usb(const GatewayConfig& c, std::string* key) {
 void validate(const GatewayConfig& c, const std::function<void(const std::string&, const std::string&)>& error) {
     if (std::string key; c.usb.enabled == UsbSettings::Mode::off && names_usb(c, &key))
         error(key, "rr+usb is turned off by usb.enabled: false (remove it, or enable USB)");
+    if (!c.discover.empty() && !c.discovery.enabled)
+        error("discover", "needs discovery, which --no-discovery turns off (remove one of them)");
     if (!valid_node_name(c.node_name))
         error("gateway.node_name", "not a NodeName (letters, digits, _ . -, starting with a letter): \"" + c.node_name + "\"");
     if (!c.node_id.empty() && !NodeID::parse(c.node_id)) error("gateway.node_id", "not a NodeID (UUID)");
@@ -259,7 +261,9 @@ void parse_discovery(const YAML::Node& root, const Reader& r, GatewayConfig& c) 
             rule.backoff_max = std::chrono::milliseconds(r.unsigned_int(n, key + ".backoff_max_ms", 3600000));
         c.discover.push_back(std::move(rule));
     }
-    if (!c.discover.empty()) c.discovery.enabled = true;
+    if (!c.discover.empty() && !c.discovery.enabled)
+        r.error(root["discovery"]["enabled"], "discover",
+                "needs discovery, which discovery.enabled: false turns off (remove one of them)");
 }
 
 // A USB id: an integer, hexadecimal with 0x (0x1209, as lsusb shows 1209) or decimal.
@@ -609,7 +613,8 @@ const std::set<std::string> kValueFlags{"--config",      "--port",       "--list
                                         "--log-level",   "--log-format", "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level", "--tls-certificate",
                                         "--tls-private-key", "--tls-client-ca"};
-const std::set<std::string> kBoolFlags{"--no-demo", "--no-local", "--discovery", "--check", "--help", "-h", "--tls-required"};
+const std::set<std::string> kBoolFlags{"--no-demo",     "--no-local", "--discovery", "--no-discovery",
+                                       "--check",       "--help",     "-h",          "--tls-required"};
 
 }  // namespace
 
@@ -692,6 +697,8 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.local = false;
         } else if (flag == "--discovery") {
             c.discovery.enabled = true;
+        } else if (flag == "--no-discovery") {
+            c.discovery.enabled = false;
         } else if (flag == "--tls-certificate") {
             c.tls.certificate = v;
         } else if (flag == "--tls-private-key") {
@@ -740,12 +747,15 @@ std::string usage_text() {
     return R"(Usage: rr-gateway [--config FILE] [options]
 
 Robot Raconteur gateway: devices re-exposed over WebSocket and HTTP.
-With no configuration it starts two demo devices (experimental.create, experimental.createwebcam).
+With no configuration it starts two demo devices (experimental.create, experimental.createwebcam),
+listens on port 8080 on every address (IPv4 and IPv6) and announces itself on the local network, as
+an official Robot Raconteur server node does, so official clients find it by type and NodeName.
 
 Options (override the configuration file):
   --config FILE              YAML configuration (docs/gateway-config.md)
   --port N                   RR + HTTP + WebSocket port (default 8080)
-  --listen ADDR              listen address (default 0.0.0.0)
+  --listen ADDR              listen address (default ::, IPv4 and IPv6 on one socket;
+                             0.0.0.0: IPv4 only; 127.0.0.1: this computer only)
   --web-root DIR             dashboard files to serve
   --allow-origin ORIGIN      allow a browser Origin (repeatable)
   --trusted-proxy ADDR[/N]   believe X-Forwarded-For/-Proto from this proxy (repeatable)
@@ -753,7 +763,10 @@ Options (override the configuration file):
                              or cam=rr+local:///?nodename=camera.driver&service=cam
   --no-demo                  do not start the demo devices
   --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
-  --discovery                node discovery: announce the gateway, list nodes (docs/discovery.md)
+  --no-discovery             no node discovery: do not announce the gateway (nor its demo node),
+                             answer or send discovery requests, or list nodes (on by default, as
+                             on an official node; docs/discovery.md)
+  --discovery                node discovery on (the default; overrides discovery.enabled: false)
   --tls-certificate FILE     serve HTTPS, WSS and rrs+tcp on the same port with this PEM
                              certificate chain (leaf first) ...
   --tls-private-key FILE     ... and its private key (docs/security.md)

@@ -15,9 +15,13 @@
 
 namespace rr::server::app {
 
-/// `discovery:` (docs/gateway-config.md, docs/discovery.md): node discovery on the network.
+/// `discovery:` (docs/gateway-config.md, docs/discovery.md): node discovery on the network. On by
+/// default, as on an official server node (ServerNodeSetup): the gateway announces itself, answers
+/// discovery requests and keeps a table of the nodes it hears.
 struct DiscoverySettings {
-    bool enabled = false;          ///< listen (and announce); also on when `discover:` has entries
+    /// Off: no UDP at all (`--no-discovery`, `discovery.enabled: false`), e.g. a container on a network
+    /// shared with strangers. `discover:` entries need it on.
+    bool enabled = true;
     bool announce = true;          ///< announce the gateway (when enabled)
     bool ipv4_broadcast = false;   ///< also IPv4 broadcast (the official IPV4_BROADCAST flag)
     std::vector<std::string> interfaces;  ///< interface names; empty = all
@@ -105,7 +109,9 @@ struct GatewayLimitsConfig {
 
 struct GatewayConfig {
     // gateway:
-    std::string listen = "0.0.0.0";
+    /// Listen address. The default `::` is one dual-stack socket (IPv4 and IPv6, as an official node);
+    /// on a host without IPv6 it falls back to `0.0.0.0`. `0.0.0.0`: IPv4 only; `127.0.0.1`: this computer.
+    std::string listen = "::";
     std::uint16_t port = 8080;
     std::string node_name = "rr.gateway";
     std::string node_id;  ///< empty = random
@@ -166,7 +172,7 @@ struct CommandLine {
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
 /// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
-/// --discovery, --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
+/// --no-discovery, --discovery (the default; overrides a file's `discovery.enabled: false`), --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).
 Result<CommandLine> parse_command_line(int argc, const char* const* argv);

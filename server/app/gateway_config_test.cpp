@@ -1,3 +1,4 @@
+#include <array>
 #include <catch2/catch.hpp>
 
 #include "server/app/gateway_auth_config.hpp"
@@ -56,6 +57,49 @@ TEST_CASE("an empty configuration gives the defaults (demo on, port 8080)") {
     CHECK(c->demo);
     CHECK(c->devices.empty());
     CHECK(c->local);  // rr+local served under the gateway's NodeName unless turned off
+}
+
+// Issue 40: with no options the gateway behaves as an official server node (ServerNodeSetup): both IP
+// families on one socket, announced, answering discovery requests.
+TEST_CASE("an empty configuration is an official server node: both IP families, discovery on") {
+    auto c = parse_gateway_config("", "empty.yaml");
+    REQUIRE(c);
+    CHECK(c->listen == "::");
+    CHECK(c->discovery.enabled);
+    CHECK(c->discovery.announce);
+    CHECK_FALSE(c->discovery.ipv4_broadcast);  // opt-in, as the official IPV4_BROADCAST flag
+    // The safe parts of the defaults stay: Origin checks (same origin only), connection limits.
+    CHECK(c->allowed_origins.empty());
+    CHECK(c->limits.connections_per_address == 256);
+    CHECK(c->max_message_size == 12u * 1024u * 1024u);
+}
+
+TEST_CASE("discovery.enabled: false and --no-discovery turn discovery off, and discover: entries need it") {
+    auto off = parse_gateway_config("discovery:\n  enabled: false\n", "t.yaml");
+    REQUIRE(off);
+    CHECK_FALSE(off->discovery.enabled);
+    const char* argv[] = {"rr-gateway", "--no-discovery"};
+    auto cmd = parse_command_line(2, argv);
+    REQUIRE(cmd);
+    GatewayConfig c;
+    REQUIRE(apply_overrides(c, *cmd));
+    CHECK_FALSE(c.discovery.enabled);
+    // --discovery (the default) overrides a file that turned it off.
+    const char* on_argv[] = {"rr-gateway", "--discovery"};
+    auto on = parse_command_line(2, on_argv);
+    REQUIRE(on);
+    REQUIRE(apply_overrides(*off, *on));
+    CHECK(off->discovery.enabled);
+    CHECK_FALSE(parse_command_line(2, std::array<const char*, 2>{"g", "--no-discovery=1"}.data()));
+    // A discover: entry cannot work without discovery: refused, naming both.
+    auto both = parse_gateway_config("discovery: {enabled: false}\ndiscover:\n  - type: a.B\n", "t.yaml");
+    REQUIRE_FALSE(both);
+    CHECK_THAT(both.error().message, Catch::Contains("t.yaml:1: discover: needs discovery"));
+    auto rules = parse_gateway_config("discover:\n  - type: a.B\n", "t.yaml");
+    REQUIRE(rules);
+    auto r = apply_overrides(*rules, *cmd);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("--no-discovery"));
 }
 
 TEST_CASE("gateway.local: false and --no-local turn the gateway's rr+local off") {

@@ -57,7 +57,14 @@ void DiscoveredDevices::start() {
     listener_ = discovery_->add_listener([weak](const discovery::DiscoveryEvent& e) {
         if (auto self = weak.lock()) self->on_event(e);
     });
-    // ServiceInfo2 is wanted for the rules and for the JSON API's list of discovered services.
+    // The nodes' services are asked for when something needs them: the rules (now), the JSON API's list
+    // (at its first request, list()). A gateway nobody asks does not interrogate every node it hears,
+    // as an official node does not.
+    if (!rules_.empty()) want_services();
+}
+
+void DiscoveredDevices::want_services() {
+    if (services_wanted_.exchange(true)) return;
     discovery_->want_services(true);
 }
 
@@ -276,7 +283,8 @@ std::vector<std::shared_ptr<gateway::DeviceMirror>> DiscoveredDevices::devices()
     return out;
 }
 
-nlohmann::json DiscoveredDevices::list() const {
+nlohmann::json DiscoveredDevices::list() {
+    want_services();
     auto nodes = nlohmann::json::array();
     auto table = discovery_->nodes();
     std::lock_guard lock(mutex_);

@@ -6,6 +6,7 @@
 // device of any discovered service for this run (removed the same way).
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -40,14 +41,16 @@ public:
     void set_api(std::shared_ptr<gateway::JsonApi> api);
     /// The gateway's users and permissions: discovered devices check them like configured ones.
     void set_auth(std::shared_ptr<gateway::auth::GatewayAuth> auth);
-    /// Subscribes to discovery events (and asks for ServiceInfo2 when there are rules).
+    /// Subscribes to discovery events, and asks the nodes for their services (ServiceInfo2) when there
+    /// are rules; without rules the first list() asks.
     void start();
     /// Stops and removes every discovered device.
     void stop();
 
     std::vector<std::shared_ptr<gateway::DeviceMirror>> devices() const;
-    /// GET /api/discovered: `{"nodes": [node_json… with "device" per service]}`.
-    nlohmann::json list() const;
+    /// GET /api/discovered: `{"nodes": [node_json… with "device" per service]}`. The first call also
+    /// starts asking the nodes for their services (their "services" stay null until they answer).
+    nlohmann::json list();
     /// The "add" action: a device for service `service` of node `node_id`, named `name` (default: the
     /// service name, sanitized and made unique). Errors: NodeNotFound / ServiceNotFound (404),
     /// InvalidArgument (400: the name is taken).
@@ -89,6 +92,8 @@ private:
     mutable std::recursive_mutex mutex_;
     std::map<std::pair<NodeID, std::string>, Entry> entries_;
     bool stopped_ = false;
+    std::atomic<bool> services_wanted_{false};
+    void want_services();  ///< once: the discovery keeps the nodes' ServiceInfo2 fresh from now on
 };
 
 }  // namespace rr::server::app

@@ -45,7 +45,7 @@ discover:
     attributes_operation: or
 )", "t.yaml");
     REQUIRE(c);
-    CHECK(c->discovery.enabled);  // implied by discover: entries
+    CHECK(c->discovery.enabled);
     CHECK(c->discovery.announce);
     CHECK(c->discovery.interfaces == std::vector<std::string>{"veth0"});
     CHECK(c->discovery.max_nodes == 32);
@@ -92,9 +92,9 @@ TEST_CASE("gateway config: discover mistakes name the key and line") {
     CHECK(bad("discovery: {max_nodes: 0}\n").find("discovery.max_nodes") != std::string::npos);
     CHECK(bad("discovery: {node_expiry_ms: 10}\n").find("at least 1000") != std::string::npos);
     CHECK(bad("discover: {type: a.B}\n").find("expected a list") != std::string::npos);
-    auto off = parse_gateway_config("", "t.yaml");
-    REQUIRE(off);
-    CHECK_FALSE(off->discovery.enabled);  // off unless asked for (multicast on every interface)
+    auto on = parse_gateway_config("", "t.yaml");
+    REQUIRE(on);
+    CHECK(on->discovery.enabled);  // on by default, as on an official server node (issue 40)
 }
 
 TEST_CASE("gateway discovery: device names from the template are RR service names") {

@@ -28,10 +28,11 @@ namespace bhttp = boost::beast::http;
 
 namespace {
 
-bhttp::response<bhttp::string_body> gateway_http_get(std::uint16_t port, const std::string& target) {
+bhttp::response<bhttp::string_body> gateway_http_get(std::uint16_t port, const std::string& target,
+                                                     const std::string& address = "127.0.0.1") {
     boost::asio::io_context io;
     beast::tcp_stream s(io);
-    s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+    s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address(address), port));
     bhttp::request<bhttp::string_body> req{bhttp::verb::get, target, 11};
     req.set(bhttp::field::host, "localhost");
     bhttp::write(s, req);
@@ -68,6 +69,30 @@ bhttp::response<bhttp::string_body> http_get_bearer(std::uint16_t port, const st
     bhttp::response<bhttp::string_body> res;
     bhttp::read(s, b, res);
     return res;
+}
+
+// Whether this host has IPv6 loopback (a container may have none).
+bool ipv6_loopback() {
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::acceptor a(io);
+    boost::system::error_code ec;
+    a.open(boost::asio::ip::tcp::v6(), ec);
+    if (!ec) a.bind(boost::asio::ip::tcp::endpoint(boost::asio::ip::address_v6::loopback(), 0), ec);
+    return !ec;
+}
+
+bool tcp_connects(const std::string& address, std::uint16_t port) {
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::socket s(io);
+    boost::system::error_code ec;
+    s.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address(address), port), ec);
+    return !ec;
+}
+
+// The port of a demo device's URL (rr+tcp://127.0.0.1:PORT/?service=…).
+std::uint16_t url_port(const std::string& url) {
+    const auto colon = url.rfind(':', url.find("/?"));
+    return static_cast<std::uint16_t>(std::stoul(url.substr(colon + 1)));
 }
 
 DemoStarter demo_starter() {
@@ -125,6 +150,52 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     CHECK_THAT(metrics.body(), Catch::Contains("rr_gateway_connections "));
     (*gw)->stop();
     device->shutdown();
+}
+
+// Issue 40: as an official server node, the gateway takes both IP families on one socket (`::` with
+// IPV6_V6ONLY off), and so does its demo node, except while gateway.auth is on (its services then need
+// a login only the gateway has: it stays on loopback). Announces: test/interop/discovery_netns.py.
+TEST_CASE("gateway: the default listen address takes IPv4 and IPv6 on one port, as does the demo node without logins") {
+    GatewayConfig cfg;  // listen: the default
+    REQUIRE(cfg.listen == "::");
+    cfg.local = false;  // tests run side by side: no shared NodeName on this computer
+    cfg.port = 0;
+    cfg.discovery.enabled = false;  // this test is about the listening sockets
+    auto gw = Gateway::start(cfg, demo_starter(), gateway::install_json_api);
+    INFO((gw ? std::string() : gw.error().message));
+    REQUIRE(gw);
+    const auto port = (*gw)->port();
+    const bool v6 = ipv6_loopback();
+    CHECK(gateway_http_get(port, "/livez").result() == bhttp::status::ok);  // IPv4 on the IPv6 socket
+    if (v6) {
+        CHECK(gateway_http_get(port, "/livez", "::1").result() == bhttp::status::ok);
+    } else {
+        WARN("no IPv6 loopback here: only the IPv4 side is checked");
+    }
+    // The demo devices are reached over 127.0.0.1 (IPv4), and the demo node takes IPv6 too.
+    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*gw)->ready());
+    const auto demo_port = url_port((*gw)->device("create")->config().url);
+    CHECK(tcp_connects("127.0.0.1", demo_port));
+    if (v6) CHECK(tcp_connects("::1", demo_port));
+    (*gw)->stop();
+
+    // With gateway.auth the demo node stays on loopback (IPv4), whatever the gateway listens on.
+    const auto dir = std::filesystem::temp_directory_path() / ("rr_gw_dual_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "tokens.txt") << "dual-stack-test-token-0123456789 wall viewer\n";
+    cfg.auth.tokens = (dir / "tokens.txt").string();
+    auto secured = Gateway::start(cfg, demo_starter(), gateway::install_json_api);
+    INFO((secured ? std::string() : secured.error().message));
+    REQUIRE(secured);
+    if (v6) CHECK(gateway_http_get((*secured)->port(), "/livez", "::1").result() == bhttp::status::ok);
+    for (int i = 0; i < 500 && !(*secured)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE((*secured)->ready());
+    const auto secured_demo = url_port((*secured)->device("create")->config().url);
+    CHECK(tcp_connects("127.0.0.1", secured_demo));
+    if (v6) CHECK_FALSE(tcp_connects("::1", secured_demo));
+    (*secured)->stop();
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("a gateway that cannot listen fails to start and says why") {
@@ -264,6 +335,11 @@ TEST_CASE("gateway: with gateway.auth the demo node requires a login only the ga
         INFO(name);
         CHECK((*gw)->demo_node()->find_service(name)->requires_authentication());
     }
+    // GET /api/features needs no login (the dashboard asks it first) and says logins are on.
+    auto features = gateway_http_get((*gw)->port(), "/api/features");
+    CHECK(features.result() == bhttp::status::ok);
+    CHECK(features.body() == "{\"auth\":true,\"discovery\":true}\n");  // JSON answers end with a newline
+    CHECK_FALSE((*gw)->demo_discovery());  // the demo node stays quiet while logins are on
 
     client::IoThreads io(1);
     // Straight to the demo node: no credentials, a made-up password, a gateway user's password.

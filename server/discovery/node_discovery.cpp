@@ -227,6 +227,7 @@ void NodeDiscovery::on_datagram(std::string_view data, const udp::endpoint& from
             if (options_.announce) announce_.announce_soon(now());
         } else if (options_.listen) {
             auto& a = std::get<core::Announce>(packet);
+            if (ignored(a.node_id)) return;
             if (from.address().is_v6() && from.address().to_v6().is_link_local()) {
                 if (auto u = parse_connection_url(a.url); u && is_link_local_host(u->host)) {
                     if (zones_.size() < options_.limits.max_nodes * options_.limits.max_urls_per_node || zones_.count(u->host))
@@ -432,7 +433,12 @@ void NodeDiscovery::refresh_services() {
     asio::post(strand_, [self = shared_from_this()] { self->arm_timer(); });
 }
 
+bool NodeDiscovery::ignored(const NodeID& id) const {
+    return std::find(options_.ignored_nodes.begin(), options_.ignored_nodes.end(), id) != options_.ignored_nodes.end();
+}
+
 rr::discovery::DetectResult NodeDiscovery::add_node(const NodeAnnouncement& announcement) {
+    if (ignored(announcement.node_id)) return core::DetectResult::ignored;
     std::vector<DiscoveryEvent> events;
     core::DetectResult res;
     {

@@ -81,6 +81,9 @@ struct DiscoveryOptions {
     std::size_t max_parallel_interrogations = 4;
     /// Interface names to use (join, send); empty = every interface.
     std::vector<std::string> interfaces;
+    /// Nodes never put in the table, whichever source reports them (as our own NodeID): a gateway's
+    /// own demo node, which announces itself but is part of the gateway.
+    std::vector<NodeID> ignored_nodes;
 };
 
 struct DiscoveryEvent {
@@ -147,6 +150,7 @@ public:
 private:
     NodeDiscovery(boost::asio::any_io_executor executor, DiscoveryOptions options);
     void stop_now();
+    bool ignored(const NodeID& id) const;  ///< in options_.ignored_nodes
     struct Socket;
     void open_sockets();
     std::vector<LocalAddress> addresses() const;

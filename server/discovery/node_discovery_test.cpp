@@ -91,6 +91,32 @@ TEST_CASE("discovery: announces received by UDP fill the table, hostile ones are
     d->stop();
 }
 
+TEST_CASE("discovery: ignored nodes (a gateway's own demo node) never enter the table") {
+    client::IoThreads io(2);
+    auto o = loopback_options();
+    const auto demo = server::random_node_id();
+    o.ignored_nodes = {demo};
+    auto d = NodeDiscovery::create(io.executor(), o);
+    REQUIRE(d->start());
+    auto announce = [](const NodeID& id, const std::string& name) {
+        return std::string(discovery::kAnnounceMagic) + "\n" + id.to_braced_string() + "," + name + "\nrr+tcp://[::1]:1234/?nodeid=" +
+               id.to_string() + "&service=RobotRaconteurServiceIndex\n";
+    };
+    const auto other = server::random_node_id();
+    send_to(d->bound_port(), announce(demo, "gw.demo"));
+    send_to(d->bound_port(), announce(other, "other.node"));
+    REQUIRE(wait_for([&] { return d->node(other).has_value(); }));
+    std::this_thread::sleep_for(100ms);
+    CHECK_FALSE(d->node(demo));
+    CHECK(d->size() == 1);
+    CHECK(d->counters().rejected_total() == 0);  // not a hostile datagram: dropped as our own would be
+    // Another source (rr+local directories) cannot add it either.
+    discovery::NodeAnnouncement a{demo, "gw.demo", {"rr+local:///?nodeid=" + demo.to_string() + "&service=RobotRaconteurServiceIndex"}, "", discovery::NodeSource::local};
+    CHECK(d->add_node(a) == discovery::DetectResult::ignored);
+    CHECK_FALSE(d->node(demo));
+    d->stop();
+}
+
 TEST_CASE("discovery: a flood of distinct NodeIDs keeps the table within its cap") {
     client::IoThreads io(2);
     auto o = loopback_options();

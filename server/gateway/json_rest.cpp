@@ -167,6 +167,10 @@ private:
             if (method == bhttp::verb::options) return preflight();
             return not_allowed(path == "/api/discovered" ? "GET" : "POST");
         }
+        if (path == "/api/features" || path == "/api/whoami") {
+            if (method == bhttp::verb::options) return preflight();
+            return not_allowed("GET");
+        }
 
         auto parsed = parse_target(target);
         if (auto* e = std::get_if<ApiError>(&parsed)) return respond(error_response(req, *e));
@@ -286,6 +290,20 @@ Result<std::string> url_decode(std::string_view text, bool plus_is_space) {
 void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
     auto router = std::make_shared<RestRouter>(std::move(api));
     auto handler = [router](const http::Request& req, http::Responder respond) { router->handle(req, std::move(respond)); };
+    // What this gateway serves of the optional parts (docs/json-api.md "GET /api/features"), so that a
+    // page asks once instead of probing routes that answer 404. Public like /api/login: it says only
+    // which features are on, which the login page and the dashboard need before anyone logs in.
+    http.add_route(bhttp::verb::get, "/api/features", [router](const http::Request& req, http::Responder respond) {
+        const auto& api = *router->api();
+        const bool logins = api.auth() && api.auth()->enabled();
+        respond(json_response(req, 200, nlohmann::json{{"discovery", static_cast<bool>(api.discovery_hooks().list)}, {"auth", logins}}));
+    });
+    // Without logins /api/whoami still answers, as documented ({"auth": false}); with them
+    // install_login_routes serves it.
+    if (!router->api()->auth())
+        http.add_route(bhttp::verb::get, "/api/whoami", [](const http::Request& req, http::Responder respond) {
+            respond(json_response(req, 200, nlohmann::json{{"auth", false}}));
+        });
     // Discovery (docs/json-api.md "Discovery"): the nodes and services found, and "add".
     auto no_discovery = [](const http::Request& req) {
         return error_response(req, api_error(404, MessageErrorType::ResourceNotFound, "discovery is not enabled"));

@@ -402,5 +402,17 @@ TEST_CASE("json api: the installer of rr-gateway serves the same API") {
     auto reply = ws.request(json{{"op", "get"}, {"device", "interop"}, {"member", "ro_value"}});
     CHECK(reply["result"] == json{{"value", 17}});
     ws.close();
+    // Issue 40: what the gateway serves of its optional parts, asked once by the dashboard.
+    auto features = http_get((*g)->port(), "/api/features");
+    CHECK(features.status == 200);
+    CHECK(features.body == json{{"discovery", true}, {"auth", false}});  // discovery is on by default
+    CHECK(http_get((*g)->port(), "/api/whoami").body == json{{"auth", false}});  // served without logins too
+    CHECK(http_request((*g)->port(), bhttp::verb::post, "/api/features").status == 405);
     (*g)->stop();
+    cfg.discovery.enabled = false;
+    auto quiet = app::Gateway::start(cfg, {}, install_json_api);
+    REQUIRE(quiet);
+    CHECK(http_get((*quiet)->port(), "/api/features").body == json{{"discovery", false}, {"auth", false}});
+    CHECK(http_get((*quiet)->port(), "/api/discovered").status == 404);
+    (*quiet)->stop();
 }

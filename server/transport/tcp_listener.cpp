@@ -7,6 +7,7 @@
 #include <array>
 #include <string_view>
 
+#include <boost/asio/ip/v6_only.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/read.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -24,6 +25,33 @@ std::string tcp_base_url(const tcp::endpoint& local) {
     return "rr+tcp://" + host + ":" + std::to_string(local.port()) + "/";
 }
 
+namespace {
+
+// Opens, binds and listens on `ep`. An IPv6 wildcard gets IPV6_V6ONLY off: one socket for both
+// families (IPv4 clients arrive as ::ffff:a.b.c.d), as the official node's TCP server takes both.
+boost::system::error_code open_acceptor(tcp::acceptor& acceptor, const tcp::endpoint& ep) {
+    boost::system::error_code ec;
+    acceptor.open(ep.protocol(), ec);
+    if (!ec && ep.address().is_v6() && ep.address().is_unspecified()) acceptor.set_option(asio::ip::v6_only(false), ec);
+    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    if (!ec) acceptor.bind(ep, ec);
+    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    if (ec) {
+        boost::system::error_code ignored;
+        acceptor.close(ignored);
+    }
+    return ec;
+}
+
+// Errors that say the host has no IPv6 (a kernel booted with ipv6.disable=1, a sandbox that refuses
+// AF_INET6 sockets), as opposed to a port in use or a missing permission.
+bool ipv6_unavailable(const boost::system::error_code& ec) {
+    return ec == asio::error::address_family_not_supported || ec == boost::system::errc::address_not_available ||
+           ec == boost::system::errc::protocol_not_supported;
+}
+
+}  // namespace
+
 Result<std::shared_ptr<TcpListener>> TcpListener::open(asio::any_io_executor executor, const std::string& address,
                                                        std::uint16_t port, std::weak_ptr<ConnectionSink> sink,
                                                        TcpListenerOptions options) {
@@ -33,14 +61,18 @@ Result<std::shared_ptr<TcpListener>> TcpListener::open(asio::any_io_executor exe
     // The acceptor's own strand: stop() closes it while an accept completion may be starting the
     // next accept on another worker thread (a data race ThreadSanitizer reported).
     tcp::acceptor acceptor(asio::make_strand(executor));
-    tcp::endpoint ep(addr, port);
-    acceptor.open(ep.protocol(), ec);
-    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-    if (!ec) acceptor.bind(ep, ec);
-    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    ec = open_acceptor(acceptor, tcp::endpoint(addr, port));
+    std::string note;
+    if (ec && addr.is_v6() && addr.is_unspecified() && ipv6_unavailable(ec)) {
+        // `::` on a host without IPv6: the IPv4 wildcard serves what can be served.
+        note = "IPv6 is not available (" + ec.message() + "): listening on 0.0.0.0 (IPv4 only)";
+        ec = open_acceptor(acceptor, tcp::endpoint(asio::ip::address_v4::any(), port));
+    }
     if (ec)
         return fail(MessageErrorType::IOError, "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message());
-    return std::shared_ptr<TcpListener>(new TcpListener(executor, std::move(acceptor), std::move(sink), std::move(options)));
+    std::shared_ptr<TcpListener> listener(new TcpListener(executor, std::move(acceptor), std::move(sink), std::move(options)));
+    listener->fallback_note_ = std::move(note);
+    return listener;
 }
 
 TcpListener::TcpListener(asio::any_io_executor executor, tcp::acceptor acceptor, std::weak_ptr<ConnectionSink> sink,

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -53,8 +54,10 @@ struct TcpListenerOptions {
 
 class TcpListener : public Listener, public std::enable_shared_from_this<TcpListener> {
 public:
-    /// Binds and listens on `address:port` (port 0 = ephemeral). Errors: InvalidArgument for a bad
-    /// address, IOError with the system message (port in use, …).
+    /// Binds and listens on `address:port` (port 0 = ephemeral). `::` is one dual-stack socket
+    /// (IPV6_V6ONLY off: IPv4 clients too); on a host without IPv6 it falls back to `0.0.0.0`
+    /// (fallback_note() says so). Errors: InvalidArgument for a bad address, IOError with the system
+    /// message (port in use, …).
     static Result<std::shared_ptr<TcpListener>> open(boost::asio::any_io_executor executor, const std::string& address,
                                                      std::uint16_t port, std::weak_ptr<ConnectionSink> sink,
                                                      TcpListenerOptions options);
@@ -67,7 +70,10 @@ public:
     std::vector<std::string> urls() const override;
     void stop() override;
     std::uint16_t port() const;
+    /// The endpoint as bound: `[::]:port` (both families), or `0.0.0.0:port` after the fallback.
     boost::asio::ip::tcp::endpoint local_endpoint() const;
+    /// Why `::` was not used (IPv6 unavailable), for the log; empty when the address was used as given.
+    const std::string& fallback_note() const noexcept { return fallback_note_; }
 
 private:
     TcpListener(boost::asio::any_io_executor executor, boost::asio::ip::tcp::acceptor acceptor,
@@ -82,6 +88,7 @@ private:
     std::weak_ptr<ConnectionSink> sink_;
     TcpListenerOptions options_;
     boost::asio::ip::tcp::endpoint bound_;
+    std::string fallback_note_;
 };
 
 /// Opens an rr+tcp listener for `node` on `address:port` (port 0 = ephemeral), adds it to the node
@@ -89,11 +96,12 @@ private:
 /// always, NodeOptions::address_limiter and on_limited unless `options` names its own. Whoever serves
 /// HTTP or TLS on the port passes its handlers in `options` (`http`; `tls`, built with the node's
 /// NodeID and NodeName for the STARTTLS reply). `NodeT`: server::Node, or anything with io_context(),
-/// options(), add_listener() and weak_from_this() as a ConnectionSink. Returns the bound port.
-/// Errors: those of TcpListener::open().
+/// options(), add_listener() and weak_from_this() as a ConnectionSink. Returns the listener (its
+/// local_endpoint() is the address as bound: see TcpListener::open for `::`). Errors: those of
+/// TcpListener::open().
 template <class NodeT>
-Result<std::uint16_t> listen_tcp(const std::shared_ptr<NodeT>& node, const std::string& address, std::uint16_t port,
-                                 TcpListenerOptions options = {}) {
+Result<std::shared_ptr<TcpListener>> open_tcp_listener(const std::shared_ptr<NodeT>& node, const std::string& address,
+                                                       std::uint16_t port, TcpListenerOptions options = {}) {
     if (!node) return fail(MessageErrorType::InvalidArgument, "no node");
     const auto& node_options = node->options();
     options.first_bytes_timeout = node_options.first_bytes_timeout;
@@ -106,6 +114,15 @@ Result<std::uint16_t> listen_tcp(const std::shared_ptr<NodeT>& node, const std::
     if (!listener) return listener.take_error();
     node->add_listener(*listener);
     (*listener)->start();
+    return *listener;
+}
+
+/// As open_tcp_listener(), returning the bound port only.
+template <class NodeT>
+Result<std::uint16_t> listen_tcp(const std::shared_ptr<NodeT>& node, const std::string& address, std::uint16_t port,
+                                 TcpListenerOptions options = {}) {
+    auto listener = open_tcp_listener(node, address, port, std::move(options));
+    if (!listener) return listener.take_error();
     return (*listener)->port();
 }
 

@@ -28,9 +28,9 @@ export function settings() {
 
 /** A child process whose stdout lines are read for a JSON object holding `key`. */
 class Child {
-  constructor(name, cmd, args, env = undefined) {
+  constructor(name, cmd, args, env = undefined, stdin = "ignore") {
     this.name = name;
-    this.proc = spawn(cmd, args, { stdio: ["ignore", "pipe", "pipe"], env });
+    this.proc = spawn(cmd, args, { stdio: [stdin, "pipe", "pipe"], env });
     this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
     this.lines = readline.createInterface({ input: this.proc.stdout });
     this.stderr = [];
@@ -72,6 +72,17 @@ class Child {
     clearTimeout(timer);
     return status;
   }
+}
+
+/**
+ * Starts `cmd args` and resolves { child, info } with its first stdout line that is JSON holding
+ * `key` (within timeoutMs). `options.stdin`: "pipe" to write to child.proc.stdin (default "ignore").
+ * child.jsonLine(key, ms) reads later lines the same way; child.stop() ends it by its PID.
+ */
+export async function startProcess(name, cmd, args, key = "url", timeoutMs = 60000, options = {}) {
+  const child = new Child(name, cmd, args, options.env, options.stdin ?? "ignore");
+  const info = await child.jsonLine(key, timeoutMs);
+  return { child, info };
 }
 
 /** Starts Reynard headless (rrPort 0 = ephemeral). Resolves { child, info } with the harness's JSON line. */

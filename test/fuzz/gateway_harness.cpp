@@ -55,6 +55,8 @@ GatewayHarness* start() {
     config.demo = true;
     config.demo_port = 0;
     config.local = false;  // no rr+local node directory entries from a fuzzing process
+    // No UDP discovery either (on by default): what the network announces must not change what an input does.
+    config.discovery.enabled = false;
     // The demo devices of demo_starter(), with 16x12 webcam images: a 320x240 frame as JSON takes
     // tens of milliseconds under the sanitizers, which would make every frame-touching input slow.
     server::demo::DemoOptions demo;

@@ -35,7 +35,7 @@ BINARIES = ["rr-gateway", "rr", "rr-robdef", "rr-demo-devices"]
 EXAMPLES = ["demo.yaml", "lab.yaml", "reynard.yaml", "secure.yaml", "nginx-rr-gateway.conf", "nginx-rr-gateway-lan.conf",
             "70-robotraconteur-usb.rules"]
 HARDENING = ["NoNewPrivileges=yes", "ProtectSystem=strict", "ProtectHome=yes", "PrivateTmp=yes", "PrivateDevices=yes",
-             "CapabilityBoundingSet=", "RestrictAddressFamilies=AF_UNIX AF_INET AF_INET6", "SystemCallFilter=@system-service",
+             "CapabilityBoundingSet=", "RestrictAddressFamilies=AF_UNIX AF_INET AF_INET6 AF_NETLINK", "SystemCallFilter=@system-service",
              "MemoryDenyWriteExecute=yes", "User=rr-gateway"]
 
 

@@ -9,7 +9,13 @@
     discovery_official.py find --type T --name NODENAME --wait S
         ClientNodeSetup(), waits S seconds for announces, then RRN.FindServiceByType(T, ["rr+tcp"]) and
         RRN.FindNodeByName(NODENAME, ["rr+tcp"]); prints {"services": [...], "nodes": [...]}.
-        --ipv4-only: listens on IPv4 broadcast only.
+        --ipv4-only: listens on IPv4 broadcast only. --also-name NAME2: FindNodeByName(NAME2) too
+        ("nodes2"). --call: connects to the first service found on node NODENAME with the URLs the
+        search gave and, for an experimental.create.Create, reads DistanceTraveled and calls Drive(0, 0)
+        ("call": {"urls", "DistanceTraveled"} or {"error"}).
+    discovery_official.py call --url URL
+        ClientNodeSetup(), ConnectService(URL) of an experimental.create.Create, reads DistanceTraveled and
+        calls Drive(0, 0); prints {"DistanceTraveled": N} or {"error": "..."}.
     discovery_official.py hostile --iface IF --flood N
         Sends hostile datagrams to FF02::BA86%IF port 48653: truncated, oversized, a bad UUID, a lying
         URL, a global address, then N announces of distinct NodeIDs. Prints {"sent": count}.
@@ -80,10 +86,45 @@ def find(args):
             services.append({"name": s.Name, "nodename": s.NodeName, "nodeid": str(s.NodeID),
                              "root_object_type": s.RootObjectType,
                              "implements": list(s.RootObjectImplements), "urls": list(s.ConnectionURL)})
-        nodes = []
-        for n in RRN.FindNodeByName(args.name, ["rr+tcp"]):
-            nodes.append({"nodename": n.NodeName, "nodeid": str(n.NodeID), "urls": list(n.ConnectionURL)})
-        print(json.dumps({"services": services, "nodes": nodes}), flush=True)
+        def by_name(name):
+            return [{"nodename": n.NodeName, "nodeid": str(n.NodeID), "urls": list(n.ConnectionURL)}
+                    for n in RRN.FindNodeByName(name, ["rr+tcp"])]
+        out = {"services": services, "nodes": by_name(args.name)}
+        if args.also_name:
+            out["nodes2"] = by_name(args.also_name)
+        if args.call:
+            mine = [s for s in services if s["nodename"] == args.name]
+            if not mine:
+                out["call"] = {"error": "no service of node %s found" % args.name}
+            else:
+                try:
+                    c = RRN.ConnectService(mine[0]["urls"])
+                    try:
+                        distance = c.DistanceTraveled
+                        c.Drive(0, 0)
+                        out["call"] = {"urls": mine[0]["urls"], "DistanceTraveled": int(distance)}
+                    finally:
+                        RRN.DisconnectService(c)
+                except Exception as e:  # noqa: BLE001 (reported to the orchestrator)
+                    out["call"] = {"error": "%s: %s" % (type(e).__name__, e)}
+        print(json.dumps(out), flush=True)
+
+
+def call(args):
+    import RobotRaconteur as RR
+    RRN = RR.RobotRaconteurNode.s
+    with RR.ClientNodeSetup():
+        try:
+            c = RRN.ConnectService(args.url)
+            try:
+                distance = c.DistanceTraveled
+                c.Drive(0, 0)
+                out = {"DistanceTraveled": int(distance)}
+            finally:
+                RRN.DisconnectService(c)
+        except Exception as e:  # noqa: BLE001 (reported to the orchestrator)
+            out = {"error": "%s: %s" % (type(e).__name__, e)}
+        print(json.dumps(out), flush=True)
 
 
 def hostile(args):
@@ -128,11 +169,15 @@ def main():
     a.add_argument("--name", required=True)
     a.add_argument("--wait", type=float, default=5)
     a.add_argument("--ipv4-only", action="store_true")
+    a.add_argument("--also-name")
+    a.add_argument("--call", action="store_true")
+    a = sub.add_parser("call")
+    a.add_argument("--url", required=True)
     a = sub.add_parser("hostile")
     a.add_argument("--iface", required=True)
     a.add_argument("--flood", type=int, default=2000)
     args = ap.parse_args()
-    {"serve": serve, "find": find, "hostile": hostile}[args.cmd](args)
+    {"serve": serve, "find": find, "call": call, "hostile": hostile}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -651,8 +651,8 @@ devices:
             expect_status(h3.call("PUT", prop, {"value": 9}), 403)
             expect_status(h3.call("GET", "/api/devices/interop/wires/w_state"), 403)
             expect_status(h3.call("GET", "/api/devices/interop/properties/name?object=child"), 403)
-            # Adding a discovered device takes read, write and call everywhere (alice: operator). This
-            # gateway runs no discovery, so the role check passes into 404 "discovery is not enabled".
+            # Adding a discovered device takes read, write and call everywhere (alice: operator). The role
+            # check passes into 404: no node has this NodeID (NodeNotFound).
             add = {"nodeid": "00000000-0000-0000-0000-000000000001", "service": "x"}
             expect_status(Http(base).call("POST", "/api/discovered/add", add), 401)
             expect_status(h3.call("POST", "/api/discovered/add", add), 403, "RobotRaconteur.PermissionDenied")

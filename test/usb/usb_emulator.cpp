@@ -77,7 +77,12 @@ public:
 
     Result<void> attach() {
         handler_ = umockdev_ioctl_base_new();
-        g_signal_connect(handler_, "handle-ioctl", G_CALLBACK(&DeviceCore::on_ioctl), this);
+        // umockdev calls the handler on its own thread, also for an ioctl that was under way while the
+        // emulator detached and dropped this device: the handler holds a weak reference, not `this`.
+        g_signal_connect_data(handler_, "handle-ioctl", G_CALLBACK(&DeviceCore::on_ioctl),
+                              new std::weak_ptr<DeviceCore>(weak_from_this()),
+                              [](gpointer weak, GClosure*) { delete static_cast<std::weak_ptr<DeviceCore>*>(weak); },
+                              GConnectFlags(0));
         if (!umockdev_testbed_attach_ioctl(tb_, devpath_.c_str(), handler_, nullptr))
             return fail(MessageErrorType::InvalidArgument, "umockdev: cannot attach an ioctl handler to " + devpath_);
         // The device node: a FIFO kept full, drained while URBs wait to be reaped (see the header).
@@ -250,8 +255,13 @@ private:
         signaled_ = false;
     }
 
-    static gboolean on_ioctl(UMockdevIoctlBase*, UMockdevIoctlClient* client, gpointer user) {
-        return static_cast<DeviceCore*>(user)->ioctl(client);
+    static gboolean on_ioctl(UMockdevIoctlBase*, UMockdevIoctlClient* client, gpointer weak) {
+        auto self = static_cast<std::weak_ptr<DeviceCore>*>(weak)->lock();
+        if (!self) {  // the device was dropped: answered as an unplugged device's would be
+            umockdev_ioctl_client_complete(client, -1, ENODEV);
+            return TRUE;
+        }
+        return self->ioctl(client);
     }
 
     gboolean ioctl(UMockdevIoctlClient* client) {

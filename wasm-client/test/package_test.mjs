@@ -33,7 +33,8 @@ try {
   const packed = JSON.parse(run("npm", ["pack", dist, "--pack-destination", tmp, "--json"], { cwd: tmp }))[0];
   const listed = new Set(packed.files.map((f) => f.path));
   const wanted = JSON.parse(fs.readFileSync(path.join(dist, "package.json"), "utf8")).files;
-  ok(wanted.every((f) => listed.has(f)), `npm pack: ${packed.filename} holds ${wanted.join(", ")} (${packed.size} bytes)`);
+  const holds = (f) => (f.endsWith("/") ? [...listed].some((p) => p.startsWith(f)) : listed.has(f));
+  ok(wanted.every(holds), `npm pack: ${packed.filename} holds ${wanted.join(", ")} (${packed.size} bytes)`);
 
   // an empty project installs the tarball (offline: nothing comes from a registry)
   const app = path.join(tmp, "app");
@@ -43,14 +44,27 @@ try {
   const installed = path.join(app, "node_modules/robotraconteur-wasm");
   ok(fs.existsSync(path.join(installed, "robotraconteur_wasm.wasm")) && fs.existsSync(path.join(installed, "index.d.ts")),
     "npm install of the tarball");
+  // the standard types (the dashboard's web/src/std) import from "robotraconteur-wasm/std"
+  fs.writeFileSync(path.join(app, "std_check.mjs"), [
+    'import { RobdefOutline, standardDescriber, typedText, decodeImage, imageToBitmap, formatUuid, FrameDecoder } from "robotraconteur-wasm/std";',
+    'const outline = new RobdefOutline({ "t.s": "service t.s\\nstruct P\\n    field double x\\nend\\n" });',
+    'const d = standardDescriber(outline).describe("P", "t.s");',
+    'const img = decodeImage({ image_info: { width: 1, height: 1, step: 3, encoding: 0x1002 }, data: Uint8Array.of(1, 2, 3) });',
+    'const ok = typedText({ x: 1.5 }, d) === "{x: 1.5}" && img.ok && Array.from(img.data).join() === "3,2,1,255"',
+    '  && formatUuid({ uuid_bytes: new Uint8Array(16).fill(255) }) === "ffffffff-ffff-ffff-ffff-ffffffffffff"',
+    '  && typeof imageToBitmap === "function" && typeof FrameDecoder === "function";',
+    'console.log(ok ? "std: ok" : "std: wrong");',
+  ].join("\n"));
+  const std = run(process.execPath, [path.join(app, "std_check.mjs")], { cwd: app });
+  ok(/std: ok/.test(std), `import from "robotraconteur-wasm/std" (standard types): ${std.trim()}`);
   // ws (the optional peer dependency for node) from this folder's node_modules
   fs.symlinkSync(path.join(pkgRoot, "node_modules/ws"), path.join(app, "node_modules/ws"), "dir");
 
-  for (const f of ["usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
+  for (const f of ["usage.ts", "std_usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
   // tsc --noEmit: usage.ts is accepted
   try {
     run(process.execPath, [tsc, "--noEmit", "-p", app]);
-    ok(true, "tsc --noEmit (strict): usage.ts type-checks against index.d.ts");
+    ok(true, "tsc --noEmit (strict): usage.ts and std_usage.ts type-check against index.d.ts and std/index.d.ts");
   } catch (e) {
     ok(false, `tsc --noEmit usage.ts:\n${e.stdout}${e.stderr}`);
   }

@@ -13,6 +13,11 @@ import { RobdefOutline } from "./robdef_outline.js";
 import { DefinitionView } from "./definition_view.js";
 import { ObjectPanel } from "./object_panel.js";
 import { EventLog } from "./event_log.js";
+import { viewContext } from "./views/context.js";
+import { standardPanels } from "./panels/standard.js";
+
+// The panels chosen by object type (panels/standard.js), the same for every device.
+const PANELS = standardPanels();
 
 // Device logins of this page, by device name: kept in memory only (never in localStorage,
 // sessionStorage or cookies), so that switching between devices does not ask again; a reload forgets them.
@@ -161,8 +166,10 @@ export class DeviceView {
     const outline = new RobdefOutline(client.$definitions);
     this.definitions = new DefinitionView(this.defBox, outline, `def-${this.name}`);
     this.typeEl.textContent = client.$type;
+    // the device's types described once, from the definitions it sent (views/context.js)
+    const view = viewContext(outline);
     this.panel = new ObjectPanel(this.members, {
-      obj: client, outline, definitions: this.definitions, log: this.log, memory: this.memory, path: "",
+      obj: client, outline, view, panels: PANELS, definitions: this.definitions, log: this.log, memory: this.memory, path: "",
     });
   }
 

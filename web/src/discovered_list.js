@@ -1,9 +1,10 @@
 // The nodes and services the gateway's discovery found (GET api/discovered, docs/json-api.md
 // "Discovery"), polled every 2 s below the device list: network (udp), this computer's rr+local nodes
 // (local) and USB boards (usb). A service no gateway device serves yet has an "Add" button that turns it
-// into a device for this run (POST api/discovered/add); the device list then shows it. Without
-// discovery (404) the section stays hidden. USB boards the gateway cannot use are listed with the
-// reason (e.g. the udev rule to install).
+// into a device for this run (POST api/discovered/add); the device list then shows it. The page starts
+// it only when GET api/features says discovery is on; should api/discovered answer 404 anyway (turned
+// off since), the section hides and polling stops. USB boards the gateway cannot use are listed with
+// the reason (e.g. the udev rule to install).
 
 import { h, errorText } from "./dom.js";
 
@@ -65,11 +66,17 @@ export class DiscoveredList extends EventTarget {
     this.timer = setInterval(() => this.poll(), POLL_MS);
   }
 
+  stop() {
+    clearInterval(this.timer);
+    this.timer = undefined;
+  }
+
   async poll() {
     try {
       const r = await fetch("api/discovered", { headers: { Accept: "application/json" }, cache: "no-store" });
       if (r.status === 404) {
-        this.section.hidden = true;  // discovery is off
+        this.section.hidden = true;  // discovery is off: nothing to ask again
+        this.stop();
         return;
       }
       if (!r.ok) throw new Error(`GET api/discovered: HTTP ${r.status}`);

@@ -5,6 +5,7 @@ import { h } from "./dom.js";
 import { DeviceList } from "./device_list.js";
 import { DeviceView } from "./device_view.js";
 import { DiscoveredList } from "./discovered_list.js";
+import { loadFeatures } from "./features.js";
 
 const list = new DeviceList(document.getElementById("device-list"), document.getElementById("gateway-status"));
 const main = document.getElementById("device-view");
@@ -36,11 +37,15 @@ discovered.addEventListener("added", (ev) => {
   if (ev.detail?.name) location.hash = `#/${encodeURIComponent(ev.detail.name)}`;
 });
 list.start();
-discovered.start();
 route();
-showUser();
+// The optional parts only when the gateway serves them (GET api/features, asked once): no polling of
+// routes that answer 404.
+loadFeatures().then((features) => {
+  if (features.discovery) discovered.start();
+  if (features.auth) showUser();
+});
 
-// With logins on (GET api/whoami says auth: true): who is logged in, and a way out.
+// With logins on: who is logged in, and a way out.
 async function showUser() {
   try {
     const r = await fetch("api/whoami", { headers: { Accept: "application/json" }, cache: "no-store" });
@@ -53,5 +58,5 @@ async function showUser() {
       location.replace("login.html");
     });
     document.querySelector(".topbar").append(h("span", { class: "user-box" }, h("span", { id: "user-name", text: me.user }), logout));
-  } catch { /* an old gateway without api/whoami */ }
+  } catch { /* the gateway went away: the device list says so */ }
 }

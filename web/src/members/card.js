@@ -21,10 +21,12 @@ function modifiers(member) {
 }
 
 /**
- * A member card. ctx.linkType(name) makes a link to a named type's definition (or null).
+ * A member card. ctx.linkType(name) makes a link to a named type's definition (or null). `described`
+ * (the member's descriptor, views/context.js): when the device's definition of a standard type has
+ * another layout than the one its renderer reads, the card says so and the values are shown plainly.
  * Returns { el, body, tools, showError(err), clearError() }.
  */
-export function memberCard(ctx, member) {
+export function memberCard(ctx, member, described = null) {
   const typeEl = h("code", { class: "member-type" });
   const words = signature(member).split(/([\s,()<>{}\[\]]+)/);
   for (const w of words) {
@@ -35,6 +37,8 @@ export function memberCard(ctx, member) {
   const error = h("div", { class: "member-error", role: "alert", hidden: true });
   const tools = h("div", { class: "member-tools" });
   const body = h("div", { class: "member-body" });
+  const mismatch = described?.type?.mismatch ?? described?.type?.element?.mismatch;
+  if (mismatch) body.append(h("div", { class: "hint type-fallback", text: `shown as plain values: ${mismatch}` }));
   const el = h("section", { class: `member member-${member.kind}`, dataset: { member: member.name, kind: member.kind } },
     h("header", { class: "member-title" },
       h("span", { class: "member-name", text: member.name }),

@@ -1,18 +1,25 @@
-// An event: subscribed while the device page is open; each firing goes to the event log.
+// An event: subscribed while the device page is open; each firing goes to the event log, its
+// arguments as readable text (std/typed_text.js) typed by the event's parameters.
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
 import { formatValue } from "../value_codec.js";
+import { typedText } from "../std/typed_text.js";
 
-export function eventView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function eventView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
+  const scope = ctx.outline?.serviceOfObject?.(ctx.obj.$type);
+  const params = (member.params || []).map((p) => {
+    try { return ctx.view?.types?.describe(p.type, scope) ?? null; } catch { return null; }
+  });
+  const text = (a, i) => (params[i] ? typedText(a, params[i], ctx.view?.text) : formatValue(a));
   const count = h("output", { class: "count", text: "0" });
   card.body.append(h("div", {}, "received: ", count));
   let n = 0, off = null;
   try {
     off = ctx.obj[member.name].on((...args) => {
       count.textContent = String(++n);
-      ctx.log.add("event", ctx.path + member.name, args.length ? args.map((a) => formatValue(a)).join(", ") : "(no arguments)");
+      ctx.log.add("event", ctx.path + member.name, args.length ? args.map(text).join(", ") : "(no arguments)");
     });
   } catch (e) {
     card.showError(e);

@@ -1,15 +1,21 @@
 // A function: a form with one input per parameter (typed from the robdef), a Call button, and the
-// result (or the device's error) shown in place. Generator functions list the items they yield.
+// result (or the device's error) shown in place as readable text (std/typed_text.js), standard
+// pictures drawn (views/image_set.js). Generator functions list the items they yield.
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
 import { formatValue, parseInput } from "../value_codec.js";
 import { asImage, drawImage } from "../image_view.js";
+import { typedText } from "../std/typed_text.js";
+import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
 
 const MAX_GENERATOR_ITEMS = 100;
 
-export function functionView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function functionView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
+  const type = described?.type ?? null;
+  const text = (v) => (type ? typedText(v, type, ctx.view?.text, 32) : formatValue(v));
+  let images = null;
   const inputs = (member.params || []).map((p) => ({ param: p, input: valueInput(p.type, p.name, ctx.outline, ctx.scope) }));
   const result = h("output", { class: "result" });
   const canvas = h("canvas", { class: "image", hidden: true });
@@ -43,7 +49,12 @@ export function functionView(ctx, member) {
   }
 
   function show(r) {
-    result.textContent = member.type === "void" ? "done" : formatValue(r);
+    result.textContent = member.type === "void" ? "done" : text(r);
+    if (type && hasImages(type)) {
+      images ??= new ImageSet(card.body, { encodings: ctx.view?.encodings, clockEnum: ctx.view?.clockEnum, label: member.name });
+      images.push(picturesOf(r, type));
+      return;
+    }
     const image = asImage(r);
     canvas.hidden = !image;
     if (image) drawImage(canvas, image);
@@ -54,7 +65,7 @@ export function functionView(ctx, member) {
     result.textContent = "";
     for await (const item of gen) {
       items.push(item);
-      result.append(h("div", { class: "generator-item", text: `${items.length}: ${formatValue(item)}` }));
+      result.append(h("div", { class: "generator-item", text: `${items.length}: ${text(item)}` }));
       if (items.length >= MAX_GENERATOR_ITEMS) {
         if (typeof gen.return === "function") await gen.return();
         break;
@@ -69,5 +80,5 @@ export function functionView(ctx, member) {
       h("small", { class: "param-type", text: param.type }))),
     button);
   card.body.append(form, result, canvas);
-  return { el: card.el, dispose() {} };
+  return { el: card.el, dispose() { images?.dispose(); } };
 }

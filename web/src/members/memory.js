@@ -7,6 +7,7 @@ import { memberCard } from "./card.js";
 import { parseInput, formatValue } from "../value_codec.js";
 import { parseType, parseNumber } from "../rr_types.js";
 import { asImage, drawImage } from "../image_view.js";
+import { typedText } from "../std/typed_text.js";
 
 const MAX_CELLS = 1024;
 const PER_ROW = 16;
@@ -15,8 +16,9 @@ function numbers(text) {
   return String(text).split(/[\s,;]+/).filter(Boolean).map((s) => parseNumber("uint64", s)).map(Number);
 }
 
-export function memoryView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function memoryView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
+  const item = described?.type?.element ?? null;  // pods and namedarrays read as their own text (UUIDs, times)
   const mem = ctx.obj[member.name];
   const t = parseType(member.type);
   const multidim = t.array === "multidim";
@@ -60,7 +62,7 @@ export function memoryView(ctx, member) {
     const shown = Array.from(values.slice(0, MAX_CELLS));
     const hex = t.base === "uint8";
     const perRow = shown.every((x) => typeof x === "number" || typeof x === "bigint") ? PER_ROW : 1;
-    const cell = (x) => (hex ? x.toString(16).padStart(2, "0") : formatValue(x));
+    const cell = (x) => (hex ? x.toString(16).padStart(2, "0") : item && typeof x === "object" ? typedText(x, item, ctx.view?.text) : formatValue(x));
     const rows = [];
     for (let i = 0; i < shown.length; i += perRow) {
       const offset = multidim ? i : s[0] + i;

@@ -10,8 +10,8 @@ import { StreamDisplay } from "./stream_display.js";
 
 const REOPEN_MS = 2000;
 
-export function pipeView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function pipeView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
   const pipe = ctx.obj[member.name];
   const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
   const memoryKey = `${ctx.path}${member.name}:open`;
@@ -27,7 +27,7 @@ export function pipeView(ctx, member) {
       if (disposed) { await ep.close(); return; }
       ctx.memory.set(memoryKey, true);
       card.clearError();
-      display = new StreamDisplay(card.body, qualified);
+      display = new StreamDisplay(card.body, { qualifiedType: qualified, type: described?.type, view: ctx.view, label: member.name });
       ep.onPacket((v) => display.push(v));
       const mine = ep;
       ep.onClose((err) => {

@@ -1,5 +1,6 @@
-// A property: its value (read on open), an editor typed from the robdef for writable properties, and
-// for numeric properties a live plot fed by polling get().
+// A property: its value (read on open) as readable text (std/typed_text.js: UUIDs, times, poses,
+// enums and flags by name), standard pictures drawn (views/image_set.js), an editor typed from the
+// robdef for writable properties, and for numeric properties a live plot fed by polling get().
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
@@ -7,26 +8,48 @@ import { formatValue, parseInput, editorText } from "../value_codec.js";
 import { isPlottable } from "../rr_types.js";
 import { numericFields } from "../numeric_fields.js";
 import { LivePlot } from "../live_plot.js";
+import { memberText } from "../std/typed_text.js";
+import { typedNumericFields } from "../std/plot_fields.js";
+import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
 
 const POLL_MS = 250;
 
-export function propertyView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function propertyView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
   const prop = ctx.obj[member.name];
   const out = h("output", { class: "value" });
-  let plot = null, timer = 0, inFlight = false, disposed = false, reads = 0;
+  let plot = null, timer = 0, inFlight = false, disposed = false, reads = 0, images = null;
+
+  // pictures: their bytes are not written out as editor text (megabytes), unless the property is writable
+  const pictures = !!described && hasImages(described.type);
+  const wantsText = !pictures || !member.readonly;
+
+  function show(v, text) {
+    if (wantsText) out.dataset.value = text;
+    out.textContent = described ? memberText(v, described, ctx.view?.text, 32) : formatValue(v);
+    if (pictures) {
+      images ??= new ImageSet(card.body, { encodings: ctx.view?.encodings, clockEnum: ctx.view?.clockEnum, label: member.name });
+      images.push(picturesOf(v, described.type));
+    }
+  }
+
+  function plotPairs(v) {
+    if (!described) return numericFields(v, null, member.name);
+    return typedNumericFields(v, described.type, member.name).map(([n, x, hide]) => [n, x, hide || !!described.flags]);
+  }
 
   async function read() {
     inFlight = true;
     try {
       const v = await prop.get();
       if (disposed) return undefined;
-      out.textContent = formatValue(v);
-      out.dataset.value = editorText(member.type, v);
+      const text = wantsText ? editorText(member.type, v) : "";  // before the pictures' bytes go to their decoder
+      const pairs = plot ? plotPairs(v) : null;
+      show(v, text);
+      if (pairs) plot?.push(pairs);
       out.dataset.reads = String(++reads);
       card.clearError();
-      plot?.push(numericFields(v, null, member.name));
-      return v;
+      return { v, text };
     } catch (e) {
       if (!disposed) card.showError(e);
       return undefined;
@@ -74,9 +97,9 @@ export function propertyView(ctx, member) {
     setPlotting(on);
   }
 
-  if (!member.writeonly) read().then((v) => { if (input && v !== undefined) input.write(editorText(member.type, v)); });
+  if (!member.writeonly) read().then((r) => { if (input && r !== undefined) input.write(r.text); });
   return {
     el: card.el,
-    dispose() { disposed = true; clearInterval(timer); plot?.dispose(); },
+    dispose() { disposed = true; clearInterval(timer); plot?.dispose(); images?.dispose(); },
   };
 }

@@ -1,57 +1,96 @@
-// What wires and pipes show for each value: an image on a canvas when the value is one, else the
-// value's text and a live plot of its numbers. Drawing waits for the next animation frame, so a fast
-// stream costs one draw per frame.
+// What wires and pipes show for each value: standard pictures (Image, CompressedImage, or arrays and
+// maps of them) in FrameViews, other image-like values (a struct with width, height, data, as the
+// demo webcam's WebcamImage) on a canvas, and otherwise the value's readable text (std/typed_text.js)
+// and a live plot of its numbers (std/plot_fields.js: no UUID bytes, identifiers or clock fields; the
+// value's own timestamp on the time axis when it carries one). Text and the plain canvas are drawn at
+// most once per animation frame; the newest value wins.
 
 import { h } from "../dom.js";
 import { formatValue } from "../value_codec.js";
 import { asImage, drawImage } from "../image_view.js";
-import { numericFields } from "../numeric_fields.js";
 import { LivePlot } from "../live_plot.js";
+import { typedText } from "../std/typed_text.js";
+import { plotSample } from "../views/plot_sample.js";
+import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
 
 export class StreamDisplay {
-  /** @param {HTMLElement} parent @param {string|null} qualifiedType  the value's struct type, for known layouts */
-  constructor(parent, qualifiedType) {
-    this.qualifiedType = qualifiedType;
+  /**
+   * @param {HTMLElement} parent
+   * @param {object} [opts]
+   * @param {string|null} [opts.qualifiedType]  the value's named type, for known byte layouts (packet_layouts.js)
+   * @param {object|null} [opts.type]  the value's type descriptor (std/describe.js)
+   * @param {object} [opts.view]  the device's view context (views/context.js)
+   * @param {string} [opts.label]  what the pictures are called
+   */
+  constructor(parent, opts = {}) {
+    this.qualifiedType = opts.qualifiedType ?? null;
+    this.type = opts.type ?? null;
+    this.view = opts.view ?? null;
+    this.label = opts.label || "stream";
+    this.pictures = hasImages(this.type);
     this.text = h("output", { class: "value" });
     this.canvas = h("canvas", { class: "image", hidden: true });
     this.stats = h("span", { class: "stream-stats" });
     this.el = h("div", { class: "stream" }, this.stats, this.text, this.canvas);
     parent.append(this.el);
+    this.images = null;
     this.plot = null;
     this.latest = undefined;
+    this.latestText = null;
     this.count = 0;
     this.frame = 0;
     this.rateStart = performance.now();
     this.rateCount = 0;
+    this.lastT = -Infinity;
   }
 
-  /** Shows `value` (and adds its numbers to the plot now, so no sample is lost). */
+  /** Shows `value` (pictures go to their decoder now; numbers to the plot now, so no sample is lost). */
   push(value) {
     this.latest = value;
     this.count++;
     this.rateCount++;
-    const image = asImage(value);
-    if (!image) {
-      const pairs = numericFields(value, this.qualifiedType);
-      if (pairs.length) {
-        this.plot ??= new LivePlot(this.el);
-        this.plot.push(pairs);
+    try {
+      if (this.pictures) {
+        // text first: the pictures' bytes may be handed to the decoder's Worker
+        this.latestText = this.describe(value);
+        this.images ??= new ImageSet(this.el, { encodings: this.view?.encodings, clockEnum: this.view?.clockEnum, label: this.label });
+        this.images.push(picturesOf(value, this.type));
+      } else if (!asImage(value)) {
+        const { pairs, t } = plotSample(value, this.type, this.qualifiedType);
+        if (pairs.length) {
+          this.plot ??= new LivePlot(this.el);
+          // the value's own clock when it has one (never going back: the plot's times must rise)
+          const time = t !== null && t >= this.lastT ? t : undefined;
+          if (time !== undefined) this.lastT = time;
+          this.plot.push(pairs, time);
+        }
       }
+    } catch (e) {
+      this.latestText = `(not shown: ${e?.message || e})`;
     }
     if (!this.frame) this.frame = requestAnimationFrame(() => this.draw());
+  }
+
+  describe(v) {
+    if (!this.type) return formatValue(v, 16);
+    return typedText(v, this.type, this.view?.text, 16);
   }
 
   draw() {
     this.frame = 0;
     const v = this.latest;
-    const image = asImage(v);
-    this.canvas.hidden = !image;
-    if (image) {
-      drawImage(this.canvas, image);
-      this.canvas.dataset.frames = String(this.count);
-      this.text.textContent = `${image.width}×${image.height}, ${image.channels} channel(s)`;
+    if (this.pictures) {
+      this.text.textContent = this.latestText ?? "";
     } else {
-      this.text.textContent = formatValue(v, 16);
+      const image = asImage(v);
+      this.canvas.hidden = !image;
+      if (image) {
+        drawImage(this.canvas, image);
+        this.canvas.dataset.frames = String(this.count);
+        this.text.textContent = `${image.width}×${image.height}, ${image.channels} channel(s)`;
+      } else {
+        try { this.text.textContent = this.describe(v); } catch (e) { this.text.textContent = formatValue(v, 16); }
+      }
     }
     const now = performance.now();
     if (now - this.rateStart >= 1000) {
@@ -65,6 +104,7 @@ export class StreamDisplay {
 
   dispose() {
     if (this.frame) cancelAnimationFrame(this.frame);
+    this.images?.dispose();
     this.plot?.dispose();
     this.el.remove();
   }

@@ -1,27 +1,30 @@
 // A wire: connected while the device page is open (readonly and read-write wires), newest in-value
 // shown and plotted; writable wires get an out-value editor. Peek reads the value without connecting.
-// A wire connection that closes while the page is open is connected again after REOPEN_MS.
+// A wire connection that closes while the page is open is connected again after REOPEN_MS. The
+// connection is shared with the panels that show the same wire (views/shared_wire.js).
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
 import { formatValue, parseInput } from "../value_codec.js";
 import { parseType } from "../rr_types.js";
+import { memberText } from "../std/typed_text.js";
 import { StreamDisplay } from "./stream_display.js";
+import { connectShared } from "../views/shared_wire.js";
 
 const REOPEN_MS = 2000;
 
-export function wireView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function wireView(ctx, member, _ObjectPanel, described = null) {
+  const card = memberCard(ctx, member, described);
   const wire = ctx.obj[member.name];
   const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
   let conn = null, display = null, disposed = false, reopen = 0;
 
   async function open() {
     try {
-      conn = await wire.connect();
+      conn = await connectShared(ctx.obj, member.name);
       if (disposed) { await conn.close(); return; }
       card.clearError();
-      display ??= new StreamDisplay(card.body, qualified);
+      display ??= new StreamDisplay(card.body, { qualifiedType: qualified, type: described?.type, view: ctx.view, label: member.name });
       conn.onChange((v) => display.push(v));
       conn.onClose((err) => {
         conn = null;
@@ -45,7 +48,11 @@ export function wireView(ctx, member) {
   if (!member.writeonly) {
     card.tools.append(h("button", {
       type: "button", class: "small", text: "Peek", onclick: async () => {
-        try { peekOut.textContent = formatValue(await wire.peekInValue()); card.clearError(); } catch (e) { card.showError(e); }
+        try {
+          const v = await wire.peekInValue();
+          peekOut.textContent = described ? memberText(v, described, ctx.view?.text) : formatValue(v);
+          card.clearError();
+        } catch (e) { card.showError(e); }
       },
     }));
   }

@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""A simulated three-joint arm on the official abstract robot base (PyPI robotraconteur-abstract-robot,
+pinned in test/interop/requirements.txt), served as a standard com.robotraconteur.robotics.robot.Robot.
+
+Its RobotInfo comes from sim_robot_info.yml through RobotRaconteurCompanion's InfoFileLoader and its
+service attributes from AttributesUtil, as the robot drivers do. The simulation (SimArm, a subclass
+of AbstractRobot) is the "controller" the base class talks to: every loop step it reports the joint
+positions, the tool pose by forward kinematics of the chain in the RobotInfo, and ready/enabled;
+commands from the base class (jog, position commands) move the joints toward their targets at the
+joint's velocity limit. It starts disabled; enable() (or --enabled) switches the motors on.
+
+Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=robot", "port": P, "device_uuid": "...",
+"joint_names": [...]}.
+
+Usage: sim_robot.py [--info FILE] [--enabled] [--period 0.02] [--max-lifetime 300]
+"""
+
+import argparse
+import os
+import sys
+import threading
+import uuid
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
+
+import numpy as np  # noqa: E402
+import general_robotics_toolbox as rox  # noqa: E402
+import RobotRaconteur as RR  # noqa: E402
+import RobotRaconteurCompanion as RRC  # noqa: E402
+from RobotRaconteurCompanion.Util.InfoFileLoader import InfoFileLoader  # noqa: E402
+from RobotRaconteurCompanion.Util.AttributesUtil import AttributesUtil  # noqa: E402
+from robotraconteur_abstract_robot import AbstractRobot  # noqa: E402
+
+RRN = RR.RobotRaconteurNode.s
+
+
+class SimArm(AbstractRobot):
+    """The arm's joints follow the base class's commands at the velocity limits of the RobotInfo."""
+
+    def __init__(self, robot_info, period, enabled):
+        super().__init__(robot_info, 0)
+        self._update_period = period
+        self._base_set_controller_state = True
+        self._uses_homing = False
+        self._has_position_command = True
+        self._has_velocity_command = False
+        self._has_jog_command = True
+        self._q = np.zeros(self._joint_count)
+        self._q_target = None
+        self._max_speed = np.array([j.joint_limits.velocity for j in robot_info.joint_info])
+        self._sim_lock = threading.Lock()
+        self._motors_on = enabled
+        self._last_step = None
+
+    # the "controller": feedback each step, then the base class's own step
+    def _run_timestep(self, now):
+        with self._sim_lock:
+            dt = 0.0 if self._last_step is None else now - self._last_step
+            self._last_step = now
+            if self._q_target is not None and self._motors_on:
+                step = np.clip(self._q_target - self._q, -self._max_speed * dt, self._max_speed * dt)
+                self._q = self._q + step
+            q = self._q.copy()
+            on = self._motors_on
+        pose = rox.fwdkin(self._rox_robots[0], q)
+        with self._lock:
+            self._joint_position = q
+            self._joint_velocity = np.zeros(self._joint_count)
+            self._joint_effort = np.zeros(self._joint_count)
+            self._endpoint_pose = [self._geometry_util.rox_transform_to_pose(pose)]
+            self._endpoint_vel = [np.zeros((1,), dtype=self._spatial_velocity_dtype)[0]]
+            self._ready = on
+            self._enabled = on
+            self._last_robot_state = now
+            self._last_joint_state = now
+            self._last_endpoint_state = now
+        super()._run_timestep(now)
+
+    def _send_robot_command(self, now, joint_pos_cmd, joint_vel_cmd):
+        if joint_pos_cmd is not None:
+            with self._sim_lock:
+                self._q_target = np.array(joint_pos_cmd, dtype=np.float64)
+
+    def _send_enable(self, handler):
+        with self._sim_lock:
+            self._motors_on = True
+        handler(None)
+
+    def _send_disable(self, handler):
+        with self._sim_lock:
+            self._motors_on = False
+        handler(None)
+
+    def _send_reset_errors(self, handler):
+        handler(None)
+
+
+def main():
+    die_with_parent()
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--info", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "sim_robot_info.yml"))
+    ap.add_argument("--enabled", action="store_true", help="motors on from the start")
+    ap.add_argument("--period", type=float, default=0.02, help="loop period in seconds")
+    ap.add_argument("--max-lifetime", type=float, default=300)
+    args = ap.parse_args()
+    port = free_port()
+    with RR.ServerNodeSetup("experimental.sim_arm", port, argv=["sim_robot"] + node_flags(port)):
+        RRC.RegisterStdRobDefServiceTypes(RRN)
+        robot_info, _ = InfoFileLoader(RRN).LoadInfoFile(args.info, "com.robotraconteur.robotics.robot.RobotInfo", "robot")
+        attributes = AttributesUtil(RRN).GetDefaultServiceAttributesFromDeviceInfo(robot_info.device_info)
+        robot = SimArm(robot_info, args.period, args.enabled)
+        robot._start_robot()
+        ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot)
+        ctx.SetServiceAttributes(attributes)
+        device_uuid = str(uuid.UUID(bytes=bytes(robot_info.device_info.device.uuid["uuid_bytes"].tobytes())))
+        ready(url=f"rr+tcp://127.0.0.1:{port}/?service=robot", port=port, device_uuid=device_uuid,
+              joint_names=list(robot._joint_names), pid=os.getpid())
+        wait_for_stop(args.max_lifetime)
+        log("robot", "stopping")
+        robot._close()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,13 @@
+// The panels of the standard object types, gathered: the device card (any object with a standard
+// device_info property), the camera panel (com.robotraconteur.imaging.Camera) and the robot panel
+// (com.robotraconteur.robotics.robot.Robot).
+
+import { PanelRegistry } from "./registry.js";
+import { deviceCardPanel } from "./device_card.js";
+import { cameraPanel } from "./camera_panel.js";
+import { robotPanel } from "./robot_panel.js";
+
+/** A new registry holding the standard panels (add your own with register()). */
+export function standardPanels() {
+  return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel);
+}

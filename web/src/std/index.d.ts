@@ -1,0 +1,188 @@
+// Type declarations of the standard-type modules (index.js), for TypeScript users of the client
+// package: import { ... } from "robotraconteur-wasm/std". Values are as the client package gives them
+// (docs: wasm-client README "Values"); see docs/dashboard.md "Standard types".
+
+/** A value of an enum as the device's definitions declare it. */
+export interface EnumValue { name: string; value: number }
+
+/** What is wrong with a frame: codes of checkImage, checkCompressedImage and imageToBitmap. */
+export interface ImageError { code: string; message: string }
+
+/** A standard Image or CompressedImage value: the fields the decoders read. */
+export interface ImageValue {
+  image_info: { width: number; height: number; step: number; encoding: number | string; [field: string]: unknown };
+  data: Uint8Array | Uint8ClampedArray;
+}
+
+export interface ImageOptions {
+  /** The device's ImageEncoding values (the standard numbering without them). */
+  encodings?: EnumValue[];
+  depthRange?: { min: number; max: number };
+  floatRange?: { min: number; max: number };
+  out?: Uint8ClampedArray;
+}
+
+export type DecodeResult =
+  | { ok: true; width: number; height: number; data: Uint8ClampedArray; encoding: string; range?: { min: number; max: number } | null; note?: string }
+  | { ok: false; error: ImageError };
+
+export interface CompressedFormat { name: string; mime: string; drawable: boolean }
+
+export type BitmapResult =
+  | { ok: true; bitmap: ImageBitmap; width: number; height: number; encoding?: string; format?: CompressedFormat;
+      range?: { min: number; max: number } | null; note?: string }
+  | { ok: false; error: ImageError };
+
+export function checkImage(value: unknown, encodings?: EnumValue[]):
+  | { ok: true; width: number; height: number; step: number; encoding: string; format: object; note?: string }
+  | { ok: false; error: ImageError };
+export function decodeImage(value: unknown, options?: ImageOptions): DecodeResult;
+export function compressedFormat(data: unknown): CompressedFormat | null;
+export function checkCompressedImage(value: unknown):
+  | { ok: true; format: CompressedFormat; width: number; height: number }
+  | { ok: false; format?: CompressedFormat; error: ImageError };
+export function imageToBitmap(value: unknown, options?: ImageOptions & {
+  compressed?: boolean;
+  createImageBitmap?: (source: ImageBitmapSource) => Promise<ImageBitmap>;
+  ImageData?: typeof ImageData;
+}): Promise<BitmapResult>;
+export function isCompressedEncoding(value: unknown, encodings?: EnumValue[]): boolean;
+export const STANDARD_IMAGE_ENCODINGS: Readonly<Record<string, number>>;
+export const PIXEL_FORMATS: Readonly<Record<string, Readonly<{ kind: string; bytes: number; sample: string }>>>;
+export const COMPRESSED_FORMATS: ReadonlyArray<Readonly<{ name: string; mime: string; drawable: boolean }>>;
+export function encodingNames(values?: EnumValue[]): Map<number, string>;
+
+/** Frames of a stream decoded in a Worker, the newest winning (frame_decoder.js). */
+export class FrameDecoder {
+  constructor(options: {
+    onResult: (result: BitmapResult, meta: Record<string, unknown> & { seq: number }) => void;
+    Worker?: typeof Worker | null;
+    workerUrl?: string | URL;
+    decode?: (value: ImageValue, options: ImageOptions & { compressed: boolean }) => Promise<BitmapResult>;
+    transfer?: boolean;
+  });
+  readonly inWorker: boolean;
+  readonly stats: { submitted: number; decoded: number; failed: number; dropped: number; refused: number };
+  /** Queues a frame; returns the refusal ({ok: false}) when its header is wrong, else null. */
+  submit(value: unknown, options?: ImageOptions & { compressed?: boolean }, meta?: Record<string, unknown>):
+    { ok: false; error: ImageError; format?: CompressedFormat } | null;
+  dispose(): void;
+}
+
+/** The named types of a device's definitions ({ service name: robdef text }, as `$definitions`). */
+export class RobdefOutline {
+  constructor(definitions: Record<string, string>);
+  readonly types: Map<string, OutlineEntry>;
+  typeOf(name: string, scope?: string | null): OutlineEntry | null;
+  enumOf(name: string, scope?: string | null): EnumValue[] | null;
+  serviceOfObject(qualified: string): string | null;
+}
+
+export interface OutlineEntry {
+  kind: "struct" | "pod" | "namedarray" | "object" | "enum";
+  name: string;
+  qualified: string;
+  service: string;
+  line: number;
+  fields: Array<{ type: string; name: string; line: number }>;
+  values: EnumValue[];
+  members: Array<{ kind: string; text: string; line: number }>;
+}
+
+export interface Renderer {
+  type: string;
+  layout?: Record<string, string | string[]>;
+  text?: (value: any, ctx: object) => string;
+  image?: (value: any, ctx: object) => DecodeResult;
+  compressed?: (value: any) => ReturnType<typeof checkCompressedImage>;
+}
+
+export interface TypeDescriptor {
+  text: string;
+  qualifiedText: string;
+  base: string;
+  array: "vector" | "multidim" | null;
+  dims: number[] | null;
+  container: "int32" | "string" | "list" | null;
+  kind: "primitive" | "struct" | "pod" | "namedarray" | "enum" | "object" | "unknown";
+  qualified: string | null;
+  renderer?: Renderer | null;
+  /** Why the device's definition does not have the renderer's layout (then no renderer). */
+  mismatch?: string | null;
+  element?: TypeDescriptor;
+  fields?: FieldDescriptor[];
+  enumValues?: EnumValue[];
+}
+
+export interface FieldDescriptor {
+  name: string;
+  type: TypeDescriptor;
+  /** The enum of a bit-flag field. */
+  flags?: EnumValue[];
+  /** The sibling field naming this field's units. */
+  units?: { field: string; enumValues: EnumValue[] | null };
+}
+
+export class RendererRegistry {
+  register(...renderers: Array<Renderer | Renderer[]>): this;
+  get(qualified: string): Renderer | null;
+  has(qualified: string): boolean;
+  types(): string[];
+}
+
+export class TypeDescriber {
+  constructor(outline: RobdefOutline, registry?: RendererRegistry | null, annotators?: Array<(owner: object, field: object, outline: RobdefOutline) => object | null>);
+  describe(text: string, scope: string): TypeDescriptor;
+  describeMember(objectQualified: string, member: { name: string; type: string }): FieldDescriptor;
+}
+
+export function standardRegistry(): RendererRegistry;
+export function standardDescriber(outline: RobdefOutline, registry?: RendererRegistry): TypeDescriber;
+export const STANDARD_ANNOTATORS: ReadonlyArray<(owner: object, field: object, outline: RobdefOutline) => object | null>;
+export function resolveName(outline: RobdefOutline, name: string, scope: string): OutlineEntry | null;
+export function findNamed(outline: RobdefOutline, name: string, scope: string): OutlineEntry | null;
+export function qualifyType(outline: RobdefOutline, text: string, scope: string): string;
+export function fieldAt(d: TypeDescriptor, path: string): FieldDescriptor | null;
+
+/** Context of the text functions: `now` in ms since the epoch, the device's definitions. */
+export interface TextContext { now?: number; outline?: RobdefOutline }
+export function typedText(value: unknown, d: TypeDescriptor | null | undefined, ctx?: TextContext, maxItems?: number): string;
+export function fieldText(owner: unknown, field: FieldDescriptor, ownerDescriptor?: TypeDescriptor | null, ctx?: TextContext, maxItems?: number): string;
+export function memberText(value: unknown, member: FieldDescriptor, ctx?: TextContext, maxItems?: number): string;
+
+export function formatUuid(value: unknown): string | null;
+export function isNilUuid(value: unknown): boolean;
+export function uuidBytes(value: unknown): ArrayLike<number> | null;
+export function formatIdentifier(value: unknown): string | null;
+export function timeParts(value: unknown): { seconds: bigint; nanoseconds: number } | null;
+export function timeSeconds(value: unknown): number | null;
+export function isoTime(parts: { seconds: bigint; nanoseconds: number } | null, offsetSeconds?: number): string | null;
+export function durationText(seconds: number): string;
+export function ageText(ageSeconds: number): string;
+export function comparableClock(clockType: unknown, clockEnum?: EnumValue[]): boolean;
+export function formatTime(value: unknown, ctx?: { now?: number; clockEnum?: EnumValue[] }): string | null;
+export function formatDuration(value: unknown): string | null;
+export function quaternionToRpy(q: unknown): [number, number, number] | null;
+export function formatRotation(q: unknown): string | null;
+export function formatPose(value: unknown): string | null;
+export function formatTransform(value: unknown): string | null;
+export function enumName(values: EnumValue[] | null | undefined, n: unknown): string | null;
+export function formatEnum(values: EnumValue[] | null | undefined, n: unknown): string;
+export function isFlagEnum(values: EnumValue[] | null | undefined): boolean;
+export function flagNames(values: EnumValue[] | null | undefined, n: unknown): string[];
+export function formatFlags(values: EnumValue[] | null | undefined, n: unknown): string;
+export function flagEnumFor(outline: RobdefOutline, owner: OutlineEntry, field: { name: string; type: string }): EnumValue[] | null;
+/** Enum values of an integer field that holds enum codes (AdvancedRobotState's joint_position_units → JointPositionUnits). */
+export function codeEnumFor(outline: RobdefOutline, owner: OutlineEntry, field: { name: string; type: string }): EnumValue[] | null;
+/** "radian" for one code, "[radian, meter]" for an array of codes. */
+export function formatCodes(values: EnumValue[] | null | undefined, v: number | bigint | ArrayLike<number>): string;
+export function siUnitText(unit: unknown): string | null;
+export function unitsOf(owner: unknown, field: FieldDescriptor, siblingField?: FieldDescriptor): string[] | null;
+export function unitsFieldFor(owner: OutlineEntry, name: string): string | null;
+export function plotRole(field: FieldDescriptor): "omit" | "hidden" | "show";
+export function leaveOutOfPlot(field: FieldDescriptor): boolean;
+export function typedNumericFields(value: unknown, d: TypeDescriptor | null | undefined, prefix?: string): Array<[string, number, boolean]>;
+export function sensorTimestamp(value: unknown, d: TypeDescriptor | null | undefined): { seconds: number; path: string; type: string } | null;
+export function deviceInfoRows(info: unknown, extraTypes?: string[]): Array<{ key: string; label: string; text: string }>;
+/** The robdef type text a com.robotraconteur.datatype.DataType value stands for ("double[3]", "string{list}"); `descriptor` gives the device's enum values. */
+export function formatDataType(value: unknown, descriptor?: TypeDescriptor | null): string | null;
