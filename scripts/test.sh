@@ -132,10 +132,12 @@ await_step() {
 
 # ctest starts the longest tests first (their COST from test/schedule/costs.cmake; regenerate it from
 # build/ctest-main.log and build/ctest-timing.log with test/schedule/ctest_costs.py when tests change).
+# --output-on-failure: a failed test's own output is in the CI log (the second ctest run overwrites
+# build/debug/Testing/Temporary/LastTest.log).
 excluded='^(docker: the image|install: the package on a fresh Debian 12 root)'
 status=0
-ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" 2>&1 | tee build/ctest-main.log || status=1
-ctest --preset debug -j 2 -L timing -E "$excluded" 2>&1 | tee build/ctest-timing.log || status=1
+ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" --output-on-failure 2>&1 | tee build/ctest-main.log || status=1
+ctest --preset debug -j 2 -L timing -E "$excluded" --output-on-failure 2>&1 | tee build/ctest-timing.log || status=1
 ((status == 0)) || { echo "test: FAILED: ctest (build/ctest-main.log, build/ctest-timing.log)"; exit 1; }
 phase_done ctest
 

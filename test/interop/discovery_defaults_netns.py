@@ -36,7 +36,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import child_procs  # noqa: E402
-from discovery_netns import IPV4_A, Failed, Net, http, run, wait_until  # noqa: E402
+from discovery_netns import IPV4_A, Failed, Net, http, netns_skip_reason, run, wait_until  # noqa: E402
 
 SKIP = 77
 NAME = "rr.gateway"  # the default NodeName
@@ -118,14 +118,9 @@ def main():
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--python", required=True)
     args = ap.parse_args()
-    if os.geteuid() != 0:
-        print("SKIP: network namespaces need root (ip netns add)")
-        return SKIP
-    if not shutil.which("ip"):
-        print("SKIP: the ip tool (iproute2) is not installed")
-        return SKIP
-    if not os.path.exists(args.python):
-        print("SKIP: %s missing (run ./scripts/setup.sh)" % args.python)
+    reason = netns_skip_reason(args.python)
+    if reason:
+        print("SKIP: " + reason)
         return SKIP
     tmp = tempfile.mkdtemp(prefix="rr_discovery_defaults_")
     net = Net()

@@ -55,6 +55,17 @@ def log(*a):
     print("[discovery_netns]", *a, flush=True)
 
 
+def netns_skip_reason(python):
+    """Why a namespace test cannot run here (None: it can): root for `ip netns add`, iproute2, the venv."""
+    if os.geteuid() != 0:
+        return "network namespaces need root (ip netns add)"
+    if not shutil.which("ip"):
+        return "the ip tool (iproute2) is not installed"
+    if not os.path.exists(python):
+        return "%s missing (run ./scripts/setup.sh)" % python
+    return None
+
+
 def run(cmd, timeout=30, check=True):
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=timeout,
                        stdin=subprocess.DEVNULL)
@@ -149,14 +160,9 @@ def main():
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--python", required=True)
     args = ap.parse_args()
-    if os.geteuid() != 0:
-        print("SKIP: network namespaces need root (ip netns add)")
-        return SKIP
-    if not shutil.which("ip"):
-        print("SKIP: the ip tool (iproute2) is not installed")
-        return SKIP
-    if not os.path.exists(args.python):
-        print("SKIP: %s missing (run ./scripts/setup.sh)" % args.python)
+    reason = netns_skip_reason(args.python)
+    if reason:
+        print("SKIP: " + reason)
         return SKIP
     tmp = tempfile.mkdtemp(prefix="rr_discovery_")
     net = Net()
