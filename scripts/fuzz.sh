@@ -9,8 +9,8 @@
 #   scripts/fuzz.sh N          every target for N seconds
 #   scripts/fuzz.sh --long     every target to 10^7 executions or RR_FUZZ_LONG_SECONDS (default 1800)
 #                              seconds, whichever comes first; one worker, nice -n 10; the corpus grows
-#                              in build/fuzz/corpus/<target>. Builds preset fuzz (-O1: about twice the
-#                              executions per second of -O0, for a campaign that runs long)
+#                              in build/fuzz/corpus/<target>. Builds preset fuzz (-O1: more executions per second
+#                              than -O0, estimated twice, for a campaign that runs long)
 #   scripts/fuzz.sh ... TARGET...   only these targets
 #
 # RR_FUZZ_PRESET=fuzz|debug picks the build either way; RR_FUZZ_JOBS=N runs N targets at a time (CI: 2).
@@ -25,7 +25,8 @@ cd "$(dirname "$0")/.."
 
 # Seconds per target in CI: the pure parsers saturate quickly; the gateway targets need a few seconds
 # to start the gateway and run slower (every input goes through the gateway's threads and sockets).
-# Twice what the -O1 build of earlier sessions had, as -O0 runs about half as many inputs per second;
+# Twice what the -O1 build of earlier sessions had, as -O0 runs fewer inputs per second (estimated half;
+# not measured side by side yet);
 # with two targets at a time the phase takes as long as it did.
 declare -A CI_SECONDS=(
   [fuzz_robdef_parser]=30 [fuzz_message_reader]=30 [fuzz_message_structured]=40 [fuzz_connection_url]=20
