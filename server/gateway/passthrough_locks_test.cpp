@@ -56,7 +56,7 @@ public:
         std::this_thread::sleep_for(delay_);  // on the session's strand: its DisconnectClientRet waits too
         inner_->on_session_close(session);
     }
-    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) override {
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, rr::server::Responder responder) override {
         inner_->handle_entry(session, std::move(entry), std::move(responder));
     }
 
