@@ -58,7 +58,8 @@ struct Fixture {
     std::shared_ptr<std::vector<std::string>> ws_log = std::make_shared<std::vector<std::string>>();
     std::shared_ptr<std::mutex> ws_log_mutex = std::make_shared<std::mutex>();
 
-    /// The last socket of "test.push.burst.v1" (set on the socket's strand, read by the test).
+    /// The last socket of "test.push.burst.v1", set on the socket's strand once its burst is sent (read by
+    /// the test: under TSan and a loaded CPU the burst outlasted a fixed wait).
     struct SocketSlot {
         std::mutex mutex;
         std::shared_ptr<http::JsonSocket> socket;
@@ -138,9 +139,9 @@ struct Fixture {
         server->add_subprotocol("test.push.burst.v1", http::JsonSocketHandler{
                                                      {},
                                                      [kept = burst_socket](const std::shared_ptr<http::JsonSocket>& s, std::string) {
-                                                         kept->set(s);
                                                          for (int i = 0; i < 100; ++i)
                                                              s->send("burst " + std::to_string(i) + std::string(64 * 1024, ' '));
+                                                         kept->set(s);  // after the burst: its drops are all counted
                                                      },
                                                      {}});
         REQUIRE(node->register_service(std::make_shared<TinyService>()));
