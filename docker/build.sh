@@ -13,7 +13,7 @@
 #   --print-key    print the inputs key (below) and exit
 #   --record-verified  after a from-source build (and --smoke) passed, write docker/from-source.verified:
 #                  the key of what that build's success depends on beyond the sources the package build
-#                  compiles too (docker/, packaging/, cmake/, CMakePresets.json, the top CMakeLists.txt,
+#                  compiles too (docker/, packaging/, cmake/, the top CMakeLists.txt,
 #                  and what any CMakeLists.txt looks for on the system: find_package and the like, as a
 #                  new dependency must reach the Containerfile's package list), and the commit.
 #                  scripts/test.sh skips the from-source build while that key is unchanged
@@ -68,7 +68,7 @@ if [ -n "$print_key" ] && [ -z "$from_build" ]; then key; exit 0; fi
 verified=docker/from-source.verified
 from_source_key() {
   {
-    git ls-tree -r HEAD -- docker packaging cmake CMakePresets.json CMakeLists.txt | grep -v "	$verified\$"
+    git ls-tree -r HEAD -- docker packaging cmake CMakeLists.txt | grep -v "	$verified\$"
     # What every other CMakeLists.txt asks of the system: a new dependency must reach the Containerfile.
     git grep -h -E 'find_package|pkg_check_modules|find_library|find_program|find_path' HEAD -- '*CMakeLists.txt' | sort
   } | sha256sum | cut -d' ' -f1

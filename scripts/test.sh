@@ -75,7 +75,7 @@ if [ -z "$from_source" ]; then
   if [ "$(./docker/build.sh --print-from-source-key)" = "$(sed -n 's/^key //p' docker/from-source.verified 2>/dev/null)" ]; then
     from_source=0
     echo "test: the Containerfile's from-source build is skipped: its inputs (docker/, packaging/, cmake/,"
-    echo "test:   CMakePresets.json, the top CMakeLists.txt, the dependencies any CMakeLists.txt looks for)"
+    echo "test:   the top CMakeLists.txt, the dependencies any CMakeLists.txt looks for)"
     echo "test:   are those verified at $(sed -n 's/^commit //p' docker/from-source.verified)"
   else
     from_source=1
