@@ -41,8 +41,8 @@ export class LivePlot {
   size() { return { width: Math.max(200, this.chartEl.clientWidth || 360), height: this.height }; }
 
   /**
-   * Adds a sample: `pairs` = [[seriesName, number, hiddenAtFirst?], ...] at `t` (seconds since the
-   * epoch, default now).
+   * Adds a sample: `pairs` = [[seriesName, number, hiddenAtFirst?, label?], ...] at `t` (seconds since
+   * the epoch, default now); the readout shows `label` (an enum's name) instead of the number when given.
    */
   push(pairs, t = performance.timeOrigin / 1000 + performance.now() / 1000) {
     if (!pairs.length) return;
@@ -70,7 +70,7 @@ export class LivePlot {
   }
 
   updateReadout(pairs) {
-    for (const [name, value] of pairs) {
+    for (const [name, value, , label] of pairs) {
       let item = this.readout.querySelector(`[data-series="${CSS.escape(name)}"]`);
       if (!item) {
         const i = this.names.indexOf(name);
@@ -82,7 +82,7 @@ export class LivePlot {
           h("span", { class: "readout-name", text: name }), h("output", { class: "readout-value" }));
         this.readout.append(item);
       }
-      item.querySelector("output").value = Number.isInteger(value) ? String(value) : String(Number(value.toPrecision(5)));
+      item.querySelector("output").value = label ?? (Number.isInteger(value) ? String(value) : String(Number(value.toPrecision(5))));
       item.dataset.value = String(value);
       item.classList.toggle("off", this.hiddenNames.has(name));
     }

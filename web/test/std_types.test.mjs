@@ -225,6 +225,15 @@ test("plots leave out identifiers, UUIDs, byte arrays and clock fields; flags an
   assert.ok(!names.some((n) => n.startsWith("ts")), names.join(" "));
   assert.deepEqual(series.filter(([, , hidden]) => hidden).map(([n]) => n), ["seqno", "robot_state_flags"]);
   assert.ok(names.includes("joint_position[1]") && names.includes("kin_chain_tcp[0].position.x") && names.includes("command_mode"));
+  // the readout names what the numbers mean: enums by name, flag words by their set flags; plain numbers get no label
+  const labels = Object.fromEntries(series.map(([n, x, , label]) => [n, [x, label]]));
+  assert.deepEqual(labels.command_mode, [1, "jog"]);
+  assert.deepEqual(labels.operational_mode, [3, "auto"]);
+  assert.deepEqual(labels.controller_state, [2, "motor_on"]);
+  assert.deepEqual(labels.robot_state_flags, [0x60000, "enabled | ready"]);
+  assert.deepEqual(labels["joint_position[1]"], [-0.2, undefined]);
+  const odd = typedNumericFields({ ...robotState(now), command_mode: 99 }, types.describe("RobotState", R));
+  assert.equal(odd.find(([n]) => n === "command_mode")[3], "99 (not a value of the enum)");
 
   const header = { ts: { clock_info: { clock_type: 1, clock_uuid: { uuid_bytes: seq }, offset_microseconds: 0n }, seconds: BigInt(Math.floor(now / 1000)), nanoseconds: 5000 },
     seqno: 7n, source_info: { source: { name: "cam", uuid: { uuid_bytes: seq } }, source_world_pose: null, source_config_nonce: "", source_params: null, extended: null } };

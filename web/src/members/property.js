@@ -35,7 +35,7 @@ export function propertyView(ctx, member, _ObjectPanel, described = null) {
 
   function plotPairs(v) {
     if (!described) return numericFields(v, null, member.name);
-    return typedNumericFields(v, described.type, member.name).map(([n, x, hide]) => [n, x, hide || !!described.flags]);
+    return typedNumericFields(v, described.type, member.name).map(([n, x, hide, label]) => [n, x, hide || !!described.flags, label]);
   }
 
   async function read() {

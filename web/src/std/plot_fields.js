@@ -3,6 +3,7 @@
 // value's own timestamp (a sensor's data_header.ts, a robot state's ts) for the time axis.
 
 import { timeSeconds } from "./datetime.js";
+import { enumName, formatFlags } from "./enums.js";
 
 const D = "com.robotraconteur.datetime";
 /** Clock types: the time axis may come from them; they are never plotted as series. */
@@ -33,27 +34,40 @@ export function plotRole(field) {
 export function leaveOutOfPlot(field) { return plotRole(field) === "omit"; }
 
 /**
- * [[seriesName, number, hiddenAtFirst], ...] of a value typed by descriptor `d` (describe.js):
+ * [[seriesName, number, hiddenAtFirst, label?], ...] of a value typed by descriptor `d` (describe.js):
  * numbers, enums, bools, short numeric vectors and the fields of structures, pods and namedarrays,
- * without the fields plotRole leaves out.
+ * without the fields plotRole leaves out. `label` is the readout's text where the number means a
+ * name: an enum value's name ("jog"), a flag word's set flags ("ready | enabled"), an enum code.
  */
 export function typedNumericFields(value, d, prefix = "") {
   const out = [];
-  collect(value, d, prefix, false, out, 0);
+  collect(value, d, prefix, false, out, 0, null);
   return out;
 }
 
-function collect(v, d, name, hidden, out, depth) {
+/** The readout text of number `v` of type `d` in field `field`, or undefined (the number itself). */
+function numberLabel(v, d, field) {
+  if (field?.flags) return formatFlags(field.flags, v);
+  const values = d?.enumValues ?? field?.codes;
+  if (values) return enumName(values, v) ?? `${v} (not a value of the enum)`;
+  return undefined;
+}
+
+function collect(v, d, name, hidden, out, depth, field) {
   if (depth > 6 || v === null || v === undefined) return;
-  if (typeof v === "number") out.push([name || "value", v, hidden]);
-  else if (typeof v === "bigint") out.push([name || "value", Number(v), hidden]);
+  const push = (x) => {
+    const label = numberLabel(v, d, field);
+    out.push(label === undefined ? [name || "value", x, hidden] : [name || "value", x, hidden, label]);
+  };
+  if (typeof v === "number") push(v);
+  else if (typeof v === "bigint") push(Number(v));
   else if (typeof v === "boolean") out.push([name || "value", v ? 1 : 0, hidden]);
   else if ((ArrayBuffer.isView(v) || Array.isArray(v)) && !(d?.array === "multidim") && v.length <= MAX_VECTOR) {
-    Array.from(v).forEach((x, i) => collect(x, d?.element, `${name}[${i}]`, hidden, out, depth + 1));
+    Array.from(v).forEach((x, i) => collect(x, d?.element, `${name}[${i}]`, hidden, out, depth + 1, field?.codes ? { codes: field.codes } : null));
   } else if (d?.fields && typeof v === "object" && !ArrayBuffer.isView(v)) {
     for (const f of d.fields) {
       const role = plotRole(f);
-      if (role !== "omit") collect(v[f.name], f.type, name ? `${name}.${f.name}` : f.name, hidden || role === "hidden", out, depth + 1);
+      if (role !== "omit") collect(v[f.name], f.type, name ? `${name}.${f.name}` : f.name, hidden || role === "hidden", out, depth + 1, f);
     }
   }
 }
