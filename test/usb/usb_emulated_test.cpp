@@ -596,7 +596,14 @@ TEST_CASE("usb emulated: the device table follows plug and unplug by hotplug, an
         CHECK(w->host->devices().empty());
         auto* dev = plug(*w);  // no enumerate or connect: the table updates by itself
         // 10 s: a liveness bound, not a latency one (polling is every 100 ms; CI runs 8 tests per 2 CPUs).
-        CHECK(eventually([&] { return w->host->devices().size() == 1; }, 10s));
+        const bool seen = eventually([&] { return w->host->devices().size() == 1; }, 10s);
+        CHECK(seen);
+        if (!seen) {  // failed twice in full CI runs, never alone or under CPU load: which half is stuck?
+            const auto& st = w->host->stats();
+            WARN("host after 10 s: " << st.scans.load() << " scans, " << st.probes.load() << " probes started, "
+                 << st.hotplug_events.load() << " hotplug events (scans but no probe: libusb never listed the device; "
+                 << "a probe and no table entry: the probe never finished)");
+        }
         w->emulator->unplug(dev);
         CHECK(eventually([&] { return w->host->devices().empty(); }, 10s));
         if (!hotplug) CHECK(w->host->stats().hotplug_events == 0);
