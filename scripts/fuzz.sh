@@ -3,17 +3,20 @@
 #
 #   scripts/fuzz.sh            CI: every target briefly (the times below, two targets at a time: about
 #                              3 minutes in all), from the seeds and regressions (a fresh corpus in
-#                              BUILD/ci-corpus), on the targets of the debug build (preset debug:
-#                              clang-14 -O0, ASan + UBSan, linked from the objects the tests use, so CI
-#                              compiles the project once); builds them there if needed
+#                              BUILD/ci-corpus). The targets that need no server library (core, robdef,
+#                              json: rr_fuzz_core_targets) from preset fuzz (-O1; about 2 minutes to
+#                              build cold, which scripts/test.sh does in the background), the server
+#                              ones (gateway config, JSON socket and REST, the gateway's port) from the
+#                              debug build (clang-14 -O0, ASan + UBSan, linked from the objects the tests
+#                              use: the server is not compiled a second time). -O0 runs the core targets
+#                              4 to 14 times slower than -O1 (docs/fuzzing.md, measured side by side).
 #   scripts/fuzz.sh N          every target for N seconds
 #   scripts/fuzz.sh --long     every target to 10^7 executions or RR_FUZZ_LONG_SECONDS (default 1800)
 #                              seconds, whichever comes first; one worker, nice -n 10; the corpus grows
-#                              in build/fuzz/corpus/<target>. Builds preset fuzz (-O1: more executions per second
-#                              than -O0, estimated twice, for a campaign that runs long)
+#                              in build/fuzz/corpus/<target>. Builds preset fuzz (-O1) for every target
 #   scripts/fuzz.sh ... TARGET...   only these targets
 #
-# RR_FUZZ_PRESET=fuzz|debug picks the build either way; RR_FUZZ_JOBS=N runs N targets at a time (CI: 2).
+# RR_FUZZ_PRESET=fuzz|debug|mixed picks the builds (CI: mixed, as above); RR_FUZZ_JOBS=N runs N targets at a time (CI: 2).
 # Inputs: test/fuzz/seeds/<target> and test/fuzz/regressions/<target> (past crashes, kept as tests and
 # replayed by ctest in the debug build). RR_FUZZ_SEED fixes libFuzzer's random seed (default 1) so that
 # a CI run from an empty corpus is reproducible: a slower machine explores a prefix of what a faster
@@ -25,9 +28,8 @@ cd "$(dirname "$0")/.."
 
 # Seconds per target in CI: the pure parsers saturate quickly; the gateway targets need a few seconds
 # to start the gateway and run slower (every input goes through the gateway's threads and sockets).
-# Twice what the -O1 build of earlier sessions had, as -O0 runs fewer inputs per second (estimated half;
-# not measured side by side yet);
-# with two targets at a time the phase takes as long as it did.
+# (Twice what the all -O1 layout of earlier sessions had; with two targets at a time the phase takes as
+# long as it did.)
 declare -A CI_SECONDS=(
   [fuzz_robdef_parser]=30 [fuzz_message_reader]=30 [fuzz_message_structured]=40 [fuzz_connection_url]=20
   [fuzz_service_path]=20 [fuzz_gateway_config]=30 [fuzz_discovery_packet]=20 [fuzz_usb_descriptors]=20
@@ -48,30 +50,46 @@ seed=${RR_FUZZ_SEED:-1}
 long_seconds=${RR_FUZZ_LONG_SECONDS:-1800}
 
 preset=${RR_FUZZ_PRESET:-}
-[ -n "$preset" ] || { if [ "$mode" = long ]; then preset=fuzz; else preset=debug; fi; }
+[ -n "$preset" ] || { if [ "$mode" = long ]; then preset=fuzz; else preset=mixed; fi; }
 case "$preset" in
-  fuzz) bin=build/fuzz/test/fuzz; out=build/fuzz ;;
-  debug) bin=build/debug/test/fuzz; out=build/debug/test/fuzz ;;
-  *) echo "fuzz: RR_FUZZ_PRESET is fuzz or debug, not $preset"; exit 2 ;;
+  fuzz) bin=build/fuzz/test/fuzz ;;
+  debug|mixed) bin=build/debug/test/fuzz ;;
+  *) echo "fuzz: RR_FUZZ_PRESET is fuzz, debug or mixed, not $preset"; exit 2 ;;
 esac
-cmake --preset "$preset" >/dev/null
-cmake --build --preset "$preset" --target rr_fuzz_targets -j "${RR_JOBS:-$(nproc)}"
+if [ "$preset" = mixed ]; then
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz --target rr_fuzz_core_targets -j "${RR_JOBS:-$(nproc)}"
+  cmake --preset debug >/dev/null
+  cmake --build --preset debug --target rr_fuzz_targets -j "${RR_JOBS:-$(nproc)}"
+else
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" --target rr_fuzz_targets -j "${RR_JOBS:-$(nproc)}"
+fi
+# The binary of target NAME: in mixed mode the -O1 one for the core targets.
+binary_of() {
+  if [ "$preset" = mixed ] && grep -qx "$1" build/fuzz/test/fuzz/core_targets.txt; then echo "build/fuzz/test/fuzz/$1"
+  else echo "$bin/$1"; fi
+}
 parallel=${RR_FUZZ_JOBS:-}
 [ -n "$parallel" ] || { if [ "$mode" = long ]; then parallel=1; else parallel=2; fi; }
 
 shopt -s nullglob
 targets=()
 if ((${#only[@]})); then
-  for t in "${only[@]}"; do targets+=("$bin/$t"); done
+  for t in "${only[@]}"; do targets+=("$(binary_of "$t")"); done
 else
-  targets=("$bin"/fuzz_*)
+  for t in "$bin"/fuzz_*; do  # the programs, not the logs and crash inputs beside them
+    [[ -f $t && -x $t && $(basename "$t") != *[.-]* ]] && targets+=("$(binary_of "$(basename "$t")")")
+  done
 fi
 if ((${#targets[@]} == 0)); then echo "fuzz: no targets"; exit 0; fi
 
 # One target: its log in $out/<name>.log, a summary line on stdout when it ends.
 run_target() {
-  local t=$1 name corpus inputs dict limits runner s start runs last d
+  local t=$1 name corpus inputs dict limits runner s start runs last d out
   name=$(basename "$t")
+  # logs, corpora and crash inputs beside the build the binary comes from
+  case "$t" in build/fuzz/*) out=build/fuzz ;; *) out=build/debug/test/fuzz ;; esac
   # libFuzzer runs its whole starting corpus before it looks at the clock: a CI run starts from the
   # seeds and regressions only (a fresh folder), so its time stays bounded; --long keeps a corpus.
   if [ "$mode" = long ]; then corpus=$out/corpus/$name; else corpus=$out/ci-corpus/$name; rm -rf "$corpus"; fi
@@ -104,7 +122,7 @@ for t in "${targets[@]}"; do [ -x "$t" ] || { echo "fuzz: no target $t"; exit 1;
 if [ "$mode" = long ]; then
   echo "fuzz: ${#targets[@]} targets ($preset build), each to 10^7 runs or ${long_seconds}s, $parallel at a time (seed $seed)"
 else
-  echo "fuzz: ${#targets[@]} targets ($preset build), $parallel at a time (seed $seed)"
+  echo "fuzz: ${#targets[@]} targets ($preset build$([ "$preset" = mixed ] && echo ': core targets -O1, server ones -O0')), $parallel at a time (seed $seed)"
 fi
 # At most $parallel targets at once; the first failure stops the others.
 pids=()

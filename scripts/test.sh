@@ -8,12 +8,13 @@
 #                    tests wait on sockets, timers and child processes); then the tests labelled
 #                    `timing` (they assert rates and latencies a crowded CPU blurs), two at a time
 #   tsan             the server tests under ThreadSanitizer (preset tsan, built meanwhile)
-#   fuzz             every libFuzzer target briefly, two at a time (scripts/fuzz.sh)
+#   fuzz             every libFuzzer target briefly, two at a time (scripts/fuzz.sh): those that need no
+#                    server library from preset fuzz (-O1, built meanwhile), the server ones from the debug build
 #   package          (meanwhile) preset package: the Release binaries and the Debian package, installed
 #                    on a fresh Debian 12 root; the container image made from those binaries (no
 #                    second compile) and its test; the Containerfile's from-source build only when
 #                    its inputs changed (docker/from-source.verified)
-# Meanwhile = in the background at nice 19, one chain: the tsan build, then the package build, then
+# Meanwhile = in the background at nice 19, one chain: the tsan build, the core fuzz targets, the package build, then
 # the fresh-Debian, container and from-source steps, so they take the CPU the tests leave idle.
 # Exits non-zero on any failure; prints how long each phase took, and warns, naming the slowest
 # phases and tests, when the whole run passes RR_CI_BUDGET_MINUTES (45).
@@ -96,6 +97,10 @@ background_chain() {
   if [ "${RR_TSAN:-1}" != 0 ]; then
     step tsan-build sh -c 'cmake --preset tsan >/dev/null && cmake --build --preset tsan -j "$1"' sh "$jobs"
   fi
+  if [ "${RR_FUZZ_SECONDS:-}" != 0 ]; then
+    # the fuzz targets that need no server library, at -O1 (scripts/fuzz.sh runs the others from build/debug)
+    step fuzz-build sh -c 'cmake --preset fuzz >/dev/null && cmake --build --preset fuzz --target rr_fuzz_core_targets -j "$1"' sh "$jobs"
+  fi
   step package-build sh -c 'cmake --preset package >/dev/null && cmake --build --preset package -j "$1"' sh "$jobs"
   if [ "${RR_FRESH_DEBIAN:-1}" != 0 ] && grep -q '^ok' build/bg-status/package-build; then
     # (the ctest test "install: the package on a fresh Debian 12 root", called directly: a second
@@ -164,6 +169,7 @@ fi
 # RR_FUZZ_SECONDS: seconds per target (0 = no fuzzing); unset = fuzz.sh's own CI times.
 fuzz_seconds=${RR_FUZZ_SECONDS:-}
 if [ "$fuzz_seconds" != 0 ]; then
+  await_step fuzz-build "the -O1 build of the core fuzz targets (preset fuzz, build/fuzz)"
   ./scripts/fuzz.sh $fuzz_seconds
   phase_done fuzz
 fi
