@@ -278,3 +278,27 @@ TEST_CASE("json access: the answer agrees with what the gateway does with the re
         }
     }
 }
+
+TEST_CASE("json access: the WebSocket's access op answers as the route") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    AuthGateway gw(device.url());
+    WsClient ws(gw.port());
+    CHECK(ws.request(json{{"op", "access"}, {"device", "interop"}})["error"]["name"] == "RobotRaconteur.AuthenticationError");
+    REQUIRE(ws.request(json{{"op", "login"}, {"username", "dora"}, {"password", "dora-pw"}}).contains("result"));
+    auto r = ws.request(json{{"op", "access"}, {"device", "interop"}, {"members", {"add", "p_int32"}}});
+    REQUIRE(r.contains("result"));
+    CHECK(r["result"]["user"] == "dora");
+    CHECK(r["result"]["members"] == json{{"add", {"call"}}, {"p_int32", json::array()}});
+    const auto cookie = gw.login("dora", "dora-pw");
+    auto rest = request_as(gw.port(), bhttp::verb::get, "/api/devices/interop/access", cookie);
+    auto whole = ws.request(json{{"op", "access"}, {"device", "interop"}});
+    CHECK(whole["result"] == rest.body);
+    auto bad = ws.request(json{{"op", "access"}, {"device", "interop"}, {"members", {"nosuch"}}});
+    CHECK(bad["error"]["name"] == "RobotRaconteur.InvalidArgument");
+    auto own = ws.request(json{{"op", "access"}, {"device", "pt"}, {"members", {"add"}}, {"device_user", "dora"}});
+    CHECK(own["result"]["members"] == json{{"add", {"call"}}});
+    CHECK(ws.request(json{{"op", "access"}, {"device", "pt"}, {"device_user", "alice"}})["error"]["name"] ==
+          "RobotRaconteur.PermissionDenied");
+    CHECK(ws.request(json{{"op", "access"}, {"device", "nosuch"}})["error"]["name"] == "RobotRaconteur.ServiceNotFound");
+}
