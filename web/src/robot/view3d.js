@@ -135,7 +135,7 @@ export function createRobotView3d(parent, info, { height = 320 } = {}) {
   controls.target.set(0, 0, size * 0.35);
   controls.update();
 
-  let q = null, reportedTcp = null, changed = true, frame = 0, renders = 0, disposed = false;
+  let q = null, reportedTcp = null, changed = true, frame = 0, renders = 0, disposed = false, drawnSize = { w: 0, h: 0 };
   const invalidate = () => { if (!frame && !disposed) frame = requestAnimationFrame(render); };
   controls.addEventListener("change", invalidate);
 
@@ -181,16 +181,20 @@ export function createRobotView3d(parent, info, { height = 320 } = {}) {
       applyJoints();
     }
     const w = canvas.clientWidth, h = canvas.clientHeight;
-    if (w && h && (canvas.width !== Math.round(w * renderer.getPixelRatio()) || canvas.height !== Math.round(h * renderer.getPixelRatio()))) {
+    if (w && h && (w !== drawnSize.w || h !== drawnSize.h)) {
       renderer.setSize(w, h, false);
       camera.aspect = w / h;
       camera.updateProjectionMatrix();
     }
+    drawnSize = { w, h };
     renderer.render(scene, camera);
     el.dataset.renders = String(++renders);
   }
 
-  const resize = new ResizeObserver(invalidate);
+  // a new frame only when the size differs from the one drawn (the observer also reports the first size)
+  const resize = new ResizeObserver(() => {
+    if (canvas.clientWidth !== drawnSize.w || canvas.clientHeight !== drawnSize.h) invalidate();
+  });
   resize.observe(canvas);
   invalidate();
 
