@@ -100,14 +100,14 @@ export function createRobotView3d(parent, info, { height = 320 } = {}) {
   const sun = new THREE.DirectionalLight(0xffffff, 1.6);
   sun.position.set(size, -size, 2 * size);
   scene.add(sun);
-  const grid = new THREE.GridHelper(4 * size, 20, 0x9aa4b2, 0xd0d6de);
+  const grid = new THREE.GridHelper(3 * size, 12, 0x9aa4b2, 0xd0d6de);
   grid.rotation.x = Math.PI / 2;   // the grid in the x-y plane: robots are z up
   scene.add(grid, triad(size * 0.15, 0.5));
 
-  const radius = size * 0.018;
+  const radius = size * 0.025;
   const unitCylinder = new THREE.CylinderGeometry(radius, radius, 1, 16);
   const revoluteDisc = new THREE.CylinderGeometry(radius * 2.2, radius * 2.2, radius * 2.4, 24);
-  const prismaticBar = new THREE.BoxGeometry(radius * 1.6, radius * 8, radius * 1.6);
+  const prismaticBar = new THREE.BoxGeometry(radius * 2.8, radius * 7, radius * 2.8);
   const materials = Object.fromEntries(["link", "revolute", "prismatic"].map((k) => [k, new THREE.MeshStandardMaterial({ color: COLORS[k], roughness: 0.6 })]));
   const baseMesh = new THREE.Mesh(new THREE.CylinderGeometry(radius * 3, radius * 3.5, radius * 2, 24), new THREE.MeshStandardMaterial({ color: COLORS.base }));
   baseMesh.rotation.x = Math.PI / 2;
@@ -130,9 +130,9 @@ export function createRobotView3d(parent, info, { height = 320 } = {}) {
 
   const camera = new THREE.PerspectiveCamera(45, 1, size / 100, size * 50);
   camera.up.set(0, 0, 1);
-  camera.position.set(size * 1.6, -size * 1.9, size * 1.3);
+  camera.position.set(size * 0.95, -size * 1.25, size * 0.8);
   const controls = new OrbitControls(camera, canvas);
-  controls.target.set(0, 0, size * 0.35);
+  controls.target.set(size * 0.1, 0, size * 0.25);
   controls.update();
 
   let q = null, reportedTcp = null, changed = true, frame = 0, renders = 0, disposed = false, drawnSize = { w: 0, h: 0 };
