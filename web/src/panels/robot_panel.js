@@ -10,6 +10,7 @@ import { describeMember } from "../views/context.js";
 import { fieldText, typedText } from "../std/typed_text.js";
 import { formatPose } from "../std/geometry.js";
 import { followWire } from "../views/shared_wire.js";
+import { mountRobot3d } from "./robot_3d.js";
 
 export const ROBOT = "com.robotraconteur.robotics.robot.Robot";
 const UNITS = { radian: "rad", degree: "°", meter: "m" };
@@ -107,10 +108,15 @@ export function createRobotPanel(parent, ctx) {
     });
   }
 
+  // ---- 3D view of the robot from its robot_info (web/src/panels/robot_3d.js, web/src/robot/view3d.js) ----
+  const view3d = mountRobot3d(el, obj, { infoMember, stateMember });
+  // ---- end of the 3D view ----
+
   return {
     el,
     dispose() {
       disposed = true;
+      view3d.dispose();
       if (frame) cancelAnimationFrame(frame);
       follow?.dispose();
       el.remove();
