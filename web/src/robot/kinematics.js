@@ -9,6 +9,8 @@
 // chain's current_tool.tcp when there is one. Positions in metres, quaternions w first; joint values
 // in radians (revolute, continuous) or metres (prismatic).
 
+import { namedFields } from "../std/geometry.js";
+
 /** com.robotraconteur.robotics.joints.JointType names by value (the wasm client gives enums as numbers). */
 const JOINT_TYPES = ["unknown", "revolute", "continuous", "prismatic", "wheel", "screw", "other", "revolute2",
   "universal", "ball", "planar", "floating", "other_compound", "fixed"];
@@ -90,14 +92,16 @@ const applyTo = (t, v) => add(t.p, rotate(t.R, v));
 
 /** [x, y, z] of a Vector3/Point value ({x, y, z} or 3 numbers), or null. */
 function xyz(v) {
-  const a = v && (ArrayBuffer.isView(v) || Array.isArray(v)) ? Array.from(v) : v ? [v.x, v.y, v.z] : null;
-  return a && a.length === 3 && a.every((n) => typeof n === "number" && Number.isFinite(n)) ? a : null;
+  const f = namedFields(v, ["x", "y", "z"]);
+  const a = f && [f.x, f.y, f.z];
+  return a && a.every(Number.isFinite) ? a : null;
 }
 
 /** Unit [w, x, y, z] of a Quaternion value ({w, x, y, z} or 4 numbers), or null when zero or not numbers. */
 function wxyz(v) {
-  const a = v && (ArrayBuffer.isView(v) || Array.isArray(v)) ? Array.from(v) : v ? [v.w, v.x, v.y, v.z] : null;
-  if (!a || a.length !== 4 || !a.every((n) => typeof n === "number" && Number.isFinite(n))) return null;
+  const f = namedFields(v, ["w", "x", "y", "z"]);
+  const a = f && [f.w, f.x, f.y, f.z];
+  if (!a || !a.every(Number.isFinite)) return null;
   const n = Math.hypot(...a);
   return n > 0 ? a.map((x) => x / n) : null;
 }

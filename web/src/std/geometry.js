@@ -3,8 +3,11 @@
 // degrees. Quaternion fields are w, x, y, z (w first). Roll, pitch and yaw are the fixed-axis x-y-z
 // angles: R = Rz(yaw) · Ry(pitch) · Rx(roll).
 
-/** A {w, x, y, z} / {x, y, z} namedarray value, also from a flat array of numbers in field order. */
-function fields(v, names) {
+/**
+ * A {w, x, y, z} / {x, y, z} namedarray value (fields `names`), also from a flat array of numbers in
+ * field order; null when it is neither.
+ */
+export function namedFields(v, names) {
   if (v && (ArrayBuffer.isView(v) || Array.isArray(v))) {
     if (v.length !== names.length) return null;
     return Object.fromEntries(names.map((n, i) => [n, Number(v[i])]));
@@ -18,7 +21,7 @@ function fields(v, names) {
  * zero or non-numeric quaternion. Pitch is in [-π/2, π/2]; at ±π/2 (gimbal lock) roll is 0.
  */
 export function quaternionToRpy(q) {
-  q = fields(q, ["w", "x", "y", "z"]);
+  q = namedFields(q, ["w", "x", "y", "z"]);
   if (!q) return null;
   const n = Math.hypot(q.w, q.x, q.y, q.z);
   if (!(n > 0) || !Number.isFinite(n)) return null;
@@ -54,7 +57,7 @@ export function formatPose(v) {
   if (v && (ArrayBuffer.isView(v) || Array.isArray(v)) && v.length === 7) {
     v = { orientation: Array.from(v).slice(0, 4), position: Array.from(v).slice(4) };
   }
-  const p = fields(v?.position, ["x", "y", "z"]);
+  const p = namedFields(v?.position, ["x", "y", "z"]);
   const r = formatRotation(v?.orientation);
   return p && r ? `position ${vectorText(p)} m, ${r}` : null;
 }
@@ -64,7 +67,7 @@ export function formatTransform(v) {
   if (v && (ArrayBuffer.isView(v) || Array.isArray(v)) && v.length === 7) {
     v = { rotation: Array.from(v).slice(0, 4), translation: Array.from(v).slice(4) };
   }
-  const p = fields(v?.translation, ["x", "y", "z"]);
+  const p = namedFields(v?.translation, ["x", "y", "z"]);
   const r = formatRotation(v?.rotation);
   return p && r ? `translation ${vectorText(p)} m, ${r}` : null;
 }
