@@ -13,30 +13,12 @@ import net from "node:net";
 import os from "node:os";
 import path from "node:path";
 import { settings, startGateway, launchChromium, waitFor, ROOT, CHROMIUM_ARGS, webRequire } from "./harness.mjs";
+import { NGINX, HAVE_OPENSSL, freePort, substitute } from "./nginx_common.mjs";
 
 const s = settings();
-const NGINX = ["/usr/sbin/nginx", "/usr/bin/nginx"].find((p) => fs.existsSync(p));
-const HAVE_OPENSSL = (() => { try { execFileSync("openssl", ["version"]); return true; } catch { return false; } })();
 const SKIP = !NGINX || !HAVE_OPENSSL ? "nginx or openssl not installed (./scripts/setup.sh installs them)" : false;
 const USER = "alice", PASSWORD = "wonderland", HOST = "lab.example.org";
 let tmp, gateway, nginx, browser, site;
-
-function freePort() {
-  return new Promise((resolve) => {
-    const srv = net.createServer().listen(0, "127.0.0.1", () => {
-      const { port } = srv.address();
-      srv.close(() => resolve(port));
-    });
-  });
-}
-
-function substitute(text, pairs) {
-  for (const [from, to] of pairs) {
-    if (!text.includes(from)) throw new Error(`${JSON.stringify(from)} not in the nginx config: this test no longer matches it`);
-    text = text.replaceAll(from, to);
-  }
-  return text;
-}
 
 before(async () => {
   if (SKIP) return;

@@ -12,13 +12,23 @@ import { ROOT, waitFor } from "./harness.mjs";
 export const NGINX = ["/usr/sbin/nginx", "/usr/bin/nginx"].find((p) => fs.existsSync(p));
 export const HAVE_OPENSSL = (() => { try { execFileSync("openssl", ["version"]); return true; } catch { return false; } })();
 
-export function freePort() {
-  return new Promise((resolve) => {
-    const srv = net.createServer().listen(0, "127.0.0.1", () => {
-      const { port } = srv.address();
-      srv.close(() => resolve(port));
+/**
+ * A free TCP port on 127.0.0.1 below the ephemeral range (the kernel's bind-to-0 and outgoing connections
+ * never take it), for nginx or a gateway that binds some time after the port is chosen.
+ * @returns {Promise<number>}
+ */
+export async function freePort() {
+  const low = Number(fs.readFileSync("/proc/sys/net/ipv4/ip_local_port_range", "utf8").split(/\s+/)[0]);
+  for (let i = 0; i < 100; i++) {
+    const port = 20000 + Math.floor(Math.random() * (Math.min(low, 29000) - 20000));
+    const free = await new Promise((resolve) => {
+      const srv = net.createServer();
+      srv.once("error", () => resolve(false));
+      srv.listen(port, "127.0.0.1", () => srv.close(() => resolve(true)));
     });
-  });
+    if (free) return port;
+  }
+  throw new Error("no free port below the ephemeral range");
 }
 
 export function substitute(text, pairs) {

@@ -44,11 +44,6 @@ PASSWORDS = {"alice": "PASSWORD", "bob": "PASSWORD-bob"}  # alice's is the one t
 HOST = "robots.example.com"
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
 
 # --- the page ------------------------------------------------------------------------------------
 
@@ -93,7 +88,7 @@ class Scratch:
         self.root = tempfile.mkdtemp(prefix="rr-deploy-")
         os.chmod(self.root, 0o755)  # nginx's workers (www-data) read below it
         self.client = os.path.join(self.root, "client")  # the official client's working folder
-        self.ports = {"gw": free_port(), "https": free_port(), "http": free_port(), "lan": free_port()}
+        self.ports = dict(zip(("gw", "https", "http", "lan"), gwproc.fixed_ports(4)))
         self.deb = None
         self.devices = None
         self.gateway = None

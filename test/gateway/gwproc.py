@@ -110,19 +110,33 @@ def wait_ready(port, timeout=30.0):
     raise RuntimeError("gateway on port %d not ready within %.0f s" % (port, timeout))
 
 
-def fixed_port():
-    """A free TCP port on 127.0.0.1 below the ephemeral range, for a device that must come back on the
-    same port after a restart (an ephemeral one could be taken meanwhile by an outgoing connection)."""
+def fixed_ports(count):
+    """`count` distinct free TCP ports on 127.0.0.1 below the ephemeral range: for a server that must come
+    back on the same port after a restart, or one that binds some time after the port was chosen (nginx,
+    a gateway): an ephemeral port could be taken meanwhile by any outgoing connection or bind to port 0."""
     low = int(open("/proc/sys/net/ipv4/ip_local_port_range").read().split()[0])
-    for _ in range(100):
-        port = random.randrange(20000, min(low, 29000))
-        with socket.socket() as s:
+    held = []
+    try:
+        for _ in range(100 * count):
+            if len(held) == count:
+                break
+            s = socket.socket()
             try:
-                s.bind(("127.0.0.1", port))
-                return port
+                s.bind(("127.0.0.1", random.randrange(20000, min(low, 29000))))
+                held.append(s)
             except OSError:
-                continue
-    raise RuntimeError("no free port below the ephemeral range")
+                s.close()
+        if len(held) < count:
+            raise RuntimeError("no %d free ports below the ephemeral range" % count)
+        return [s.getsockname()[1] for s in held]
+    finally:
+        for s in held:
+            s.close()
+
+
+def fixed_port():
+    """One port of fixed_ports()."""
+    return fixed_ports(1)[0]
 
 
 def vm_rss_kib(pid):

@@ -19,7 +19,6 @@ import http.client
 import json
 import os
 import shutil
-import socket
 import ssl
 import subprocess
 import sys
@@ -35,11 +34,6 @@ from gwproc import expect
 SITE = "https://lab.example.org"
 USER, PASSWORD = "alice", "wonderland"
 
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def substitute(text, pairs):
@@ -79,7 +73,7 @@ def main():
         # nginx workers run as an unprivileged user and read the password file on every request.
         os.chmod(tmp, 0o755)
         os.chmod(htpasswd, 0o644)
-        https_port, http_port = free_port(), free_port()
+        https_port, http_port = gwproc.fixed_ports(2)
         site = substitute(open(a.conf).read(), [
             ("server 127.0.0.1:8080;", "server 127.0.0.1:%d;" % gw.port),
             ("    listen 80;\n    listen [::]:80;\n", "    listen 127.0.0.1:%d;\n" % http_port),
