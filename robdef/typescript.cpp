@@ -115,12 +115,12 @@ public:
 private:
     // A reference to a named type: its own name in this module, `ns.Name` for another definition's.
     std::string named_ref(const TypeDefinition& t);
-    // A value of type `t` as the package gives it. `field`: inside a struct, where null structs and
-    // containers occur (the runtime gives null for them).
-    std::string value_ts(const TypeDefinition& t, bool field);
+    // A value of type `t` as the package gives and takes it. Structs, containers and varvalues may be
+    // null wherever they occur (a member's value, a field, a list item: to_js gives null for them).
+    std::string value_ts(const TypeDefinition& t);
     std::string value_ts_without_container(TypeDefinition t) {
         t.container = ContainerKind::none;
-        return value_ts(t, false);
+        return value_ts(t);
     }
     // Element type of a namedarray (all its leaves share it), or void_t when unknown.
     DataTypes namedarray_element(const ServiceEntryDefinition& na, int depth = 0) const;
@@ -155,8 +155,8 @@ std::string Generator::named_ref(const TypeDefinition& t) {
     return typescript_namespace_name(svc) + "." + name;
 }
 
-std::string Generator::value_ts(const TypeDefinition& t, bool field) {
-    const std::string null_suffix = field ? " | null" : "";
+std::string Generator::value_ts(const TypeDefinition& t) {
+    const std::string null_suffix = " | null";
     if (t.container == ContainerKind::list || t.container == ContainerKind::map_int32 ||
         t.container == ContainerKind::map_string) {
         std::string item = value_ts_without_container(t);
@@ -222,7 +222,7 @@ std::string Generator::params_ts(const std::vector<TypeDefinition>& params, std:
     std::string s;
     for (std::size_t i = 0; i < count && i < params.size(); ++i) {
         if (i) s += ", ";
-        s += binding_name(params[i].name) + ": " + value_ts(params[i], false);
+        s += binding_name(params[i].name) + ": " + value_ts(params[i]);
     }
     return s;
 }
@@ -235,11 +235,11 @@ std::string Generator::member_ts(const MemberDefinition& m) {
     };
     switch (m.kind) {
         case MemberKind::property:
-            return m.name + ": " + directed("Property", "ReadonlyProperty", "WriteonlyProperty", value_ts(m.type, false));
+            return m.name + ": " + directed("Property", "ReadonlyProperty", "WriteonlyProperty", value_ts(m.type));
         case MemberKind::wire:
-            return m.name + ": " + directed("Wire", "ReadonlyWire", "WriteonlyWire", value_ts(m.type, false));
+            return m.name + ": " + directed("Wire", "ReadonlyWire", "WriteonlyWire", value_ts(m.type));
         case MemberKind::pipe:
-            return m.name + ": " + directed("Pipe", "ReadonlyPipe", "WriteonlyPipe", value_ts(m.type, false));
+            return m.name + ": " + directed("Pipe", "ReadonlyPipe", "WriteonlyPipe", value_ts(m.type));
         case MemberKind::memory: {
             TypeDefinition item = m.type;
             const bool multidim = item.array == ArrayKind::multidimarray;
@@ -247,17 +247,17 @@ std::string Generator::member_ts(const MemberDefinition& m) {
             item.array_length.clear();
             std::string kind = std::string(dir == MemberDirection::readonly ? "Readonly" : "") +
                                (multidim ? "MultiDimMemory" : "ArrayMemory");
-            return m.name + ": $rr." + kind + "<" + value_ts(item, false) + ">";
+            return m.name + ": $rr." + kind + "<" + value_ts(item) + ">";
         }
         case MemberKind::event: return m.name + ": $rr.Event<[" + params_ts(m.parameters, m.parameters.size()) + "]>";
         case MemberKind::callback:
             return m.name + ": $rr.Callback<(" + params_ts(m.parameters, m.parameters.size()) + ") => " +
-                   value_ts(m.type, false) + ">";
+                   value_ts(m.type) + ">";
         case MemberKind::objref: {
             TypeDefinition target_type = m.type;  // `T{int32}` / `T[]` name the indexed object type T
             target_type.array = ArrayKind::none;
             target_type.container = ContainerKind::none;
-            std::string target = value_ts(target_type, false);
+            std::string target = value_ts(target_type);
             switch (objref_index_kind(m.type)) {
                 case ObjRefIndexKind::none: return m.name + ": $rr.ObjRef<" + target + ">";
                 case ObjRefIndexKind::int32: return m.name + ": $rr.IndexedObjRef<" + target + ", number>";
@@ -267,14 +267,14 @@ std::string Generator::member_ts(const MemberDefinition& m) {
         }
         case MemberKind::function: {
             if (!m.is_generator())
-                return m.name + "(" + params_ts(m.parameters, m.parameters.size()) + "): Promise<" + value_ts(m.type, false) + ">";
+                return m.name + "(" + params_ts(m.parameters, m.parameters.size()) + "): Promise<" + value_ts(m.type) + ">";
             const bool param_gen = !m.parameters.empty() && m.parameters.back().container == ContainerKind::generator;
             std::size_t n = m.parameters.size() - (param_gen ? 1 : 0);
-            std::string ret = value_ts(m.type, false);
-            std::string param = param_gen ? value_ts(m.parameters.back(), false) : "undefined";
+            std::string ret = value_ts(m.type);
+            std::string param = param_gen ? value_ts(m.parameters.back()) : "undefined";
             return m.name + "(" + params_ts(m.parameters, n) + "): Promise<$rr.Generator<" + ret + ", " + param + ">>";
         }
-        case MemberKind::field: return m.name + ": " + value_ts(m.type, true);
+        case MemberKind::field: return m.name + ": " + value_ts(m.type);
     }
     return m.name + ": unknown";
 }
@@ -424,7 +424,7 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
         if (e.kind == EntryKind::namedarray)
             body_ += "  " + m.name + ": " + namedarray_field_ts(m, element) + ";\n";
         else if (e.kind == EntryKind::pod)
-            body_ += "  " + m.name + ": " + value_ts(m.type, false) + ";\n";
+            body_ += "  " + m.name + ": " + value_ts(m.type) + ";\n";
         else
             body_ += "  " + member_ts(m) + ";\n";
     }

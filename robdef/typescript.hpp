@@ -34,10 +34,10 @@ struct TypeScriptModule {
 ///  - double/single/int8..uint32 → number; int64/uint64 → bigint; bool → boolean; c* → Complex;
 ///  - numeric arrays → Float64Array … BigUint64Array (bool[] → boolean[], complex → Complex[]);
 ///    multi-dim → MultiDimArray<that array>;
-///  - string → string; enum → the union of its values (numbers); varvalue → VarValue;
-///  - struct → its interface (| null as a field: the runtime gives null for a null struct);
+///  - string → string; enum → the union of its values (numbers); varvalue → VarValue | null;
+///  - struct → its interface | null (the runtime gives null for a null struct, wherever it occurs);
 ///  - pod/namedarray → its interface; arrays of them → T[]; multi-dim → MultiDimArray<T[]>;
-///  - {list} → T[]; {string} → Record<string, T>; {int32} → Map<number, T> (| null as a field);
+///  - {list} → Array<T> | null; {string} → Record<string, T> | null; {int32} → Map<number, T> | null;
 ///  - namedarray fields: scalars as their element type (number, or bigint for 64-bit elements),
 ///    fixed arrays as typed arrays of the element type.
 /// Objects become interfaces extending ObjectBase, one member proxy type per member.

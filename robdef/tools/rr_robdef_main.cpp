@@ -185,7 +185,8 @@ int typescript(const std::vector<std::string>& args) {
             std::string found;
             for (const auto& dir : include_dirs) {
                 fs::path p = fs::path(dir) / (imp + ".robdef");
-                if (fs::exists(p)) {
+                std::error_code exists_error;  // the error_code forms: the wasm build has no exceptions
+                if (fs::exists(p, exists_error)) {
                     found = p.string();
                     break;
                 }
