@@ -89,7 +89,7 @@ try {
   let out = "";
   try {
     run(process.execPath, [tsc, "--noEmit", "--strict", "--module", "NodeNext", "--moduleResolution", "NodeNext", "--target", "ES2022",
-      "--types", "", "misuse.ts", "ws.d.ts"], { cwd: app });
+      "misuse.ts", "ws.d.ts"], { cwd: app });
   } catch (e) { out = e.stdout + e.stderr; }
   const errors = [...out.matchAll(/^misuse\.ts\((\d+),\d+\): error (TS\d+): (.*(?:\n {2}.*)*)/gm)].map((m) => ({ line: +m[1], code: m[2], text: m[3] }));
   const lines = fs.readFileSync(path.join(app, "misuse.ts"), "utf8").split("\n");

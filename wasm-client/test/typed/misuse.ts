@@ -10,7 +10,7 @@ export async function wrong(url: string): Promise<void> {
   const create = await connect<Create>(url);
   const root = await connect<Root>(url);
   const robot = await connect<Robot>(url);
-  const p: SensorPacket = { ID: 1, Data: [1, 2] };                  // MISUSE TS2322 Type 'number[]' is missing the following properties from type 'Uint8Array'
+  const p: SensorPacket = { ID: 1, Data: [1, 2] };                  // MISUSE TS2740 Type 'number[]' is missing the following properties from type 'Uint8Array'
   const i: Inner = { id: "1", label: "x", values: Float64Array.of() }; // MISUSE TS2322 Type 'string' is not assignable to type 'number'
   await create.Drive(200);                                           // MISUSE TS2554 Expected 2 arguments, but got 1
   await create.DistanceTraveled.set(3);                              // MISUSE TS2339 Property 'set' does not exist on type 'ReadonlyProperty<number>'
