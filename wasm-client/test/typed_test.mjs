@@ -5,9 +5,11 @@
 //  2. tsc --strict --noEmit: typed/demo.ts, interop.ts and std.ts (every member kind) compile with every
 //     generated module; typed/misuse.ts fails on exactly its MISUSE lines, each with its own error code
 //     and message;
-//  3. the compiled demo.js and interop.js run against rr-gateway's demo devices and rr_interop_service,
+//  3. the compiled demo.js and interop.js (beside the .ts, as the generated .js files are) run against rr-gateway's demo devices and rr_interop_service,
 //     checking each value is what its declared type says.
-// Usage: node typed_test.mjs --rr-robdef PATH --gateway PATH --interop-service PATH
+// Usage: node typed_test.mjs --rr-robdef PATH --gateway PATH --interop-service PATH [--python PATH]
+// (interop.js also runs against the official Python service, test/interop/official_service.py, when
+// the venv's python exists).
 // Exit 77 (skipped) when dist/, typescript or the shared standard definitions are missing.
 import { execFileSync, spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
@@ -115,9 +117,18 @@ try {
   const interop = spawn(interopBin, ["--port", "0", "--websocket", "--max-lifetime", "300"], { stdio: ["ignore", "pipe", "inherit"] });
   children.push(interop);
   const { ws_url: interopUrl } = await readyLine(interop, "ws_url");
-  for (const [prog, url, done] of [["demo.js", `rr+ws://127.0.0.1:${port}/`, "typed demo: all ok"], ["interop.js", interopUrl, "typed interop: all ok"]]) {
+  const runs = [["demo.js", `rr+ws://127.0.0.1:${port}/`, "typed demo: all ok"], ["interop.js", interopUrl, "typed interop: all ok"]];
+  // the official Python service too (the same definition), when the venv has it
+  const py = arg("--python") ?? path.join(root, ".venv/bin/python");
+  if (fs.existsSync(py)) {
+    const official = spawn(py, [path.join(root, "test/interop/official_service.py"), "--port", "0", "--websocket", "--max-lifetime", "300"],
+      { stdio: ["ignore", "pipe", "inherit"] });
+    children.push(official);
+    runs.push(["interop.js", (await readyLine(official, "ws_url")).ws_url, "typed interop: all ok"]);
+  }
+  for (const [prog, url, done] of runs) {
     try {
-      const r = run(process.execPath, [path.join(app, "out", prog), url], { cwd: app, timeout: 120000 });
+      const r = run(process.execPath, [path.join(app, prog), url], { cwd: app, timeout: 120000 });
       process.stdout.write(`${r.trimEnd().replace(/^/gm, "  | ")}\n`);
       ok(r.includes(done), `${prog} against ${url}: every value has its declared JS type`);
     } catch (e) {
