@@ -46,5 +46,22 @@ for f in "$dist"/dashboard/std/*.js; do [ -f "$web/std/$(basename "$f")" ] || rm
 mkdir -p "$dist/dashboard/robot"
 for f in "$web"/robot/*.js "$web"/robot/*.d.ts; do [ -f "$f" ] && copy_if_changed "$f" "$dist/dashboard/robot/$(basename "$f")"; done
 for f in "$dist"/dashboard/robot/*; do [ -f "$web/robot/$(basename "$f")" ] || rm -f "$f"; done
+# The standard service definitions as TypeScript (`rr-robdef ts`, robdef/typescript.hpp; the node build of
+# rr-robdef from this build folder): dist/types/std/<service>.d.ts + .js, imported as
+# "robotraconteur-wasm/std/<service>" (package.json exports "./std/*"; "./std" alone stays the dashboard's
+# standard-type modules above). The definitions are read from the shared folder, never copied into the repo.
+std_robdefs="${RR_ROBDEF_STANDARD:-$root/../shared/robdef-standard/group1}"
+if compgen -G "$std_robdefs/*.robdef" >/dev/null; then
+  gen="$build/std-types.tmp"
+  rm -rf "$gen"
+  # --no-experimental-fetch: emscripten 3.1.6 would fetch() the .wasm by path under node 18+
+  node --no-experimental-fetch "$build/rr_robdef_node.cjs" ts -o "$gen" "$std_robdefs"/*.robdef
+  mkdir -p "$dist/types/std"
+  for f in "$gen"/*; do copy_if_changed "$f" "$dist/types/std/$(basename "$f")"; done
+  for f in "$dist"/types/std/*; do [ -f "$gen/$(basename "$f")" ] || rm -f "$f"; done
+  rm -rf "$gen"
+else
+  echo "wasm-client/build.sh: no *.robdef in $std_robdefs: the package has no standard TypeScript types (std/*)" >&2
+fi
 copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
 echo "wasm-client: package in $dist"

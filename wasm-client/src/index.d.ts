@@ -132,7 +132,8 @@ export interface MemoryMember {
   write(start: number | number[], data: RRValue): Promise<void>;
 }
 
-export interface ObjectProxy {
+/** What every object proxy has, typed or not: the generated interfaces (`rr-robdef ts`) extend it. */
+export interface ObjectBase {
   /** Qualified object type, e.g. "experimental.create.Create". */
   readonly $type: string;
   /** Service path of the object. */
@@ -145,6 +146,10 @@ export interface ObjectProxy {
   /** Takes the object's monitor lock (timeoutMs −1: wait as long as it takes). */
   $monitorEnter(timeoutMs?: number): Promise<void>;
   $monitorExit(): Promise<void>;
+}
+
+/** An object proxy without generated types: members by name are `any`. */
+export interface ObjectProxy extends ObjectBase {
   /** Members by name: PropertyMember, function, EventMember, ObjRefMember, PipeMember, CallbackMember,
    *  WireMember or MemoryMember according to the member's kind. */
   [member: string]: any;
@@ -165,11 +170,147 @@ export interface ConnectOptions {
   ca?: string | Uint8Array | Array<string | Uint8Array>;
 }
 
-/** Connects to `url` (`rr+ws://host:port/?service=name`, or rr+wss) and returns the root object's proxy. */
-export function connect(url: string, options?: ConnectOptions): Promise<ObjectProxy>;
+/** Connects to `url` (`rr+ws://host:port/?service=name`, or rr+wss) and returns the root object's proxy.
+ *  `T`: the root object's generated interface (`connect<Robot>(url)`, README "Typed use"); it is not
+ *  checked against the service's type (compare `$type`). Without it the proxy is an untyped ObjectProxy. */
+export function connect<T extends ObjectBase = ObjectProxy>(url: string, options?: ConnectOptions): Promise<T>;
 
 /** Loads the WebAssembly module (connect() does it on first use). */
 export function loadModule(): Promise<unknown>;
 
 /** Subprotocol of RR over WebSocket. */
 export const WEBSOCKET_PROTOCOL: string;
+
+// ---- Typed values and member proxies: what `rr-robdef ts` generates declarations with (README "Typed use").
+// The runtime objects are the same as above; these types only narrow them by the member's robdef.
+
+/** `cdouble` / `csingle`. */
+export interface Complex {
+  real: number;
+  imag: number;
+}
+
+/** A multi-dim array (`T[*]`, `T[N,M]`): column-major, element (i, j) is `array[i + j*dims[0]]`. `A` is a
+ *  typed array for numbers, `boolean[]` / `Complex[]`, or an array of pod/namedarray objects. */
+export interface MultiDimArray<A> {
+  dims: number[];
+  array: A;
+}
+
+/** A `varvalue` as the package gives it: `{type, value}` with the type text as the official Python client
+ *  names it (numerics always arrays). Narrow on `type`; named types (`svc.Struct`, `svc.Pod[]`, enums) are
+ *  `${string}.${string}` with an untyped value. The runtime gives null for a null varvalue (a field's type
+ *  says `| null`). As input the package also takes a bare string, number (→ "double[]") or typed array. */
+export type VarValue =
+  | { type: "double[]"; value: Float64Array }
+  | { type: "single[]"; value: Float32Array }
+  | { type: "int8[]"; value: Int8Array }
+  | { type: "uint8[]"; value: Uint8Array }
+  | { type: "int16[]"; value: Int16Array }
+  | { type: "uint16[]"; value: Uint16Array }
+  | { type: "int32[]"; value: Int32Array }
+  | { type: "uint32[]"; value: Uint32Array }
+  | { type: "int64[]"; value: BigInt64Array }
+  | { type: "uint64[]"; value: BigUint64Array }
+  | { type: "bool[]"; value: boolean[] }
+  | { type: "cdouble[]" | "csingle[]"; value: Complex[] }
+  | { type: "double[*]"; value: MultiDimArray<Float64Array> }
+  | { type: "single[*]"; value: MultiDimArray<Float32Array> }
+  | { type: "int8[*]"; value: MultiDimArray<Int8Array> }
+  | { type: "uint8[*]"; value: MultiDimArray<Uint8Array> }
+  | { type: "int16[*]"; value: MultiDimArray<Int16Array> }
+  | { type: "uint16[*]"; value: MultiDimArray<Uint16Array> }
+  | { type: "int32[*]"; value: MultiDimArray<Int32Array> }
+  | { type: "uint32[*]"; value: MultiDimArray<Uint32Array> }
+  | { type: "int64[*]"; value: MultiDimArray<BigInt64Array> }
+  | { type: "uint64[*]"; value: MultiDimArray<BigUint64Array> }
+  | { type: "bool[*]"; value: MultiDimArray<boolean[]> }
+  | { type: "cdouble[*]" | "csingle[*]"; value: MultiDimArray<Complex[]> }
+  | { type: "string"; value: string }
+  | { type: "varvalue{list}"; value: Array<VarValue | null> }
+  | { type: "varvalue{string}"; value: Record<string, VarValue | null> }
+  | { type: "varvalue{int32}"; value: Map<number, VarValue | null> }
+  | { type: `${string}.${string}`; value: unknown };
+
+/** `property T name`. */
+export type Property<T> = PropertyMember<T>;
+/** `property T name [readonly]`: no set(). */
+export interface ReadonlyProperty<T> {
+  get(): Promise<T>;
+}
+/** `property T name [writeonly]`: no get(). */
+export interface WriteonlyProperty<T> {
+  set(value: T): Promise<void>;
+}
+
+/** `event name(A...)`: `on(fn)` with the event's parameters, e.g. `Event<[seq: number, text: string]>`. */
+export interface Event<A extends unknown[]> {
+  /** `fn(...params)` for every event; returns the function that unsubscribes. */
+  on(fn: (...args: A) => void): () => void;
+}
+
+/** `callback R name(P...)`, e.g. `Callback<(x: number) => number>`: the handler may be async. */
+export interface Callback<F extends (...args: any[]) => any> {
+  /** Sets the handler (a thrown RRError keeps its errorName); null clears it. */
+  set(fn: ((...args: Parameters<F>) => ReturnType<F> | Promise<ReturnType<F>>) | null): void;
+}
+
+/** `objref T name`: the object's proxy. */
+export interface ObjRef<T> {
+  get(): Promise<T>;
+}
+/** `objref T{int32} name` / `T[]` (K = number), `objref T{string} name` (K = string). */
+export interface IndexedObjRef<T, K extends number | string> {
+  get(index: K): Promise<T>;
+}
+
+/** `pipe T name`. */
+export type Pipe<T> = PipeMember<T>;
+/** A pipe endpoint of a `[readonly]` pipe: the service sends, the client cannot. */
+export type ReadonlyPipeEndpoint<T> = Omit<PipeEndpoint<T>, "send">;
+/** A pipe endpoint of a `[writeonly]` pipe: the client sends, nothing arrives. */
+export type WriteonlyPipeEndpoint<T> = Omit<PipeEndpoint<T>, "receive" | "onPacket" | typeof Symbol.asyncIterator>;
+/** `pipe T name [readonly]`. */
+export interface ReadonlyPipe<T> {
+  connect(index?: number): Promise<ReadonlyPipeEndpoint<T>>;
+}
+/** `pipe T name [writeonly]`. */
+export interface WriteonlyPipe<T> {
+  connect(index?: number): Promise<WriteonlyPipeEndpoint<T>>;
+}
+
+/** `wire T name`. */
+export type Wire<T> = WireMember<T>;
+/** A connection of a `[readonly]` wire: InValue only (the service sends). */
+export type ReadonlyWireConnection<T> = Omit<WireConnection<T>, "outValue" | "outValueTime">;
+/** A connection of a `[writeonly]` wire: OutValue only (the client sends). */
+export type WriteonlyWireConnection<T> = Omit<WireConnection<T>, "inValue" | "inValueTime" | "inValueValid" | "waitInValue" | "onChange">;
+/** `wire T name [readonly]`. */
+export interface ReadonlyWire<T> {
+  connect(): Promise<ReadonlyWireConnection<T>>;
+  peekInValue(): Promise<T>;
+  peekInValueWithTime(): Promise<{ value: T; ts: TimeSpec }>;
+}
+/** `wire T name [writeonly]`. */
+export interface WriteonlyWire<T> {
+  connect(): Promise<WriteonlyWireConnection<T>>;
+  peekOutValue(): Promise<T>;
+  pokeOutValue(value: T): Promise<void>;
+}
+
+/** `memory T[] name`: `A` is the array (a typed array, or pod/namedarray objects). */
+export interface ArrayMemory<A> {
+  length(): Promise<number>;
+  /** Items [start, start+count). */
+  read(start: number, count: number): Promise<A>;
+  write(start: number, data: A): Promise<void>;
+}
+export type ReadonlyArrayMemory<A> = Omit<ArrayMemory<A>, "write">;
+/** `memory T[*] name`. */
+export interface MultiDimMemory<A> {
+  dimensions(): Promise<number[]>;
+  dimCount(): Promise<number>;
+  read(start: number[], count: number[]): Promise<MultiDimArray<A>>;
+  write(start: number[], data: MultiDimArray<A>): Promise<void>;
+}
+export type ReadonlyMultiDimMemory<A> = Omit<MultiDimMemory<A>, "write">;
