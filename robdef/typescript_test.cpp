@@ -254,7 +254,7 @@ end
     CHECK(typescript_namespace_name("com.robotraconteur.geometry") == "com_robotraconteur_geometry");
 }
 
-TEST_CASE("ts: every standard definition generates without an unknown type") {
+TEST_CASE("ts: every standard definition generates without an unknown type", "[shared]") {
     auto dir = rr::robdef::test::shared_path("robdef-standard/group1");
     if (!dir) RR_SKIP("robdef-standard/group1 not found");
     ServiceDefinitionSet set;
