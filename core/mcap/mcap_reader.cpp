@@ -395,16 +395,18 @@ struct MessageIterator::State {
     // Indexed: chunks still to load (by start time), and the loaded messages as a min-heap.
     struct Pending {
         std::uint64_t log_time;
-        std::uint64_t order;  // load order: ties keep file order
+        std::uint64_t chunk_offset;   // ties in log_time keep file order
+        std::uint64_t record_offset;
         Message message;
     };
     std::vector<const ChunkIndex*> chunks;
     std::size_t next_chunk = 0;
     std::vector<Pending> heap;
-    std::uint64_t order = 0;
 
     static bool later(const Pending& a, const Pending& b) {
-        return a.log_time != b.log_time ? a.log_time > b.log_time : a.order > b.order;
+        if (a.log_time != b.log_time) return a.log_time > b.log_time;
+        if (a.chunk_offset != b.chunk_offset) return a.chunk_offset > b.chunk_offset;
+        return a.record_offset > b.record_offset;
     }
 
     Result<std::optional<Message>> fail_with(Unexpected u) {
@@ -506,7 +508,7 @@ Result<void> MessageIterator::State::load_indexed_chunk(const ChunkIndex& ci) {
         if (!m) return m.take_error();
         if (!*m) continue;
         const auto t = (**m).log_time;
-        heap.push_back(Pending{t, order++, std::move(**m)});
+        heap.push_back(Pending{t, at, (*item)->offset, std::move(**m)});
         std::push_heap(heap.begin(), heap.end(), later);
     }
     return {};

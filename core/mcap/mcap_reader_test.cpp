@@ -129,8 +129,13 @@ TEST_CASE("mcap: a file cut off mid-chunk reads up to its last complete chunk") 
     auto first = write_sample(w, 100);
     REQUIRE(w.flush());
     const auto after_first = file.size();
-    std::vector<std::byte> payload_bytes(300, std::byte{7});
-    for (std::uint32_t i = 0; i < 100; ++i) REQUIRE(w.write({0, i, 5000 + i, 5000 + i, payload_bytes}));
+    // Payloads that do not compress, so the chunk is much longer than its message indexes.
+    std::uint32_t x = 12345;
+    std::vector<std::byte> payload_bytes(300);
+    for (std::uint32_t i = 0; i < 100; ++i) {
+        for (auto& b : payload_bytes) b = static_cast<std::byte>((x = x * 1103515245u + 12345u) >> 24);
+        REQUIRE(w.write({0, i, 5000 + i, 5000 + i, payload_bytes}));
+    }
     REQUIRE(w.flush());
     const auto after_second = file.size();
     // A writer killed here leaves the file as it is: no summary, no footer.
