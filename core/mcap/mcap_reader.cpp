@@ -155,7 +155,8 @@ std::string in_chunk(std::uint64_t chunk_offset) {
 }
 
 bool wanted(const MessageQuery& q, std::uint16_t channel, std::uint64_t log_time) {
-    return log_time >= q.start_time && log_time < q.end_time && (!q.channels || q.channels->count(channel));
+    return log_time >= q.start_time && (!q.end_time || log_time < *q.end_time) &&
+           (!q.channels || q.channels->count(channel));
 }
 
 }  // namespace
@@ -429,7 +430,8 @@ struct MessageIterator::State {
     }
 
     bool chunk_wanted(const ChunkIndex& ci) const {
-        if (ci.message_end_time < query.start_time || ci.message_start_time >= query.end_time) return false;
+        if (ci.message_end_time < query.start_time || (query.end_time && ci.message_start_time >= *query.end_time))
+            return false;
         if (query.channels && !ci.message_index_offsets.empty()) {
             bool any = false;
             for (auto c : *query.channels) any = any || ci.message_index_offsets.count(c);
@@ -504,6 +506,15 @@ Result<void> MessageIterator::State::load_indexed_chunk(const ChunkIndex& ci) {
         if (!item) return item.take_error();
         if (!*item) break;
         if ((*item)->opcode != op(Opcode::Message)) continue;
+        // The merge by log_time trusts the ChunkIndex time ranges: a message outside its range is an error.
+        if ((*item)->content.size() >= 14) {
+            const auto t = load_le<std::uint64_t>((*item)->content.data() + 6);
+            if (t < ci.message_start_time || t > ci.message_end_time)
+                return record_error(op(Opcode::Message), (*item)->offset, kCorrupt,
+                                    "log_time " + std::to_string(t) + " outside its ChunkIndex range [" +
+                                        std::to_string(ci.message_start_time) + ", " +
+                                        std::to_string(ci.message_end_time) + "]" + in_chunk(at));
+        }
         auto m = message_from((*item)->content, (*item)->offset, at);
         if (!m) return m.take_error();
         if (!*m) continue;
