@@ -56,22 +56,33 @@ public:
             return stop("file ends inside " + opcode_name(opcode) + " at offset " + std::to_string(pos_) +
                         " (content length " + std::to_string(length) + ", " +
                         std::to_string(size - pos_ - kRecordPrefixBytes) + " bytes left)");
+        RawRecord rec{opcode, pos_, {}};
+        if (opcode == op(Opcode::DataEnd) || opcode == op(Opcode::Footer)) done_ = true;
+        if (!wanted_content(opcode)) {  // attachments, metadata, indexes, private records: skipped unread
+            pos_ += kRecordPrefixBytes + length;
+            return std::optional<RawRecord>(std::move(rec));
+        }
         if (length > limits_.max_record_bytes)
             return record_error(opcode, pos_, MessageErrorType::BufferLimitViolation,
                                 "content length " + std::to_string(length) + " over the limit of " +
                                     std::to_string(limits_.max_record_bytes) + " bytes");
-        RawRecord rec{opcode, pos_, {}};
         auto content = read_bytes(source_, pos_ + kRecordPrefixBytes, length);
         if (!content) return content.take_error();
         rec.content = std::move(*content);
         pos_ += kRecordPrefixBytes + length;
-        if (opcode == op(Opcode::DataEnd) || opcode == op(Opcode::Footer)) done_ = true;
         return std::optional<RawRecord>(std::move(rec));
     }
 
     const std::optional<std::string>& truncated() const { return truncated_; }
 
 private:
+    // Records whose content a linear read uses; the others are stepped over (a linear read only counts
+    // Attachment and Metadata records).
+    static bool wanted_content(std::uint8_t opcode) {
+        return opcode == op(Opcode::Schema) || opcode == op(Opcode::Channel) || opcode == op(Opcode::Message) ||
+               opcode == op(Opcode::Chunk);
+    }
+
     Result<std::optional<RawRecord>> stop(std::string why) {
         done_ = true;
         truncated_ = std::move(why);
@@ -105,10 +116,7 @@ Result<Bytes> load_chunk(std::span<const std::byte> content, std::uint64_t offse
             return record_error(op(Opcode::Chunk), offset, kCorrupt, buf);
         }
     }
-    if (fields) {
-        *fields = *chunk;
-        fields->records = {};
-    }
+    if (fields) *fields = *chunk;  // its records view points into `content`
     return std::move(*records);
 }
 
@@ -320,7 +328,7 @@ Result<void> McapReader::State::scan_linear() {
         ci.chunk_start_offset = r.offset;
         ci.chunk_length = kRecordPrefixBytes + r.content.size();
         ci.compression = fields.compression;
-        ci.compressed_size = r.content.size();  // approximate: content minus the fixed fields
+        ci.compressed_size = fields.records.size();
         ci.uncompressed_size = fields.uncompressed_size;
         summary.chunk_indexes.push_back(std::move(ci));
         ++summary.statistics.chunk_count;

@@ -22,7 +22,8 @@
 //     its ChunkIndex's time range (the log-time merge relies on those ranges);
 //   BufferLimitViolation: a record or a chunk's uncompressed size over ReaderLimits;
 //   IOError: the Source's own errors, unchanged.
-// Not thread-safe; the Source must outlive the reader and its iterators.
+// Not thread-safe. The Source must outlive the reader, and the reader its MessageIterators (moving the
+// reader is fine: iterators refer to state that stays put).
 #pragma once
 
 #include <cstddef>

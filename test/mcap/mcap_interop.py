@@ -2,7 +2,8 @@
 """MCAP interop (issue 44): our writer and reader (core/mcap, through rr_mcap_tool) against the reference
 implementations, the `mcap` PyPI package and `@mcap/core` from npm (mcap_reference.mjs), both ways.
 
-Every writer writes the same sample recording (described in rr_mcap_tool.cpp): ours chunked with zstd,
+Every writer writes the same sample recording (described in rr_mcap_tool.cpp; Python's adds an attachment
+and a metadata record in the middle): ours chunked with zstd,
 chunked uncompressed, and in one chunk; Python's and TypeScript's chunked with zstd, chunked
 uncompressed and unchunked. Every reader dumps every file in one JSON shape: ours, Python's indexed
 (seeking) and streaming readers (CRCs checked, the data section CRC too), TypeScript's indexed reader
@@ -80,6 +81,10 @@ def py_write(path, compression, chunked, chunk_size=4096):
             t = T0 + i * 1000003
             w.add_message(js if i % 2 == 0 else rr, log_time=t, data=sample_payload(i), publish_time=t - 7,
                           sequence=i // 2)
+            if i == COUNT // 2:  # records our writer never writes, which our reader steps over
+                w.add_attachment(create_time=t, log_time=t, name="calibration.txt", media_type="text/plain",
+                                 data=b"x" * 100)
+                w.add_metadata("robot", {"serial": "42"})
         w.finish()
 
 
