@@ -16,7 +16,8 @@ using detail::Bytes;
 using detail::kRecordPrefixBytes;
 using detail::record_error;
 
-namespace {
+// Named, not anonymous: MessageIterator::State holds a LinearScanner and a RecordWalker.
+namespace reader_detail {
 
 constexpr auto kCorrupt = MessageErrorType::DataSerializationError;
 
@@ -167,7 +168,8 @@ bool wanted(const MessageQuery& q, std::uint16_t channel, std::uint64_t log_time
            (!q.channels || q.channels->count(channel));
 }
 
-}  // namespace
+}  // namespace reader_detail
+using namespace reader_detail;
 
 struct McapReader::State {
     Source* source = nullptr;
@@ -222,8 +224,9 @@ Result<void> McapReader::State::read_footer_and_summary() {
         }
     }
     const std::uint64_t summary_end = f.summary_offset_start ? f.summary_offset_start : footer_at;
-    RecordWalker walk(std::span(*covered).first(static_cast<std::size_t>(summary_end - f.summary_start)),
-                      f.summary_start, " (in the summary section)");
+    const auto summary_bytes = std::span<const std::byte>(*covered).first(
+        static_cast<std::size_t>(summary_end - f.summary_start));
+    RecordWalker walk(summary_bytes, f.summary_start, " (in the summary section)");
     Summary s;
     s.from_summary_section = true;
     bool have_statistics = false;
