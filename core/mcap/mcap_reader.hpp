@@ -1,0 +1,111 @@
+// McapReader: reads MCAP files from a Source (MCAP specification, mcap.dev/spec), both the ones
+// McapWriter writes and other writers' (chunked or not, zstd or uncompressed).
+//
+// Two ways to read, chosen by open():
+//  - Indexed: the file ends with a valid footer and magic and has Chunk Index records in its summary.
+//    summary() comes from the Summary section; messages() seeks to the chunks overlapping the query and
+//    yields messages in log_time order (ties: file order).
+//  - Linear: anything else (a file whose writer was killed, or one without a summary/indexes). open()
+//    reads the data section from the start to Data End or to the end of the last complete record,
+//    checking every chunk, and builds summary() from what it saw; messages() reads the file again and
+//    yields messages in file order. truncated() then tells where the readable part ends.
+//
+// Checks: every length is checked against the bytes left in its record, the file and
+// ReaderLimits before anything is allocated; chunk CRCs (when not 0) are verified; zstd output must
+// have exactly the announced size. A record cut off by the end of the file ends a linear read (that is
+// truncation, not an error); anything malformed inside the readable part is an error.
+//
+// Errors (RRError.message always names the record and its file offset, e.g.
+// "mcap: Chunk at offset 1234: uncompressed_crc mismatch (file 0x..., computed 0x...)"):
+//   DataSerializationError: bad magic, malformed record, CRC mismatch, bad compressed data, unknown
+//     compression, a message on a channel never defined, (indexed) a message whose log_time is outside
+//     its ChunkIndex's time range (the log-time merge relies on those ranges);
+//   BufferLimitViolation: a record or a chunk's uncompressed size over ReaderLimits;
+//   IOError: the Source's own errors, unchanged.
+// Not thread-safe. The Source must outlive the reader, and the reader its MessageIterators (moving the
+// reader is fine: iterators refer to state that stays put).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "core/error/rr_error.hpp"
+#include "core/mcap/mcap_io.hpp"
+#include "core/mcap/mcap_records.hpp"
+
+namespace rr::mcap {
+
+/// Allocation bounds for reading untrusted files. Each failure is BufferLimitViolation.
+struct ReaderLimits {
+    /// Largest record read into memory (a compressed chunk, a summary record, an unchunked message).
+    std::uint64_t max_record_bytes = 512ull * 1024 * 1024;
+    /// Largest uncompressed size a chunk may announce.
+    std::uint64_t max_chunk_uncompressed_bytes = 512ull * 1024 * 1024;
+    /// Largest Summary section read at open().
+    std::uint64_t max_summary_bytes = 256ull * 1024 * 1024;
+};
+
+/// Which messages messages() yields.
+struct MessageQuery {
+    std::uint64_t start_time = 0;  ///< ns, inclusive: log_time >= start_time
+    /// ns, exclusive: log_time < end_time; nullopt = no end (every time up to UINT64_MAX included).
+    std::optional<std::uint64_t> end_time;
+    /// Channel ids to yield; nullopt = all channels.
+    std::optional<std::set<std::uint16_t>> channels;
+};
+
+class McapReader;
+
+/// Pulls messages one at a time. Holds at most the decompressed chunks whose time ranges overlap the
+/// current position (indexed) or one chunk (linear).
+class MessageIterator {
+public:
+    MessageIterator(MessageIterator&&) noexcept;
+    MessageIterator& operator=(MessageIterator&&) noexcept;
+    ~MessageIterator();
+
+    /// The next message, or nullopt at the end (for a truncated file: at the end of its last complete
+    /// record). An error is final: later calls return it again.
+    Result<std::optional<Message>> next();
+
+private:
+    friend class McapReader;
+    struct State;
+    explicit MessageIterator(std::unique_ptr<State> s);
+    std::unique_ptr<State> s_;
+};
+
+class McapReader {
+public:
+    /// Checks the leading magic, reads the Header, then the summary (indexed) or the whole readable
+    /// data section (linear), as described above. Errors: see above.
+    static Result<McapReader> open(Source& source, ReaderLimits limits = {});
+
+    McapReader(McapReader&&) noexcept;
+    McapReader& operator=(McapReader&&) noexcept;
+    ~McapReader();
+
+    const Header& header() const noexcept;
+    const Summary& summary() const noexcept;
+    /// True when messages() can seek by time through Chunk Index records (the indexed way).
+    bool indexed() const noexcept;
+    /// For a linear read that ended inside a record: the file offset where the readable part ends and
+    /// why ("file ends inside Chunk at offset 1234"). nullopt when the file was read to its Data End
+    /// (or is indexed).
+    const std::optional<std::string>& truncated() const noexcept;
+
+    /// Messages matching `query`: indexed files in log_time order, linear ones in file order.
+    MessageIterator messages(MessageQuery query = {});
+
+private:
+    friend class MessageIterator;
+    struct State;
+    explicit McapReader(std::unique_ptr<State> s);
+    std::unique_ptr<State> s_;
+};
+
+}  // namespace rr::mcap
