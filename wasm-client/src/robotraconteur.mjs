@@ -158,6 +158,9 @@ export class Connection {
   onClosed(error) {
     if (this.state === "closed") return;
     this.state = "closed";
+    // Format the stack now: an unformatted V8 stack trace holds the `this` of its frames (this closed
+    // connection and all its proxies) for as long as anyone keeps the error (a reconnect loop does).
+    void error?.stack;
     this.closeError = error;
     if (this.timer) clearTimeout(this.timer);
     try {

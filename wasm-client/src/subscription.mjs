@@ -7,6 +7,9 @@ import { backoffDelay, backoffOptions, later, Listeners } from "./backoff.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
+/** A copy to keep: a V8 error's unformatted stack trace holds the `this` of its frames (the closed
+ * connection and, through it, its proxies) for as long as the error lives. */
+const keepable = (e) => (e ? new RRError(e.errorName, e.message, e.code) : null);
 const invalid = (m) => new RRError("RobotRaconteur.InvalidArgument", m, 18);
 
 /**
@@ -212,9 +215,9 @@ export class ServiceSubscription {
         proxy = await this.connectFn(c.url, this.connectOptions);
       } catch (e) {
         if (this.closed || c.removed) break;
-        c.lastError = toRRError(e);
+        c.lastError = keepable(toRRError(e));
         c.state = "waiting";
-        this.errorListeners.emit(c.lastError, c);
+        this.errorListeners.emit(toRRError(e), c);
         if (!c.fixed && !c.listed) break;
         await this.sleep(c, backoffDelay(c.attempt++, this.backoff));
         continue;
@@ -238,7 +241,7 @@ export class ServiceSubscription {
       for (const s of [...this.wires, ...this.pipes]) s.detach(c);
       if (this.closed || c.removed) break;
       c.state = "waiting";
-      c.lastError = error ?? null;
+      c.lastError = keepable(error);
       this.disconnectListeners.emit(c, error ?? null);
       if (!c.fixed && !c.listed) break;
       await this.sleep(c, backoffDelay(c.attempt++, this.backoff));
@@ -496,10 +499,19 @@ export class WireSubscription extends MemberSubscription {
   }
 
   listen(conn, c) {
-    conn.onChange((value, ts) => {
-      if (this.links.get(c) === conn) this.deliver(value, ts, c);
-    });
-    if (conn.inValueValid) this.deliver(conn.inValue, conn.inValueTime, c);
+    // A new wire connection starts with the newest value the service (or the gateway) has, which may be
+    // the one already delivered from the previous connection: the same sender time stamp from the same
+    // service is that value again, not a new one, and is not delivered twice.
+    let first = true;
+    const take = (value, ts) => {
+      if (this.links.get(c) !== conn) return;
+      const again = first && this.latest?.client === c && this.latest.ts.seconds === ts.seconds &&
+        this.latest.ts.nanoseconds === ts.nanoseconds;
+      first = false;
+      if (!again) this.deliver(value, ts, c);
+    };
+    conn.onChange(take);
+    if (conn.inValueValid) take(conn.inValue, conn.inValueTime);
   }
 
   deliver(value, ts, client) {
