@@ -171,6 +171,9 @@ export class Connection {
     } catch {
       // already closed
     }
+    // A browser keeps a closing WebSocket (and so its handlers, this connection, its proxies) until the
+    // close handshake ends or times out: let go of them now.
+    this.ws.onopen = this.ws.onmessage = this.ws.onerror = this.ws.onclose = null;
     for (const fn of this.closeListeners) queueMicrotask(() => fn(error));
     // Free the native object once no C++ frame is on the stack.
     setTimeout(() => {

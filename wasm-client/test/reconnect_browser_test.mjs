@@ -60,6 +60,15 @@ try {
   await page.goto(url);
   await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 170000, polling: 200 });
   const r = await page.evaluate(() => window.__result);
+  if (process.env.SUBS_SNAPSHOT) {  // debugging aid: a heap snapshot of the page after the checks
+    const cdp = await page.context().newCDPSession(page);
+    const chunks = [];
+    cdp.on("HeapProfiler.addHeapSnapshotChunk", (e) => chunks.push(e.chunk));
+    await cdp.send("HeapProfiler.enable");
+    await cdp.send("HeapProfiler.collectGarbage");
+    await cdp.send("HeapProfiler.takeHeapSnapshot", { reportProgress: false });
+    (await import("node:fs")).writeFileSync(process.env.SUBS_SNAPSHOT, chunks.join(""));
+  }
   for (const f of r.failed) console.log(`  FAIL ${f.name}: ${f.error}`);
   console.log(`== chromium: ${r.passed.length} passed, ${r.failed.length} failed`);
   code = r.failed.length || !r.passed.length ? 1 : 0;
