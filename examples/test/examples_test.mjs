@@ -227,8 +227,8 @@ RRN.DisconnectService(c)
           && Number(document.getElementById("connects").textContent) >= n && /^ID \d+/.test(document.getElementById("packet").textContent),
         connects, { timeout: 30000 })
           .catch(async (e) => { throw new Error(`${e.message}; page: ${await page.textContent("body")}; errors: ${errors}`); });
-        const first = await page.textContent("#packet");
-        await page.waitForFunction((p) => document.getElementById("packet").textContent !== p, first, { timeout: 10000 });
+        const first = Number(await page.textContent("#count"));
+        await page.waitForFunction((n) => Number(document.getElementById("count").textContent) >= n + 2, first, { timeout: 10000 });
         ok(true, `${what}: ${await page.textContent("#packet")}, connections ${await page.textContent("#connects")}`);
       };
       await packetAfter("the hook shows the wire", 1);

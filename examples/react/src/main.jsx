@@ -4,9 +4,12 @@ import { StrictMode } from "react";
 import { createRoot } from "react-dom/client";
 import { useServiceSubscription, useWire } from "./use_subscription.js";
 
+// The demo robot sends its packets to the clients that asked for them: ask again on every connection.
+const startStreaming = (client, create) => create.StartStreaming().catch((e) => console.error(e));
+
 function PacketView({ url }) {
-  const sub = useServiceSubscription(url);
-  const { value, time, connected, connects } = useWire(sub, "packets");
+  const sub = useServiceSubscription(url, { onConnect: startStreaming });
+  const { value, time, count, connected, connects } = useWire(sub, "packets");
   return (
     <section>
       <p>
@@ -16,6 +19,9 @@ function PacketView({ url }) {
       <p>
         Sensor packet: <span id="packet">{value ? `ID ${value.ID}, ${value.Data.length} bytes` : "none yet"}</span>
         {time ? ` at ${new Date(time.seconds * 1000).toISOString()}` : ""}
+      </p>
+      <p>
+        Values received: <span id="count">{count}</span>
       </p>
     </section>
   );
