@@ -4,7 +4,10 @@
 // and the network between page and gateway can be cut silently. The page asks the test to restart the
 // device, restart the gateway, cut and restore the network, and drop connections (window.rrControl).
 //
-// Usage: node reconnect_browser_test.mjs --interop-service PATH --gateway PATH [--reconnects N]
+// With --target direct the RR WebSocket goes straight to rr_interop_service --websocket instead (the page
+// still comes from the gateway, both through the same proxy port).
+//
+// Usage: node reconnect_browser_test.mjs --interop-service PATH --gateway PATH [--target gateway|direct] [--reconnects N]
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
 import { existsSync } from "node:fs";
 import { spawnSync } from "node:child_process";
@@ -37,12 +40,18 @@ const { chromium: pw } = createRequire(import.meta.url)(playwrightPath);
 let browser;
 let code = 2;
 try {
+  const target = arg("--target", "gateway");
   const svc = await interopService(arg("--interop-service"), await freePort());
   const gw = await gateway(arg("--gateway"), await freePort(), svc.tcpUrl);
   await gw.start(pkgRoot);
-  const proxy = await cutProxy(gw.port);
-  const actions = { restartDevice: () => svc.restart(), restartGateway: () => gw.restart(), cut: () => proxy.cut(),
-    restore: () => proxy.restore(), dropAll: () => proxy.dropAll() };
+  // gateway: page and RR WebSocket both to the gateway. direct: the page from the gateway, the RR
+  // WebSocket (an upgrade request) straight to the service; both through one proxy port, so that the
+  // page's origin is the proxy's, which the service takes as its own (same Host).
+  const proxy = await cutProxy(target === "direct"
+    ? (first) => (/^upgrade:\s*websocket/im.test(first.toString("latin1")) ? svc.port : gw.port) : gw.port);
+  const actions = { restartDevice: () => svc.restart(), cut: () => proxy.cut(), restore: () => proxy.restore(),
+    dropAll: () => proxy.dropAll() };
+  if (target === "gateway") actions.restartGateway = () => gw.restart();
   browser = await pw.launch({ executablePath: chromium, headless: true,
     args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
       "--disable-component-update", "--disable-sync", "--js-flags=--expose-gc", "--enable-precise-memory-info"] });
@@ -56,7 +65,7 @@ try {
   const origin = `http://127.0.0.1:${proxy.port}`;
   const url = `${origin}/test/reconnect.html?url=${encodeURIComponent(`rr+ws://127.0.0.1:${proxy.port}/?service=interop`)}` +
     `&controls=${Object.keys(actions).join(",")}&reconnects=${arg("--reconnects", "100")}`;
-  console.log(`== chromium ${browser.version()}: ${url}`);
+  console.log(`== chromium ${browser.version()}, ${target}: ${url}`);
   await page.goto(url);
   await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 170000, polling: 200 });
   const r = await page.evaluate(() => window.__result);

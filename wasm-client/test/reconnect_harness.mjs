@@ -130,28 +130,34 @@ export async function gateway(binary, port, deviceUrl, auth = "shared") {
 }
 
 /**
- * A TCP proxy on 127.0.0.1 to `targetPort`. cut(): from now on every byte either way is dropped and
- * no socket is closed (a network that silently loses packets), new connections included. restore():
- * forwards again for new connections (connections open during the cut are ended: their streams have holes).
- * dropAll(): ends every connection at once (both sides see the close).
+ * A TCP proxy on 127.0.0.1 to `target`: a port, or `(firstBytes: Buffer) => port` choosing per connection
+ * from what the client sends first (e.g. WebSocket upgrades to one server, page loads to another).
+ * cut(): from now on every byte either way is dropped and no socket is closed (a network that silently
+ * loses packets), new connections included. restore(): forwards again for new connections (connections
+ * open during the cut are ended: their streams have holes). dropAll(): ends every connection at once.
  */
-export async function cutProxy(targetPort) {
+export async function cutProxy(target) {
   const pairs = new Set();
   const state = { cut: false, accepted: 0 };
   const server = createServer((down) => {
     state.accepted++;
-    const up = connectTcp(targetPort, "127.0.0.1");
-    const pair = { down, up, cut: state.cut };
+    const pair = { down, up: null, cut: state.cut };
     pairs.add(pair);
     const end = () => {
       pairs.delete(pair);
       down.destroy();
-      up.destroy();
+      pair.up?.destroy();
     };
-    down.on("data", (d) => pair.cut || up.write(d));
-    up.on("data", (d) => pair.cut || down.write(d));
+    down.on("data", (d) => {
+      if (pair.cut) return;
+      if (!pair.up) {
+        pair.up = connectTcp(typeof target === "function" ? target(d) : target, "127.0.0.1");
+        pair.up.on("data", (x) => pair.cut || down.write(x));
+        pair.up.on("error", end).on("close", end);
+      }
+      pair.up.write(d);
+    });
     down.on("error", end).on("close", end);
-    up.on("error", end).on("close", end);
   });
   await new Promise((r) => server.listen(0, "127.0.0.1", r));
   return {
@@ -169,14 +175,14 @@ export async function cutProxy(targetPort) {
       for (const p of [...pairs]) if (p.cut) {
         pairs.delete(p);
         p.down.destroy();
-        p.up.destroy();
+        p.up?.destroy();
       }
     },
     dropAll() {
       for (const p of [...pairs]) {
         pairs.delete(p);
         p.down.destroy();
-        p.up.destroy();
+        p.up?.destroy();
       }
     },
     close() {
