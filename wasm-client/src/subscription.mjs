@@ -142,6 +142,7 @@ export class ServiceSubscription {
     if (this.closed) return;
     try {
       const found = await this.candidates();
+      if (this.closed) return;
       for (const c of this.clientsById.values()) if (!c.fixed) c.listed = found.has(c.id);
       for (const [id, { url, info }] of found) {
         if (this.clientsById.size >= this.maxConnections) break;
