@@ -10,7 +10,7 @@ export { RRError };
 /** Subprotocol of the gateway's JSON WebSocket API (docs/json-api.md "WebSocket"). */
 export const JSON_PROTOCOL = "rr-gateway.json.v1";
 
-const inNode = typeof process !== "undefined" && !!process.versions?.node;
+const ignore = () => {};
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
 const invalid = (m) => new RRError("RobotRaconteur.InvalidArgument", m, 18);
 
@@ -170,7 +170,8 @@ export class JsonClient {
     if (ws !== this.ws || this.state === "closed") return;
     this.ws = null;
     clearTimeout(this.liveTimer);
-    ws.onopen = ws.onmessage = ws.onerror = ws.onclose = null;
+    ws.onopen = ws.onmessage = ws.onclose = null;
+    ws.onerror = ignore;  // node's `ws` emits an error for a socket ended while connecting
     try {
       if (typeof ws.terminate === "function") ws.terminate();
       else ws.close();
@@ -331,7 +332,8 @@ export class JsonClient {
     for (const s of this.subscriptions) s.closed = true;
     this.subscriptions.clear();
     if (ws) {
-      ws.onopen = ws.onmessage = ws.onerror = ws.onclose = null;
+      ws.onopen = ws.onmessage = ws.onclose = null;
+      ws.onerror = ignore;
       try {
         ws.close();
       } catch {

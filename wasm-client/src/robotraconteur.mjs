@@ -65,6 +65,7 @@ export function parseUrl(url) {
 }
 
 const now = () => performance.now();
+const ignore = () => {};
 
 let webcrypto = globalThis.crypto;
 function randomBytes(n) {
@@ -172,8 +173,10 @@ export class Connection {
       // already closed
     }
     // A browser keeps a closing WebSocket (and so its handlers, this connection, its proxies) until the
-    // close handshake ends or times out: let go of them now.
-    this.ws.onopen = this.ws.onmessage = this.ws.onerror = this.ws.onclose = null;
+    // close handshake ends or times out: let go of them now. onerror stays a no-op: node's `ws` emits
+    // an error for a socket ended while connecting, which would be an uncaught exception without one.
+    this.ws.onopen = this.ws.onmessage = this.ws.onclose = null;
+    this.ws.onerror = ignore;
     for (const fn of this.closeListeners) queueMicrotask(() => fn(error));
     // Free the native object once no C++ frame is on the stack.
     setTimeout(() => {
