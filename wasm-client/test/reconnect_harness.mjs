@@ -2,7 +2,7 @@
 // rr-gateway on fixed ports so that they can be restarted where clients look for them, and a TCP proxy
 // that can cut the network silently (bytes dropped, sockets left open) or drop every connection.
 import { spawn } from "node:child_process";
-import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { createServer, connect as connectTcp } from "node:net";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
@@ -21,13 +21,23 @@ export function stopAll() {
 }
 process.on("exit", stopAll);
 
-export function freePort() {
-  return new Promise((resolve) => {
-    const srv = createServer().listen(0, "127.0.0.1", () => {
-      const { port } = srv.address();
-      srv.close(() => resolve(port));
+/**
+ * A free port below the ephemeral range: servers here are restarted on their port, and in between the
+ * proxy's connection attempts to it take ephemeral local ports, which could otherwise be that very port.
+ */
+export async function freePort() {
+  const low = Number(readFileSync("/proc/sys/net/ipv4/ip_local_port_range", "utf8").split(/\s+/)[0]) || 32768;
+  const from = low > 29500 ? 29000 : 20000;
+  for (let i = 0; i < 100; i++) {
+    const port = from + Math.floor(Math.random() * (low - from));
+    const free = await new Promise((resolve) => {
+      const srv = createServer();
+      srv.once("error", () => resolve(false));
+      srv.listen(port, "127.0.0.1", () => srv.close(() => resolve(true)));
     });
-  });
+    if (free) return port;
+  }
+  throw new Error("no free port below the ephemeral range");
 }
 
 /** Starts `cmd` and resolves with the process once it printed a JSON line holding `key`. */
