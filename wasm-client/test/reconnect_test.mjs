@@ -4,6 +4,7 @@
 //   gateway: rr+ws to rr-gateway in front of the service, through the proxy (device restarted, gateway
 //            restarted, network cut, 100 reconnects with the heap measured after a full GC)
 //   filter:  subscribe({gateway, serviceTypes}) found through the gateway's device list, across a gateway restart
+//   then: heartbeats keep an idle connect() alive past receiveTimeoutMs; a silent peer is dropped in time
 //
 // Usage: node --expose-gc reconnect_test.mjs --interop-service PATH --gateway PATH [--target NAME] [--reconnects N]
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
@@ -119,6 +120,36 @@ if (chosen.includes("filter")) {
   await none.close();
   failed += results.filter((x) => !x).length;
   ran++;
+  stopAll();
+}
+// Heartbeats: an idle connection (nothing subscribed, no requests) outlives receiveTimeoutMs several
+// times over because the client's ConnectionTest gets an answer; a silent peer (proxy cut) is dropped.
+if (!arg("--target")) {
+  const svc = await interopService(arg("--interop-service"), await freePort());
+  const proxy = await cutProxy(svc.port);
+  const url = `rr+ws://127.0.0.1:${proxy.port}/?service=interop`;
+  console.log(`== heartbeat: ${url}`);
+  const c = await rr.connect(url, { heartbeatPeriodMs: 300, receiveTimeoutMs: 1200 });
+  let closedAt = null;
+  c.$client.onClose(() => (closedAt = performance.now()));
+  await sleep(4000);
+  const idleOk = c.$client.state === "connected" && closedAt === null;
+  console.log(`  ${idleOk ? "ok  " : "FAIL"} idle for 4000 ms with receiveTimeoutMs 1200: state ${c.$client.state}`);
+  const t0 = performance.now();
+  proxy.cut();
+  await sleep(2500);
+  const cutOk = closedAt !== null && closedAt - t0 <= 1700;
+  console.log(`  ${cutOk ? "ok  " : "FAIL"} silent peer: closed after ${closedAt === null ? "never" : Math.round(closedAt - t0)} ms`);
+  let bad = null;
+  try {
+    await rr.connect(url, { heartbeatPeriodMs: 2000, receiveTimeoutMs: 1000 });
+  } catch (e) {
+    bad = e;
+  }
+  const badOk = bad?.errorName === "RobotRaconteur.InvalidArgument";
+  console.log(`  ${badOk ? "ok  " : "FAIL"} heartbeatPeriodMs >= receiveTimeoutMs refused: ${bad?.message}`);
+  failed += [idleOk, cutOk, badOk].filter((x) => !x).length;
+  proxy.close();
   stopAll();
 }
 console.log(failed ? `FAILED: ${failed} checks` : `all checks passed (${ran} targets)`);
