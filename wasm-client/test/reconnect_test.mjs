@@ -106,6 +106,15 @@ if (chosen.includes("filter")) {
     ok(again.$type === "experimental.interop_test.Root" && sub.clients[0].connectCount === 2 && wire.tryGetInValue() !== v0,
       `after a gateway restart: connectCount ${sub.clients[0].connectCount}, wire values again`);
     ok(none.clients.length === 0 && none.state === "connecting", "a filter nothing matches connects to nothing");
+    // Two URLs (the service through the gateway and directly): two clients, values from both.
+    const two = rr.subscribe([gw.rrUrl, svc.wsUrl], FAST);
+    const w2 = two.subscribeWire("w_state");
+    const from = new Set();
+    w2.onValueChanged((v, ts, client) => from.add(client.id));
+    for (let i = 0; i < 300 && (from.size < 2 || w2.activeWireConnectionCount < 2); i++) await sleep(20);
+    ok(two.clients.length === 2 && two.getConnectedClients().size === 2 && w2.activeWireConnectionCount === 2 && from.size === 2,
+      `two URLs: ${two.getConnectedClients().size} connected, ${w2.activeWireConnectionCount} wire connections, values from ${from.size}`);
+    await two.close();
     let bad = null;
     try {
       rr.subscribe({ serviceTypes: ["x"] });
