@@ -98,6 +98,15 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   (cd wasm-client && npm ci --no-audit --no-fund --loglevel=error)
   echo "$want" > "$stamp"
 fi
+# npm: the React example's packages (react, react-dom, esbuild; examples/react/package-lock.json).
+lock=examples/react/package-lock.json
+stamp=examples/react/node_modules/.lock.sha
+want=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing npm packages from $lock"
+  (cd examples/react && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$want" > "$stamp"
+fi
 fi
 # npm: the TypeScript reference MCAP implementation for the MCAP interop test (test/mcap/package-lock.json).
 if wants test; then

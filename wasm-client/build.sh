@@ -31,7 +31,7 @@ mkdir -p "$dist"
 copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || { cp "$1" "$2.tmp$$" && mv -f "$2.tmp$$" "$2"; }; }
 copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
 copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
-for f in robotraconteur.mjs errors.mjs proxy.mjs index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
+for f in robotraconteur.mjs errors.mjs proxy.mjs subscription.mjs backoff.mjs json_client.mjs json_client.d.ts index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
 copy_if_changed "$here/README.md" "$dist/README.md"
 # The dashboard's standard-type modules (web/src/std: renderers, image decoding, readable text) for
 # the package's users, with the three page modules they import, in the same layout:

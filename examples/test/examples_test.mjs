@@ -3,6 +3,7 @@
 //   node examples_test.mjs --gateway PATH cpp-service BINARY PYTHON   (the official Python client)
 //   node examples_test.mjs --gateway PATH node-client
 //   node examples_test.mjs --gateway PATH html                          (headless Chromium)
+//   node examples_test.mjs --gateway PATH react                         (esbuild, headless Chromium)
 // Exit 0 passed, 1 failed, 77 skipped (a part is missing: the reason is printed).
 import { execFile, spawn } from "node:child_process";
 import fs from "node:fs";
@@ -186,6 +187,69 @@ RRN.DisconnectService(c)
       await page.click("#drive");
       await page.waitForFunction((b) => Number(document.getElementById("distance").textContent) > b, before, { timeout: 10000 });
       ok(true, `Drive moved the robot: ${before} -> ${await page.textContent("#distance")} mm`);
+      ok(errors.length === 0, `no page errors ${errors.join("; ")}`);
+    } finally {
+      await browser?.close();
+      fs.rmSync(tmp, { recursive: true, force: true });
+    }
+  },
+
+  // examples/react built as its README says (npm ci, npm run build: esbuild), served with the package in
+  // rr/; the gateway is then stopped and started again on the same port: the page must show the wire
+  // again by itself (the subscription reconnects; the hook shows the second connection).
+  async react() {
+    if (!fs.existsSync(path.join(DIST, "robotraconteur_wasm.wasm"))) skip("wasm-client/dist not built (wasm-client/build.sh)");
+    if (!fs.existsSync("/usr/bin/chromium")) skip("/usr/bin/chromium missing (./scripts/setup.sh)");
+    const pw = path.join(ROOT, "web/node_modules/playwright-core");
+    if (!fs.existsSync(pw)) skip("web/node_modules missing (./scripts/setup.sh)");
+    const ex = path.join(ROOT, "examples/react");
+    if (!fs.existsSync(path.join(ex, "node_modules/esbuild"))) skip("examples/react/node_modules missing (./scripts/setup.sh runs npm ci there)");
+    const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "rr-example-react-"));
+    let browser;
+    try {
+      const { stdout } = await run(process.execPath, [path.join(ex, "build.mjs")], { cwd: ex, timeout: 60000 });
+      ok(/built dist\/app\.js/.test(stdout), "esbuild bundled the React app");
+      fs.copyFileSync(path.join(ex, "index.html"), path.join(tmp, "index.html"));
+      fs.cpSync(path.join(ex, "dist"), path.join(tmp, "dist"), { recursive: true });
+      fs.cpSync(DIST, path.join(tmp, "rr"), { recursive: true });
+      let g = await gateway(["--web-root", tmp]);
+      const port = g.port;
+      await waitDevices(g.base, ["create"]);
+      const { chromium } = (await import(path.join(pw, "index.mjs"))).default ?? (await import(path.join(pw, "index.mjs")));
+      browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true,
+        args: ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--no-first-run"] });
+      const page = await browser.newPage();
+      const errors = [];
+      page.on("pageerror", (e) => errors.push(String(e)));
+      await page.goto(`${g.base}/`);
+      const packetAfter = async (what, connects) => {
+        await page.waitForFunction((n) => document.getElementById("state")?.textContent === "connected"
+          && Number(document.getElementById("connects").textContent) >= n && /^ID \d+/.test(document.getElementById("packet").textContent),
+        connects, { timeout: 30000 })
+          .catch(async (e) => { throw new Error(`${e.message}; page: ${await page.textContent("body")}; errors: ${errors}`); });
+        const first = Number(await page.textContent("#count"));
+        await page.waitForFunction((n) => Number(document.getElementById("count").textContent) >= n + 2, first, { timeout: 10000 });
+        ok(true, `${what}: ${await page.textContent("#packet")}, connections ${await page.textContent("#connects")}`);
+      };
+      await packetAfter("the hook shows the wire", 1);
+      g.proc.kill("SIGKILL");
+      await new Promise((r) => g.proc.once("exit", r));
+      await page.waitForFunction(() => document.getElementById("state").textContent === "reconnecting", null, { timeout: 20000 });
+      ok(true, "the page shows the lost connection");
+      for (let i = 0; ; i++) {  // the port a killed process held can take a moment to bind again
+        try {
+          const again = startJson(gatewayBin, ["--listen", "127.0.0.1", "--port", String(port), "--no-local", "--log-level", "warning",
+            "--web-root", tmp], "port");
+          await again.value;
+          g = { ...again, port, base: `http://127.0.0.1:${port}` };
+          break;
+        } catch (e) {
+          if (i > 20) throw e;
+          await new Promise((r) => setTimeout(r, 200));
+        }
+      }
+      await waitDevices(g.base, ["create"]);
+      await packetAfter("after the gateway restarted, by itself", 2);
       ok(errors.length === 0, `no page errors ${errors.join("; ")}`);
     } finally {
       await browser?.close();

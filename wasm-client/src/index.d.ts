@@ -314,3 +314,143 @@ export interface MultiDimMemory<A> {
   write(start: number[], data: MultiDimArray<A>): Promise<void>;
 }
 export type ReadonlyMultiDimMemory<A> = Omit<MultiDimMemory<A>, "write">;
+
+// --- Subscriptions (subscription.mjs; README.md "Subscriptions") -------------------------------------
+
+/** Liveness options of every connection (wire.md §6.3). */
+export interface LivenessOptions {
+  /** Send an RR ConnectionTest after this long (ms) without sending (default 10000). */
+  heartbeatPeriodMs?: number;
+  /** Close the connection (ConnectionError) after this long (ms) without receiving anything (default 15000). */
+  receiveTimeoutMs?: number;
+}
+
+/** Reconnect delays: min(maxMs, initialMs·factor^n), spread uniformly by ±jitter. */
+export interface BackoffOptions {
+  /** First delay after a drop (default 500 ms). */
+  initialMs?: number;
+  /** Largest delay (default 10000 ms). */
+  maxMs?: number;
+  /** Growth per failed attempt (default 2). */
+  factor?: number;
+  /** Spread as a fraction of the delay, 0–1 (default 0.25). */
+  jitter?: number;
+}
+
+export const DEFAULT_BACKOFF: Readonly<Required<BackoffOptions>>;
+/** The delay before reconnect attempt `attempt` (0-based) under `backoff`. */
+export function backoffDelay(attempt: number, backoff: Required<BackoffOptions>, random?: () => number): number;
+
+/** A service as discovery describes it (the gateway's GET /api/devices and /api/discovered). */
+export interface ServiceInfo {
+  /** The name to connect with: the gateway device's name when a gateway device serves it. */
+  name: string;
+  /** The service's own name on its node. */
+  serviceName: string;
+  nodeName: string;
+  nodeId: string;
+  rootObjectType: string;
+  implements: string[];
+  attributes: Record<string, unknown>;
+  /** The gateway device serving it, or null (then it is reached directly over rr+ws). */
+  device: string | null;
+  urls?: string[];
+}
+
+/** Which services a subscription keeps connections to (the official ServiceSubscriptionFilter's fields). */
+export interface SubscriptionFilter {
+  /** The gateway whose discovery is used: "http://host:port" (or rr+ws://host:port). */
+  gateway: string;
+  /** Root object type or an implemented type, e.g. "experimental.create.Create". */
+  serviceTypes?: string[];
+  serviceNames?: string[];
+  nodes?: { nodeName?: string; nodeId?: string }[];
+  /** Attribute name → text or pattern its value must match. */
+  attributes?: Record<string, string | RegExp>;
+  /** "all" (default) or "any" of the attributes. */
+  attributesMatch?: "all" | "any";
+  predicate?: (info: ServiceInfo) => boolean;
+  maxConnections?: number;
+}
+
+export interface SubscribeOptions extends ConnectOptions, LivenessOptions {
+  backoff?: BackoffOptions;
+  /** How often (ms) a filter's matches are looked up again (default 5000). */
+  discoveryIntervalMs?: number;
+}
+
+export type SubscriptionClientState = "connecting" | "connected" | "waiting" | "closed";
+
+/** One service a subscription keeps a connection to. */
+export interface SubscriptionClient<T = ObjectProxy> {
+  readonly id: string;
+  readonly url: string;
+  readonly state: SubscriptionClientState;
+  /** The root object while connected, else null. */
+  readonly proxy: T | null;
+  readonly serviceInfo: ServiceInfo | null;
+  readonly lastError: RRError | null;
+  /** Connections made so far (1 after the first, 2 after the first reconnect, ...). */
+  readonly connectCount: number;
+}
+
+export interface WireSubscription<V = RRValue> {
+  /** The newest InValue from any service; throws RRError "RobotRaconteur.ValueNotSet" when none is valid. */
+  readonly inValue: V;
+  readonly inValueTime: TimeSpec;
+  readonly inValueValid: boolean;
+  /** InValue older than this many ms is not valid (−1: forever, the default). */
+  inValueLifespanMs: number;
+  tryGetInValue(): { value: V; ts: TimeSpec; client: SubscriptionClient } | undefined;
+  /** Resolves true once an InValue is valid, false after timeoutMs (−1, the default: no limit). */
+  waitInValueValid(timeoutMs?: number): Promise<boolean>;
+  /** `fn(value, ts, client)` for every new InValue; returns the remover. Fires once per value. */
+  onValueChanged(fn: (value: V, ts: TimeSpec, client: SubscriptionClient) => void): () => void;
+  readonly activeWireConnectionCount: number;
+  /** Sets the OutValue on every wire connection open now. */
+  setOutValueAll(value: V): void;
+  close(): Promise<void>;
+}
+
+export interface PipeSubscription<P = RRValue> extends AsyncIterable<P> {
+  /** Packets queued for receivePacket (at most maxBacklog; the oldest are dropped). */
+  readonly available: number;
+  tryReceivePacket(): P | undefined;
+  /** The next packet; undefined after timeoutMs (−1, the default: no limit) or once closed. */
+  receivePacket(timeoutMs?: number): Promise<P | undefined>;
+  /** `fn(packet, client)` for every packet; returns the remover. */
+  onPacketReceived(fn: (packet: P, client: SubscriptionClient) => void): () => void;
+  readonly activePipeEndpointCount: number;
+  sendPacketAll(packet: P): Promise<number[]>;
+  close(): Promise<void>;
+}
+
+export interface ServiceSubscription<T = ObjectProxy> {
+  /** "connected" while at least one service is connected. */
+  readonly state: "connecting" | "connected" | "closed";
+  readonly clients: SubscriptionClient<T>[];
+  getConnectedClients(): Map<string, T>;
+  /** The first connected service's root object; throws RRError ConnectionError when none is. */
+  getDefaultClient(): T;
+  tryGetDefaultClient(): T | null;
+  /** Waits for a connected service (timeoutMs −1, the default: no limit); rejects with ConnectionError. */
+  getDefaultClientWait(timeoutMs?: number): Promise<T>;
+  onConnect(fn: (client: SubscriptionClient<T>, proxy: T) => void): () => void;
+  onDisconnect(fn: (client: SubscriptionClient<T>, error: RRError | null) => void): () => void;
+  onError(fn: (error: RRError, client: SubscriptionClient<T> | null) => void): () => void;
+  /** `servicePath`: objref path below the root ("child", "items[3]"); "" (default) is the root. */
+  subscribeWire<V = RRValue>(name: string, servicePath?: string): WireSubscription<V>;
+  subscribePipe<P = RRValue>(name: string, servicePath?: string, maxBacklog?: number): PipeSubscription<P>;
+  /** `fn(...params, client)` for every firing on every connected service; returns the remover. */
+  subscribeEvent(name: string, fn: (...args: any[]) => void, servicePath?: string): () => void;
+  /** Sets callback `name` on every service, also after reconnects; null clears it. */
+  setCallback(name: string, fn: ((...args: any[]) => RRValue | Promise<RRValue>) | null, servicePath?: string): void;
+  close(): Promise<void>;
+}
+
+/** Keeps connections to the services `target` names, reconnecting with backoff (README.md "Subscriptions"). */
+export function subscribe<T = ObjectProxy>(target: string | string[] | SubscriptionFilter, options?: SubscribeOptions): ServiceSubscription<T>;
+/** Whether `info` passes `filter`. */
+export function matchesFilter(info: ServiceInfo, filter: Omit<SubscriptionFilter, "gateway">): boolean;
+/** connect() takes the liveness options too (merged into ConnectOptions above). */
+export interface ConnectOptions extends LivenessOptions {}

@@ -482,8 +482,15 @@ ClientContextConfig NativeClient::make_config(const val& c) {
     cfg.session.stream.local_node_id = NodeID(b);
     cfg.session.stream.enable_string_table = true;
     cfg.session.local_endpoint = c["endpoint"].as<std::uint32_t>();
-    if (c["requestTimeoutMs"].typeOf().as<std::string>() == "number")
-        cfg.session.request_timeout = std::chrono::milliseconds(c["requestTimeoutMs"].as<int>());
+    auto ms = [&](const char* k) -> std::optional<std::chrono::milliseconds> {
+        if (c[k].typeOf().as<std::string>() != "number") return std::nullopt;
+        return std::chrono::milliseconds(c[k].as<int>());
+    };
+    if (auto t = ms("requestTimeoutMs")) cfg.session.request_timeout = *t;
+    // Liveness (wire.md §6.3): ConnectionTest after this long without sending, close after this long
+    // without receiving. The JS layer validates them; the defaults are the official TCP client's.
+    if (auto t = ms("heartbeatPeriodMs")) cfg.session.stream.heartbeat_period = *t;
+    if (auto t = ms("receiveTimeoutMs")) cfg.session.stream.receive_timeout = *t;
     return cfg;
 }
 

@@ -34,6 +34,7 @@ struct Typed {
 class NativeClient {
 public:
     /// `config`: {service, targetNodeId, targetNodeName, nodeName, username, password, requestTimeoutMs,
+    /// heartbeatPeriodMs?, receiveTimeoutMs? (default 10000 / 15000, wire.md §6.3),
     /// nodeId: Uint8Array(16) (random, from the host), endpoint: uint32 (random, non-zero), now}.
     explicit NativeClient(val config);
 

@@ -39,6 +39,11 @@ class AsyncQueue {
   }
 }
 
+const CONNECTION = Symbol("connection");
+function definitionsOf() {
+  return this[CONNECTION].definitions;
+}
+
 export function makeProxy(conn, desc) {
   const proxy = {
     $type: desc.type,
@@ -50,7 +55,10 @@ export function makeProxy(conn, desc) {
     $monitorEnter: (timeoutMs = -1) => conn.op((cb) => conn.native.monitor(desc.path, true, timeoutMs, now(), cb)),
     $monitorExit: () => conn.op((cb) => conn.native.monitor(desc.path, false, 0, now(), cb)),
   };
-  Object.defineProperty(proxy, "$definitions", { get: () => conn.definitions, enumerable: true });
+  // One getter shared by every proxy, reading the connection from a hidden slot: V8 keeps an accessor in
+  // the object's hidden class, and a closure over `conn` there would keep a closed connection alive.
+  Object.defineProperty(proxy, CONNECTION, { value: conn });
+  Object.defineProperty(proxy, "$definitions", { get: definitionsOf, enumerable: true });
   for (const m of desc.members) {
     const make = MEMBER_KINDS[m.kind];
     if (make) proxy[m.name] = make(conn, desc.path, m);

@@ -4,8 +4,10 @@
 import createRRModule from "./robotraconteur_wasm.mjs";
 import { RRError, toRRError } from "./errors.mjs";
 import { makeProxy } from "./proxy.mjs";
+import { ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter } from "./subscription.mjs";
+import { DEFAULT_BACKOFF, backoffDelay } from "./backoff.mjs";
 
-export { RRError, toRRError };
+export { RRError, toRRError, ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter, DEFAULT_BACKOFF, backoffDelay };
 
 /** Subprotocol of RR over WebSocket (wire.md §8). */
 export const WEBSOCKET_PROTOCOL = "robotraconteur.robotraconteur.com";
@@ -63,6 +65,7 @@ export function parseUrl(url) {
 }
 
 const now = () => performance.now();
+const ignore = () => {};
 
 let webcrypto = globalThis.crypto;
 function randomBytes(n) {
@@ -91,6 +94,8 @@ export class Connection {
       username: options.username ?? "",
       password: options.password ?? "",
       requestTimeoutMs: options.timeoutMs ?? 15000,
+      heartbeatPeriodMs: options.heartbeatPeriodMs ?? 10000,
+      receiveTimeoutMs: options.receiveTimeoutMs ?? 15000,
       nodeId: randomBytes(16),
       endpoint,
       now: now(),
@@ -154,13 +159,24 @@ export class Connection {
   onClosed(error) {
     if (this.state === "closed") return;
     this.state = "closed";
+    // Format the stack now: an unformatted V8 stack trace holds the `this` of its frames (this closed
+    // connection and all its proxies) for as long as anyone keeps the error (a reconnect loop does).
+    void error?.stack;
     this.closeError = error;
     if (this.timer) clearTimeout(this.timer);
     try {
-      this.ws.close();
+      // node's `ws` would wait up to 30 s for the close handshake of a peer that may be gone: drop the
+      // socket at once unless this side closed cleanly.
+      if (error && typeof this.ws.terminate === "function") this.ws.terminate();
+      else this.ws.close();
     } catch {
       // already closed
     }
+    // A browser keeps a closing WebSocket (and so its handlers, this connection, its proxies) until the
+    // close handshake ends or times out: let go of them now. onerror stays a no-op: node's `ws` emits
+    // an error for a socket ended while connecting, which would be an uncaught exception without one.
+    this.ws.onopen = this.ws.onmessage = this.ws.onclose = null;
+    this.ws.onerror = ignore;
     for (const fn of this.closeListeners) queueMicrotask(() => fn(error));
     // Free the native object once no C++ frame is on the stack.
     setTimeout(() => {
@@ -279,12 +295,23 @@ export class Connection {
 
 /**
  * Connects to the service named in `url` (rr+ws:// or rr+wss://) and returns the root object's proxy.
- * Options: timeoutMs (connect and per request, default 15000), username, password, nodeName,
+ * Options: timeoutMs (connect and per request, default 15000), heartbeatPeriodMs (send an RR
+ * ConnectionTest after this long without sending, default 10000) and receiveTimeoutMs (close the
+ * connection with ConnectionError after this long without receiving anything, default 15000: a dead
+ * peer or a network that silently drops packets is noticed within it; wire.md §6.3), username, password, nodeName,
  * WebSocket (a WebSocket class; default globalThis.WebSocket, else the `ws` package in node), ca (node
  * only: the PEM certificates an rr+wss server's chain must lead to, instead of node's own list).
  */
 export async function connect(url, options = {}) {
   const u = parseUrl(url);
+  for (const k of ["timeoutMs", "heartbeatPeriodMs", "receiveTimeoutMs"]) {
+    const v = options[k];
+    if (v !== undefined && !(Number.isInteger(v) && v > 0 && v <= 2 ** 31 - 1))
+      throw new RRError("RobotRaconteur.InvalidArgument", `${k} must be a positive integer (ms), not ${v}`, 18);
+  }
+  if ((options.heartbeatPeriodMs ?? 10000) >= (options.receiveTimeoutMs ?? 15000))
+    throw new RRError("RobotRaconteur.InvalidArgument",
+      "heartbeatPeriodMs must be shorter than receiveTimeoutMs (the peer answers each heartbeat)", 18);
   if (options.ca !== undefined && !inNode && !options.WebSocket)
     throw new RRError("RobotRaconteur.InvalidArgument",
       "the ca option works in node only: a browser checks an rr+wss certificate against its own trust store", 18);
@@ -300,4 +327,23 @@ export async function connect(url, options = {}) {
     c.fail(String(e.message));
     throw e;
   }
+}
+
+/**
+ * A ServiceSubscription (README.md "Subscriptions"; the official ServiceSubscription's semantics): keeps
+ * a connection to each service `target` names, connects again after any drop (backoff: 0.5 s doubling
+ * to 10 s, ±25 % jitter; `options.backoff` {initialMs, maxMs, factor, jitter}) and restores the wires,
+ * pipes, events and callbacks opened through it. Returns at once; connecting goes on in the background.
+ *
+ * `target`: an RR URL, an array of URLs, or a filter resolved through the gateway's discovery:
+ * {gateway: "http://host:port", serviceTypes?, serviceNames?, nodes?: [{nodeName?, nodeId?}],
+ *  attributes?: {name: text | RegExp}, attributesMatch?: "all" | "any", predicate?: (info) => bool,
+ *  maxConnections?}, matched against the gateway's devices (GET /api/devices) and discovered services
+ * (GET /api/discovered) every `options.discoveryIntervalMs` (5000).
+ * `options`: connect()'s options (used for every connection: timeoutMs, heartbeatPeriodMs,
+ * receiveTimeoutMs, username, password, ...), plus backoff and discoveryIntervalMs.
+ * Throws RRError InvalidArgument for a malformed target or option.
+ */
+export function subscribe(target, options = {}) {
+  return new ServiceSubscription(target, options, connect);
 }

@@ -72,11 +72,11 @@ try {
   // ws (the optional peer dependency for node) from this folder's node_modules
   fs.symlinkSync(path.join(pkgRoot, "node_modules/ws"), path.join(app, "node_modules/ws"), "dir");
 
-  for (const f of ["usage.ts", "std_usage.ts", "robot_usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
+  for (const f of ["usage.ts", "std_usage.ts", "robot_usage.ts", "subscription_usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
   // tsc --noEmit: usage.ts is accepted
   try {
     run(process.execPath, [tsc, "--noEmit", "-p", app]);
-    ok(true, "tsc --noEmit (strict): usage.ts, std_usage.ts and robot_usage.ts type-check against index.d.ts, std/index.d.ts and robot/*.d.ts");
+    ok(true, "tsc --noEmit (strict): usage.ts, std_usage.ts, robot_usage.ts and subscription_usage.ts type-check against index.d.ts, std/index.d.ts and robot/*.d.ts");
   } catch (e) {
     ok(false, `tsc --noEmit usage.ts:\n${e.stdout}${e.stderr}`);
   }

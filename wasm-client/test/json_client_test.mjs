@@ -1,0 +1,135 @@
+// The JSON WebSocket client (src/json_client.mjs, "robotraconteur-wasm/json") in node against a real
+// rr-gateway in front of rr_interop_service, through a TCP proxy the test controls: requests, wire /
+// event / pipe subscriptions, and their resumption after a gateway restart, a device restart (the
+// gateway ends pipe subscriptions then; the client subscribes again) and a silent network cut.
+//
+// Usage: node json_client_test.mjs --interop-service PATH --gateway PATH
+// Exit: 0 passed, 1 a check failed, 2 setup failed.
+import { dirname, join } from "node:path";
+import { fileURLToPath } from "node:url";
+import { arg, cutProxy, freePort, gateway, interopService, sleep, stopAll } from "./reconnect_harness.mjs";
+
+const here = dirname(fileURLToPath(import.meta.url));
+// The source module: it needs no build (no wasm), and dist/json_client.mjs is a copy of it.
+const { connectJson, decodeBinaryPush } = await import(join(here, "..", "src", "json_client.mjs"));
+
+const FAST = { backoff: { initialMs: 50, maxMs: 400 }, heartbeatPeriodMs: 300, receiveTimeoutMs: 1200, timeoutMs: 5000 };
+let failed = 0;
+const ok = (cond, what) => {
+  console.log(`  ${cond ? "ok  " : "FAIL"} ${what}`);
+  if (!cond) failed++;
+};
+async function until(cond, what, timeoutMs = 20000) {
+  const end = Date.now() + timeoutMs;
+  while (!cond()) {
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await sleep(10);
+  }
+}
+
+let svc;
+let gw;
+let proxy;
+try {
+  svc = await interopService(arg("--interop-service"), await freePort());
+  gw = await gateway(arg("--gateway"), await freePort(), svc.tcpUrl);
+  await gw.start();
+  proxy = await cutProxy(gw.port);
+} catch (e) {
+  console.error(`setup failed: ${e.message}`);
+  process.exit(2);
+}
+
+const client = connectJson(`http://127.0.0.1:${proxy.port}`, FAST);
+const seen = { connects: 0, disconnects: 0, wire: 0, wireKeys: new Set(), wireDup: 0, events: [], packets: [], closedPushes: 0 };
+client.onConnect(() => seen.connects++);
+client.onDisconnect(() => seen.disconnects++);
+const dev = client.device("interop");
+
+/** Wire, event and pipe subscriptions deliver (again), each push once. */
+async function works(what) {
+  await until(() => client.state === "connected", `${what}: connected`);
+  const w0 = seen.wire;
+  await until(() => seen.wire >= w0 + 2, `${what}: wire values`);
+  await gw.deviceConnected();
+  seen.events.length = 0;
+  await until(() => pipeSub.resubscribed >= 0 && pipeSub.socketId !== null, `${what}: pipe subscribed`);
+  await dev.call("fire_events", [3]);
+  await until(() => seen.events.length >= 3, `${what}: 3 events`);
+  seen.packets.length = 0;
+  await dev.call("send_stream", [2]);
+  await until(() => seen.packets.length >= 2, `${what}: 2 packets`);
+  await sleep(300);
+  ok(JSON.stringify(seen.events) === "[0,1,2]" && JSON.stringify(seen.packets) === "[0,1]" && seen.wireDup === 0,
+    `${what}: events ${JSON.stringify(seen.events)}, packets ${JSON.stringify(seen.packets)}, wire values twice: ${seen.wireDup}`);
+}
+
+let pipeSub;
+try {
+  console.log(`== JSON client: ${client.url}`);
+  ok(await dev.call("add", [2, 3]) === 5, "call add(2, 3) before the socket was open (waits for it)");
+  const devices = await client.devices();
+  ok(devices[0]?.name === "interop", "devices()");
+  await dev.subscribe("w_state", (v, push) => {
+    seen.wire++;
+    const key = `${v.id}/${v.label}/${push.time.seconds}.${push.time.nanoseconds}`;
+    if (seen.wireKeys.has(key)) seen.wireDup++;
+    seen.wireKeys.add(key);
+  });
+  const evSub = await dev.subscribe("ev_values", (args) => seen.events.push(args.seq));
+  ok(evSub.kind === "event", `event subscription kind ${evSub.kind}`);
+  pipeSub = await dev.subscribe("p_stream", (p) => seen.packets.push(p[0]));
+  pipeSub.onClose(() => seen.closedPushes++);
+  ok(pipeSub.kind === "pipe", `pipe subscription kind ${pipeSub.kind}`);
+  await works("first socket");
+
+  const c0 = client.connectCount;
+  await gw.restart();
+  await works("after a gateway restart");
+  ok(client.connectCount === c0 + 1 && seen.disconnects === 1, `one reconnect (connectCount ${client.connectCount}, onDisconnect ${seen.disconnects})`);
+
+  const r0 = pipeSub.resubscribed;
+  await svc.restart();
+  await until(() => seen.closedPushes >= 1, "the pipe's closed push");
+  await works("after a device restart");
+  ok(pipeSub.resubscribed > r0, `pipe subscribed again after the gateway closed it (${pipeSub.resubscribed - r0} times)`);
+
+  const d0 = seen.disconnects;
+  const t0 = performance.now();
+  proxy.cut();
+  await until(() => seen.disconnects > d0, "onDisconnect after the cut", 6000);
+  const noticed = performance.now() - t0;
+  ok(noticed <= FAST.receiveTimeoutMs + 500, `silent cut noticed after ${Math.round(noticed)} ms (receiveTimeoutMs ${FAST.receiveTimeoutMs})`);
+  const late = await dev.get("p_double").then(() => null, (e) => e);
+  ok(late?.errorName === "RobotRaconteur.ConnectionError", `a request during the cut waits, then fails: ${late?.errorName}`);
+  proxy.restore();
+  await works("after the cut");
+
+  const json = new TextEncoder().encode('{"v":{"$binary":0,"type":"uint8","length":3,"offset":0}}');
+  const buf = new Uint8Array(8 + json.length + 16);
+  buf.set([0x52, 0x52, 0x4a, 0x42]);
+  new DataView(buf.buffer).setUint32(4, json.length, true);
+  buf.set(json, 8);
+  const base = (8 + json.length + 7) & ~7;
+  buf.set([7, 8, 9], base);
+  const decoded = decodeBinaryPush(buf.buffer);
+  ok(decoded.v instanceof Uint8Array && decoded.v.join() === "7,8,9", "decodeBinaryPush");
+  let bad = null;
+  try {
+    decodeBinaryPush(new ArrayBuffer(4));
+  } catch (e) {
+    bad = e;
+  }
+  ok(bad?.errorName === "RobotRaconteur.ProtocolError", "a malformed binary push is a ProtocolError");
+
+  client.close();
+  const w0 = seen.wire;
+  await sleep(500);
+  ok(client.state === "closed" && seen.wire === w0, "close(): no more pushes, no reconnect");
+} catch (e) {
+  ok(false, e.message);
+}
+stopAll();
+proxy?.close();
+console.log(failed ? `FAILED: ${failed} checks` : "all checks passed");
+process.exit(failed ? 1 : 0);
