@@ -527,7 +527,7 @@ void Recording::writer_loop() {
         // A chunk at least every second: a killed gateway loses at most about a second.
         if (clock::now() - last_flush >= std::chrono::seconds(1)) {
             last_flush = clock::now();
-            if (auto r = file_->writer->flush(); !r) return fail_with(RRError{r.error().type, "record: " + file_->path + ": " + r.error().message});
+            if (auto r = file_->writer->flush(); !r) return fail_with(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message));
             std::lock_guard<std::mutex> lock(mutex_);
             if (!files_.empty()) files_.back().second = file_->writer->bytes_written();
         }

@@ -62,7 +62,7 @@ std::variant<RecordingStatus, ApiError> Recordings::start(RecordingSpec spec) {
 void Recordings::start_when_connected(RecordingSpec spec) {
     auto device = api_->find_device(spec.device);
     if (!device) {
-        failed_start(spec, RRError{MessageErrorType::ServiceNotFound, "record: no device \"" + spec.device + "\""});
+        failed_start(spec, make_error(MessageErrorType::ServiceNotFound, "record: no device \"" + spec.device + "\""));
         return;
     }
     auto started = std::make_shared<std::atomic<bool>>(false);
@@ -75,7 +75,7 @@ void Recordings::start_when_connected(RecordingSpec spec) {
         std::thread([self, spec] {
             auto r = self->start(spec);
             if (auto* e = std::get_if<ApiError>(&r); e && e->status != 507)
-                self->failed_start(spec, RRError{e->type, e->message});
+                self->failed_start(spec, make_error(MessageErrorType::OperationFailed, e->message));
         }).detach();
     };
     auto id = device->add_state_listener(try_start);

@@ -37,8 +37,8 @@ Result<MessageEntry> decode_entry(std::span<const std::byte> bytes) {
 }
 
 RRError refused(const std::string& name, const std::string& file) {
-    return RRError{MessageErrorType::InvalidOperation,
-                   "device \"" + name + "\" is a recording (" + file + "): functions are not replayed"};
+    return make_error(MessageErrorType::InvalidOperation,
+                   "device \"" + name + "\" is a recording (" + file + "): functions are not replayed");
 }
 
 }  // namespace
@@ -84,9 +84,10 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     if (!types) return err(MessageErrorType::InvalidArgument, "recorded service definitions: " + types.error().message);
     d->types_ = *types;
 
-    for (const auto& [id, ch] : summary.channels) {
+    for (const auto& [id, channel] : summary.channels) {
+        const auto& ch = channel;
         if (ch.message_encoding != "robotraconteur") continue;
-        auto meta = [&](const char* k) {
+        auto meta = [&ch](const char* k) {
             auto it = ch.metadata.find(k);
             return it == ch.metadata.end() ? std::string() : it->second;
         };
@@ -136,10 +137,10 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
         if (m.kind == robdef::MemberKind::function) {
             if (m.is_generator())
                 (void)d->root_->set_generator_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<std::shared_ptr<Generator>> {
-                    return refused(name, file);
+                    return fail(refused(name, file));
                 });
             else
-                (void)d->root_->set_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<Value> { return refused(name, file); });
+                (void)d->root_->set_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<Value> { return fail(refused(name, file)); });
         } else if (m.kind == robdef::MemberKind::property) {
             const std::string member = m.name;
             (void)d->root_->set_property_handlers(
