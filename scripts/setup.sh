@@ -22,6 +22,7 @@ wants() { local p; for p in "${parts[@]}"; do [ "$p" = "$1" ] && return 0; done;
 RUN_PACKAGES=(
   cmake ninja-build g++ pkg-config ccache
   libboost1.81-all-dev libssl-dev nlohmann-json3-dev libusb-1.0-0-dev libyaml-cpp-dev libjwt-dev
+  libzstd-dev zlib1g-dev
   emscripten node-acorn
 )
 PYTHON_PACKAGES=(python3-venv)
@@ -95,6 +96,17 @@ want=$(sha256sum "$lock" | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "setup: installing npm packages from $lock"
   (cd wasm-client && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$want" > "$stamp"
+fi
+fi
+# npm: the TypeScript reference MCAP implementation for the MCAP interop test (test/mcap/package-lock.json).
+if wants test; then
+lock=test/mcap/package-lock.json
+stamp=test/mcap/node_modules/.lock.sha
+want=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing npm packages from $lock"
+  (cd test/mcap && npm ci --no-audit --no-fund --loglevel=error)
   echo "$want" > "$stamp"
 fi
 fi

@@ -100,6 +100,7 @@ public:
     MessageIterator messages(MessageQuery query = {});
 
 private:
+    friend class MessageIterator;
     struct State;
     explicit McapReader(std::unique_ptr<State> s);
     std::unique_ptr<State> s_;

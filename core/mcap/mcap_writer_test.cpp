@@ -1,0 +1,156 @@
+#include <catch2/catch.hpp>
+
+#include "core/mcap/mcap_test_files.hpp"
+
+using namespace rr;
+using namespace rr::mcap;
+using namespace rr::mcap::test;
+
+namespace {
+
+// A sink that fails once `capacity` bytes have been written.
+class FailingSink final : public Sink {
+public:
+    explicit FailingSink(std::size_t capacity) : capacity_(capacity) {}
+    Result<void> write(std::span<const std::byte> bytes) override {
+        if (written_ + bytes.size() > capacity_) return fail(MessageErrorType::IOError, "disk full");
+        written_ += bytes.size();
+        return {};
+    }
+    std::size_t flushes = 0;
+    Result<void> flush() override {
+        ++flushes;
+        return {};
+    }
+
+private:
+    std::size_t capacity_;
+    std::size_t written_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("mcap: a written file starts and ends with the magic and reads back exactly") {
+    auto compression = GENERATE(Compression::Zstd, Compression::None);
+    std::vector<std::byte> file;
+    VectorSink sink(file);
+    WriterOptions options;
+    options.compression = compression;
+    options.chunk_size = 4096;
+    options.library = "mcap test";
+    McapWriter w(sink, options);
+    auto written = write_sample(w, 500);
+    REQUIRE(w.close());
+    CHECK(w.is_closed());
+    CHECK(w.bytes_written() == file.size());
+    REQUIRE(file.size() > 16);
+    for (std::size_t i = 0; i < 8; ++i) {
+        CHECK(static_cast<std::uint8_t>(file[i]) == kMagic[i]);
+        CHECK(static_cast<std::uint8_t>(file[file.size() - 8 + i]) == kMagic[i]);
+    }
+
+    SpanSource source(file);
+    auto reader = McapReader::open(source);
+    REQUIRE(reader);
+    CHECK(reader->indexed());
+    CHECK_FALSE(reader->truncated());
+    CHECK(reader->header() == Header{"", "mcap test"});
+    const auto& summary = reader->summary();
+    CHECK(summary.from_summary_section);
+    REQUIRE(summary.schemas.size() == 1);
+    CHECK(summary.schemas.at(1).encoding == "jsonschema");
+    REQUIRE(summary.channels.size() == 2);
+    CHECK(summary.channels.at(0).metadata == std::map<std::string, std::string>{{"device", "dev"}, {"member", "a"}});
+    CHECK(summary.channels.at(1).schema_id == 0);
+    CHECK(summary.channels.at(1).message_encoding == "robotraconteur");
+    CHECK(summary.statistics.message_count == 500);
+    CHECK(summary.statistics.channel_message_counts == std::map<std::uint16_t, std::uint64_t>{{0, 250}, {1, 250}});
+    CHECK(summary.statistics.message_start_time == 1000);
+    CHECK(summary.statistics.message_end_time == 1000 + 10 * 499);
+    CHECK(summary.statistics.chunk_count == summary.chunk_indexes.size());
+    CHECK(summary.chunk_indexes.size() > 3);
+    for (const auto& ci : summary.chunk_indexes) {
+        CHECK(ci.compression == (compression == Compression::Zstd ? "zstd" : ""));
+        CHECK(ci.message_index_offsets.size() == 2);
+    }
+    CHECK(drain(reader->messages()) == written);
+    CHECK(w.statistics() == summary.statistics);
+}
+
+TEST_CASE("mcap: chunks close at the size limit, and a message larger than a chunk gets one of its own") {
+    std::vector<std::byte> file;
+    VectorSink sink(file);
+    WriterOptions options;
+    options.chunk_size = 256;
+    McapWriter w(sink, options);
+    REQUIRE(w.open());
+    auto ch = w.add_channel(0, "big", "robotraconteur");
+    REQUIRE(ch);
+    std::vector<std::byte> big(10000, std::byte{0x5A});
+    std::vector<std::byte> small(10, std::byte{1});
+    REQUIRE(w.write({*ch, 0, 5, 5, small}));
+    CHECK(w.statistics().chunk_count == 0);  // the channel record and one message: under 256 bytes
+    REQUIRE(w.write({*ch, 1, 6, 6, big}));
+    CHECK(w.statistics().chunk_count == 1);  // full: written
+    REQUIRE(w.write({*ch, 2, 7, 7, small}));
+    REQUIRE(w.flush());  // explicit flush writes the partial chunk
+    CHECK(w.statistics().chunk_count == 2);
+    REQUIRE(w.flush());  // nothing open: no empty chunk
+    CHECK(w.statistics().chunk_count == 2);
+    REQUIRE(w.close());
+
+    SpanSource source(file);
+    auto reader = McapReader::open(source);
+    REQUIRE(reader);
+    const auto& ci = reader->summary().chunk_indexes;
+    REQUIRE(ci.size() == 2);
+    CHECK(ci[0].message_start_time == 5);
+    CHECK(ci[0].message_end_time == 6);
+    CHECK(ci[1].message_start_time == 7);
+    auto got = drain(reader->messages());
+    REQUIRE(got.size() == 3);
+    CHECK(got[1].data == big);
+}
+
+TEST_CASE("mcap: writer refuses calls out of order and unknown ids, and keeps the first sink error") {
+    std::vector<std::byte> file;
+    VectorSink sink(file);
+    McapWriter w(sink);
+    std::vector<std::byte> data(3);
+    CHECK(w.write({0, 0, 0, 0, data}).error().type == MessageErrorType::InvalidState);
+    REQUIRE(w.open());
+    CHECK(w.add_channel(7, "t", "json").error().type == MessageErrorType::InvalidArgument);
+    CHECK(w.write({0, 0, 0, 0, data}).error().type == MessageErrorType::InvalidArgument);
+    REQUIRE(w.close());
+    CHECK(w.write({0, 0, 0, 0, data}).error().type == MessageErrorType::InvalidState);
+    CHECK(w.close().error().type == MessageErrorType::InvalidState);
+
+    FailingSink small(200);
+    WriterOptions options;
+    options.chunk_size = 64;
+    McapWriter f(small, options);
+    REQUIRE(f.open());
+    auto ch = f.add_channel(0, "t", "json");
+    REQUIRE(ch);
+    Result<void> r;
+    std::vector<std::byte> payload(50);
+    for (int i = 0; i < 20 && r; ++i) r = f.write({*ch, 0, 1, 1, payload});
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::IOError);
+    CHECK(r.error().message == "disk full");
+    auto again = f.write({*ch, 0, 1, 1, payload});
+    CHECK(again.error().type == MessageErrorType::InvalidState);
+    CHECK(again.error().message.find("disk full") != std::string::npos);
+    CHECK_FALSE(f.is_open());
+}
+
+TEST_CASE("mcap: each completed chunk is flushed to the sink") {
+    FailingSink sink(1 << 20);
+    WriterOptions options;
+    options.chunk_size = 512;
+    McapWriter w(sink, options);
+    write_sample(w, 100);
+    auto chunks = w.statistics().chunk_count;
+    CHECK(chunks > 2);
+    CHECK(sink.flushes == chunks + 1);  // + the one after the header
+}
