@@ -34,6 +34,7 @@ declare -A CI_SECONDS=(
   [fuzz_robdef_parser]=30 [fuzz_message_reader]=30 [fuzz_message_structured]=40 [fuzz_connection_url]=20
   [fuzz_service_path]=20 [fuzz_gateway_config]=30 [fuzz_discovery_packet]=20 [fuzz_usb_descriptors]=20
   [fuzz_usb_packets]=20 [fuzz_json_socket]=40 [fuzz_json_rest]=40 [fuzz_gateway_port]=50
+  [fuzz_mcap_reader]=20
 )
 
 mode=ci

@@ -31,6 +31,14 @@ Result<std::vector<std::byte>> decompress_chunk(std::string_view compression, st
         return fail(MessageErrorType::DataSerializationError,
                     "compression \"" + std::string(compression) + "\" is not supported (only \"\" and \"zstd\")");
     if (records.empty() && uncompressed_size == 0) return std::vector<std::byte>{};
+    // A first frame that announces more than the whole chunk is wrong: say so before allocating.
+    const unsigned long long first = ZSTD_getFrameContentSize(records.data(), records.size());
+    if (first == ZSTD_CONTENTSIZE_ERROR)
+        return fail(MessageErrorType::DataSerializationError, "records are not zstd data");
+    if (first != ZSTD_CONTENTSIZE_UNKNOWN && first > uncompressed_size)
+        return fail(MessageErrorType::DataSerializationError,
+                    "zstd frame announces " + std::to_string(first) + " bytes, uncompressed_size says " +
+                        std::to_string(uncompressed_size));
     // The announced size bounds the output: zstd stops with an error rather than write past it.
     std::vector<std::byte> out(static_cast<std::size_t>(uncompressed_size));
     std::size_t n = ZSTD_decompress(out.data(), out.size(), records.data(), records.size());

@@ -16,7 +16,8 @@ using detail::Bytes;
 using detail::kRecordPrefixBytes;
 using detail::record_error;
 
-namespace {
+// Named, not anonymous: MessageIterator::State holds a LinearScanner and a RecordWalker.
+namespace reader_detail {
 
 constexpr auto kCorrupt = MessageErrorType::DataSerializationError;
 
@@ -56,22 +57,33 @@ public:
             return stop("file ends inside " + opcode_name(opcode) + " at offset " + std::to_string(pos_) +
                         " (content length " + std::to_string(length) + ", " +
                         std::to_string(size - pos_ - kRecordPrefixBytes) + " bytes left)");
+        RawRecord rec{opcode, pos_, {}};
+        if (opcode == op(Opcode::DataEnd) || opcode == op(Opcode::Footer)) done_ = true;
+        if (!wanted_content(opcode)) {  // attachments, metadata, indexes, private records: skipped unread
+            pos_ += kRecordPrefixBytes + length;
+            return std::optional<RawRecord>(std::move(rec));
+        }
         if (length > limits_.max_record_bytes)
             return record_error(opcode, pos_, MessageErrorType::BufferLimitViolation,
                                 "content length " + std::to_string(length) + " over the limit of " +
                                     std::to_string(limits_.max_record_bytes) + " bytes");
-        RawRecord rec{opcode, pos_, {}};
         auto content = read_bytes(source_, pos_ + kRecordPrefixBytes, length);
         if (!content) return content.take_error();
         rec.content = std::move(*content);
         pos_ += kRecordPrefixBytes + length;
-        if (opcode == op(Opcode::DataEnd) || opcode == op(Opcode::Footer)) done_ = true;
         return std::optional<RawRecord>(std::move(rec));
     }
 
     const std::optional<std::string>& truncated() const { return truncated_; }
 
 private:
+    // Records whose content a linear read uses; the others are stepped over (a linear read only counts
+    // Attachment and Metadata records).
+    static bool wanted_content(std::uint8_t opcode) {
+        return opcode == op(Opcode::Schema) || opcode == op(Opcode::Channel) || opcode == op(Opcode::Message) ||
+               opcode == op(Opcode::Chunk);
+    }
+
     Result<std::optional<RawRecord>> stop(std::string why) {
         done_ = true;
         truncated_ = std::move(why);
@@ -105,10 +117,7 @@ Result<Bytes> load_chunk(std::span<const std::byte> content, std::uint64_t offse
             return record_error(op(Opcode::Chunk), offset, kCorrupt, buf);
         }
     }
-    if (fields) {
-        *fields = *chunk;
-        fields->records = {};
-    }
+    if (fields) *fields = *chunk;  // its records view points into `content`
     return std::move(*records);
 }
 
@@ -155,10 +164,12 @@ std::string in_chunk(std::uint64_t chunk_offset) {
 }
 
 bool wanted(const MessageQuery& q, std::uint16_t channel, std::uint64_t log_time) {
-    return log_time >= q.start_time && log_time < q.end_time && (!q.channels || q.channels->count(channel));
+    return log_time >= q.start_time && (!q.end_time || log_time < *q.end_time) &&
+           (!q.channels || q.channels->count(channel));
 }
 
-}  // namespace
+}  // namespace reader_detail
+using namespace reader_detail;
 
 struct McapReader::State {
     Source* source = nullptr;
@@ -213,8 +224,9 @@ Result<void> McapReader::State::read_footer_and_summary() {
         }
     }
     const std::uint64_t summary_end = f.summary_offset_start ? f.summary_offset_start : footer_at;
-    RecordWalker walk(std::span(*covered).first(static_cast<std::size_t>(summary_end - f.summary_start)),
-                      f.summary_start, " (in the summary section)");
+    const auto summary_bytes = std::span<const std::byte>(*covered).first(
+        static_cast<std::size_t>(summary_end - f.summary_start));
+    RecordWalker walk(summary_bytes, f.summary_start, " (in the summary section)");
     Summary s;
     s.from_summary_section = true;
     bool have_statistics = false;
@@ -319,7 +331,7 @@ Result<void> McapReader::State::scan_linear() {
         ci.chunk_start_offset = r.offset;
         ci.chunk_length = kRecordPrefixBytes + r.content.size();
         ci.compression = fields.compression;
-        ci.compressed_size = r.content.size();  // approximate: content minus the fixed fields
+        ci.compressed_size = fields.records.size();
         ci.uncompressed_size = fields.uncompressed_size;
         summary.chunk_indexes.push_back(std::move(ci));
         ++summary.statistics.chunk_count;
@@ -429,7 +441,8 @@ struct MessageIterator::State {
     }
 
     bool chunk_wanted(const ChunkIndex& ci) const {
-        if (ci.message_end_time < query.start_time || ci.message_start_time >= query.end_time) return false;
+        if (ci.message_end_time < query.start_time || (query.end_time && ci.message_start_time >= *query.end_time))
+            return false;
         if (query.channels && !ci.message_index_offsets.empty()) {
             bool any = false;
             for (auto c : *query.channels) any = any || ci.message_index_offsets.count(c);
@@ -504,6 +517,15 @@ Result<void> MessageIterator::State::load_indexed_chunk(const ChunkIndex& ci) {
         if (!item) return item.take_error();
         if (!*item) break;
         if ((*item)->opcode != op(Opcode::Message)) continue;
+        // The merge by log_time trusts the ChunkIndex time ranges: a message outside its range is an error.
+        if ((*item)->content.size() >= 14) {
+            const auto t = load_le<std::uint64_t>((*item)->content.data() + 6);
+            if (t < ci.message_start_time || t > ci.message_end_time)
+                return record_error(op(Opcode::Message), (*item)->offset, kCorrupt,
+                                    "log_time " + std::to_string(t) + " outside its ChunkIndex range [" +
+                                        std::to_string(ci.message_start_time) + ", " +
+                                        std::to_string(ci.message_end_time) + "]" + in_chunk(at));
+        }
         auto m = message_from((*item)->content, (*item)->offset, at);
         if (!m) return m.take_error();
         if (!*m) continue;

@@ -18,15 +18,16 @@
 // Errors (RRError.message always names the record and its file offset, e.g.
 // "mcap: Chunk at offset 1234: uncompressed_crc mismatch (file 0x..., computed 0x...)"):
 //   DataSerializationError: bad magic, malformed record, CRC mismatch, bad compressed data, unknown
-//     compression, a message on a channel never defined;
+//     compression, a message on a channel never defined, (indexed) a message whose log_time is outside
+//     its ChunkIndex's time range (the log-time merge relies on those ranges);
 //   BufferLimitViolation: a record or a chunk's uncompressed size over ReaderLimits;
 //   IOError: the Source's own errors, unchanged.
-// Not thread-safe; the Source must outlive the reader and its iterators.
+// Not thread-safe. The Source must outlive the reader, and the reader its MessageIterators (moving the
+// reader is fine: iterators refer to state that stays put).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
@@ -51,7 +52,8 @@ struct ReaderLimits {
 /// Which messages messages() yields.
 struct MessageQuery {
     std::uint64_t start_time = 0;  ///< ns, inclusive: log_time >= start_time
-    std::uint64_t end_time = std::numeric_limits<std::uint64_t>::max();  ///< ns, exclusive
+    /// ns, exclusive: log_time < end_time; nullopt = no end (every time up to UINT64_MAX included).
+    std::optional<std::uint64_t> end_time;
     /// Channel ids to yield; nullopt = all channels.
     std::optional<std::set<std::uint16_t>> channels;
 };

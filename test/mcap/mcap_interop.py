@@ -2,7 +2,8 @@
 """MCAP interop (issue 44): our writer and reader (core/mcap, through rr_mcap_tool) against the reference
 implementations, the `mcap` PyPI package and `@mcap/core` from npm (mcap_reference.mjs), both ways.
 
-Every writer writes the same sample recording (described in rr_mcap_tool.cpp): ours chunked with zstd,
+Every writer writes the same sample recording (described in rr_mcap_tool.cpp; Python's adds an attachment
+and a metadata record in the middle): ours chunked with zstd,
 chunked uncompressed, and in one chunk; Python's and TypeScript's chunked with zstd, chunked
 uncompressed and unchunked. Every reader dumps every file in one JSON shape: ours, Python's indexed
 (seeking) and streaming readers (CRCs checked, the data section CRC too), TypeScript's indexed reader
@@ -12,7 +13,9 @@ Then: files cut in the middle of their last chunk (ours and Python's) read by al
 readers give exactly the messages of the complete chunks; our reader's seek by time and topic matches
 a filter of the sample; and a file with a corrupted chunk makes our reader fail with a clear message.
 
-Usage: mcap_interop.py --tool PATH/rr_mcap_tool. Exit 0 pass, 1 fail, 77 skip (no `mcap` package in the
+Usage: mcap_interop.py --tool PATH/rr_mcap_tool [--seeds DIR]. With --seeds, writes small sample files of
+each writer (and cut ones) into DIR instead: the seeds of the fuzz target (test/fuzz/seeds/fuzz_mcap_reader).
+Exit 0 pass, 1 fail, 77 skip (no `mcap` package in the
 venv or no test/mcap/node_modules: ./scripts/setup.sh installs both).
 """
 import argparse
@@ -67,9 +70,9 @@ def expected():
 
 
 # --- writers ---------------------------------------------------------------------------------------
-def py_write(path, compression, chunked):
+def py_write(path, compression, chunked, chunk_size=4096):
     with open(path, "wb") as f:
-        w = Writer(f, chunk_size=4096, compression=compression, use_chunking=chunked)
+        w = Writer(f, chunk_size=chunk_size, compression=compression, use_chunking=chunked)
         w.start(profile="", library="mcap python")
         sid = w.register_schema(SCHEMA_NAME, "jsonschema", SCHEMA_DATA)
         js = w.register_channel("sample/json", "json", sid, {"device": "sample", "member": "json"})
@@ -78,6 +81,10 @@ def py_write(path, compression, chunked):
             t = T0 + i * 1000003
             w.add_message(js if i % 2 == 0 else rr, log_time=t, data=sample_payload(i), publish_time=t - 7,
                           sequence=i // 2)
+            if i == COUNT // 2:  # records our writer never writes, which our reader steps over
+                w.add_attachment(create_time=t, log_time=t, name="calibration.txt", media_type="text/plain",
+                                 data=b"x" * 100)
+                w.add_metadata("robot", {"serial": "42"})
         w.finish()
 
 
@@ -158,11 +165,34 @@ def compare(label, dump, want, messages=None):
         print(f"ok  {label}: {len(got)} messages")
 
 
+def write_seeds(out):
+    global COUNT
+    COUNT = 10
+    os.makedirs(out, exist_ok=True)
+    mjs = os.path.join(HERE, "mcap_reference.mjs")
+    n = str(COUNT)
+    checked([TOOL, "write-sample", os.path.join(out, "ours_zstd.mcap"), "--chunk-size", "200", "--count", n])
+    checked([TOOL, "write-sample", os.path.join(out, "ours_none.mcap"), "--compression", "none", "--chunk-size", "150", "--count", n])
+    py_write(os.path.join(out, "python_zstd.mcap"), CompressionType.ZSTD, True, chunk_size=200)
+    py_write(os.path.join(out, "python_unchunked.mcap"), CompressionType.NONE, False)
+    checked([NODE, mjs, "write-sample", os.path.join(out, "ts_zstd.mcap"), "--count", n, "--chunk-size", "200"])
+    checked([NODE, mjs, "write-sample", os.path.join(out, "ts_unchunked.mcap"), "--count", n, "--chunked", "no", "--compression", "none"])
+    for name in ("ours_zstd", "ours_none"):
+        data = open(os.path.join(out, name + ".mcap"), "rb").read()
+        open(os.path.join(out, name + "_cut.mcap"), "wb").write(data[: len(data) * 2 // 3])
+    print("seeds written to", out)
+    return 0
+
+
 def main():
     global TOOL
     ap = argparse.ArgumentParser()
     ap.add_argument("--tool", required=True)
-    TOOL = ap.parse_args().tool
+    ap.add_argument("--seeds")
+    args = ap.parse_args()
+    TOOL = args.tool
+    if args.seeds:
+        return write_seeds(args.seeds)
     want = expected()
     tmp = tempfile.mkdtemp(prefix="rr_mcap_interop_")
     try:

@@ -152,9 +152,9 @@ int main(int argc, char** argv) {
     try {
         if (command == "write-sample") return write_sample(argv[2], rest);
         if (command == "dump") return dump(argv[2], rest);
-    } catch (const std::exception& e) {  // std::stoull on a bad number
-        std::cerr << "rr_mcap_tool: bad argument: " << e.what() << "\n";
-        return 2;
+    } catch (const std::exception& e) {  // std::stoull on a bad number; a topic that is not UTF-8 in dump
+        std::cerr << "rr_mcap_tool: " << e.what() << "\n";
+        return 1;
     }
     return usage();
 }
