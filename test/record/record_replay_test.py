@@ -363,6 +363,38 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         checks["replay_gateway_exit"] = code
 
 
+def mcap_core_phase(exe, work, path, checks):
+    """The recording rewritten by the TypeScript reference writer (@mcap/core) replays: its wire value
+    after a seek is the recorded one."""
+    node = shutil.which("node")
+    script = os.path.join(os.path.dirname(__file__), "rewrite_with_mcap_core.mjs")
+    if not node or not os.path.isdir(os.path.join(os.path.dirname(__file__), "..", "mcap", "node_modules", "@mcap")):
+        checks["mcap_core_file"] = "SKIP: node or test/mcap/node_modules missing (run ./scripts/setup.sh)"
+        return
+    rewritten = os.path.join(work, "mcap_core.mcap")
+    r = subprocess.run([node, script, path, rewritten], capture_output=True, text=True, timeout=60)
+    expect(r.returncode == 0, "@mcap/core rewrite: %s" % r.stderr[-500:])
+    proc, port, base = start_gateway(exe, ["--no-demo", "--replay", "ts_create=" + rewritten], os.path.join(work, "gateway3.log"))
+    try:
+        status, st = http(base, "POST", "/api/replays/ts_create", {"state": "paused", "position_s": 2.0})
+        expect(status == 200, "seek in the @mcap/core file: %s %s" % (status, st))
+        time.sleep(0.5)
+        target = st["start_ns"] + 2_000_000_000
+        want = None
+        with open(path, "rb") as f:
+            for _, ch, m in make_reader(f).iter_messages(topics=["create/packets"]):
+                if ch.message_encoding == "json" and m.log_time <= target:
+                    d = bytes(json.loads(m.data)["value"]["Data"])
+                    want = d[2] | (d[3] << 8)
+        status, w = http(base, "GET", "/api/devices/ts_create/wires/packets")
+        expect(status == 200, "wire of the @mcap/core file's device: %s %s" % (status, w))
+        d = bytes(w["value"]["Data"])
+        expect((d[2] | (d[3] << 8)) == want, "the @mcap/core file replays the recorded value")
+        checks["mcap_core_file"] = {"rewrite": json.loads(r.stdout), "wire_seq_at_2s": want}
+    finally:
+        stop(proc)
+
+
 def corrupt_phase(exe, work, path, checks):
     cases = {}
     garbage = os.path.join(work, "garbage.mcap")
@@ -402,6 +434,7 @@ def main():
     try:
         path, rr_packets, props = record_phase(a.gateway, work, a.seconds, checks)
         replay_phase(a.gateway, work, path, rr_packets, props, a.tolerance_ms, checks)
+        mcap_core_phase(a.gateway, work, path, checks)
         corrupt_phase(a.gateway, work, path, checks)
         ok = True
     except (CheckFailed, AssertionError, jsonschema.ValidationError, McapError, RR.RobotRaconteurException,
