@@ -6,11 +6,17 @@
 #include "server/record/json_schema.hpp"
 
 using namespace rr;
+namespace record = rr::server::record;
 using nlohmann::json;
 
 namespace {
 
 constexpr const char* kDef = R"(service test.rec
+
+enum Mode
+    idle = 0,
+    run = 1
+end
 
 struct Point
     field double x
@@ -22,11 +28,6 @@ namedarray Vec3
     field double x
     field double y
     field double z
-end
-
-enum Mode
-    idle = 0,
-    run = 1
 end
 
 object Dev
@@ -45,6 +46,7 @@ struct Fixture {
     const robdef::ServiceEntryDefinition* dev = nullptr;
     Fixture() {
         auto r = set.add_text(kDef, "test.rec.robdef");
+        INFO((r ? std::string() : r.error().message));
         REQUIRE(r);
         auto ref = set.find("Dev", "test.rec");
         REQUIRE(ref.entry);

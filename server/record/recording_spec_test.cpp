@@ -6,6 +6,7 @@
 #include "server/record/recording_spec.hpp"
 
 using namespace rr;
+namespace record = rr::server::record;
 using nlohmann::json;
 
 TEST_CASE("record spec: defaults and every key") {
@@ -26,6 +27,7 @@ TEST_CASE("record spec: defaults and every key") {
                                          {"max_total_bytes", 5000000},
                                          {"duration_s", 10},
                                          {"compression", "none"}});
+    INFO((s ? std::string() : s.error().message));
     REQUIRE(s);
     CHECK(s->members == std::vector<std::string>{"frames", "pos"});
     CHECK_FALSE(s->json);
