@@ -17,7 +17,7 @@ and the reference MCAP reader (PyPI `mcap`):
   failures a directory that cannot be created: 507 and a failed recording with the reason; a full disk
            (a small tmpfs, mounted here as root; SKIP of that part otherwise): the recording fails with
            "No space left on device" while the gateway goes on serving; corrupt files handed to
-           --replay: a clear error and exit status 1, no crash.
+           --replay: a clear error and exit status 2 (a start error), no crash.
 
 Prints one JSON summary; exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's
 packages.
@@ -196,6 +196,7 @@ def record_phase(exe, work, seconds, checks):
         listener = WireListener(client, "packets")
         client.play_callback.Function = lambda distance, angle: [60, 32]  # the robot asks what to play
         client.StartStreaming()
+        client.Drive(200, 32767)  # DistanceTraveled changes while recorded
         status, rec = http(base, "POST", "/api/recordings",
                            {"device": "create", "members": ["packets", "Bump", "DistanceTraveled"],
                             "property_period_ms": 200, "directory": os.path.join(work, "rec"), "chunk_bytes": 16384})
@@ -409,14 +410,30 @@ def corrupt_phase(exe, work, path, checks):
     mid = len(data) // 2
     with open(flipped, "wb") as f:
         f.write(data[:mid] + bytes(b ^ 0x5A for b in data[mid:mid + 64]) + data[mid + 64:])
-    for name, p in (("garbage", garbage), ("cut", cut), ("flipped", flipped), ("missing", os.path.join(work, "none.mcap"))):
+    for name, p in (("garbage", garbage), ("cut", cut), ("missing", os.path.join(work, "none.mcap"))):
         r = subprocess.run([exe, "--listen", "127.0.0.1", "--port", "0", "--no-local", "--no-discovery", "--no-demo",
                             "--replay", p], capture_output=True, text=True, timeout=60)
         cases[name] = {"exit": r.returncode, "stderr": r.stderr.strip()[-300:]}
-        if name == "flipped" and r.returncode == 0:
-            continue  # a flip inside one chunk may only show when that chunk is played
-        expect(r.returncode == 1, "%s: exit status 1, not a crash (%s)" % (name, r.returncode))
+        expect(r.returncode == 2, "%s: exit status 2 (a start error), not a crash (%s)" % (name, r.returncode))
         expect(p in r.stderr, "%s: the error names the file" % name)
+    # Bytes flipped inside a chunk: the file opens (its summary is intact); the chunk's CRC fails when
+    # it is played, which ends the replay in state failed while the gateway goes on serving.
+    proc, port, base = start_gateway(exe, ["--no-demo", "--replay", flipped], os.path.join(work, "gateway4.log"))
+    try:
+        http(base, "POST", "/api/replays/create", {"speed": 20})
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            status, st = http(base, "GET", "/api/replays/create")
+            if st["state"] in ("failed", "ended"):
+                break
+            time.sleep(0.2)
+        cases["flipped"] = {"state": st["state"], "error": st.get("error", "")}
+        expect(st["state"] == "failed" and flipped in st.get("error", ""), "flipped chunk: replay failed naming the file: %s" % st)
+        status, _ = http(base, "GET", "/api/devices")
+        expect(status == 200, "the gateway serves after a failed replay")
+    finally:
+        code = stop(proc)
+    expect(code == 0, "the gateway with a failed replay stops cleanly (%s)" % code)
     checks["corrupt"] = cases
 
 
