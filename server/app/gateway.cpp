@@ -1,5 +1,6 @@
 #include "server/app/gateway.hpp"
 #include "server/app/gateway_auth_config.hpp"
+#include "server/record/replay_routes.hpp"
 #include "server/gateway/mirror_service.hpp"
 
 #include <cstdio>
@@ -276,6 +277,52 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         }
     }
 
+    // Replayed devices (docs/recording.md "Replay"): each recording served by a service on the replay
+    // node (loopback only; behind a login only this process knows while gateway.auth is on) and mirrored
+    // like any device, so every kind of client sees it as a live one.
+    if (!c.replays.empty()) {
+        NodeOptions ropts;
+        ropts.node_name = c.node_name + ".replay";
+        ropts.threads = 1;
+        g->replay_node_ = Node::create(ropts);
+        auto replay_listener = open_tcp_listener(g->replay_node_, std::string("127.0.0.1"), 0);
+        if (!replay_listener) return replay_listener.take_error();
+        const auto replay_port = (*replay_listener)->port();
+        DemoLogin login;
+        if (g->auth_) {
+            auto password = random_demo_password();
+            if (!password) return password.take_error();
+            login = DemoLogin{std::string(kDemoUser), std::move(*password)};
+        }
+        for (const auto& rc : c.replays) {
+            record::ReplayOptions ro{rc.file, rc.name, rc.speed, rc.loop, rc.paused};
+            auto replay = record::ReplayDevice::open(ro);
+            if (!replay) return fail(MessageErrorType::InvalidConfiguration, replay.error().message);
+            const auto& name = (*replay)->name();
+            for (const auto& x : devices)
+                if (x.name == name)
+                    return fail(MessageErrorType::InvalidConfiguration, "replay " + rc.file + ": device name \"" + name + "\" is taken");
+            for (const auto& x : g->replays_)
+                if (x->name() == name)
+                    return fail(MessageErrorType::InvalidConfiguration, "replay " + rc.file + ": device name \"" + name + "\" is taken");
+            if (login.required()) {
+                PasswordTable users;
+                users.add_user(login.username, login.password);
+                (*replay)->service()->set_users(std::move(users));
+            }
+            if (auto r = g->replay_node_->register_service((*replay)->service()); !r) return r.take_error();
+            gateway::DeviceConfig dc;
+            dc.name = name;
+            dc.url = "rr+tcp://127.0.0.1:" + std::to_string(replay_port) + "/?service=" + name;
+            dc.username = login.username;
+            dc.password = login.password;
+            dc.backoff_initial = std::chrono::milliseconds(100);
+            devices.push_back(std::move(dc));
+            g->replays_.push_back(*replay);
+        }
+        for (const auto& r : g->replays_) r->start();
+    }
+
     for (const auto& d : devices) {
         auto m = gateway::DeviceMirror::create(g->node_, d);
         if (!m) return m.take_error();
@@ -332,6 +379,18 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     });
     std::shared_ptr<gateway::JsonApi> json_api;
     if (api) json_api = api(*g->http_, g->devices_, g->auth_);
+    // Recording (docs/recording.md): from the JSON API and the configuration's `record:` entries.
+    if (json_api) {
+        g->recordings_ = std::make_shared<record::Recordings>(json_api, [](const record::RecordingStatus& s, std::string_view what) {
+            const bool failed = what == "failed";
+            log(failed ? LogLevel::error : LogLevel::info,
+                "recording " + std::to_string(s.id) + " of " + s.spec.device + ": " + std::string(what) +
+                    (failed ? " (" + s.error + ")" : s.files.empty() ? "" : " (" + s.files.back() + ")"),
+                LogContext{.device = s.spec.device});
+        });
+        record::install_recording_routes(*g->http_, json_api, g->recordings_);
+        record::install_replay_routes(*g->http_, json_api, g->replays_);
+    }
 
     // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the
     // services that `discover:` filters select into devices.
@@ -399,6 +458,8 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         });
         d->start();
     }
+    if (g->recordings_)
+        for (const auto& spec : c.record) g->recordings_->start_when_connected(spec);
 
     // The gateway's one TCP port: raw RR, HTTP and WebSocket upgrades (server/http), and with
     // gateway.tls also TLS, rrs+tcp, HTTPS and WSS (server/transport/tls).
@@ -489,7 +550,11 @@ void Gateway::stop() {
 #endif
     if (demo_discovery_) demo_discovery_->stop();
     if (discovery_) discovery_->stop(std::chrono::milliseconds(6000));  // before the node's threads stop
+    // Recordings close their files (summary and index) while the devices still run.
+    if (recordings_) recordings_->stop_all();
     for (auto& d : devices_) d->stop();
+    for (auto& r : replays_) r->stop();
+    if (replay_node_) replay_node_->shutdown();
 #ifdef RR_HAVE_USB
     if (usb_host_) {
         // Before the node's threads stop: the host's strand runs on them.

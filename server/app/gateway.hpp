@@ -21,6 +21,8 @@
 #include "server/node/node.hpp"
 #include "server/transport/tls/tls_context.hpp"
 #include "server/discovery/node_discovery.hpp"
+#include "server/record/recordings.hpp"
+#include "server/record/replay_device.hpp"
 
 namespace rr::server::app {
 
@@ -96,6 +98,11 @@ public:
     Result<void> reload_tls();
     /// Prometheus text exposition of the gateway's counters (/metrics).
     std::string metrics_text() const;
+    /// The recordings (docs/recording.md), nullptr without the JSON API.
+    const std::shared_ptr<record::Recordings>& recordings() const noexcept { return recordings_; }
+    /// The replayed devices (`replay:` entries, --replay), served from replay_node().
+    const std::vector<std::shared_ptr<record::ReplayDevice>>& replays() const noexcept { return replays_; }
+    const std::shared_ptr<Node>& replay_node() const noexcept { return replay_node_; }
 
 private:
     Gateway() = default;
@@ -122,6 +129,10 @@ private:
     std::shared_ptr<usb::UsbHost> usb_host_;
     std::shared_ptr<discovery::LocalDiscoverySource> local_source_;
     std::shared_ptr<usb::UsbDiscoverySource> usb_source_;
+    std::shared_ptr<record::Recordings> recordings_;
+    /// Replayed devices live on a node of their own on loopback, mirrored like any device.
+    std::shared_ptr<Node> replay_node_;
+    std::vector<std::shared_ptr<record::ReplayDevice>> replays_;
 };
 
 }  // namespace rr::server::app

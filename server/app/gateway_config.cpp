@@ -12,6 +12,7 @@
 #include "core/names/connection_url.hpp"
 #include "core/names/node_id.hpp"
 #include "server/http/forwarded.hpp"
+#include "server/record/recording_spec.hpp"
 
 namespace rr::server::app {
 namespace {
@@ -450,10 +451,67 @@ void parse_limits(const YAML::Node& l, const Reader& r, GatewayLimitsConfig& c) 
     }
 }
 
+// A YAML mapping as JSON (scalars: integers, true/false, else strings), for the `record:` entries,
+// whose keys are those of POST /api/recordings (record::spec_from_json checks them).
+nlohmann::json yaml_to_json(const YAML::Node& n) {
+    if (n.IsMap()) {
+        auto o = nlohmann::json::object();
+        for (const auto& kv : n) o[kv.first.as<std::string>()] = yaml_to_json(kv.second);
+        return o;
+    }
+    if (n.IsSequence()) {
+        auto a = nlohmann::json::array();
+        for (const auto& x : n) a.push_back(yaml_to_json(x));
+        return a;
+    }
+    if (n.IsNull()) return nullptr;
+    const std::string& s = n.Scalar();
+    std::uint64_t u = 0;
+    if (auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), u); !s.empty() && ec == std::errc() && p == s.data() + s.size())
+        return u;
+    bool b = false;
+    if (n.Tag() != "!" && YAML::convert<bool>::decode(n, b)) return b;
+    return s;
+}
+
+// record: a list of recordings (docs/recording.md "Configuration").
+void parse_record(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
+    auto rec = root["record"];
+    if (!rec) return;
+    if (!rec.IsSequence()) r.error(rec, "record", "expected a list of recordings");
+    for (const auto& e : rec) {
+        if (!e.IsMap()) r.error(e, "record[]", "expected a mapping");
+        auto spec = record::spec_from_json(yaml_to_json(e));
+        if (!spec) r.error(e, "record[]", spec.error().message);
+        c.record.push_back(std::move(*spec));
+    }
+}
+
+// devices[] with `replay: FILE` (docs/recording.md "Replay").
+void parse_replay_device(const YAML::Node& d, const Reader& r, GatewayConfig& c, std::set<std::string>& names) {
+    r.check_keys(d, "devices[]", {"name", "replay", "speed", "loop", "paused"});
+    ReplayDeviceConfig rc;
+    if (!d["name"]) r.error(d, "devices[].name", "missing");
+    rc.name = r.string(d["name"], "devices[].name");
+    const std::string key = "devices." + rc.name;
+    rc.file = r.string(d["replay"], key + ".replay");
+    if (rc.file.empty()) r.error(d["replay"], key + ".replay", "empty file name");
+    if (auto n = d["speed"]) {
+        double v = 0;
+        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !(v > 0) || v > 1000)
+            r.error(n, key + ".speed", "expected a number above 0 and at most 1000");
+        rc.speed = v;
+    }
+    if (auto n = d["loop"]) rc.loop = r.boolean(n, key + ".loop");
+    if (auto n = d["paused"]) rc.paused = r.boolean(n, key + ".paused");
+    if (!names.insert(rc.name).second) r.error(d["name"], key, "duplicate device name");
+    c.replays.push_back(std::move(rc));
+}
+
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record"});
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
@@ -523,9 +581,13 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
         if (!devs.IsSequence()) r.error(devs, "devices", "expected a list of devices");
         std::set<std::string> names;
         for (const auto& d : devs) {
+            if (d.IsMap() && d["replay"]) {
+                parse_replay_device(d, r, c, names);
+                continue;
+            }
             r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms", "tls_ca",
                                           "tls_certificate", "tls_private_key", "auth", "max_passthrough_sessions",
-                                          "json_api_requires_device_login"});
+                                          "json_api_requires_device_login", "replay"});
             gateway::DeviceConfig dc;
             if (!d["name"]) r.error(d, "devices[].name", "missing");
             if (!d["url"]) r.error(d, "devices[].url", "missing");
@@ -570,6 +632,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     }
     parse_discovery(root, r, c);
     parse_usb(root, r, c);
+    parse_record(root, r, c);
     return c;
 }
 
@@ -609,7 +672,7 @@ namespace {
 
 // Flags that take a value, with their official RR spellings mapped to ours.
 const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
-                                        "--allow-origin", "--device",     "--demo-port", "--threads", "--trusted-proxy",
+                                        "--allow-origin", "--device",     "--replay",    "--demo-port", "--threads", "--trusted-proxy",
                                         "--log-level",   "--log-format", "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level", "--tls-certificate",
                                         "--tls-private-key", "--tls-client-ca"};
@@ -733,6 +796,18 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
                 return fail(MessageErrorType::InvalidConfiguration, "--device " + d.name + ": URL names no service");
             std::erase_if(c.devices, [&](const gateway::DeviceConfig& x) { return x.name == d.name; });
             c.devices.push_back(std::move(d));
+        } else if (flag == "--replay") {
+            // [NAME=]FILE: NAME defaults to the recorded device's name.
+            ReplayDeviceConfig rc;
+            auto e2 = v.find('=');
+            if (e2 != std::string::npos && v.find('/') > e2) {
+                rc.name = v.substr(0, e2);
+                rc.file = v.substr(e2 + 1);
+            } else {
+                rc.file = v;
+            }
+            if (rc.file.empty()) return fail(MessageErrorType::InvalidConfiguration, "--replay: expected [NAME=]FILE");
+            c.replays.push_back(std::move(rc));
         }
     }
     std::string problem;
@@ -761,6 +836,8 @@ Options (override the configuration file):
   --trusted-proxy ADDR[/N]   believe X-Forwarded-For/-Proto from this proxy (repeatable)
   --device NAME=URL          add a device, e.g. reynard=rr+tcp://localhost:29200/?service=reynard
                              or cam=rr+local:///?nodename=camera.driver&service=cam
+  --replay [NAME=]FILE       serve an MCAP recording as a device (docs/recording.md); NAME
+                             defaults to the recorded device's name
   --no-demo                  do not start the demo devices
   --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
   --no-discovery             no node discovery: do not announce the gateway (nor its demo node),

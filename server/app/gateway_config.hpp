@@ -12,6 +12,7 @@
 #include "core/discovery/service_filter.hpp"
 #include "core/error/rr_error.hpp"
 #include "server/gateway/device_mirror.hpp"
+#include "server/record/recording_spec.hpp"
 
 namespace rr::server::app {
 
@@ -107,6 +108,16 @@ struct GatewayLimitsConfig {
     unsigned burst_s = 1;
 };
 
+/// A `devices:` entry with `replay: FILE` instead of `url:` (docs/recording.md "Replay"): a device
+/// whose source is an MCAP recording.
+struct ReplayDeviceConfig {
+    std::string name;  ///< device name ("" from --replay: the recorded device's name)
+    std::string file;
+    double speed = 1.0;  ///< playback speed factor (> 0)
+    bool loop = false;   ///< start again at the end
+    bool paused = false; ///< start paused (play from the API or the dashboard)
+};
+
 struct GatewayConfig {
     // gateway:
     /// Listen address. The default `::` is one dual-stack socket (IPv4 and IPv6, as an official node);
@@ -142,6 +153,10 @@ struct GatewayConfig {
     std::uint16_t demo_port = 0;  ///< RR port of the embedded demo devices' node (0 = ephemeral)
     // devices:
     std::vector<gateway::DeviceConfig> devices;
+    // devices: entries with `replay:` (--replay FILE)
+    std::vector<ReplayDeviceConfig> replays;
+    // record: (docs/recording.md): recordings started when their device connects
+    std::vector<record::RecordingSpec> record;
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;
@@ -171,7 +186,7 @@ struct CommandLine {
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
-/// --device NAME=URL (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
+/// --device NAME=URL (repeat), --replay FILE (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
 /// --no-discovery, --discovery (the default; overrides a file's `discovery.enabled: false`), --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).

@@ -10,26 +10,6 @@ namespace rr::server::gateway {
 
 namespace bhttp = boost::beast::http;
 
-namespace {
-
-int hex_value(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
-
-std::vector<std::string_view> split(std::string_view s, char sep) {
-    std::vector<std::string_view> out;
-    while (true) {
-        auto p = s.find(sep);
-        out.push_back(s.substr(0, p));
-        if (p == std::string_view::npos) break;
-        s.remove_prefix(p + 1);
-    }
-    return out;
-}
-
 http::Response json_response(const http::Request& req, unsigned status, const nlohmann::json& body) {
     auto r = http::make_response(req, static_cast<bhttp::status>(status), json_text(body) + "\n", "application/json");
     r.set(bhttp::field::cache_control, "no-store");
@@ -48,6 +28,35 @@ http::Response result_response(const http::Request& req, const ApiResult& result
 
 http::Response error_response(const http::Request& req, const ApiError& e) {
     return json_response(req, e.status, nlohmann::json{{"error", error_object(e)}});
+}
+
+// With logins on (auth: gateway), a request without a valid login gets 401 / 429.
+std::optional<ApiError> login_needed(const JsonApi& api, const http::Request& req) {
+    const auto& a = api.auth();
+    if (!a || !a->enabled()) return std::nullopt;
+    auto who = auth::authenticate_request(*a, req);
+    if (auto* e = std::get_if<ApiError>(&who)) return *e;
+    return std::nullopt;
+}
+
+namespace {
+
+int hex_value(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+std::vector<std::string_view> split(std::string_view s, char sep) {
+    std::vector<std::string_view> out;
+    while (true) {
+        auto p = s.find(sep);
+        out.push_back(s.substr(0, p));
+        if (p == std::string_view::npos) break;
+        s.remove_prefix(p + 1);
+    }
+    return out;
 }
 
 struct Target {
@@ -100,15 +109,6 @@ std::optional<ApiError> read_max_items(const nlohmann::json& j, std::size_t& out
         return std::nullopt;
     }
     return api_error(400, MessageErrorType::InvalidArgument, "max_items must be a non-negative integer");
-}
-
-// With logins on (auth: gateway), a request without a valid login gets 401 / 429.
-std::optional<ApiError> login_needed(const JsonApi& api, const http::Request& req) {
-    const auto& a = api.auth();
-    if (!a || !a->enabled()) return std::nullopt;
-    auto who = auth::authenticate_request(*a, req);
-    if (auto* e = std::get_if<ApiError>(&who)) return *e;
-    return std::nullopt;
 }
 
 // POST /api/discovered/add with logins on: a principal allowed to add devices (Principal::may_add_devices).

@@ -25,6 +25,14 @@ namespace rr::server::gateway {
 /// Adds the /api routes to `http` (before the server accepts connections).
 void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api);
 
+/// A JSON response (`application/json`, no-store, CORS for an allowed Origin) with `body`.
+http::Response json_response(const http::Request& req, unsigned status, const nlohmann::json& body);
+/// `result`'s value (200) or its error as {"error": {"name", "message"}} with its status.
+http::Response result_response(const http::Request& req, const ApiResult& result);
+http::Response error_response(const http::Request& req, const ApiError& e);
+/// With logins on (auth: gateway): 401 / 429 for a request without a valid login; nothing otherwise.
+std::optional<ApiError> login_needed(const JsonApi& api, const http::Request& req);
+
 /// Percent-decoding of a URL path segment or query value (`+` is a space in query values).
 /// Errors: InvalidArgument for a malformed escape.
 Result<std::string> url_decode(std::string_view text, bool plus_is_space);

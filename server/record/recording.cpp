@@ -1,0 +1,600 @@
+#include "server/record/recording.hpp"
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <system_error>
+
+#include "core/mcap/mcap_writer.hpp"
+#include "core/value/timespec.hpp"
+#include "server/gateway/json_push.hpp"
+#include "server/gateway/mirror_service.hpp"
+#include "server/gateway/session_endpoints.hpp"
+#include "server/mcap/mcap_file.hpp"
+#include "server/record/json_schema.hpp"
+
+namespace rr::server::record {
+
+namespace fs = std::filesystem;
+using gateway::MemberTarget;
+using gateway::SharedEntry;
+using gateway::SharedEntryPtr;
+
+std::string_view recording_state_name(RecordingState s) noexcept {
+    switch (s) {
+        case RecordingState::recording: return "recording";
+        case RecordingState::stopping: return "stopping";
+        case RecordingState::stopped: return "stopped";
+        case RecordingState::failed: return "failed";
+    }
+    return "?";
+}
+
+std::string_view member_kind_name(RecordedMember::Kind k) noexcept {
+    switch (k) {
+        case RecordedMember::Kind::wire: return "wire";
+        case RecordedMember::Kind::pipe: return "pipe";
+        case RecordedMember::Kind::event: return "event";
+        case RecordedMember::Kind::property: return "property";
+    }
+    return "?";
+}
+
+nlohmann::json status_json(const RecordingStatus& s) {
+    nlohmann::json j{{"id", s.id},           {"device", s.spec.device},   {"state", recording_state_name(s.state)},
+                     {"files", s.files},     {"bytes", s.bytes},          {"messages", s.messages},
+                     {"drops", s.drops},     {"queued_bytes", s.queued_bytes}, {"duration_s", s.duration_s},
+                     {"members", s.members}, {"spec", spec_json(s.spec)}};
+    if (!s.error.empty()) j["error"] = s.error;
+    return j;
+}
+
+namespace {
+
+std::uint64_t now_ns() {
+    return static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+// What an entry weighs in the queue: its payload bytes plus a fixed overhead per element.
+std::size_t approx_bytes(const std::vector<MessageElement>& elements) {
+    std::size_t n = 0;
+    for (const auto& e : elements) n += 64 + e.data.size() + approx_bytes(e.elements);
+    return n;
+}
+
+std::string utc_stamp() {
+    const std::time_t t = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", &tm);
+    return buf;
+}
+
+// The service name a definition text declares (`service a.b.c`), for the schema's name.
+std::string service_name_of(const std::string& text) {
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        std::size_t end = text.find('\n', pos);
+        if (end == std::string::npos) end = text.size();
+        std::string_view line(text.data() + pos, end - pos);
+        while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+        if (line.substr(0, 8) == "service ") {
+            line.remove_prefix(8);
+            while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
+            return std::string(line);
+        }
+        pos = end + 1;
+    }
+    return "unknown";
+}
+
+std::span<const std::byte> as_bytes(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
+
+}  // namespace
+
+// The open MCAP file and its channel ids.
+struct Recording::File {
+    std::string path;
+    std::unique_ptr<mcap::FileSink> sink;
+    std::unique_ptr<mcap::McapWriter> writer;
+    std::vector<int> json_channel, rr_channel;  // per member; -1 = none
+    std::chrono::steady_clock::time_point opened = std::chrono::steady_clock::now();
+};
+
+Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingSpec spec,
+                                                    std::shared_ptr<gateway::DeviceMirror> device,
+                                                    std::shared_ptr<gateway::JsonApi> api, ErrorListener on_error) {
+    if (!device || !api) return fail(MessageErrorType::InvalidArgument, "record: no such device \"" + spec.device + "\"");
+    if (!device->upstream())
+        return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\" is not connected (its definitions are needed)");
+    gateway::ApiError type_error;
+    auto types = api->types_for(*device, &type_error);
+    if (!types) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": " + type_error.message);
+    const std::string object_type = device->object_type();
+    auto object = types->find_object(object_type);
+    if (!object) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": unknown root type " + object_type);
+
+    std::vector<RecordedMember> members;
+    auto add = [&](const robdef::MemberDefinition& m) -> Result<void> {
+        RecordedMember r;
+        switch (m.kind) {
+            case robdef::MemberKind::wire: r.kind = RecordedMember::Kind::wire; break;
+            case robdef::MemberKind::pipe: r.kind = RecordedMember::Kind::pipe; break;
+            case robdef::MemberKind::event: r.kind = RecordedMember::Kind::event; break;
+            case robdef::MemberKind::property:
+                if (m.direction() == robdef::MemberDirection::writeonly)
+                    return fail(MessageErrorType::InvalidArgument, "record: members: property \"" + m.name + "\" is write-only");
+                r.kind = RecordedMember::Kind::property;
+                break;
+            default:
+                return fail(MessageErrorType::InvalidArgument,
+                            "record: members: \"" + m.name + "\" is " + robdef::with_article(robdef::member_kind_keyword(m.kind)) +
+                                " (wires, pipes, events and properties can be recorded)");
+        }
+        auto t = std::make_shared<MemberTarget>();
+        t->device = device;
+        t->types = types;
+        t->path = device->config().name;
+        t->object_type = object_type;
+        t->service = object->service;
+        t->object = object->entry;
+        t->member = &m;
+        r.target = std::move(t);
+        members.push_back(std::move(r));
+        return {};
+    };
+    if (spec.members.empty()) {
+        for (const auto& m : object->entry->members) {
+            const bool stream = m.kind == robdef::MemberKind::wire || m.kind == robdef::MemberKind::pipe ||
+                                m.kind == robdef::MemberKind::event;
+            const bool prop = m.kind == robdef::MemberKind::property && spec.property_period.count() > 0 &&
+                              m.direction() != robdef::MemberDirection::writeonly;
+            if (stream || prop)
+                if (auto r = add(m); !r) return r.take_error();
+        }
+    } else {
+        for (const auto& name : spec.members) {
+            const auto* m = object->entry->find_member(name);
+            if (!m) return fail(MessageErrorType::InvalidArgument, "record: members: " + object_type + " has no member \"" + name + "\"");
+            if (auto r = add(*m); !r) return r.take_error();
+        }
+    }
+    if (members.empty()) return fail(MessageErrorType::InvalidArgument, "record: " + object_type + ": nothing to record");
+    if (members.size() > 30000) return fail(MessageErrorType::InvalidArgument, "record: too many members");
+
+    std::error_code ec;
+    fs::create_directories(spec.directory, ec);
+    if (ec) return fail(MessageErrorType::IOError, "record: cannot create directory " + spec.directory + ": " + ec.message());
+    if (spec.prefix.empty()) spec.prefix = spec.device;
+
+    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(members)));
+    r->on_error_ = std::move(on_error);
+    r->sequence_.assign(r->members_.size() * 2, 0);
+    if (auto opened = r->open_file(); !opened) return opened.take_error();
+    r->writer_ = std::thread([r = r.get()] { r->writer_loop(); });
+    r->subscribe_members();
+    if (std::any_of(r->members_.begin(), r->members_.end(), [](const RecordedMember& m) { return m.kind == RecordedMember::Kind::property; }))
+        r->poller_ = std::thread([r = r.get()] { r->poll_loop(); });
+    return r;
+}
+
+Recording::Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+                     std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members)
+    : id_(id), spec_(std::move(spec)), device_(std::move(device)), api_(std::move(api)), members_(std::move(members)) {}
+
+Recording::~Recording() {
+    stop();
+    wait();
+}
+
+void Recording::wait() {
+    // The last reference may go on one of these threads (a listener's): it cannot join itself.
+    for (auto* t : {&writer_, &poller_}) {
+        if (!t->joinable()) continue;
+        if (t->get_id() == std::this_thread::get_id()) t->detach();
+        else t->join();
+    }
+}
+
+// --- the live path -------------------------------------------------------------------------------
+
+void Recording::offer(std::uint16_t member, SharedEntryPtr entry) {
+    const std::uint64_t t = now_ns();
+    const std::size_t bytes = approx_bytes(entry->entry().elements) + 128;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (stopping_) return;
+        if (queued_bytes_ + bytes > spec_.queue_bytes) {
+            drops_.fetch_add(1, std::memory_order_relaxed);
+            return;
+        }
+        queued_bytes_ += bytes;
+        queue_.push_back(Item{member, t, std::move(entry), bytes});
+    }
+    wake_.notify_one();
+}
+
+void Recording::subscribe_members() {
+    std::weak_ptr<Recording> weak = weak_from_this();
+    for (std::size_t i = 0; i < members_.size(); ++i) {
+        const auto& m = members_[i];
+        const auto index = static_cast<std::uint16_t>(i);
+        const auto& t = *m.target;
+        if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event) {
+            auto sid = device_->subscribe(
+                t.path, t.member->name, m.kind == RecordedMember::Kind::wire,
+                [weak, index](const SharedEntryPtr& e) {
+                    // WireClosed has no value: only values are recorded.
+                    if (e->entry().entry_type == MessageEntryType::WireClosed) return;
+                    if (auto self = weak.lock()) self->offer(index, e);
+                },
+                [](Result<void>) {});  // a wire not connected now is connected when the device is back
+            std::lock_guard<std::mutex> lock(mutex_);
+            subscriptions_.push_back(sid);
+        } else if (m.kind == RecordedMember::Kind::pipe) {
+            gateway::GatewayPipeHandlers h;
+            const std::string path = t.path, member = t.member->name;
+            h.on_packet = [weak, index, path, member](const MessageElement& packet, std::uint32_t) {
+                auto self = weak.lock();
+                if (!self) return;
+                MessageEntry e;
+                e.entry_type = MessageEntryType::PipePacket;
+                e.service_path = path;
+                e.member_name = member;
+                e.elements.push_back(packet);
+                self->offer(index, std::make_shared<SharedEntry>(std::move(e)));
+            };
+            h.on_closed = [](const RRError&) {};
+            device_->mirror_service()->shared_endpoints()->open_pipe(
+                t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
+                [weak](Result<std::uint64_t> id) {
+                    auto self = weak.lock();
+                    if (!self || !id) return;
+                    std::unique_lock<std::mutex> lock(self->mutex_);
+                    if (self->stopping_) {
+                        lock.unlock();
+                        self->device_->mirror_service()->shared_endpoints()->close_pipe(*id);
+                        return;
+                    }
+                    self->pipes_.push_back(*id);
+                });
+        }
+    }
+}
+
+void Recording::unsubscribe_members() {
+    std::vector<std::uint64_t> subs, pipes;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        subs.swap(subscriptions_);
+        pipes.swap(pipes_);
+    }
+    for (auto id : subs) device_->unsubscribe(id);
+    for (auto id : pipes) device_->mirror_service()->shared_endpoints()->close_pipe(id);
+}
+
+void Recording::poll_loop() {
+    const auto period = spec_.property_period.count() > 0 ? spec_.property_period : std::chrono::milliseconds(1000);
+    auto outstanding = std::make_shared<std::atomic<int>>(0);
+    std::weak_ptr<Recording> weak = weak_from_this();
+    auto next = std::chrono::steady_clock::now();
+    for (;;) {
+        {
+            std::unique_lock<std::mutex> lock(mutex_);
+            if (poll_wake_.wait_until(lock, next, [&] { return stopping_; })) return;
+        }
+        next += period;
+        if (outstanding->load() > 0) continue;  // the device is slower than the period: skip a round
+        for (std::size_t i = 0; i < members_.size(); ++i) {
+            if (members_[i].kind != RecordedMember::Kind::property) continue;
+            const auto& t = *members_[i].target;
+            MessageEntry e;
+            e.entry_type = MessageEntryType::PropertyGetReq;
+            e.service_path = t.path;
+            e.member_name = t.member->name;
+            outstanding->fetch_add(1);
+            device_->request(std::move(e), [weak, outstanding, index = static_cast<std::uint16_t>(i)](Result<MessageEntry> r) {
+                outstanding->fetch_sub(1);
+                auto self = weak.lock();
+                if (!self || !r || r->error != MessageErrorType::None) return;
+                self->offer(index, std::make_shared<SharedEntry>(std::move(*r)));
+            });
+        }
+    }
+}
+
+// --- the writer thread ------------------------------------------------------------------------------
+
+Result<void> Recording::open_file() {
+    enforce_budget();
+    auto f = std::make_unique<File>();
+    char suffix[32];
+    std::snprintf(suffix, sizeof suffix, "-%03llu.mcap", static_cast<unsigned long long>(++file_counter_));
+    f->path = (fs::path(spec_.directory) / (spec_.prefix + "-" + utc_stamp() + suffix)).string();
+    auto sink = mcap::FileSink::create(f->path);
+    if (!sink) return fail(MessageErrorType::IOError, "record: " + sink.error().message);
+    f->sink = std::move(*sink);
+    mcap::WriterOptions wo;
+    wo.library = "rr-gateway recorder";
+    wo.chunk_size = spec_.chunk_bytes;
+    wo.compression = spec_.compress ? mcap::Compression::Zstd : mcap::Compression::None;
+    f->writer = std::make_unique<mcap::McapWriter>(*f->sink, wo);
+    auto check = [&](Result<void> r) -> Result<void> {
+        if (!r) return fail(r.error().type, "record: " + f->path + ": " + r.error().message);
+        return {};
+    };
+    if (auto r = check(f->writer->open()); !r) return r;
+
+    // The device's service definitions (root first): the `robotraconteur` channels' schema, the
+    // definition holding the root object; the others are there for replay and RR tools.
+    const auto& texts = members_.front().target->types->texts();
+    std::uint16_t root_schema = 0;
+    for (std::size_t i = 0; i < texts.size(); ++i) {
+        auto id = f->writer->add_schema(service_name_of(texts[i]), "robotraconteur_servicedef", as_bytes(texts[i]));
+        if (!id) return check(id.take_error());
+        if (i == 0) root_schema = *id;
+    }
+    const std::string device = spec_.device;
+    for (const auto& m : members_) {
+        const auto& t = *m.target;
+        std::map<std::string, std::string> meta{{"device", device},
+                                                {"member", t.member->name},
+                                                {"kind", std::string(member_kind_name(m.kind))},
+                                                {"object_type", t.object_type},
+                                                {"path", ""}};
+        if (m.kind != RecordedMember::Kind::event) meta["type"] = t.member->type.to_string();
+        if (m.kind == RecordedMember::Kind::property)
+            meta["period_ms"] = std::to_string(spec_.property_period.count() > 0 ? spec_.property_period.count() : 1000);
+        const std::string topic = device + "/" + t.member->name;
+        int json_id = -1, rr_id = -1;
+        if (spec_.json) {
+            const std::string title = t.object_type + "." + t.member->name;
+            nlohmann::json schema;
+            switch (m.kind) {
+                case RecordedMember::Kind::wire:
+                    schema = wire_message_schema(t.member->type, t.types->set(), t.context(), title);
+                    break;
+                case RecordedMember::Kind::event:
+                    schema = event_message_schema(*t.member, t.types->set(), t.context(), title);
+                    break;
+                default: schema = value_message_schema(t.member->type, t.types->set(), t.context(), title);
+            }
+            const std::string text = schema.dump();
+            auto sid = f->writer->add_schema(title, "jsonschema", as_bytes(text));
+            if (!sid) return check(sid.take_error());
+            auto cid = f->writer->add_channel(*sid, topic, "json", meta);
+            if (!cid) return check(cid.take_error());
+            json_id = *cid;
+        }
+        if (spec_.robotraconteur) {
+            auto rr_meta = meta;
+            rr_meta["entry_format"] = "4";
+            auto cid = f->writer->add_channel(root_schema, topic, "robotraconteur", rr_meta);
+            if (!cid) return check(cid.take_error());
+            rr_id = *cid;
+        }
+        f->json_channel.push_back(json_id);
+        f->rr_channel.push_back(rr_id);
+    }
+    // Schemas and channels on disk at once: a file killed before its first full chunk still names them.
+    if (auto r = check(f->writer->flush()); !r) return r;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        files_.emplace_back(f->path, f->writer->bytes_written());
+    }
+    file_ = std::move(f);
+    return {};
+}
+
+Result<void> Recording::close_file() {
+    if (!file_) return {};
+    auto f = std::move(file_);
+    auto r = f->writer->close();
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!files_.empty()) files_.back().second = f->writer->bytes_written();
+    }
+    auto c = f->sink->close();
+    if (!r) return fail(r.error().type, "record: " + f->path + ": " + r.error().message);
+    if (!c) return fail(c.error().type, "record: " + f->path + ": " + c.error().message);
+    return {};
+}
+
+// The disk budget: the oldest closed files go while the files and a full new one would exceed it.
+void Recording::enforce_budget() {
+    if (!spec_.max_total_bytes) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto total = [&] {
+        std::uint64_t n = 0;
+        for (const auto& f : files_) n += f.second;
+        return n;
+    };
+    const std::uint64_t next = spec_.max_file_bytes ? spec_.max_file_bytes : 0;
+    while (!files_.empty() && total() + next > spec_.max_total_bytes) {
+        std::error_code ec;
+        fs::remove(files_.front().first, ec);
+        files_.erase(files_.begin());
+    }
+}
+
+Result<void> Recording::write_item(const Item& item) {
+    const auto& m = members_[item.member];
+    const auto& t = *m.target;
+    const MessageEntry& e = item.entry->entry();
+    std::uint64_t publish = item.log_ns;
+    if (m.kind == RecordedMember::Kind::wire) {
+        if (const auto* ts = e.find("packettime"))
+            if (auto time = unpack_timespec(*ts); time && time->seconds >= 0)
+                publish = static_cast<std::uint64_t>(time->seconds) * 1000000000ull + static_cast<std::uint64_t>(time->nanoseconds);
+    }
+    auto write = [&](int channel, std::uint32_t& seq, std::span<const std::byte> data) -> Result<void> {
+        mcap::MessageView v;
+        v.channel_id = static_cast<std::uint16_t>(channel);
+        v.sequence = seq++;
+        v.log_time = item.log_ns;
+        v.publish_time = publish;
+        v.data = data;
+        auto r = file_->writer->write(v);
+        if (!r) return fail(r.error().type, "record: " + file_->path + ": " + r.error().message);
+        messages_.fetch_add(1, std::memory_order_relaxed);
+        return {};
+    };
+    if (file_->rr_channel[item.member] >= 0) {
+        // The bytes native clients are sent (cached in the SharedEntry, made once).
+        auto bytes = item.entry->bytes(4);
+        if (bytes)
+            if (auto r = write(file_->rr_channel[item.member], sequence_[item.member * 2 + 1], *bytes); !r) return r;
+    }
+    if (file_->json_channel[item.member] >= 0) {
+        std::string text;
+        switch (m.kind) {
+            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t); break;
+            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t); break;
+            default: {
+                const MessageElement* el = m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
+                                                                                : e.find("value");
+                nlohmann::json body = nlohmann::json::object();
+                if (!el) {
+                    body["error"] = {{"message", "no value"}};
+                } else {
+                    auto j = api_->element_json(*el, t.member->type, t);
+                    if (j) body["value"] = std::move(j.value);
+                    else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
+                }
+                text = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+            }
+        }
+        if (auto r = write(file_->json_channel[item.member], sequence_[item.member * 2], as_bytes(text)); !r) return r;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!files_.empty()) files_.back().second = file_->writer->bytes_written();
+    return {};
+}
+
+void Recording::fail_with(const RRError& error) {
+    std::vector<std::function<void(const RecordingStatus&)>> listeners;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        state_ = RecordingState::failed;
+        error_ = error.message;
+        stopping_ = true;
+        ended_ = std::chrono::steady_clock::now();
+        queue_.clear();
+        queued_bytes_ = 0;
+        listeners.swap(stop_listeners_);
+    }
+    wake_.notify_all();
+    poll_wake_.notify_all();
+    unsubscribe_members();
+    // What was written stays: its complete chunks are readable; a close that fails again changes nothing.
+    if (file_) {
+        (void)file_->writer->close();
+        (void)file_->sink->close();
+        file_.reset();
+    }
+    auto s = status();
+    if (on_error_) on_error_(s);
+    for (auto& l : listeners) l(s);
+}
+
+void Recording::writer_loop() {
+    using clock = std::chrono::steady_clock;
+    auto last_flush = clock::now();
+    std::deque<Item> batch;
+    for (;;) {
+        bool stopping = false;
+        {
+            std::unique_lock<std::mutex> lock(mutex_);
+            wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stopping_ || !queue_.empty(); });
+            if (state_ == RecordingState::failed) return;
+            batch.swap(queue_);
+            queued_bytes_ = 0;
+            stopping = stopping_;
+        }
+        for (const auto& item : batch) {
+            const auto now = clock::now();
+            const bool too_big = spec_.max_file_bytes && file_->writer->bytes_written() >= spec_.max_file_bytes;
+            const bool too_old = spec_.max_file_duration.count() && now - file_->opened >= spec_.max_file_duration;
+            if (too_big || too_old) {
+                if (auto r = close_file(); !r) return fail_with(r.error());
+                if (auto r = open_file(); !r) return fail_with(r.error());
+            }
+            if (auto r = write_item(item); !r) return fail_with(r.error());
+        }
+        batch.clear();
+        // A chunk at least every second: a killed gateway loses at most about a second.
+        if (clock::now() - last_flush >= std::chrono::seconds(1)) {
+            last_flush = clock::now();
+            if (auto r = file_->writer->flush(); !r) return fail_with(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message));
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (!files_.empty()) files_.back().second = file_->writer->bytes_written();
+        }
+        if (spec_.duration.count() && clock::now() - started_ >= spec_.duration && !stopping) {
+            // Ends itself: taps go, then the queue is drained on the next rounds.
+            std::thread([self = shared_from_this()] { self->stop(); }).detach();
+        }
+        if (stopping) {
+            std::unique_lock<std::mutex> lock(mutex_);
+            if (!queue_.empty()) continue;
+            lock.unlock();
+            auto r = close_file();
+            if (!r) return fail_with(r.error());
+            std::vector<std::function<void(const RecordingStatus&)>> listeners;
+            {
+                std::lock_guard<std::mutex> l2(mutex_);
+                state_ = RecordingState::stopped;
+                ended_ = clock::now();
+                listeners.swap(stop_listeners_);
+            }
+            auto s = status();
+            for (auto& l : listeners) l(s);
+            return;
+        }
+    }
+}
+
+void Recording::stop(std::function<void(const RecordingStatus&)> done) {
+    bool first = false;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (state_ == RecordingState::recording) {
+            state_ = RecordingState::stopping;
+            stopping_ = true;
+            first = true;
+        }
+        if (state_ == RecordingState::stopping) {
+            if (done) stop_listeners_.push_back(std::move(done));
+            done = nullptr;
+        }
+    }
+    if (first) {
+        unsubscribe_members();
+        wake_.notify_all();
+        poll_wake_.notify_all();
+    }
+    if (done) done(status());
+}
+
+RecordingStatus Recording::status() const {
+    RecordingStatus s;
+    s.id = id_;
+    s.spec = spec_;
+    for (const auto& m : members_) s.members.push_back(m.target->member->name);
+    s.drops = drops_.load();
+    s.messages = messages_.load();
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.state = state_;
+    s.error = error_;
+    for (const auto& f : files_) {
+        s.files.push_back(f.first);
+        s.bytes += f.second;
+    }
+    s.queued_bytes = queued_bytes_;
+    const auto end = (state_ == RecordingState::stopped || state_ == RecordingState::failed) ? ended_ : std::chrono::steady_clock::now();
+    s.duration_s = std::chrono::duration<double>(end - started_).count();
+    return s;
+}
+
+}  // namespace rr::server::record

@@ -1,0 +1,149 @@
+// One recording (docs/recording.md): the members of one gateway device written to MCAP files.
+//
+// The live path only hands over what it already has: each wire value and event is the SharedEntry the
+// gateway fans out to its clients (DeviceMirror::subscribe), each pipe packet the element the gateway's
+// own pipe endpoint received, each polled property the device's reply. They wait in a bounded queue
+// (RecordingSpec::queue_bytes; when it is full the entry is dropped and counted, the live path never
+// waits) and one writer thread per recording encodes them (`robotraconteur`: the entry's bytes in RR
+// message format 4, cached and shared with the native clients' sends; `json`: the JSON API's mapping)
+// and writes them with McapWriter (core/mcap), rotating files by size and time, deleting the oldest
+// files over the disk budget.
+//
+// Times: log_time = the gateway's receive time (system clock, ns since the Unix epoch); publish_time =
+// the device's own time stamp where the value carries one (a wire value's `packettime`), else log_time.
+//
+// Failure: an I/O error (an unwritable directory, a full disk) ends the recording in state `failed`
+// with the error (status(), the log through the error listener); the file written so far keeps its
+// complete chunks. The gateway goes on serving.
+//
+// Thread-safe. stop() may be called from any thread, including the device's strand.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "server/gateway/device_mirror.hpp"
+#include "server/gateway/json_api.hpp"
+#include "server/gateway/shared_entry.hpp"
+#include "server/record/recording_spec.hpp"
+
+namespace rr::server::record {
+
+enum class RecordingState : std::uint8_t { recording, stopping, stopped, failed };
+std::string_view recording_state_name(RecordingState s) noexcept;
+
+/// One recorded member: what it is and how it is written.
+struct RecordedMember {
+    enum class Kind : std::uint8_t { wire, pipe, event, property };
+    Kind kind = Kind::wire;
+    std::shared_ptr<const gateway::MemberTarget> target;
+};
+std::string_view member_kind_name(RecordedMember::Kind k) noexcept;
+
+struct RecordingStatus {
+    std::uint64_t id = 0;
+    RecordingSpec spec;
+    RecordingState state = RecordingState::recording;
+    std::string error;                 ///< why it failed ("" otherwise)
+    std::vector<std::string> files;    ///< this recording's files still on disk, oldest first
+    std::uint64_t bytes = 0;           ///< their size now
+    std::uint64_t messages = 0;        ///< messages written (all channels, all files)
+    std::uint64_t drops = 0;           ///< entries dropped because the queue was full
+    std::uint64_t queued_bytes = 0;    ///< waiting for the writer now
+    double duration_s = 0;             ///< since start (until the end, once ended)
+    std::vector<std::string> members;  ///< the members recorded
+};
+/// {"id", "device", "state", "error"?, "files", "bytes", "messages", "drops", "queued_bytes",
+///  "duration_s", "members", "spec"} (docs/recording.md "JSON API").
+nlohmann::json status_json(const RecordingStatus& s);
+
+class Recording : public std::enable_shared_from_this<Recording> {
+public:
+    using ErrorListener = std::function<void(const RecordingStatus&)>;
+
+    /// Starts recording `spec.device` (`device`, connected: its definitions are needed). Creates the
+    /// directory and the first file before returning. Errors: InvalidArgument (a member the root object
+    /// does not have, or of a kind that cannot be recorded: functions, callbacks, objrefs, memories),
+    /// InvalidState (device not connected), IOError (directory or file not writable; the message names
+    /// the path and the reason).
+    static Result<std::shared_ptr<Recording>> start(std::uint64_t id, RecordingSpec spec,
+                                                    std::shared_ptr<gateway::DeviceMirror> device,
+                                                    std::shared_ptr<gateway::JsonApi> api, ErrorListener on_error = {});
+    ~Recording();
+
+    /// Stops taking entries, writes what is queued, closes the file (summary and index); `done` (may be
+    /// empty) is called from the writer thread once the file is closed, or at once when already ended.
+    void stop(std::function<void(const RecordingStatus&)> done = {});
+    /// Blocks until the writer thread has ended (after stop() or a failure).
+    void wait();
+    RecordingStatus status() const;
+    std::uint64_t id() const noexcept { return id_; }
+
+private:
+    struct Item {
+        std::uint16_t member = 0;
+        std::uint64_t log_ns = 0;
+        gateway::SharedEntryPtr entry;
+        std::size_t bytes = 0;
+    };
+    struct File;
+
+    Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+              std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members);
+    /// From the live path: queue or drop.
+    void offer(std::uint16_t member, gateway::SharedEntryPtr entry);
+    void subscribe_members();
+    void unsubscribe_members();
+    void poll_loop();
+    void writer_loop();
+    Result<void> open_file();
+    Result<void> write_item(const Item& item);
+    Result<void> close_file();
+    void fail_with(const RRError& error);
+    void enforce_budget();
+
+    const std::uint64_t id_;
+    const RecordingSpec spec_;
+    const std::shared_ptr<gateway::DeviceMirror> device_;
+    const std::shared_ptr<gateway::JsonApi> api_;
+    const std::vector<RecordedMember> members_;
+    const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+    ErrorListener on_error_;
+
+    mutable std::mutex mutex_;
+    std::condition_variable wake_;       // the writer thread's
+    std::condition_variable poll_wake_;  // the property poller's
+    std::deque<Item> queue_;
+    std::size_t queued_bytes_ = 0;
+    bool stopping_ = false;
+    RecordingState state_ = RecordingState::recording;
+    std::string error_;
+    std::chrono::steady_clock::time_point ended_;
+    std::vector<std::function<void(const RecordingStatus&)>> stop_listeners_;
+    std::vector<std::pair<std::string, std::uint64_t>> files_;  // path, size (the open one: updated as written)
+    std::atomic<std::uint64_t> drops_{0}, messages_{0};
+
+    // Subscriptions (guarded by mutex_).
+    std::vector<std::uint64_t> subscriptions_;  // DeviceMirror::subscribe ids
+    std::vector<std::uint64_t> pipes_;          // shared_endpoints pipe ids
+
+    // Writer thread only.
+    std::unique_ptr<File> file_;
+    std::vector<std::uint32_t> sequence_;
+    std::uint64_t file_counter_ = 0;
+
+    std::thread writer_, poller_;
+};
+
+}  // namespace rr::server::record

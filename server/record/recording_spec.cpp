@@ -1,0 +1,121 @@
+#include "server/record/recording_spec.hpp"
+
+#include <set>
+
+namespace rr::server::record {
+namespace {
+
+using nlohmann::json;
+
+Result<void> bad(const std::string& key, const std::string& problem) {
+    return fail(MessageErrorType::InvalidArgument, "record: " + key + ": " + problem);
+}
+
+Result<std::uint64_t> unsigned_of(const json& j, const std::string& key) {
+    if (j.is_number_unsigned()) return j.get<std::uint64_t>();
+    if (j.is_number_integer() && j.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(j.get<std::int64_t>());
+    return fail(MessageErrorType::InvalidArgument, "record: " + key + ": expected a non-negative integer");
+}
+
+Result<std::string> string_of(const json& j, const std::string& key) {
+    if (!j.is_string()) return fail(MessageErrorType::InvalidArgument, "record: " + key + ": expected a string");
+    return j.get<std::string>();
+}
+
+}  // namespace
+
+Result<RecordingSpec> spec_from_json(const json& j) {
+    static const std::set<std::string> keys{"device",         "members",          "encoding",        "directory",
+                                            "prefix",         "property_period_ms", "max_file_bytes",  "max_file_seconds",
+                                            "max_total_bytes", "duration_s",       "queue_bytes",     "chunk_bytes",
+                                            "compression"};
+    if (!j.is_object()) return fail(MessageErrorType::InvalidArgument, "record: expected an object");
+    for (const auto& [k, v] : j.items())
+        if (!keys.count(k)) {
+            std::string list;
+            for (const auto& x : keys) list += (list.empty() ? "" : ", ") + x;
+            return fail(MessageErrorType::InvalidArgument, "record: " + k + ": unknown key (expected one of: " + list + ")");
+        }
+    RecordingSpec s;
+    if (!j.contains("device")) return fail(MessageErrorType::InvalidArgument, "record: device: missing");
+    auto device = string_of(j["device"], "device");
+    if (!device) return device.take_error();
+    s.device = *device;
+    if (s.device.empty()) return fail(MessageErrorType::InvalidArgument, "record: device: empty");
+    if (j.contains("members")) {
+        if (!j["members"].is_array()) return fail(MessageErrorType::InvalidArgument, "record: members: expected a list of member names");
+        for (const auto& m : j["members"]) {
+            auto name = string_of(m, "members[]");
+            if (!name) return name.take_error();
+            s.members.push_back(*name);
+        }
+    }
+    if (j.contains("encoding")) {
+        json e = j["encoding"].is_array() ? j["encoding"] : json::array({j["encoding"]});
+        s.json = s.robotraconteur = false;
+        for (const auto& x : e) {
+            if (x == "json") s.json = true;
+            else if (x == "robotraconteur") s.robotraconteur = true;
+            else return fail(MessageErrorType::InvalidArgument, "record: encoding: expected \"json\", \"robotraconteur\" or a list of both, not " + x.dump());
+        }
+        if (!s.json && !s.robotraconteur) return fail(MessageErrorType::InvalidArgument, "record: encoding: empty list");
+    }
+    if (j.contains("directory")) {
+        auto d = string_of(j["directory"], "directory");
+        if (!d) return d.take_error();
+        if (d->empty()) return fail(MessageErrorType::InvalidArgument, "record: directory: empty");
+        s.directory = *d;
+    }
+    if (j.contains("prefix")) {
+        auto p = string_of(j["prefix"], "prefix");
+        if (!p) return p.take_error();
+        if (p->find('/') != std::string::npos) return fail(MessageErrorType::InvalidArgument, "record: prefix: must not contain '/'");
+        s.prefix = *p;
+    }
+    auto number = [&](const char* key, auto apply) -> Result<void> {
+        if (!j.contains(key)) return {};
+        auto v = unsigned_of(j[key], key);
+        if (!v) return v.take_error();
+        apply(*v);
+        return {};
+    };
+    if (auto r = number("property_period_ms", [&](std::uint64_t v) { s.property_period = std::chrono::milliseconds(v); }); !r) return r.take_error();
+    if (auto r = number("max_file_bytes", [&](std::uint64_t v) { s.max_file_bytes = v; }); !r) return r.take_error();
+    if (auto r = number("max_file_seconds", [&](std::uint64_t v) { s.max_file_duration = std::chrono::seconds(v); }); !r) return r.take_error();
+    if (auto r = number("max_total_bytes", [&](std::uint64_t v) { s.max_total_bytes = v; }); !r) return r.take_error();
+    if (auto r = number("duration_s", [&](std::uint64_t v) { s.duration = std::chrono::seconds(v); }); !r) return r.take_error();
+    if (auto r = number("queue_bytes", [&](std::uint64_t v) { s.queue_bytes = v; }); !r) return r.take_error();
+    if (auto r = number("chunk_bytes", [&](std::uint64_t v) { s.chunk_bytes = v; }); !r) return r.take_error();
+    if (j.contains("compression")) {
+        if (j["compression"] == "zstd") s.compress = true;
+        else if (j["compression"] == "none") s.compress = false;
+        else return fail(MessageErrorType::InvalidArgument, "record: compression: expected \"zstd\" or \"none\"");
+    }
+    if (s.chunk_bytes < 1024 || s.chunk_bytes > (64u << 20))
+        return fail(MessageErrorType::InvalidArgument, "record: chunk_bytes: between 1024 and 67108864");
+    if (s.queue_bytes < 4096) return fail(MessageErrorType::InvalidArgument, "record: queue_bytes: at least 4096");
+    if (s.max_total_bytes && s.max_file_bytes && s.max_total_bytes < s.max_file_bytes)
+        return fail(MessageErrorType::InvalidArgument, "record: max_total_bytes: smaller than max_file_bytes");
+    return s;
+}
+
+json spec_json(const RecordingSpec& s) {
+    json enc = json::array();
+    if (s.json) enc.push_back("json");
+    if (s.robotraconteur) enc.push_back("robotraconteur");
+    return json{{"device", s.device},
+                {"members", s.members},
+                {"encoding", enc},
+                {"directory", s.directory},
+                {"prefix", s.prefix},
+                {"property_period_ms", s.property_period.count()},
+                {"max_file_bytes", s.max_file_bytes},
+                {"max_file_seconds", s.max_file_duration.count()},
+                {"max_total_bytes", s.max_total_bytes},
+                {"duration_s", s.duration.count()},
+                {"queue_bytes", s.queue_bytes},
+                {"chunk_bytes", s.chunk_bytes},
+                {"compression", s.compress ? "zstd" : "none"}};
+}
+
+}  // namespace rr::server::record
