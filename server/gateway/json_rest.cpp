@@ -1,6 +1,7 @@
 #include "server/gateway/json_rest.hpp"
 
 #include "server/gateway/auth/http_auth.hpp"
+#include "server/gateway/json_access.hpp"
 
 #include <charconv>
 #include <map>
@@ -204,9 +205,17 @@ private:
             if (method != bhttp::verb::get) return not_allowed("GET");
             return respond(result_response(req, api_->definitions(device)));
         }
+        if (seg.size() == 2 && seg[1] == "access") {
+            if (method != bhttp::verb::get) return not_allowed("GET");
+            auto param = [&](const char* key) -> std::optional<std::string> {
+                auto it = t.query.find(key);
+                return it == t.query.end() ? std::nullopt : std::optional<std::string>(it->second);
+            };
+            return respond(result_response(req, member_access(*api_, device, principal, param("members"), param("device_user"))));
+        }
         if (seg.size() != 3 || (seg[1] != "properties" && seg[1] != "functions" && seg[1] != "wires"))
             return respond(error_response(req, api_error(404, MessageErrorType::ResourceNotFound,
-                                                         "no such resource (routes of a device: /definitions, "
+                                                         "no such resource (routes of a device: /definitions, /access, "
                                                          "/properties/NAME, /functions/NAME, /wires/NAME)")));
 
         MemberAddress address{device, {}, seg[2], principal};

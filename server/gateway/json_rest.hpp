@@ -5,11 +5,13 @@
 //   GET  /api/devices                               device list
 //   GET  /api/devices/{name}                        status + definitions + root members
 //   GET  /api/devices/{name}/definitions            definition texts
+//   GET  /api/devices/{name}/access                 what the caller's roles allow on each root member (json_access.hpp)
 //   GET  /api/devices/{name}/properties/{member}    {"value": …}
 //   PUT  /api/devices/{name}/properties/{member}    body {"value": …} → {}
 //   POST /api/devices/{name}/functions/{member}     body {"args": […] | {…}, "max_items"?: n} → {"return": …} | {"items": […]}
 //   GET  /api/devices/{name}/wires/{member}         {"value": …, "time": {…}}
-// Query parameters: `object` (relative service path of an object below the root), `max_items`.
+// Query parameters: `object` (relative service path of an object below the root), `max_items`;
+// /access takes `members` and `device_user`.
 // Request bodies are bounded by HttpOptions::max_body_bytes (413 beyond, by the HttpServer).
 #pragma once
 

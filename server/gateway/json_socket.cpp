@@ -10,6 +10,7 @@
 #include "core/value/timespec.hpp"
 #include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/binary_push.hpp"
+#include "server/gateway/json_access.hpp"
 #include "server/gateway/json_push.hpp"
 #include "server/gateway/json_socket_request.hpp"
 #include "server/gateway/json_subscriptions.hpp"
@@ -163,6 +164,9 @@ private:
     void act(const nlohmann::json& id, DeviceLogoutRequest r) { device_logout(id, r); }
     void act(const nlohmann::json& id, DevicesRequest) { send_reply(id, ApiResult::ok(api_->device_list())); }
     void act(const nlohmann::json& id, DeviceRequest r) { send_reply(id, api_->device_info(r.device)); }
+    void act(const nlohmann::json& id, AccessRequest r) {
+        send_reply(id, member_access(*api_, r.device, principal(), r.members, r.device_user));
+    }
     void act(const nlohmann::json& id, UnsubscribeRequest r) { unsubscribe(id, r.subscription); }
     void act(const nlohmann::json& id, SetOutValueRequest r) { set_out_value(id, r.subscription, r.value); }
     void act(const nlohmann::json& id, SendRequest r) { send_packet(id, r.subscription, r.value, r.request_ack); }

@@ -68,6 +68,27 @@ Parsed parse_device(const Json& msg) {
     return DeviceRequest{*d};
 }
 
+Parsed parse_access(const Json& msg) {
+    const auto* d = request_string(msg, "device");
+    if (!d) return bad_request("\"device\" (string) is required");
+    AccessRequest r{*d, std::nullopt, std::nullopt};
+    if (auto m = msg.find("members"); m != msg.end() && !m->is_null()) {
+        if (!m->is_array()) return bad_request("\"members\" must be an array of member names");
+        std::string joined;
+        for (const auto& name : *m) {
+            if (!name.is_string()) return bad_request("\"members\" must be an array of member names");
+            if (!joined.empty() || &name != &m->front()) joined += ',';
+            joined += name.get<std::string>();
+        }
+        r.members = std::move(joined);
+    }
+    if (auto u = msg.find("device_user"); u != msg.end() && !u->is_null()) {
+        if (!u->is_string()) return bad_request("\"device_user\" must be a string");
+        r.device_user = u->get<std::string>();
+    }
+    return r;
+}
+
 Parsed parse_unsubscribe(const Json& msg) {
     UnsubscribeRequest r;
     if (auto e = parse_subscription_id(msg, r.subscription)) return *e;
@@ -131,12 +152,13 @@ struct OpEntry {
 };
 
 // "login" first: without gateway users the table starts after it.
-constexpr std::array<OpEntry, 13> kOps{{
+constexpr std::array<OpEntry, 14> kOps{{
     {"login", parse_login},
     {"device_login", parse_device_login},
     {"device_logout", parse_device_logout},
     {"devices", parse_devices},
     {"device", parse_device},
+    {"access", parse_access},
     {"get", parse_member<MemberOp::get>},
     {"set", parse_member<MemberOp::set>},
     {"call", parse_member<MemberOp::call>},

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -53,6 +54,13 @@ struct DevicesRequest {};
 struct DeviceRequest {
     std::string device;
 };
+/// {"op": "access", "device", "members"?: [names], "device_user"?}: GET /api/devices/{name}/access on the
+/// socket (json_access.hpp), for the socket's gateway login. `members` arrives joined by commas (an
+/// empty list or name stays an error there).
+struct AccessRequest {
+    std::string device;
+    std::optional<std::string> members, device_user;
+};
 /// {"op": "unsubscribe", "subscription"}.
 struct UnsubscribeRequest {
     std::uint64_t subscription = 0;
@@ -83,7 +91,7 @@ struct MemberRequest {
 };
 
 using SocketRequest = std::variant<LoginRequest, DeviceLoginRequest, DeviceLogoutRequest, DevicesRequest, DeviceRequest,
-                                   UnsubscribeRequest, SetOutValueRequest, SendRequest, MemberRequest>;
+                                   AccessRequest, UnsubscribeRequest, SetOutValueRequest, SendRequest, MemberRequest>;
 
 /// Checks the op's fields. `with_logins`: the gateway has users, so "login" is an op (without them it
 /// is unknown, as any other name outside the table). Errors: InvalidArgument (400) naming the missing

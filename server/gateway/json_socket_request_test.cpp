@@ -68,9 +68,9 @@ TEST_CASE("socket request: an envelope keeps the id, the op and the whole messag
 
 TEST_CASE("socket request: the op table") {
     auto ops = socket_ops();
-    REQUIRE(ops.size() == 13);
+    REQUIRE(ops.size() == 14);
     CHECK(ops.front() == "login");
-    for (auto name : {"device_login", "device_logout", "devices", "device", "get", "set", "call", "peek", "subscribe",
+    for (auto name : {"device_login", "device_logout", "devices", "device", "access", "get", "set", "call", "peek", "subscribe",
                       "unsubscribe", "set_out_value", "send"})
         CHECK(std::find(ops.begin(), ops.end(), std::string_view(name)) != ops.end());
     // Every op in the table is known: a message without its fields is refused for a field, not the op.
@@ -112,6 +112,27 @@ TEST_CASE("socket request: device_login, device_logout, devices, device") {
     CHECK(std::holds_alternative<DevicesRequest>(request(json{{"id", 1}, {"op", "devices"}})));
     CHECK(std::get<DeviceRequest>(request(json{{"id", 1}, {"op", "device"}, {"device", "cam"}})).device == "cam");
     CHECK(error(json{{"id", 1}, {"op", "device"}, {"device", 3}}).message == "\"device\" (string) is required");
+}
+
+TEST_CASE("socket request: access") {
+    auto all = std::get<AccessRequest>(request(json{{"id", 1}, {"op", "access"}, {"device", "arm"}}));
+    CHECK(all.device == "arm");
+    CHECK_FALSE(all.members);
+    CHECK_FALSE(all.device_user);
+    auto some = std::get<AccessRequest>(
+        request(json{{"id", 1}, {"op", "access"}, {"device", "arm"}, {"members", {"jog", "halt"}}, {"device_user", "ann"}}));
+    CHECK(some.members == std::optional<std::string>("jog,halt"));
+    CHECK(some.device_user == std::optional<std::string>("ann"));
+    // Empty names stay visible as empty entries (member_access refuses them).
+    CHECK(std::get<AccessRequest>(request(json{{"id", 1}, {"op", "access"}, {"device", "a"}, {"members", json::array()}})).members ==
+          std::optional<std::string>(""));
+    CHECK(std::get<AccessRequest>(request(json{{"id", 1}, {"op", "access"}, {"device", "a"}, {"members", {"", "x"}}})).members ==
+          std::optional<std::string>(",x"));
+    CHECK(error(json{{"id", 1}, {"op", "access"}}).message == "\"device\" (string) is required");
+    CHECK(error(json{{"id", 1}, {"op", "access"}, {"device", "a"}, {"members", "jog"}}).message ==
+          "\"members\" must be an array of member names");
+    CHECK(error(json{{"id", 1}, {"op", "access"}, {"device", "a"}, {"members", {1}}}).status == 400);
+    CHECK(error(json{{"id", 1}, {"op", "access"}, {"device", "a"}, {"device_user", 5}}).message == "\"device_user\" must be a string");
 }
 
 TEST_CASE("socket request: member operations") {
