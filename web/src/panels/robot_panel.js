@@ -88,7 +88,8 @@ export function createRobotPanel(parent, ctx) {
     send: (c) => (c.kind === "joint" ? obj.jog_joint(c.velocity, JOG_TIMEOUT_S, false) : obj.jog_cartesian(c.velocity, JOG_TIMEOUT_S, false)),
     onError: (e, c) => { if (!disposed) showError(`${c.kind === "joint" ? "jog_joint" : "jog_cartesian"}: ${errorText(e)}`); },
     onStop: (reason) => {
-      if (reason !== "replaced") releaseLock();
+      if (reason === "replaced") return;  // another control took over the hold
+      releaseLock();
       el.dataset.jog = "off";
       el.dataset.jogStop = reason;
       for (const b of el.querySelectorAll("button.held")) b.classList.remove("held");
@@ -149,17 +150,18 @@ export function createRobotPanel(parent, ctx) {
   el.addEventListener("focusout", (ev) => { if (heldKey && !el.contains(ev.relatedTarget)) release("blur"); });
 
   const jogEnabled = () => canJog() && !!state && !isStale(lastStateMs, Date.now()) && modeText(modeEnum, state.command_mode) === "jog";
-  const jogButtons = [];
-  function jogButton(label, dataset, makeCommand) {
+  // the jog buttons now on the page: the Cartesian ones and the joint table's (rebuilt with the table)
+  const cartButtons = [], tableButtons = [];
+  function jogButton(list, label, dataset, makeCommand) {
     const b = h("button", { type: "button", class: "small jog", text: label, dataset });
-    cleanups.push(holdButton(b, () => press(makeCommand), release));
-    jogButtons.push(b);
+    holdButton(b, () => press(makeCommand), release);  // the listeners go with the button
+    list.push(b);
     return b;
   }
   function refreshJogEnabled() {
     const on = jogEnabled();
     const why = on ? "" : !state ? "no robot state" : isStale(lastStateMs, Date.now()) ? "robot state is stale" : "set the command mode to jog";
-    for (const b of jogButtons) { b.disabled = !on; b.title = why; }
+    for (const b of [...cartButtons, ...tableButtons]) { b.disabled = !on; b.title = why; }
     if (!on && repeater.active) release("not jogging");
   }
 
@@ -211,7 +213,7 @@ export function createRobotPanel(parent, ctx) {
   }
 
   function buildJog() {
-    jogButtons.length = 0;
+    cartButtons.length = 0;
     const jog = canJog() && model.length > 0;
     jogBox.hidden = lockBox.hidden = !jog;
     if (jog) {
@@ -221,7 +223,7 @@ export function createRobotPanel(parent, ctx) {
     const cart = jog && caps.has("jog_command") && may("jog_cartesian");
     cartBox.hidden = !cart;
     cartBox.replaceChildren(...(cart ? [h("span", { class: "state-label", text: "Cartesian jog" }),
-      ...CARTESIAN_AXES.flatMap((a) => [-1, 1].map((d) => jogButton(`${a.label}${d > 0 ? "+" : "−"}`, { axis: a.id, dir: String(d) },
+      ...CARTESIAN_AXES.flatMap((a) => [-1, 1].map((d) => jogButton(cartButtons, `${a.label}${d > 0 ? "+" : "−"}`, { axis: a.id, dir: String(d) },
         () => ({ kind: "cartesian", velocity: cartesianVelocity(a.id, d, Number(speed.value)) }))))] : []));
     buildMoveForm(jog && may("jog_freespace"));
     renderJoints(true);
@@ -259,20 +261,20 @@ export function createRobotPanel(parent, ctx) {
   }
 
   // ---- the state ----
-  const jogCells = [];
   function renderJoints(rebuild) {
     const rows = jointRows(state ?? { joint_position: new Float64Array(model.length) }, model);
     const jog = !jogBox.hidden;
     if (rebuild || joints.tBodies[0]?.rows.length !== rows.length) {
-      jogCells.length = 0;
+      if (tableButtons.some((b) => b.classList.contains("held"))) release("table rebuilt");
+      tableButtons.length = 0;
       joints.replaceChildren(
         h("thead", {}, h("tr", {}, ...["joint", "position", "limits", "velocity", "effort", jog ? "jog" : ""].map((t) => h("th", { text: t })))),
         h("tbody", {}, ...rows.map((r, i) => h("tr", { dataset: { joint: r.name } },
           h("td", { class: "joint-name", text: r.name }), h("td", { class: "joint-position" }),
           h("td", { class: "joint-limits" }, h("span", { class: "limit-bar" }, h("span", { class: "limit-mark" }))),
           h("td", { class: "joint-velocity" }), h("td", { class: "joint-effort" }),
-          h("td", { class: "joint-jog" }, ...(jog ? [jogButton("−", { joint: r.name, dir: "-1" }, jointCommand(i, -1)),
-            jogButton("+", { joint: r.name, dir: "1" }, jointCommand(i, 1))] : []))))));
+          h("td", { class: "joint-jog" }, ...(jog ? [jogButton(tableButtons, "−", { joint: r.name, dir: "-1" }, jointCommand(i, -1)),
+            jogButton(tableButtons, "+", { joint: r.name, dir: "1" }, jointCommand(i, 1))] : []))))));
     }
     if (!state) return;
     Array.from(joints.tBodies[0].rows).forEach((tr, i) => {
