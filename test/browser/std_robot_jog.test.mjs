@@ -116,11 +116,11 @@ async function loggedInPage(user, password, base = gateway.base) {
   await page.click("#login-submit");
   await page.waitForURL((u) => !/login\.html/.test(String(u)), { timeout: 20000 });
   await page.goto(`${base}/#/robot`);
-  await panel(page).waitFor({ timeout: 30000 }).catch(async (e) => {
+  await panel(page).waitFor({ timeout: 60000 }).catch(async (e) => {
     const text = await page.locator("body").innerText().catch(() => "");
     throw new Error(`${e.message}\npage ${page.url()}: ${text.slice(0, 1500)}`);
   });
-  await waitFor(async () => (await panel(page).getAttribute("data-ready")) === "true", "robot panel ready", 20000);
+  await waitFor(async () => (await panel(page).getAttribute("data-ready")) === "true", "robot panel ready", 40000);
   return page;
 }
 
