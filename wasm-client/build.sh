@@ -41,5 +41,10 @@ mkdir -p "$dist/dashboard/std"
 for f in rr_types.js value_codec.js robdef_outline.js; do copy_if_changed "$web/$f" "$dist/dashboard/$f"; done
 for f in "$web"/std/*.js "$web"/std/index.d.ts; do copy_if_changed "$f" "$dist/dashboard/std/$(basename "$f")"; done
 for f in "$dist"/dashboard/std/*.js; do [ -f "$web/std/$(basename "$f")" ] || rm -f "$f"; done
+# The robot modules (web/src/robot: forward kinematics, the three.js view, ...), the whole folder with
+# its declarations: import { ... } from "robotraconteur-wasm/robot/kinematics.js" (dashboard/robot/).
+mkdir -p "$dist/dashboard/robot"
+for f in "$web"/robot/*.js "$web"/robot/*.d.ts; do [ -f "$f" ] && copy_if_changed "$f" "$dist/dashboard/robot/$(basename "$f")"; done
+for f in "$dist"/dashboard/robot/*; do [ -f "$web/robot/$(basename "$f")" ] || rm -f "$f"; done
 copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
 echo "wasm-client: package in $dist"

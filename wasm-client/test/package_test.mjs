@@ -57,14 +57,26 @@ try {
   ].join("\n"));
   const std = run(process.execPath, [path.join(app, "std_check.mjs")], { cwd: app });
   ok(/std: ok/.test(std), `import from "robotraconteur-wasm/std" (standard types): ${std.trim()}`);
+  // the robot modules (web/src/robot) import from "robotraconteur-wasm/robot/<module>.js"; kinematics runs in node
+  fs.writeFileSync(path.join(app, "robot_check.mjs"), [
+    'import { chainModel, forwardKinematics } from "robotraconteur-wasm/robot/kinematics.js";',
+    'const info = { joint_info: [{ joint_type: 1 }, { joint_type: 3 }], chains: [{ H: [{ x: 0, y: 0, z: 1 }, { x: 1, y: 0, z: 0 }],',
+    '  P: [{ x: 0, y: 0, z: 0.5 }, { x: 0.3, y: 0, z: 0 }, { x: 0, y: 0, z: 0 }], joint_numbers: Uint32Array.of(0, 1) }] };',
+    'const { position: p } = forwardKinematics(chainModel(info), [Math.PI / 2, 0.2]).tcp;',
+    'console.log(Math.abs(p.x) < 1e-12 && Math.abs(p.y - 0.5) < 1e-12 && Math.abs(p.z - 0.5) < 1e-12 ? "robot: ok" : `robot: wrong ${JSON.stringify(p)}`);',
+  ].join("\n"));
+  const robotOut = run(process.execPath, [path.join(app, "robot_check.mjs")], { cwd: app });
+  ok(/robot: ok/.test(robotOut), `import from "robotraconteur-wasm/robot/kinematics.js" (forward kinematics): ${robotOut.trim()}`);
+  ok(fs.existsSync(path.join(installed, "dashboard/robot/view3d.js")) && fs.existsSync(path.join(installed, "dashboard/robot/view3d.d.ts")),
+    "the package holds dashboard/robot/view3d.js and its declarations");
   // ws (the optional peer dependency for node) from this folder's node_modules
   fs.symlinkSync(path.join(pkgRoot, "node_modules/ws"), path.join(app, "node_modules/ws"), "dir");
 
-  for (const f of ["usage.ts", "std_usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
+  for (const f of ["usage.ts", "std_usage.ts", "robot_usage.ts", "misuse.ts", "ws.d.ts", "tsconfig.json"]) fs.copyFileSync(path.join(here, "typecheck", f), path.join(app, f));
   // tsc --noEmit: usage.ts is accepted
   try {
     run(process.execPath, [tsc, "--noEmit", "-p", app]);
-    ok(true, "tsc --noEmit (strict): usage.ts and std_usage.ts type-check against index.d.ts and std/index.d.ts");
+    ok(true, "tsc --noEmit (strict): usage.ts, std_usage.ts and robot_usage.ts type-check against index.d.ts, std/index.d.ts and robot/*.d.ts");
   } catch (e) {
     ok(false, `tsc --noEmit usage.ts:\n${e.stdout}${e.stderr}`);
   }

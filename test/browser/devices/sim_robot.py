@@ -9,13 +9,18 @@ positions, the tool pose by forward kinematics of the chain in the RobotInfo, an
 commands from the base class (jog, position commands) move the joints toward their targets at the
 joint's velocity limit. It starts disabled; enable() (or --enabled) switches the motors on.
 
+--joints-stdin (for tests): each line on stdin, a JSON list of joint positions, puts the joints there
+at once (motors on or off), cancelling any motion; the next loop step reports them and their tool pose.
+
 Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=robot", "port": P, "device_uuid": "...",
 "joint_names": [...]}.
 
-Usage: sim_robot.py [--info FILE] [--enabled] [--start-position Q0,Q1,...] [--period 0.02] [--max-lifetime 300]
+Usage: sim_robot.py [--info FILE] [--enabled] [--start-position Q0,Q1,...] [--joints-stdin] [--period 0.02]
+                    [--max-lifetime 300]
 """
 
 import argparse
+import json
 import os
 import sys
 import threading
@@ -80,6 +85,15 @@ class SimArm(AbstractRobot):
             self._last_endpoint_state = now
         super()._run_timestep(now)
 
+    def teleport(self, q):
+        """Puts the joints at q at once (a test's shortcut; no velocity limits)."""
+        q = np.array(q, dtype=np.float64)
+        if q.shape != (self._joint_count,):
+            raise ValueError(f"{self._joint_count} joint positions expected, got {q.shape}")
+        with self._sim_lock:
+            self._q = q
+            self._q_target = None
+
     def _send_robot_command(self, now, joint_pos_cmd, joint_vel_cmd):
         if joint_pos_cmd is not None:
             with self._sim_lock:
@@ -99,6 +113,17 @@ class SimArm(AbstractRobot):
         handler(None)
 
 
+def teleport_from_stdin(robot):
+    """--joints-stdin: every line a JSON list of joint positions; a bad line is logged and skipped."""
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        try:
+            robot.teleport(json.loads(line))
+        except (ValueError, TypeError) as e:
+            log("robot", f"--joints-stdin: {e}: {line.strip()[:200]}")
+
+
 def main():
     die_with_parent()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -106,6 +131,8 @@ def main():
     ap.add_argument("--enabled", action="store_true", help="motors on from the start")
     ap.add_argument("--start-position", type=lambda t: [float(x) for x in t.split(",")], default=None,
                     help="joint positions to start at (joint units, comma-separated; default all 0)")
+    ap.add_argument("--joints-stdin", action="store_true",
+                    help="each stdin line, a JSON list of joint positions, puts the joints there at once")
     ap.add_argument("--period", type=float, default=0.02, help="loop period in seconds")
     ap.add_argument("--max-lifetime", type=float, default=300)
     args = ap.parse_args()
@@ -121,6 +148,8 @@ def main():
         device_uuid = str(uuid.UUID(bytes=bytes(robot_info.device_info.device.uuid["uuid_bytes"].tobytes())))
         ready(url=f"rr+tcp://127.0.0.1:{port}/?service=robot", port=port, device_uuid=device_uuid,
               joint_names=list(robot._joint_names), pid=os.getpid())
+        if args.joints_stdin:
+            threading.Thread(target=teleport_from_stdin, args=(robot,), daemon=True).start()
         wait_for_stop(args.max_lifetime)
         log("robot", "stopping")
         robot._close()

@@ -23,6 +23,7 @@ import { holdButton, jogKey, jogKeysText } from "../robot/hold.js";
 import { CARTESIAN_AXES, cartesianVelocity } from "../robot/cartesian.js";
 import { locksText } from "../robot/lock_text.js";
 import { formatFlags } from "../std/enums.js";
+import { mountRobot3d } from "./robot_3d.js";
 
 export const ROBOT = "com.robotraconteur.robotics.robot.Robot";
 const RR_ROBOT = "com.robotraconteur.robotics.robot";
@@ -51,14 +52,14 @@ export function createRobotPanel(parent, ctx) {
   const errorsBox = h("ul", { class: "robot-current-errors", hidden: true });
   const controls = h("div", { class: "camera-controls robot-controls" });
   const lockBox = h("div", { class: "robot-lock", hidden: true });
-  const view3d = h("div", { class: "robot-view3d" });  // the 3D view mounts here (robot/view3d.js)
+  const view3dBox = h("div", { class: "robot-view3d-box" });  // the 3D view mounts here (panels/robot_3d.js)
   const joints = h("table", { class: "robot-joints" });
   const jogBox = h("div", { class: "robot-jog", hidden: true });
   const cartBox = h("div", { class: "robot-cartesian", hidden: true });
   const moveForm = h("form", { class: "robot-move", hidden: true });
   const poses = h("div", { class: "robot-tcp" });
   const el = h("section", { class: "panel robot-panel", tabindex: "0", dataset: { panel: "robot", jog: "off" } },
-    h("h3", {}, "Robot ", staleBadge), controls, lockBox, error, summary, errorsBox, view3d, jogBox, joints, cartBox, moveForm, poses);
+    h("h3", {}, "Robot ", staleBadge), controls, lockBox, error, summary, errorsBox, view3dBox, jogBox, joints, cartBox, moveForm, poses);
   parent.append(el);
 
   // ---- what the user may do: the gateway's answer and the robot's capabilities ----
@@ -391,6 +392,10 @@ export function createRobotPanel(parent, ctx) {
   });
   renderJoints(true);
 
+  // ---- 3D view of the robot from its robot_info (web/src/panels/robot_3d.js, web/src/robot/view3d.js) ----
+  const view3d = mountRobot3d(view3dBox, obj, { infoMember: find("robot_info", "property"), stateMember });
+  // ---- end of the 3D view ----
+
   return {
     el,
     /** Ends any hold now (for tests and the page). */
@@ -398,6 +403,7 @@ export function createRobotPanel(parent, ctx) {
     dispose() {
       disposed = true;
       release("dispose");
+      view3d.dispose();
       if (frame) cancelAnimationFrame(frame);
       follow?.dispose();
       for (const c of cleanups) c();
