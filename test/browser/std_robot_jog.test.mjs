@@ -17,15 +17,13 @@
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
-import crypto from "node:crypto";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { settings, startGateway, launchChromium, waitFor, startProcess, TcpRelay } from "./harness.mjs";
+import { settings, writeOperatorViewerConfig, startGateway, launchChromium, waitFor, startProcess, TcpRelay } from "./harness.mjs";
 import { startDevice, screenshot, DEVICES } from "./std_support.mjs";
 
 const s = settings();
-const md5 = (t) => crypto.createHash("md5").update(t).digest("hex");
 const WRIST_START = 2.9;   // limits ±3: within 5 % (0.3) of the upper limit
 const STOP_BOUND_S = 0.5;  // what the brief asks of every way a hold can end
 const EPS = 1e-6;
@@ -44,25 +42,11 @@ before(async () => {
       if (Array.isArray(v.q)) samples.push(v);
     } catch { /* not a sample */ }
   });
-  const users = path.join(tmp, "users.txt");
-  fs.writeFileSync(users, `alice ${md5("alice-pw")} operator,objectlock\nbob ${md5("bob-pw")} viewer\n`, { mode: 0o600 });
-  const config = path.join(tmp, "gateway.yaml");
-  fs.writeFileSync(config, [
-    "gateway:",
-    "  auth:",
-    `    users: ${users}`,
-    "    roles:",
-    "      operator:",
-    "        - allow: [read, write, call]",
-    "      viewer:",
-    "        - devices: \"*\"",
-    "          members: \"*\"",
-    "          allow: [read]",
+  const config = writeOperatorViewerConfig(tmp, [
     "devices:",
     "  - name: robot",
     `    url: ${robot.info.url}`,
-    "",
-  ].join("\n"));
+  ]);
   gateway = await startGateway(s, {}, 0, ["--config", config, "--no-demo", "--no-discovery"]);
   const cookie = await apiLogin("alice", "alice-pw");
   await waitFor(async () => {
