@@ -37,7 +37,7 @@ const settle = () => new Promise((r) => setImmediate(r));
 
 test("jog timer: a call at once and one per 50 ms while held, none after release", async () => {
   assert.equal(JOG_PERIOD_MS, 50);
-  assert.equal(JOG_TIMEOUT_S, 0.2);
+  assert.equal(JOG_TIMEOUT_S, 0.15);
   const timers = fakeTimers();
   const calls = [];
   const stops = [];

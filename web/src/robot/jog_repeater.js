@@ -1,18 +1,18 @@
 // Hold-to-jog: while a jog control is held, the same jog call is sent at once and then every 50 ms,
-// each with a short timeout (0.2 s) after which the robot stops by itself. Stopping is simply not
+// each with a short timeout (0.15 s) after which the robot stops by itself. Stopping is simply not
 // sending: whatever ends the hold (release, a lost page, network or gateway), the robot stops within
 // the timeout. Calls never pile up: while one is still outstanding, a tick is skipped. A refused or
 // failed call ends the hold and is reported. No DOM here, so the timing is tested with fake timers.
 
 /** Seconds the robot keeps jogging after the last call (the robdef's `timeout` argument). */
-export const JOG_TIMEOUT_S = 0.2;
+export const JOG_TIMEOUT_S = 0.15;
 /** Milliseconds between two jog calls while a control is held. */
 export const JOG_PERIOD_MS = 50;
 
 export class JogRepeater {
   /**
    * @param {object} options
-   * @param {(command: any) => Promise<unknown>} options.send  makes one jog call (e.g. jog_joint(v, 0.2, false))
+   * @param {(command: any) => Promise<unknown>} options.send  makes one jog call (e.g. jog_joint(v, 0.15, false))
    * @param {(error: unknown, command: any) => void} [options.onError]  a call failed: the hold has ended
    * @param {(reason: string) => void} [options.onStop]  the hold ended ("release", "error", "blur", ...)
    * @param {number} [options.periodMs]  JOG_PERIOD_MS unless a test says otherwise
