@@ -265,16 +265,23 @@ test("a viewer sees no moving control; its page's jog_joint is refused and the r
 test("killing the page's connection (a TCP relay) while a button is held stops the robot within 0.5 s", async () => {
   const relay = new TcpRelay(gateway.port);
   await relay.listen();
-  const page = await loggedInPage("alice", "alice-pw", `http://127.0.0.1:${relay.port}`);
-  await holdDown(page, "shoulder", "1");
-  await sleep(500);
-  const killed = Date.now() / 1000;
-  await relay.drop();
-  await assertStopsAfter(0, killed, STOP_BOUND_S, "connection killed");
-  // the page noticed: the hold ended
-  await waitFor(async () => (await panel(page).count()) === 0 || (await panel(page).getAttribute("data-jog")) === "off", "the page's hold ended", 5000);
-  await page.mouse.up();
-  await page.context().close();
+  let page = null, dropped = false;
+  try {
+    page = await loggedInPage("alice", "alice-pw", `http://127.0.0.1:${relay.port}`);
+    await holdDown(page, "shoulder", "1");
+    await sleep(500);
+    const killed = Date.now() / 1000;
+    await relay.drop();
+    dropped = true;
+    await assertStopsAfter(0, killed, STOP_BOUND_S, "connection killed");
+    // the page noticed: the hold ended
+    await waitFor(async () => (await panel(page).count()) === 0 || (await panel(page).getAttribute("data-jog")) === "off", "the page's hold ended", 5000);
+    await page.mouse.up();
+  } finally {
+    // a failure above must not leave the relay listening or the page connected: node would not exit
+    if (!dropped) await relay.drop();
+    await page?.context().close();
+  }
 });
 
 test("stopping the gateway while a button is held stops the robot within 0.5 s", async () => {
