@@ -109,7 +109,6 @@ export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = 
   return { child, port, base: `http://127.0.0.1:${port}` };
 }
 
-/** Polls `fn` until it returns a truthy value; rejects with `what` after timeoutMs. */
 /**
  * Writes a gateway configuration with logins into folder `dir`: users alice (password alice-pw, role
  * operator: read, write and call everything, and objectlock) and bob (bob-pw, role viewer: read only),
@@ -137,6 +136,7 @@ export function writeOperatorViewerConfig(dir, rest) {
   return config;
 }
 
+/** Polls `fn` until it returns a truthy value; rejects with `what` after timeoutMs. */
 export async function waitFor(fn, what, timeoutMs = 20000, everyMs = 100) {
   const deadline = Date.now() + timeoutMs;
   let last;

@@ -6,21 +6,25 @@
 //
 // Checked: the status chips and joint table match what the driver sends, the wrist warns near its
 // limit; holding a joint's jog button for 1 s moves that joint only and releasing stops it within
-// the jog timeout; a keyboard shortcut jogs while the panel has focus; closing the tab, killing the
-// page's TCP connection (a relay between browser and gateway) and stopping the gateway while a button
-// is held each stop the robot within 0.5 s; a viewer sees no moving control, and a jog_joint call
-// from its page is refused by the gateway (PermissionDenied) and the robot does not move.
+// the jog timeout; a keyboard shortcut jogs while the panel has focus; the lock offer takes the
+// device's object lock for the hold (the holder shown) and lets it go after; "move to" (jog_freespace)
+// puts the joints where the form says; the sim has no jog_cartesian (NotImplementedError), so its
+// Cartesian buttons go after the first press without motion; closing the tab, killing the page's TCP
+// connection (a relay between browser and gateway) and stopping the gateway while a button is held
+// each stop the robot within 0.5 s; a viewer sees no moving control (no jog, Enable, Disable, Reset
+// errors, Halt, mode switch, lock offer or move form), and a jog_joint call from its page is refused
+// by the gateway (PermissionDenied) and the robot does not move. The controls come from the gateway's
+// access endpoint (GET api/devices/<device>/access), not from a stub.
 //
-// The gateway's access endpoint (GET api/devices/<device>/access) is built on another branch: when
-// this gateway answers it with 404, the page gets the answer the endpoint would give for the role
-// (a stub route, reported in the test's output); the gateway still checks every call itself.
+// No failure can hang the file: every wait has a deadline, and each scenario closes what it opened
+// in a finally (after() again, each step bounded).
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { settings, writeOperatorViewerConfig, startGateway, launchChromium, waitFor, startProcess, TcpRelay } from "./harness.mjs";
+import { settings, writeOperatorViewerConfig, startGateway, launchChromium, waitFor, startProcess, TcpRelay, webRequire, CHROMIUM_ARGS } from "./harness.mjs";
 import { startDevice, screenshot, DEVICES } from "./std_support.mjs";
 
 const s = settings();
@@ -30,7 +34,8 @@ const EPS = 1e-6;
 let tmp, robot, probe, gateway, browser, operator, members;
 const samples = [];        // {t (s, wall clock), q: [..]} from the official client
 const pageErrors = [];
-let stubbed = false;
+const consoleLines = [];   // the pages' console errors and warnings, shown when a hold does not start
+const relays = [];         // TcpRelays to drop in after() should a scenario fail before its own finally
 
 before(async () => {
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), "rr-web-jog-"));
@@ -62,10 +67,14 @@ before(async () => {
 });
 
 after(async () => {
-  await browser?.close();
-  await gateway?.child.stop();
-  await probe?.child.stop();
-  await robot?.child.stop();
+  // each step bounded: a browser or process that does not close must not keep node (and ctest) waiting
+  const bounded = (what, p, ms = 15000) => Promise.race([Promise.resolve(p).catch((e) => console.log(`# after: ${what}: ${e.message}`)),
+    sleep(ms).then(() => console.log(`# after: ${what} still not done after ${ms} ms`))]);
+  for (const r of relays) await bounded("relay drop", r.drop());
+  await bounded("browser close", browser?.close());
+  await bounded("gateway stop", gateway?.child.stop());
+  await bounded("probe stop", probe?.child.stop());
+  await bounded("robot stop", robot?.child.stop());
   if (tmp) fs.rmSync(tmp, { recursive: true, force: true });
 });
 
@@ -76,23 +85,12 @@ async function apiLogin(user, password) {
   return r.headers.get("set-cookie").split(";")[0];
 }
 
-/** The access answer the endpoint gives `role` (used only when the gateway has no such endpoint). */
-function stubAccess(user) {
-  const ops = user === "alice" ? ["read", "write", "call"] : ["read"];
-  return { device: "robot", auth: true, user, members: Object.fromEntries(members.map((m) => [m, ops])) };
-}
-
-/** A new browser context logged in as `user` at `base`, on the robot's page; resolves the page. */
-async function loggedInPage(user, password, base = gateway.base) {
-  const context = await browser.newContext({ viewport: { width: 1366, height: 1100 } });
-  await context.route("**/api/devices/*/access*", async (route) => {
-    const r = await route.fetch();
-    if (r.status() !== 404) return route.fulfill({ response: r });
-    if (!stubbed) { stubbed = true; console.log("# note: the gateway has no access endpoint (404): stub answers by role"); }
-    return route.fulfill({ status: 200, contentType: "application/json", body: JSON.stringify(stubAccess(user)) });
-  });
+/** A new browser context (of `inBrowser`) logged in as `user` at `base`, on the robot's page; resolves the page. */
+async function loggedInPage(user, password, base = gateway.base, inBrowser = browser) {
+  const context = await inBrowser.newContext({ viewport: { width: 1366, height: 1100 } });
   const page = await context.newPage();
   page.on("pageerror", (e) => pageErrors.push(String(e)));
+  page.on("console", (m) => { if (m.type() === "error" || m.type() === "warning") consoleLines.push(`${user}: ${m.type()}: ${m.text()}`); });
   await page.goto(`${base}/#/robot`);
   await page.waitForURL(/\/login\.html/, { timeout: 20000 });
   await page.fill("#login-username", user);
@@ -146,13 +144,28 @@ async function holdEnd(page) {
   return why === "release" || why === "keyup" ? why : `${why}: ${err}`;
 }
 
-/** Presses the mouse on a jog button and keeps it down. */
+/**
+ * Presses the mouse on a jog button and keeps it down; resolves once the page's hold has started and
+ * is still on. A hold that does not start, or ends at once, fails with what the pointer pressed, the
+ * hold's end reason and the pages' console errors.
+ */
 async function holdDown(page, joint, dir) {
   const b = jogButton(page, joint, dir);
   await waitFor(async () => !(await b.isDisabled()), `jog ${joint} ${dir} enabled`, 15000);
-  await b.hover();
+  const holds = Number((await panel(page).getAttribute("data-jog-holds")) ?? 0);
+  await b.hover({ timeout: 10000 });
   await page.mouse.down();
-  await waitFor(async () => (await panel(page).getAttribute("data-jog")) === "on", "jogging", 5000);
+  try {
+    await waitFor(async () => Number((await panel(page).getAttribute("data-jog-holds")) ?? 0) > holds, "a hold started", 5000, 20);
+    assert.equal(await panel(page).getAttribute("data-jog"), "on", "the hold ended at once");
+  } catch (e) {
+    const pressed = await page.evaluate(() => {
+      const el = document.querySelector("button.jog.held") ?? document.activeElement;
+      return el ? `${el.tagName.toLowerCase()}.${[...el.classList].join(".")} ${JSON.stringify({ ...el.dataset })}` : "nothing";
+    }).catch((x) => `(page: ${x.message})`);
+    await page.mouse.up().catch(() => {});
+    throw new Error(`jog ${joint} ${dir}: ${e.message}; held/focused: ${pressed}; hold end: ${await holdEnd(page).catch(() => "?")}; console: ${consoleLines.slice(-5).join(" | ") || "none"}`);
+  }
 }
 
 test("status chips and joint table match the driver; the wrist warns near its upper limit", async () => {
@@ -220,6 +233,70 @@ test("keyboard: S held while the panel has focus jogs the elbow −, keyup stops
   assert.ok(Math.abs(after[0] - before[0]) < EPS, "the shoulder stayed");
 });
 
+test("lock offer: a hold takes the device's lock (holder shown on the panel and by the gateway) and lets it go after", async () => {
+  const p = panel(operator);
+  const lockCheck = p.locator('input[name="jog-lock"]');
+  const cookie = await apiLogin("alice", "alice-pw");
+  const gatewayLocks = async () => {
+    const r = await fetch(`${gateway.base}/api/devices/robot`, { headers: { cookie } });
+    return r.ok ? (await r.json()).locks ?? [] : [];
+  };
+  assert.equal(await p.getAttribute("data-locks"), "");
+  await lockCheck.check();
+  try {
+    await holdDown(operator, "shoulder", "-1");
+    await waitFor(async () => /by alice$/.test((await p.getAttribute("data-locks")) ?? ""), "the panel shows alice holding the lock", 5000);
+    assert.match(await p.locator(".robot-lock-holder").textContent(), /lock on .* by alice\)$/);
+    assert.ok((await gatewayLocks()).some((l) => l.user === "alice"), JSON.stringify(await gatewayLocks()));
+    await sleep(300);
+    await operator.mouse.up();
+    assert.equal(await holdEnd(operator), "release");
+    await waitFor(async () => (await gatewayLocks()).length === 0, "the gateway reports the lock released", 5000);
+    await waitFor(async () => (await p.getAttribute("data-locks")) === "", "the panel shows no lock", 5000);
+  } finally {
+    await operator.mouse.up().catch(() => {});
+    await lockCheck.uncheck();
+  }
+});
+
+test("move to: the form's joint values (degrees) reach the robot through jog_freespace", async () => {
+  const p = panel(operator);
+  const form = p.locator("form.robot-move");
+  await form.locator("button", { hasText: "Current" }).click();
+  const wristDeg = Number(await form.locator('input[name="wrist"]').inputValue());
+  assert.ok(Math.abs(wristDeg - latest().q[2] * 180 / Math.PI) < 1e-3, `Current filled ${wristDeg}° for ${latest().q[2]} rad`);
+  await form.locator('input[name="shoulder"]').fill("10");
+  await form.locator('input[name="elbow"]').fill("-5");
+  await form.locator('input[name="max-velocity"]').fill("50");
+  await form.locator('button[data-action="jog_freespace"]').click();
+  const target = [10 * Math.PI / 180, -5 * Math.PI / 180, wristDeg * Math.PI / 180];
+  await waitFor(async () => latest().q.every((x, i) => Math.abs(x - target[i]) < 1e-3), `the robot at ${target} (now ${latest().q})`, 15000);
+  assert.equal(await p.locator(".robot-error").isHidden(), true, await p.locator(".robot-error").textContent());
+});
+
+test("Cartesian jog: the sim's driver has no jog_cartesian, so the first press removes the buttons and nothing moves", async () => {
+  const p = panel(operator);
+  const box = p.locator(".robot-cartesian");
+  assert.equal(await box.getAttribute("data-missing"), "false");
+  assert.equal(await box.locator("button.jog").count(), 12);
+  const q0 = latest().q;
+  const from = Date.now() / 1000;
+  await box.locator('button.jog[data-axis="x"][data-dir="1"]').hover();
+  await operator.mouse.down();
+  try {
+    await waitFor(async () => (await box.getAttribute("data-missing")) === "true", "the Cartesian box says the driver has none", 5000);
+  } finally {
+    await operator.mouse.up();
+  }
+  assert.equal(await box.locator("button").count(), 0);
+  assert.match(await box.textContent(), /does not implement jog_cartesian/);
+  assert.equal(await p.getAttribute("data-jog"), "off");
+  assert.equal(await p.locator(".robot-error").isHidden(), true, await p.locator(".robot-error").textContent());
+  await sleep(400);
+  assert.equal(lastMotion(0, from), null, "the robot moved");
+  assert.deepEqual(latest().q, q0);
+});
+
 test("closing the tab while a button is held stops the robot within 0.5 s", async () => {
   const page = await loggedInPage("alice", "alice-pw");
   await holdDown(page, "shoulder", "-1");
@@ -227,6 +304,25 @@ test("closing the tab while a button is held stops the robot within 0.5 s", asyn
   const closed = Date.now() / 1000;
   await page.close();
   await assertStopsAfter(0, closed, STOP_BOUND_S, "tab closed");
+});
+
+test("killing the browser (SIGKILL: no page event runs) while a button is held stops the robot within 0.5 s", async () => {
+  // a browser of its own, as a server: the test holds its process and kills it
+  const { chromium } = webRequire("playwright-core");
+  const server = await chromium.launchServer({ executablePath: "/usr/bin/chromium", headless: true, args: CHROMIUM_ARGS });
+  let killed = false;
+  try {
+    const own = await chromium.connect(server.wsEndpoint(), { timeout: 30000 });
+    const page = await loggedInPage("alice", "alice-pw", gateway.base, own);
+    await holdDown(page, "shoulder", "1");
+    await sleep(500);
+    const at = Date.now() / 1000;
+    server.process().kill("SIGKILL");
+    killed = true;
+    await assertStopsAfter(0, at, STOP_BOUND_S, "browser killed");
+  } finally {
+    if (!killed) await Promise.race([server.close(), sleep(15000)]);
+  }
 });
 
 test("a viewer sees no moving control; its page's jog_joint is refused and the robot does not move", async () => {
@@ -237,6 +333,14 @@ test("a viewer sees no moving control; its page's jog_joint is refused and the r
   await waitFor(async () => (await p.getAttribute("data-flags")) === "enabled | ready", "viewer sees the flags", 10000);
   for (const sel of ["button.jog", "button[data-action]", 'select[name="command-mode"]', "form.robot-move button"]) {
     assert.equal(await p.locator(sel).count(), 0, `a viewer sees ${sel}`);
+  }
+  // by name, the controls main's panel showed everyone before issue 42
+  for (const name of ["Enable", "Disable", "Reset errors", "Halt", "Set mode", "Move to"]) {
+    assert.equal(await p.getByRole("button", { name, exact: true }).count(), 0, `a viewer sees ${name}`);
+  }
+  // while the operator's page (same panel) has them all
+  for (const name of ["Enable", "Disable", "Reset errors", "Halt", "Set mode", "Move to"]) {
+    assert.equal(await panel(operator).getByRole("button", { name, exact: true }).count(), 1, `the operator lacks ${name}`);
   }
   assert.ok(await p.locator(".robot-jog").isHidden());
   assert.ok(await p.locator(".robot-lock").isHidden());
@@ -265,6 +369,7 @@ test("a viewer sees no moving control; its page's jog_joint is refused and the r
 test("killing the page's connection (a TCP relay) while a button is held stops the robot within 0.5 s", async () => {
   const relay = new TcpRelay(gateway.port);
   await relay.listen();
+  relays.push(relay);
   let page = null, dropped = false;
   try {
     page = await loggedInPage("alice", "alice-pw", `http://127.0.0.1:${relay.port}`);

@@ -9,7 +9,7 @@ import { jointModel, jointRows, limitState, jogVelocity, positionText, toDisplay
 import { flagChips, flagTone, modeText, isStale, capabilitySet, STALE_MS } from "../src/robot/status.js";
 import { accessUrl, fetchAccess, allows } from "../src/robot/access.js";
 import { jogKey, jogKeysText } from "../src/robot/hold.js";
-import { cartesianVelocity, CARTESIAN_LINEAR_MPS } from "../src/robot/cartesian.js";
+import { cartesianVelocity, isNotImplemented, CARTESIAN_LINEAR_MPS } from "../src/robot/cartesian.js";
 import { locksText } from "../src/robot/lock_text.js";
 
 /** Fake setInterval/clearInterval driven by advance(ms). */
@@ -191,6 +191,16 @@ test("Cartesian jog velocity: one axis of chain 0", () => {
   assert.deepEqual(v.get(0), { angular: { x: 0, y: 0, z: 0 }, linear: { x: 0, y: 0, z: -0.5 * CARTESIAN_LINEAR_MPS } });
   assert.equal(cartesianVelocity("rx", 1, 1).get(0).angular.x, 0.5);
   assert.throws(() => cartesianVelocity("w", 1, 1), /axis/);
+  assert.throws(() => cartesianVelocity("x", 0, 1), /direction/);
+  assert.throws(() => cartesianVelocity("x", 1, 0), /speed/);
+});
+
+test("Cartesian jog: only NotImplementedError says the driver has none (refusals and other errors do not)", () => {
+  assert.equal(isNotImplemented(Object.assign(new Error("x"), { errorName: "RobotRaconteur.NotImplementedError" })), true);
+  assert.equal(isNotImplemented(Object.assign(new Error("x"), { errorName: "RobotRaconteur.PermissionDenied" })), false);
+  assert.equal(isNotImplemented(Object.assign(new Error("x"), { errorName: "RobotRaconteur.InvalidOperation" })), false);
+  assert.equal(isNotImplemented(new Error("NotImplementedError")), false);
+  assert.equal(isNotImplemented(null), false);
 });
 
 const flagEnum = [{ name: "unknown", value: 0 }, { name: "error", value: 1 }, { name: "estop", value: 4 }, { name: "estop_released", value: 0x8000 },

@@ -20,7 +20,7 @@ import { jointModel, jointRows, jogVelocity, toDisplay, fromDisplay, displayUnit
 import { flagChips, modeText, isStale, capabilitySet, STALE_MS } from "../robot/status.js";
 import { fetchAccess, allows } from "../robot/access.js";
 import { holdButton, jogKey, jogKeysText } from "../robot/hold.js";
-import { CARTESIAN_AXES, cartesianVelocity } from "../robot/cartesian.js";
+import { CARTESIAN_AXES, cartesianVelocity, isNotImplemented } from "../robot/cartesian.js";
 import { locksText } from "../robot/lock_text.js";
 import { formatFlags } from "../std/enums.js";
 import { mountRobot3d } from "./robot_3d.js";
@@ -52,14 +52,17 @@ export function createRobotPanel(parent, ctx) {
   const errorsBox = h("ul", { class: "robot-current-errors", hidden: true });
   const controls = h("div", { class: "camera-controls robot-controls" });
   const lockBox = h("div", { class: "robot-lock", hidden: true });
-  const view3dBox = h("div", { class: "robot-view3d-box" });  // the 3D view mounts here (panels/robot_3d.js)
+  // the 3D view mounts here (panels/robot_3d.js), last: it appears once three.js has loaded, and above
+  // the jog buttons it pushed them down under a pointer about to press one (std_robot_jog saw the press
+  // land on the canvas under load)
+  const view3dBox = h("div", { class: "robot-view3d-box" });
   const joints = h("table", { class: "robot-joints" });
   const jogBox = h("div", { class: "robot-jog", hidden: true });
   const cartBox = h("div", { class: "robot-cartesian", hidden: true });
   const moveForm = h("form", { class: "robot-move", hidden: true });
   const poses = h("div", { class: "robot-tcp" });
   const el = h("section", { class: "panel robot-panel", tabindex: "0", dataset: { panel: "robot", jog: "off" } },
-    h("h3", {}, "Robot ", staleBadge), controls, lockBox, error, summary, errorsBox, view3dBox, jogBox, joints, cartBox, moveForm, poses);
+    h("h3", {}, "Robot ", staleBadge), controls, lockBox, error, summary, errorsBox, jogBox, joints, cartBox, moveForm, poses, view3dBox);
   parent.append(el);
 
   // ---- what the user may do: the gateway's answer and the robot's capabilities ----
@@ -72,6 +75,7 @@ export function createRobotPanel(parent, ctx) {
   // ---- jogging ----
   let state = null, lastStateMs = 0;
   let lockHeld = false, pressId = 0, heldKey = null;
+  let cartesianMissing = false;  // the driver answered jog_cartesian with NotImplementedError
   const speed = h("input", { type: "range", min: "0.05", max: "1", step: "0.05", value: "0.25", name: "jog-speed" });
   const speedText = h("output", { class: "robot-speed" });
   const showSpeed = () => { speedText.textContent = `${Math.round(Number(speed.value) * 100)}% of the reduced velocity limit`; };
@@ -87,7 +91,17 @@ export function createRobotPanel(parent, ctx) {
   };
   const repeater = new JogRepeater({
     send: (c) => (c.kind === "joint" ? obj.jog_joint(c.velocity, JOG_TIMEOUT_S, false) : obj.jog_cartesian(c.velocity, JOG_TIMEOUT_S, false)),
-    onError: (e, c) => { if (!disposed) showError(`${c.kind === "joint" ? "jog_joint" : "jog_cartesian"}: ${errorText(e)}`); },
+    onError: (e, c) => {
+      if (disposed) return;
+      if (c.kind === "cartesian" && isNotImplemented(e)) {
+        // the robdef has no capability for it: the first refused call tells, the buttons go
+        cartesianMissing = true;
+        buildCartesian(!jogBox.hidden);
+        refreshJogEnabled();
+        return;
+      }
+      showError(`${c.kind === "joint" ? "jog_joint" : "jog_cartesian"}: ${errorText(e)}`);
+    },
     onStop: (reason) => {
       if (reason === "replaced") return;  // another control took over the hold
       releaseLock();
@@ -118,6 +132,7 @@ export function createRobotPanel(parent, ctx) {
     }
     showError(null);
     el.dataset.jog = "on";
+    el.dataset.jogHolds = String(Number(el.dataset.jogHolds ?? 0) + 1);  // for tests: a hold started
     repeater.start(command);
   }
   const release = (reason) => { pressId++; heldKey = null; repeater.stop(reason); };
@@ -214,21 +229,28 @@ export function createRobotPanel(parent, ctx) {
   }
 
   function buildJog() {
-    cartButtons.length = 0;
     const jog = canJog() && model.length > 0;
     jogBox.hidden = lockBox.hidden = !jog;
     if (jog) {
       jogBox.replaceChildren(h("label", {}, "jog speed ", speed), speedText,
         h("span", { class: "hint", text: `hold a − / + button (keys ${model.slice(0, 7).map((_, i) => jogKeysText(i)).join(", ")} while the panel has focus)` }));
     }
-    const cart = jog && caps.has("jog_command") && may("jog_cartesian");
-    cartBox.hidden = !cart;
-    cartBox.replaceChildren(...(cart ? [h("span", { class: "state-label", text: "Cartesian jog" }),
-      ...CARTESIAN_AXES.flatMap((a) => [-1, 1].map((d) => jogButton(cartButtons, `${a.label}${d > 0 ? "+" : "−"}`, { axis: a.id, dir: String(d) },
-        () => ({ kind: "cartesian", velocity: cartesianVelocity(a.id, d, Number(speed.value)) }))))] : []));
+    buildCartesian(jog);
     buildMoveForm(jog && may("jog_freespace"));
     renderJoints(true);
     refreshJogEnabled();
+  }
+
+  function buildCartesian(jog) {
+    cartButtons.length = 0;
+    const cart = jog && caps.has("jog_command") && may("jog_cartesian");
+    cartBox.hidden = !cart;
+    cartBox.dataset.missing = String(cartesianMissing);
+    if (cart && cartesianMissing) {
+      cartBox.replaceChildren(h("span", { class: "hint", text: "Cartesian jog: this driver does not implement jog_cartesian" }));
+    } else cartBox.replaceChildren(...(cart ? [h("span", { class: "state-label", text: "Cartesian jog" }),
+      ...CARTESIAN_AXES.flatMap((a) => [-1, 1].map((d) => jogButton(cartButtons, `${a.label}${d > 0 ? "+" : "−"}`, { axis: a.id, dir: String(d) },
+        () => ({ kind: "cartesian", velocity: cartesianVelocity(a.id, d, Number(speed.value)) }))))] : []));
   }
 
   function buildMoveForm(show) {

@@ -25,3 +25,12 @@ export function cartesianVelocity(id, direction, speed) {
   v[a.part][a.axis] = direction * speed * (a.part === "linear" ? CARTESIAN_LINEAR_MPS : CARTESIAN_ANGULAR_RADPS);
   return new Map([[0, v]]);
 }
+
+/**
+ * True when `error` (a failed jog_cartesian call) says the driver does not implement Cartesian jogging
+ * (RobotRaconteur.NotImplementedError, as the abstract robot's base class answers): the robdef has no
+ * capability flag for it, so the panel learns it from the first call and then hides the Cartesian buttons.
+ */
+export function isNotImplemented(error) {
+  return error?.errorName === "RobotRaconteur.NotImplementedError";
+}
