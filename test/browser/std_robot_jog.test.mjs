@@ -68,8 +68,12 @@ before(async () => {
 
 after(async () => {
   // each step bounded: a browser or process that does not close must not keep node (and ctest) waiting
-  const bounded = (what, p, ms = 15000) => Promise.race([Promise.resolve(p).catch((e) => console.log(`# after: ${what}: ${e.message}`)),
-    sleep(ms).then(() => console.log(`# after: ${what} still not done after ${ms} ms`))]);
+  const bounded = async (what, p, ms = 15000) => {
+    let timer;
+    await Promise.race([Promise.resolve(p).catch((e) => console.log(`# after: ${what}: ${e.message}`)),
+      new Promise((r) => { timer = setTimeout(() => { console.log(`# after: ${what} still not done after ${ms} ms`); r(); }, ms); })]);
+    clearTimeout(timer);
+  };
   for (const r of relays) await bounded("relay drop", r.drop());
   await bounded("browser close", browser?.close());
   await bounded("gateway stop", gateway?.child.stop());
@@ -270,7 +274,11 @@ test("move to: the form's joint values (degrees) reach the robot through jog_fre
   await form.locator('input[name="max-velocity"]').fill("50");
   await form.locator('button[data-action="jog_freespace"]').click();
   const target = [10 * Math.PI / 180, -5 * Math.PI / 180, wristDeg * Math.PI / 180];
-  await waitFor(async () => latest().q.every((x, i) => Math.abs(x - target[i]) < 1e-3), `the robot at ${target} (now ${latest().q})`, 15000);
+  await waitFor(async () => latest().q.every((x, i) => Math.abs(x - target[i]) < 1e-3), "the robot at the form's values", 15000).catch(async (e) => {
+    const why = await p.locator(".robot-error").textContent();
+    const invalid = await form.evaluate((f) => [...f.elements].filter((x) => x.willValidate && !x.checkValidity()).map((x) => `${x.name}=${x.value}: ${x.validationMessage}`));
+    throw new Error(`${e.message}: at ${latest().q}, wanted ${target}; panel error: ${why || "none"}; invalid fields: ${invalid.join(", ") || "none"}`);
+  });
   assert.equal(await p.locator(".robot-error").isHidden(), true, await p.locator(".robot-error").textContent());
 });
 

@@ -7,7 +7,7 @@
 //
 // Moving controls appear only once the gateway said this page's user may use their member
 // (robot/access.js) and the robot's capabilities allow them. Jogging is safe by construction
-// (robot/jog_repeater.js): each call asks for 0.2 s of motion, repeated every 50 ms while held, and
+// (robot/jog_repeater.js): each call asks for 0.15 s of motion, repeated every 50 ms while held, and
 // every way a hold can end just stops sending, so the robot stops by itself (docs/dashboard.md).
 
 import { h, errorText } from "../dom.js";
