@@ -274,7 +274,14 @@ test("move to: the form's joint values (degrees) reach the robot through jog_fre
   await form.locator('input[name="max-velocity"]').fill("50");
   await form.locator('button[data-action="jog_freespace"]').click();
   const target = [10 * Math.PI / 180, -5 * Math.PI / 180, wristDeg * Math.PI / 180];
-  await waitFor(async () => latest().q.every((x, i) => Math.abs(x - target[i]) < 1e-3), "the robot at the form's values", 15000).catch(async (e) => {
+  const start = latest().q;
+  assert.ok(Math.abs(start[0] - target[0]) > 0.1 && Math.abs(start[1] - target[1]) > 0.1, `the move is too short to tell: from ${start}`);
+  // The abstract robot ends a jog_freespace move with the last command of its trajectory before the
+  // trajectory's end, one 20 ms loop step or more (under load) short of it: seen 1.1e-3 rad off.
+  // The test tells the form's values from anything else, so 0.01 rad (0.57°) on moves of 0.17 rad and more.
+  const TOL = 0.01;
+  await waitFor(async () => latest().q.every((x, i) => Math.abs(x - target[i]) < TOL) && lastMotion(0, Date.now() / 1000 - 0.3) === null
+    && lastMotion(1, Date.now() / 1000 - 0.3) === null, "the robot at the form's values, stopped", 15000).catch(async (e) => {
     const why = await p.locator(".robot-error").textContent();
     const invalid = await form.evaluate((f) => [...f.elements].filter((x) => x.willValidate && !x.checkValidity()).map((x) => `${x.name}=${x.value}: ${x.validationMessage}`));
     throw new Error(`${e.message}: at ${latest().q}, wanted ${target}; panel error: ${why || "none"}; invalid fields: ${invalid.join(", ") || "none"}`);
