@@ -17,7 +17,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import die_with_parent, ready, wait_for_stop  # noqa: E402
+from common import die_with_parent, log, ready, wait_for_stop  # noqa: E402
 
 import RobotRaconteur as RR  # noqa: E402
 import RobotRaconteurCompanion as RRC  # noqa: E402
@@ -35,9 +35,14 @@ def main():
     flags = ["robot_probe", "--robotraconteur-local-enable=false", "--robotraconteur-tcp-ipv4-discovery=false",
              "--robotraconteur-tcp-ipv6-discovery=false"]
     with RR.ClientNodeSetup(argv=flags):
+        # each step on stderr: a probe that never gets ready (once, under a load average of 10) says where it stuck
+        log("probe", "registering the standard types")
         RRC.RegisterStdRobDefServiceTypes(RRN)
+        log("probe", f"connecting to {args.url}")
         robot = RRN.ConnectService(args.url)
+        log("probe", "connected; connecting the robot_state wire")
         wire = robot.robot_state.Connect()
+        log("probe", "wire connected")
 
         def on_state(_wc, value, _ts):
             line = json.dumps({"t": time.time(), "q": [float(x) for x in value.joint_position],
