@@ -186,6 +186,10 @@ test("status chips and joint table match the driver; the wrist warns near its up
   assert.equal(await p.locator('dd[data-row="operational_mode"]').textContent(), "cobot");
   assert.equal(await p.locator('dd[data-row="command_mode"]').textContent(), "halt");
   assert.equal(await p.getAttribute("data-stale"), "false");
+  assert.ok(await p.locator(".robot-stale").isHidden(), "the stale badge shows on fresh states");
+  // the jog column inside the panel (in a narrow column the table pushed it out)
+  const [panelBox, lastJog] = [await p.boundingBox(), await p.locator('button.jog[data-joint="wrist"][data-dir="1"]').boundingBox()];
+  assert.ok(lastJog.x + lastJog.width <= panelBox.x + panelBox.width, `the wrist's + button ends at ${lastJog.x + lastJog.width}, the panel at ${panelBox.x + panelBox.width}`);
   const rows = p.locator("table.robot-joints tbody tr");
   assert.deepEqual(await rows.evaluateAll((r) => r.map((x) => x.dataset.joint)), robot.info.joint_names);
   assert.equal(await p.locator('tr[data-joint="shoulder"] .joint-position').textContent(), "0.00° (0.0000 rad)");
