@@ -52,9 +52,8 @@ export function createRobotPanel(parent, ctx) {
   const errorsBox = h("ul", { class: "robot-current-errors", hidden: true });
   const controls = h("div", { class: "camera-controls robot-controls" });
   const lockBox = h("div", { class: "robot-lock", hidden: true });
-  // the 3D view mounts here (panels/robot_3d.js), last: it appears once three.js has loaded, and above
-  // the jog buttons it pushed them down under a pointer about to press one (std_robot_jog saw the press
-  // land on the canvas under load)
+  // the 3D view mounts here (panels/robot_3d.js), last: it appears only once three.js has loaded, and
+  // above the jog buttons it would push them away from a pointer about to press one
   const view3dBox = h("div", { class: "robot-view3d-box" });
   const joints = h("table", { class: "robot-joints" });
   const jogBox = h("div", { class: "robot-jog", hidden: true });
