@@ -170,8 +170,12 @@ async function holdDown(page, joint, dir) {
       const el = document.querySelector("button.jog.held") ?? document.activeElement;
       return el ? `${el.tagName.toLowerCase()}.${[...el.classList].join(".")} ${JSON.stringify({ ...el.dataset })}` : "nothing";
     }).catch((x) => `(page: ${x.message})`);
+    // a button disabled at the press (no state for 1 s: stale) takes no pointerdown at all
+    const button = await b.evaluate((x) => `disabled ${x.disabled} (${x.title || "no reason"})`).catch(() => "gone");
+    const stale = await panel(page).getAttribute("data-stale").catch(() => "?");
     await page.mouse.up().catch(() => {});
-    throw new Error(`jog ${joint} ${dir}: ${e.message}; held/focused: ${pressed}; hold end: ${await holdEnd(page).catch(() => "?")}; console: ${consoleLines.slice(-5).join(" | ") || "none"}`);
+    throw new Error(`jog ${joint} ${dir}: ${e.message}; held/focused: ${pressed}; button: ${button}; stale: ${stale}; `
+      + `hold end: ${await holdEnd(page).catch(() => "?")}; console: ${consoleLines.slice(-5).join(" | ") || "none"}`);
   }
 }
 
