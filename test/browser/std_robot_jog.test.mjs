@@ -115,12 +115,15 @@ const jogButton = (page, joint, dir) => panel(page).locator(`button.jog[data-joi
 const latest = () => samples.at(-1);
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
-/** The time (s) of the last sample after `from` in which joint `j` moved, or null. */
-function lastMotion(j, from) {
+/**
+ * The time (s) of the last sample after `from` in which joint `j` moved, or null: when the official
+ * client received it (`clock` "t"), or when the robot sent it ("sent", the robot's node's clock).
+ */
+function lastMotion(j, from, clock = "t") {
   let last = null;
   for (let i = 1; i < samples.length; i++) {
     if (samples[i].t < from) continue;
-    if (Math.abs(samples[i].q[j] - samples[i - 1].q[j]) > EPS) last = samples[i].t;
+    if (Math.abs(samples[i].q[j] - samples[i - 1].q[j]) > EPS) last = samples[i][clock];
   }
   return last;
 }
@@ -139,10 +142,12 @@ async function assertStopsAfter(j, t, bound, what) {
   const moving = lastMotion(j, t - 0.3);
   assert.ok(moving !== null, `${what}: joint ${j} was not moving when the hold ended`);
   await sleep(1500);
-  const stoppedAt = lastMotion(j, t - 0.3);
-  const delay = stoppedAt - t;
-  console.log(`# ${what}: last motion ${(delay * 1000).toFixed(0)} ms after the hold ended`);
-  assert.ok(delay <= bound, `${what}: the robot still moved ${(delay * 1000).toFixed(0)} ms after (bound ${bound * 1000} ms)`);
+  // The bound is on the robot: the time it sent its last moving state. When the client received it is
+  // logged too (under load the delivery to the client alone was seen to add 0.3 s and more).
+  const delay = lastMotion(j, t - 0.3, "sent") - t;
+  const received = lastMotion(j, t - 0.3) - t;
+  console.log(`# ${what}: last motion ${(delay * 1000).toFixed(0)} ms after the hold ended (received ${(received * 1000).toFixed(0)} ms after)`);
+  assert.ok(delay <= bound, `${what}: the robot still moved ${(delay * 1000).toFixed(0)} ms after (bound ${bound * 1000} ms; received ${(received * 1000).toFixed(0)} ms after)`);
   // and it stays stopped
   const q = latest().q[j];
   await sleep(400);

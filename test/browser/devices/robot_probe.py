@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The official Python client watching a robot for the jog tests (std_robot_jog.test.mjs): connects
 straight to the robot (not through the gateway), follows its robot_state wire and prints one JSON line
-per state received: {"t": <time.time() of receipt, s>, "q": [joint positions], "mode": command_mode}.
+per state received: {"t": <time.time() of receipt, s>, "sent": <the robot's clock when it sent the state,
+s>, "q": [joint positions], "mode": command_mode}.
 The test compares these times with its own clock (same machine) to say when the robot stopped.
 
 Ready line: {"url": "<robot url>", "probe": true}. Runs until SIGTERM or --max-lifetime.
@@ -44,9 +45,10 @@ def main():
         wire = robot.robot_state.Connect()
         log("probe", "wire connected")
 
-        def on_state(_wc, value, _ts):
-            line = json.dumps({"t": time.time(), "q": [float(x) for x in value.joint_position],
-                               "mode": int(value.command_mode)})
+        def on_state(_wc, value, ts):
+            # ts: the robot's node's clock when it sent this state (same machine, same clock as t)
+            line = json.dumps({"t": time.time(), "sent": ts.seconds + ts.nanoseconds * 1e-9,
+                               "q": [float(x) for x in value.joint_position], "mode": int(value.command_mode)})
             with out:
                 print(line, flush=True)
 
