@@ -2,6 +2,8 @@
 // with its demo devices and Reynard behind it, and headless Debian Chromium through playwright-core
 // (web/node_modules, pinned in web/package.json). Every process is stopped by its PID.
 
+import crypto from "node:crypto";
+import fs from "node:fs";
 import { spawn } from "node:child_process";
 import { createRequire } from "node:module";
 import { fileURLToPath } from "node:url";
@@ -105,6 +107,33 @@ export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = 
   const child = new Child("rr-gateway", s.gateway, args, options.env);
   const { port } = await child.jsonLine("port", 30000);
   return { child, port, base: `http://127.0.0.1:${port}` };
+}
+
+/**
+ * Writes a gateway configuration with logins into folder `dir`: users alice (password alice-pw, role
+ * operator: read, write and call everything, and objectlock) and bob (bob-pw, role viewer: read only),
+ * then the YAML lines `rest` (devices:, demo:, ...). Returns the configuration file's path.
+ */
+export function writeOperatorViewerConfig(dir, rest) {
+  const md5 = (t) => crypto.createHash("md5").update(t).digest("hex");
+  const users = path.join(dir, "users.txt");
+  fs.writeFileSync(users, `alice ${md5("alice-pw")} operator,objectlock\nbob ${md5("bob-pw")} viewer\n`, { mode: 0o600 });
+  const config = path.join(dir, "gateway.yaml");
+  fs.writeFileSync(config, [
+    "gateway:",
+    "  auth:",
+    `    users: ${users}`,
+    "    roles:",
+    "      operator:",
+    "        - allow: [read, write, call]",
+    "      viewer:",
+    "        - devices: \"*\"",
+    "          members: \"*\"",
+    "          allow: [read]",
+    ...rest,
+    "",
+  ].join("\n"));
+  return config;
 }
 
 /** Polls `fn` until it returns a truthy value; rejects with `what` after timeoutMs. */

@@ -8,38 +8,22 @@
 
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
-import crypto from "node:crypto";
 import fs from "node:fs";
 import http from "node:http";
 import net from "node:net";
 import os from "node:os";
 import path from "node:path";
-import { settings, startGateway, launchChromium, waitFor } from "./harness.mjs";
+import { settings, writeOperatorViewerConfig, startGateway, launchChromium, waitFor } from "./harness.mjs";
 
 const s = settings();
-const md5 = (t) => crypto.createHash("md5").update(t).digest("hex");
 let tmp, gateway, browser, base;
 
 before(async () => {
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), "rr-web-login-"));
-  const users = path.join(tmp, "users.txt");
-  fs.writeFileSync(users, `alice ${md5("alice-pw")} operator,objectlock\nbob ${md5("bob-pw")} viewer\n`, { mode: 0o600 });
-  const config = path.join(tmp, "gateway.yaml");
-  fs.writeFileSync(config, [
-    "gateway:",
-    "  auth:",
-    `    users: ${users}`,
-    "    roles:",
-    "      operator:",
-    "        - allow: [read, write, call]",
-    "      viewer:",
-    "        - devices: \"*\"",
-    "          members: \"*\"",
-    "          allow: [read]",
+  const config = writeOperatorViewerConfig(tmp, [
     "demo:",
     "  enabled: true",
-    "",
-  ].join("\n"));
+  ]);
   gateway = await startGateway(s, {}, 0, ["--config", config]);
   base = gateway.base;
   browser = await launchChromium();

@@ -73,7 +73,7 @@ test("flags by name: Enable in the robot panel turns 'none' into 'enabled | read
   assert.match(await robotPanel.locator('dd[data-row="ts"]').textContent(), ISO);
   assert.deepEqual(await robotPanel.locator("table.robot-joints tbody tr").evaluateAll((rows) => rows.map((r) => r.dataset.joint)),
     robot.info.joint_names);
-  assert.match(await robotPanel.locator('tr[data-joint="shoulder"]').textContent(), /shoulder0\.0000 rad/);
+  assert.match(await robotPanel.locator('tr[data-joint="shoulder"]').textContent(), /shoulder0\.00° \(0\.0000 rad\)/);
   assert.equal(await robotPanel.locator(".robot-tool").textContent(), "tool: position (0.7, 0, 0.3) m, rpy (0, 0, 0)°");
   const t = await text();
   assert.match(t, new RegExp(`^\\{ts: ${ISO.source} \\([\\d.]+ m?s ago\\), seqno: \\d+, command_mode: [a-z_]+, operational_mode: [a-z_]+, controller_state: motor_on,`));

@@ -170,6 +170,8 @@ export class DeviceView {
     const view = viewContext(outline);
     this.panel = new ObjectPanel(this.members, {
       obj: client, outline, view, panels: PANELS, definitions: this.definitions, log: this.log, memory: this.memory, path: "",
+      // for panels that ask the gateway about this device (the robot panel: access, locks)
+      device: this.name, session: this.session, devices: this.list,
     });
   }
 

@@ -8,7 +8,6 @@ import { PanelRegistry, objectTypes } from "../src/panels/registry.js";
 import { standardPanels } from "../src/panels/standard.js";
 import { deviceInfoMember } from "../src/panels/device_card.js";
 import { structRows } from "../src/panels/camera_panel.js";
-import { jointRows, jointInfo } from "../src/panels/robot_panel.js";
 import { deviceInfoRows } from "../src/std/device_info.js";
 import { RobdefOutline } from "../src/robdef_outline.js";
 import { viewContext, describeMember } from "../src/views/context.js";
@@ -141,17 +140,4 @@ test("plots: a robot's sensor data without UUID bytes or clocks, on its own time
   // a value the page could not describe: the generic numbers, no time
   assert.deepEqual(plotSample({ a: 1, b: [2, 3] }, null).pairs, [["a", 1], ["b[0]", 2], ["b[1]", 3]]);
   assert.deepEqual(plotSample({ a: 1 }, { kind: "unknown" }), { pairs: [["a", 1]], t: null });
-});
-
-test("robot panel: joints named from the RobotInfo, with their units and commands", () => {
-  const unitEnum = [{ name: "implicit", value: 0 }, { name: "meter", value: 1 }, { name: "radian", value: 2 }];
-  const info = { joint_info: [{ joint_identifier: { name: "shoulder" }, default_units: 2 }, { joint_identifier: { name: "slide" }, default_units: 1 }] };
-  const { names, units } = jointInfo(info, unitEnum);
-  assert.deepEqual([names, units], [["shoulder", "slide"], ["rad", "m"]]);
-  assert.deepEqual(jointRows({ joint_position: new Float64Array([0.5, 0.25]), joint_position_command: new Float64Array(0) }, names, units),
-    [{ name: "shoulder", position: "0.5000 rad", command: "" }, { name: "slide", position: "0.2500 m", command: "" }]);
-  assert.deepEqual(jointRows({ joint_position: [1, 2, 3], joint_position_command: [1.5, 2, 3] }, ["a"]).map((r) => [r.name, r.command]),
-    [["a", "1.5000"], ["joint_1", "2.0000"], ["joint_2", "3.0000"]]);
-  assert.deepEqual(jointRows(null), []);
-  assert.deepEqual(jointInfo(null), { names: [], units: [] });
 });

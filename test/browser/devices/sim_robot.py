@@ -15,7 +15,8 @@ at once (motors on or off), cancelling any motion; the next loop step reports th
 Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=robot", "port": P, "device_uuid": "...",
 "joint_names": [...]}.
 
-Usage: sim_robot.py [--info FILE] [--enabled] [--joints-stdin] [--period 0.02] [--max-lifetime 300]
+Usage: sim_robot.py [--info FILE] [--enabled] [--start-position Q0,Q1,...] [--joints-stdin] [--period 0.02]
+                    [--max-lifetime 300]
 """
 
 import argparse
@@ -42,7 +43,7 @@ RRN = RR.RobotRaconteurNode.s
 class SimArm(AbstractRobot):
     """The arm's joints follow the base class's commands at the velocity limits of the RobotInfo."""
 
-    def __init__(self, robot_info, period, enabled):
+    def __init__(self, robot_info, period, enabled, start_position=None):
         super().__init__(robot_info, 0)
         self._update_period = period
         self._base_set_controller_state = True
@@ -51,6 +52,9 @@ class SimArm(AbstractRobot):
         self._has_velocity_command = False
         self._has_jog_command = True
         self._q = np.zeros(self._joint_count)
+        if start_position is not None:
+            given = start_position[:self._joint_count]
+            self._q[:len(given)] = given
         self._q_target = None
         self._max_speed = np.array([j.joint_limits.velocity for j in robot_info.joint_info])
         self._sim_lock = threading.Lock()
@@ -125,6 +129,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--info", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "sim_robot_info.yml"))
     ap.add_argument("--enabled", action="store_true", help="motors on from the start")
+    ap.add_argument("--start-position", type=lambda t: [float(x) for x in t.split(",")], default=None,
+                    help="joint positions to start at (joint units, comma-separated; default all 0)")
     ap.add_argument("--joints-stdin", action="store_true",
                     help="each stdin line, a JSON list of joint positions, puts the joints there at once")
     ap.add_argument("--period", type=float, default=0.02, help="loop period in seconds")
@@ -135,7 +141,7 @@ def main():
         RRC.RegisterStdRobDefServiceTypes(RRN)
         robot_info, _ = InfoFileLoader(RRN).LoadInfoFile(args.info, "com.robotraconteur.robotics.robot.RobotInfo", "robot")
         attributes = AttributesUtil(RRN).GetDefaultServiceAttributesFromDeviceInfo(robot_info.device_info)
-        robot = SimArm(robot_info, args.period, args.enabled)
+        robot = SimArm(robot_info, args.period, args.enabled, args.start_position)
         robot._start_robot()
         ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot)
         ctx.SetServiceAttributes(attributes)

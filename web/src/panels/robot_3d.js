@@ -22,11 +22,14 @@ export function mountRobot3d(parent, obj, { infoMember, stateMember }) {
     follow = followWire(obj, stateMember.name, {
       onValue: (s) => { latest = s; view?.update(s?.joint_position, s?.kin_chain_tcp); },
     });
+    // the canvas's height is kept free while three.js loads, so nothing below jumps when it appears
+    slot.dataset.loading = "true";
     Promise.all([obj[infoMember.name].get(), import("../robot/view3d.js")]).then(([info, { createRobotView3d }]) => {
       if (disposed) return;
+      delete slot.dataset.loading;
       view = createRobotView3d(slot, info);
       if (latest) view.update(latest.joint_position, latest.kin_chain_tcp);
-    }).catch((e) => { if (!disposed) message(errorText(e)); });
+    }).catch((e) => { if (!disposed) { delete slot.dataset.loading; message(errorText(e)); } });
   }
 
   return {
