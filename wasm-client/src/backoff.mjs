@@ -1,4 +1,5 @@
-// Reconnect delays shared by the RR subscriptions (subscription.mjs) and the JSON client (json_client.mjs).
+// Reconnect delays shared by the RR subscriptions (subscription.mjs) and the JSON client (json_client.mjs),
+// and the listener helpers they and the proxies (proxy.mjs) share.
 import { RRError } from "./errors.mjs";
 
 /** Defaults: 0.5 s, doubling up to 10 s, each delay spread ±25 % (README.md "Subscriptions"). */

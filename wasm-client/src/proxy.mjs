@@ -1,20 +1,10 @@
 // Object proxies: one JS object per RR object, with one entry per member, shaped by the member kind
 // (README.md "API"). Every network call goes through Connection.op (a Promise) or Connection.sync.
 import { RRError, toRRError } from "./errors.mjs";
+// later(): user code runs outside the native call stack; its errors are reported, never thrown into C++.
+import { later } from "./backoff.mjs";
 
 const now = () => performance.now();
-
-/** Runs user code outside the native call stack; errors in it are reported, never thrown into C++. */
-function later(fn, ...args) {
-  queueMicrotask(() => {
-    try {
-      const r = fn(...args);
-      if (r && typeof r.catch === "function") r.catch((e) => console.error(e));
-    } catch (e) {
-      console.error(e);
-    }
-  });
-}
 
 /** A queue that async iterators wait on. */
 class AsyncQueue {
