@@ -4,40 +4,23 @@
 //
 // Usage: node browser_test.mjs --interop-service PATH --gateway PATH [--only REGEX]
 // Exit: 0 all passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
-import { spawn, spawnSync } from "node:child_process";
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from "node:fs";
+import { spawn } from "node:child_process";
+import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
-import { createRequire } from "node:module";
 import { createInterface } from "node:readline";
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
+import { CHROMIUM, chromiumOrSkip } from "./chromium_setup.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const pkgRoot = join(here, "..");
-const root = join(pkgRoot, "..");
-const chromium = "/usr/bin/chromium";
 
 function arg(name, fallback = null) {
   const i = process.argv.indexOf(name);
   return i > 0 && i + 1 < process.argv.length ? process.argv[i + 1] : fallback;
 }
 
-const playwrightPath = join(root, "web", "node_modules", "playwright-core");
-for (const [what, path] of [["Chromium", chromium], ["playwright-core (web/node_modules)", playwrightPath]]) {
-  if (!existsSync(path)) {
-    console.log(`SKIP: ${what} missing: ${path} (run scripts/setup.sh)`);
-    process.exit(77);
-  }
-}
-if (!existsSync(join(pkgRoot, "dist", "robotraconteur.mjs"))) {
-  if (spawnSync("sh", ["-c", "command -v emcmake"]).status !== 0) {
-    console.log("SKIP: emscripten is not installed, so wasm-client/dist cannot be built (run scripts/setup.sh)");
-    process.exit(77);
-  }
-  console.error("wasm-client/dist missing: run wasm-client/build.sh (scripts/test.sh does)");
-  process.exit(2);
-}
-const { chromium: pw } = createRequire(import.meta.url)(playwrightPath);
+const pw = chromiumOrSkip();
 
 const children = [];
 function start(cmd, args) {
@@ -86,7 +69,7 @@ try {
     if (i > 300) throw new Error("gateway not ready");
     await new Promise((r) => setTimeout(r, 100));
   }
-  browser = await pw.launch({ executablePath: chromium, headless: true,
+  browser = await pw.launch({ executablePath: CHROMIUM, headless: true,
     args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
       "--disable-component-update", "--disable-sync"] });
   const page = await browser.newPage();

@@ -9,33 +9,14 @@
 //
 // Usage: node reconnect_browser_test.mjs --interop-service PATH --gateway PATH [--target gateway|direct] [--reconnects N]
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
-import { existsSync } from "node:fs";
-import { spawnSync } from "node:child_process";
-import { createRequire } from "node:module";
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
+import { CHROMIUM, chromiumOrSkip } from "./chromium_setup.mjs";
 import { arg, cutProxy, freePort, gateway, interopService, stopAll } from "./reconnect_harness.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const pkgRoot = join(here, "..");
-const root = join(pkgRoot, "..");
-const chromium = "/usr/bin/chromium";
-const playwrightPath = join(root, "web", "node_modules", "playwright-core");
-for (const [what, path] of [["Chromium", chromium], ["playwright-core (web/node_modules)", playwrightPath]]) {
-  if (!existsSync(path)) {
-    console.log(`SKIP: ${what} missing: ${path} (run scripts/setup.sh)`);
-    process.exit(77);
-  }
-}
-if (!existsSync(join(pkgRoot, "dist", "robotraconteur.mjs"))) {
-  if (spawnSync("sh", ["-c", "command -v emcmake"]).status !== 0) {
-    console.log("SKIP: emscripten is not installed, so wasm-client/dist cannot be built (run scripts/setup.sh)");
-    process.exit(77);
-  }
-  console.error("wasm-client/dist missing: run wasm-client/build.sh");
-  process.exit(2);
-}
-const { chromium: pw } = createRequire(import.meta.url)(playwrightPath);
+const pw = chromiumOrSkip();
 
 let browser;
 let code = 2;
@@ -52,7 +33,7 @@ try {
   const actions = { restartDevice: () => svc.restart(), cut: () => proxy.cut(), restore: () => proxy.restore(),
     dropAll: () => proxy.dropAll() };
   if (target === "gateway") actions.restartGateway = () => gw.restart();
-  browser = await pw.launch({ executablePath: chromium, headless: true,
+  browser = await pw.launch({ executablePath: CHROMIUM, headless: true,
     args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
       "--disable-component-update", "--disable-sync", "--js-flags=--expose-gc", "--enable-precise-memory-info"] });
   const page = await browser.newPage();
