@@ -56,6 +56,16 @@ def read_json_line(proc, timeout, what):
         raise StepFailed("%s: bad ready line %r: %s" % (what, buf[:200], e))
 
 
+def proc_state(pid):
+    """The kernel's view of a process that does not end: its State line and where it sleeps (wchan)."""
+    try:
+        state = next((l.strip() for l in open("/proc/%d/status" % pid) if l.startswith("State:")), "?")
+        wchan = open("/proc/%d/wchan" % pid).read().strip() or "-"
+        return "%s, wchan %s" % (state, wchan)
+    except OSError as e:
+        return "no /proc entry (%s)" % e
+
+
 def stop(proc, wait_s=10):
     """SIGTERM, wait up to `wait_s`, then SIGKILL. Returns the exit status (None for no process)."""
     if proc is None:
@@ -66,7 +76,10 @@ def stop(proc, wait_s=10):
             proc.wait(wait_s)
         except subprocess.TimeoutExpired:
             proc.kill()
-            proc.wait(5)
+            try:
+                proc.wait(30)  # a loaded machine has taken over 5 s to end a killed official node
+            except subprocess.TimeoutExpired:
+                raise StepFailed("pid %d (%s) still there 30 s after SIGKILL: %s" % (proc.pid, proc.args[:3], proc_state(proc.pid)))
     if proc.stdout:
         proc.stdout.close()
     return proc.returncode
