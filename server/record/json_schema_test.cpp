@@ -41,10 +41,10 @@ object Dev
 end
 )";
 
-struct Fixture {
+struct SchemaFixture {
     robdef::ServiceDefinitionSet set;
     const robdef::ServiceEntryDefinition* dev = nullptr;
-    Fixture() {
+    SchemaFixture() {
         auto r = set.add_text(kDef, "test.rec.robdef");
         INFO((r ? std::string() : r.error().message));
         REQUIRE(r);
@@ -58,7 +58,7 @@ struct Fixture {
 }  // namespace
 
 TEST_CASE("record json schema: a wire of a recursive struct refers to its $defs entry") {
-    Fixture f;
+    SchemaFixture f;
     auto s = record::wire_message_schema(f.m("pos").type, f.set, "test.rec", "test.rec.Dev.pos");
     CHECK(s["title"] == "test.rec.Dev.pos");
     CHECK(s["required"] == json({"time", "value"}));
@@ -71,7 +71,7 @@ TEST_CASE("record json schema: a wire of a recursive struct refers to its $defs 
 }
 
 TEST_CASE("record json schema: arrays, multidim arrays, maps, enums and events") {
-    Fixture f;
+    SchemaFixture f;
     auto path = record::wire_message_schema(f.m("path").type, f.set, "test.rec", "p");
     CHECK(path["properties"]["value"]["type"] == "array");
     CHECK(path["$defs"]["test.rec.Vec3"]["required"] == json({"x", "y", "z"}));

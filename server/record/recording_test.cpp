@@ -15,20 +15,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
+struct RecordingDir {
     fs::path path;
-    TempDir() {
+    RecordingDir() {
         char tmpl[] = "/tmp/rr-recording-test-XXXXXX";
         REQUIRE(::mkdtemp(tmpl));
         path = tmpl;
     }
-    ~TempDir() {
+    ~RecordingDir() {
         std::error_code ec;
         fs::remove_all(path, ec);
     }
 };
 
-std::map<std::string, std::vector<rr::mcap::Message>> read_file(const std::string& file, rr::mcap::Summary* summary = nullptr) {
+std::map<std::string, std::vector<rr::mcap::Message>> read_recording(const std::string& file, rr::mcap::Summary* summary = nullptr) {
     auto src = rr::mcap::FileSource::open(file);
     REQUIRE(src);
     auto reader = rr::mcap::McapReader::open(**src);
@@ -55,7 +55,7 @@ TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") 
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());
-    TempDir dir;
+    RecordingDir dir;
     auto r = http_post(gw.port(), "/api/recordings",
                        json{{"device", "interop"}, {"members", {"p_stream", "w_state", "ev_values"}}, {"directory", dir.path.string()}});
     REQUIRE(r.status == 201);
@@ -73,7 +73,7 @@ TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") 
     REQUIRE(stopped.body["files"].size() == 1);
 
     rr::mcap::Summary summary;
-    auto msgs = read_file(stopped.body["files"][0].get<std::string>(), &summary);
+    auto msgs = read_recording(stopped.body["files"][0].get<std::string>(), &summary);
     REQUIRE(msgs["interop/p_stream json"].size() == 5);
     REQUIRE(msgs["interop/p_stream robotraconteur"].size() == 5);
     for (int i = 0; i < 5; ++i) CHECK(json::parse(text_of(msgs["interop/p_stream json"][i]))["value"] == json({i, i * 0.5}));
@@ -101,7 +101,7 @@ TEST_CASE("recording: rotation by size keeps the disk budget") {
     if (!interop_service_built()) return;
     InteropProcess device;
     TestGateway gw(device.url());
-    TempDir dir;
+    RecordingDir dir;
     auto r = http_post(gw.port(), "/api/recordings",
                        json{{"device", "interop"}, {"members", {"p_stream"}}, {"directory", dir.path.string()},
                             {"max_file_bytes", 20000}, {"max_total_bytes", 60000}, {"chunk_bytes", 4096}, {"compression", "none"}});
@@ -121,7 +121,7 @@ TEST_CASE("recording: rotation by size keeps the disk budget") {
     CHECK(total <= 60000 + 20000);  // the budget, plus the chunk that may overshoot the open file
     CHECK(stopped.body["bytes"].get<std::uint64_t>() == total);
     // Each file is complete on its own.
-    for (const auto& f : files) CHECK(read_file(f.get<std::string>()).count("interop/p_stream json") == 1);
+    for (const auto& f : files) CHECK(read_recording(f.get<std::string>()).count("interop/p_stream json") == 1);
 }
 
 TEST_CASE("recording: bad requests are clear errors") {

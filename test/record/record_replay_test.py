@@ -322,8 +322,10 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         errors.sort()
         checks["spacing_error_ms"] = {"median": errors[len(errors) // 2], "p95": errors[int(len(errors) * 0.95)],
                                       "max": errors[-1], "intervals": len(errors)}
-        within = sum(1 for e in errors if e <= tolerance_ms)
-        if within < 0.95 * len(errors):
+        within = sum(1 for e in errors if tolerance_ms is not None and e <= tolerance_ms)
+        if tolerance_ms is None:
+            checks["spacing_judged"] = "no (--spacing report): judged by the test labelled timing"
+        elif within < 0.95 * len(errors):
             # Timing is judged only on a machine that is not overloaded (the 1-minute load average at
             # most the number of CPUs): elsewhere the delays measured are the scheduler's, not the
             # replay's, and the check reports SKIP instead of passing or failing.
@@ -332,7 +334,6 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
             checks["spacing_skipped"] = "load average %.1f on %d CPUs: spacing not judged" % (load, cpus)
 
         # Seek lands on the right value: the wire and the property at 1.5 s.
-        t0 = rr_packets[0].log_time
         status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 1.5})
         expect(status == 200, "seek: %s %s" % (status, st))
         time.sleep(0.5)
@@ -443,6 +444,8 @@ def main():
     ap.add_argument("--seconds", type=float, default=10.0)
     ap.add_argument("--tolerance-ms", type=float, default=5.0)
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--spacing", choices=["judge", "report"], default="judge",
+                    help="report: measure the replay's spacing but leave judging it to a run on a quieter CPU")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-test-")
     RRN.RegisterTransport(RR.TcpTransport())
@@ -450,7 +453,7 @@ def main():
     ok = False
     try:
         path, rr_packets, props = record_phase(a.gateway, work, a.seconds, checks)
-        replay_phase(a.gateway, work, path, rr_packets, props, a.tolerance_ms, checks)
+        replay_phase(a.gateway, work, path, rr_packets, props, a.tolerance_ms if a.spacing == "judge" else None, checks)
         mcap_core_phase(a.gateway, work, path, checks)
         corrupt_phase(a.gateway, work, path, checks)
         ok = True
