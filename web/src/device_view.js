@@ -79,7 +79,7 @@ export class DeviceView {
       let mayControl = true;
       try {
         const access = await fetchAccess(this.name);
-        mayControl = access.members === null || Object.values(access.members).some((ops) => ops.includes("write"));
+        mayControl = access.members === null || Object.values(access.members).some((ops) => Array.isArray(ops) && ops.includes("write"));
       } catch { mayControl = false; }
       if (this.closed) return;
       this.replay = new ReplayTimeline(this.tools, { name: this.name, status, mayControl });

@@ -91,7 +91,7 @@ export class ReplayTimeline {
     this.el.dataset.position = String(s.position_s);
     this.duration.textContent = formatSeconds(s.duration_s);
     if (document.activeElement !== this.speed) {
-      if (!SPEEDS.includes(s.speed)) this.speed.append(h("option", { value: String(s.speed), text: `${s.speed}×` }));
+      if (![...this.speed.options].some((o) => Number(o.value) === s.speed)) this.speed.append(h("option", { value: String(s.speed), text: `${s.speed}×` }));
       this.speed.value = String(s.speed);
     }
     this.loop.checked = !!s.loop;
