@@ -8,7 +8,9 @@
 //     lists the recording as failed;
 // (3) a second gateway replays that file (`--replay create_replay=FILE`): the page shows a timeline
 //     under the device; pause, seek, speed, loop and play from the page change what GET
-//     api/replays/create_replay reports, and the page shows the values the gateway reports.
+//     api/replays/create_replay reports, and the page shows the values the gateway reports;
+// (4) with logins (gateway.auth), a viewer (read only) sees the timeline with its controls disabled
+//     and the gateway refuses its POST; an operator (write) gets the controls.
 // Screenshots: docs/img/dashboard-recording.png and dashboard-replay.png with RR_DOCS_SCREENSHOTS=1.
 
 import { test, before, after, afterEach } from "node:test";
@@ -17,11 +19,11 @@ import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
 import { spawnSync } from "node:child_process";
-import { settings, startGateway, launchChromium, apiDevices, waitFor } from "./harness.mjs";
+import { settings, startGateway, launchChromium, apiDevices, waitFor, writeOperatorViewerConfig } from "./harness.mjs";
 import { screenshot } from "./std_support.mjs";
 
 const s = settings();
-let gateway, replayGateway, browser, page, work, recordedFile, recordedMessages;
+let gateway, replayGateway, authGateway, browser, page, work, recordedFile, recordedMessages;
 const pageErrors = [];
 
 const view = (name) => page.locator(`.device-view[data-device="${name}"]`);
@@ -66,7 +68,7 @@ after(async () => {
   if (page) await screenshot(page, "recording-end.png", { docs: false, fullPage: true }).catch(() => {});
   await browser?.close();
   const statuses = [];
-  for (const g of [gateway, replayGateway]) if (g) statuses.push(await g.child.stop());
+  for (const g of [gateway, replayGateway, authGateway]) if (g) statuses.push(await g.child.stop());
   if (work) fs.rmSync(work, { recursive: true, force: true });
   for (const st of statuses) assert.equal(st.code, 0, `rr-gateway exited with ${JSON.stringify(st)}`);
 });
@@ -214,4 +216,49 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   await waitFor(async () => seconds(await t.locator(".replay-position").textContent()) !== target, "the page's position moves");
   // the replayed device's packets reach the page like a live device's
   await card("packets").locator(".plot-readout [data-series]").first().waitFor({ timeout: 15000 });
+});
+
+test("with logins: a viewer's timeline is read only, an operator's is not", async () => {
+  assert.ok(recordedFile, "the recording of the first test");
+  const config = writeOperatorViewerConfig(work, [
+    "demo:",
+    "  enabled: false",
+    "devices:",
+    "  - name: create_replay",
+    `    replay: ${JSON.stringify(recordedFile)}`,
+    "    paused: true",
+  ]);
+  authGateway = await startGateway(s, {}, 0, ["--config", config, "--no-discovery"]);
+  const as = async (user, password) => {
+    const context = await browser.newContext({ viewport: { width: 1366, height: 900 } });
+    const p = await context.newPage();
+    p.on("pageerror", (e) => pageErrors.push(e));
+    await p.goto(`${authGateway.base}/#/create_replay`);
+    await p.waitForURL(/\/login\.html/, { timeout: 20000 });
+    await p.fill("#login-username", user);
+    await p.fill("#login-password", password);
+    await p.click("#login-submit");
+    await p.waitForURL((u) => !u.pathname.endsWith("login.html"), { timeout: 20000 });
+    const t = p.locator('.device-view[data-device="create_replay"] .replay-timeline');
+    await t.waitFor({ timeout: 20000 });
+    return { context, p, t };
+  };
+  const bob = await as("bob", "bob-pw");
+  assert.equal(await bob.t.getAttribute("data-state"), "paused");
+  for (const c of [".replay-play", ".replay-seek", ".replay-speed", ".replay-loop"]) {
+    assert.equal(await bob.t.locator(c).isDisabled(), true, `${c} disabled for a viewer`);
+  }
+  assert.match(await bob.t.locator(".hint").textContent(), /needs write on the device/);
+  const refused = await bob.p.evaluate(async () => (await fetch("api/replays/create_replay", { method: "POST", body: JSON.stringify({ state: "playing" }) })).status);
+  assert.equal(refused, 403, "the gateway refuses a viewer's control");
+  // every logged-in user may record (the recording routes need a login only)
+  await bob.p.locator('.device-view[data-device="create_replay"] .record-button').waitFor({ timeout: 20000 });
+  await bob.context.close();
+
+  const alice = await as("alice", "alice-pw");
+  assert.equal(await alice.t.locator(".replay-play").isDisabled(), false, "an operator may control the replay");
+  assert.equal(await alice.t.locator(".hint").count(), 0);
+  await alice.t.locator(".replay-play").click();
+  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 10000 });
+  await alice.context.close();
 });
