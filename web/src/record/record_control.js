@@ -17,7 +17,7 @@ function recordingItem(r) {
   const facts = [`${formatSeconds(r.duration_s)}`, formatBytes(r.bytes), `${r.messages} messages`, `${r.drops} drops`];
   return h("li", { class: "recording", dataset: { id: String(r.id), state: r.state } },
     h("span", { class: "recording-id", text: `#${r.id}` }),
-    h("span", { class: "badge", dataset: { state: r.state === "recording" ? "connected" : r.state === "failed" ? "failed" : "closed" }, text: r.state }),
+    h("span", { class: "badge", dataset: { state: r.state === "recording" ? "connected" : r.state === "failed" ? "failed" : "idle" }, text: r.state }),
     h("span", { class: "recording-facts", text: facts.join(" · ") }),
     r.error ? h("p", { class: "recording-error", role: "alert", text: r.error }) : null,
     h("ul", { class: "recording-files" }, ...(r.files || []).map((f) => h("li", {}, h("code", { text: f })))));

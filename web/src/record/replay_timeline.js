@@ -36,12 +36,12 @@ export class ReplayTimeline {
     this.file = h("code", { class: "replay-file" });
     this.error = h("p", { class: "replay-error", role: "alert", hidden: true });
     this.el = h("section", { class: "replay-timeline", dataset: { device: name } },
-      h("h3", {}, "Replay of ", this.file),
+      h("h3", { text: "Replay" }),
+      h("div", { class: "replay-row" }, h("span", { class: "state-label", text: "file" }), this.file, this.span),
       h("div", { class: "replay-row" }, this.playButton, this.position, this.slider, this.duration, this.state),
       h("div", { class: "replay-row" },
         h("label", {}, h("span", { text: "Speed" }), this.speed),
-        h("label", {}, this.loop, h("span", { text: "Loop" })),
-        this.span),
+        h("label", {}, this.loop, h("span", { text: "Loop" }))),
       mayControl ? null : h("p", { class: "hint", text: "Your login may not control this replay (it needs write on the device)." }),
       this.error);
     for (const c of [this.playButton, this.slider, this.speed, this.loop]) c.disabled = !mayControl;
@@ -79,7 +79,7 @@ export class ReplayTimeline {
     this.status = s;
     this.el.dataset.state = s.state;
     this.state.textContent = s.state;
-    this.state.dataset.state = s.state === "playing" ? "connected" : s.state === "failed" ? "failed" : "closed";
+    this.state.dataset.state = s.state === "playing" ? "connected" : s.state === "failed" ? "failed" : "idle";
     this.playButton.textContent = s.state === "playing" ? "Pause" : "Play";
     this.file.textContent = s.file;
     const durMs = Math.round((s.duration_s || 0) * 1000);
