@@ -15,6 +15,10 @@ import { ObjectPanel } from "./object_panel.js";
 import { EventLog } from "./event_log.js";
 import { viewContext } from "./views/context.js";
 import { standardPanels } from "./panels/standard.js";
+import { RecordControl } from "./record/record_control.js";
+import { ReplayTimeline } from "./record/replay_timeline.js";
+import { listReplays } from "./record/recording_api.js";
+import { fetchAccess } from "./robot/access.js";
 
 // The panels chosen by object type (panels/standard.js), the same for every device.
 const PANELS = standardPanels();
@@ -40,6 +44,8 @@ export class DeviceView {
       h("span", { class: "state-label", text: "device user" }), this.userName,
       h("button", { type: "button", class: "small device-logout", text: "Log out of device", onclick: () => this.logout() }));
     this.members = h("div", { class: "device-members" });
+    // the replay timeline (a replayed device) and the Record control, above the members
+    this.tools = h("div", { class: "device-tools" });
     const logBox = h("section", { class: "side-section event-section" }, h("h3", { text: "Event log" }));
     this.defBox = h("section", { class: "side-section definition-section" }, h("h3", { text: "Service definition" }));
     this.el = h("div", { class: "device-view", dataset: { device: name } },
@@ -48,7 +54,7 @@ export class DeviceView {
         h("span", { class: "state-label", text: "gateway → device" }), this.gatewayBadge,
         h("span", { class: "state-label", text: "this page → gateway" }), this.sessionBadge, this.userBox),
       this.banner,
-      h("div", { class: "device-body" }, h("div", { class: "device-main" }, this.loginForm.el, this.members), h("aside", { class: "device-side" }, logBox, this.defBox)));
+      h("div", { class: "device-body" }, h("div", { class: "device-main" }, this.loginForm.el, this.tools, this.members), h("aside", { class: "device-side" }, logBox, this.defBox)));
     root.append(this.el);
     this.log = new EventLog(logBox);
 
@@ -59,6 +65,28 @@ export class DeviceView {
     this.session = new DeviceSession(deviceUrl(name), { credentials: deviceLogins.get(name) ?? null });
     this.session.addEventListener("state", (ev) => this.sessionUpdate(ev.detail));
     this.session.start();
+    this.showReplay();
+  }
+
+  /**
+   * A device replayed from a file (listed by GET api/replays) gets its timeline; the controls need
+   * write on the device (api/devices/<name>/access), as POST api/replays/<name> does.
+   */
+  async showReplay() {
+    try {
+      const status = (await listReplays()).replays?.find((r) => r.name === this.name);
+      if (!status || this.closed) return;
+      let mayControl = true;
+      try {
+        const access = await fetchAccess(this.name);
+        mayControl = access.members === null || Object.values(access.members).some((ops) => Array.isArray(ops) && ops.includes("write"));
+      } catch { mayControl = false; }
+      if (this.closed) return;
+      this.replay = new ReplayTimeline(this.tools, { name: this.name, status, mayControl });
+      this.tools.prepend(this.replay.el);
+    } catch (e) {
+      this.log.add("error", "", `replay status: ${errorText(e)}`);
+    }
   }
 
   /** The form asking for the device's own login: user, password, "Log in", the device's error. */
@@ -157,6 +185,8 @@ export class DeviceView {
   clear() {
     this.panel?.dispose();
     this.panel = null;
+    this.recorder?.dispose();
+    this.recorder = null;
     this.definitions?.el.remove();
     this.definitions = null;
   }
@@ -166,6 +196,7 @@ export class DeviceView {
     const outline = new RobdefOutline(client.$definitions);
     this.definitions = new DefinitionView(this.defBox, outline, `def-${this.name}`);
     this.typeEl.textContent = client.$type;
+    this.recorder = new RecordControl(this.tools, { device: this.name, members: client.$members });
     // the device's types described once, from the definitions it sent (views/context.js)
     const view = viewContext(outline);
     this.panel = new ObjectPanel(this.members, {
@@ -176,6 +207,8 @@ export class DeviceView {
   }
 
   close() {
+    this.closed = true;
+    this.replay?.dispose();
     this.list.removeEventListener("update", this.onDevices);
     this.session.stop();
     this.clear();

@@ -1,0 +1,267 @@
+// The dashboard's Record control and replay timeline (issue 44; web/src/record/, docs/recording.md
+// "In the dashboard") in headless Chromium against rr-gateway with its demo devices:
+// (1) the `create` device's packets wire, Bump event and DistanceTraveled property are recorded from
+//     the page for a few seconds (live duration, size and message count shown and growing), stopped,
+//     and the file is read by the reference reader (PyPI `mcap` in the venv): the channels of both
+//     encodings and as many messages as the page said;
+// (2) a recording into a directory that cannot be created shows the gateway's reason on the page and
+//     lists the recording as failed;
+// (3) a second gateway replays that file (`--replay create_replay=FILE`): the page shows a timeline
+//     under the device; pause, seek, speed, loop and play from the page change what GET
+//     api/replays/create_replay reports, and the page shows the values the gateway reports;
+// (4) with logins (gateway.auth), a viewer (read only) sees the timeline with its controls disabled
+//     and the gateway refuses its POST; an operator (write) gets the controls.
+// Screenshots: docs/img/dashboard-recording.png and dashboard-replay.png with RR_DOCS_SCREENSHOTS=1.
+
+import { test, before, after, afterEach } from "node:test";
+import assert from "node:assert/strict";
+import fs from "node:fs";
+import os from "node:os";
+import path from "node:path";
+import { spawnSync } from "node:child_process";
+import { settings, startGateway, launchChromium, apiDevices, waitFor, writeOperatorViewerConfig } from "./harness.mjs";
+import { screenshot } from "./std_support.mjs";
+
+const s = settings();
+let gateway, replayGateway, authGateway, browser, page, work, recordedFile, recordedMessages;
+const pageErrors = [];
+
+const view = (name) => page.locator(`.device-view[data-device="${name}"]`);
+const card = (member) => page.locator(`.member[data-member="${member}"]`).first();
+const control = () => view("create").locator(".record-control");
+const timeline = () => view("create_replay").locator(".replay-timeline");
+
+async function api(base, method, url, body) {
+  const r = await fetch(`${base}/${url}`, { method, headers: { "Content-Type": "application/json" }, body: body && JSON.stringify(body) });
+  return { status: r.status, body: await r.json() };
+}
+
+async function callFunction(c) {
+  const result = c.locator("output.result");
+  const before = Number((await result.getAttribute("data-calls")) || 0);
+  await c.locator("button[type=submit]").click();
+  await waitFor(async () => Number((await result.getAttribute("data-calls")) || 0) > before, "the call to finish");
+}
+
+async function openDevice(base, name) {
+  await page.goto(`${base}/#/${name}`);
+  await view(name).locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 30000 });
+}
+
+/** "m:ss.s" → seconds. */
+const seconds = (text) => {
+  const [m, sec] = text.trim().split(":");
+  return Number(m) * 60 + Number(sec);
+};
+
+before(async () => {
+  assert.ok(s.gateway, "RR_GATEWAY (path of rr-gateway) must be set");
+  work = fs.mkdtempSync(path.join(os.tmpdir(), "rr-recui-"));
+  gateway = await startGateway(s, {}, 0, ["--no-discovery"]);
+  await waitFor(async () => (await apiDevices(gateway.base)).every((d) => d.state === "connected"), "the demo devices connected", 30000);
+  browser = await launchChromium();
+  page = await (await browser.newContext({ viewport: { width: 1366, height: 1000 } })).newPage();
+  page.on("pageerror", (e) => pageErrors.push(e));
+});
+
+after(async () => {
+  if (page) await screenshot(page, "recording-end.png", { docs: false, fullPage: true }).catch(() => {});
+  await browser?.close();
+  const statuses = [];
+  for (const g of [gateway, replayGateway, authGateway]) if (g) statuses.push(await g.child.stop());
+  if (work) fs.rmSync(work, { recursive: true, force: true });
+  for (const st of statuses) assert.equal(st.code, 0, `rr-gateway exited with ${JSON.stringify(st)}`);
+});
+
+afterEach(() => {
+  assert.deepEqual(pageErrors.splice(0).map(String), [], "uncaught errors in the page");
+});
+
+test("records the create device's members from the page; the file reads", async () => {
+  await openDevice(gateway.base, "create");
+  // the device streams its packets wire only while a client asked it to (and answers play_callback)
+  const cb = card("play_callback");
+  await cb.locator('[aria-label="play_callback reply"]').fill("60, 16");
+  await cb.locator("input[type=checkbox]").check();
+  await callFunction(card("StartStreaming"));
+
+  const c = control();
+  await c.locator("details.record-options summary").click();
+  const boxes = c.locator('input[name="record-member"]');
+  // defaults: wires, pipes and events checked, properties not
+  assert.equal(await c.locator('input[value="packets"]').isChecked(), true);
+  assert.equal(await c.locator('input[value="Bump"]').isChecked(), true);
+  assert.equal(await c.locator('input[value="DistanceTraveled"]').isChecked(), false);
+  assert.equal(await c.locator('input[value="Drive"]').count(), 0, "functions are not offered");
+  await c.locator("button", { hasText: "none" }).click();
+  assert.equal(await boxes.evaluateAll((bs) => bs.filter((b) => b.checked).length), 0);
+  for (const m of ["packets", "Bump", "DistanceTraveled"]) await c.locator(`input[value="${m}"]`).check();
+  await c.locator('select[name="record-encoding"]').selectOption("both");
+  await c.locator('input[name="record-directory"]').fill(path.join(work, "rec"));
+
+  await c.locator(".record-button").click();
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  assert.equal(await c.getAttribute("data-state"), "recording");
+  // the live line grows: duration, size and messages
+  const live = c.locator(".record-live");
+  const facts = async () => {
+    const t = await live.textContent();
+    const m = t.match(/recording (\d+:\d+\.\d) · ([\d.]+ \w+) · (\d+) messages · (\d+) drops/);
+    assert.ok(m, `live line "${t}"`);
+    return { duration: seconds(m[1]), size: m[2], messages: Number(m[3]), drops: Number(m[4]) };
+  };
+  await waitFor(async () => (await facts()).messages > 0, "messages counted on the page", 10000);
+  const first = await facts();
+  await screenshot(view("create").locator(".device-tools"), "dashboard-recording.png");
+  await waitFor(async () => (await facts()).duration >= first.duration + 2, "the duration grows on the page", 10000);
+  const second = await facts();
+  assert.ok(second.messages > first.messages, `messages grow: ${first.messages} → ${second.messages}`);
+  assert.equal(second.drops, 0);
+
+  await c.locator(".record-button").click();
+  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
+  await callFunction(card("StopStreaming"));
+  const item = c.locator(".recordings > li").first();
+  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 10000);
+  const files = await item.locator(".recording-files code").allTextContents();
+  assert.equal(files.length, 1, `one file: ${files}`);
+  recordedFile = path.resolve(files[0]);
+  assert.ok(recordedFile.startsWith(path.join(work, "rec")), `${recordedFile} in the chosen directory`);
+  assert.ok(fs.statSync(recordedFile).size > 0);
+  const id = Number(await item.getAttribute("data-id"));
+  const listed = (await api(gateway.base, "GET", "api/recordings")).body.recordings.find((r) => r.id === id);
+  recordedMessages = listed.messages;
+  assert.match(await item.locator(".recording-facts").textContent(), new RegExp(`· ${listed.messages} messages · 0 drops`));
+
+  // the reference reader (PyPI mcap): channels of both encodings, and as many messages as listed
+  const py = [
+    "import sys, json, collections",
+    "from mcap.reader import make_reader",
+    "with open(sys.argv[1], 'rb') as f:",
+    "    r = make_reader(f)",
+    "    n = collections.Counter()",
+    "    for schema, channel, message in r.iter_messages():",
+    "        n[channel.topic + ' ' + channel.message_encoding] += 1",
+    "print(json.dumps(n))",
+  ].join("\n");
+  const out = spawnSync(s.python, ["-c", py, recordedFile], { encoding: "utf8" });
+  assert.equal(out.status, 0, out.stderr);
+  const counts = JSON.parse(out.stdout);
+  for (const topic of ["create/packets", "create/DistanceTraveled"]) {
+    for (const enc of ["json", "robotraconteur"]) assert.ok(counts[`${topic} ${enc}`] > 0, `${topic} ${enc} messages: ${out.stdout}`);
+  }
+  assert.equal(Object.values(counts).reduce((a, b) => a + b, 0), recordedMessages, `messages in the file ${out.stdout}`);
+});
+
+test("a directory the gateway cannot create: the reason on the page, the recording failed", async () => {
+  const c = control();
+  await c.locator('input[name="record-directory"]').fill("/proc/no/such/dir");
+  await c.locator(".record-button").click();
+  const error = c.locator(".record-error");
+  await error.waitFor({ state: "visible", timeout: 10000 });
+  assert.match(await error.textContent(), /\/proc\/no\/such\/dir/);
+  const item = c.locator(".recordings > li").first();
+  await waitFor(async () => (await item.getAttribute("data-state")) === "failed", "the recording listed as failed", 10000);
+  assert.match(await item.locator(".recording-error").textContent(), /\/proc\/no\/such\/dir/);
+  assert.equal(await c.locator(".record-button").textContent(), "Record", "nothing is recording");
+});
+
+test("a replayed file: play, pause, seek, speed and loop from the timeline", async () => {
+  assert.ok(recordedFile, "the recording of the first test");
+  replayGateway = await startGateway(s, {}, 0, ["--no-demo", "--no-discovery", "--replay", `create_replay=${recordedFile}`]);
+  const status = async () => (await api(replayGateway.base, "GET", "api/replays/create_replay")).body;
+  await openDevice(replayGateway.base, "create_replay");
+  const t = timeline();
+  await t.waitFor({ timeout: 10000 });
+  assert.equal(await view("create_replay").locator(".record-control").count(), 1, "a replayed device can be recorded too");
+  assert.equal(await t.locator(".replay-file").textContent(), recordedFile);
+  const st0 = await status();
+  assert.ok(Math.abs(seconds(await t.locator(".replay-duration").textContent()) - st0.duration_s) <= 0.05, "the page shows the duration");
+  assert.match(await t.locator(".replay-span").textContent(), /recorded \d{4}-\d\d-\d\dT.*Z – \d{4}-.*Z/);
+
+  // loop on first: the short file then never ends while the test drives it
+  await t.locator(".replay-loop").check();
+  await waitFor(async () => (await status()).loop === true, "loop at the gateway");
+  // playing (it may have ended before the page opened: Play starts it again), then pause
+  if ((await t.locator(".replay-play").textContent()) === "Play") await t.locator(".replay-play").click();
+  await waitFor(async () => (await status()).state === "playing", "playing at the gateway");
+  await t.locator(".replay-play", { hasText: "Pause" }).waitFor();
+  await t.locator(".replay-play").click();
+  await waitFor(async () => (await status()).state === "paused", "paused at the gateway");
+  await t.locator(".replay-play", { hasText: "Play" }).waitFor();
+  const p1 = (await status()).position_s;
+  await new Promise((r) => setTimeout(r, 700));
+  assert.equal((await status()).position_s, p1, "the position stays while paused");
+
+  // seek to the middle with the slider
+  const target = Math.round(st0.duration_s * 500) / 1000;
+  await t.locator(".replay-seek").evaluate((el, v) => {
+    el.value = String(v);
+    el.dispatchEvent(new Event("input", { bubbles: true }));
+    el.dispatchEvent(new Event("change", { bubbles: true }));
+  }, Math.round(target * 1000));
+  await waitFor(async () => Math.abs((await status()).position_s - target) < 0.01, `the gateway at ${target} s`);
+  await waitFor(async () => Math.abs(seconds(await t.locator(".replay-position").textContent()) - target) <= 0.05, "the page shows the position");
+  assert.equal((await status()).state, "paused");
+  const shownAtSeek = await t.locator(".replay-position").textContent();
+
+  // speed
+  await t.locator(".replay-speed").selectOption("2");
+  await waitFor(async () => (await status()).speed === 2, "speed 2 at the gateway");
+  await screenshot(view("create_replay").locator(".device-tools"), "dashboard-replay.png");
+
+  // play: the position moves on (at twice the recorded pace) and the page follows
+  await t.locator(".replay-play").click();
+  await waitFor(async () => (await status()).state === "playing", "playing at the gateway");
+  await waitFor(async () => (await status()).position_s !== target, "the position moves on", 10000);
+  await waitFor(async () => (await t.locator(".replay-position").textContent()) !== shownAtSeek, "the page's position moves");
+  await t.locator(".replay-loop").uncheck();
+  await waitFor(async () => (await status()).loop === false, "loop off at the gateway");
+  // the replayed device's packets reach the page like a live device's
+  await card("packets").locator(".plot-readout [data-series]").first().waitFor({ timeout: 15000 });
+});
+
+test("with logins: a viewer's timeline is read only, an operator's is not", async () => {
+  assert.ok(recordedFile, "the recording of the first test");
+  const config = writeOperatorViewerConfig(work, [
+    "demo:",
+    "  enabled: false",
+    "devices:",
+    "  - name: create_replay",
+    `    replay: ${JSON.stringify(recordedFile)}`,
+    "    paused: true",
+  ]);
+  authGateway = await startGateway(s, {}, 0, ["--config", config, "--no-discovery"]);
+  const as = async (user, password) => {
+    const context = await browser.newContext({ viewport: { width: 1366, height: 900 } });
+    const p = await context.newPage();
+    p.on("pageerror", (e) => pageErrors.push(e));
+    await p.goto(`${authGateway.base}/#/create_replay`);
+    await p.waitForURL(/\/login\.html/, { timeout: 20000 });
+    await p.fill("#login-username", user);
+    await p.fill("#login-password", password);
+    await p.click("#login-submit");
+    await p.waitForURL((u) => !u.pathname.endsWith("login.html"), { timeout: 20000 });
+    const t = p.locator('.device-view[data-device="create_replay"] .replay-timeline');
+    await t.waitFor({ timeout: 20000 });
+    return { context, p, t };
+  };
+  const bob = await as("bob", "bob-pw");
+  assert.equal(await bob.t.getAttribute("data-state"), "paused");
+  for (const c of [".replay-play", ".replay-seek", ".replay-speed", ".replay-loop"]) {
+    assert.equal(await bob.t.locator(c).isDisabled(), true, `${c} disabled for a viewer`);
+  }
+  assert.match(await bob.t.locator(".hint").textContent(), /needs write on the device/);
+  const refused = await bob.p.evaluate(async () => (await fetch("api/replays/create_replay", { method: "POST", body: JSON.stringify({ state: "playing" }) })).status);
+  assert.equal(refused, 403, "the gateway refuses a viewer's control");
+  // every logged-in user may record (the recording routes need a login only)
+  await bob.p.locator('.device-view[data-device="create_replay"] .record-button').waitFor({ timeout: 20000 });
+  await bob.context.close();
+
+  const alice = await as("alice", "alice-pw");
+  assert.equal(await alice.t.locator(".replay-play").isDisabled(), false, "an operator may control the replay");
+  assert.equal(await alice.t.locator(".hint").count(), 0);
+  await alice.t.locator(".replay-play").click();
+  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 10000 });
+  await alice.context.close();
+});
