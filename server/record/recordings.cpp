@@ -2,6 +2,7 @@
 
 #include <charconv>
 
+#include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/json_rest.hpp"
 
 namespace rr::server::record {
@@ -161,6 +162,18 @@ ApiError not_found(std::string_view what) {
     return api_error(404, MessageErrorType::ResourceNotFound, "no recording " + std::string(what));
 }
 
+// With logins on, starting or stopping a device's recording writes files on the gateway's disk: it takes
+// the right to write that device (docs/security.md), as replay control does; a viewer may only list.
+std::optional<ApiError> write_refused(const gateway::JsonApi& api, const http::Request& req, const std::string& device) {
+    if (!api.auth() || !api.auth()->enabled()) return std::nullopt;
+    gateway::MemberAddress a;
+    a.device = device;
+    a.member = "*";
+    auto who = gateway::auth::authenticate_request(*api.auth(), req);
+    if (auto* p = std::get_if<gateway::auth::PrincipalPtr>(&who)) a.principal = *p;
+    return api.check_access(a, gateway::auth::Operation::write);
+}
+
 }  // namespace
 
 void install_recording_routes(http::HttpServer& http, std::shared_ptr<gateway::JsonApi> api,
@@ -179,6 +192,7 @@ void install_recording_routes(http::HttpServer& http, std::shared_ptr<gateway::J
         if (!body) return respond(error_response(req, api_error(400, MessageErrorType::InvalidArgument, body.error().message)));
         auto spec = spec_from_json(*body);
         if (!spec) return respond(error_response(req, api_error(400, spec.error().type, spec.error().message)));
+        if (auto denied = write_refused(*api, req, spec->device)) return respond(error_response(req, *denied));
         auto r = recordings->start(std::move(*spec));
         if (auto* e = std::get_if<ApiError>(&r)) return respond(error_response(req, *e));
         respond(json_response(req, 201, status_json(std::get<RecordingStatus>(r))));
@@ -195,6 +209,9 @@ void install_recording_routes(http::HttpServer& http, std::shared_ptr<gateway::J
         if (auto e = gateway::login_needed(*api, req)) return respond(error_response(req, *e));
         auto id = parse_id_path(req.target());
         if (!id || !id->second) return respond(error_response(req, not_found(std::string(req.target()))));
+        auto current = recordings->get(id->first);
+        if (!current) return respond(error_response(req, not_found(std::to_string(id->first))));
+        if (auto denied = write_refused(*api, req, current->spec.device)) return respond(error_response(req, *denied));
         auto head = std::make_shared<http::Request>(req.base(), std::string());
         recordings->stop(id->first, [head, respond, n = id->first](std::optional<RecordingStatus> s) {
             if (!s) return respond(error_response(*head, not_found(std::to_string(n))));

@@ -254,8 +254,13 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.match(await bob.t.locator(".hint").textContent(), /needs write on the device/);
   const refused = await bob.p.evaluate(async () => (await fetch("api/replays/create_replay", { method: "POST", body: JSON.stringify({ state: "playing" }) })).status);
   assert.equal(refused, 403, "the gateway refuses a viewer's control");
-  // every logged-in user may record (the recording routes need a login only)
-  await bob.p.locator('.device-view[data-device="create_replay"] .record-button').waitFor({ timeout: 20000 });
+  // recording needs write on the device too: a viewer's Record button is disabled, the gateway refuses
+  const bobRecord = bob.p.locator('.device-view[data-device="create_replay"] .record-button');
+  await bobRecord.waitFor({ timeout: 20000 });
+  await bob.p.locator('.device-view[data-device="create_replay"] .record-refused').waitFor({ timeout: 20000 });
+  assert.equal(await bobRecord.isDisabled(), true, "Record disabled for a viewer");
+  const refusedRecording = await bob.p.evaluate(async () => (await fetch("api/recordings", { method: "POST", body: JSON.stringify({ device: "create_replay" }) })).status);
+  assert.equal(refusedRecording, 403, "the gateway refuses a viewer's recording");
   await bob.context.close();
 
   const alice = await as("alice", "alice-pw");
@@ -263,5 +268,7 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.equal(await alice.t.locator(".hint").count(), 0);
   await alice.t.locator(".replay-play").click();
   await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 10000 });
+  assert.equal(await alice.p.locator('.device-view[data-device="create_replay"] .record-button').isDisabled(), false, "an operator may record");
+  assert.equal(await alice.p.locator(".record-refused").count(), 0);
   await alice.context.close();
 });

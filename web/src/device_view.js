@@ -76,17 +76,26 @@ export class DeviceView {
     try {
       const status = (await listReplays()).replays?.find((r) => r.name === this.name);
       if (!status || this.closed) return;
-      let mayControl = true;
-      try {
-        const access = await fetchAccess(this.name);
-        mayControl = access.members === null || Object.values(access.members).some((ops) => Array.isArray(ops) && ops.includes("write"));
-      } catch { mayControl = false; }
+      const mayControl = await this.mayWriteDevice();
       if (this.closed) return;
       this.replay = new ReplayTimeline(this.tools, { name: this.name, status, mayControl });
       this.tools.prepend(this.replay.el);
     } catch (e) {
       this.log.add("error", "", `replay status: ${errorText(e)}`);
     }
+  }
+
+  /**
+   * Whether this login may write the whole device (write on every member), which replay control and
+   * recording need (POST api/replays/<name>, POST api/recordings: docs/security.md). Asked once per page.
+   * @returns {Promise<boolean>}
+   */
+  mayWriteDevice() {
+    this.writeAccess ??= fetchAccess(this.name).then(
+      (access) => access.members === null ||
+        (Object.keys(access.members).length > 0 && Object.values(access.members).every((ops) => Array.isArray(ops) && ops.includes("write"))),
+      () => false);
+    return this.writeAccess;
   }
 
   /** The form asking for the device's own login: user, password, "Log in", the device's error. */
@@ -196,7 +205,8 @@ export class DeviceView {
     const outline = new RobdefOutline(client.$definitions);
     this.definitions = new DefinitionView(this.defBox, outline, `def-${this.name}`);
     this.typeEl.textContent = client.$type;
-    this.recorder = new RecordControl(this.tools, { device: this.name, members: client.$members });
+    const recorder = this.recorder = new RecordControl(this.tools, { device: this.name, members: client.$members });
+    this.mayWriteDevice().then((may) => { if (!may) recorder.refuse("Your login may not record this device (it needs write on the device)."); });
     // the device's types described once, from the definitions it sent (views/context.js)
     const view = viewContext(outline);
     this.panel = new ObjectPanel(this.members, {

@@ -65,6 +65,14 @@ export class RecordControl {
     this.timer = setInterval(() => this.poll(), POLL_MS);
   }
 
+  /** Disables starting a recording, saying why (the gateway would refuse it: 403). */
+  refuse(reason) {
+    this.refused = true;
+    if (!this.active) this.button.disabled = true;
+    this.button.title = reason;
+    this.el.querySelector(".record-row").after(h("p", { class: "hint record-refused", text: reason }));
+  }
+
   showError(text) {
     this.error.textContent = text || "";
     this.error.hidden = !text;
@@ -87,7 +95,8 @@ export class RecordControl {
     this.el.dataset.state = this.active ? this.active.state : newest?.state === "failed" ? "failed" : "idle";
     this.button.textContent = this.active ? "Stop" : "Record";
     this.button.dataset.action = this.active ? "stop" : "record";
-    if (!this.busy) this.button.disabled = this.active?.state === "stopping";
+    // a login without the right may still see a recording someone else started, not start one
+    if (!this.busy) this.button.disabled = this.active ? this.active.state === "stopping" : Boolean(this.refused);
     this.live.textContent = this.active
       ? `● ${this.active.state} ${formatSeconds(this.active.duration_s)} · ${formatBytes(this.active.bytes)} · ${this.active.messages} messages · ${this.active.drops} drops`
       : "";
