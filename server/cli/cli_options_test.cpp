@@ -137,7 +137,7 @@ TEST_CASE("cli: record and replay command lines") {
              {"record"}, {"record", "u", "v"}, {"record", "u", "--members", "a,,b"}, {"record", "u", "--encoding", "xml"},
              {"record", "u", "--duration", "0"}, {"record", "u", "--port", "1"}, {"replay"}, {"replay", "f", "--dir", "d"},
              {"replay", "f", "--speed", "0"}, {"replay", "f", "--port", "70000"}, {"get", "u", "m", "--loop"}}) {
-        INFO(bad.size() > 1 ? bad[1] : bad[0]);
+        INFO((bad.size() > 1 ? bad[1] : bad[0]));
         auto e = parse(bad);
         REQUIRE_FALSE(e);
         CHECK(e.error().type == MessageErrorType::InvalidArgument);
