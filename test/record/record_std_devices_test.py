@@ -72,7 +72,20 @@ def start_device(script, args, work):
     errf = open(os.path.join(work, os.path.basename(script) + ".log"), "wb")
     proc = subprocess.Popen([sys.executable, os.path.join(DEVICES, script)] + args, stdout=subprocess.PIPE,
                             stderr=errf, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
-    return proc, read_json_line(proc, 120, script)
+    # The drivers print other lines first (the camera driver: "Press Ctrl-C to quit..."): the ready line
+    # is the first JSON object with a url.
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            raise CheckFailed("%s exited early (status %s)" % (script, proc.wait(5)))
+        try:
+            info = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(info, dict) and "url" in info:
+            return proc, info
+    raise CheckFailed("%s: no ready line within 120 s" % script)
 
 
 def start_gateway(exe, args, work, name):
