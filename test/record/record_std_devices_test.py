@@ -11,7 +11,8 @@ MCAP reader (PyPI `mcap`) and compared with what the official Python client rece
   checks   channels (json and robotraconteur per member), schemas (the standard service definitions),
            counts; the json messages parse and (the first few, the frames being large) validate against
            their JSON Schema; every recorded robot_state value (seqno, joint_position, command_mode) and
-           every recorded frame (its bytes) is one the official client received live; the robot's file
+           every recorded frame (its seqno and
+           bytes) is one the official client received live; the robot's file
            replayed by `rr-gateway --replay` gives an official client recorded robot_state values.
 
 Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
@@ -165,7 +166,8 @@ def run(gateway_exe, work, seconds, checks):
             while e.Available > 0:
                 img = e.ReceivePacket()
                 with lock:
-                    live_frames.append(hashlib.sha256(bytes(bytearray(img.data))).hexdigest())
+                    live_frames.append((int(img.image_info.data_header.seqno),
+                                        hashlib.sha256(bytes(bytearray(img.data))).hexdigest()))
 
         ep.PacketReceivedEvent += on_frame
         try:
@@ -207,7 +209,10 @@ def run(gateway_exe, work, seconds, checks):
         expect(seen >= len(states) - 2, "recorded robot_state values are those the official client received live")
         frames = check_file(finals["camera"]["files"][0], "camera", "frame_stream", "com.robotraconteur.imaging",
                             checks, validate_max=3)
-        hashes = [hashlib.sha256(bytes(f["data"])).hexdigest() for f in frames]
+        # A frame is its sequence number (the driver's data_header.seqno) and its bytes (the synthetic
+        # pattern repeats, so the bytes alone would not tell frames apart).
+        hashes = [(int(f["image_info"]["data_header"]["seqno"]), hashlib.sha256(bytes(f["data"])).hexdigest()) for f in frames]
+        expect(len(set(hashes)) == len(hashes), "recorded frames are distinct (seqno, bytes)")
         expect(len(frames) >= seconds * 10 * 0.5, "frames recorded (%d in %s s at 10 fps)" % (len(frames), seconds))
         expect(all(f["image_info"]["width"] == 160 and f["image_info"]["height"] == 120 for f in frames), "frame size")
         fseen = sum(h in live_f for h in hashes)
