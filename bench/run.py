@@ -20,9 +20,13 @@ Issue 14's rows, off unless asked for (--rr-fanout, --camera, --browser, or --on
   * camera: 640x480 RGB frames at 30 Hz (the Frames wire) to N JSON clients with binary pushes;
   * browser: the wasm client in node and in headless Chromium (wasm_bench.mjs), Nop and a property
     read through the gateway over rr+ws, with the native client and the TCP floor in the same rounds.
+  * record (issue 44, --record): the camera row (640x480 RGB at 30 Hz to 10 JSON clients) and a
+    1,000 values/s wire (Ticks to 10 JSON clients), each without and with a recording of it running in
+    the gateway (POST /api/recordings), alternating within each round (--record-rounds, default 2).
 
 Usage: run.py --build DIR [--rounds R] [--count N] [--quick] [--no-busy] [--skip-fanout] [--skip-scale]
-              [--rr-fanout] [--camera] [--browser] [--only calls,fanout,scale,rr-fanout,camera,browser]
+              [--rr-fanout] [--camera] [--browser] [--record]
+              [--only calls,fanout,scale,rr-fanout,camera,browser,pairs,record]
 """
 import argparse
 import datetime
@@ -36,6 +40,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -180,7 +185,7 @@ class Sampler(threading.Thread):
                 "vcsw_per_s": (s[-1][3] - s[0][3]) / dt}
 
 
-SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs")
+SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record")
 # Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
 # allows by default (256); 0 lifts the limit.
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
@@ -294,6 +299,72 @@ def camera_section(exe, args, procs):
         procs.remove(gw)
     dev.stop()
     procs.remove(dev)
+    return rows
+
+
+def post_json(port, path, body, timeout=120):
+    req = urllib.request.Request("http://127.0.0.1:%d%s" % (port, path), data=json.dumps(body).encode(), method="POST",
+                                 headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(req, timeout=timeout) as r:
+        return json.loads(r.read())
+
+
+def record_section(exe, args, procs):
+    """Issue 44: what a recording running in the gateway costs the live path. Two workloads, each on a
+    fresh gateway per row, without and with a recording (docs/recording.md) of the member, alternating
+    within each round so that each pair shares the moment:
+      * camera: 640x480 RGB frames (921,600 bytes) at 30 Hz on Frames to 10 JSON clients (binary pushes),
+        recorded with the `robotraconteur` encoding only (the frame as JSON numbers would cost ~4 ms and
+        3.5 MB a frame; `json` is for plots, not images);
+      * wire: Ticks at 1,000 values/s (16 doubles) to 10 JSON clients, recorded in both encodings.
+    Each recorded row gets the recording's final status (messages, drops, bytes): drops > 0 means the
+    writer fell behind and the queue overflowed."""
+    rows = []
+    work = tempfile.mkdtemp(prefix="rr-bench-record-")
+    seconds = "3" if args.quick else "5"
+    workloads = [
+        ("camera", [exe["rr_bench_service"], "--frame-hz", "30", "--frame-bytes", str(640 * 480 * 3)],
+         ["--member", "Frames", "--binary", "--hz", "30"], {"members": ["Frames"], "encoding": "robotraconteur"},
+         {"frame_bytes": 640 * 480 * 3, "hz": 30.0}),
+        ("wire", [exe["rr_bench_service"], "--tick-hz", "1000", "--tick-size", "16"],
+         ["--member", "Ticks", "--hz", "1000"], {"members": ["Ticks"]}, {"hz": 1000.0}),
+    ]
+    try:
+        for name, dev_argv, load_args, spec, fields in workloads:
+            dev = Proc(dev_argv, "bench_service (%s)" % name)
+            procs.append(dev)
+            for r in range(args.record_rounds):
+                for recording in ((False, True) if r % 2 == 0 else (True, False)):
+                    log("record, round %d/%d: %s to 10 JSON clients, %s" % (r + 1, args.record_rounds, name,
+                                                                       "with a recording" if recording else "no recording"))
+                    gw = gateway_proc(exe, dev.ready["url"], unlimited=True)
+                    procs.append(gw)
+                    port = gw.ready["port"]
+                    rec = None
+                    if recording:
+                        rec = post_json(port, "/api/recordings", dict(spec, device="bench", directory=work))
+                    label = {"workload": name, "round": r + 1, "recording": recording, "server": "gateway",
+                             "path": "device->gateway->10 x JSON" + (" + recording" if recording else "")}
+                    label.update(fields)
+                    got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(port), "--clients", "10", "fanout",
+                                             "--seconds", seconds] + load_args, label)
+                    if rec:
+                        final = post_json(port, "/api/recordings/%d/stop" % rec["id"], {})
+                        for row in got:
+                            row["recording_status"] = {k: final.get(k) for k in ("state", "messages", "drops", "bytes",
+                                                                                 "duration_s", "error")}
+                        for f in final.get("files", []):
+                            try:
+                                os.remove(f)
+                            except OSError:
+                                pass
+                    rows += got
+                    gw.stop()
+                    procs.remove(gw)
+            dev.stop()
+            procs.remove(dev)
+    finally:
+        subprocess.run(["rm", "-rf", work])
     return rows
 
 
@@ -491,6 +562,8 @@ def main(argv=None):
     ap.add_argument("--rr-fanout-threads", type=int, default=1, help="IO threads of rr_bench_rr_fanout (default 1)")
     ap.add_argument("--camera", action="store_true", help="also: 640x480 RGB at 30 Hz to N JSON clients (binary pushes)")
     ap.add_argument("--browser", action="store_true", help="also: the wasm client in node and Chromium, with the native client")
+    ap.add_argument("--record", action="store_true", help="also: the camera row and a 1,000 values/s wire with and without a recording")
+    ap.add_argument("--record-rounds", type=int, default=2, help="rounds of the record section (default 2)")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
     ap.add_argument("--pairs", action="store_true", help="also: issue 14's ratios from short interleaved blocks")
     ap.add_argument("--pair-blocks", type=int, default=24, help="blocks of the pairs section (default 24)")
@@ -514,6 +587,7 @@ def main(argv=None):
         args.skip_calls, args.skip_fanout, args.skip_scale = "calls" not in only, "fanout" not in only, "scale" not in only
         args.rr_fanout, args.camera, args.browser = "rr-fanout" in only, "camera" in only, "browser" in only
         args.pairs = "pairs" in only
+        args.record = "record" in only
         stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
     browser_rounds = args.rounds
 
@@ -653,6 +727,7 @@ def main(argv=None):
         camera = camera_section(exe, args, procs) if args.camera else []
         browser = browser_section(exe, args, browser_rounds, procs) if args.browser else []
         pairs = pairs_section(exe, args, procs) if args.pairs else {}
+        record = record_section(exe, args, procs) if args.record else []
     finally:
         for p in reversed(procs):
             p.stop()
@@ -661,6 +736,7 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
+    result.update({"record": record})
     result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser,
                    "pairs": pairs.get("figures", []), "pairs_raw": pairs.get("raw", [])})
     result["load_average_end"] = list(os.getloadavg())
@@ -877,6 +953,22 @@ def markdown(res):
                 out.append("| %s | %s | %s | %s | %.1f %% | %s | %s | %s |" % (
                     fmt(f["clients"]), fmt(w["clients"]), fmt(w["read_delay_ms"]), fmt(w["per_client_per_s_median"]),
                     100 * w["delivered_of_sent"], fmt(w["p50_us"] / 1000), fmt(w["p99_us"] / 1000), fmt(w["max_us"] / 1000)))
+    if res.get("record"):
+        out += ["", "Recording while serving (issue 44): the camera row (640×480 RGB at 30 Hz, `robotraconteur` encoding) and a "
+                "1,000 values/s wire (`Ticks`, 16 doubles, both encodings), each to 10 JSON clients, without and with a recording "
+                "of the member in the gateway; the two rows of a pair ran one after the other in the same round:", "",
+                "| workload | round | recording | values/s per client min, median | delivered of sent | p50 ms | p99 ms | max ms "
+                "| gateway CPU % | gateway CPU µs / value | gateway RSS MiB (max) | recorded messages | drops | MB written |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["record"]:
+            st = f.get("recording_status") or {}
+            out.append("| %s | %s | %s | %s, %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                f["workload"], f["round"], "yes" if f["recording"] else "no", fmt(f["per_client_per_s_min"]),
+                fmt(f["per_client_per_s_median"]), 100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000, 2),
+                fmt(f["p99_us"] / 1000, 2), fmt(f["max_us"] / 1000, 2), fmt(f.get("server_cpu_pct")),
+                fmt(f.get("server_cpu_us_per_value")), fmt(f.get("server_rss_kib", 0) / 1024),
+                fmt(st.get("messages"), 0) if st else "", fmt(st.get("drops"), 0) if st else "",
+                fmt((st.get("bytes") or 0) / 1e6) if st else ""))
     if res.get("browser"):
         out += ["", "Browser row: one call after the other through the gateway over rr+ws, the native client, the wasm client "
                 "in node (`ws` package) and in headless Chromium (`bench/wasm_bench.mjs`); × native and × TCP floor are per round "

@@ -4,6 +4,7 @@
 
 #include "robdef/builtin/service_index.hpp"
 #include "server/cli/cli_discover.hpp"
+#include "server/cli/cli_record.hpp"
 #include "server/cli/cli_target.hpp"
 #include "server/cli/cli_watch.hpp"
 
@@ -227,6 +228,8 @@ void print_error(std::ostream& err, const RRError& e) {
 
 ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err, const std::atomic<bool>& stop) {
     if (cl.kind == CommandKind::discover) return run_discover(cl, out, err);
+    if (cl.kind == CommandKind::record) return run_record(cl, out, err, stop);
+    if (cl.kind == CommandKind::replay) return run_replay(cl, out, err, stop);
     // Command-line JSON first: a typo must not need a connection to be reported.
     std::vector<nlohmann::json> json;
     for (std::size_t i = 0; i < cl.values.size(); ++i) {
@@ -280,6 +283,8 @@ ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err
             case CommandKind::call: f = run_call(cl, t, json, out); break;
             case CommandKind::watch: f = run_watch(cl, t, out, stop); break;
             case CommandKind::discover:  // handled above
+            case CommandKind::record:
+            case CommandKind::replay:
             case CommandKind::help: break;
         }
     }

@@ -13,6 +13,7 @@ Unexpected usage(std::string message) { return fail(MessageErrorType::InvalidArg
 const std::map<std::string, CommandKind, std::less<>> kCommands = {
     {"info", CommandKind::info}, {"get", CommandKind::get},     {"set", CommandKind::set},
     {"call", CommandKind::call}, {"watch", CommandKind::watch}, {"discover", CommandKind::discover},
+    {"record", CommandKind::record}, {"replay", CommandKind::replay},
 };
 
 Result<double> parse_seconds(std::string_view flag, std::string_view text) {
@@ -81,6 +82,10 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.json = true;
             continue;
         }
+        if (a == "--loop") {
+            cl.loop = true;
+            continue;
+        }
         std::string flag = a, value;
         if (auto eq = a.find('='); eq != std::string::npos) {
             flag = a.substr(0, eq);
@@ -88,7 +93,9 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
         } else {
             static const char* kWithValue[] = {"--timeout", "--username", "--password", "--token", "--object",
                                                "--count",   "--seconds",  "--tls-ca",   "--http-login",
-                                               "--type",    "--interface", "--tls-cert", "--tls-key"};
+                                               "--type",    "--interface", "--tls-cert", "--tls-key",
+                                               "--duration", "--dir",      "--members", "--encoding",
+                                               "--prefix",   "--name",     "--port",    "--address", "--speed"};
             bool known = false;
             for (const char* k : kWithValue) known = known || flag == k;
             if (!known) return usage("unknown option " + flag);
@@ -133,6 +140,42 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
             cl.http_login = value;
         } else if (flag == "--object") {
             object_path = value;
+        } else if (flag == "--duration") {
+            auto v = parse_seconds(flag, value);
+            if (!v) return v.take_error();
+            cl.duration = *v;
+        } else if (flag == "--speed") {
+            auto v = parse_seconds(flag, value);
+            if (!v || *v > 1000) return usage("--speed needs a factor above 0 and at most 1000, not \"" + value + "\"");
+            cl.speed = *v;
+        } else if (flag == "--dir") {
+            if (value.empty()) return usage("--dir needs a directory");
+            cl.directory = value;
+        } else if (flag == "--members") {
+            std::size_t start = 0;
+            while (start <= value.size()) {
+                auto comma = value.find(',', start);
+                if (comma == std::string::npos) comma = value.size();
+                if (comma == start) return usage("--members needs names separated by commas, not \"" + value + "\"");
+                cl.record_members.push_back(value.substr(start, comma - start));
+                start = comma + 1;
+            }
+        } else if (flag == "--encoding") {
+            if (value != "json" && value != "robotraconteur" && value != "both")
+                return usage("--encoding is json, robotraconteur or both, not \"" + value + "\"");
+            cl.encoding = value == "both" ? "" : value;
+        } else if (flag == "--prefix") {
+            cl.prefix = value;
+        } else if (flag == "--name") {
+            cl.device_name = value;
+        } else if (flag == "--address") {
+            cl.address = value;
+        } else if (flag == "--port") {
+            unsigned n = 0;
+            auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
+            if (ec != std::errc() || p != value.data() + value.size() || n > 65535)
+                return usage("--port needs a port number 0..65535, not \"" + value + "\"");
+            cl.port = static_cast<std::uint16_t>(n);
         } else {
             return usage("unknown option " + flag);
         }
@@ -165,6 +208,25 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
         if (cl.count || cl.seconds || object_path) return usage("--count, --seconds and --object do not apply to discover");
         return cl;
     }
+    const bool record_flags = cl.duration || !cl.record_members.empty() || !cl.encoding.empty() || !cl.prefix.empty() ||
+                              !cl.device_name.empty() || cl.directory != "recordings";
+    const bool replay_flags = cl.port != 0 || cl.address != "127.0.0.1" || cl.speed != 1.0 || cl.loop;
+    if (record_flags && cl.kind != CommandKind::record)
+        return usage("--duration, --dir, --members, --encoding, --prefix and --name apply to record only");
+    if (replay_flags && cl.kind != CommandKind::replay)
+        return usage("--port, --address, --speed and --loop apply to replay only");
+    if (cl.kind == CommandKind::replay) {
+        if (positional.size() != 2) return usage("replay takes one FILE (try rr replay --help)");
+        if (cl.count || cl.seconds || object_path) return usage("--count, --seconds and --object do not apply to replay");
+        cl.file = positional[1];
+        return cl;
+    }
+    if (cl.kind == CommandKind::record) {
+        if (positional.size() != 2) return usage("record takes one URL (try rr record --help)");
+        if (cl.count || cl.seconds || object_path) return usage("--count, --seconds and --object do not apply to record");
+        cl.url = positional[1];
+        return cl;
+    }
     auto need = [&](std::size_t min, std::size_t max) -> Result<void> {
         std::size_t n = positional.size() - 1;
         if (n < min || n > max) return usage("wrong number of arguments for \"" + name + "\" (try rr " + name + " --help)");
@@ -178,6 +240,8 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
         case CommandKind::call: shape = need(2, SIZE_MAX); break;
         case CommandKind::watch: shape = need(2, 2); break;
         case CommandKind::discover:
+        case CommandKind::record:
+        case CommandKind::replay:
         case CommandKind::help: break;
     }
     if (!shape) return shape.take_error();
@@ -215,6 +279,8 @@ std::string help_text(std::string_view topic) {
         "  call  URL FUNCTION [JSON...] call a function; a generator prints each item\n"
         "  watch URL MEMBER             stream a wire's values, an event or a pipe's packets\n"
         "  discover [--type T] [--json] nodes and services found on the network (docs/discovery.md)\n"
+        "  record URL [--duration S]    record the service's wires, pipes and events to MCAP files\n"
+        "  replay FILE [--port P]       serve a recording as a service on an rr+tcp node\n"
         "\n"
         "URL: rr+tcp://HOST:PORT/?service=NAME (also nodeid=, nodename=; rrs+tcp://, rr+ws://, rr+wss://;\n"
         "     rr+local:///?nodename=NAME&service=S on this computer;\n"
@@ -249,6 +315,18 @@ std::string help_text(std::string_view topic) {
                "S seconds (default 5), asks each node found for its services (RobotRaconteurServiceIndex),\n"
                "and prints every node with its URLs and services. --type keeps only services whose root\n"
                "object type is TYPE or implements it. --json prints one JSON object per node.\n";
+    if (topic == "record")
+        return "usage: rr record URL [--duration S] [--dir D] [--members A,B] [--encoding json|robotraconteur|both]\n"
+               "                     [--prefix P] [--name NAME]\n"
+               "Records the root object's wires, pipes and events (or the --members named, properties\n"
+               "polled every second) into MCAP files in D (default ./recordings), the gateway's format\n"
+               "(docs/recording.md), until SIGINT/SIGTERM or S seconds, then prints the recording's status\n"
+               "as one JSON line. NAME (default: the URL's service) names the topics NAME/MEMBER.\n";
+    if (topic == "replay")
+        return "usage: rr replay FILE [--port P] [--address A] [--speed S] [--loop]\n"
+               "Serves the recorded service of FILE (its robotraconteur channels) on an rr+tcp node at\n"
+               "A:P (default 127.0.0.1, a free port) until SIGINT/SIGTERM, playing wires, pipes and events\n"
+               "with the recorded spacing divided by S; prints the service's URL as the first line.\n";
     if (topic == "get")
         return "usage: rr get URL MEMBER [--object PATH]\n"
                "Prints the value of property MEMBER as one JSON line. For a wire, prints its InValue\n"

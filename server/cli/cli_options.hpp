@@ -25,7 +25,7 @@ enum class ExitCode : int {
     connect_failure = 3,  ///< no client session: unreachable, ServiceNotFound, authentication, …
 };
 
-enum class CommandKind { help, info, get, set, call, watch, discover };
+enum class CommandKind { help, info, get, set, call, watch, discover, record, replay };
 
 /// One segment of a member path: an objref (or, last, the member) name and an optional index key.
 struct PathSegment {
@@ -57,6 +57,19 @@ struct CommandLine {
     std::vector<std::string> types;       ///< --type: only services of these types (root or implemented)
     bool json = false;                    ///< --json: one JSON object per node
     std::vector<std::string> interfaces;  ///< --interface: network interfaces to use (default: all)
+    // record (docs/recording.md "From the command line")
+    std::optional<double> duration;        ///< --duration: stop after this many seconds (default: Ctrl-C)
+    std::string directory = "recordings";  ///< --dir: where the MCAP files go
+    std::vector<std::string> record_members;  ///< --members a,b: root members (default: every wire, pipe, event)
+    std::string encoding;                  ///< --encoding json|robotraconteur ("" = both)
+    std::string prefix;                    ///< --prefix: file name prefix ("" = the device name)
+    std::string device_name;               ///< --name: the device's name in topics ("" = the URL's service)
+    // replay
+    std::string file;                      ///< replay: the MCAP file
+    std::uint16_t port = 0;                ///< --port: rr+tcp port to serve on (0 = any free port)
+    std::string address = "127.0.0.1";     ///< --address: address to listen on
+    double speed = 1.0;                    ///< --speed: playback speed factor
+    bool loop = false;                     ///< --loop: start again at the end
 };
 
 /// Parses a member path (`a.b[3].c`). Errors: InvalidArgument (empty segment, unterminated `[`, text

@@ -106,3 +106,42 @@ TEST_CASE("cli: usage errors") {
         CHECK_FALSE(r.error().message.empty());
     }
 }
+
+TEST_CASE("cli: record and replay command lines") {
+    auto r = parse({"record", "rr+tcp://h:1/?service=s", "--duration", "2.5", "--dir", "/tmp/x", "--members", "a,b",
+                    "--encoding", "json", "--prefix", "p", "--name", "n"});
+    REQUIRE(r);
+    CHECK(r->kind == CommandKind::record);
+    CHECK(r->url == "rr+tcp://h:1/?service=s");
+    CHECK(r->duration == 2.5);
+    CHECK(r->directory == "/tmp/x");
+    CHECK(r->record_members == std::vector<std::string>{"a", "b"});
+    CHECK(r->encoding == "json");
+    CHECK(r->prefix == "p");
+    CHECK(r->device_name == "n");
+    auto both = parse({"record", "u", "--encoding", "both"});
+    REQUIRE(both);
+    CHECK(both->encoding.empty());
+    CHECK_FALSE(both->duration);
+
+    auto p = parse({"replay", "f.mcap", "--port", "8000", "--speed", "2", "--loop", "--address", "::1"});
+    REQUIRE(p);
+    CHECK(p->kind == CommandKind::replay);
+    CHECK(p->file == "f.mcap");
+    CHECK(p->port == 8000);
+    CHECK(p->speed == 2.0);
+    CHECK(p->loop);
+    CHECK(p->address == "::1");
+
+    for (auto bad : std::vector<std::vector<std::string>>{
+             {"record"}, {"record", "u", "v"}, {"record", "u", "--members", "a,,b"}, {"record", "u", "--encoding", "xml"},
+             {"record", "u", "--duration", "0"}, {"record", "u", "--port", "1"}, {"replay"}, {"replay", "f", "--dir", "d"},
+             {"replay", "f", "--speed", "0"}, {"replay", "f", "--port", "70000"}, {"get", "u", "m", "--loop"}}) {
+        INFO((bad.size() > 1 ? bad[1] : bad[0]));
+        auto e = parse(bad);
+        REQUIRE_FALSE(e);
+        CHECK(e.error().type == MessageErrorType::InvalidArgument);
+    }
+    CHECK_FALSE(help_text("record").empty());
+    CHECK_FALSE(help_text("replay").empty());
+}

@@ -1,0 +1,276 @@
+#!/usr/bin/env python3
+"""`rr record` and `rr replay` (docs/recording.md "From the command line") against rr_interop_service,
+with the official Robot Raconteur Python client and the reference MCAP reader (PyPI `mcap`):
+
+  record   an official client connects to the service's w_state wire (a tick every 200 ms) and keeps
+           every value it receives; `rr record URL --duration S --members w_state,p_stream,ev_values`
+           runs while the client asks for 5 pipe packets and 3 events; the reference reader lists the
+           channels (json and robotraconteur per member), schemas and counts, every json message is
+           valid against its JSON Schema, and the recorded w_state values are values the official client
+           received live (same id, label and values, in order).
+  sigint   `rr record` without --duration ends on SIGINT with exit status 0 and a complete (indexed) file.
+  replay   `rr replay FILE --port 0 --loop` prints its URL; an official client connected to it receives
+           w_state values that are recorded ones and the 5 recorded pipe packets; SIGINT ends it (status 0,
+           a final status line with played > 0).
+  errors   a member the object lacks (status 2), an unreachable service (status 3), an unwritable
+           directory and a file that is not MCAP (status 1, messages naming the member / path).
+
+Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
+from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+
+try:
+    import jsonschema
+    from mcap.reader import make_reader
+    import RobotRaconteur as RR
+except ImportError as e:  # pragma: no cover
+    print("SKIP: %s (run ./scripts/setup.sh)" % e)
+    sys.exit(77)
+
+RRN = RR.RobotRaconteurNode.s
+
+
+class CheckFailed(Exception):
+    pass
+
+
+def expect(cond, what):
+    if not cond:
+        raise CheckFailed(what)
+
+
+def inner_tuple(v):
+    """An Inner struct (official client value or JSON mapping) as (id, label, values)."""
+    if isinstance(v, dict):
+        return (v["id"], v["label"], tuple(float(x) for x in v["values"]))
+    return (int(v.id), str(v.label), tuple(float(x) for x in v.values))
+
+
+def read_channels(path):
+    """{(topic, encoding): (channel, schema, [messages])} with the reference reader, and its summary."""
+    out = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        for schema, channel, message in reader.iter_messages():
+            out.setdefault((channel.topic, channel.message_encoding), (channel, schema, []))[2].append(message)
+    with open(path, "rb") as f:
+        summary = make_reader(f).get_summary()
+    return out, summary
+
+
+def start_rr(exe, args):
+    return subprocess.Popen([exe] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+
+
+def wait_stderr_line(proc, prefix, timeout):
+    """Reads proc's stderr until a line starting with prefix (returns it) or timeout/EOF (raises)."""
+    box = {}
+
+    def reader():
+        for line in proc.stderr:
+            if line.startswith(prefix):
+                box["line"] = line
+                return
+            box.setdefault("other", []).append(line)
+
+    t = threading.Thread(target=reader, daemon=True)
+    t.start()
+    t.join(timeout)
+    expect("line" in box, "rr printed %r within %d s (got %r)" % (prefix, timeout, box.get("other")))
+    return box["line"]
+
+
+def record_phase(rr, url, work, seconds, checks):
+    client = RRN.ConnectService(url)
+    live = []
+    lock = threading.Lock()
+    wire = client.w_state.Connect()
+
+    def on_value(conn, value, ts):
+        with lock:
+            live.append(inner_tuple(value))
+
+    wire.WireValueChanged += on_value
+    time.sleep(0.5)
+    proc = start_rr(rr, ["record", url, "--duration", str(seconds), "--dir", work,
+                         "--members", "w_state,p_stream,ev_values"])
+    wait_stderr_line(proc, "rr: recording", 60)
+    time.sleep(1.0)  # the recorder's pipe endpoint is open
+    client.send_stream(5)
+    client.fire_events(3)
+    out, err = proc.communicate(timeout=seconds + 120)
+    time.sleep(0.5)
+    wire.Close()
+    RRN.DisconnectService(client)
+    expect(proc.returncode == 0, "rr record exits 0 (rc=%s, stderr=%s)" % (proc.returncode, err[-1500:]))
+    status = json.loads(out.strip().splitlines()[-1])
+    checks["record_status"] = {k: status[k] for k in ("state", "messages", "drops", "files", "members")}
+    expect(status["state"] == "stopped" and status["drops"] == 0, "the recording stopped without drops")
+    expect(len(status["files"]) == 1, "one file")
+    path = status["files"][0]
+
+    channels, summary = read_channels(path)
+    topics = sorted("%s %s %d" % (t, e, len(m[2])) for (t, e), m in channels.items())
+    checks["channels"] = topics
+    for member in ("w_state", "p_stream", "ev_values"):
+        for enc in ("json", "robotraconteur"):
+            expect(("interop/" + member, enc) in channels, "channel interop/%s (%s)" % (member, enc))
+    expect(len(channels[("interop/p_stream", "json")][2]) == 5, "5 pipe packets recorded")
+    expect(len(channels[("interop/ev_values", "json")][2]) == 3, "3 events recorded")
+    n_state = len(channels[("interop/w_state", "json")][2])
+    expect(n_state >= seconds * 5 * 0.5, "w_state recorded at about 5 Hz (%d values in %s s)" % (n_state, seconds))
+    expect(n_state == len(channels[("interop/w_state", "robotraconteur")][2]), "both encodings hold every w_state value")
+    rr_schema = [s for s in summary.schemas.values() if s.encoding == "robotraconteur_servicedef"]
+    expect(rr_schema and rr_schema[0].name == "experimental.interop_test", "the service definition is a schema")
+    for (topic, enc), (channel, schema, messages) in channels.items():
+        if enc != "json":
+            continue
+        expect(schema.encoding == "jsonschema", topic + ": jsonschema")
+        validator = jsonschema.Draft202012Validator(json.loads(schema.data))
+        for m in messages:
+            validator.validate(json.loads(m.data))
+    packets = [json.loads(m.data)["value"] for m in channels[("interop/p_stream", "json")][2]]
+    expect(packets == [[i, i * 0.5] for i in range(5)], "pipe packets as sent: %r" % packets)
+    recorded = [inner_tuple(json.loads(m.data)["value"]) for m in channels[("interop/w_state", "json")][2]]
+    with lock:
+        live_set = list(live)
+    expect(all(r in live_set for r in recorded), "every recorded w_state value was received live by the official client")
+    ids = [r[0] for r in recorded]
+    expect(ids == sorted(ids) and len(set(ids)) == len(ids), "recorded w_state values in order")
+    checks["w_state"] = {"recorded": len(recorded), "live": len(live_set), "first_id": ids[0], "last_id": ids[-1]}
+    return path, recorded
+
+
+def sigint_phase(rr, url, work, checks):
+    d = os.path.join(work, "sigint")
+    proc = start_rr(rr, ["record", url, "--dir", d, "--members", "w_state", "--encoding", "json"])
+    wait_stderr_line(proc, "rr: recording", 60)
+    time.sleep(1.5)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    expect(proc.returncode == 0, "rr record ends on SIGINT with 0 (rc=%s, %s)" % (proc.returncode, err[-800:]))
+    status = json.loads(out.strip().splitlines()[-1])
+    with open(status["files"][0], "rb") as f:
+        summary = make_reader(f).get_summary()
+    expect(summary is not None and summary.statistics.message_count >= 3, "the SIGINT file is complete, with values")
+    expect(all(c.message_encoding == "json" for c in summary.channels.values()), "--encoding json: json channels only")
+    checks["sigint"] = {"messages": summary.statistics.message_count}
+
+
+def replay_phase(rr, path, recorded, checks):
+    proc = start_rr(rr, ["replay", path, "--port", "0", "--loop"])
+    line = proc.stdout.readline().strip()
+    expect(line.startswith("rr+tcp://127.0.0.1:") and "service=interop" in line, "rr replay prints its URL: %r" % line)
+    try:
+        client = RRN.ConnectService(line)
+        got, pipe_got = [], []
+        lock = threading.Lock()
+        wire = client.w_state.Connect()
+
+        def on_value(conn, value, ts):
+            with lock:
+                got.append(inner_tuple(value))
+
+        wire.WireValueChanged += on_value
+        ep = client.p_stream.Connect(-1)
+
+        def on_packet(e):
+            while e.Available > 0:
+                with lock:
+                    pipe_got.append([float(x) for x in e.ReceivePacket()])
+
+        ep.PacketReceivedEvent += on_packet
+        duration = (recorded and len(recorded) * 0.2) or 3
+        deadline = time.monotonic() + duration + 4
+        want = [[float(i), i * 0.5] for i in range(5)]
+        while time.monotonic() < deadline:
+            time.sleep(0.2)
+            with lock:
+                if len(got) >= 5 and any(pipe_got[i:i + 5] == want for i in range(len(pipe_got))):
+                    break
+        with lock:
+            got_c, pipe_c = list(got), list(pipe_got)
+        ep.Close()
+        wire.Close()
+        RRN.DisconnectService(client)
+        checks["replay"] = {"w_state_received": len(got_c), "pipe_packets": len(pipe_c)}
+        expect(len(got_c) >= 5, "the official client receives replayed w_state values")
+        expect(all(g in recorded for g in got_c), "every replayed w_state value is a recorded one")
+        expect(any(pipe_c[i:i + 5] == want for i in range(len(pipe_c))), "the 5 recorded pipe packets are replayed: %r" % pipe_c[:10])
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    expect(proc.returncode == 0, "rr replay ends on SIGINT with 0 (rc=%s, %s)" % (proc.returncode, err[-800:]))
+    final = json.loads(out.strip().splitlines()[-1])
+    expect(final["played"] > 0 and final["loop"] is True, "final replay status: %r" % final)
+
+
+def errors_phase(rr, url, work, checks):
+    def run(args, timeout=90):
+        p = subprocess.run([rr] + args, capture_output=True, text=True, timeout=timeout)
+        return p.returncode, p.stderr
+
+    rc, err = run(["record", url, "--members", "no_such_member", "--dir", work])
+    expect(rc == 2 and "no_such_member" in err, "an unknown member: status 2 naming it (rc=%s, %s)" % (rc, err))
+    rc, err = run(["record", "rr+tcp://127.0.0.1:9/?service=interop", "--timeout", "2", "--dir", work])
+    expect(rc == 3 and "not connected" in err, "an unreachable service: status 3 (rc=%s, %s)" % (rc, err))
+    rc, err = run(["record", url, "--dir", "/proc/rr-no-such-dir"])
+    expect(rc == 1 and "/proc/rr-no-such-dir" in err, "an unwritable directory: status 1 naming it (rc=%s, %s)" % (rc, err))
+    bad = os.path.join(work, "not-mcap.mcap")
+    with open(bad, "w") as f:
+        f.write("this is not an MCAP file\n")
+    rc, err = run(["replay", bad])
+    expect(rc == 1 and "not-mcap.mcap" in err, "a file that is not MCAP: status 1 naming it (rc=%s, %s)" % (rc, err))
+    rc, err = run(["replay", bad, "--duration", "3"])
+    expect(rc == 2, "record options refused by replay (rc=%s)" % rc)
+    checks["errors"] = "ok"
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rr", required=True)
+    ap.add_argument("--service", required=True, help="rr_interop_service")
+    ap.add_argument("--seconds", type=float, default=4.0)
+    ap.add_argument("--keep", action="store_true")
+    a = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="rr-record-cli-")
+    RRN.RegisterTransport(RR.TcpTransport())
+    checks, ok = {}, False
+    svc = subprocess.Popen([a.service, "--port", "0", "--max-lifetime", "280"], stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    try:
+        url = read_json_line(svc, 60, "rr_interop_service")["url"]
+        path, recorded = record_phase(a.rr, url, work, a.seconds, checks)
+        sigint_phase(a.rr, url, work, checks)
+        replay_phase(a.rr, path, recorded, checks)
+        errors_phase(a.rr, url, work, checks)
+        ok = True
+    except (CheckFailed, AssertionError, jsonschema.ValidationError, RR.RobotRaconteurException, OSError, KeyError,
+            ValueError, IndexError, subprocess.TimeoutExpired, StepFailed) as e:
+        checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
+    finally:
+        stop(svc)
+        print(json.dumps(checks, indent=1, default=str))
+        if a.keep:
+            print("kept", work)
+        else:
+            shutil.rmtree(work, ignore_errors=True)
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()

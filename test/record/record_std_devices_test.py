@@ -1,0 +1,272 @@
+#!/usr/bin/env python3
+"""Recording a standard robot and camera (issue 44; docs/recording.md "How it is tested"): the PyPI
+drivers of the browser tests behind rr-gateway, recorded through the JSON API, read with the reference
+MCAP reader (PyPI `mcap`) and compared with what the official Python client received live.
+
+  robot    test/browser/devices/sim_robot.py (robotraconteur-abstract-robot, a standard
+           com.robotraconteur.robotics.robot.Robot): its `robot_state` wire, recorded for --seconds.
+  camera   test/browser/devices/camera_synthetic.py (robotraconteur-camera-driver with synthetic frames,
+           a standard com.robotraconteur.imaging.Camera): its `frame_stream` pipe, which is a member of
+           the driver's root object, recorded while an official client streams it.
+  checks   channels (json and robotraconteur per member), schemas (the standard service definitions),
+           counts; the json messages parse and (the first few, the frames being large) validate against
+           their JSON Schema; every recorded robot_state value (seqno, joint_position, command_mode) and
+           every recorded frame (its seqno and
+           bytes) is one the official client received live; the robot's file
+           replayed by `rr-gateway --replay` gives an official client recorded robot_state values.
+
+Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
+"""
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.error
+import urllib.request
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DEVICES = os.path.join(HERE, "..", "browser", "devices")
+sys.path.insert(0, os.path.join(HERE, "..", "interop"))
+from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+
+try:
+    import jsonschema
+    from mcap.reader import make_reader
+    import RobotRaconteur as RR
+    import RobotRaconteurCompanion as RRC
+    import robotraconteur_abstract_robot  # noqa: F401
+    import robotraconteur_camera_driver  # noqa: F401
+except ImportError as e:  # pragma: no cover
+    print("SKIP: %s (run ./scripts/setup.sh)" % e)
+    sys.exit(77)
+
+RRN = RR.RobotRaconteurNode.s
+
+
+class CheckFailed(Exception):
+    pass
+
+
+def expect(cond, what):
+    if not cond:
+        raise CheckFailed(what)
+
+
+def http(base, method, path, body=None, timeout=60):
+    data = None if body is None else json.dumps(body).encode()
+    req = urllib.request.Request(base + path, data=data, method=method, headers={"Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=timeout) as r:
+            return r.status, json.loads(r.read() or b"null")
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read() or b"null")
+
+
+def start_device(script, args, work):
+    errf = open(os.path.join(work, os.path.basename(script) + ".log"), "wb")
+    proc = subprocess.Popen([sys.executable, os.path.join(DEVICES, script)] + args, stdout=subprocess.PIPE,
+                            stderr=errf, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    # The drivers print other lines first (the camera driver: "Press Ctrl-C to quit..."): the ready line
+    # is the first JSON object with a url.
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            raise CheckFailed("%s exited early (status %s)" % (script, proc.wait(5)))
+        try:
+            info = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(info, dict) and "url" in info:
+            return proc, info
+    raise CheckFailed("%s: no ready line within 120 s" % script)
+
+
+def start_gateway(exe, args, work, name):
+    errf = open(os.path.join(work, name + ".log"), "wb")
+    proc = subprocess.Popen([exe, "--listen", "127.0.0.1", "--port", "0", "--no-local", "--no-discovery", "--no-demo"] + args,
+                            stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    port = read_json_line(proc, 60, "rr-gateway")["port"]
+    base = "http://127.0.0.1:%d" % port
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(base + "/readyz", timeout=5) as r:
+                if r.status == 200:
+                    return proc, port, base
+        except (urllib.error.URLError, OSError):
+            pass
+        time.sleep(0.2)
+    raise CheckFailed("rr-gateway not ready")
+
+
+def state_key(v):
+    """A RobotState (official client value or JSON mapping) as comparable values."""
+    if isinstance(v, dict):
+        return (int(v["seqno"]), tuple(round(float(x), 9) for x in v["joint_position"]), int(v["command_mode"]))
+    return (int(v.seqno), tuple(round(float(x), 9) for x in v.joint_position), int(v.command_mode))
+
+
+def read_channels(path):
+    out = {}
+    with open(path, "rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages():
+            out.setdefault((channel.topic, channel.message_encoding), (channel, schema, []))[2].append(message)
+    with open(path, "rb") as f:
+        summary = make_reader(f).get_summary()
+    return out, summary
+
+
+def check_file(path, device, member, service, checks, validate_max=None):
+    channels, summary = read_channels(path)
+    expect(summary is not None, device + ": the file is complete (summary)")
+    checks[device + "_channels"] = sorted("%s [%s] %d" % (t, e, len(v[2])) for (t, e), v in channels.items())
+    for enc in ("json", "robotraconteur"):
+        expect((device + "/" + member, enc) in channels, "%s/%s [%s] recorded" % (device, member, enc))
+    names = {s.name for s in summary.schemas.values() if s.encoding == "robotraconteur_servicedef"}
+    expect(service in names, "%s: schema %s among %s" % (device, service, sorted(names)))
+    channel, schema, messages = channels[(device + "/" + member, "json")]
+    expect(len(messages) == len(channels[(device + "/" + member, "robotraconteur")][2]), device + ": both encodings alike")
+    expect(schema.encoding == "jsonschema", device + ": jsonschema")
+    validator = jsonschema.Draft202012Validator(json.loads(schema.data))
+    values = []
+    for i, m in enumerate(messages):
+        j = json.loads(m.data)
+        if validate_max is None or i < validate_max:
+            validator.validate(j)
+        values.append(j["value"])
+    return values
+
+
+def run(gateway_exe, work, seconds, checks):
+    robot, robot_info = start_device("sim_robot.py", ["--enabled", "--max-lifetime", "280"], work)
+    camera, cam_info = start_device("camera_synthetic.py", ["--camera-info", os.path.join(DEVICES, "synthetic_camera_info.yml"),
+                                                            "--width", "160", "--height", "120", "--fps", "10",
+                                                            "--max-lifetime", "280"], work)
+    gw = None
+    try:
+        gw, port, base = start_gateway(gateway_exe, ["--device", "robot=" + robot_info["url"], "--device",
+                                                     "camera=" + cam_info["url"]], work, "gateway1")
+        r = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=robot" % port)
+        c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=camera" % port)
+        lock = threading.Lock()
+        live_states, live_frames = [], []
+        wire = r.robot_state.Connect()
+        wire.WireValueChanged += lambda _c, v, _t: (lock.acquire(), live_states.append(state_key(v)), lock.release())
+        ep = c.frame_stream.Connect(-1)
+
+        def on_frame(e):
+            while e.Available > 0:
+                img = e.ReceivePacket()
+                with lock:
+                    live_frames.append((int(img.image_info.data_header.seqno),
+                                        hashlib.sha256(bytes(bytearray(img.data))).hexdigest()))
+
+        ep.PacketReceivedEvent += on_frame
+        try:
+            c.start_streaming()
+        except RR.RobotRaconteurException as e:  # already streaming is fine
+            checks["start_streaming"] = str(e)
+        time.sleep(1.0)
+        ids = {}
+        for device, member in (("robot", "robot_state"), ("camera", "frame_stream")):
+            st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member], "directory": work})
+            expect(st == 201, "POST /api/recordings %s: %s %s" % (device, st, body))
+            ids[device] = body["id"]
+        time.sleep(seconds)
+        finals = {}
+        for device, rid in ids.items():
+            st, body = http(base, "POST", "/api/recordings/%d/stop" % rid, {})
+            expect(st == 200 and body["state"] == "stopped", "stop %s: %s %s" % (device, st, body))
+            finals[device] = body
+        checks["recordings"] = {d: {k: b[k] for k in ("messages", "drops", "bytes")} for d, b in finals.items()}
+        time.sleep(1.0)
+        try:
+            c.stop_streaming()
+        except RR.RobotRaconteurException:
+            pass
+        ep.Close()
+        wire.Close()
+        RRN.DisconnectService(r)
+        RRN.DisconnectService(c)
+        with lock:
+            live_s, live_f = list(live_states), set(live_frames)
+
+        robot_file = finals["robot"]["files"][0]
+        states = [state_key(v) for v in check_file(robot_file, "robot", "robot_state",
+                                                     "com.robotraconteur.robotics.robot", checks)]
+        expect(len(states) >= seconds * 10, "robot_state recorded (%d values in %s s)" % (len(states), seconds))
+        live_set = set(live_s)
+        seen = sum(s in live_set for s in states)
+        checks["robot_state"] = {"recorded": len(states), "live": len(live_s), "recorded_seen_live": seen}
+        expect(seen >= len(states) - 2, "recorded robot_state values are those the official client received live")
+        frames = check_file(finals["camera"]["files"][0], "camera", "frame_stream", "com.robotraconteur.imaging",
+                            checks, validate_max=3)
+        # A frame is its sequence number (the driver's data_header.seqno) and its bytes (the synthetic
+        # pattern repeats, so the bytes alone would not tell frames apart).
+        hashes = [(int(f["image_info"]["data_header"]["seqno"]), hashlib.sha256(bytes(f["data"])).hexdigest()) for f in frames]
+        expect(len(set(hashes)) == len(hashes), "recorded frames are distinct (seqno, bytes)")
+        expect(len(frames) >= seconds * 10 * 0.5, "frames recorded (%d in %s s at 10 fps)" % (len(frames), seconds))
+        expect(all(f["image_info"]["width"] == 160 and f["image_info"]["height"] == 120 for f in frames), "frame size")
+        fseen = sum(h in live_f for h in hashes)
+        checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": fseen}
+        expect(fseen == len(frames), "every recorded frame is one the official client received live")
+    finally:
+        stop(gw)
+        stop(camera)
+        stop(robot)
+
+    # The robot's file replayed through the gateway: an official client gets recorded states.
+    gw, port, base = start_gateway(gateway_exe, ["--replay", "robot_replay=" + robot_file], work, "gateway2")
+    try:
+        r = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=robot_replay" % port)
+        got = []
+        wire = r.robot_state.Connect()
+        wire.WireValueChanged += lambda _c, v, _t: got.append(state_key(v))
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and len(got) < 20:
+            time.sleep(0.1)
+        wire.Close()
+        RRN.DisconnectService(r)
+        recorded = set(states)
+        checks["replay"] = {"received": len(got), "recorded": sum(g in recorded for g in got)}
+        expect(len(got) >= 20, "the replayed robot_state reaches the official client")
+        expect(all(g in recorded for g in got), "every replayed robot_state is a recorded one")
+    finally:
+        stop(gw)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument("--keep", action="store_true")
+    a = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="rr-record-std-")
+    RRN.RegisterTransport(RR.TcpTransport())
+    RRC.RegisterStdRobDefServiceTypes(RRN)
+    checks, ok = {}, False
+    try:
+        run(a.gateway, work, a.seconds, checks)
+        ok = True
+    except (CheckFailed, AssertionError, jsonschema.ValidationError, RR.RobotRaconteurException, OSError, KeyError,
+            ValueError, IndexError, StepFailed, subprocess.TimeoutExpired) as e:
+        checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
+    finally:
+        print(json.dumps(checks, indent=1, default=str))
+        if a.keep:
+            print("kept", work)
+        else:
+            shutil.rmtree(work, ignore_errors=True)
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
