@@ -31,6 +31,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "record"))
+from record_checks import CheckFailed, expect  # noqa: E402
 
 try:
     import jsonschema
@@ -41,15 +43,6 @@ except ImportError as e:  # pragma: no cover
     sys.exit(77)
 
 RRN = RR.RobotRaconteurNode.s
-
-
-class CheckFailed(Exception):
-    pass
-
-
-def expect(cond, what):
-    if not cond:
-        raise CheckFailed(what)
 
 
 def inner_tuple(v):

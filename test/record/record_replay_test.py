@@ -38,6 +38,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import die_with_parent, read_json_line, stop  # noqa: E402
+from record_checks import CheckFailed, expect, http  # noqa: E402
 
 try:
     import jsonschema
@@ -51,25 +52,6 @@ except ImportError as e:  # pragma: no cover
     sys.exit(77)
 
 RRN = RR.RobotRaconteurNode.s
-
-
-class CheckFailed(Exception):
-    pass
-
-
-def expect(cond, what):
-    if not cond:
-        raise CheckFailed(what)
-
-
-def http(base, method, path, body=None, timeout=30):
-    data = None if body is None else json.dumps(body).encode()
-    req = urllib.request.Request(base + path, data=data, method=method, headers={"Content-Type": "application/json"})
-    try:
-        with urllib.request.urlopen(req, timeout=timeout) as r:
-            return r.status, json.loads(r.read() or b"null")
-    except urllib.error.HTTPError as e:
-        return e.code, json.loads(e.read() or b"null")
 
 
 def start_gateway(exe, args, log_path):
