@@ -219,12 +219,12 @@ std::optional<Failure> run_call(const CommandLine& cl, Target& t, const std::vec
     return std::nullopt;
 }
 
+}  // namespace
+
 void print_error(std::ostream& err, const RRError& e) {
     std::string name = e.name.empty() ? std::string(error_name(e.type)) : e.name;
     err << "rr: " << name << ": " << e.message << std::endl;
 }
-
-}  // namespace
 
 ExitCode run_command(const CommandLine& cl, std::ostream& out, std::ostream& err, const std::atomic<bool>& stop) {
     if (cl.kind == CommandKind::discover) return run_discover(cl, out, err);

@@ -6,9 +6,14 @@
 #include <atomic>
 #include <ostream>
 
+#include "core/error/rr_error.hpp"
 #include "server/cli/cli_options.hpp"
 
 namespace rr::cli {
+
+/// Writes `rr: <ErrorName>: <message>` and a newline to `err` (the error name from the type when the
+/// error has none).
+void print_error(std::ostream& err, const RRError& e);
 
 /// Runs a parsed command (not help). `stop` ends a watch (set from a signal handler).
 /// Returns the exit status: ok, rr_error (service or typed-client error: MemberNotFound,

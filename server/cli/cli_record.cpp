@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "core/names/connection_url.hpp"
+#include "server/cli/cli_commands.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/node/node.hpp"
@@ -17,11 +18,6 @@ namespace {
 
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
-
-void print_error(std::ostream& err, const RRError& e) {
-    std::string name = e.name.empty() ? std::string(error_name(e.type)) : e.name;
-    err << "rr: " << name << ": " << e.message << std::endl;
-}
 
 ExitCode fail_with(std::ostream& err, ExitCode code, const RRError& e) {
     print_error(err, e);
