@@ -18,8 +18,9 @@ namespace {
 struct RecordingDir {
     fs::path path;
     RecordingDir() {
-        char tmpl[] = "/tmp/rr-recording-test-XXXXXX";
-        REQUIRE(::mkdtemp(tmpl));
+        // a folder of its own under TMPDIR (or /tmp), made atomically so parallel test runs never share one
+        std::string tmpl = (fs::temp_directory_path() / "rr-recording-test-XXXXXX").string();
+        REQUIRE(::mkdtemp(tmpl.data()));
         path = tmpl;
     }
     ~RecordingDir() {

@@ -13,8 +13,8 @@
 // connection (a relay between browser and gateway) and stopping the gateway while a button is held
 // each stop the robot within 0.5 s; a viewer sees no moving control (no jog, Enable, Disable, Reset
 // errors, Halt, mode switch, lock offer or move form), and a jog_joint call from its page is refused
-// by the gateway (PermissionDenied) and the robot does not move. The controls come from the gateway's
-// access endpoint (GET api/devices/<device>/access), not from a stub.
+// by the gateway (PermissionDenied) and the robot does not move. The page decides which controls to show
+// from the gateway's answer to GET api/devices/<device>/access, as a user's page does.
 //
 // No failure can hang the file: every wait has a deadline, and each scenario closes what it opened
 // in a finally (after() again, each step bounded).
