@@ -49,8 +49,16 @@ for f in "$dist"/dashboard/robot/*; do [ -f "$web/robot/$(basename "$f")" ] || r
 # The standard service definitions as TypeScript (`rr-robdef ts`, robdef/typescript.hpp; the node build of
 # rr-robdef from this build folder): dist/types/std/<service>.d.ts + .js, imported as
 # "robotraconteur-wasm/std/<service>" (package.json exports "./std/*"; "./std" alone stays the dashboard's
-# standard-type modules above). The definitions are read from the shared folder, never copied into the repo.
-std_robdefs="${RR_ROBDEF_STANDARD:-$root/../shared/robdef-standard/group1}"
+# standard-type modules above). The definitions are never copied into the repo: they come from
+# RR_ROBDEF_STANDARD if set, else the official robotraconteurcompanion package in .venv (PyPI, pinned in
+# test/interop/requirements.txt; the same files the drivers load), else the shared folder next to the clone.
+std_robdefs="${RR_ROBDEF_STANDARD:-}"
+if [ -z "$std_robdefs" ]; then
+  for d in "$root"/.venv/lib/python3*/site-packages/RobotRaconteurCompanion/StdRobDef \
+           "$root/../shared/robdef-standard/group1"; do
+    if compgen -G "$d/*.robdef" >/dev/null; then std_robdefs="$d"; break; fi
+  done
+fi
 if compgen -G "$std_robdefs/*.robdef" >/dev/null; then
   gen="$build/std-types.tmp"
   rm -rf "$gen"
@@ -61,7 +69,7 @@ if compgen -G "$std_robdefs/*.robdef" >/dev/null; then
   for f in "$dist"/types/std/*; do [ -f "$gen/$(basename "$f")" ] || rm -f "$f"; done
   rm -rf "$gen"
 else
-  echo "wasm-client/build.sh: no *.robdef in $std_robdefs: the package has no standard TypeScript types (std/*)" >&2
+  echo "wasm-client/build.sh: no standard *.robdef found (RR_ROBDEF_STANDARD, .venv's robotraconteurcompanion, ../shared): the package has no standard TypeScript types (std/*)" >&2
 fi
 copy_if_changed "$here/src/package.dist.json" "$dist/package.json"
 echo "wasm-client: package in $dist"

@@ -219,9 +219,10 @@ TEST_CASE("pipes: a full backlog is refused with BufferLimitViolation, never dro
     // The client stops reading (its strand is blocked in the hook) so the service's queue grows.
     std::promise<void> release;
     auto released = release.get_future().share();
-    std::atomic<bool> blocked{false};
-    *c.hook = [released, &blocked](MessageEntry&) {
-        if (!blocked.exchange(true)) released.wait();
+    // Owned by the hook: the client's thread may still run it while this test's locals unwind.
+    auto blocked = std::make_shared<std::atomic<bool>>(false);
+    *c.hook = [released, blocked](MessageEntry&) {
+        if (!blocked->exchange(true)) released.wait();
         return true;
     };
     auto ep = pipe->endpoints().at(0);

@@ -241,6 +241,7 @@ test("holding shoulder + for 1 s moves the shoulder only; releasing stops it wit
   assert.equal(await holdEnd(operator), "release");
   await assertStopsAfter(0, released, STOP_BOUND_S, "release");
   const after = latest().q;
+  console.log(`# hold of 1 s: the shoulder moved ${(after[0] - before[0]).toFixed(3)} rad`);
   assert.ok(after[0] - before[0] > 0.2, `the shoulder moved ${after[0] - before[0]} rad`);
   assert.ok(Math.abs(after[1] - before[1]) < EPS && Math.abs(after[2] - before[2]) < EPS, `only the shoulder: ${before} -> ${after}`);
   // the table follows

@@ -1,10 +1,10 @@
 // The robot panel's pure parts (src/robot/): the hold-to-jog timer with fake timers (one call at
-// once, one per 50 ms, none while one is outstanding, none after the hold ends in any way, an error
+// once, one per 50 ms, none while two are outstanding, none after the hold ends in any way, an error
 // ends it), joint rows from a RobotInfo and a RobotState (units, degrees, limit warnings within 5 %
 // of the range), the jog_joint velocity, Cartesian velocity, status chips, staleness, access.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { JogRepeater, JOG_PERIOD_MS, JOG_TIMEOUT_S } from "../src/robot/jog_repeater.js";
+import { JogRepeater, JOG_PERIOD_MS, JOG_TIMEOUT_S, JOG_MAX_IN_FLIGHT } from "../src/robot/jog_repeater.js";
 import { jointModel, jointRows, limitState, jogVelocity, positionText, toDisplay, fromDisplay, NEAR_LIMIT_FRACTION } from "../src/robot/joints.js";
 import { flagChips, flagTone, modeText, isStale, capabilitySet, STALE_MS } from "../src/robot/status.js";
 import { accessUrl, fetchAccess, allows } from "../src/robot/access.js";
@@ -58,27 +58,37 @@ test("jog timer: a call at once and one per 50 ms while held, none after release
   assert.deepEqual(stops, ["release"]);
 });
 
-test("jog timer: never two calls outstanding, a slow call skips ticks", async () => {
+test("jog timer: never more than two calls outstanding, slow calls skip ticks", async () => {
+  assert.equal(JOG_MAX_IN_FLIGHT, 2);
   const timers = fakeTimers();
   const pending = [];
   const r = new JogRepeater({ send: () => new Promise((res) => pending.push(res)), timers });
   r.start("x");
-  timers.advance(200);  // four ticks while the first call is outstanding
-  assert.equal(pending.length, 1);
-  assert.equal(r.skipped, 4);
+  timers.advance(200);  // four ticks: the first sends the second call, three are skipped
+  assert.equal(pending.length, 2);
+  assert.equal(r.skipped, 3);
   pending[0]();
   await settle();
   timers.advance(50);
-  assert.equal(pending.length, 2);
-  // released and pressed again while a call is outstanding: the new hold waits for it too
+  assert.equal(pending.length, 3);
+  timers.advance(50);
+  assert.equal(pending.length, 3);  // two outstanding again
+  // released and pressed again while calls are outstanding: the new hold counts them too
   r.stop();
   r.start("y");
-  assert.equal(pending.length, 2);
+  assert.equal(pending.length, 3);
   pending[1]();
   await settle();
   timers.advance(50);
-  assert.equal(pending.length, 3);
+  assert.equal(pending.length, 4);
+  timers.advance(50);
+  assert.equal(pending.length, 4);
+  // failures free their slot as answers do (a failed call of an ended hold changes nothing else)
   r.stop();
+  pending[2]();
+  pending[3]();
+  await settle();
+  assert.equal(r.inFlight, 0);
 });
 
 test("jog timer: an error ends the hold and is reported once; a late error of an ended hold is ignored", async () => {

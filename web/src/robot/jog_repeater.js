@@ -1,13 +1,17 @@
 // Hold-to-jog: while a jog control is held, the same jog call is sent at once and then every 50 ms,
 // each with a short timeout (0.15 s) after which the robot stops by itself. Stopping is simply not
 // sending: whatever ends the hold (release, a lost page, network or gateway), the robot stops within
-// the timeout. Calls never pile up: while one is still outstanding, a tick is skipped. A refused or
-// failed call ends the hold and is reported. No DOM here, so the timing is tested with fake timers.
+// the timeout. Calls never pile up: at most JOG_MAX_IN_FLIGHT are outstanding, beyond that a tick is
+// skipped. Two rather than one keep the robot moving while a round trip is longer than the timeout (a
+// busy machine), and bound what can still arrive after the hold ends to two calls. A refused or failed
+// call ends the hold and is reported. No DOM here, so the timing is tested with fake timers.
 
 /** Seconds the robot keeps jogging after the last call (the robdef's `timeout` argument). */
 export const JOG_TIMEOUT_S = 0.15;
 /** Milliseconds between two jog calls while a control is held. */
 export const JOG_PERIOD_MS = 50;
+/** Jog calls outstanding at most (of this hold and earlier ones together). */
+export const JOG_MAX_IN_FLIGHT = 2;
 
 export class JogRepeater {
   /**
@@ -28,7 +32,7 @@ export class JogRepeater {
     this.command = null;
     this.timer = null;
     this.hold = 0;          // id of the current hold; a late answer of an earlier hold is ignored
-    this.inFlight = false;  // a call is outstanding (of this or an earlier hold)
+    this.inFlight = 0;  // calls outstanding (of this or earlier holds)
     this.sent = 0;
     this.skipped = 0;
   }
@@ -47,8 +51,8 @@ export class JogRepeater {
 
   tick(hold) {
     if (hold !== this.hold || !this.active) return;
-    if (this.inFlight) { this.skipped++; return; }
-    this.inFlight = true;
+    if (this.inFlight >= JOG_MAX_IN_FLIGHT) { this.skipped++; return; }
+    this.inFlight++;
     this.sent++;
     const command = this.command;
     let call;
@@ -57,8 +61,8 @@ export class JogRepeater {
     } catch (e) {
       call = Promise.reject(e);
     }
-    call.then(() => { this.inFlight = false; }, (e) => {
-      this.inFlight = false;
+    call.then(() => { this.inFlight--; }, (e) => {
+      this.inFlight--;
       if (hold !== this.hold || !this.active) return;  // the hold ended meanwhile: nothing to stop
       this.stop("error");
       this.onError(e, command);
