@@ -24,6 +24,7 @@ import json
 import os
 import sys
 import threading
+import time
 import uuid
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -60,6 +61,7 @@ class SimArm(AbstractRobot):
         self._sim_lock = threading.Lock()
         self._motors_on = enabled
         self._last_step = None
+        self._log_jog = False
 
     # the "controller": feedback each step, then the base class's own step
     def _run_timestep(self, now):
@@ -93,6 +95,13 @@ class SimArm(AbstractRobot):
         with self._sim_lock:
             self._q = q
             self._q_target = None
+
+    def async_jog_joint(self, joint_velocity, timeout, wait, handler):
+        # --log-jog: one stdout line per jog call as it reaches the driver, so a test can tell a late
+        # call (starved delivery) from a robot that kept moving past the call's timeout.
+        if self._log_jog:
+            print(json.dumps({"jog_joint": time.time(), "timeout": timeout}), flush=True)
+        return super().async_jog_joint(joint_velocity, timeout, wait, handler)
 
     def _send_robot_command(self, now, joint_pos_cmd, joint_vel_cmd):
         if joint_pos_cmd is not None:
@@ -135,6 +144,7 @@ def main():
                     help="each stdin line, a JSON list of joint positions, puts the joints there at once")
     ap.add_argument("--period", type=float, default=0.02, help="loop period in seconds")
     ap.add_argument("--max-lifetime", type=float, default=300)
+    ap.add_argument("--log-jog", action="store_true", help="print a JSON line as each jog_joint call arrives")
     args = ap.parse_args()
     port = free_port()
     with RR.ServerNodeSetup("experimental.sim_arm", port, argv=["sim_robot"] + node_flags(port)):
@@ -142,6 +152,7 @@ def main():
         robot_info, _ = InfoFileLoader(RRN).LoadInfoFile(args.info, "com.robotraconteur.robotics.robot.RobotInfo", "robot")
         attributes = AttributesUtil(RRN).GetDefaultServiceAttributesFromDeviceInfo(robot_info.device_info)
         robot = SimArm(robot_info, args.period, args.enabled, args.start_position)
+        robot._log_jog = args.log_jog
         robot._start_robot()
         ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot)
         ctx.SetServiceAttributes(attributes)
