@@ -4,7 +4,7 @@
 
 import crypto from "node:crypto";
 import fs from "node:fs";
-import { spawn } from "node:child_process";
+import { spawn, spawnSync } from "node:child_process";
 import { createRequire } from "node:module";
 import { fileURLToPath } from "node:url";
 import path from "node:path";
@@ -26,6 +26,23 @@ export function settings() {
     webRoot: env.RR_WEB_ROOT || path.join(ROOT, "web/dist"),
     artifacts: env.RR_ARTIFACTS || path.join(ROOT, "build/test-artifacts/browser"),
   };
+}
+
+/** Where the threads of a live process are: gdb's backtraces (bounded), else each thread's wchan. */
+function threadsOf(pid) {
+  const gdb = spawnSync("gdb", ["-p", String(pid), "-batch", "-nx", "-ex", "thread apply all bt 25"],
+    { encoding: "utf8", timeout: 30000 });
+  if (gdb.status === 0 && /Thread /.test(gdb.stdout)) {
+    return gdb.stdout.split("\n").filter((l) => /^(Thread |#)/.test(l)).join("\n").slice(0, 12000);
+  }
+  try {
+    return fs.readdirSync(`/proc/${pid}/task`).map((t) => {
+      const read = (f) => { try { return fs.readFileSync(`/proc/${pid}/task/${t}/${f}`, "utf8").trim(); } catch { return "?"; } };
+      return `${t} ${read("comm")} ${read("wchan")}`;
+    }).join("\n");
+  } catch (e) {
+    return `(no thread list: ${e.message})`;
+  }
 }
 
 /** A child process whose stdout lines are read for a JSON object holding `key`. */
@@ -65,14 +82,22 @@ class Child {
     });
   }
 
-  /** SIGTERM, then SIGKILL after graceMs. Resolves with the exit status. */
+  /**
+   * SIGTERM, then SIGKILL after graceMs. Resolves with the exit status ({code, signal}); when SIGKILL
+   * was needed it also has `stuck`: where the process's threads were (gdb backtraces, else each
+   * thread's wchan) and its last stderr, so a shutdown hang names itself in the test's failure.
+   */
   async stop(graceMs = 8000) {
     if (this.proc.exitCode !== null || this.proc.signalCode !== null) return this.exited;
     this.proc.kill("SIGTERM");
-    const timer = setTimeout(() => this.proc.kill("SIGKILL"), graceMs);
+    let stuck = null;
+    const timer = setTimeout(() => {
+      stuck = `${threadsOf(this.proc.pid)}\n--- last stderr ---\n${this.stderr.join("").slice(-2000)}`;
+      this.proc.kill("SIGKILL");
+    }, graceMs);
     const status = await this.exited;
     clearTimeout(timer);
-    return status;
+    return stuck ? { ...status, stuck } : status;
   }
 }
 
