@@ -35,7 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEVICES = os.path.join(HERE, "..", "browser", "devices")
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http  # noqa: E402
+from record_checks import CheckFailed, expect, foxglove_check, http  # noqa: E402
 
 try:
     import jsonschema
@@ -200,6 +200,7 @@ def run(gateway_exe, work, seconds, checks):
         fseen = sum(h in live_f for h in hashes)
         checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": fseen}
         expect(fseen == len(frames), "every recorded frame is one the official client received live")
+        foxglove_check([robot_file, finals["camera"]["files"][0]], checks, max_messages=5)
     finally:
         stop(gw)
         stop(camera)
