@@ -43,3 +43,18 @@ def foxglove_check(paths, checks, max_messages=20):
         return
     expect(r.returncode == 0, "json channels as Foxglove reads them: %s%s" % (r.stdout[-1500:], r.stderr[-500:]))
     checks["foxglove"] = json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def official_foxglove_schemas():
+    """{"foxglove.RawImage": schema, "foxglove.CompressedImage": schema} from the npm package
+    @foxglove/schemas (pinned in test/mcap/package.json), or None without node or the package."""
+    node = shutil.which("node")
+    here = os.path.dirname(os.path.abspath(__file__))
+    mcap_dir = os.path.join(here, "..", "mcap")
+    if not node or not os.path.isdir(os.path.join(mcap_dir, "node_modules", "@foxglove", "schemas")):
+        return None
+    code = ('const s = require("@foxglove/schemas/jsonschema");'
+            'console.log(JSON.stringify({"foxglove.RawImage": s.RawImage, "foxglove.CompressedImage": s.CompressedImage}))')
+    r = subprocess.run([node, "-e", code], cwd=mcap_dir, capture_output=True, text=True, timeout=60)
+    expect(r.returncode == 0, "@foxglove/schemas: %s" % r.stderr[-500:])
+    return json.loads(r.stdout)
