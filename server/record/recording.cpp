@@ -400,7 +400,7 @@ Result<void> Recording::open_file() {
                                            ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
                                              "bayer_*8888 depth_u16; other frames are not on this channel"
                                            : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
-                auto cid = f->writer->add_channel(*sid, topic + "/foxglove", "json", fox_meta);
+                auto cid = f->writer->add_channel(sid, topic + "/foxglove", "json", fox_meta);
                 if (!cid) return check(cid.take_error());
                 foxglove_id = *cid;
             }
