@@ -26,16 +26,16 @@ std::string base64(std::span<const std::byte> bytes) {
 // The image's bytes: a {"$binary": i} reference (element_json with BinaryArrays) or a JSON number array.
 std::optional<std::span<const std::byte>> image_bytes(const json& data, const BinaryArrays& binary,
                                                       std::vector<std::byte>& storage) {
-    if (data.is_object() && data.contains("$binary") && data["$binary"].is_number_unsigned()) {
-        const auto i = data["$binary"].get<std::size_t>();
-        if (i >= binary.blobs.size()) return std::nullopt;
-        return binary.blobs[i].bytes();
+    if (data.is_object() && data.contains("$binary") && data["$binary"].is_number_integer()) {
+        const auto i = data["$binary"].get<std::int64_t>();
+        if (i < 0 || static_cast<std::size_t>(i) >= binary.blobs.size()) return std::nullopt;
+        return binary.blobs[static_cast<std::size_t>(i)].bytes();
     }
     if (!data.is_array()) return std::nullopt;
     storage.reserve(data.size());
     for (const auto& b : data) {
-        if (!b.is_number_unsigned() || b.get<std::uint64_t>() > 255) return std::nullopt;
-        storage.push_back(static_cast<std::byte>(b.get<std::uint8_t>()));
+        if (!b.is_number_integer() || b.get<std::int64_t>() < 0 || b.get<std::int64_t>() > 255) return std::nullopt;
+        storage.push_back(static_cast<std::byte>(b.get<std::int64_t>()));
     }
     return std::span<const std::byte>(storage);
 }

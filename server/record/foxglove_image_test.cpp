@@ -93,7 +93,9 @@ TEST_CASE("foxglove image: the device's time stamp when it is on the Unix epoch,
     auto with_ts = [](std::int64_t sec, std::int64_t nsec) {
         json v = rgb_image(json{1, 2, 3, 4, 5, 6});
         v["image_info"]["data_header"] = {{"ts", {{"seconds", sec}, {"nanoseconds", nsec}}}};
-        return json::parse(*record::foxglove_image_message(record::FoxgloveImageKind::raw, v, {}, kLog))["timestamp"];
+        auto text = record::foxglove_image_message(record::FoxgloveImageKind::raw, v, {}, kLog);
+        REQUIRE(text);
+        return json::parse(*text)["timestamp"];
     };
     CHECK(with_ts(1764179990, 7) == json({{"sec", 1764179990}, {"nsec", 7}}));
     CHECK(with_ts(12, 7) == json({{"sec", 1764180000}, {"nsec", 5}}));  // a clock since boot
