@@ -2,9 +2,14 @@
 // what a recording's `json` channels declare as their schema, so that Foxglove / Lichtblick (and any
 // JSON Schema validator) know the fields of each message without the service definition.
 //
-// Named types (structs, pods, namedarrays, enums) go to "$defs" under their qualified name and are
-// referenced with "$ref", so recursive structs are finite. Types the lookup cannot resolve, and
-// varvalue, are described loosely ({} or {"type": ["object", "null"]}).
+// The schemas keep to the subset of JSON Schema that Foxglove's / Lichtblick's channel parser reads
+// (docs/recording.md "Opening a recording in Foxglove or Lichtblick"): one `type` per property, objects
+// with `properties`, array items of one non-array type, named types inlined (no "$ref"; a struct inside
+// itself is an object without fields). Values that subset cannot describe (void, objrefs, unknown types,
+// lists of arrays, a varvalue's value) are left out of `properties` and named in the object's
+// description. Values the JSON mapping writes as strings (non-finite floats, integers beyond 2^53) or
+// null (a null struct, list, map or varvalue) are described, not declared: such a message does not
+// validate against its schema.
 #pragma once
 
 #include <string_view>
@@ -16,10 +21,10 @@
 
 namespace rr::server::record {
 
-/// Schema of one value of `type` as the JSON mapping writes it; named types resolved through `lookup`
-/// (unqualified names in `context_service`) are added to `defs` (an object: qualified name → schema).
+/// Schema of one value of `type` as the JSON mapping writes it, named types resolved through `lookup`
+/// (unqualified names in `context_service`) and inlined; null when the subset cannot describe it.
 nlohmann::json value_schema(const robdef::TypeDefinition& type, const robdef::TypeLookup& lookup,
-                            std::string_view context_service, nlohmann::json& defs);
+                            std::string_view context_service);
 
 /// The whole schema of a recorded wire value: {"time": {"seconds", "nanoseconds"}, "value": T} (the
 /// JSON API's wire push body, docs/json-api.md), titled `title`.

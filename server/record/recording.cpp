@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <system_error>
 
 #include "core/mcap/mcap_writer.hpp"
@@ -11,6 +12,7 @@
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/mcap/mcap_file.hpp"
+#include "server/record/foxglove_image.hpp"
 #include "server/record/json_schema.hpp"
 
 namespace rr::server::record {
@@ -100,6 +102,10 @@ struct Recording::File {
     std::unique_ptr<mcap::FileSink> sink;
     std::unique_ptr<mcap::McapWriter> writer;
     std::vector<int> json_channel, rr_channel;  // per member; -1 = none
+    // Per member: the Foxglove image channel (-1 = none), its kind and its sequence counter.
+    std::vector<int> foxglove_channel;
+    std::vector<FoxgloveImageKind> foxglove_kind;
+    std::vector<std::uint32_t> foxglove_sequence;
     std::chrono::steady_clock::time_point opened = std::chrono::steady_clock::now();
 };
 
@@ -337,6 +343,7 @@ Result<void> Recording::open_file() {
         if (i == 0) root_schema = *id;
     }
     const std::string device = spec_.device;
+    std::map<std::string, std::uint16_t> image_schemas;  // Foxglove schema name -> id, added once
     for (const auto& m : members_) {
         const auto& t = *m.target;
         std::map<std::string, std::string> meta{{"device", device},
@@ -375,8 +382,34 @@ Result<void> Recording::open_file() {
             if (!cid) return check(cid.take_error());
             rr_id = *cid;
         }
+        // A standard image also as Foxglove's RawImage / CompressedImage (foxglove_image.hpp).
+        int foxglove_id = -1;
+        FoxgloveImageKind foxglove_kind = FoxgloveImageKind::raw;
+        if (spec_.json && spec_.foxglove_images && m.kind != RecordedMember::Kind::event) {
+            if (auto kind = foxglove_image_kind(t.member->type, t.types->set(), t.context())) {
+                foxglove_kind = *kind;
+                const std::string name(foxglove_schema_name(*kind));
+                auto& sid = image_schemas[name];
+                if (!sid) {
+                    auto id = f->writer->add_schema(name, "jsonschema", as_bytes(foxglove_image_schema(*kind).dump()));
+                    if (!id) return check(id.take_error());
+                    sid = *id;
+                }
+                auto fox_meta = meta;
+                fox_meta["foxglove"] = *kind == FoxgloveImageKind::raw
+                                           ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
+                                             "bayer_*8888 depth_u16; other frames are not on this channel"
+                                           : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
+                auto cid = f->writer->add_channel(sid, topic + "/foxglove", "json", fox_meta);
+                if (!cid) return check(cid.take_error());
+                foxglove_id = *cid;
+            }
+        }
         f->json_channel.push_back(json_id);
         f->rr_channel.push_back(rr_id);
+        f->foxglove_channel.push_back(foxglove_id);
+        f->foxglove_kind.push_back(foxglove_kind);
+        f->foxglove_sequence.push_back(0);
     }
     // Schemas and channels on disk at once: a file killed before its first full chunk still names them.
     if (auto r = check(f->writer->flush()); !r) return r;
@@ -467,6 +500,22 @@ Result<void> Recording::write_item(const Item& item) {
             }
         }
         if (auto r = write(file_->json_channel[item.member], sequence_[item.member * 2], as_bytes(text)); !r) return r;
+    }
+    if (file_->foxglove_channel[item.member] >= 0) {
+        // The image with its pixel bytes as binary blobs (no JSON numbers), then base64 for Foxglove.
+        const MessageElement* el = m.kind == RecordedMember::Kind::wire   ? e.find("packet")
+                                   : m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
+                                                                          : e.find("value");
+        if (el) {
+            BinaryArrays binary;
+            auto j = api_->element_json(*el, t.member->type, t, &binary);
+            if (j)
+                if (auto text = foxglove_image_message(file_->foxglove_kind[item.member], j.value, binary, item.log_ns))
+                    if (auto r = write(file_->foxglove_channel[item.member], file_->foxglove_sequence[item.member],
+                                       as_bytes(*text));
+                        !r)
+                        return r;
+        }
     }
     std::lock_guard<std::mutex> lock(mutex_);
     if (!files_.empty()) files_.back().second = file_->writer->bytes_written();

@@ -28,7 +28,7 @@ Result<RecordingSpec> spec_from_json(const json& j) {
     static const std::set<std::string> keys{"device",         "members",          "encoding",        "directory",
                                             "prefix",         "property_period_ms", "max_file_bytes",  "max_file_seconds",
                                             "max_total_bytes", "duration_s",       "queue_bytes",     "chunk_bytes",
-                                            "compression"};
+                                            "compression",    "foxglove_images"};
     if (!j.is_object()) return fail(MessageErrorType::InvalidArgument, "record: expected an object");
     for (const auto& [k, v] : j.items())
         if (!keys.count(k)) {
@@ -91,6 +91,11 @@ Result<RecordingSpec> spec_from_json(const json& j) {
         else if (j["compression"] == "none") s.compress = false;
         else return fail(MessageErrorType::InvalidArgument, "record: compression: expected \"zstd\" or \"none\"");
     }
+    if (j.contains("foxglove_images")) {
+        if (!j["foxglove_images"].is_boolean())
+            return fail(MessageErrorType::InvalidArgument, "record: foxglove_images: expected true or false");
+        s.foxglove_images = j["foxglove_images"].get<bool>();
+    }
     if (s.chunk_bytes < 1024 || s.chunk_bytes > (64u << 20))
         return fail(MessageErrorType::InvalidArgument, "record: chunk_bytes: between 1024 and 67108864");
     if (s.queue_bytes < 4096) return fail(MessageErrorType::InvalidArgument, "record: queue_bytes: at least 4096");
@@ -115,7 +120,8 @@ json spec_json(const RecordingSpec& s) {
                 {"duration_s", s.duration.count()},
                 {"queue_bytes", s.queue_bytes},
                 {"chunk_bytes", s.chunk_bytes},
-                {"compression", s.compress ? "zstd" : "none"}};
+                {"compression", s.compress ? "zstd" : "none"},
+                {"foxglove_images", s.foxglove_images}};
 }
 
 }  // namespace rr::server::record

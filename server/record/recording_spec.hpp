@@ -20,6 +20,9 @@ struct RecordingSpec {
     std::vector<std::string> members;
     bool json = true;                  ///< `json` channels (JSON mapping + JSON Schema)
     bool robotraconteur = true;        ///< `robotraconteur` channels (RR entry bytes, for replay)
+    /// With `json`: a standard image member (com.robotraconteur.image.Image / CompressedImage) also on a
+    /// channel `<device>/<member>/foxglove` as foxglove.RawImage / CompressedImage (foxglove_image.hpp).
+    bool foxglove_images = true;
     std::string directory = "recordings";
     /// File name prefix ("" = the device name): files are <directory>/<prefix>-<UTC time>-<n>.mcap.
     std::string prefix;
@@ -44,7 +47,7 @@ struct RecordingSpec {
 /// The spec from JSON (POST /api/recordings, docs/recording.md), the same keys as a `record:` entry:
 /// {"device", "members"?, "encoding"?: "json"|"robotraconteur"|["json","robotraconteur"], "directory"?,
 /// "prefix"?, "property_period_ms"?, "max_file_bytes"?, "max_file_seconds"?, "max_total_bytes"?,
-/// "duration_s"?, "queue_bytes"?, "chunk_bytes"?, "compression"?: "zstd"|"none"}.
+/// "duration_s"?, "queue_bytes"?, "chunk_bytes"?, "compression"?: "zstd"|"none", "foxglove_images"?: bool}.
 /// Errors: InvalidArgument naming the key (unknown keys included).
 Result<RecordingSpec> spec_from_json(const nlohmann::json& j);
 /// The spec as JSON (the same keys).

@@ -86,3 +86,16 @@ record:
     REQUIRE_FALSE(bad_replay);
     CHECK(bad_replay.error().message.find("devices.r.speed") != std::string::npos);
 }
+
+TEST_CASE("record spec: foxglove_images, on by default") {
+    auto d = record::spec_from_json(json{{"device", "cam"}});
+    REQUIRE(d);
+    CHECK(d->foxglove_images);
+    CHECK(record::spec_json(*d)["foxglove_images"] == true);
+    auto off = record::spec_from_json(json{{"device", "cam"}, {"foxglove_images", false}});
+    REQUIRE(off);
+    CHECK_FALSE(off->foxglove_images);
+    auto bad = record::spec_from_json(json{{"device", "cam"}, {"foxglove_images", "no"}});
+    REQUIRE_FALSE(bad);
+    CHECK(bad.error().message == "record: foxglove_images: expected true or false");
+}

@@ -38,7 +38,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http  # noqa: E402
+from record_checks import CheckFailed, expect, foxglove_check, http  # noqa: E402
 
 try:
     import jsonschema
@@ -151,6 +151,7 @@ def check_recording(path, live, checks):
             validator.validate(json.loads(m.data))
             validated += 1
     checks["json_messages_validated"] = validated
+    foxglove_check([path], checks)
     # The recorded packets are those the official client received live: same sequence, same bytes.
     recorded = {}
     for m in json_packets[2]:

@@ -19,6 +19,7 @@ Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's 
 """
 
 import argparse
+import base64
 import hashlib
 import json
 import os
@@ -35,7 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEVICES = os.path.join(HERE, "..", "browser", "devices")
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http  # noqa: E402
+from record_checks import CheckFailed, expect, foxglove_check, http, official_foxglove_schemas  # noqa: E402
 
 try:
     import jsonschema
@@ -127,6 +128,34 @@ def check_file(path, device, member, service, checks, validate_max=None):
     return values
 
 
+def check_foxglove_images(path, hashes, checks):
+    """The camera's frames also on camera/frame_stream/foxglove: valid against the official
+    foxglove.RawImage JSON Schema (@foxglove/schemas), base64 bytes equal to the recorded frames'."""
+    official = official_foxglove_schemas()
+    if official is None:
+        checks["foxglove_images"] = "SKIP: node or test/mcap/node_modules missing (run ./scripts/setup.sh)"
+        return
+    channels, _ = read_channels(path)
+    expect(("camera/frame_stream/foxglove", "json") in channels, "camera/frame_stream/foxglove recorded: %s" % sorted(channels))
+    channel, schema, messages = channels[("camera/frame_stream/foxglove", "json")]
+    expect(schema.name == "foxglove.RawImage" and schema.encoding == "jsonschema", "schema foxglove.RawImage (jsonschema)")
+    validator = jsonschema.Draft202012Validator(official["foxglove.RawImage"])
+    recorded = {h for _, h in hashes}
+    same = 0
+    for m in messages:
+        j = json.loads(m.data)
+        validator.validate(j)
+        expect(j["width"] == 160 and j["height"] == 120 and j["encoding"] in ("rgb8", "bgr8", "mono8", "rgba8", "bgra8"),
+               "RawImage size and encoding: %s" % {k: j[k] for k in ("width", "height", "encoding", "step")})
+        data = base64.b64decode(j["data"], validate=True)
+        expect(len(data) >= j["step"] * j["height"], "RawImage data holds step*height bytes")
+        same += hashlib.sha256(data).hexdigest() in recorded
+    checks["foxglove_images"] = {"messages": len(messages), "same_bytes_as_recorded_frames": same,
+                                 "encoding": json.loads(messages[0].data)["encoding"] if messages else None}
+    expect(len(messages) == len(hashes), "one RawImage per recorded frame (%d, %d)" % (len(messages), len(hashes)))
+    expect(same == len(messages), "every RawImage has the bytes of a recorded frame")
+
+
 def run(gateway_exe, work, seconds, checks):
     robot, robot_info = start_device("sim_robot.py", ["--enabled", "--max-lifetime", "280"], work)
     camera, cam_info = start_device("camera_synthetic.py", ["--camera-info", os.path.join(DEVICES, "synthetic_camera_info.yml"),
@@ -200,6 +229,8 @@ def run(gateway_exe, work, seconds, checks):
         fseen = sum(h in live_f for h in hashes)
         checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": fseen}
         expect(fseen == len(frames), "every recorded frame is one the official client received live")
+        foxglove_check([robot_file, finals["camera"]["files"][0]], checks, max_messages=5)
+        check_foxglove_images(finals["camera"]["files"][0], hashes, checks)
     finally:
         stop(gw)
         stop(camera)

@@ -1,0 +1,48 @@
+// Extra `json` channels that Foxglove's / Lichtblick's Image panel shows (docs/recording.md "Opening a
+// recording in Foxglove or Lichtblick"): a recorded member whose value is a standard image
+// (com.robotraconteur.image.Image or CompressedImage) also gets a channel `<device>/<member>/foxglove`
+// whose schema is named foxglove.RawImage or foxglove.CompressedImage and whose messages have those
+// schemas' fields, the pixel bytes in base64.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "core/json/value_json.hpp"
+#include "robdef/service_definition.hpp"
+#include "robdef/type_lookup.hpp"
+
+namespace rr::server::record {
+
+enum class FoxgloveImageKind { raw, compressed };
+
+/// Which Foxglove image a value of `type` becomes: a single (not array, not container) value of
+/// com.robotraconteur.image.Image (raw) or CompressedImage (compressed); nothing for anything else.
+std::optional<FoxgloveImageKind> foxglove_image_kind(const robdef::TypeDefinition& type,
+                                                     const robdef::TypeLookup& lookup, std::string_view context_service);
+
+/// "foxglove.RawImage" or "foxglove.CompressedImage": the schema name Foxglove's Image panel looks for.
+std::string_view foxglove_schema_name(FoxgloveImageKind kind);
+
+/// The channel's JSON Schema (our own text of the fields of the foxglove schema of that name; data is a
+/// base64 string, `contentEncoding: base64`, timestamp {sec, nsec}).
+nlohmann::json foxglove_image_schema(FoxgloveImageKind kind);
+
+/// Foxglove's raw image encoding name for an RR ImageEncoding value (rgb888 → "rgb8", mono16 → "mono16",
+/// depth_u16 → "16UC1", bayer_rggb8888 → "bayer_rggb8", ...); nothing for the encodings Foxglove has no
+/// equivalent of (rgba16_16_16_16, mono32, floating-point, the other depth formats, freeform, ...).
+std::optional<std::string_view> foxglove_raw_encoding(std::int64_t rr_encoding);
+
+/// The Foxglove message for one recorded image: `value` is the image as element_json writes it with
+/// `binary` (its `data` a {"$binary": i} reference into binary.blobs, or a JSON array of numbers).
+/// `timestamp` is the image's data_header.ts when it lies within a day of `log_ns` (a device clock on the
+/// Unix epoch), else `log_ns`; frame_id is "". Nothing when the value is null or malformed, a raw
+/// image's encoding has no Foxglove equivalent, or a compressed image's bytes are not JPEG, PNG or WebP.
+std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const nlohmann::json& value,
+                                                  const BinaryArrays& binary, std::uint64_t log_ns);
+
+}  // namespace rr::server::record
