@@ -53,6 +53,28 @@ nlohmann::json status_json(const RecordingStatus& s) {
 
 namespace {
 
+// A json channel leaves a null member out of its object (an absent struct, list, map or varvalue):
+// its schema gives every property one type, as Foxglove's parser requires, so a null there would not
+// validate; an absent member does. Nulls inside arrays stay (removing them would shift the indices).
+void drop_null_members(nlohmann::json& j) {
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end();) {
+            if (it->is_null()) it = j.erase(it);
+            else drop_null_members(*it++);
+        }
+    } else if (j.is_array()) {
+        for (auto& x : j) drop_null_members(x);
+    }
+}
+
+std::string without_null_members(std::string text) {
+    if (text.find("null") == std::string::npos) return text;  // the common case: nothing to parse again
+    auto j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_discarded()) return text;
+    drop_null_members(j);
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 std::uint64_t now_ns() {
     return static_cast<std::uint64_t>(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
@@ -496,9 +518,12 @@ Result<void> Recording::write_item(const Item& item) {
                     if (j) body["value"] = std::move(j.value);
                     else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
                 }
+                drop_null_members(body);
                 text = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
             }
         }
+        if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event)
+            text = without_null_members(std::move(text));
         if (auto r = write(file_->json_channel[item.member], sequence_[item.member * 2], as_bytes(text)); !r) return r;
     }
     if (file_->foxglove_channel[item.member] >= 0) {

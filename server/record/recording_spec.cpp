@@ -7,10 +7,6 @@ namespace {
 
 using nlohmann::json;
 
-Result<void> bad(const std::string& key, const std::string& problem) {
-    return fail(MessageErrorType::InvalidArgument, "record: " + key + ": " + problem);
-}
-
 Result<std::uint64_t> unsigned_of(const json& j, const std::string& key) {
     if (j.is_number_unsigned()) return j.get<std::uint64_t>();
     if (j.is_number_integer() && j.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(j.get<std::int64_t>());
