@@ -27,7 +27,6 @@ or wasm-client/dist missing).
 import argparse
 import json
 import os
-import queue
 import shutil
 import subprocess
 import sys
@@ -74,8 +73,12 @@ def record(rr, service_exe, work, seconds, checks):
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL,
                                 preexec_fn=die_with_parent)
         # The recorder says what it records once its wire, pipe and event are connected.
-        line = proc.stderr.readline()
-        expect(line.startswith("rr: recording"), "rr record started: %r" % line)
+        seen = []
+        for line in proc.stderr:
+            seen.append(line)
+            if line.startswith("rr: recording"):
+                break
+        expect(seen and seen[-1].startswith("rr: recording"), "rr record started: %r" % seen[-5:])
         time.sleep(seconds * 0.25)
         client.send_stream(5)
         time.sleep(0.3)
