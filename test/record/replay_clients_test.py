@@ -229,13 +229,14 @@ class JsonClient:
 class WasmClient:
     """replay_clients_wasm.mjs in node: the wasm client over rr+ws."""
 
-    def __init__(self, node, url):
-        self.proc = subprocess.Popen([node, os.path.join(HERE, "replay_clients_wasm.mjs"), url], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=die_with_parent)
+    def __init__(self, node, url, log):
+        with open(log, "wb") as errf:
+            self.proc = subprocess.Popen([node, os.path.join(HERE, "replay_clients_wasm.mjs"), url], stdin=subprocess.PIPE,
+                                         stdout=subprocess.PIPE, stderr=errf, preexec_fn=die_with_parent)
         try:
             ready = read_json_line(self.proc, 60, "replay_clients_wasm.mjs")
         except StepFailed as e:
-            raise CheckFailed("wasm client: %s: %s" % (e, self.proc.stderr.read().decode(errors="replace")[-800:]))
+            raise CheckFailed("wasm client: %s: %s" % (e, open(log, errors="replace").read()[-800:]))
         expect(ready.get("ready"), "wasm client ready: %r" % ready)
 
     def report(self):
@@ -324,7 +325,7 @@ def replay(gateway, path, rec, work, checks):
         clients["rr+ws"] = OfficialClient("rr+ws://127.0.0.1:%d/?service=interop" % port)
         node, wasm_skip = wasm_prerequisite()
         if node:
-            clients["wasm"] = WasmClient(node, "rr+ws://127.0.0.1:%d/?service=interop" % port)
+            clients["wasm"] = WasmClient(node, "rr+ws://127.0.0.1:%d/?service=interop" % port, os.path.join(work, "wasm.log"))
         clients["json"] = JsonClient(port, "interop")
         time.sleep(0.5)
         status, st = http(base, "POST", "/api/replays/interop", {"state": "playing"})
