@@ -15,8 +15,8 @@ tested against a replay"):
            in the recorded order (a wire may skip a value for a slow client, at most a third here) ending
            with the last recorded one; the 5 recorded pipe packets; the 3 recorded events; p_int32 =
            its last recorded value; add(1, 2) refused with InvalidOperation "… functions are not replayed".
-  seek     POST /api/replays/interop {"position_s": T, "state": "paused"} with T just after the first
-           p_int32 poll (value A): each client then sees the w_state value recorded at T (its wire's
+  seek     POST /api/replays/interop {"position_s": T, "state": "paused"} with T just after the last
+           p_int32 poll that read A: each client then sees the w_state value recorded at T (its wire's
            InValue, or the JSON push) and p_int32 = A again.
 
 Prints one JSON summary; exit 0 when every check passed, 1 when one failed, 77 (SKIP, with the reason)
@@ -341,9 +341,9 @@ def replay(gateway, path, rec, work, checks):
             played[name] = check_played(name, c.report(), rec)
         checks["played"] = played
 
-        # Seek to just after the first p_int32 poll (value A), paused: every client sees the wire value
-        # and the property of that position.
-        t_ns = rec["property"][0][0] + 50_000_000
+        # Seek back to just after the last p_int32 poll that read A (before the set to B), paused: every
+        # client sees the wire value and the property of that position.
+        t_ns = [t for t, v in rec["property"] if v == P_INT32_A][-1] + 50_000_000
         want_wire = [i for t, i in rec["wire"] if t <= t_ns]
         if not want_wire:
             t_ns = rec["wire"][0][0] + 50_000_000
