@@ -321,7 +321,9 @@ std::string help_text(std::string_view topic) {
                "Records the root object's wires, pipes and events (or the --members named, properties\n"
                "polled every second) into MCAP files in D (default ./recordings), the gateway's format\n"
                "(docs/recording.md), until SIGINT/SIGTERM or S seconds, then prints the recording's status\n"
-               "as one JSON line. NAME (default: the URL's service) names the topics NAME/MEMBER.\n";
+               "as one JSON line. NAME (default: the URL's service) names the topics NAME/MEMBER.\n"
+               "Credentials as for the other commands: --username/--password, --username NAME@token\n"
+               "--token T (a device behind a gateway's logins), --http-login, --tls-ca/--tls-cert/--tls-key.\n";
     if (topic == "replay")
         return "usage: rr replay FILE [--port P] [--address A] [--speed S] [--loop]\n"
                "Serves the recorded service of FILE (its robotraconteur channels) on an rr+tcp node at\n"

@@ -5,6 +5,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "server/cli/cli_commands.hpp"
+#include "server/cli/cli_target.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/node/node.hpp"
@@ -46,6 +47,8 @@ ExitCode run_record(const CommandLine& cl, std::ostream& out, std::ostream& err,
     dc.url = cl.url;
     dc.username = cl.username;
     dc.password = cl.password;
+    dc.token = cl.token;
+    dc.http_authorization = http_authorization(cl);
     dc.tls_ca = cl.tls_ca_file;
     dc.tls_certificate = cl.tls_certificate_file;
     dc.tls_private_key = cl.tls_private_key_file;

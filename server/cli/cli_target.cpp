@@ -51,6 +51,12 @@ Result<ObjRefIndex> objref_index(const MemberInfo& m, const PathSegment& seg) {
 
 }  // namespace
 
+std::string http_authorization(const CommandLine& cl) {
+    const auto colon = cl.http_login.find(':');
+    if (colon == std::string::npos) return {};
+    return server::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
+}
+
 std::optional<Failure> connect_target(const CommandLine& cl, const std::string& url, Target& target) {
     // A URL that does not parse is the user's typo (status 2), never a connect failure.
     if (auto parsed = parse_connection_url(url); !parsed) return Failure{ExitCode::usage_error, parsed.error()};
@@ -65,8 +71,7 @@ std::optional<Failure> connect_target(const CommandLine& cl, const std::string& 
     options.tls_ca_file = cl.tls_ca_file;
     options.tls_certificate_file = cl.tls_certificate_file;
     options.tls_private_key_file = cl.tls_private_key_file;
-    if (auto colon = cl.http_login.find(':'); colon != std::string::npos)
-        options.http_authorization = server::basic_authorization(cl.http_login.substr(0, colon), cl.http_login.substr(colon + 1));
+    options.http_authorization = http_authorization(cl);
     options.enable_message4 = !cl.disable_message4;
     target.io = command_io_threads(1);
     auto c = Client::connect(target.io->executor(), url, options);

@@ -40,6 +40,10 @@ struct Target {
 /// `url` with `service=` replaced (when `service` is set).
 Result<std::string> url_with_service(const std::string& url, const std::string& service);
 
+/// The WebSocket handshake's Authorization header for --http-login USER:PASSWORD ("" without it);
+/// used by every command that connects, `rr record` included.
+std::string http_authorization(const CommandLine& cl);
+
 /// Connects to cl.url with cl's timeout and credentials and walks cl.objects.
 /// Errors: connect_failure (no session), rr_error (a segment is no objref, unknown key, …).
 std::optional<Failure> connect_target(const CommandLine& cl, const std::string& url, Target& target);

@@ -6,6 +6,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "core/message/error_entry.hpp"
+#include "server/client/raw_client.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/transport/completion_guard.hpp"
 
@@ -115,13 +116,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     cfg.session.service_name = url->service;
     cfg.session.username = options.username;
     cfg.session.password = options.password;
-    if (!options.token.empty()) {
-        MessageElement credentials;
-        credentials.name = "credentials";
-        credentials.type = DataTypes::dictionary_t;
-        credentials.elements.push_back(make_string_element("token", options.token));
-        cfg.session.credentials = std::move(credentials);
-    }
+    if (!options.token.empty()) cfg.session.credentials = server::token_credentials(options.token);
     cfg.session.request_timeout = options.request_timeout;
     // One bound for the whole connect when asked for: the session counts it from here, before the
     // transport starts (its message then wins over the stream's own CreateConnection timeout).

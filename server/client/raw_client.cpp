@@ -2,6 +2,7 @@
 
 #include <boost/asio/strand.hpp>
 
+#include "core/message/error_entry.hpp"
 #include "core/session/request_map.hpp"
 #include "server/common/connection_strand.hpp"
 #include "server/common/random_ids.hpp"
@@ -10,6 +11,14 @@
 namespace rr::server {
 
 namespace asio = boost::asio;
+
+MessageElement token_credentials(const std::string& token) {
+    MessageElement credentials;
+    credentials.name = "credentials";
+    credentials.type = DataTypes::dictionary_t;
+    credentials.elements.push_back(make_string_element("token", token));
+    return credentials;
+}
 
 /// The strand-side half: owns the ClientSession and routes its events.
 class RawClient::Logic : public ConnectionLogic {

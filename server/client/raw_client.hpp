@@ -43,6 +43,10 @@ struct RawClientOptions {
     const TransportRegistry* transports = nullptr;
 };
 
+/// The `credentials` a gateway's bearer token or JWT logs in with (docs/security.md "Native RR clients"):
+/// the dictionary {"token": token}; the user name is then `<name>@token` or `<sub>@jwt`.
+MessageElement token_credentials(const std::string& token);
+
 class RawClient : public std::enable_shared_from_this<RawClient> {
 public:
     using ConnectHandler = std::function<void(Result<std::shared_ptr<RawClient>>)>;

@@ -116,6 +116,7 @@ void DeviceMirror::connect() {
     RawClientOptions options = upstream_options(*node);
     options.username = config_.username;
     options.password = config_.password;
+    if (!config_.token.empty()) options.credentials = token_credentials(config_.token);
     std::weak_ptr<DeviceMirror> weak = weak_from_this();
     RawClient::connect(
         node->io_context().get_executor(), url_, options,
@@ -158,6 +159,7 @@ RawClientOptions DeviceMirror::upstream_options(Node& node) const {
     options.tls_ca_file = config_.tls_ca;
     options.tls_certificate_file = config_.tls_certificate;
     options.tls_private_key_file = config_.tls_private_key;
+    options.http_authorization = config_.http_authorization;
     options.transports = &node.transports();
     return options;
 }

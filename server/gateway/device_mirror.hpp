@@ -53,6 +53,13 @@ struct DeviceConfig {
     std::string name;  ///< service name on the gateway (a valid RR service name)
     std::string url;   ///< rr+tcp://host:port/?service=…
     std::string username, password;
+    /// Log in with a gateway's bearer token or JWT (credentials {"token": …}, token_credentials) instead
+    /// of `password`; `username` is then `<name>@token` or `<sub>@jwt`. Set by `rr record --token`
+    /// (a device behind another gateway's logins); not a gateway config key.
+    std::string token;
+    /// rr+ws/rr+wss: the WebSocket handshake's Authorization header (a reverse proxy's basic auth,
+    /// `rr record --http-login`); "" = none. Not a gateway config key.
+    std::string http_authorization;
     /// rr+wss, rrs+tcp: PEM certificates to trust ("" = the system's), and the gateway's own
     /// certificate and key to present when the device requires client certificates ("" = none).
     std::string tls_ca, tls_certificate, tls_private_key;

@@ -174,6 +174,11 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   const t = timeline();
   await t.waitFor({ timeout: 10000 });
   assert.equal(await view("create_replay").locator(".record-control").count(), 1, "a replayed device can be recorded too");
+  // ... and its Record section says so (docs/recording.md "Recording a replay")
+  const replayRecord = view("create_replay").locator(".record-control");
+  await replayRecord.locator(".record-replay-note").waitFor({ timeout: 20000 });
+  assert.equal(await replayRecord.locator("h3").textContent(), "Record this replay");
+  assert.ok((await replayRecord.locator(".record-replay-note").textContent()).includes(recordedFile), "the note names the replayed file");
   assert.equal(await t.locator(".replay-file").textContent(), recordedFile);
   const st0 = await status();
   assert.ok(Math.abs(seconds(await t.locator(".replay-duration").textContent()) - st0.duration_s) <= 0.05, "the page shows the duration");

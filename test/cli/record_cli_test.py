@@ -14,6 +14,9 @@ with the official Robot Raconteur Python client and the reference MCAP reader (P
            a final status line with played > 0).
   errors   a member the object lacks (status 2), an unreachable service (status 3), an unwritable
            directory and a file that is not MCAP (status 1, messages naming the member / path).
+  login    (with --gateway) the service behind rr-gateway with logins on (gateway.auth, a bearer token):
+           `rr record` through the gateway is refused without a login and with a wrong token (status 3,
+           the gateway's reason), and records with `--username rec@token --token T`.
 
 Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
 """
@@ -249,10 +252,70 @@ def errors_phase(rr, url, work, checks):
     checks["errors"] = "ok"
 
 
+GATEWAY_TOKEN = "recorder-token-8f14e45fceea167a"
+
+
+def gateway_login_phase(rr, gateway, url, work, checks):
+    """`rr record` of a device behind a gateway with logins on (gateway.auth): refused without
+    credentials or with a wrong token (status 3, the gateway's reason), recorded with
+    `--username rec@token --token T` (the credentials every rr command takes)."""
+    d = os.path.join(work, "gw")
+    os.makedirs(d)
+    with open(os.path.join(d, "tokens.txt"), "w") as f:
+        f.write("%s rec viewer\n" % GATEWAY_TOKEN)
+    with open(os.path.join(d, "gateway.yaml"), "w") as f:
+        f.write("""gateway:
+  port: 0
+  listen: 127.0.0.1
+  local: false
+  auth:
+    tokens: {d}/tokens.txt
+    roles:
+      viewer:
+        - allow: [read]
+    # the recorder retries a refused login until --timeout: no lockout for this test's address
+    login_limit: {{max_failures: 1000, window_s: 60, lockout_s: 1}}
+demo:
+  enabled: false
+devices:
+  - name: interop
+    url: {url}
+""".format(d=d, url=url))
+    with open(os.path.join(d, "gateway.err"), "wb") as errf:
+        gw = subprocess.Popen([gateway, "--config", os.path.join(d, "gateway.yaml"), "--no-discovery"],
+                              stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    try:
+        port = read_json_line(gw, 60, "rr-gateway")["port"]
+        gw_url = "rr+tcp://127.0.0.1:%d/?service=interop" % port
+
+        def run(extra):
+            p = subprocess.run([rr, "record", gw_url, "--members", "w_state", "--duration", "2", "--timeout", "8",
+                                "--dir", os.path.join(d, "rec")] + extra, capture_output=True, text=True, timeout=120)
+            return p.returncode, p.stdout, p.stderr
+
+        rc, _, err = run([])
+        expect(rc == 3 and "not connected" in err,
+               "without a login: status 3 with the gateway's reason (rc=%s, %s)" % (rc, err.strip()[-600:]))
+        refused = err.strip().splitlines()[-1]
+        rc, _, err = run(["--username", "rec@token", "--token", GATEWAY_TOKEN + "x"])
+        expect(rc == 3 and "Invalid token" in err, "a wrong token: status 3, 'Invalid token' (rc=%s, %s)"
+               % (rc, err.strip()[-600:]))
+        rc, out, err = run(["--username", "rec@token", "--token", GATEWAY_TOKEN])
+        expect(rc == 0, "with --token: rr record exits 0 (rc=%s, %s)" % (rc, err.strip()[-800:]))
+        status = json.loads(out.strip().splitlines()[-1])
+        channels, _ = read_channels(status["files"][0])
+        n = len(channels.get(("interop/w_state", "json"), (None, None, []))[2])
+        expect(n >= 3, "with --token: w_state values recorded through the gateway (%d)" % n)
+        checks["gateway_login"] = {"refused": refused[-300:], "recorded_w_state": n}
+    finally:
+        stop(gw)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rr", required=True)
     ap.add_argument("--service", required=True, help="rr_interop_service")
+    ap.add_argument("--gateway", help="rr-gateway: also record a device behind its logins with --token")
     ap.add_argument("--seconds", type=float, default=4.0)
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
@@ -267,6 +330,10 @@ def main():
         sigint_phase(a.rr, url, work, checks)
         replay_phase(a.rr, path, recorded, checks)
         errors_phase(a.rr, url, work, checks)
+        if a.gateway:
+            gateway_login_phase(a.rr, a.gateway, url, work, checks)
+        else:
+            checks["gateway_login"] = "not run (no --gateway)"
         ok = True
     except (CheckFailed, AssertionError, jsonschema.ValidationError, RR.RobotRaconteurException, OSError, KeyError,
             ValueError, IndexError, subprocess.TimeoutExpired, StepFailed) as e:

@@ -80,6 +80,9 @@ export class DeviceView {
       if (this.closed) return;
       this.replay = new ReplayTimeline(this.tools, { name: this.name, status, mayControl });
       this.tools.prepend(this.replay.el);
+      // the Record control (made when the device connects, before or after this) says it records a replay
+      this.replayFile = status.file;
+      this.recorder?.markReplay(status.file);
     } catch (e) {
       this.log.add("error", "", `replay status: ${errorText(e)}`);
     }
@@ -206,6 +209,7 @@ export class DeviceView {
     this.definitions = new DefinitionView(this.defBox, outline, `def-${this.name}`);
     this.typeEl.textContent = client.$type;
     const recorder = this.recorder = new RecordControl(this.tools, { device: this.name, members: client.$members });
+    if (this.replayFile) recorder.markReplay(this.replayFile);
     this.mayWriteDevice().then((may) => { if (!may) recorder.refuse("Your login may not record this device (it needs write on the device)."); });
     // the device's types described once, from the definitions it sent (views/context.js)
     const view = viewContext(outline);

@@ -46,8 +46,9 @@ export class RecordControl {
     const memberList = h("div", { class: "record-members" }, ...this.members.map((m, i) =>
       h("label", {}, this.boxes[i], h("span", { text: m.name }), h("span", { class: "member-kind", text: m.kind }))));
     const all = (on) => () => { for (const b of this.boxes) b.checked = on; };
+    this.heading = h("h3", { text: "Recording" });
     this.el = h("section", { class: "record-control", dataset: { state: "idle" } },
-      h("h3", { text: "Recording" }),
+      this.heading,
       h("details", { class: "record-options" },
         h("summary", { text: "Members and options" }),
         h("div", { class: "record-select" },
@@ -63,6 +64,21 @@ export class RecordControl {
     this.active = null;
     this.poll();
     this.timer = setInterval(() => this.poll(), POLL_MS);
+  }
+
+  /**
+   * Says that the device is a replay of `file` (docs/recording.md "Recording a replay"): recording it
+   * stays possible (to cut a part, or to get the json encoding of a file that has only robotraconteur
+   * channels), and the section says what such a recording holds. Called once; later calls do nothing.
+   * @param {string} file  the replayed file's path on the gateway (the replay status's `file`)
+   */
+  markReplay(file) {
+    if (this.el.dataset.replay) return;
+    this.el.dataset.replay = "true";
+    this.heading.textContent = "Record this replay";
+    this.heading.after(h("p", { class: "hint record-replay-note",
+      text: `This device is a replay of ${file}. A recording takes what the replay plays from now on ` +
+        "(time stamps of now, not of the original): to cut a part, seek, Record, play, Stop." }));
   }
 
   /** Disables starting a recording, saying why (the gateway would refuse it: 403). */
