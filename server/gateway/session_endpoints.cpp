@@ -361,7 +361,7 @@ bool SessionEndpoints::take_pipe_elements(MessageEntry& entry) {
         if (acks) {
             if (d.handlers->on_ack) d.handlers->on_ack(d.number);
         } else if (d.handlers->on_packet) {
-            d.handlers->on_packet(std::move(d.packet), d.number);  // the handler may keep it without a copy
+            d.handlers->on_packet(d.packet, d.number);
         }
     }
     return entry.elements.empty();

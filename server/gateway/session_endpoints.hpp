@@ -32,12 +32,11 @@
 namespace rr::server::gateway {
 
 /// What a pipe endpoint of the gateway itself hears (JSON API pipe subscriptions). `on_packet` gets the
-/// packet's `packet` element (its to keep: moved, one handler per endpoint) and its number
-/// (acknowledgements the sender asked for are sent already);
+/// packet's `packet` element and its number (acknowledgements the sender asked for are sent already);
 /// `on_ack` a packet number the device acknowledged; `on_closed` once, when the device closes the
 /// endpoint (PipeClosed) or the session ends: not after the owner closed it.
 struct GatewayPipeHandlers {
-    std::function<void(MessageElement&& packet, std::uint32_t packet_number)> on_packet;
+    std::function<void(const MessageElement& packet, std::uint32_t packet_number)> on_packet;
     std::function<void(std::uint32_t packet_number)> on_ack;
     std::function<void(const RRError& reason)> on_closed;
 };

@@ -228,14 +228,14 @@ void Recording::subscribe_members() {
         } else if (m.kind == RecordedMember::Kind::pipe) {
             gateway::GatewayPipeHandlers h;
             const std::string path = t.path, member = t.member->name;
-            h.on_packet = [weak, index, path, member](MessageElement&& packet, std::uint32_t) {
+            h.on_packet = [weak, index, path, member](const MessageElement& packet, std::uint32_t) {
                 auto self = weak.lock();
                 if (!self) return;
                 MessageEntry e;
                 e.entry_type = MessageEntryType::PipePacket;
                 e.service_path = path;
                 e.member_name = member;
-                e.elements.push_back(std::move(packet));  // the endpoint's own copy: taken, not copied
+                e.elements.push_back(packet);  // its bytes are shared (SharedBytes), not copied
                 self->offer(index, std::make_shared<SharedEntry>(std::move(e)));
             };
             h.on_closed = [](const RRError&) {};

@@ -2,7 +2,7 @@
 //
 // The live path only hands over what it already has: each wire value and event is the SharedEntry the
 // gateway fans out to its clients (DeviceMirror::subscribe; the reference, not a copy), each pipe packet
-// the element the gateway's own pipe endpoint received (moved, not copied), each polled property the
+// the element the gateway's own pipe endpoint received (its bytes shared), each polled property the
 // device's reply. They wait in a RecordQueue (record_queue.hpp: bounded by RecordingSpec::queue_bytes;
 // when it is full the entry is dropped and counted, the live path never waits, allocates nothing per
 // value once warm and does not wake the writer per value) and one writer thread per recording (named
