@@ -158,21 +158,23 @@ def proc_vcsw(pid):
 
 
 def threads_cpu(pid, prefix):
-    """CPU seconds (utime + stime) of a process's live threads whose name (comm) starts with `prefix`,
-    from /proc/<pid>/task/*/stat. A thread that ended is no longer counted (its time stays in the
-    process's own figure)."""
+    """(CPU seconds (utime + stime) of a process's live threads whose name (comm) starts with `prefix`,
+    minor page faults of the other live threads), from /proc/<pid>/task/*/stat. A thread that ended is
+    no longer counted (its time stays in the process's own figure)."""
     ticks = os.sysconf("SC_CLK_TCK")
-    total = 0
+    total, other_minflt = 0, 0
     for tid in os.listdir("/proc/%d/task" % pid):
         try:
             with open("/proc/%d/task/%s/stat" % (pid, tid)) as f:
                 head, rest = f.read().rsplit(")", 1)
         except OSError:
             continue  # the thread ended
+        fields = rest.split()
         if head.split("(", 1)[1].startswith(prefix):
-            fields = rest.split()
             total += int(fields[11]) + int(fields[12])
-    return total / ticks
+        else:
+            other_minflt += int(fields[7])
+    return total / ticks, other_minflt
 
 
 class Sampler(threading.Thread):
@@ -187,8 +189,8 @@ class Sampler(threading.Thread):
     def run(self):
         while not self.stop_flag.is_set():
             try:
-                named = threads_cpu(self.pid, self.thread_prefix) if self.thread_prefix else 0.0
-                self.samples.append((time.time(),) + proc_sample(self.pid) + (proc_vcsw(self.pid), named))
+                named = threads_cpu(self.pid, self.thread_prefix) if self.thread_prefix else (0.0, 0)
+                self.samples.append((time.time(),) + proc_sample(self.pid) + (proc_vcsw(self.pid),) + named)
             except OSError:
                 return
             time.sleep(0.2)
@@ -203,7 +205,8 @@ class Sampler(threading.Thread):
             return None
         dt = s[-1][0] - s[0][0]
         return {"cpu_pct": 100 * (s[-1][1] - s[0][1]) / dt, "rss_kib_max": max(x[2] for x in s),
-                "vcsw_per_s": (s[-1][3] - s[0][3]) / dt, "named_threads_cpu_pct": 100 * (s[-1][4] - s[0][4]) / dt}
+                "vcsw_per_s": (s[-1][3] - s[0][3]) / dt, "named_threads_cpu_pct": 100 * (s[-1][4] - s[0][4]) / dt,
+                "other_threads_minflt_per_s": (s[-1][5] - s[0][5]) / dt}
 
 
 SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record")
@@ -271,7 +274,8 @@ def sampled(pid, argv, label_fields, thread_prefix=None):
                 named, other = w["named_threads_cpu_pct"], w["cpu_pct"] - w["named_threads_cpu_pct"]
                 row.update({"named_threads": thread_prefix, "named_threads_cpu_pct": named, "other_threads_cpu_pct": other,
                             "named_threads_cpu_us_per_value": named * 1e4 / per_s if per_s else None,
-                            "other_threads_cpu_us_per_value": other * 1e4 / per_s if per_s else None})
+                            "other_threads_cpu_us_per_value": other * 1e4 / per_s if per_s else None,
+                            "other_threads_minflt_per_value": w["other_threads_minflt_per_s"] / per_s if per_s else None})
         if sampler.samples:
             row["server_rss_after_kib"] = sampler.samples[-1][2]
         out.append(row)
@@ -988,16 +992,17 @@ def markdown(res):
                 "of the member in the gateway; the two rows of a pair ran one after the other in the same round:", "",
                 "| workload | round | recording | values/s per client min, median | delivered of sent | p50 ms | p99 ms | max ms "
                 "| gateway CPU % | gateway CPU µs / value | live path (other threads) µs / value | recorder threads µs / value "
-                "| gateway RSS MiB (max) | recorded messages | drops | MB written |",
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                "| live path page faults / value | gateway RSS MiB (max) | recorded messages | drops | MB written |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for f in res["record"]:
             st = f.get("recording_status") or {}
-            out.append("| %s | %s | %s | %s, %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            out.append("| %s | %s | %s | %s, %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 f["workload"], f["round"], "yes" if f["recording"] else "no", fmt(f["per_client_per_s_min"]),
                 fmt(f["per_client_per_s_median"]), 100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000, 2),
                 fmt(f["p99_us"] / 1000, 2), fmt(f["max_us"] / 1000, 2), fmt(f.get("server_cpu_pct")),
                 fmt(f.get("server_cpu_us_per_value")), fmt(f.get("other_threads_cpu_us_per_value")),
-                fmt(f.get("named_threads_cpu_us_per_value"), 2), fmt(f.get("server_rss_kib", 0) / 1024),
+                fmt(f.get("named_threads_cpu_us_per_value"), 2), fmt(f.get("other_threads_minflt_per_value"), 1),
+                fmt(f.get("server_rss_kib", 0) / 1024),
                 fmt(st.get("messages"), 0) if st else "", fmt(st.get("drops"), 0) if st else "",
                 fmt((st.get("bytes") or 0) / 1e6) if st else ""))
     if res.get("browser"):
