@@ -157,17 +157,40 @@ def proc_vcsw(pid):
     return n
 
 
-class Sampler(threading.Thread):
-    """Samples a process's CPU, RSS and voluntary context switches every 0.2 s with wall-clock stamps."""
+def threads_cpu(pid, prefix):
+    """(CPU seconds (utime + stime) of a process's live threads whose name (comm) starts with `prefix`,
+    minor page faults of the other live threads), from /proc/<pid>/task/*/stat. A thread that ended is
+    no longer counted (its time stays in the process's own figure)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    total, other_minflt = 0, 0
+    for tid in os.listdir("/proc/%d/task" % pid):
+        try:
+            with open("/proc/%d/task/%s/stat" % (pid, tid)) as f:
+                head, rest = f.read().rsplit(")", 1)
+        except OSError:
+            continue  # the thread ended
+        fields = rest.split()
+        if head.split("(", 1)[1].startswith(prefix):
+            total += int(fields[11]) + int(fields[12])
+        else:
+            other_minflt += int(fields[7])
+    return total / ticks, other_minflt
 
-    def __init__(self, pid):
+
+class Sampler(threading.Thread):
+    """Samples a process's CPU, RSS and voluntary context switches every 0.2 s with wall-clock stamps;
+    with `thread_prefix`, also the CPU of its threads so named (threads_cpu)."""
+
+    def __init__(self, pid, thread_prefix=None):
         super().__init__(daemon=True)
         self.pid, self.samples, self.stop_flag = pid, [], threading.Event()
+        self.thread_prefix = thread_prefix
 
     def run(self):
         while not self.stop_flag.is_set():
             try:
-                self.samples.append((time.time(),) + proc_sample(self.pid) + (proc_vcsw(self.pid),))
+                named = threads_cpu(self.pid, self.thread_prefix) if self.thread_prefix else (0.0, 0)
+                self.samples.append((time.time(),) + proc_sample(self.pid) + (proc_vcsw(self.pid),) + named)
             except OSError:
                 return
             time.sleep(0.2)
@@ -182,7 +205,8 @@ class Sampler(threading.Thread):
             return None
         dt = s[-1][0] - s[0][0]
         return {"cpu_pct": 100 * (s[-1][1] - s[0][1]) / dt, "rss_kib_max": max(x[2] for x in s),
-                "vcsw_per_s": (s[-1][3] - s[0][3]) / dt}
+                "vcsw_per_s": (s[-1][3] - s[0][3]) / dt, "named_threads_cpu_pct": 100 * (s[-1][4] - s[0][4]) / dt,
+                "other_threads_minflt_per_s": (s[-1][5] - s[0][5]) / dt}
 
 
 SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record")
@@ -225,10 +249,12 @@ def run_timed(argv, timeout=600):
     return rows
 
 
-def sampled(pid, argv, label_fields):
+def sampled(pid, argv, label_fields, thread_prefix=None):
     """Runs a load generator while sampling `pid`; each row gets the server's CPU, RSS and context
-    switches over the row's measuring window (the last `seconds` before its line), per delivered value too."""
-    sampler = Sampler(pid)
+    switches over the row's measuring window (the last `seconds` before its line), per delivered value too.
+    With `thread_prefix`: also the CPU of the server's threads so named (`named_threads_cpu_*`) and of the
+    others (`other_threads_cpu_*`: the process less those threads)."""
+    sampler = Sampler(pid, thread_prefix)
     sampler.start()
     t0 = time.time()
     rows = run_timed(argv)
@@ -244,6 +270,12 @@ def sampled(pid, argv, label_fields):
             row.update({"server_cpu_pct": w["cpu_pct"], "server_rss_kib": w["rss_kib_max"],
                         "server_cpu_us_per_value": w["cpu_pct"] * 1e4 / per_s if per_s else None,
                         "server_vcsw_per_value": w["vcsw_per_s"] / per_s if per_s else None})
+            if thread_prefix:
+                named, other = w["named_threads_cpu_pct"], w["cpu_pct"] - w["named_threads_cpu_pct"]
+                row.update({"named_threads": thread_prefix, "named_threads_cpu_pct": named, "other_threads_cpu_pct": other,
+                            "named_threads_cpu_us_per_value": named * 1e4 / per_s if per_s else None,
+                            "other_threads_cpu_us_per_value": other * 1e4 / per_s if per_s else None,
+                            "other_threads_minflt_per_value": w["other_threads_minflt_per_s"] / per_s if per_s else None})
         if sampler.samples:
             row["server_rss_after_kib"] = sampler.samples[-1][2]
         out.append(row)
@@ -318,7 +350,8 @@ def record_section(exe, args, procs):
         3.5 MB a frame; `json` is for plots, not images);
       * wire: Ticks at 1,000 values/s (16 doubles) to 10 JSON clients, recorded in both encodings.
     Each recorded row gets the recording's final status (messages, drops, bytes): drops > 0 means the
-    writer fell behind and the queue overflowed."""
+    writer fell behind and the queue overflowed. Each row also splits the gateway's CPU by thread: the
+    recorder's threads (named rr-record*, server/record/recording.cpp) and the rest (the live path)."""
     rows = []
     work = tempfile.mkdtemp(prefix="rr-bench-record-")
     seconds = "3" if args.quick else "5"
@@ -347,7 +380,7 @@ def record_section(exe, args, procs):
                              "path": "device->gateway->10 x JSON" + (" + recording" if recording else "")}
                     label.update(fields)
                     got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(port), "--clients", "10", "fanout",
-                                             "--seconds", seconds] + load_args, label)
+                                             "--seconds", seconds] + load_args, label, thread_prefix="rr-record")
                     if rec:
                         final = post_json(port, "/api/recordings/%d/stop" % rec["id"], {})
                         for row in got:
@@ -958,15 +991,18 @@ def markdown(res):
                 "1,000 values/s wire (`Ticks`, 16 doubles, both encodings), each to 10 JSON clients, without and with a recording "
                 "of the member in the gateway; the two rows of a pair ran one after the other in the same round:", "",
                 "| workload | round | recording | values/s per client min, median | delivered of sent | p50 ms | p99 ms | max ms "
-                "| gateway CPU % | gateway CPU µs / value | gateway RSS MiB (max) | recorded messages | drops | MB written |",
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                "| gateway CPU % | gateway CPU µs / value | live path (other threads) µs / value | recorder threads µs / value "
+                "| live path page faults / value | gateway RSS MiB (max) | recorded messages | drops | MB written |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for f in res["record"]:
             st = f.get("recording_status") or {}
-            out.append("| %s | %s | %s | %s, %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            out.append("| %s | %s | %s | %s, %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 f["workload"], f["round"], "yes" if f["recording"] else "no", fmt(f["per_client_per_s_min"]),
                 fmt(f["per_client_per_s_median"]), 100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000, 2),
                 fmt(f["p99_us"] / 1000, 2), fmt(f["max_us"] / 1000, 2), fmt(f.get("server_cpu_pct")),
-                fmt(f.get("server_cpu_us_per_value")), fmt(f.get("server_rss_kib", 0) / 1024),
+                fmt(f.get("server_cpu_us_per_value")), fmt(f.get("other_threads_cpu_us_per_value")),
+                fmt(f.get("named_threads_cpu_us_per_value"), 2), fmt(f.get("other_threads_minflt_per_value"), 1),
+                fmt(f.get("server_rss_kib", 0) / 1024),
                 fmt(st.get("messages"), 0) if st else "", fmt(st.get("drops"), 0) if st else "",
                 fmt((st.get("bytes") or 0) / 1e6) if st else ""))
     if res.get("browser"):

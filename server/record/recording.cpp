@@ -4,6 +4,7 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <pthread.h>
 #include <system_error>
 
 #include "core/mcap/mcap_writer.hpp"
@@ -80,12 +81,12 @@ std::uint64_t now_ns() {
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
-// What an entry weighs in the queue: its payload bytes plus a fixed overhead per element.
-std::size_t approx_bytes(const std::vector<MessageElement>& elements) {
-    std::size_t n = 0;
-    for (const auto& e : elements) n += 64 + e.data.size() + approx_bytes(e.elements);
-    return n;
-}
+// The recorder's threads by name (pthread names are at most 15 characters): per-thread CPU in
+// /proc/<pid>/task/*/stat tells the recorder's cost from the live path's (bench/run.py, record section).
+void name_recorder_thread(const char* name) { pthread_setname_np(pthread_self(), name); }
+
+// How long the writer lets entries gather before it takes them (earlier when the queue is half full).
+constexpr std::chrono::milliseconds recorder_writer_period{50};
 
 std::string utc_stamp() {
     const std::time_t t = std::time(nullptr);
@@ -210,7 +211,12 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
 
 Recording::Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
                      std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members)
-    : id_(id), spec_(std::move(spec)), device_(std::move(device)), api_(std::move(api)), members_(std::move(members)) {}
+    : id_(id),
+      spec_(std::move(spec)),
+      device_(std::move(device)),
+      api_(std::move(api)),
+      members_(std::move(members)),
+      queue_(spec_.queue_bytes) {}
 
 Recording::~Recording() {
     stop();
@@ -228,21 +234,7 @@ void Recording::wait() {
 
 // --- the live path -------------------------------------------------------------------------------
 
-void Recording::offer(std::uint16_t member, SharedEntryPtr entry) {
-    const std::uint64_t t = now_ns();
-    const std::size_t bytes = approx_bytes(entry->entry().elements) + 128;
-    {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (stopping_) return;
-        if (queued_bytes_ + bytes > spec_.queue_bytes) {
-            drops_.fetch_add(1, std::memory_order_relaxed);
-            return;
-        }
-        queued_bytes_ += bytes;
-        queue_.push_back(Item{member, t, std::move(entry), bytes});
-    }
-    wake_.notify_one();
-}
+void Recording::offer(std::uint16_t member, SharedEntryPtr entry) { (void)queue_.offer(member, now_ns(), std::move(entry)); }
 
 void Recording::subscribe_members() {
     std::weak_ptr<Recording> weak = weak_from_this();
@@ -271,7 +263,7 @@ void Recording::subscribe_members() {
                 e.entry_type = MessageEntryType::PipePacket;
                 e.service_path = path;
                 e.member_name = member;
-                e.elements.push_back(packet);
+                e.elements.push_back(packet);  // its bytes are shared (SharedBytes), not copied
                 self->offer(index, std::make_shared<SharedEntry>(std::move(e)));
             };
             h.on_closed = [](const RRError&) {};
@@ -304,6 +296,7 @@ void Recording::unsubscribe_members() {
 }
 
 void Recording::poll_loop() {
+    name_recorder_thread("rr-record-poll");
     const auto period = spec_.property_period.count() > 0 ? spec_.property_period : std::chrono::milliseconds(1000);
     auto outstanding = std::make_shared<std::atomic<int>>(0);
     std::weak_ptr<Recording> weak = weak_from_this();
@@ -542,9 +535,14 @@ Result<void> Recording::write_item(const Item& item) {
                         return r;
         }
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!files_.empty()) files_.back().second = file_->writer->bytes_written();
     return {};
+}
+
+void Recording::note_file_size() {
+    if (!file_) return;
+    const auto n = file_->writer->bytes_written();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!files_.empty()) files_.back().second = n;
 }
 
 void Recording::fail_with(const RRError& error) {
@@ -555,11 +553,9 @@ void Recording::fail_with(const RRError& error) {
         error_ = error.message;
         stopping_ = true;
         ended_ = std::chrono::steady_clock::now();
-        queue_.clear();
-        queued_bytes_ = 0;
         listeners.swap(stop_listeners_);
     }
-    wake_.notify_all();
+    queue_.close_and_clear();
     poll_wake_.notify_all();
     unsubscribe_members();
     // What was written stays: its complete chunks are readable; a close that fails again changes nothing.
@@ -574,19 +570,13 @@ void Recording::fail_with(const RRError& error) {
 }
 
 void Recording::writer_loop() {
+    name_recorder_thread("rr-record");
     using clock = std::chrono::steady_clock;
     auto last_flush = clock::now();
-    std::deque<Item> batch;
+    std::vector<Item> batch;  // swapped with the queue's: both keep their capacity
+    bool ending_requested = false;
     for (;;) {
-        bool stopping = false;
-        {
-            std::unique_lock<std::mutex> lock(mutex_);
-            wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stopping_ || !queue_.empty(); });
-            if (state_ == RecordingState::failed) return;
-            batch.swap(queue_);
-            queued_bytes_ = 0;
-            stopping = stopping_;
-        }
+        const bool closed = queue_.take(batch, recorder_writer_period);
         for (const auto& item : batch) {
             const auto now = clock::now();
             const bool too_big = spec_.max_file_bytes && file_->writer->bytes_written() >= spec_.max_file_bytes;
@@ -597,22 +587,21 @@ void Recording::writer_loop() {
             }
             if (auto r = write_item(item); !r) return fail_with(r.error());
         }
-        batch.clear();
+        batch.clear();  // the entries' last references usually go here, off the live path
+        note_file_size();
         // A chunk at least every second: a killed gateway loses at most about a second.
         if (clock::now() - last_flush >= std::chrono::seconds(1)) {
             last_flush = clock::now();
             if (auto r = file_->writer->flush(); !r) return fail_with(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message));
-            std::lock_guard<std::mutex> lock(mutex_);
-            if (!files_.empty()) files_.back().second = file_->writer->bytes_written();
+            note_file_size();
         }
-        if (spec_.duration.count() && clock::now() - started_ >= spec_.duration && !stopping) {
+        if (spec_.duration.count() && clock::now() - started_ >= spec_.duration && !closed && !ending_requested) {
             // Ends itself: taps go, then the queue is drained on the next rounds.
+            ending_requested = true;
             std::thread([self = shared_from_this()] { self->stop(); }).detach();
         }
-        if (stopping) {
-            std::unique_lock<std::mutex> lock(mutex_);
-            if (!queue_.empty()) continue;
-            lock.unlock();
+        if (closed) {
+            // Closed before the swap: `batch` held the last items.
             auto r = close_file();
             if (!r) return fail_with(r.error());
             std::vector<std::function<void(const RecordingStatus&)>> listeners;
@@ -645,7 +634,7 @@ void Recording::stop(std::function<void(const RecordingStatus&)> done) {
     }
     if (first) {
         unsubscribe_members();
-        wake_.notify_all();
+        queue_.close();  // after the taps are gone: what they queued is written
         poll_wake_.notify_all();
     }
     if (done) done(status());
@@ -656,7 +645,8 @@ RecordingStatus Recording::status() const {
     s.id = id_;
     s.spec = spec_;
     for (const auto& m : members_) s.members.push_back(m.target->member->name);
-    s.drops = drops_.load();
+    s.drops = queue_.drops();
+    s.queued_bytes = queue_.queued_bytes();
     s.messages = messages_.load();
     std::lock_guard<std::mutex> lock(mutex_);
     s.state = state_;
@@ -665,7 +655,6 @@ RecordingStatus Recording::status() const {
         s.files.push_back(f.first);
         s.bytes += f.second;
     }
-    s.queued_bytes = queued_bytes_;
     const auto end = (state_ == RecordingState::stopped || state_ == RecordingState::failed) ? ended_ : std::chrono::steady_clock::now();
     s.duration_s = std::chrono::duration<double>(end - started_).count();
     return s;

@@ -1,10 +1,12 @@
 // One recording (docs/recording.md): the members of one gateway device written to MCAP files.
 //
 // The live path only hands over what it already has: each wire value and event is the SharedEntry the
-// gateway fans out to its clients (DeviceMirror::subscribe), each pipe packet the element the gateway's
-// own pipe endpoint received, each polled property the device's reply. They wait in a bounded queue
-// (RecordingSpec::queue_bytes; when it is full the entry is dropped and counted, the live path never
-// waits) and one writer thread per recording encodes them (`robotraconteur`: the entry's bytes in RR
+// gateway fans out to its clients (DeviceMirror::subscribe; the reference, not a copy), each pipe packet
+// the element the gateway's own pipe endpoint received (its bytes shared), each polled property the
+// device's reply. They wait in a RecordQueue (record_queue.hpp: bounded by RecordingSpec::queue_bytes;
+// when it is full the entry is dropped and counted, the live path never waits, allocates nothing per
+// value once warm and does not wake the writer per value) and one writer thread per recording (named
+// "rr-record"; the property poller "rr-record-poll") encodes them (`robotraconteur`: the entry's bytes in RR
 // message format 4, cached and shared with the native clients' sends; `json`: the JSON API's mapping)
 // and writes them with McapWriter (core/mcap), rotating files by size and time, deleting the oldest
 // files over the disk budget.
@@ -23,7 +25,6 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -36,6 +37,7 @@
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/gateway/shared_entry.hpp"
+#include "server/record/record_queue.hpp"
 #include "server/record/recording_spec.hpp"
 
 namespace rr::server::record {
@@ -91,18 +93,15 @@ public:
     std::uint64_t id() const noexcept { return id_; }
 
 private:
-    struct Item {
-        std::uint16_t member = 0;
-        std::uint64_t log_ns = 0;
-        gateway::SharedEntryPtr entry;
-        std::size_t bytes = 0;
-    };
+    using Item = RecordQueue::Item;
     struct File;
 
     Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
               std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members);
-    /// From the live path: queue or drop.
+    /// From the live path: queue (the reference) or drop.
     void offer(std::uint16_t member, gateway::SharedEntryPtr entry);
+    /// The open file's size into files_ (once per batch: the writer does not take mutex_ per item).
+    void note_file_size();
     void subscribe_members();
     void unsubscribe_members();
     void poll_loop();
@@ -122,17 +121,15 @@ private:
     ErrorListener on_error_;
 
     mutable std::mutex mutex_;
-    std::condition_variable wake_;       // the writer thread's
     std::condition_variable poll_wake_;  // the property poller's
-    std::deque<Item> queue_;
-    std::size_t queued_bytes_ = 0;
     bool stopping_ = false;
     RecordingState state_ = RecordingState::recording;
     std::string error_;
     std::chrono::steady_clock::time_point ended_;
     std::vector<std::function<void(const RecordingStatus&)>> stop_listeners_;
     std::vector<std::pair<std::string, std::uint64_t>> files_;  // path, size (the open one: updated as written)
-    std::atomic<std::uint64_t> drops_{0}, messages_{0};
+    std::atomic<std::uint64_t> messages_{0};
+    RecordQueue queue_;  // its own lock: the live path never takes mutex_
 
     // Subscriptions (guarded by mutex_).
     std::vector<std::uint64_t> subscriptions_;  // DeviceMirror::subscribe ids

@@ -1,0 +1,75 @@
+#include "server/record/record_queue.hpp"
+
+namespace rr::server::record {
+
+namespace {
+
+std::size_t elements_weight(const std::vector<MessageElement>& elements) noexcept {
+    std::size_t n = 0;
+    for (const auto& e : elements) n += 64 + e.data.size() + elements_weight(e.elements);
+    return n;
+}
+
+}  // namespace
+
+std::size_t RecordQueue::weight(const MessageEntry& entry) noexcept { return 128 + elements_weight(entry.elements); }
+
+RecordQueue::Offered RecordQueue::offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry) {
+    const std::size_t bytes = weight(entry->entry());
+    const std::size_t half = budget_ / 2;
+    bool wake = false;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (closed_) return Offered::closed;
+        if (queued_bytes_ + bytes > budget_) {
+            ++drops_;
+            return Offered::dropped;
+        }
+        // The writer is woken once, when the queue crosses half its budget; otherwise it wakes on its period.
+        wake = queued_bytes_ < half && queued_bytes_ + bytes >= half;
+        queued_bytes_ += bytes;
+        items_.push_back(Item{member, log_ns, std::move(entry), bytes});
+    }
+    if (wake) wake_.notify_one();
+    return Offered::queued;
+}
+
+bool RecordQueue::take(std::vector<Item>& batch, std::chrono::milliseconds period) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait_for(lock, period, [&] { return closed_ || queued_bytes_ >= budget_ / 2; });
+    batch.swap(items_);
+    queued_bytes_ = 0;
+    return closed_;
+}
+
+void RecordQueue::close() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        closed_ = true;
+    }
+    wake_.notify_all();
+}
+
+void RecordQueue::close_and_clear() {
+    std::vector<Item> gone;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        closed_ = true;
+        gone.swap(items_);
+        queued_bytes_ = 0;
+    }
+    wake_.notify_all();
+    // `gone` releases its entries here, outside the lock.
+}
+
+std::uint64_t RecordQueue::drops() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return drops_;
+}
+
+std::size_t RecordQueue::queued_bytes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return queued_bytes_;
+}
+
+}  // namespace rr::server::record
