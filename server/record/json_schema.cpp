@@ -102,8 +102,12 @@ public:
                 left_out.push_back(name);
                 continue;
             }
+            // A value that may be null (struct, list, map, varvalue: their descriptions say so) is left
+            // out of its object's JSON when null (recording.cpp), so it is not required.
+            const bool nullable = s->contains("description") && (*s)["description"].is_string() &&
+                                  (*s)["description"].get<std::string>().ends_with("or null");
             props[name] = std::move(*s);
-            required.push_back(name);
+            if (!nullable) required.push_back(name);
         }
         json o{{"type", "object"}, {"properties", std::move(props)}, {"required", std::move(required)}};
         if (!left_out.empty()) o["description"] = "not described (no single JSON Schema type): " + json(left_out).dump();
