@@ -60,6 +60,8 @@ class Proc:
         try:
             return self.p.wait(timeout)
         except subprocess.TimeoutExpired:
+            sys.stderr.write("gateway pid %d did not end %.0f s after SIGTERM; its threads:\n%s\n"
+                             % (self.p.pid, timeout, threads_of(self.p.pid)))
             self.kill()
             return "killed"
 
@@ -67,6 +69,31 @@ class Proc:
         if self.p.poll() is None:
             self.p.kill()
         self.p.wait()
+
+
+def threads_of(pid):
+    """Where a live process's threads are, for a hang's report: each thread's name, wchan and CPU
+    ticks, then gdb's backtraces when gdb can attach (LeakSanitizer's exit check holds ptrace then)."""
+    lines = []
+    try:
+        for t in sorted(os.listdir("/proc/%d/task" % pid), key=int):
+            try:
+                comm = open("/proc/%d/task/%s/comm" % (pid, t)).read().strip()
+                wchan = open("/proc/%d/task/%s/wchan" % (pid, t)).read().strip() or "-"
+                f = open("/proc/%d/task/%s/stat" % (pid, t)).read().rsplit(")", 1)[1].split()
+                lines.append("  %s %s %s (state %s, cpu ticks %s)" % (t, comm, wchan, f[0], int(f[11]) + int(f[12])))
+            except OSError:
+                pass
+    except OSError as e:
+        return "  (no /proc entry: %s)" % e
+    try:
+        gdb = subprocess.run(["gdb", "-p", str(pid), "-batch", "-nx", "-ex", "thread apply all bt 20"],
+                             capture_output=True, text=True, timeout=60)
+        bt = [l for l in (gdb.stdout + gdb.stderr).splitlines() if l.startswith(("Thread ", "#", "ptrace", "warning: process"))]
+        lines += bt[:300]
+    except (OSError, subprocess.TimeoutExpired) as e:
+        lines.append("  (gdb: %s)" % e)
+    return "\n".join(lines)
 
 
 def gateway_env():
