@@ -24,7 +24,6 @@ Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's 
 import argparse
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -35,7 +34,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "record"))
-from record_checks import CheckFailed, expect  # noqa: E402
+from record_checks import CheckFailed, expect, report_and_clean  # noqa: E402
 
 try:
     import jsonschema
@@ -340,11 +339,7 @@ def main():
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
         stop(svc)
-        print(json.dumps(checks, indent=1, default=str))
-        if a.keep:
-            print("kept", work)
-        else:
-            shutil.rmtree(work, ignore_errors=True)
+        report_and_clean(checks, work, a.keep)
     sys.exit(0 if ok else 1)
 
 

@@ -58,3 +58,12 @@ def official_foxglove_schemas():
     r = subprocess.run([node, "-e", code], cwd=mcap_dir, capture_output=True, text=True, timeout=60)
     expect(r.returncode == 0, "@foxglove/schemas: %s" % r.stderr[-500:])
     return json.loads(r.stdout)
+
+
+def report_and_clean(checks, work, keep):
+    """Prints the test's checks as JSON, then removes its work folder (or says where it was kept)."""
+    print(json.dumps(checks, indent=1, default=str))
+    if keep:
+        print("kept", work)
+    else:
+        shutil.rmtree(work, ignore_errors=True)

@@ -23,7 +23,6 @@ import base64
 import hashlib
 import json
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -36,7 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEVICES = os.path.join(HERE, "..", "browser", "devices")
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, foxglove_check, http, official_foxglove_schemas  # noqa: E402
+from record_checks import CheckFailed, expect, foxglove_check, http, official_foxglove_schemas, report_and_clean  # noqa: E402
 
 try:
     import jsonschema
@@ -273,11 +272,7 @@ def main():
             ValueError, IndexError, StepFailed, subprocess.TimeoutExpired) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        print(json.dumps(checks, indent=1, default=str))
-        if a.keep:
-            print("kept", work)
-        else:
-            shutil.rmtree(work, ignore_errors=True)
+        report_and_clean(checks, work, a.keep)
     sys.exit(0 if ok else 1)
 
 

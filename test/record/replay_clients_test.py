@@ -38,7 +38,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http  # noqa: E402
+from record_checks import CheckFailed, expect, http, report_and_clean  # noqa: E402
 
 try:
     import websocket
@@ -401,11 +401,7 @@ def main():
             IndexError, TypeError, subprocess.TimeoutExpired, websocket.WebSocketException) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        print(json.dumps(checks, indent=1, default=str))
-        if a.keep:
-            print("kept", work)
-        else:
-            shutil.rmtree(work, ignore_errors=True)
+        report_and_clean(checks, work, a.keep)
     if ok and wasm_skip:
         print("SKIP: every other client passed; the wasm client was not run: %s" % wasm_skip)
         sys.exit(77)
