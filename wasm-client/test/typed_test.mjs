@@ -10,7 +10,7 @@
 // Usage: node typed_test.mjs --rr-robdef PATH --gateway PATH --interop-service PATH [--python PATH]
 // (interop.js also runs against the official Python service, test/interop/official_service.py, when
 // the venv's python exists).
-// Exit 77 (skipped) when dist/, typescript or the shared standard definitions are missing.
+// Exit 77 (skipped) when dist/, typescript or every source of the standard definitions is missing.
 import { execFileSync, spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
@@ -23,7 +23,15 @@ const pkgRoot = path.resolve(here, "..");
 const root = path.resolve(pkgRoot, "..");
 const dist = path.join(pkgRoot, "dist");
 const tsc = path.join(pkgRoot, "node_modules/typescript/bin/tsc");
-const stdDir = process.env.RR_ROBDEF_STANDARD ?? path.resolve(root, "../shared/robdef-standard/group1");
+// The standard definitions, found as build.sh finds them: $RR_ROBDEF_STANDARD, else the official
+// robotraconteurcompanion package in .venv, else the shared folder beside the clone.
+const venvLib = path.join(root, ".venv/lib");
+const companionDirs = fs.existsSync(venvLib)
+  ? fs.readdirSync(venvLib).filter((d) => d.startsWith("python3")).map((d) => path.join(venvLib, d, "site-packages/RobotRaconteurCompanion/StdRobDef"))
+  : [];
+const stdDir = [process.env.RR_ROBDEF_STANDARD, ...companionDirs, path.resolve(root, "../shared/robdef-standard/group1")]
+  .filter(Boolean).find((d) => fs.existsSync(d) && fs.readdirSync(d).some((f) => f.endsWith(".robdef")))
+  ?? "the standard definitions";
 const arg = (name) => { const i = process.argv.indexOf(name); return i > 0 ? process.argv[i + 1] : undefined; };
 const [robdefBin, gatewayBin, interopBin] = [arg("--rr-robdef"), arg("--gateway"), arg("--interop-service")];
 
@@ -31,7 +39,7 @@ function skip(why) { console.log(`SKIP: ${why}`); process.exit(77); }
 if (!robdefBin || !gatewayBin || !interopBin) { console.error("usage: typed_test.mjs --rr-robdef PATH --gateway PATH --interop-service PATH"); process.exit(2); }
 if (!fs.existsSync(path.join(dist, "robotraconteur_wasm.wasm"))) skip("wasm-client/dist not built (wasm-client/build.sh)");
 if (!fs.existsSync(tsc)) skip("typescript missing (npm ci in wasm-client/, scripts/setup.sh)");
-if (!fs.existsSync(stdDir)) skip(`${stdDir} not found (the shared standard definitions)`);
+if (!fs.existsSync(stdDir)) skip("no standard definitions: $RR_ROBDEF_STANDARD, .venv's robotraconteurcompanion (scripts/setup.sh) and ../shared/robdef-standard/group1 are all missing");
 
 let failures = 0;
 const ok = (cond, what) => { console.log(`${cond ? "ok" : "FAIL"}: ${what}`); if (!cond) failures++; };
@@ -72,8 +80,14 @@ try {
   // imports followed from the file's folder: robot alone pulls in what it imports
   gen("robot-only", [path.join(stdDir, "com.robotraconteur.robotics.robot.robdef")]);
   ok(fs.existsSync(path.join(app, "gen/robot-only/com.robotraconteur.geometry.d.ts")), "imports followed: robot.robdef alone generates geometry too");
-  const g2 = path.resolve(stdDir, "../group2/com.robotraconteur.a1.robotics.planning.robdef");
-  if (fs.existsSync(g2)) {
+  // a definition whose import is not beside it (the shared group2 has one; else a file of our own)
+  let g2 = path.resolve(stdDir, "../group2/com.robotraconteur.a1.robotics.planning.robdef");
+  if (!fs.existsSync(g2)) {
+    fs.mkdirSync(path.join(app, "lonely"), { recursive: true });
+    g2 = path.join(app, "lonely/example.planning.robdef");
+    fs.writeFileSync(g2, "service example.planning\n\nstdver 0.10\n\nimport com.robotraconteur.geometry\n\nstruct Plan\n    field com.robotraconteur.geometry.Pose goal\nend\n");
+  }
+  {
     const r = spawnSync(robdefBin, ["ts", "-o", path.join(app, "gen/none"), g2], { encoding: "utf8" });
     ok(r.status === 1 && /planning\.robdef:\d+: error: Service definition "com\.robotraconteur\.geometry" not found/.test(r.stdout) &&
       !fs.existsSync(path.join(app, "gen/none")), `a missing import is an error naming it: ${r.stdout.trim().split("\n")[0]}`);
