@@ -164,6 +164,10 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
                       return;
                   }
                   client->pump_ = *pump;
+                  // A close() that came while connecting found no pump to tell: disconnect now, or the
+                  // connection (and its pump, which the logic holds) would live on unowned.
+                  if (client->close_requested_.load())
+                      (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
               });
 }
 
@@ -207,6 +211,7 @@ void Client::set_closed_handler(std::function<void(const RRError&)> handler) {
 }
 
 void Client::close() {
+    close_requested_.store(true);
     run([](ClientContext& ctx, MonoTime now) { ctx.disconnect(now); });
 }
 

@@ -179,6 +179,7 @@ private:
     ObjectRef root_;
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
+    std::atomic<bool> close_requested_{false};  // close() before the connection had its pump
     bool caller_runs_io_ = false;
     /// caller_runs_io: a lone caller waits for its answer without a timeout (caller_io.hpp), which
     /// needs the request timeout to bound the wait.

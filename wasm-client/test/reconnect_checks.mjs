@@ -12,7 +12,7 @@ export const FAST = {
   // Fast enough for a test; the defaults (0.5 s .. 10 s, 10 s / 15 s) are for real networks.
   backoff: { initialMs: 50, maxMs: 400, factor: 2, jitter: 0.25 },
   heartbeatPeriodMs: 300,
-  receiveTimeoutMs: 1200,
+  receiveTimeoutMs: 2500,  // 8 heartbeats: 1.2 s saw a spurious timeout in a loaded CI run (Chromium stalled)
   timeoutMs: 3000,
 };
 
