@@ -112,14 +112,26 @@ Result<void> NodeDiscovery::start() {
 }
 
 void NodeDiscovery::stop(std::chrono::milliseconds wait) {
+    std::map<std::uint64_t, std::shared_ptr<void>> clients;
+    {
+        std::lock_guard lock(mutex_);
+        clients = interrogation_clients_;
+    }
     stop_now();
     const auto until = std::chrono::steady_clock::now() + wait;
     while (std::chrono::steady_clock::now() < until) {
         {
             std::lock_guard lock(mutex_);
-            if (running_interrogations_ == 0) return;
+            if (running_interrogations_ == 0) break;
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    // close() only posts the disconnect: wait for the connections to end, so that a caller that then
+    // stops its io threads leaves none behind (rr discover's exit leaked one under load).
+    for (auto& [k, c] : clients) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now());
+        if (left.count() <= 0) break;
+        (void)std::static_pointer_cast<client::Client>(c)->close_wait(left);
     }
 }
 

@@ -101,9 +101,10 @@ public:
     /// Opens the sockets and starts the timers. Errors: IOError when no socket could be opened.
     Result<void> start();
     /// Closes the sockets and cancels everything, then waits (at most `wait`) until the interrogations
-    /// in flight have ended (a connect to a silent address ends at its 5 s timeout): stopping the
-    /// executor under a pending client connect would leave it unfinished. Idempotent. Not on the
-    /// executor's threads when `wait` > 0.
+    /// in flight have ended (a connect to a silent address ends at its 5 s timeout) and their clients'
+    /// connections have closed, all within `wait`: stopping the executor under a pending client
+    /// connect or disconnect would leave it unfinished. Idempotent. Not on the executor's threads when
+    /// `wait` > 0.
     void stop(std::chrono::milliseconds wait = std::chrono::milliseconds(0));
 
     /// Starts a round of 3 discovery requests (ignored when a round is running).
