@@ -102,12 +102,9 @@ public:
                 left_out.push_back(name);
                 continue;
             }
-            // A value that may be null (struct, list, map, varvalue: their descriptions say so) is left
-            // out of its object's JSON when null (recording.cpp), so it is not required.
-            const bool nullable = s->contains("description") && (*s)["description"].is_string() &&
-                                  (*s)["description"].get<std::string>().ends_with("or null");
             props[name] = std::move(*s);
-            if (!nullable) required.push_back(name);
+            // A value that may be null is left out of its object's JSON when null (recording.cpp).
+            if (!may_be_null(*type, context)) required.push_back(name);
         }
         json o{{"type", "object"}, {"properties", std::move(props)}, {"required", std::move(required)}};
         if (!left_out.empty()) o["description"] = "not described (no single JSON Schema type): " + json(left_out).dump();
@@ -115,6 +112,15 @@ public:
     }
 
 private:
+    // Whether the JSON mapping can give null for a value of `type`: a list, a map, a varvalue or a struct.
+    bool may_be_null(const robdef::TypeDefinition& type, std::string_view context) const {
+        if (type.container != robdef::ContainerKind::none) return true;
+        if (type.base == DataTypes::varvalue_t) return true;
+        if (type.base != DataTypes::namedtype_t || type.array != robdef::ArrayKind::none) return false;
+        auto ref = lookup_.find(type.type_name, context);
+        return ref && ref.entry && ref.entry->kind == robdef::EntryKind::structure;
+    }
+
     std::optional<json> item_schema(const robdef::TypeDefinition& type, std::string_view context) {
         if (type.base != DataTypes::namedtype_t) {
             json s = scalar_schema(type.base);
