@@ -32,6 +32,8 @@ finish() {
   local rc=$?
   if [ -n "$bg_pid" ]; then kill -- -"$bg_pid" 2>/dev/null || true; fi
   echo "test: phases: ${phases[*]/%/,} total $SECONDS s"
+  # CI's disk is finite (a landing failed with "No space left on device" while linking build/debug).
+  echo "test: disk: build/ $(du -sh build 2>/dev/null | cut -f1), $(df -h --output=avail . | tail -1 | tr -d ' ') left"
   if ((SECONDS > budget_min * 60)); then
     echo "test: WARNING: the run took $((SECONDS / 60)) min, over the budget of $budget_min min (CI allows 90 on a"
     echo "test: fresh clone with an empty compiler cache; docs/development.md \"CI time\"). Slowest phases:"
@@ -45,6 +47,7 @@ finish() {
 }
 trap finish EXIT
 
+echo "test: disk: $(df -h --output=avail . | tail -1 | tr -d ' ') free at the start"
 ./scripts/setup.sh
 phase_done setup
 jobs=${RR_JOBS:-$(nproc)}

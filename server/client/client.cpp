@@ -68,6 +68,11 @@ public:
     void on_timer(MonoTime now) override { ctx.on_timer(now); }
     bool wants_close() const override { return ctx.is_closed(); }
     void on_transport_closed(RRError error) override { ctx.on_transport_closed(std::move(error)); }
+    // The connect handler holds the Client, which holds this logic: left set, neither would be freed.
+    void on_abandoned() noexcept override {
+        ctx.set_connect_handler({});
+        user_closed = nullptr;
+    }
 
     ClientContext ctx;
     std::function<void(const RRError&)> user_closed;  // strand only
@@ -91,17 +96,26 @@ std::optional<asio::io_context::executor_type> io_context_executor(const asio::a
 
 void Client::connect(asio::any_io_executor executor, std::string_view url_text, ClientOptions options,
                      ConnectHandler done) {
+    (void)start_connect(std::move(executor), url_text, std::move(options), std::move(done));
+}
+
+std::shared_ptr<Client> Client::start_connect(asio::any_io_executor executor, std::string_view url_text,
+                                              ClientOptions options, ConnectHandler done) {
+    const auto failed = [&](Unexpected e) -> std::shared_ptr<Client> {
+        done(std::move(e));
+        return nullptr;
+    };
     auto url = parse_connection_url(url_text);
-    if (!url) return done(url.take_error());
+    if (!url) return failed(url.take_error());
     if (url->service.empty())
-        return done(fail(MessageErrorType::InvalidArgument, "URL names no service: " + std::string(url_text)));
+        return failed(fail(MessageErrorType::InvalidArgument, "URL names no service: " + std::string(url_text)));
     const server::TransportRegistry& transports = options.transports ? *options.transports : server::default_transports();
     if (!transports.find(url->scheme))
-        return done(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
+        return failed(fail(MessageErrorType::ConnectionError, "no client transport for \"" + url->scheme + "\""));
     auto io = io_context_executor(executor);
     if (!io)
-        return done(fail(MessageErrorType::InvalidArgument,
-                         "the client's executor is neither an io_context's executor nor a strand of one"));
+        return failed(fail(MessageErrorType::InvalidArgument,
+                           "the client's executor is neither an io_context's executor nor a strand of one"));
 
     ClientContextConfig cfg;
     cfg.session.stream.local_node_id = options.local_node_id.is_any() ? server::random_node_id() : options.local_node_id;
@@ -139,6 +153,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
     // The connect handler holds the client until the connect completes (the context then drops it).
     logic->ctx.set_connect_handler([client, lp, done](Result<ObjectRef> r) mutable {
         auto c = std::move(client);
+        c->connecting_.store(false);
         if (!r) return done(r.take_error());
         c->info_ = lp->ctx.info();
         c->root_ = *r;
@@ -154,8 +169,21 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
         }
         if (h) h(e);
     });
+    // Asio destroys a pending operation's handler uncalled when its io_context goes away first (a
+    // program that exits while connecting): the context's connect handler, which holds the client,
+    // which holds the logic, would then keep both alive for good. The last uncalled copy of the
+    // transport's completion drops that handler (nothing else runs then: the io_context is gone).
+    struct UncalledConnect {
+        std::shared_ptr<Logic> logic;
+        ~UncalledConnect() {
+            if (logic) logic->ctx.set_connect_handler({});
+        }
+    };
+    auto uncalled = std::make_shared<UncalledConnect>();
+    uncalled->logic = logic;
     transports.connect(*client->strand_, *url, connect_options(options), logic,
-              [client, logic](Result<std::shared_ptr<PumpHandle>> pump) mutable {
+              [client, logic, uncalled](Result<std::shared_ptr<PumpHandle>> pump) mutable {
+                  uncalled->logic.reset();
                   if (!pump) {
                       auto h = std::move(client);
                       // Never connected: hand the error to the connect handler (and drop it).
@@ -169,6 +197,7 @@ void Client::connect(asio::any_io_executor executor, std::string_view url_text, 
                   if (client->close_requested_.load())
                       (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
               });
+    return client;
 }
 
 Result<std::shared_ptr<Client>> Client::connect(asio::any_io_executor executor, std::string_view url,
@@ -218,15 +247,21 @@ void Client::close() {
 Result<void> Client::close_wait(std::chrono::milliseconds timeout) {
     if (on_strand()) return fail(MessageErrorType::InvalidOperation, "blocking client call on the client's strand");
     close();
-    if (!pump_.lock() && !open_.load()) return {};
+    const auto ended = [this] {
+        return (!connecting_.load() && !open_.load()) ||
+               closed_future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    };
+    if (ended()) return {};
+    const auto until = std::chrono::steady_clock::now() + timeout;
     if (caller_runs_io_) {
-        const auto closed = [this] { return closed_future_.wait_for(std::chrono::seconds(0)) == std::future_status::ready; };
-        detail::run_io_until(*io_runners_, closed,
-                             std::chrono::steady_clock::now() + timeout);
-        timeout = {};
+        detail::run_io_until(*io_runners_, ended, until);
+    } else {
+        // The closed future is set when an open connection closes; a failed connect only clears
+        // connecting_, hence the short waits.
+        while (!ended() && std::chrono::steady_clock::now() < until)
+            (void)closed_future_.wait_for(std::chrono::milliseconds(10));
     }
-    if (closed_future_.wait_for(timeout) != std::future_status::ready && open_.load())
-        return fail(MessageErrorType::OperationTimeout, "connection did not close in time");
+    if (!ended()) return fail(MessageErrorType::OperationTimeout, "connection did not close in time");
     return {};
 }
 

@@ -126,6 +126,11 @@ public:
     /// that io_context.
     static void connect(boost::asio::any_io_executor executor, std::string_view url, ClientOptions options,
                         ConnectHandler done);
+    /// connect(), returning the client while it connects (nullptr when `done` already ran with an
+    /// error), so that the caller can abandon the attempt: close() or close_wait() on it ends the
+    /// connect (`done` then gets an error) and the connection.
+    static std::shared_ptr<Client> start_connect(boost::asio::any_io_executor executor, std::string_view url,
+                                                 ClientOptions options, ConnectHandler done);
     /// Blocking connect. Errors: those of the transport and of the connect exchange.
     static Result<std::shared_ptr<Client>> connect(boost::asio::any_io_executor executor, std::string_view url,
                                                    ClientOptions options = {});
@@ -146,7 +151,8 @@ public:
     void set_closed_handler(std::function<void(const RRError&)> handler);
     /// DisconnectClient, then close; returns at once.
     void close();
-    /// close(), then waits (up to `timeout`) until the connection is closed. Not on the strand.
+    /// close(), then waits (up to `timeout`) until the connection is closed, or, for a client still
+    /// connecting (start_connect), until the attempt has ended. Not on the strand.
     Result<void> close_wait(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000));
     /// With ClientOptions::caller_runs_io: runs the connection's pending I/O, events and timers on this
     /// thread for `duration`. Otherwise (worker threads do that) it only waits. Not on the strand.
@@ -180,6 +186,7 @@ private:
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
     std::atomic<bool> close_requested_{false};  // close() before the connection had its pump
+    std::atomic<bool> connecting_{true};        // until the connect handler has run
     bool caller_runs_io_ = false;
     /// caller_runs_io: a lone caller waits for its answer without a timeout (caller_io.hpp), which
     /// needs the request timeout to bound the wait.

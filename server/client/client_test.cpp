@@ -399,3 +399,68 @@ TEST_CASE("client: total_connect_timeout bounds a peer that accepts and never an
     });
     t.join();
 }
+
+TEST_CASE("client: a connect in progress ends by close_wait, and frees itself when its io threads go first") {
+    // A peer that accepts and never answers (rr discover's interrogations met one: the program's exit
+    // then leaked the connection, LeakSanitizer failed it).
+    boost::asio::io_context io;
+    boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
+    const auto port = acceptor.local_endpoint().port();
+    std::vector<boost::asio::ip::tcp::socket> held;
+    std::function<void()> accept = [&] {
+        acceptor.async_accept([&](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
+            if (ec) return;
+            held.push_back(std::move(s));
+            accept();
+        });
+    };
+    accept();
+    std::thread t([&] { io.run(); });
+    const std::string url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
+    rr::client::ClientOptions o;
+    o.connect_timeout = 30s;
+    o.request_timeout = 30s;
+
+    SECTION("close_wait ends the attempt and the connect handler gets the error") {
+        rr::client::IoThreads threads{1};
+        std::promise<Result<std::shared_ptr<Client>>> result;
+        auto pending = Client::start_connect(threads.executor(), url, o,
+                                             [&](Result<std::shared_ptr<Client>> r) { result.set_value(std::move(r)); });
+        REQUIRE(pending);
+        std::this_thread::sleep_for(200ms);  // connected at the TCP level, the RR handshake unanswered
+        const auto t0 = std::chrono::steady_clock::now();
+        CHECK(pending->close_wait(5000ms));
+        CHECK(std::chrono::steady_clock::now() - t0 < 2s);
+        auto f = result.get_future();
+        REQUIRE(f.wait_for(1s) == std::future_status::ready);
+        auto r = f.get();
+        REQUIRE_FALSE(r);
+        CHECK(r.error().type == MessageErrorType::ConnectionError);
+    }
+    SECTION("io threads destroyed while connecting: nothing is left holding the client") {
+        std::weak_ptr<Client> weak;
+        std::atomic<bool> called{false};
+        {
+            rr::client::IoThreads threads{1};
+            weak = Client::start_connect(threads.executor(), url, o, [&](auto) { called = true; });
+            REQUIRE_FALSE(weak.expired());
+            std::this_thread::sleep_for(200ms);
+        }
+        CHECK_FALSE(called.load());
+        CHECK(weak.expired());
+    }
+    SECTION("io threads destroyed before the TCP connect completed") {
+        std::weak_ptr<Client> weak;
+        {
+            rr::client::IoThreads threads{1};
+            boost::asio::post(threads.executor(), [] { std::this_thread::sleep_for(300ms); });  // delays the connect
+            weak = Client::start_connect(threads.executor(), url, o, [](auto) {});
+        }
+        CHECK(weak.expired());
+    }
+    boost::asio::post(io, [&] {
+        acceptor.close();
+        held.clear();
+    });
+    t.join();
+}

@@ -131,7 +131,7 @@ void NodeDiscovery::stop(std::chrono::milliseconds wait) {
     for (auto& [k, c] : clients) {
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now());
         if (left.count() <= 0) break;
-        (void)std::static_pointer_cast<client::Client>(c)->close_wait(left);
+        if (c) (void)std::static_pointer_cast<client::Client>(c)->close_wait(left);
     }
 }
 
@@ -146,7 +146,8 @@ void NodeDiscovery::stop_now() {
         listeners_.clear();
         clients.swap(interrogation_clients_);
     }
-    for (auto& [k, c] : clients) std::static_pointer_cast<client::Client>(c)->close();
+    for (auto& [k, c] : clients)
+        if (c) std::static_pointer_cast<client::Client>(c)->close();
     clients.clear();
     asio::post(strand_, [self = shared_from_this(), sockets] {
         boost::system::error_code ec;
@@ -641,40 +642,68 @@ void NodeDiscovery::interrogate(NodeID id, std::vector<std::string> urls, std::s
     opts.request_timeout = options_.interrogate_timeout;
     opts.limits.max_message_size = 1u << 20;  // a service index reply is small (CORE drops > 64 KiB elements)
     opts.transports = options_.transports;
+    // One bound for the whole attempt (transport, handshake, service index), so that each URL's try
+    // ends by itself within interrogate_timeout.
+    opts.total_connect_timeout = options_.interrogate_timeout;
+    // The attempt is registered under `key` from the start, so that stop() can end it while it still
+    // connects (a peer that accepts but never answers held rr discover's exit past stop's wait).
+    std::uint64_t key = 0;
+    {
+        std::lock_guard lock(mutex_);
+        key = next_interrogation_++;
+        interrogation_clients_[key] = nullptr;  // filled in once start_connect returns
+    }
     std::string url = urls[index];
-    client::Client::connect(executor_, url, opts,
-                            [self, id, urls, index, nonce, finish](Result<std::shared_ptr<client::Client>> c) mutable {
-                                if (!c) {
-                                    if (index + 1 < urls.size())
-                                        return self->interrogate(id, std::move(urls), index + 1, std::move(nonce));
-                                    return finish(c.take_error());
-                                }
-                                auto client = *c;
-                                std::string name;
-                                std::uint64_t key = 0;
-                                {
-                                    std::lock_guard lock(self->mutex_);
-                                    if (self->stopped_) {
-                                        client->close();
-                                        return;
-                                    }
-                                    if (const auto* e = self->table_.find(id)) name = e->node_name;
-                                    key = self->next_interrogation_++;
-                                    self->interrogation_clients_[key] = client;
-                                }
-                                std::weak_ptr<client::Client> weak_client = client;
-                                client->root().async_call(
-                                    "GetLocalNodeServices", {},
-                                    [self, weak_client, key, id, name, finish](Result<Value> v) {
-                                        {
-                                            std::lock_guard lock(self->mutex_);
-                                            self->interrogation_clients_.erase(key);
-                                        }
-                                        if (auto cl = weak_client.lock()) cl->close();
-                                        if (!v) return finish(v.take_error());
-                                        finish(core::service_infos_from_value(*v, id, name, self->options_.limits.services));
-                                    });
-                            });
+    auto pending = client::Client::start_connect(
+        executor_, url, opts,
+        [self, id, urls, index, nonce, finish, key](Result<std::shared_ptr<client::Client>> c) mutable {
+            if (!c) {
+                {
+                    std::lock_guard lock(self->mutex_);
+                    self->interrogation_clients_.erase(key);
+                }
+                if (index + 1 < urls.size()) return self->interrogate(id, std::move(urls), index + 1, std::move(nonce));
+                return finish(c.take_error());
+            }
+            auto client = *c;
+            std::string name;
+            {
+                std::lock_guard lock(self->mutex_);
+                if (self->stopped_) {
+                    self->interrogation_clients_.erase(key);
+                    if (self->running_interrogations_) --self->running_interrogations_;
+                    client->close();
+                    return;
+                }
+                if (const auto* e = self->table_.find(id)) name = e->node_name;
+                self->interrogation_clients_[key] = client;
+            }
+            std::weak_ptr<client::Client> weak_client = client;
+            client->root().async_call("GetLocalNodeServices", {},
+                                      [self, weak_client, key, id, name, finish](Result<Value> v) {
+                                          {
+                                              std::lock_guard lock(self->mutex_);
+                                              self->interrogation_clients_.erase(key);
+                                          }
+                                          if (auto cl = weak_client.lock()) cl->close();
+                                          if (!v) return finish(v.take_error());
+                                          finish(core::service_infos_from_value(*v, id, name,
+                                                                                self->options_.limits.services));
+                                      });
+        });
+    if (!pending) return;  // failed at once: the completion ran and dropped the key
+    bool close_now = false;
+    {
+        std::lock_guard lock(mutex_);
+        if (auto it = interrogation_clients_.find(key); it != interrogation_clients_.end()) {
+            if (!it->second) it->second = pending;
+        } else {
+            // Ended already (the key is gone), or stop() took the map before the client was known:
+            // closing an ended client does nothing.
+            close_now = stopped_;
+        }
+    }
+    if (close_now) pending->close();
 }
 
 void NodeDiscovery::emit(std::vector<DiscoveryEvent> events) {

@@ -48,6 +48,11 @@ public:
     virtual void on_wake() {}
     /// The socket failed or the peer closed it; called once.
     virtual void on_transport_closed(RRError error) = 0;
+    /// The pump is being destroyed without having reported the transport's end: its io_context went
+    /// away first, and Asio destroyed the pending operations uncalled (a program exiting mid-connect).
+    /// Drop whatever refers back to the logic's owner (completions that hold it), calling nothing:
+    /// no thread runs the connection any more.
+    virtual void on_abandoned() noexcept {}
 };
 
 }  // namespace rr::server

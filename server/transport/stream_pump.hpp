@@ -90,6 +90,10 @@ public:
             if (const auto* caller_runs = strand_.template target<CallerRunsStrand>()) read_strand_ = *caller_runs;
     }
 
+    ~StreamPump() {
+        if (!transport_reported_ && logic_) logic_->on_abandoned();
+    }
+
     /// Keeps `hold` alive until the pump is destroyed (the connection's per-address slot).
     void keep(std::shared_ptr<const void> hold) { hold_ = std::move(hold); }
 
