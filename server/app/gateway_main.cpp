@@ -4,11 +4,13 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <string>
 #include <thread>
 
 #include "server/app/gateway.hpp"
 #include "server/app/gateway_auth_config.hpp"
 #include "server/app/log.hpp"
+#include "server/app/malloc_tuning.hpp"
 #include "server/app/web_root.hpp"
 #include "server/app/demo_starter.hpp"
 #include "server/gateway/json_api_installer.hpp"
@@ -65,6 +67,9 @@ void reload_on_hangup(Gateway& gateway, const CommandLine& cmd) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Before any thread starts: keep camera-frame-sized buffers mapped (a recording otherwise costs the
+    // live path ~225 page faults per frame; docs/benchmarks.md, "Recording while serving").
+    const std::string malloc_tuning = tune_malloc_for_frames();
     auto cmd = parse_command_line(argc, argv);
     if (!cmd) {
         std::cerr << "rr-gateway: " << cmd.error().message << "\n";
@@ -109,6 +114,7 @@ int main(int argc, char** argv) {
     }
     set_log_level(log_level_from_string(config.log_level));
     if (LogFormat f; log_format_from_string(config.log_format, f)) set_log_format(f);
+    if (!malloc_tuning.empty()) log(LogLevel::debug, malloc_tuning);
 
     DemoStarter demo = [](const std::shared_ptr<rr::server::Node>& node, std::uint16_t port, const DemoLogin& login) {
         return rr::server::app::start_demo_devices_for_gateway(*node, port, login);
