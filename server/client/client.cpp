@@ -191,11 +191,15 @@ std::shared_ptr<Client> Client::start_connect(asio::any_io_executor executor, st
                       ctx.on_transport_closed(pump.error());
                       return;
                   }
-                  client->pump_ = *pump;
+                  bool closing = false;
+                  {
+                      std::lock_guard lock(client->pump_mutex_);
+                      client->pump_ = *pump;
+                      closing = client->close_requested_;
+                  }
                   // A close() that came while connecting found no pump to tell: disconnect now, or the
-                  // connection (and its pump, which the logic holds) would live on unowned.
-                  if (client->close_requested_.load())
-                      (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
+                  // connection would live on unowned.
+                  if (closing) (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
               });
     return client;
 }
@@ -216,7 +220,7 @@ Result<std::shared_ptr<Client>> Client::connect(asio::any_io_executor executor, 
 }
 
 Client::~Client() {
-    if (auto pump = pump_.lock()) {
+    if (auto pump = current_pump()) {
         auto logic = logic_;
         pump->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
         if (caller_runs_io_ && !on_strand()) {
@@ -239,8 +243,18 @@ void Client::set_closed_handler(std::function<void(const RRError&)> handler) {
     });
 }
 
+std::shared_ptr<PumpHandle> Client::current_pump() const {
+    std::lock_guard lock(pump_mutex_);
+    return pump_.lock();
+}
+
 void Client::close() {
-    close_requested_.store(true);
+    {
+        // With the pump's arrival under one lock: either this close finds the pump, or the connect
+        // completion finds close_requested_.
+        std::lock_guard lock(pump_mutex_);
+        close_requested_ = true;
+    }
     run([](ClientContext& ctx, MonoTime now) { ctx.disconnect(now); });
 }
 
@@ -276,7 +290,7 @@ void Client::poll(std::chrono::milliseconds duration) {
 }
 
 void Client::run(std::function<void(ClientContext&, MonoTime)> fn) {
-    auto pump = pump_.lock();
+    auto pump = current_pump();
     if (!pump) return;
     auto logic = logic_;
     pump->dispatch([logic, fn = std::move(fn)] { fn(logic->ctx, mono_now()); });
