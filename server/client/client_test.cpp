@@ -360,23 +360,44 @@ TEST_CASE("client: rr+wss refuses a server whose certificate it cannot verify") 
     CHECK(r.error().message.find("/nonexistent/ca.pem") != std::string::npos);
 }
 
-TEST_CASE("client: total_connect_timeout bounds a peer that accepts and never answers (rr+tcp, rr+ws)") {
-    // A listener that accepts every connection and never writes a byte (issue 15: `rr --timeout 1`
-    // took 7 s). The whole connect (TCP, WebSocket handshake, CreateConnection, service connect) must
-    // end within the bound with one message.
+namespace {
+
+// A TCP listener on loopback that accepts every connection and never writes a byte.
+struct SilentAcceptor {
     boost::asio::io_context io;
-    boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
-    const auto port = acceptor.local_endpoint().port();
+    boost::asio::ip::tcp::acceptor acceptor{io, {boost::asio::ip::make_address("127.0.0.1"), 0}};
+    const std::uint16_t port = acceptor.local_endpoint().port();
     std::vector<boost::asio::ip::tcp::socket> held;
-    std::function<void()> accept = [&] {
-        acceptor.async_accept([&](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
+    std::thread thread;
+
+    SilentAcceptor() {
+        accept();
+        thread = std::thread([this] { io.run(); });
+    }
+    ~SilentAcceptor() {
+        boost::asio::post(io, [this] {
+            acceptor.close();
+            held.clear();
+        });
+        thread.join();
+    }
+    void accept() {
+        acceptor.async_accept([this](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
             if (ec) return;
             held.push_back(std::move(s));
             accept();
         });
-    };
-    accept();
-    std::thread t([&] { io.run(); });
+    }
+};
+
+}  // namespace
+
+TEST_CASE("client: total_connect_timeout bounds a peer that accepts and never answers (rr+tcp, rr+ws)") {
+    // A listener that accepts every connection and never writes a byte (issue 15: `rr --timeout 1`
+    // took 7 s). The whole connect (TCP, WebSocket handshake, CreateConnection, service connect) must
+    // end within the bound with one message.
+    SilentAcceptor silent;
+    const auto port = silent.port;
     rr::client::IoThreads threads{1};
     rr::client::ClientOptions o;
     o.connect_timeout = 1000ms;
@@ -393,29 +414,13 @@ TEST_CASE("client: total_connect_timeout bounds a peer that accepts and never an
         CHECK(elapsed >= 900ms);
         CHECK(elapsed < 2500ms);  // the bound plus scheduling slack; was 7 s before
     }
-    boost::asio::post(io, [&] {
-        acceptor.close();
-        held.clear();
-    });
-    t.join();
 }
 
 TEST_CASE("client: a connect in progress ends by close_wait, and frees itself when its io threads go first") {
     // A peer that accepts and never answers (rr discover's interrogations met one: the program's exit
     // then leaked the connection, LeakSanitizer failed it).
-    boost::asio::io_context io;
-    boost::asio::ip::tcp::acceptor acceptor(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
-    const auto port = acceptor.local_endpoint().port();
-    std::vector<boost::asio::ip::tcp::socket> held;
-    std::function<void()> accept = [&] {
-        acceptor.async_accept([&](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
-            if (ec) return;
-            held.push_back(std::move(s));
-            accept();
-        });
-    };
-    accept();
-    std::thread t([&] { io.run(); });
+    SilentAcceptor silent;
+    const auto port = silent.port;
     const std::string url = "rr+tcp://127.0.0.1:" + std::to_string(port) + "/?service=svc";
     rr::client::ClientOptions o;
     o.connect_timeout = 30s;
@@ -458,9 +463,4 @@ TEST_CASE("client: a connect in progress ends by close_wait, and frees itself wh
         }
         CHECK(weak.expired());
     }
-    boost::asio::post(io, [&] {
-        acceptor.close();
-        held.clear();
-    });
-    t.join();
 }
