@@ -696,7 +696,12 @@ void NodeDiscovery::interrogate(NodeID id, std::vector<std::string> urls, std::s
     {
         std::lock_guard lock(mutex_);
         if (auto it = interrogation_clients_.find(key); it != interrogation_clients_.end()) {
-            if (!it->second) it->second = pending;
+            if (stopped_) {  // stopped between the registration and now: stop_now() did not see it
+                interrogation_clients_.erase(it);
+                close_now = true;
+            } else if (!it->second) {
+                it->second = pending;
+            }
         } else {
             // Ended already (the key is gone), or stop() took the map before the client was known:
             // closing an ended client does nothing.
