@@ -176,7 +176,7 @@ std::shared_ptr<Client> Client::start_connect(asio::any_io_executor executor, st
     struct UncalledConnect {
         std::shared_ptr<Logic> logic;
         ~UncalledConnect() {
-            if (logic) logic->ctx.set_connect_handler({});
+            if (logic) logic->on_abandoned();
         }
     };
     auto uncalled = std::make_shared<UncalledConnect>();
@@ -191,15 +191,15 @@ std::shared_ptr<Client> Client::start_connect(asio::any_io_executor executor, st
                       ctx.on_transport_closed(pump.error());
                       return;
                   }
-                  bool closing = false;
-                  {
-                      std::lock_guard lock(client->pump_mutex_);
-                      client->pump_ = *pump;
-                      closing = client->close_requested_;
-                  }
+                  // pump_ is written once, here, then published; readers look only after pump_set_.
+                  client->pump_ = *pump;
+                  client->pump_set_.store(true);
                   // A close() that came while connecting found no pump to tell: disconnect now, or the
-                  // connection would live on unowned.
-                  if (closing) (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
+                  // connection would live on unowned. (Both stores and loads are sequentially
+                  // consistent: a close() either sees pump_set_ or is seen here; a second disconnect
+                  // does nothing.)
+                  if (client->close_requested_.load())
+                      (*pump)->dispatch([logic] { logic->ctx.disconnect(mono_now()); });
               });
     return client;
 }
@@ -244,17 +244,13 @@ void Client::set_closed_handler(std::function<void(const RRError&)> handler) {
 }
 
 std::shared_ptr<PumpHandle> Client::current_pump() const {
-    std::lock_guard lock(pump_mutex_);
+    // No lock on the request path: pump_ does not change once published.
+    if (!pump_set_.load()) return nullptr;
     return pump_.lock();
 }
 
 void Client::close() {
-    {
-        // With the pump's arrival under one lock: either this close finds the pump, or the connect
-        // completion finds close_requested_.
-        std::lock_guard lock(pump_mutex_);
-        close_requested_ = true;
-    }
+    close_requested_.store(true);
     run([](ClientContext& ctx, MonoTime now) { ctx.disconnect(now); });
 }
 

@@ -180,14 +180,14 @@ private:
 
     std::shared_ptr<Logic> logic_;
     std::shared_ptr<PumpHandle> current_pump() const;
-    mutable std::mutex pump_mutex_;  // pump_ and close_requested_: set on the strand, read by any thread
-    std::weak_ptr<PumpHandle> pump_;
+    std::weak_ptr<PumpHandle> pump_;        // written once on the strand, before pump_set_
+    std::atomic<bool> pump_set_{false};
     std::optional<ClientStrand> strand_;
     ClientSessionInfo info_;
     ObjectRef root_;
     NodeID remote_node_id_;
     std::atomic<bool> open_{false};
-    bool close_requested_ = false;              // close() before the connection had its pump
+    std::atomic<bool> close_requested_{false};  // close() before the connection had its pump
     std::atomic<bool> connecting_{true};        // until the connect handler has run
     bool caller_runs_io_ = false;
     /// caller_runs_io: a lone caller waits for its answer without a timeout (caller_io.hpp), which

@@ -112,12 +112,7 @@ Result<void> NodeDiscovery::start() {
 }
 
 void NodeDiscovery::stop(std::chrono::milliseconds wait) {
-    std::map<std::uint64_t, std::shared_ptr<void>> clients;
-    {
-        std::lock_guard lock(mutex_);
-        clients = interrogation_clients_;
-    }
-    stop_now();
+    const auto clients = stop_now();
     const auto until = std::chrono::steady_clock::now() + wait;
     while (std::chrono::steady_clock::now() < until) {
         {
@@ -135,12 +130,12 @@ void NodeDiscovery::stop(std::chrono::milliseconds wait) {
     }
 }
 
-void NodeDiscovery::stop_now() {
+std::map<std::uint64_t, std::shared_ptr<void>> NodeDiscovery::stop_now() {
     std::vector<std::shared_ptr<Socket>> sockets;
     std::map<std::uint64_t, std::shared_ptr<void>> clients;
     {
         std::lock_guard lock(mutex_);
-        if (stopped_) return;
+        if (stopped_) return {};
         stopped_ = true;
         sockets.swap(sockets_);
         listeners_.clear();
@@ -148,12 +143,12 @@ void NodeDiscovery::stop_now() {
     }
     for (auto& [k, c] : clients)
         if (c) std::static_pointer_cast<client::Client>(c)->close();
-    clients.clear();
     asio::post(strand_, [self = shared_from_this(), sockets] {
         boost::system::error_code ec;
         for (auto& s : sockets) s->socket.close(ec);
         self->timer_.cancel();
     });
+    return clients;
 }
 
 void NodeDiscovery::open_sockets() {

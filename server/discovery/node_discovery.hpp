@@ -150,7 +150,9 @@ public:
 
 private:
     NodeDiscovery(boost::asio::any_io_executor executor, DiscoveryOptions options);
-    void stop_now();
+    /// Closes the sockets and the interrogations' clients at once; returns those clients (empty when
+    /// already stopped).
+    std::map<std::uint64_t, std::shared_ptr<void>> stop_now();
     bool ignored(const NodeID& id) const;  ///< in options_.ignored_nodes
     struct Socket;
     void open_sockets();
