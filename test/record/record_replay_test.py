@@ -380,6 +380,26 @@ def mcap_core_phase(exe, work, path, checks):
         stop(proc)
 
 
+def chunk_records_middle(path, data):
+    """Offset and length of bytes in the middle of the largest chunk's records (the part its CRC covers).
+
+    The middle of the whole file can fall between chunks, in message index records that a reader
+    following the summary's chunk indexes never reads: flipping those proves nothing."""
+    with open(path, "rb") as f:
+        chunks = make_reader(f).get_summary().chunk_indexes
+    expect(chunks, "the recording has chunk indexes")
+    c = max(chunks, key=lambda c: c.chunk_length)
+    # chunk record: opcode u8, length u64, start u64, end u64, uncompressed size u64, crc u32,
+    # compression string (u32 length + bytes), records length u64, records
+    at = c.chunk_start_offset + 1 + 8 + 8 + 8 + 8 + 4
+    at += 4 + int.from_bytes(data[at:at + 4], "little")
+    records = int.from_bytes(data[at:at + 8], "little")
+    at += 8
+    expect(records >= 8, "the largest chunk holds records (%d bytes)" % records)
+    span = min(64, records // 2)
+    return at + (records - span) // 2, span
+
+
 def corrupt_phase(exe, work, path, checks):
     cases = {}
     garbage = os.path.join(work, "garbage.mcap")
@@ -391,9 +411,9 @@ def corrupt_phase(exe, work, path, checks):
     with open(cut, "wb") as f:
         f.write(data[:40])  # magic and part of the header
     flipped = os.path.join(work, "flipped.mcap")
-    mid = len(data) // 2
+    mid, span = chunk_records_middle(path, data)
     with open(flipped, "wb") as f:
-        f.write(data[:mid] + bytes(b ^ 0x5A for b in data[mid:mid + 64]) + data[mid + 64:])
+        f.write(data[:mid] + bytes(b ^ 0x5A for b in data[mid:mid + span]) + data[mid + span:])
     for name, p in (("garbage", garbage), ("cut", cut), ("missing", os.path.join(work, "none.mcap"))):
         r = subprocess.run([exe, "--listen", "127.0.0.1", "--port", "0", "--no-local", "--no-discovery", "--no-demo",
                             "--replay", p], capture_output=True, text=True, timeout=60)
