@@ -112,6 +112,15 @@ async function openDashboard() {
     samples: async () => Number(await plot.getAttribute("data-samples")),
     /** The replica (host:port) answering this page's requests now. */
     replica: () => page.evaluate(async () => (await fetch("api/devices", { cache: "no-store" })).headers.get("x-rr-replica")),
+    /** From now on, remembers in the page whether the session badge leaves "connected": the page may
+     * reconnect faster than a poll sees it disconnected. */
+    watchDrop: () => page.evaluate(() => {
+      const el = document.querySelectorAll('.device-view[data-device="create"] .badge')[1];
+      window.rrDropped = false;
+      new MutationObserver(() => { if (el.textContent !== "connected") window.rrDropped = true; })
+        .observe(el, { childList: true, characterData: true, subtree: true, attributes: true });
+    }),
+    dropped: () => page.evaluate(() => window.rrDropped === true),
     async live(what) {
       await waitFor(async () => (await d.state()) === "connected", `${what}: RR session`, 40000);
       const n = await waitFor(d.samples, `${what}: samples`, 20000);
@@ -147,10 +156,11 @@ async function failover(start) {
 
   const victim = 0, survivor = 1;
   const moved = on(victim), stayed = on(survivor);
+  for (const d of moved) await d.watchDrop();
   replicas[victim].child.proc.kill("SIGKILL");
   await replicas[victim].child.exited;
   for (const d of moved)
-    await waitFor(async () => (await d.state()) !== "connected", "the dashboard notices its replica is gone", 20000);
+    await waitFor(d.dropped, "the dashboard notices its replica is gone", 20000);
   for (const [i, d] of moved.entries()) {
     await d.live(`moved dashboard ${i}`);
     assert.equal(await at(d), addr[survivor]);
