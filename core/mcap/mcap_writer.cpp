@@ -63,6 +63,12 @@ struct McapWriter::State {
 
     Result<void> write_chunk() {
         if (chunk.empty()) return {};
+        if (!chunk_has_messages) {  // only schemas and channels: outside a chunk (mcap_writer.hpp)
+            if (auto r = emit(chunk, true); !r) return r;
+            chunk.clear();
+            if (auto r = sink.flush(); !r) return failed(r.take_error());
+            return {};
+        }
         std::string_view compression;
         std::span<const std::byte> records = chunk;
         if (options.compression == Compression::Zstd) {

@@ -6,6 +6,10 @@
 //   Summary Offset records, Footer, Magic.
 // Schema and Channel records go into the chunk being filled when they are added (so every chunk only
 // refers to schemas and channels of earlier chunks or itself), and again into the summary at close.
+// Records that would make a chunk without any message (a flush() before the first message, or
+// channels added after the last one) are written outside a chunk, in the data section, instead: a
+// chunk without messages has no Message Index, which @mcap/core before 2.1 (Lichtblick 1.10) refuses
+// to read, and its zero time range makes readers that take the chunk indexes' times start at 1970.
 //
 // Durability: a chunk is written to the sink (and Sink::flush called) when its uncompressed records
 // reach WriterOptions::chunk_size, or on flush(). A writer killed before close() leaves a file that

@@ -112,6 +112,54 @@ TEST_CASE("mcap: chunks close at the size limit, and a message larger than a chu
     CHECK(got[1].data == big);
 }
 
+TEST_CASE("mcap: schemas and channels flushed before any message go outside a chunk, so no chunk lacks messages") {
+    // A chunk without messages has no Message Index and times 0: @mcap/core 2.0 (Lichtblick 1.10)
+    // refuses to read such a file, and readers taking the chunk indexes' times start it at 1970.
+    std::vector<std::byte> file;
+    VectorSink sink(file);
+    McapWriter w(sink);
+    REQUIRE(w.open());
+    const std::string text = "service example";
+    auto schema = w.add_schema("example", "robotraconteur_servicedef", std::as_bytes(std::span(text)));
+    REQUIRE(schema);
+    auto ch = w.add_channel(*schema, "dev/wire", "robotraconteur");
+    REQUIRE(ch);
+    REQUIRE(w.flush());  // what a recording does at start, so a killed gateway's file has its channels
+    CHECK(w.statistics().chunk_count == 0);
+    const auto before_messages = file.size();
+    std::vector<std::byte> data(8, std::byte{7});
+    REQUIRE(w.write({*ch, 0, 1000, 1000, data}));
+    auto late = w.add_channel(*schema, "dev/late", "robotraconteur");  // added after the last message
+    REQUIRE(late);
+    REQUIRE(w.flush());
+    CHECK(w.statistics().chunk_count == 1);
+    auto later = w.add_channel(*schema, "dev/later", "robotraconteur");
+    REQUIRE(later);
+    REQUIRE(w.close());
+    CHECK(w.statistics().chunk_count == 1);
+
+    SpanSource source(file);
+    auto reader = McapReader::open(source);
+    REQUIRE(reader);
+    REQUIRE(reader->indexed());
+    const auto& summary = reader->summary();
+    REQUIRE(summary.chunk_indexes.size() == 1);
+    CHECK(summary.chunk_indexes[0].message_start_time == 1000);
+    CHECK(summary.chunk_indexes[0].message_index_length > 0);
+    CHECK(summary.channels.size() == 3);
+    CHECK(drain(reader->messages()).size() == 1);
+
+    // Killed after the first flush: the channels are in the data section, read linearly.
+    std::span<const std::byte> killed(file.data(), before_messages);
+    SpanSource killed_source(killed);
+    auto linear = McapReader::open(killed_source);
+    REQUIRE(linear);
+    CHECK_FALSE(linear->indexed());
+    CHECK(linear->summary().schemas.size() == 1);
+    CHECK(linear->summary().channels.size() == 1);
+    CHECK(drain(linear->messages()).empty());
+}
+
 TEST_CASE("mcap: writer refuses calls out of order and unknown ids, and keeps the first sink error") {
     std::vector<std::byte> file;
     VectorSink sink(file);

@@ -1,0 +1,268 @@
+// Opens rr-gateway recordings in Lichtblick, the open-source Foxglove Studio (issue 44: "opens the
+// file in Foxglove"), in headless Chromium, and checks what a user sees there. Recorded through the
+// JSON API: the demo `create` device driving (wire `packets`, property `DistanceTraveled`, event
+// `Bump`; both encodings, the default) and the official camera driver's `frame_stream` with
+// synthetic frames (json alone). Checked: Raw Messages shows the property's value at the chosen time
+// and a packet, a Plot draws the rising distance, the Image panel shows the camera's picture from the
+// foxglove.RawImage channel, the Topics list has every channel and schema, and the Problems list
+// names only the robotraconteur channels (an encoding Lichtblick does not decode).
+//
+//   LICHTBLICK_WEB=/path/to/lichtblick/web/.webpack node test/record/lichtblick_open_test.mjs
+//
+// LICHTBLICK_WEB is a built Lichtblick web app (scripts/build-lichtblick.sh). Without it the test
+// reports SKIP (77): CI cannot build Lichtblick (its sources come from GitHub). The app is served by a
+// small static server here, its index.html given a layout through Lichtblick's default-layout
+// placeholder; the files are opened as its "remote file" data source (?ds=remote-file&ds.url=…, HTTP
+// range requests). Env as the browser tests: RR_GATEWAY, RR_PYTHON, RR_ARTIFACTS (screenshots).
+import { test, before, after } from "node:test";
+import assert from "node:assert/strict";
+import fs from "node:fs";
+import http from "node:http";
+import os from "node:os";
+import path from "node:path";
+import { createRequire } from "node:module";
+import { ROOT, settings, startGateway, launchChromium, apiDevices, waitFor } from "../browser/harness.mjs";
+import { DEVICES, startDevice, screenshot } from "../browser/std_support.mjs";
+
+const s = settings();
+const web = process.env.LICHTBLICK_WEB;
+if (!web || !fs.existsSync(path.join(web || "", "index.html"))) {
+  console.log(`SKIP: LICHTBLICK_WEB ${web ? `(${web}) has no index.html` : "is not set"}: build the app with scripts/build-lichtblick.sh`);
+  process.exit(77);
+}
+const mcapRequire = createRequire(path.join(ROOT, "test/mcap/package.json"));
+let McapIndexedReader, zstd;
+try {
+  ({ McapIndexedReader } = mcapRequire("@mcap/core"));
+  zstd = mcapRequire("@foxglove/wasm-zstd");
+} catch (e) {
+  console.log(`SKIP: test/mcap/node_modules incomplete (run ./scripts/setup.sh): ${e.message}`);
+  process.exit(77);
+}
+
+const work = fs.mkdtempSync(path.join(os.tmpdir(), "rr-lichtblick-"));
+let camera, gateway, server, browser, page;
+const files = {};
+const pageErrors = [];
+
+/** The layout Lichtblick opens with (its LayoutData: configById + a mosaic tree). */
+const LAYOUT = {
+  configById: {
+    "RawMessages!wire": { topicPath: "create/packets.value", diffEnabled: false, diffMethod: "custom", diffTopicPath: "", showFullMessageForDiff: false },
+    "RawMessages!prop": { topicPath: "create/DistanceTraveled.value", diffEnabled: false, diffMethod: "custom", diffTopicPath: "", showFullMessageForDiff: false },
+    "Plot!dist": {
+      paths: [{ value: "create/DistanceTraveled.value", enabled: true, timestampMethod: "receiveTime" }],
+      showXAxisLabels: true, showYAxisLabels: true, showLegend: true, legendDisplay: "floating",
+      showPlotValuesInLegend: true, isSynced: true, xAxisVal: "timestamp",
+    },
+    "Image!cam": { imageMode: { imageTopic: "camera/frame_stream/foxglove" } },
+  },
+  globalVariables: {},
+  userNodes: {},
+  playbackConfig: { speed: 1 },
+  layout: {
+    direction: "row",
+    first: { direction: "column", first: "RawMessages!wire", second: "RawMessages!prop", splitPercentage: 50 },
+    second: { direction: "column", first: "Plot!dist", second: "Image!cam", splitPercentage: 50 },
+    splitPercentage: 40,
+  },
+};
+
+/** Serves the app (index.html with LAYOUT) and the recordings (/rec/<name>, with byte ranges). */
+function serve() {
+  const index = fs.readFileSync(path.join(web, "index.html"), "utf8");
+  assert.ok(index.includes("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/"), "the app's index.html has the default-layout placeholder");
+  const indexWithLayout = index.replace("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/", JSON.stringify(LAYOUT));
+  const types = { ".js": "text/javascript", ".wasm": "application/wasm", ".html": "text/html", ".css": "text/css",
+    ".json": "application/json", ".png": "image/png", ".svg": "image/svg+xml", ".woff2": "font/woff2", ".ico": "image/x-icon" };
+  const srv = http.createServer((req, res) => {
+    const url = new URL(req.url, "http://x");
+    if (url.pathname.startsWith("/rec/")) {
+      const file = files[decodeURIComponent(url.pathname.slice(5))];
+      if (!file) { res.writeHead(404); return res.end(); }
+      const size = fs.statSync(file).size;
+      const range = /^bytes=(\d+)-(\d*)$/.exec(req.headers.range || "");
+      const headers = { "Accept-Ranges": "bytes", "Content-Type": "application/octet-stream" };
+      if (!range) {
+        res.writeHead(200, { ...headers, "Content-Length": size });
+        return fs.createReadStream(file).pipe(res);
+      }
+      const start = Number(range[1]), end = Math.min(range[2] ? Number(range[2]) : size - 1, size - 1);
+      if (start > end) { res.writeHead(416, { "Content-Range": `bytes */${size}` }); return res.end(); }
+      res.writeHead(206, { ...headers, "Content-Length": end - start + 1, "Content-Range": `bytes ${start}-${end}/${size}` });
+      return fs.createReadStream(file, { start, end }).pipe(res);
+    }
+    const rel = url.pathname === "/" ? "index.html" : path.normalize(decodeURIComponent(url.pathname)).replace(/^\/+/, "");
+    if (rel === "index.html") {
+      res.writeHead(200, { "Content-Type": "text/html" });
+      return res.end(indexWithLayout);
+    }
+    const p = path.join(web, rel);
+    if (!p.startsWith(web) || !fs.existsSync(p) || !fs.statSync(p).isFile()) { res.writeHead(404); return res.end(); }
+    res.writeHead(200, { "Content-Type": types[path.extname(p)] || "application/octet-stream" });
+    fs.createReadStream(p).pipe(res);
+  });
+  return new Promise((resolve) => srv.listen(0, "127.0.0.1", () => resolve(srv)));
+}
+
+async function api(method, p, body) {
+  const r = await fetch(`${gateway.base}${p}`, { method, headers: { "content-type": "application/json" }, body: body && JSON.stringify(body) });
+  const text = await r.text();
+  return { status: r.status, body: text ? JSON.parse(text) : null };
+}
+
+/** Every message of `file` on topic `topic` with json encoding: [{logTime (bigint), data (parsed)}]. */
+async function jsonMessages(file, topic) {
+  const buf = fs.readFileSync(file);
+  const readable = { size: async () => BigInt(buf.length), read: async (o, n) => buf.subarray(Number(o), Number(o) + Number(n)) };
+  const reader = await McapIndexedReader.Initialize({ readable,
+    decompressHandlers: { zstd: (data, size) => zstd.decompress(data, Number(size)) } });
+  const ids = [...reader.channelsById.values()].filter((c) => c.topic === topic && c.messageEncoding === "json").map((c) => c.id);
+  const out = [];
+  for await (const m of reader.readMessages({ topics: [topic] }))
+    if (ids.includes(m.channelId)) out.push({ logTime: m.logTime, data: JSON.parse(new TextDecoder().decode(m.data)) });
+  return out;
+}
+
+before(async () => {
+  assert.ok(s.gateway, "RR_GATEWAY must be set");
+  await zstd.isLoaded;
+  camera = await startDevice("camera_synthetic.py",
+    ["--camera-info", path.join(DEVICES, "synthetic_camera_info.yml"), "--width", "160", "--height", "120", "--fps", "10",
+      "--max-lifetime", "240"]);
+  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-discovery"]);
+  await waitFor(async () => {
+    const d = await apiDevices(gateway.base);
+    return ["camera", "create"].every((n) => d.find((x) => x.name === n)?.state === "connected");
+  }, "camera and create connected", 40000);
+  const drive = await api("POST", "/api/devices/create/functions/Drive", { args: { velocity: 200, radius: 32767 } });
+  assert.equal(drive.status, 200, `Drive: ${JSON.stringify(drive.body)}`);
+  const started = await api("POST", "/api/devices/camera/functions/start_streaming", {});
+  assert.ok(started.status < 300, `start_streaming: ${started.status} ${JSON.stringify(started.body)}`);
+  const recs = {};
+  for (const [device, spec] of Object.entries({
+    create: { members: ["packets", "DistanceTraveled", "Bump"], property_period_ms: 100 },
+    camera: { members: ["frame_stream"], encoding: "json" },  // json alone: what a file for Foxglove needs
+  })) {
+    const r = await api("POST", "/api/recordings", { device, directory: work, ...spec });
+    assert.equal(r.status, 201, `POST /api/recordings ${device}: ${JSON.stringify(r.body)}`);
+    recs[device] = r.body.id;
+  }
+  await new Promise((r) => setTimeout(r, 4000));
+  for (const [device, id] of Object.entries(recs)) {
+    const r = await api("POST", `/api/recordings/${id}/stop`, {});
+    assert.equal(r.status, 200, `stop ${device}: ${JSON.stringify(r.body)}`);
+    assert.ok(r.body.messages > 10, `${device}: ${r.body.messages} messages recorded`);
+    files[`${device}.mcap`] = r.body.files.at(-1);
+  }
+  server = await serve();
+  browser = await launchChromium();
+  page = await (await browser.newContext({ viewport: { width: 1400, height: 900 } })).newPage();
+  page.on("pageerror", (e) => pageErrors.push(String(e)));
+  page.on("response", (r) => { if (r.status() >= 400) console.log(`# HTTP ${r.status()} ${r.url()}`); });
+});
+
+after(async () => {
+  if (page) await screenshot(page, "lichtblick-end.png", { docs: false }).catch(() => {});
+  await browser?.close();
+  server?.close();
+  await gateway?.child.stop();
+  await camera?.child.stop();
+  fs.rmSync(work, { recursive: true, force: true });
+});
+
+/** RFC 3339 with nanoseconds of a log time (ns since the epoch, bigint): Lichtblick's `time=` parameter. */
+function rfc3339(ns) {
+  const iso = new Date(Number(ns / 1000000n)).toISOString();
+  return `${iso.slice(0, 19)}.${String(ns % 1000000000n).padStart(9, "0")}Z`;
+}
+
+/** The RGBA pixels of a locator's screenshot, decoded by the page itself: { width, height, data }. */
+async function shotPixels(locator) {
+  const png = await locator.screenshot();
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement("canvas");
+    c.width = img.width; c.height = img.height;
+    const g = c.getContext("2d");
+    g.drawImage(img, 0, 0);
+    return { width: c.width, height: c.height, data: Array.from(g.getImageData(0, 0, c.width, c.height).data) };
+  }, png.toString("base64"));
+}
+
+const panel = (id) => page.locator(`[data-testid="panel-mouseenter-container ${id}"]`);
+
+test("Lichtblick opens the recordings: topics, raw messages, a plot and the camera image", { timeout: 180000 }, async () => {
+  // What the file holds: the DistanceTraveled values (rising: the demo Create was driving) and a packet.
+  const distance = await jsonMessages(files["create.mcap"], "create/DistanceTraveled");
+  assert.ok(distance.length > 10, `${distance.length} DistanceTraveled values recorded`);
+  const k = Math.floor(distance.length * 2 / 3);
+  const expected = distance[k].data.value;
+  assert.notEqual(expected, distance[0].data.value, "the distance changed while recording (the Create drove)");
+  const packets = await jsonMessages(files["create.mcap"], "create/packets");
+  const packetBytes = packets[0].data.value.Data.length;
+
+  const base = `http://127.0.0.1:${server.address().port}`;
+  const urls = Object.keys(files).map((f) => `ds.url=${encodeURIComponent(`${base}/rec/${f}`)}`).join("&");
+  // time=: the player starts paused just after the chosen DistanceTraveled value
+  await page.goto(`${base}/?ds=remote-file&${urls}&time=${encodeURIComponent(rfc3339(distance[k].logTime + 1000n))}`);
+
+  // Raw Messages: the property's value at that time, and a wire packet with its bytes
+  await waitFor(async () => (await panel("RawMessages!prop").innerText()).includes(String(expected)),
+    `Raw Messages shows DistanceTraveled ${expected}`, 60000);
+  const prop = await panel("RawMessages!prop").innerText();
+  assert.ok(!distance.filter((m, i) => i !== k && m.data.value !== expected).some((m) => prop.split(/\s+/).includes(String(m.data.value))),
+    `Raw Messages shows only the value at the chosen time: ${prop}`);
+  await waitFor(async () => (await panel("RawMessages!wire").innerText()).includes(`${packetBytes} items`),
+    `Raw Messages shows a packet of ${packetBytes} bytes`, 30000);
+  assert.match(await panel("RawMessages!wire").innerText(), /experimental\.create\.Create\.packets/);
+
+  // Plot: a rising line, so its pixels (the series' colour) span many rows of the chart
+  await new Promise((r) => setTimeout(r, 2000));
+  const plot = await shotPixels(panel("Plot!dist"));
+  const rows = new Set();
+  for (let i = 0; i < plot.data.length; i += 4) {
+    const [r, g, b] = plot.data.slice(i, i + 3);
+    if (b > 150 && b - r > 60 && b - g > 20) rows.add(Math.floor(i / 4 / plot.width));
+  }
+  assert.ok(rows.size > plot.height / 4, `the plotted line spans ${rows.size} of ${plot.height} rows (rising data)`);
+
+  // Image panel: the synthetic camera's picture (many saturated colours), from the foxglove.* channel
+  const img = await shotPixels(panel("Image!cam"));
+  const colours = new Map();
+  for (let i = 0; i < img.data.length; i += 4) {
+    const [r, g, b] = img.data.slice(i, i + 3);
+    if (Math.max(r, g, b) - Math.min(r, g, b) < 80) continue;  // greys: background, text
+    const key = `${r >> 5},${g >> 5},${b >> 5}`;
+    colours.set(key, (colours.get(key) || 0) + 1);
+  }
+  const big = [...colours.values()].filter((n) => n > img.width * img.height / 100).length;
+  assert.ok(big >= 5, `the Image panel shows the camera's picture: ${big} saturated colours`);
+
+  // Topics: every channel, with its schema name
+  await page.locator('[data-testid="topics-left"]').click();
+  const sidebar = page.locator('[data-testid="sidebar-left"]');
+  await waitFor(async () => (await sidebar.innerText()).includes("camera/frame_stream/foxglove"), "the topics list", 20000);
+  const topics = await sidebar.innerText();
+  for (const t of ["create/packets", "create/DistanceTraveled", "create/Bump", "camera/frame_stream", "camera/frame_stream/foxglove",
+    "experimental.create.Create.packets", "foxglove.RawImage"])
+    assert.ok(topics.includes(t), `the topics list shows ${t}:\n${topics}`);
+
+  // Problems: only the robotraconteur channels (an encoding Lichtblick does not decode) and the two
+  // files' overlapping times; nothing about the json channels, their schemas or the file structure.
+  await page.locator('[data-testid="problems-left"]').click();
+  await new Promise((r) => setTimeout(r, 500));
+  const problems = (await sidebar.innerText()).split("\n").map((l) => l.trim()).filter(Boolean);
+  const known = [/^Error in topic (\S+) \(channel \d+\): Unsupported encoding robotraconteur$/, /^Unsupported encoding robotraconteur$/,
+    /^Received message on channel \d+ without prior channel info$/, /^No details provided$/,
+    /^MCAP time overlap detected\./, /^Check the time range of the MCAPs$/];
+  const listed = problems.slice(problems.indexOf("Layouts") + 1);
+  for (const line of listed) assert.ok(known.some((re) => re.test(line)), `an unexpected problem in Lichtblick: ${line}\n${listed.join("\n")}`);
+  const undecoded = listed.map((l) => known[0].exec(l)?.[1]).filter(Boolean).sort();
+  assert.deepEqual(undecoded, ["create/Bump", "create/DistanceTraveled", "create/packets"],
+    "the robotraconteur channels, and only they, are reported (the camera was recorded in json alone)");
+  await screenshot(page, "lichtblick-open.png", { docs: false });
+  assert.deepEqual(pageErrors, []);
+});
