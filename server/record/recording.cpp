@@ -15,6 +15,7 @@
 #include "server/mcap/mcap_file.hpp"
 #include "server/record/foxglove_image.hpp"
 #include "server/record/json_schema.hpp"
+#include "server/record/object_path.hpp"
 
 namespace rr::server::record {
 
@@ -115,6 +116,12 @@ std::string service_name_of(const std::string& text) {
     return "unknown";
 }
 
+// The object's path below the root from a target's service path in gateway naming (`<device>` or
+// `<device>.<relative path>`): "" for the root.
+std::string object_path_of(const std::string& service_path, const std::string& device) {
+    return service_path.size() > device.size() ? service_path.substr(device.size() + 1) : std::string();
+}
+
 std::span<const std::byte> as_bytes(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
 
 }  // namespace
@@ -146,7 +153,8 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
     if (!object) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": unknown root type " + object_type);
 
     std::vector<RecordedMember> members;
-    auto add = [&](const robdef::MemberDefinition& m) -> Result<void> {
+    // `m` of the object at `below` (nullptr: the root).
+    auto add = [&](const robdef::MemberDefinition& m, const ObjectBelow* below = nullptr) -> Result<void> {
         RecordedMember r;
         switch (m.kind) {
             case robdef::MemberKind::wire: r.kind = RecordedMember::Kind::wire; break;
@@ -165,10 +173,10 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
         auto t = std::make_shared<MemberTarget>();
         t->device = device;
         t->types = types;
-        t->path = device->config().name;
-        t->object_type = object_type;
-        t->service = object->service;
-        t->object = object->entry;
+        t->path = below ? device->config().name + "." + below->path : device->config().name;
+        t->object_type = below ? below->object_type : object_type;
+        t->service = below ? below->object.service : object->service;
+        t->object = below ? below->object.entry : object->entry;
         t->member = &m;
         r.target = std::move(t);
         members.push_back(std::move(r));
@@ -185,9 +193,20 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
         }
     } else {
         for (const auto& name : spec.members) {
-            const auto* m = object->entry->find_member(name);
-            if (!m) return fail(MessageErrorType::InvalidArgument, "record: members: " + object_type + " has no member \"" + name + "\"");
-            if (auto r = add(*m); !r) return r.take_error();
+            const auto split = split_member_path(name);
+            if (split.object.empty()) {
+                const auto* m = object->entry->find_member(name);
+                if (!m) return fail(MessageErrorType::InvalidArgument, "record: members: " + object_type + " has no member \"" + name + "\"");
+                if (auto r = add(*m); !r) return r.take_error();
+                continue;
+            }
+            auto below = object_below(*types, object_type, split.object);
+            if (!below) return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below.error().message);
+            const auto* m = below->object.entry->find_member(split.member);
+            if (!m)
+                return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below->object_type +
+                                                                   " has no member \"" + split.member + "\"");
+            if (auto r = add(*m, &*below); !r) return r.take_error();
         }
     }
     if (members.empty()) return fail(MessageErrorType::InvalidArgument, "record: " + object_type + ": nothing to record");
@@ -352,10 +371,13 @@ Result<void> Recording::open_file() {
     // definition holding the root object; the others are there for replay and RR tools.
     const auto& texts = members_.front().target->types->texts();
     std::uint16_t root_schema = 0;
+    std::map<std::string, std::uint16_t> definition_schemas;  // service name -> schema id
     for (std::size_t i = 0; i < texts.size(); ++i) {
-        auto id = f->writer->add_schema(service_name_of(texts[i]), "robotraconteur_servicedef", as_bytes(texts[i]));
+        const auto name = service_name_of(texts[i]);
+        auto id = f->writer->add_schema(name, "robotraconteur_servicedef", as_bytes(texts[i]));
         if (!id) return check(id.take_error());
         if (i == 0) root_schema = *id;
+        definition_schemas.emplace(name, *id);
     }
     const std::string device = spec_.device;
     std::map<std::string, std::uint16_t> image_schemas;  // Foxglove schema name -> id, added once
@@ -365,11 +387,12 @@ Result<void> Recording::open_file() {
                                                 {"member", t.member->name},
                                                 {"kind", std::string(member_kind_name(m.kind))},
                                                 {"object_type", t.object_type},
-                                                {"path", ""}};
+                                                {"path", object_path_of(t.path, device)},
+                                                {"root_type", device_->object_type()}};
         if (m.kind != RecordedMember::Kind::event) meta["type"] = t.member->type.to_string();
         if (m.kind == RecordedMember::Kind::property)
             meta["period_ms"] = std::to_string(spec_.property_period.count() > 0 ? spec_.property_period.count() : 1000);
-        const std::string topic = device + "/" + t.member->name;
+        const std::string topic = device + "/" + (meta["path"].empty() ? "" : meta["path"] + "/") + t.member->name;
         int json_id = -1, rr_id = -1;
         if (spec_.json) {
             const std::string title = t.object_type + "." + t.member->name;
@@ -393,7 +416,9 @@ Result<void> Recording::open_file() {
         if (spec_.robotraconteur) {
             auto rr_meta = meta;
             rr_meta["entry_format"] = "4";
-            auto cid = f->writer->add_channel(root_schema, topic, "robotraconteur", rr_meta);
+            // the schema: the definition holding the member's object (the root's for root members)
+            const auto d = definition_schemas.find(t.service->name);
+            auto cid = f->writer->add_channel(d != definition_schemas.end() ? d->second : root_schema, topic, "robotraconteur", rr_meta);
             if (!cid) return check(cid.take_error());
             rr_id = *cid;
         }
@@ -644,7 +669,10 @@ RecordingStatus Recording::status() const {
     RecordingStatus s;
     s.id = id_;
     s.spec = spec_;
-    for (const auto& m : members_) s.members.push_back(m.target->member->name);
+    for (const auto& m : members_) {
+        const auto object = object_path_of(m.target->path, device_->config().name);
+        s.members.push_back(object.empty() ? m.target->member->name : object + "." + m.target->member->name);
+    }
     s.drops = queue_.drops();
     s.queued_bytes = queue_.queued_bytes();
     s.messages = messages_.load();

@@ -6,6 +6,7 @@
 #include "core/message/message_reader.hpp"
 #include "core/message/message_writer.hpp"
 #include "core/value/pack_value.hpp"
+#include "core/names/service_path.hpp"
 #include "server/mcap/mcap_file.hpp"
 #include "server/service/pipe_member.hpp"
 #include "server/service/wire_member.hpp"
@@ -64,19 +65,36 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     d->playback_->reader.emplace(std::move(*reader));
     const auto& summary = d->playback_->reader->summary();
 
-    // The definitions: every robotraconteur_servicedef schema; the root's is the channels' schema.
-    std::vector<std::string> texts;
+    auto meta_of = [](const mcap::Channel& ch, const char* k) {
+        auto it = ch.metadata.find(k);
+        return it == ch.metadata.end() ? std::string() : it->second;
+    };
+    // The root object's type: a root channel's `object_type` (its schema is the root's definition),
+    // else `root_type` of a channel below the root (a file of objects below the root only).
+    std::string root_type;
     std::uint16_t root_schema = 0;
-    for (const auto& [id, ch] : summary.channels)
-        if (ch.message_encoding == "robotraconteur") {
+    for (const auto& [id, ch] : summary.channels) {
+        if (ch.message_encoding != "robotraconteur") continue;
+        if (meta_of(ch, "path").empty()) {
+            root_type = meta_of(ch, "object_type");
             root_schema = ch.schema_id;
+            d->recorded_device_ = meta_of(ch, "device");
             break;
         }
-    if (!root_schema) return err(MessageErrorType::InvalidArgument, "no \"robotraconteur\" channel with a schema (record with encoding robotraconteur to replay)");
+        if (root_type.empty()) {
+            root_type = meta_of(ch, "root_type");
+            d->recorded_device_ = meta_of(ch, "device");
+        }
+    }
+    if (root_type.empty())
+        return err(MessageErrorType::InvalidArgument, "no \"robotraconteur\" channel naming its object type (record with encoding robotraconteur to replay)");
+    const std::string root_service = root_type.substr(0, root_type.rfind('.'));
+    // The definitions: every robotraconteur_servicedef schema, the root's first.
+    std::vector<std::string> texts;
     for (const auto& [id, s] : summary.schemas) {
         if (s.encoding != "robotraconteur_servicedef") continue;
         std::string text(reinterpret_cast<const char*>(s.data.data()), s.data.size());
-        if (id == root_schema) texts.insert(texts.begin(), std::move(text));
+        if (id == root_schema || (!root_schema && s.name == root_service)) texts.insert(texts.begin(), std::move(text));
         else texts.push_back(std::move(text));
     }
     if (texts.empty()) return err(MessageErrorType::InvalidArgument, "no service definition (schema encoding robotraconteur_servicedef)");
@@ -84,24 +102,23 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     if (!types) return err(MessageErrorType::InvalidArgument, "recorded service definitions: " + types.error().message);
     d->types_ = *types;
 
+    d->object_type_ = root_type;
+    std::map<std::uint16_t, std::string> channel_types;  // object type of each replayed channel
     for (const auto& [id, channel] : summary.channels) {
         const auto& ch = channel;
         if (ch.message_encoding != "robotraconteur") continue;
-        auto meta = [&ch](const char* k) {
-            auto it = ch.metadata.find(k);
-            return it == ch.metadata.end() ? std::string() : it->second;
-        };
-        if (d->object_type_.empty()) {
-            d->object_type_ = meta("object_type");
-            d->recorded_device_ = meta("device");
-        }
-        if (meta("object_type") != d->object_type_ || !meta("path").empty()) continue;  // root object only
-        const auto* obj = d->types_->find_object(d->object_type_);
-        if (!obj) return err(MessageErrorType::InvalidArgument, "the recorded definitions have no object type \"" + d->object_type_ + "\"");
+        auto meta = [&](const char* k) { return meta_of(ch, k); };
+        const std::string path = meta("path"), type = meta("object_type");
+        if (path.empty() && type != d->object_type_) continue;  // not this device's root
+        const auto* obj = d->types_->find_object(type);
+        if (!obj) return err(MessageErrorType::InvalidArgument, "the recorded definitions have no object type \"" + type + "\" (channel " + ch.topic + ")");
         const auto* m = obj->find_member(meta("member"));
-        if (!m) return err(MessageErrorType::InvalidArgument, d->object_type_ + " has no member \"" + meta("member") + "\" (channel " + ch.topic + ")");
+        if (!m) return err(MessageErrorType::InvalidArgument, type + " has no member \"" + meta("member") + "\" (channel " + ch.topic + ")");
         Channel c;
         c.member = m;
+        c.path = path;
+        c.context = type.substr(0, type.rfind('.'));
+        c.property_key = path + '\n' + m->name;
         const std::string kind = meta("kind");
         if (kind == "wire" && m->kind == robdef::MemberKind::wire) c.kind = Channel::Kind::wire;
         else if (kind == "pipe" && m->kind == robdef::MemberKind::pipe) c.kind = Channel::Kind::pipe;
@@ -109,10 +126,11 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
         else if (kind == "property" && m->kind == robdef::MemberKind::property) c.kind = Channel::Kind::property;
         else return err(MessageErrorType::InvalidArgument, "channel " + ch.topic + ": kind \"" + kind + "\" does not match member " + m->name);
         d->channels_[id] = c;
+        channel_types[id] = type;
         d->playback_->all_ids.insert(id);
         if (c.kind == Channel::Kind::wire || c.kind == Channel::Kind::property) d->playback_->state_ids.insert(id);
     }
-    if (d->channels_.empty()) return err(MessageErrorType::InvalidArgument, "no replayable channel of the root object");
+    if (d->channels_.empty()) return err(MessageErrorType::InvalidArgument, "no replayable channel");
     d->context_service_ = d->object_type_.substr(0, d->object_type_.rfind('.'));
     d->name_ = options.name.empty() ? d->recorded_device_ : options.name;
     if (d->name_.empty()) return err(MessageErrorType::InvalidArgument, "no device name (the channels do not name the device; give one)");
@@ -131,25 +149,42 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     auto root = ServiceObject::create(d->types_, d->object_type_);
     if (!root) return err(MessageErrorType::InvalidArgument, root.error().message);
     d->root_ = *root;
-    std::weak_ptr<ReplayDevice> weak = d;
-    const std::string name = d->name_;
-    for (const auto& m : d->root_->definition().members) {
+    d->objects_[""] = d->root_;
+    d->serve_members(*d->root_, "");
+    for (auto& [id, c] : d->channels_) {
+        auto object = d->object_at(c.path, channel_types[id]);
+        if (!object) return err(MessageErrorType::InvalidArgument, object.error().message);
+        c.object = *object;
+    }
+    auto service = ObjectService::create(d->name_, d->root_);
+    if (!service) return err(MessageErrorType::InvalidArgument, service.error().message);
+    d->service_ = *service;
+    d->speed_ = options.speed;
+    d->loop_ = options.loop;
+    d->playing_ = !options.paused;
+    return d;
+}
+
+void ReplayDevice::serve_members(ServiceObject& object, const std::string& path) {
+    std::weak_ptr<ReplayDevice> weak = weak_from_this();
+    const std::string name = name_, file = options_.file;
+    for (const auto& m : object.definition().members) {
         if (m.kind == robdef::MemberKind::function) {
             if (m.is_generator())
-                (void)d->root_->set_generator_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<std::shared_ptr<Generator>> {
+                (void)object.set_generator_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<std::shared_ptr<Generator>> {
                     return fail(refused(name, file));
                 });
             else
-                (void)d->root_->set_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<Value> { return fail(refused(name, file)); });
+                (void)object.set_function(m.name, [name, file](const SessionRef&, std::vector<Value>) -> Result<Value> { return fail(refused(name, file)); });
         } else if (m.kind == robdef::MemberKind::property) {
-            const std::string member = m.name;
-            (void)d->root_->set_property_handlers(
+            const std::string member = m.name, key = path + '\n' + m.name;
+            (void)object.set_property_handlers(
                 m.name,
-                [weak, member, file](const SessionRef&) -> Result<Value> {
+                [weak, member, key, file](const SessionRef&) -> Result<Value> {
                     auto self = weak.lock();
                     if (!self) return fail(MessageErrorType::ServiceError, "replay ended");
                     std::lock_guard<std::mutex> lock(self->mutex_);
-                    auto it = self->properties_.find(member);
+                    auto it = self->properties_.find(key);
                     if (it == self->properties_.end())
                         return fail(MessageErrorType::ValueNotSet, "property \"" + member + "\" has no recorded value at this point of " + file);
                     return it->second;
@@ -159,13 +194,62 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
                 });
         }
     }
-    auto service = ObjectService::create(d->name_, d->root_);
-    if (!service) return err(MessageErrorType::InvalidArgument, service.error().message);
-    d->service_ = *service;
-    d->speed_ = options.speed;
-    d->loop_ = options.loop;
-    d->playing_ = !options.paused;
-    return d;
+}
+
+Result<ServiceObject*> ReplayDevice::object_at(const std::string& path, const std::string& type) {
+    if (auto it = objects_.find(path); it != objects_.end()) return it->second.get();
+    // Recorded paths are normalized (recording.cpp): segments `name` or `name[encoded index]`, no '.'
+    // inside an index.
+    const auto dot = path.rfind('.');
+    const std::string parent_path = dot == std::string::npos ? std::string() : path.substr(0, dot);
+    const std::string segment = dot == std::string::npos ? path : path.substr(dot + 1);
+    const std::string member = segment.substr(0, segment.find('['));
+    // The parent: already served, else of the type its own objref declares (walked from the root).
+    ServiceObject* parent = nullptr;
+    if (auto it = objects_.find(parent_path); it != objects_.end()) {
+        parent = it->second.get();
+    } else {
+        std::string parent_type = object_type_;
+        std::size_t pos = 0;
+        while (pos < parent_path.size()) {
+            auto end = parent_path.find('.', pos);
+            if (end == std::string::npos) end = parent_path.size();
+            const std::string seg = parent_path.substr(pos, end - pos);
+            const auto* def = types_->find_object(parent_type);
+            const auto* ref = def ? def->find_member(seg.substr(0, seg.find('['))) : nullptr;
+            if (!ref || ref->kind != robdef::MemberKind::objref || ref->type.qualified_name.empty())
+                return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + seg + "\" on " + parent_type);
+            parent_type = ref->type.qualified_name;
+            pos = end + 1;
+        }
+        auto p = object_at(parent_path, parent_type);
+        if (!p) return p.take_error();
+        parent = *p;
+    }
+    const auto* ref = parent->definition().find_member(member);
+    if (!ref || ref->kind != robdef::MemberKind::objref)
+        return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + member + "\" on " + parent->type());
+    auto object = ServiceObject::create(types_, type);
+    if (!object) return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": " + object.error().message);
+    objects_[path] = *object;
+    serve_members(**object, path);
+    // The parent's objref answers the recorded objects (objects_ is complete before serving starts).
+    std::weak_ptr<ReplayDevice> weak = weak_from_this();
+    const std::string file = options_.file;
+    (void)parent->set_objref(member, [weak, parent_path, member, file](const SessionRef&, const ObjRefIndex& index)
+                                         -> Result<std::shared_ptr<ServiceObject>> {
+        auto self = weak.lock();
+        if (!self) return fail(MessageErrorType::ServiceError, "replay ended");
+        std::string seg = member;
+        if (const auto* i = std::get_if<std::int32_t>(&index)) seg += "[" + encode_service_path_index(*i) + "]";
+        else if (const auto* k = std::get_if<std::string>(&index)) seg += "[" + encode_service_path_index(std::string_view(*k)) + "]";
+        const std::string p = parent_path.empty() ? seg : parent_path + "." + seg;
+        auto it = self->objects_.find(p);
+        if (it == self->objects_.end())
+            return fail(MessageErrorType::ObjectNotFound, "object \"" + p + "\" is not in the recording " + file);
+        return it->second;
+    });
+    return object->get();
 }
 
 ReplayDevice::~ReplayDevice() { stop(); }
@@ -184,7 +268,7 @@ void ReplayDevice::stop() {
     }
     wake_.notify_all();
     if (thread_.joinable() && thread_.get_id() != std::this_thread::get_id()) thread_.join();
-    if (root_) root_->clear_handlers();
+    for (auto& [path, object] : objects_) object->clear_handlers();
     if (service_) service_->shutdown();
 }
 
@@ -250,7 +334,7 @@ ReplayStatus ReplayDevice::status() const {
     s.start_ns = start_ns_;
     s.duration_s = static_cast<double>(end_ns_ - start_ns_) / 1e9;
     s.played = played_.load();
-    for (const auto& [id, c] : channels_) s.members.push_back(c.member->name);
+    for (const auto& [id, c] : channels_) s.members.push_back(c.path.empty() ? c.member->name : c.path + "." + c.member->name);
     std::lock_guard<std::mutex> lock(mutex_);
     s.speed = speed_;
     s.loop = loop_;
@@ -274,7 +358,7 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
     const auto& set = types_->set();
     auto unpack = [&](const MessageElement* el, const robdef::TypeDefinition& type) -> std::optional<Value> {
         if (!el) return std::nullopt;
-        auto v = unpack_value(*el, type, set, context_service_);
+        auto v = unpack_value(*el, type, set, c.context);
         if (!v) return std::nullopt;
         return std::move(*v);
     };
@@ -282,14 +366,14 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
         case Channel::Kind::wire: {
             auto v = unpack(entry->find("packet"), c.member->type);
             if (!v) return;
-            if (auto w = root_->wire(c.member->name)) (void)(*w)->set_out_value(std::move(*v));
+            if (auto w = c.object->wire(c.member->name)) (void)(*w)->set_out_value(std::move(*v));
             break;
         }
         case Channel::Kind::pipe: {
             if (!live || entry->elements.empty()) return;
             auto v = unpack(&entry->elements[0], c.member->type);
             if (!v) return;
-            if (auto p = root_->pipe(c.member->name)) (*p)->broadcast(*v);
+            if (auto p = c.object->pipe(c.member->name)) (*p)->broadcast(*v);
             break;
         }
         case Channel::Kind::event: {
@@ -300,14 +384,14 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
                 if (!v) return;
                 args.push_back(std::move(*v));
             }
-            (void)root_->fire_event(c.member->name, std::move(args));
+            (void)c.object->fire_event(c.member->name, std::move(args));
             break;
         }
         case Channel::Kind::property: {
             auto v = unpack(entry->find("value"), c.member->type);
             if (!v) return;
             std::lock_guard<std::mutex> lock(mutex_);
-            properties_[c.member->name] = std::move(*v);
+            properties_[c.property_key] = std::move(*v);
             break;
         }
     }

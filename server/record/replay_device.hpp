@@ -89,6 +89,10 @@ private:
     struct Channel {
         enum class Kind : std::uint8_t { wire, pipe, event, property } kind = Kind::wire;
         const robdef::MemberDefinition* member = nullptr;
+        std::string path;         ///< the object's path below the root ("" = the root)
+        ServiceObject* object = nullptr;  ///< the served object at `path` (owned by objects_)
+        std::string context;      ///< the service defining the object (for unqualified type names)
+        std::string property_key; ///< key of properties_: path + '\n' + member
     };
     struct Playback;
 
@@ -103,6 +107,13 @@ private:
     std::string name_, recorded_device_, object_type_, context_service_;
     std::shared_ptr<const ServiceTypes> types_;
     std::shared_ptr<ServiceObject> root_;
+    /// Every served object by its path below the root ("" = root_), the recorded ones and those on
+    /// the way to them (docs/recording.md "Objects below the root").
+    std::map<std::string, std::shared_ptr<ServiceObject>> objects_;
+    /// Creates the object at `path` of `type` and those on the way, with their objref resolvers.
+    Result<ServiceObject*> object_at(const std::string& path, const std::string& type);
+    /// Functions refused, properties answering their recorded value.
+    void serve_members(ServiceObject& object, const std::string& path);
     std::shared_ptr<ObjectService> service_;
     std::map<std::uint16_t, Channel> channels_;  // robotraconteur channels by id
     std::uint64_t start_ns_ = 0, end_ns_ = 0;
@@ -116,7 +127,7 @@ private:
     std::chrono::steady_clock::time_point anchor_steady_;
     std::uint64_t anchor_file_ns_ = 0;
     std::string error_;
-    std::map<std::string, Value> properties_;  // last value at the position, by member name
+    std::map<std::string, Value> properties_;  // last value at the position, by Channel::property_key
     std::atomic<std::uint64_t> played_{0};
     std::unique_ptr<Playback> playback_;
     std::thread thread_;
