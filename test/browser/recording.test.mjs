@@ -10,7 +10,9 @@
 //     under the device; pause, seek, speed, loop and play from the page change what GET
 //     api/replays/create_replay reports, and the page shows the values the gateway reports;
 // (4) with logins (gateway.auth), a viewer (read only) sees the timeline with its controls disabled
-//     and the gateway refuses its POST; an operator (write) gets the controls.
+//     and the gateway refuses its POST; an operator (write) gets the controls;
+// (5) on the `webcam` device, members below the root typed into the control ("Below the root":
+//     `Webcams[0].Name, Webcams[1].Name`) are recorded; a name that leads nowhere shows the refusal.
 // Screenshots: docs/img/dashboard-recording.png and dashboard-replay.png with RR_DOCS_SCREENSHOTS=1.
 
 import { test, before, after, afterEach } from "node:test";
@@ -276,4 +278,31 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.equal(await alice.p.locator('.device-view[data-device="create_replay"] .record-button').isDisabled(), false, "an operator may record");
   assert.equal(await alice.p.locator(".record-refused").count(), 0);
   await alice.context.close();
+});
+
+test("members below the root object typed into the Record control (the webcam's cameras)", async () => {
+  await openDevice(gateway.base, "webcam");
+  const c = view("webcam").locator(".record-control");
+  await c.locator("details.record-options summary").click();
+  await c.locator("button", { hasText: "none" }).click();
+  const paths = c.locator('input[name="record-paths"]');
+  assert.match(await paths.getAttribute("placeholder"), /Webcams\[0\]\./, "the hint names the device's objref");
+  // a name that leads nowhere: the gateway's reason on the page, nothing recorded
+  await paths.fill("Webcams.Name");
+  await c.locator(".record-button").click();
+  await waitFor(async () => /needs an index/.test(await c.locator(".record-error").textContent()), "the refusal on the page", 10000);
+  assert.equal(await c.locator(".record-button").textContent(), "Record");
+  await paths.fill("Webcams[0].Name, Webcams[1].Name");
+  await c.locator('input[name="record-directory"]').fill(path.join(work, "sub"));
+  await c.locator(".record-button").click();
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  await waitFor(async () => /[1-9]\d* messages/.test(await c.locator(".record-live").textContent()), "the cameras' names recorded", 15000);
+  await c.locator(".record-button").click();
+  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
+  const item = c.locator(".recordings > li").first();
+  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 10000);
+  const id = Number(await item.getAttribute("data-id"));
+  const listed = (await api(gateway.base, "GET", "api/recordings")).body.recordings.find((r) => r.id === id);
+  assert.deepEqual(listed.members, ["Webcams[0].Name", "Webcams[1].Name"]);
+  assert.ok(listed.messages >= 2, `${listed.messages} messages`);
 });

@@ -3,7 +3,7 @@
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import {
-  recordableMembers, recordingBody, formatBytes, formatSeconds, timeSpan, recordingsOf, replayControlBody,
+  recordableMembers, parseMemberPaths, recordingBody, formatBytes, formatSeconds, timeSpan, recordingsOf, replayControlBody,
   apiRequest, ApiRequestError, startRecording, stopRecording, controlReplay,
 } from "../src/record/recording_api.js";
 
@@ -78,4 +78,11 @@ test("requests: relative URLs, JSON bodies, the gateway's error message on a ref
   await assert.rejects(startRecording({ device: "d", members: ["a"] }, refused),
     (e) => e instanceof ApiRequestError && e.status === 507 && e.message === "record: /proc/rec: Permission denied");
   await assert.rejects(apiRequest("GET", "api/replays", undefined, fake(502)), /GET api\/replays: HTTP 502/);
+});
+
+test("members below the root as typed: split on commas, spaces and new lines outside brackets", () => {
+  assert.deepEqual(parseMemberPaths("Webcams[0].FrameStream, Webcams[1].Name"), ["Webcams[0].FrameStream", "Webcams[1].Name"]);
+  assert.deepEqual(parseMemberPaths(" a.b\n\n c[x, y].d ,,"), ["a.b", "c[x, y].d"]);
+  assert.deepEqual(parseMemberPaths(""), []);
+  assert.deepEqual(parseMemberPaths(undefined), []);
 });

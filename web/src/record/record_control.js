@@ -5,7 +5,7 @@
 
 import { h, errorText } from "../dom.js";
 import {
-  DEFAULT_KINDS, recordableMembers, recordingBody, recordingsOf, formatBytes, formatSeconds,
+  DEFAULT_KINDS, recordableMembers, parseMemberPaths, recordingBody, recordingsOf, formatBytes, formatSeconds,
   listRecordings, startRecording, stopRecording,
 } from "./recording_api.js";
 
@@ -39,6 +39,9 @@ export class RecordControl {
       h("option", { value: "json", text: "json (Foxglove)" }),
       h("option", { value: "robotraconteur", text: "robotraconteur (replay)" }));
     this.directory = h("input", { name: "record-directory", placeholder: "recordings (the gateway's default)", size: 28 });
+    // members of objects below the root, by path: offered when the device has objrefs
+    const objref = (members || []).find((m) => m.kind === "objref");
+    this.paths = objref ? h("input", { name: "record-paths", size: 28, placeholder: `e.g. ${objref.name}[0].member, …` }) : null;
     this.button = h("button", { type: "button", class: "record-button", text: "Record", onclick: () => this.toggle() });
     this.live = h("span", { class: "record-live", "aria-live": "polite" });
     this.error = h("p", { class: "record-error", role: "alert", hidden: true });
@@ -55,6 +58,8 @@ export class RecordControl {
           h("button", { type: "button", class: "small", text: "all", onclick: all(true) }),
           h("button", { type: "button", class: "small", text: "none", onclick: all(false) })),
         memberList,
+        this.paths ? h("label", { title: "object path, '.', member; separated by commas or spaces" },
+          h("span", { text: "Below the root" }), this.paths) : null,
         h("label", {}, h("span", { text: "Encoding" }), this.encoding),
         h("label", {}, h("span", { text: "Directory" }), this.directory)),
       h("div", { class: "record-row" }, this.button, this.live),
@@ -127,7 +132,8 @@ export class RecordControl {
       if (this.active) {
         await stopRecording(this.active.id, this.fetchImpl);
       } else {
-        const members = this.members.filter((_, i) => this.boxes[i].checked).map((m) => m.name);
+        const members = [...this.members.filter((_, i) => this.boxes[i].checked).map((m) => m.name),
+          ...parseMemberPaths(this.paths?.value)];
         await startRecording(recordingBody({ device: this.device, members, encoding: this.encoding.value, directory: this.directory.value }), this.fetchImpl);
       }
     } catch (e) {

@@ -15,6 +15,31 @@ export function recordableMembers(members) {
 }
 
 /**
+ * Members below the root object typed by the user (docs/recording.md "Objects below the root"):
+ * object path, `.`, member, e.g. `Webcams[0].FrameStream`; separated by commas, spaces or new lines
+ * outside brackets (a string key in brackets may hold them). Empty entries are dropped; the gateway
+ * checks each name (400 with the reason).
+ * @param {string} text
+ * @returns {string[]}
+ */
+export function parseMemberPaths(text) {
+  const out = [];
+  let cur = "", depth = 0;
+  for (const c of String(text ?? "")) {
+    if (c === "[") depth++;
+    else if (c === "]" && depth > 0) depth--;
+    if (depth === 0 && /[\s,]/.test(c)) {
+      if (cur) out.push(cur);
+      cur = "";
+    } else {
+      cur += c;
+    }
+  }
+  if (cur) out.push(cur);
+  return out;
+}
+
+/**
  * The body of POST api/recordings: { device, members, encoding[, directory] }.
  * Throws Error when no member is chosen or the encoding is not a key of ENCODINGS.
  */
