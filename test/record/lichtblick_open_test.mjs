@@ -6,7 +6,8 @@
 // Checked: Raw Messages shows the property's value at the chosen time and a packet, a Plot draws the
 // rising distance, the Image panel shows the camera's picture from the foxglove.RawImage channel, the
 // Topics list has every channel and schema, and the Problems list names only the robotraconteur
-// channels (an encoding Lichtblick does not decode).
+// channels (an encoding Lichtblick does not decode). Then the create file opened from the disk
+// (Lichtblick's local file source) and played to the end.
 //
 //   LICHTBLICK_WEB=/path/to/lichtblick/web/.webpack node test/record/lichtblick_open_test.mjs
 //
@@ -142,6 +143,7 @@ before(async () => {
   assert.ok(started.status < 300, `start_streaming: ${started.status} ${JSON.stringify(started.body)}`);
   browser = await launchChromium();
   page = await (await browser.newContext({ viewport: { width: 1400, height: 900 } })).newPage();
+  page.setDefaultTimeout(60000);  // clicks on a loaded 2-vCPU machine (a CI run beside) took over 30 s
   page.on("pageerror", (e) => pageErrors.push(String(e)));
   page.on("response", (r) => { if (r.status() >= 400) console.log(`# HTTP ${r.status()} ${r.url()}`); });
 
@@ -206,7 +208,7 @@ async function shotPixels(locator) {
 
 const panel = (id) => page.locator(`[data-testid="panel-mouseenter-container ${id}"]`);
 
-test("Lichtblick opens the recordings: topics, raw messages, a plot and the camera image", { timeout: 180000 }, async () => {
+test("Lichtblick opens the recordings: topics, raw messages, a plot and the camera image", { timeout: 400000 }, async () => {
   // What the file holds: the DistanceTraveled values (rising: the demo Create was driving) and a packet.
   const distance = await jsonMessages(files["create.mcap"], "create/DistanceTraveled");
   assert.ok(distance.length >= 4, `${distance.length} DistanceTraveled values recorded`);
@@ -276,5 +278,32 @@ test("Lichtblick opens the recordings: topics, raw messages, a plot and the came
   assert.deepEqual(undecoded, ["create/Bump", "create/DistanceTraveled", "create/packets"],
     "the robotraconteur channels, and only they, are reported (the camera was recorded in json alone)");
   await screenshot(page, "lichtblick-recording.png");  // docs/img with RR_DOCS_SCREENSHOTS=1
+  assert.deepEqual(pageErrors, []);
+});
+
+// The other way a user opens a file: from the disk. "Open local file" (the File System Access picker,
+// which Playwright cannot answer) and dropping a file on the window both give the file to Lichtblick's
+// local MCAP source (McapLocalDataSourceFactory, read from a Blob: another reader than the remote
+// file's HTTP ranges); the drop listener's hidden file input (data-puppeteer-file-upload, kept by
+// Lichtblick for its own browser tests) takes the file the way a drop does.
+test("Lichtblick opens a recording from the disk (its local file source), played to the end", { timeout: 300000 }, async () => {
+  const distance = await jsonMessages(files["create.mcap"], "create/DistanceTraveled");
+  const last = String(distance.at(-1).data.value);
+  const base = `http://127.0.0.1:${server.address().port}`;
+  await page.goto(`${base}/`);
+  await page.locator("input[data-puppeteer-file-upload]").setInputFiles(files["create.mcap"]);
+  await page.getByText(path.basename(files["create.mcap"])).first().waitFor({ timeout: 60000 });  // the app bar names it
+  // The player opens the file paused at its start; Play runs it to the end (about 7 s at speed 1).
+  const play = page.locator('button[title="Play"]');
+  await page.locator('button[title="Play"], button[title="Pause"]').first().waitFor({ timeout: 30000 });
+  if (await play.count()) await play.click();
+  await waitFor(async () => (await panel("RawMessages!prop").innerText()).split(/\s+/).includes(last),
+    `Raw Messages shows the last recorded DistanceTraveled ${last} once played to the end`, 60000);
+  assert.match(await panel("RawMessages!wire").innerText(), /experimental\.create\.Create\.packets/);
+  await page.locator('[data-testid="problems-left"]').click();
+  await new Promise((r) => setTimeout(r, 500));
+  const problems = await page.locator('[data-testid="sidebar-left"]').innerText();
+  assert.doesNotMatch(problems, /chunk|message index|time range/i, `no problem with the file's structure:\n${problems}`);
+  await screenshot(page, "lichtblick-local-file.png", { docs: false });
   assert.deepEqual(pageErrors, []);
 });
