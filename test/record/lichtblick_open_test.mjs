@@ -137,8 +137,6 @@ before(async () => {
     const d = await apiDevices(gateway.base);
     return ["camera", "create"].every((n) => d.find((x) => x.name === n)?.state === "connected");
   }, "camera and create connected", 40000);
-  const drive = await api("POST", "/api/devices/create/functions/Drive", { args: { velocity: 200, radius: 32767 } });
-  assert.equal(drive.status, 200, `Drive: ${JSON.stringify(drive.body)}`);
   const started = await api("POST", "/api/devices/camera/functions/start_streaming", {});
   assert.ok(started.status < 300, `start_streaming: ${started.status} ${JSON.stringify(started.body)}`);
   browser = await launchChromium();
@@ -162,6 +160,10 @@ before(async () => {
   await c.locator('input[name="record-directory"]').fill(work);
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  // Driven once the recording runs, so the recorded distance rises (the demo Create stops at a wall
+  // after about 7 s: driven earlier, a slow start recorded it standing there)
+  const drive = await api("POST", "/api/devices/create/functions/Drive", { args: { velocity: 200, radius: 32767 } });
+  assert.equal(drive.status, 200, `Drive: ${JSON.stringify(drive.body)}`);
   await new Promise((r) => setTimeout(r, 7000));  // the property is polled every second
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
@@ -293,12 +295,14 @@ test("Lichtblick opens a recording from the disk (its local file source), played
   await page.goto(`${base}/`);
   await page.locator("input[data-puppeteer-file-upload]").setInputFiles(files["create.mcap"]);
   await page.getByText(path.basename(files["create.mcap"])).first().waitFor({ timeout: 60000 });  // the app bar names it
-  // The player opens the file paused at its start; Play runs it to the end (about 7 s at speed 1).
+  // The player opens the file paused at its start; Play runs it to the end (about 8 s at speed 1). A
+  // click while the file is still loading can be lost, so Play is pressed again while it shows.
   const play = page.locator('button[title="Play"]');
-  await page.locator('button[title="Play"], button[title="Pause"]').first().waitFor({ timeout: 30000 });
-  if (await play.count()) await play.click();
-  await waitFor(async () => (await panel("RawMessages!prop").innerText()).split(/\s+/).includes(last),
-    `Raw Messages shows the last recorded DistanceTraveled ${last} once played to the end`, 60000);
+  await waitFor(async () => {
+    if ((await panel("RawMessages!prop").innerText()).split(/\s+/).includes(last)) return true;
+    if (await play.count()) await play.click({ timeout: 5000 }).catch(() => {});
+    return false;
+  }, `Raw Messages shows the last recorded DistanceTraveled ${last} once played to the end`, 120000, 1000);
   assert.match(await panel("RawMessages!wire").innerText(), /experimental\.create\.Create\.packets/);
   await page.locator('[data-testid="problems-left"]').click();
   await new Promise((r) => setTimeout(r, 500));
