@@ -3,8 +3,10 @@
 # from a source tree, for test/record/lichtblick_open_test.mjs (docs/recording.md "Opening a recording
 # in Foxglove or Lichtblick"). Not run by setup.sh or CI: Lichtblick's sources come from GitHub.
 #
-#   scripts/build-lichtblick.sh SRC_DIR        # a git work tree of Lichtblick (tested: 1.10.8)
-#   LICHTBLICK_WEB=SRC_DIR/web/.webpack ctest --preset debug -R lichtblick
+#   scripts/build-lichtblick.sh SRC_DIR [OUT_DIR]
+#     SRC_DIR  a git work tree of Lichtblick (tested: 1.10.8, `git clone <lichtblick repo> SRC_DIR`)
+#     OUT_DIR  where the built app is copied (replaced if present); default SRC_DIR/web/.webpack only
+#   LICHTBLICK_WEB=OUT_DIR ctest --preset debug -R lichtblick
 #
 # What it does, in SRC_DIR (idempotent; about 2 min of yarn install and 2 min of webpack on 2 vCPUs):
 # - yarn 3 through corepack, fetched from the npm registry (COREPACK_NPM_REGISTRY), and packages from
@@ -17,7 +19,9 @@
 # The app is SRC_DIR/web/.webpack: static files, served by any HTTP server.
 set -euo pipefail
 
-src=${1:?usage: scripts/build-lichtblick.sh SRC_DIR}
+src=${1:?usage: scripts/build-lichtblick.sh SRC_DIR [OUT_DIR]}
+out=${2:-}
+[ -z "$out" ] || out=$(realpath -m "$out")
 cd "$src"
 [ -f package.json ] && grep -q '"name": "lichtblick"' package.json || { echo "build-lichtblick: $src is not a Lichtblick source tree" >&2; exit 2; }
 
@@ -54,4 +58,10 @@ export COREPACK_NPM_REGISTRY=https://registry.npmjs.org COREPACK_ENABLE_DOWNLOAD
 export ELECTRON_SKIP_BINARY_DOWNLOAD=1 PUPPETEER_SKIP_DOWNLOAD=1 PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1
 corepack yarn install
 corepack yarn web:build:prod
-echo "build-lichtblick: built $src/web/.webpack"
+[ -f web/.webpack/index.html ] || { echo "build-lichtblick: webpack wrote no web/.webpack/index.html" >&2; exit 1; }
+if [ -n "$out" ] && [ "$out" != "$(realpath web/.webpack)" ]; then
+  rm -rf "$out"
+  mkdir -p "$(dirname "$out")"
+  cp -a web/.webpack "$out"
+fi
+echo "build-lichtblick: built ${out:-$PWD/web/.webpack}"
