@@ -246,7 +246,7 @@ Result<ServiceObject*> ReplayDevice::object_at(const std::string& path, const st
         const std::string p = parent_path.empty() ? seg : parent_path + "." + seg;
         auto it = self->objects_.find(p);
         if (it == self->objects_.end())
-            return fail(MessageErrorType::ObjectNotFound, "object \"" + p + "\" is not in the recording " + file);
+            return fail(MessageErrorType::ObjectNotFound, "object \"" + p + "\" was not recorded (not in the recording " + file + ")");
         return it->second;
     });
     return object->get();

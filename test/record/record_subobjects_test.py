@@ -170,7 +170,7 @@ def replay_phase(exe, work, path, recorded_frames, live_names, checks):
                 refusals["object"] = str(e)
             checks["refused"] = refusals
             expect(refusals["function"] and "functions are not replayed" in refusals["function"], "a function is refused: %s" % refusals)
-            expect(refusals["object"] and "not in the recording" in refusals["object"], "an object not recorded: %s" % refusals)
+            expect(refusals["object"] and "was not recorded" in refusals["object"], "an object not recorded: %s" % refusals)
         finally:
             RRN.DisconnectService(c)
     finally:
