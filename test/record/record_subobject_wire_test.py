@@ -1,0 +1,233 @@
+#!/usr/bin/env python3
+"""Wires two objrefs below a device's root object, recorded and replayed (docs/recording.md "Objects
+below the root", issue 44).
+
+The device is a standard com.robotraconteur.signal.SignalDevice served by the official Python library
+(signal_device.py): `signal_groups{string}` then `signals{int32}`, each signal's `signal_value_vec`
+wire sending [group, signal, seq, seq/2] every 50 ms. Through rr-gateway's JSON API the test records
+`signal_groups[arm].signals[0].signal_value_vec` and `signal_groups[gripper].signals[1].signal_value_vec`
+(both encodings) for a few seconds, then checks:
+- names that do not lead to a member get 400 naming the problem (an index missing on the string-keyed
+  objref, an unknown member of the Signal, a wire used as an objref);
+- the reference reader (PyPI mcap): channels `signals/signal_groups[arm].signals[0]/signal_value_vec`,
+  ... with metadata `path`, `object_type` com.robotraconteur.signal.Signal, `root_type`, the
+  `robotraconteur` channels' schema com.robotraconteur.signal; each channel's values are those of its
+  own object (group and signal numbers), seq strictly increasing, about 50 ms apart;
+- `rr-gateway --replay FILE`: an official client (rr+tcp) reaches both signals through the two objrefs,
+  receives on their wires values that were recorded for that object, spaced as recorded (median within
+  25..150 ms of a 50 ms recording); the JSON API reads the wire with `?object=`; an objref index that
+  was not recorded is refused with "was not recorded".
+
+  record_subobject_wire_test.py --gateway build/debug/server/app/rr-gateway [--seconds 3]
+Prints a JSON summary; exit 0, 1 (a check failed) or 77 (the venv's packages are missing).
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.parse
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "interop"))
+sys.path.insert(0, HERE)
+from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+from record_checks import CheckFailed, expect, http, report_and_clean  # noqa: E402
+import record_replay_test  # noqa: E402  (its gateway launcher)
+
+try:
+    from mcap.reader import make_reader
+    import numpy  # noqa: F401  (signal_device.py)
+    import RobotRaconteur as RR
+    import RobotRaconteurCompanion as RRC
+except ImportError as e:  # pragma: no cover
+    print("SKIP: %s (run ./scripts/setup.sh)" % e)
+    sys.exit(77)
+
+RRN = RR.RobotRaconteurNode.s
+MEMBERS = ["signal_groups[arm].signals[0].signal_value_vec", "signal_groups[gripper].signals[1].signal_value_vec"]
+# (path, group number, signal number) of each recorded member
+OBJECTS = [("signal_groups[arm].signals[0]", 0, 0), ("signal_groups[gripper].signals[1]", 1, 1)]
+
+
+def start_gateway(exe, args, work, name):
+    return record_replay_test.start_gateway(exe, ["--no-demo"] + args, os.path.join(work, name + ".log"))
+
+
+def start_device(work):
+    errf = open(os.path.join(work, "signal_device.log"), "wb")
+    proc = subprocess.Popen([sys.executable, os.path.join(HERE, "signal_device.py"), "--period-ms", "50"],
+                            stdout=subprocess.PIPE, stderr=errf, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    return proc, read_json_line(proc, 60, "signal_device.py")
+
+
+def record_phase(exe, work, seconds, checks):
+    dev, info = start_device(work)
+    gw = None
+    try:
+        gw, port, base = start_gateway(exe, ["--device", "signals=" + info["url"]], work, "gateway")
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            status, d = http(base, "GET", "/api/devices/signals")
+            if status == 200 and d.get("state") == "connected":
+                break
+            time.sleep(0.2)
+        expect(d.get("state") == "connected", "the signal device connected: %s" % d)
+        bad = {}
+        for name, want in (("signal_groups.signals[0].signal_value_vec", "needs an index"),
+                           ("signal_groups[arm].signals[0].nope", "has no member \"nope\""),
+                           ("signal_groups[arm].signals[0].signal_value_vec.x", "is a wire, not an objref")):
+            status, body = http(base, "POST", "/api/recordings", {"device": "signals", "members": [name], "directory": work})
+            message = (body or {}).get("error", {}).get("message", "")
+            bad[name] = [status, message]
+            expect(status == 400 and want in message, "%s: 400 with \"%s\", got %s %s" % (name, want, status, message))
+        checks["refused_names"] = bad
+        status, rec = http(base, "POST", "/api/recordings", {"device": "signals", "members": MEMBERS, "directory": work})
+        expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
+        expect(rec["members"] == MEMBERS, "the status names the members with their objects: %s" % rec["members"])
+        time.sleep(seconds)
+        status, done = http(base, "POST", "/api/recordings/%d/stop" % rec["id"], {})
+        expect(status == 200 and done["state"] == "stopped", "stop: %s %s" % (status, done))
+        checks["recording"] = {k: done[k] for k in ("messages", "drops", "files", "members")}
+        return done["files"][-1]
+    finally:
+        if gw:
+            stop(gw)
+        stop(dev)
+
+
+def read_file(path, checks):
+    """{object path: [(log_time ns, value list)]} of the json channels, after the channels' checks."""
+    channels, values = {}, {}
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        for c in summary.channels.values():
+            schema = summary.schemas.get(c.schema_id)
+            channels[(c.topic, c.message_encoding)] = {k: c.metadata.get(k) for k in ("path", "object_type", "root_type", "member")}
+            channels[(c.topic, c.message_encoding)].update(
+                schema=schema.name if schema else None, messages=summary.statistics.channel_message_counts.get(c.id, 0))
+        for _, ch, m in reader.iter_messages():
+            if ch.message_encoding == "json":
+                values.setdefault(ch.metadata["path"], []).append((m.log_time, json.loads(m.data)["value"]))
+    checks["channels"] = {"%s [%s]" % k: v for k, v in sorted(channels.items())}
+    expect(len(channels) == 4, "two members, two encodings: %s" % sorted(channels))
+    for obj, group, signal in OBJECTS:
+        topic = "signals/%s/signal_value_vec" % obj
+        for enc in ("json", "robotraconteur"):
+            c = channels.get((topic, enc))
+            expect(c is not None, "channel %s [%s] in the file" % (topic, enc))
+            expect(c["path"] == obj, "%s: metadata path %s" % (topic, c["path"]))
+            expect(c["member"] == "signal_value_vec", "%s: metadata member %s" % (topic, c["member"]))
+            expect(c["object_type"] == "com.robotraconteur.signal.Signal", "%s: object_type %s" % (topic, c["object_type"]))
+            expect(c["root_type"] == "com.robotraconteur.signal.SignalDevice", "%s: root_type %s" % (topic, c["root_type"]))
+            expect(c["messages"] >= 10, "%s [%s]: %d messages" % (topic, enc, c["messages"]))
+        expect(channels[(topic, "robotraconteur")]["schema"] == "com.robotraconteur.signal",
+               "%s: the robotraconteur channel's schema is the definition of Signal" % topic)
+        recorded = values.get(obj, [])
+        wrong = [v for _, v in recorded if v[0] != group or v[1] != signal]
+        expect(not wrong, "%s: every recorded value is of that object (%d of %d are not: %s)" % (obj, len(wrong), len(recorded), wrong[:3]))
+        seqs = [v[2] for _, v in recorded]
+        expect(all(b > a for a, b in zip(seqs, seqs[1:])), "%s: seq strictly increasing" % obj)
+        gaps = [(b - a) / 1e6 for (a, _), (b, _) in zip(recorded, recorded[1:])]
+        checks.setdefault("recorded_median_gap_ms", {})[obj] = round(statistics.median(gaps), 1)
+    return {obj: {tuple(v) for _, v in vals} for obj, vals in values.items()}
+
+
+class WireValues:
+    """What an official client receives on a wire, with arrival times."""
+
+    def __init__(self, obj):
+        self.values, self.lock = [], threading.Lock()
+        self.conn = obj.signal_value_vec.Connect()
+        self.conn.WireValueChanged += self._on
+
+    def _on(self, conn, value, ts):
+        with self.lock:
+            self.values.append((time.monotonic(), tuple(float(x) for x in value)))
+
+    def snapshot(self):
+        with self.lock:
+            return list(self.values)
+
+
+def replay_phase(exe, work, path, recorded, checks):
+    gw, port, base = start_gateway(exe, ["--replay", path], work, "replay")
+    try:
+        status, st = http(base, "POST", "/api/replays/signals", {"loop": True})
+        expect(status == 200, "replay control: %s %s" % (status, st))
+        expect(sorted(st["members"]) == sorted(MEMBERS), "the replay's members: %s" % st["members"])
+        c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=signals" % port)
+        try:
+            listeners = {}
+            for obj, group, signal in OBJECTS:
+                key = obj.split("[")[1].split("]")[0]
+                listeners[obj] = WireValues(c.get_signal_groups(key).get_signals(signal))
+            time.sleep(2.5)
+            got = {}
+            for obj, group, signal in OBJECTS:
+                received = listeners[obj].snapshot()
+                listeners[obj].conn.Close()
+                expect(len(received) >= 10, "%s: values through the replayed wire: %d" % (obj, len(received)))
+                unknown = [v for _, v in received if v not in recorded[obj]]
+                expect(not unknown, "%s: every replayed value is one recorded for that object (%d of %d not: %s)"
+                       % (obj, len(unknown), len(received), unknown[:3]))
+                gaps = [(b - a) * 1000 for (a, _), (b, _) in zip(received, received[1:])]
+                median = statistics.median(gaps)
+                expect(25 <= median <= 150, "%s: replayed values %.1f ms apart (recorded about 50 ms)" % (obj, median))
+                got[obj] = {"received": len(received), "median_gap_ms": round(median, 1)}
+            checks["replayed"] = got
+
+            q = urllib.parse.quote(OBJECTS[0][0], safe="")
+            status, body = http(base, "GET", "/api/devices/signals/wires/signal_value_vec?object=" + q)
+            expect(status == 200 and tuple(float(x) for x in body["value"]) in recorded[OBJECTS[0][0]],
+                   "JSON API wire ?object=%s: %s %s" % (OBJECTS[0][0], status, body))
+            checks["json_api_value"] = body["value"]
+
+            refusals = {}
+            for what, get in (("signals[1] of arm", lambda: c.get_signal_groups("arm").get_signals(1).signal_info),
+                              ("group hand", lambda: c.get_signal_groups("hand").signal_info)):
+                try:
+                    get()
+                    refusals[what] = None
+                except RR.RobotRaconteurException as e:
+                    refusals[what] = str(e)
+            checks["refused"] = refusals
+            for what, message in refusals.items():
+                expect(message and "was not recorded" in message, "%s refused as not recorded: %s" % (what, message))
+        finally:
+            RRN.DisconnectService(c)
+    finally:
+        code = stop(gw)
+    expect(code == 0, "the replaying gateway stops cleanly (%s)" % code)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gateway", required=True)
+    ap.add_argument("--seconds", type=float, default=3.0)
+    ap.add_argument("--keep", action="store_true")
+    a = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="rr-record-subwire-")
+    RRN.RegisterTransport(RR.TcpTransport())
+    RRC.RegisterStdRobDefServiceTypes(RRN)
+    checks, ok = {}, False
+    try:
+        path = record_phase(a.gateway, work, a.seconds, checks)
+        recorded = read_file(path, checks)
+        replay_phase(a.gateway, work, path, recorded, checks)
+        ok = True
+    except (CheckFailed, AssertionError, RR.RobotRaconteurException, OSError, KeyError, ValueError, TypeError, IndexError,
+            StepFailed, subprocess.TimeoutExpired, statistics.StatisticsError) as e:
+        checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
+    finally:
+        report_and_clean(checks, work, a.keep)
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
