@@ -14,6 +14,17 @@ MemberPath split_member_path(std::string_view name) {
     return {"", std::string(name)};
 }
 
+std::string channel_topic(std::string_view device, std::string_view object_path, std::string_view member) {
+    std::string topic(device);
+    topic += '/';
+    if (!object_path.empty()) {
+        topic += object_path;
+        topic += '/';
+    }
+    topic += member;
+    return topic;
+}
+
 Result<ObjectBelow> object_below(const gateway::DeviceTypes& types, std::string_view root_type, std::string_view relative) {
     auto normalized = gateway::normalize_object_path(relative);
     if (!normalized) return normalized.take_error();

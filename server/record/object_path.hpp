@@ -21,6 +21,11 @@ struct MemberPath {
 };
 MemberPath split_member_path(std::string_view name);
 
+/// The topic of a recorded member's channels: `<device>/<member>` for the root (object_path ""),
+/// `<device>/<object_path>/<member>` below it, e.g. `webcam/Webcams[0]/FrameStream`. object_path is
+/// normalized (object_below), so an index holds no '/' (it is `%2f`) and the topic splits at '/'.
+std::string channel_topic(std::string_view device, std::string_view object_path, std::string_view member);
+
 /// An object below the root, found through objrefs.
 struct ObjectBelow {
     std::string path;         ///< the relative path normalized (indexes encoded as in RR service paths)

@@ -76,3 +76,19 @@ TEST_CASE("record: an object below the root is found through the objrefs' declar
     CHECK_THAT(message("main..tool"), Catch::Contains("main..tool"));
     CHECK_THAT(message("arms[x"), Catch::Contains("without ']'"));
 }
+
+TEST_CASE("record: channel topics name the object's path between the device and the member") {
+    CHECK(channel_topic("create", "", "packets") == "create/packets");
+    CHECK(channel_topic("webcam", "Webcams[0]", "FrameStream") == "webcam/Webcams[0]/FrameStream");
+    // The path as object_below normalizes it: a '/' in a string index is encoded, so the topic keeps
+    // three parts.
+    auto types = gateway::DeviceTypes::parse({kArmDef, kToolDef});
+    REQUIRE(types);
+    auto below = object_below(**types, "example.arm.Cell", "arms[a/b].tool");
+    REQUIRE(below);
+    CHECK(below->path == "arms[a%2fb].tool");
+    CHECK(channel_topic("cell", below->path, "state") == "cell/arms[a%2fb].tool/state");
+    below = object_below(**types, "example.arm.Cell", "main.tools[-1]");
+    REQUIRE(below);
+    CHECK(channel_topic("cell", below->path, "state") == "cell/main.tools[%2d1]/state");
+}

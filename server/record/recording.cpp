@@ -392,7 +392,7 @@ Result<void> Recording::open_file() {
         if (m.kind != RecordedMember::Kind::event) meta["type"] = t.member->type.to_string();
         if (m.kind == RecordedMember::Kind::property)
             meta["period_ms"] = std::to_string(spec_.property_period.count() > 0 ? spec_.property_period.count() : 1000);
-        const std::string topic = device + "/" + (meta["path"].empty() ? "" : meta["path"] + "/") + t.member->name;
+        const std::string topic = channel_topic(device, meta["path"], t.member->name);
         int json_id = -1, rr_id = -1;
         if (spec_.json) {
             const std::string title = t.object_type + "." + t.member->name;

@@ -1,14 +1,18 @@
 // Recording against a real device (rr_interop_service behind a Gateway): a pipe, a wire and an event
 // recorded through POST /api/recordings, read back with McapReader: channels, schemas, the pipe
-// packets' values in both encodings; rotation by size with a disk budget; a stop answering with the
-// final status; bad requests.
+// packets' values in both encodings; members below the root named by path (channels, metadata, and a
+// ReplayDevice of the file serving those objects through the objrefs); rotation by size with a disk
+// budget; a stop answering with the final status; bad requests.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "core/mcap/mcap_reader.hpp"
 #include "server/gateway/json_api_test_fixture.hpp"
+#include "core/names/service_path.hpp"
 #include "server/mcap/mcap_file.hpp"
+#include "server/record/replay_device.hpp"
 
 using namespace rr::server::gateway::testing;
 namespace fs = std::filesystem;
@@ -96,6 +100,77 @@ TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") 
     auto list = http_get(gw.port(), "/api/recordings");
     REQUIRE(list.status == 200);
     CHECK(list.body["recordings"][0]["state"] == "stopped");
+}
+
+TEST_CASE("recording: members below the root by path, read back, and served again by a replay") {
+    if (!interop_service_built()) return;
+    InteropProcess device;
+    TestGateway gw(device.url());
+    RecordingDir dir;
+    // Two objrefs deep, a string index with characters RR encodes, an int32 index below zero.
+    const std::string key = "with space_and-dash", enc = rr::encode_service_path_index(std::string_view(key));
+    auto r = http_post(gw.port(), "/api/recordings",
+                       json{{"device", "interop"},
+                            {"members", {"child_by_name[" + key + "].value", "child_by_name[" + key + "].leaf.x", "child_by_int[-1].name"}},
+                            {"directory", dir.path.string()},
+                            {"property_period_ms", 100}});
+    INFO(r.body.dump());
+    REQUIRE(r.status == 201);
+    const json names = {"child_by_name[" + enc + "].value", "child_by_name[" + enc + "].leaf.x", "child_by_int[%2d1].name"};
+    CHECK(r.body["members"] == names);
+    std::this_thread::sleep_for(700ms);
+    auto stopped = http_post(gw.port(), "/api/recordings/" + r.body["id"].dump() + "/stop", json::object());
+    REQUIRE(stopped.status == 200);
+    REQUIRE(stopped.body["files"].size() == 1);
+    const auto file = stopped.body["files"][0].get<std::string>();
+
+    rr::mcap::Summary summary;
+    auto msgs = read_recording(file, &summary);
+    const std::string value_topic = "interop/child_by_name[" + enc + "]/value", x_topic = "interop/child_by_name[" + enc + "].leaf/x",
+                      name_topic = "interop/child_by_int[%2d1]/name";
+    REQUIRE(!msgs[value_topic + " json"].empty());
+    REQUIRE(!msgs[x_topic + " json"].empty());
+    REQUIRE(!msgs[name_topic + " robotraconteur"].empty());
+    CHECK(json::parse(text_of(msgs[value_topic + " json"].back()))["value"] == 201);  // the interop service's value of that child
+    CHECK(json::parse(text_of(msgs[x_topic + " json"].back()))["value"] == 201.5);
+    CHECK(json::parse(text_of(msgs[name_topic + " json"].back()))["value"] == "child[-1]");
+    std::map<std::string, std::string> path_of, type_of;
+    for (const auto& [cid, c] : summary.channels) {
+        CHECK(c.metadata.at("root_type") == "experimental.interop_test.Root");
+        path_of[c.topic] = c.metadata.at("path");
+        type_of[c.topic] = c.metadata.at("object_type");
+        if (c.message_encoding == "robotraconteur") CHECK(summary.schemas.at(c.schema_id).name == "experimental.interop_test");
+    }
+    CHECK(summary.channels.size() == 6);
+    CHECK(path_of[value_topic] == "child_by_name[" + enc + "]");
+    CHECK(type_of[value_topic] == "experimental.interop_test.Child");
+    CHECK(path_of[x_topic] == "child_by_name[" + enc + "].leaf");
+    CHECK(type_of[x_topic] == "experimental.interop_test.Leaf");
+    CHECK(path_of[name_topic] == "child_by_int[%2d1]");
+
+    // The replay serves the recorded objects through the objrefs, and only those.
+    auto replay = rr::server::record::ReplayDevice::open({file, "again"});
+    REQUIRE(replay);
+    auto members = (*replay)->status().members;
+    std::sort(members.begin(), members.end());
+    std::vector<std::string> want = {names[0].get<std::string>(), names[1].get<std::string>(), names[2].get<std::string>()};
+    std::sort(want.begin(), want.end());
+    CHECK(members == want);
+    const auto& root = (*replay)->service()->root();
+    auto child = root->resolve_objref({}, "child_by_name", key, true);
+    REQUIRE(child);
+    CHECK((*child)->type() == "experimental.interop_test.Child");
+    auto leaf = (*child)->resolve_objref({}, "leaf", "", false);
+    REQUIRE(leaf);
+    CHECK((*leaf)->type() == "experimental.interop_test.Leaf");
+    REQUIRE(root->resolve_objref({}, "child_by_int", "-1", true));
+    auto other = root->resolve_objref({}, "child_by_name", "alpha", true);
+    REQUIRE_FALSE(other);
+    CHECK(other.error().type == rr::MessageErrorType::ObjectNotFound);
+    CHECK_THAT(other.error().message, Catch::Contains("child_by_name[alpha]") && Catch::Contains("was not recorded"));
+    CHECK_FALSE(root->resolve_objref({}, "child_by_int", "7", true));
+    CHECK_FALSE(root->resolve_objref({}, "child", "", false));  // an objref none of whose objects was recorded
+    (*replay)->stop();
 }
 
 TEST_CASE("recording: rotation by size keeps the disk budget") {

@@ -8,8 +8,10 @@
 // own and mirrored like any device (so native clients, the JSON API and the dashboard see it alike);
 // play, pause, seek and speed come from the JSON API (replay_routes.hpp).
 //
-// Only the root object is replayed (objrefs are not recorded). Values are sent with the replay's wall
-// clock as their wire time stamp (the recorded device time stays in the file's publish_time).
+// Objects below the root are served when members of theirs were recorded (channels with a `path`): the
+// objrefs on the way answer them, and refuse other indexes with ObjectNotFound "… was not recorded".
+// Values are sent with the replay's wall clock as their wire time stamp (the recorded device time
+// stays in the file's publish_time).
 //
 // Threads: one playback thread per device; every public function is thread-safe.
 #pragma once
