@@ -18,7 +18,12 @@ wire sending [group, signal, seq, seq/2] every 50 ms. Through rr-gateway's JSON 
   25..150 ms of a 50 ms recording); the JSON API reads the wire with `?object=`; an objref index that
   was not recorded is refused with "was not recorded".
 
-  record_subobject_wire_test.py --gateway build/debug/server/app/rr-gateway [--seconds 3]
+- with --rr: `rr record` of the device itself records a member by path on its topic (the gripper's
+  values), and refuses a path without an index (exit 2);
+- the json channels as Foxglove/Lichtblick's parser reads them (record_checks.foxglove_check).
+
+  record_subobject_wire_test.py --gateway build/debug/server/app/rr-gateway [--rr build/debug/server/cli/rr]
+                                [--seconds 3]
 Prints a JSON summary; exit 0, 1 (a check failed) or 77 (the venv's packages are missing).
 """
 import argparse
@@ -36,7 +41,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 sys.path.insert(0, HERE)
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http, report_and_clean  # noqa: E402
+from record_checks import CheckFailed, expect, foxglove_check, http, report_and_clean  # noqa: E402
 import record_replay_test  # noqa: E402  (its gateway launcher)
 
 try:
@@ -65,7 +70,30 @@ def start_device(work):
     return proc, read_json_line(proc, 60, "signal_device.py")
 
 
-def record_phase(exe, work, seconds, checks):
+def rr_record(rr_exe, url, work, checks):
+    """`rr record` of the device itself (no gateway): a member by path is recorded on its topic with the
+    object's values; a path that leads nowhere exits 2 naming it."""
+    cli_dir = os.path.join(work, "cli")
+    member = MEMBERS[1]
+    p = subprocess.run([rr_exe, "record", url, "--members", member, "--duration", "2", "--dir", cli_dir, "--encoding", "json"],
+                       capture_output=True, text=True, timeout=120)
+    expect(p.returncode == 0, "rr record --members %s: exit %s, %s" % (member, p.returncode, p.stderr[-1500:]))
+    status = json.loads(p.stdout.strip().splitlines()[-1])
+    expect(status["members"] == [member], "rr record's members: %s" % status["members"])
+    obj, group, signal = OBJECTS[1]
+    with open(status["files"][0], "rb") as f:
+        values = [json.loads(m.data)["value"] for _, ch, m in make_reader(f).iter_messages()
+                  if ch.topic == "signals/%s/signal_value_vec" % obj and ch.metadata.get("path") == obj]
+    expect(len(values) >= 5 and all(v[0] == group and v[1] == signal for v in values),
+           "rr record: %d values of %s on its topic: %s" % (len(values), obj, values[:3]))
+    bad = subprocess.run([rr_exe, "record", url, "--members", "signal_groups[arm].signals.signal_value_vec", "--duration", "1",
+                          "--dir", cli_dir], capture_output=True, text=True, timeout=120)
+    expect(bad.returncode == 2 and "needs an index" in bad.stderr,
+           "rr record of a path without an index: exit %s, %s" % (bad.returncode, bad.stderr[-800:]))
+    checks["rr_record"] = {"values": len(values), "refused": bad.stderr.strip()[-300:]}
+
+
+def record_phase(exe, work, seconds, checks, rr_exe=None):
     dev, info = start_device(work)
     gw = None
     try:
@@ -93,6 +121,8 @@ def record_phase(exe, work, seconds, checks):
         status, done = http(base, "POST", "/api/recordings/%d/stop" % rec["id"], {})
         expect(status == 200 and done["state"] == "stopped", "stop: %s %s" % (status, done))
         checks["recording"] = {k: done[k] for k in ("messages", "drops", "files", "members")}
+        if rr_exe:
+            rr_record(rr_exe, info["url"], work, checks)
         return done["files"][-1]
     finally:
         if gw:
@@ -134,7 +164,9 @@ def read_file(path, checks):
         seqs = [v[2] for _, v in recorded]
         expect(all(b > a for a, b in zip(seqs, seqs[1:])), "%s: seq strictly increasing" % obj)
         gaps = [(b - a) / 1e6 for (a, _), (b, _) in zip(recorded, recorded[1:])]
-        checks.setdefault("recorded_median_gap_ms", {})[obj] = round(statistics.median(gaps), 1)
+        median = statistics.median(gaps)
+        expect(25 <= median <= 150, "%s: recorded values %.1f ms apart (sent every 50 ms)" % (obj, median))
+        checks.setdefault("recorded_median_gap_ms", {})[obj] = round(median, 1)
     return {obj: {tuple(v) for _, v in vals} for obj, vals in values.items()}
 
 
@@ -209,6 +241,7 @@ def replay_phase(exe, work, path, recorded, checks):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gateway", required=True)
+    ap.add_argument("--rr", help="the rr command: also record a member by path with `rr record`")
     ap.add_argument("--seconds", type=float, default=3.0)
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
@@ -217,8 +250,9 @@ def main():
     RRC.RegisterStdRobDefServiceTypes(RRN)
     checks, ok = {}, False
     try:
-        path = record_phase(a.gateway, work, a.seconds, checks)
+        path = record_phase(a.gateway, work, a.seconds, checks, a.rr)
         recorded = read_file(path, checks)
+        foxglove_check([path], checks)
         replay_phase(a.gateway, work, path, recorded, checks)
         ok = True
     except (CheckFailed, AssertionError, RR.RobotRaconteurException, OSError, KeyError, ValueError, TypeError, IndexError,
