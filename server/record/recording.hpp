@@ -75,8 +75,11 @@ public:
     using ErrorListener = std::function<void(const RecordingStatus&)>;
 
     /// Starts recording `spec.device` (`device`, connected: its definitions are needed). Creates the
-    /// directory and the first file before returning. Errors: InvalidArgument (a member the root object
-    /// does not have, or of a kind that cannot be recorded: functions, callbacks, objrefs, memories),
+    /// directory and the first file before returning. `spec.members` names root members (`packets`) or
+    /// members below the root by path (`Webcams[0].FrameStream`, object_path.hpp); empty: every wire,
+    /// pipe and event of the root. Errors: InvalidArgument (a member the root object, or the object at
+    /// the path, does not have; a path that does not follow objrefs, object_path.hpp; a member of a kind
+    /// that cannot be recorded: functions, callbacks, objrefs, memories),
     /// InvalidState (device not connected), IOError (directory or file not writable; the message names
     /// the path and the reason).
     static Result<std::shared_ptr<Recording>> start(std::uint64_t id, RecordingSpec spec,
