@@ -19,7 +19,8 @@ wire sending [group, signal, seq, seq/2] every 50 ms. Through rr-gateway's JSON 
   was not recorded is refused with "was not recorded".
 
 - with --rr: `rr record` of the device itself records a member by path on its topic (the gripper's
-  values), and refuses a path without an index (exit 2);
+  values), and refuses a path without an index (exit 2); `rr replay` of that file gives an official
+  client recorded values through the two objrefs and refuses the arm's group (not recorded);
 - the json channels as Foxglove/Lichtblick's parser reads them (record_checks.foxglove_check).
 
   record_subobject_wire_test.py --gateway build/debug/server/app/rr-gateway [--rr build/debug/server/cli/rr]
@@ -29,6 +30,7 @@ Prints a JSON summary; exit 0, 1 (a check failed) or 77 (the venv's packages are
 import argparse
 import json
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -75,22 +77,55 @@ def rr_record(rr_exe, url, work, checks):
     object's values; a path that leads nowhere exits 2 naming it."""
     cli_dir = os.path.join(work, "cli")
     member = MEMBERS[1]
-    p = subprocess.run([rr_exe, "record", url, "--members", member, "--duration", "2", "--dir", cli_dir, "--encoding", "json"],
+    p = subprocess.run([rr_exe, "record", url, "--members", member, "--duration", "2", "--dir", cli_dir],
                        capture_output=True, text=True, timeout=120)
     expect(p.returncode == 0, "rr record --members %s: exit %s, %s" % (member, p.returncode, p.stderr[-1500:]))
     status = json.loads(p.stdout.strip().splitlines()[-1])
     expect(status["members"] == [member], "rr record's members: %s" % status["members"])
-    obj, group, signal = OBJECTS[1]
+    obj, group, sig = OBJECTS[1]
     with open(status["files"][0], "rb") as f:
         values = [json.loads(m.data)["value"] for _, ch, m in make_reader(f).iter_messages()
-                  if ch.topic == "signals/%s/signal_value_vec" % obj and ch.metadata.get("path") == obj]
-    expect(len(values) >= 5 and all(v[0] == group and v[1] == signal for v in values),
+                  if ch.topic == "signals/%s/signal_value_vec" % obj and ch.metadata.get("path") == obj
+                  and ch.message_encoding == "json"]
+    expect(len(values) >= 5 and all(v[0] == group and v[1] == sig for v in values),
            "rr record: %d values of %s on its topic: %s" % (len(values), obj, values[:3]))
     bad = subprocess.run([rr_exe, "record", url, "--members", "signal_groups[arm].signals.signal_value_vec", "--duration", "1",
                           "--dir", cli_dir], capture_output=True, text=True, timeout=120)
     expect(bad.returncode == 2 and "needs an index" in bad.stderr,
            "rr record of a path without an index: exit %s, %s" % (bad.returncode, bad.stderr[-800:]))
     checks["rr_record"] = {"values": len(values), "refused": bad.stderr.strip()[-300:]}
+    rr_replay(rr_exe, status["files"][0], {tuple(v) for v in values}, checks)
+
+
+def rr_replay(rr_exe, path, recorded, checks):
+    """`rr replay` of rr record's file: an official client reaches the gripper's signal through the two
+    objrefs and receives recorded values; the arm's group was not recorded."""
+    proc = subprocess.Popen([rr_exe, "replay", path, "--port", "0", "--loop"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    try:
+        url = proc.stdout.readline().strip()
+        expect(url.startswith("rr+tcp://127.0.0.1:") and "service=signals" in url, "rr replay prints its URL: %r" % url)
+        c = RRN.ConnectService(url)
+        try:
+            listener = WireValues(c.get_signal_groups("gripper").get_signals(1))
+            time.sleep(1.5)
+            got = listener.snapshot()
+            listener.conn.Close()
+            expect(len(got) >= 5 and all(v in recorded for _, v in got),
+                   "rr replay: %d values through the objrefs, all recorded ones: %s" % (len(got), [v for _, v in got][:3]))
+            try:
+                c.get_signal_groups("arm").signal_info
+                refused = None
+            except RR.RobotRaconteurException as e:
+                refused = str(e)
+            expect(refused and "was not recorded" in refused, "rr replay: the arm's group refused: %s" % refused)
+        finally:
+            RRN.DisconnectService(c)
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    expect(proc.returncode == 0, "rr replay ends on SIGINT with 0 (rc=%s, %s)" % (proc.returncode, err[-800:]))
+    checks["rr_replay"] = {"values": len(got), "refused": refused}
 
 
 def record_phase(exe, work, seconds, checks, rr_exe=None):
@@ -146,7 +181,7 @@ def read_file(path, checks):
                 values.setdefault(ch.metadata["path"], []).append((m.log_time, json.loads(m.data)["value"]))
     checks["channels"] = {"%s [%s]" % k: v for k, v in sorted(channels.items())}
     expect(len(channels) == 4, "two members, two encodings: %s" % sorted(channels))
-    for obj, group, signal in OBJECTS:
+    for obj, group, sig in OBJECTS:
         topic = "signals/%s/signal_value_vec" % obj
         for enc in ("json", "robotraconteur"):
             c = channels.get((topic, enc))
@@ -159,7 +194,7 @@ def read_file(path, checks):
         expect(channels[(topic, "robotraconteur")]["schema"] == "com.robotraconteur.signal",
                "%s: the robotraconteur channel's schema is the definition of Signal" % topic)
         recorded = values.get(obj, [])
-        wrong = [v for _, v in recorded if v[0] != group or v[1] != signal]
+        wrong = [v for _, v in recorded if v[0] != group or v[1] != sig]
         expect(not wrong, "%s: every recorded value is of that object (%d of %d are not: %s)" % (obj, len(wrong), len(recorded), wrong[:3]))
         seqs = [v[2] for _, v in recorded]
         expect(all(b > a for a, b in zip(seqs, seqs[1:])), "%s: seq strictly increasing" % obj)
@@ -196,12 +231,12 @@ def replay_phase(exe, work, path, recorded, checks):
         c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=signals" % port)
         try:
             listeners = {}
-            for obj, group, signal in OBJECTS:
+            for obj, group, sig in OBJECTS:
                 key = obj.split("[")[1].split("]")[0]
-                listeners[obj] = WireValues(c.get_signal_groups(key).get_signals(signal))
+                listeners[obj] = WireValues(c.get_signal_groups(key).get_signals(sig))
             time.sleep(2.5)
             got = {}
-            for obj, group, signal in OBJECTS:
+            for obj, group, sig in OBJECTS:
                 received = listeners[obj].snapshot()
                 listeners[obj].conn.Close()
                 expect(len(received) >= 10, "%s: values through the replayed wire: %d" % (obj, len(received)))
