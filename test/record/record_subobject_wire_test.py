@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Wires two objrefs below a device's root object, recorded and replayed (docs/recording.md "Objects
-below the root", issue 44).
+"""Wires two objrefs below a device's root object, and events and a property one objref below,
+recorded and replayed (docs/recording.md "Objects below the root", issue 44).
 
 The device is a standard com.robotraconteur.signal.SignalDevice served by the official Python library
 (signal_device.py): `signal_groups{string}` then `signals{int32}`, each signal's `signal_value_vec`
@@ -18,6 +18,10 @@ wire sending [group, signal, seq, seq/2] every 50 ms. Through rr-gateway's JSON 
   25..150 ms of a 50 ms recording); the JSON API reads the wire with `?object=`; an objref index that
   was not recorded is refused with "was not recorded".
 
+- the device's second service "tools" (an objref `tools{int32}` to Tools with a `tick` event and a
+  `number` property): `tools[1].tick` and `tools[1].number` recorded in a second recording at the same
+  time; replayed, an official client gets tool 1's recorded events spaced as recorded and its number,
+  and tools[0] is refused as not recorded;
 - with --rr: `rr record` of the device itself records a member by path on its topic (the gripper's
   values), and refuses a path without an index (exit 2); `rr replay` of that file gives an official
   client recorded values through the two objrefs and refuses the arm's group (not recorded);
@@ -57,6 +61,7 @@ except ImportError as e:  # pragma: no cover
 
 RRN = RR.RobotRaconteurNode.s
 MEMBERS = ["signal_groups[arm].signals[0].signal_value_vec", "signal_groups[gripper].signals[1].signal_value_vec"]
+TOOL_MEMBERS = ["tools[1].tick", "tools[1].number"]  # the device's second service (signal_device.py)
 # (path, group number, signal number) of each recorded member
 OBJECTS = [("signal_groups[arm].signals[0]", 0, 0), ("signal_groups[gripper].signals[1]", 1, 1)]
 
@@ -132,14 +137,16 @@ def record_phase(exe, work, seconds, checks, rr_exe=None):
     dev, info = start_device(work)
     gw = None
     try:
-        gw, port, base = start_gateway(exe, ["--device", "signals=" + info["url"]], work, "gateway")
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            status, d = http(base, "GET", "/api/devices/signals")
-            if status == 200 and d.get("state") == "connected":
-                break
-            time.sleep(0.2)
-        expect(d.get("state") == "connected", "the signal device connected: %s" % d)
+        gw, port, base = start_gateway(exe, ["--device", "signals=" + info["url"], "--device", "tools=" + info["tools_url"]],
+                                       work, "gateway")
+        for device in ("signals", "tools"):
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline:
+                status, d = http(base, "GET", "/api/devices/" + device)
+                if status == 200 and d.get("state") == "connected":
+                    break
+                time.sleep(0.2)
+            expect(d.get("state") == "connected", "the %s device connected: %s" % (device, d))
         bad = {}
         for name, want in (("signal_groups.signals[0].signal_value_vec", "needs an index"),
                            ("signal_groups[arm].signals[0].nope", "has no member \"nope\""),
@@ -152,13 +159,19 @@ def record_phase(exe, work, seconds, checks, rr_exe=None):
         status, rec = http(base, "POST", "/api/recordings", {"device": "signals", "members": MEMBERS, "directory": work})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["members"] == MEMBERS, "the status names the members with their objects: %s" % rec["members"])
+        status, tools_rec = http(base, "POST", "/api/recordings", {"device": "tools", "members": TOOL_MEMBERS, "directory": work,
+                                                                   "property_period_ms": 200})
+        expect(status == 201, "POST /api/recordings (tools): %s %s" % (status, tools_rec))
         time.sleep(seconds)
         status, done = http(base, "POST", "/api/recordings/%d/stop" % rec["id"], {})
         expect(status == 200 and done["state"] == "stopped", "stop: %s %s" % (status, done))
         checks["recording"] = {k: done[k] for k in ("messages", "drops", "files", "members")}
+        status, tools_done = http(base, "POST", "/api/recordings/%d/stop" % tools_rec["id"], {})
+        expect(status == 200 and tools_done["state"] == "stopped", "stop (tools): %s %s" % (status, tools_done))
+        checks["tools_recording"] = {k: tools_done[k] for k in ("messages", "drops", "files", "members")}
         if rr_exe:
             rr_record(rr_exe, info["url"], work, checks)
-        return done["files"][-1]
+        return done["files"][-1], tools_done["files"][-1]
     finally:
         if gw:
             stop(gw)
@@ -205,6 +218,68 @@ def read_file(path, checks):
     return {obj: {tuple(v) for _, v in vals} for obj, vals in values.items()}
 
 
+def read_tools_file(path, checks):
+    """The recorded `tools[1].tick` events as (tool, seq) tuples, after the channels' checks."""
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        topics = {(c.topic, c.message_encoding): c.metadata for c in summary.channels.values()}
+        events, numbers = [], []
+        for _, ch, m in reader.iter_messages():
+            if ch.message_encoding != "json":
+                continue
+            if ch.topic == "tools/tools[1]/tick":
+                args = json.loads(m.data)["args"]
+                events.append((args["tool"], args["seq"]))
+            elif ch.topic == "tools/tools[1]/number":
+                numbers.append(json.loads(m.data)["value"])
+    for topic in ("tools/tools[1]/tick", "tools/tools[1]/number"):
+        for enc in ("json", "robotraconteur"):
+            meta = topics.get((topic, enc))
+            expect(meta is not None and meta.get("path") == "tools[1]" and meta.get("object_type") == "experimental.record_tools.Tool",
+                   "channel %s [%s] with path tools[1] and its object type: %s" % (topic, enc, meta))
+    expect(len(events) >= 10 and all(t == 1 for t, _ in events), "tools[1].tick events of tool 1: %s" % events[:5])
+    expect(all(b[1] > a[1] for a, b in zip(events, events[1:])), "tick seq strictly increasing")
+    expect(numbers and all(n == 1 for n in numbers), "tools[1].number polled: %s" % numbers[:5])
+    checks["tools_file"] = {"tick": len(events), "number": len(numbers)}
+    return set(events)
+
+
+def tools_replay(c, recorded, checks):
+    """Through the replaying gateway: tools[1]'s events arrive, recorded ones, spaced as recorded; its
+    property answers; tools[0] was not recorded."""
+    tool = c.get_tools(1)
+    got, lock = [], threading.Lock()
+
+    def on_tick(t, seq):
+        with lock:
+            got.append((time.monotonic(), (t, seq)))
+    tool.tick += on_tick
+    time.sleep(2.0)
+    with lock:
+        received = list(got)
+    expect(len(received) >= 10, "tools[1].tick events through the replay: %d" % len(received))
+    unknown = [v for _, v in received if v not in recorded]
+    expect(not unknown, "every replayed event is a recorded one: %s" % unknown[:3])
+    median = statistics.median([(b - a) * 1000 for (a, _), (b, _) in zip(received, received[1:])])
+    expect(25 <= median <= 150, "replayed events %.1f ms apart (recorded about 50 ms)" % median)
+    number = None
+    deadline = time.monotonic() + 5
+    while number is None and time.monotonic() < deadline:
+        try:
+            number = tool.number
+        except RR.RobotRaconteurException:  # ValueNotSet until the first polled value is played
+            time.sleep(0.2)
+    expect(number == 1, "tools[1].number answers its recorded value: %s" % number)
+    try:
+        c.get_tools(0).number
+        refused = None
+    except RR.RobotRaconteurException as e:
+        refused = str(e)
+    expect(refused and "was not recorded" in refused, "tools[0] refused as not recorded: %s" % refused)
+    checks["tools_replayed"] = {"events": len(received), "median_gap_ms": round(median, 1), "number": number}
+
+
 class WireValues:
     """What an official client receives on a wire, with arrival times."""
 
@@ -222,9 +297,16 @@ class WireValues:
             return list(self.values)
 
 
-def replay_phase(exe, work, path, recorded, checks):
-    gw, port, base = start_gateway(exe, ["--replay", path], work, "replay")
+def replay_phase(exe, work, path, recorded, tools_path, tools_recorded, checks):
+    gw, port, base = start_gateway(exe, ["--replay", path, "--replay", tools_path], work, "replay")
     try:
+        status, st = http(base, "POST", "/api/replays/tools", {"loop": True})
+        expect(status == 200, "replay control (tools): %s %s" % (status, st))
+        t = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=tools" % port)
+        try:
+            tools_replay(t, tools_recorded, checks)
+        finally:
+            RRN.DisconnectService(t)
         status, st = http(base, "POST", "/api/replays/signals", {"loop": True})
         expect(status == 200, "replay control: %s %s" % (status, st))
         expect(sorted(st["members"]) == sorted(MEMBERS), "the replay's members: %s" % st["members"])
@@ -285,10 +367,11 @@ def main():
     RRC.RegisterStdRobDefServiceTypes(RRN)
     checks, ok = {}, False
     try:
-        path = record_phase(a.gateway, work, a.seconds, checks, a.rr)
+        path, tools_path = record_phase(a.gateway, work, a.seconds, checks, a.rr)
         recorded = read_file(path, checks)
-        foxglove_check([path], checks)
-        replay_phase(a.gateway, work, path, recorded, checks)
+        tools_recorded = read_tools_file(tools_path, checks)
+        foxglove_check([path, tools_path], checks)
+        replay_phase(a.gateway, work, path, recorded, tools_path, tools_recorded, checks)
         ok = True
     except (CheckFailed, AssertionError, RR.RobotRaconteurException, OSError, KeyError, ValueError, TypeError, IndexError,
             StepFailed, subprocess.TimeoutExpired, statistics.StatisticsError) as e:

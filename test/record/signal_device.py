@@ -12,7 +12,12 @@ signal's `signal_value_vec` wire (double[]) sends, every --period-ms, the value
 (group number: 0 arm, 1 gripper; seq counts from 0 per signal), so a value names the object it came
 from and its place in the stream. Other groups or signals: ObjectNotFound.
 
-Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=signals", "port": P, "groups": {...}}.
+A second service on the same node, "tools" (experimental.record_tools.ToolHost, defined below), has
+events below its root: `tools{int32}` (0 and 1), each Tool firing `tick(int32 tool, int32 seq)` every
+--period-ms (seq counts from 0 per tool). Other tools: ObjectNotFound.
+
+Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=signals", "tools_url": ".../?service=tools", "port": P,
+"groups": {...}}.
 
 Usage: signal_device.py [--period-ms 50] [--max-lifetime 300]
 """
@@ -75,6 +80,42 @@ class SignalGroup:
         return self.signals_by_index[k], "com.robotraconteur.signal.Signal"
 
 
+TOOLS_ROBDEF = """service experimental.record_tools
+
+stdver 0.10
+
+object Tool
+    property int32 number [readonly]
+    event tick(int32 tool, int32 seq)
+end
+
+object ToolHost
+    objref Tool{int32} tools
+end
+"""
+
+
+class Tool:
+    def __init__(self, number):
+        self.number, self.seq = number, 0
+        self.tick = RR.EventHook()
+
+    def fire(self):
+        self.tick.fire(self.number, self.seq)
+        self.seq += 1
+
+
+class ToolHost:
+    def __init__(self):
+        self.tools_by_index = [Tool(i) for i in range(2)]
+
+    def get_tools(self, ind):
+        k = int(ind)  # the Python skeleton hands int32 indexes over as text
+        if not 0 <= k < len(self.tools_by_index):
+            raise RR.ObjectNotFoundException("no tools[%d]" % k)
+        return self.tools_by_index[k], "experimental.record_tools.Tool"
+
+
 class SignalDevice:
     def __init__(self):
         self.device_info = None
@@ -101,15 +142,21 @@ def main():
     with RR.ServerNodeSetup("experimental.signal_device", port, argv=["signal_device"] + node_flags(port)):
         RRC.RegisterStdRobDefServiceTypes(RRN)
         RRN.RegisterService("signals", "com.robotraconteur.signal.SignalDevice", device)
+        RRN.RegisterServiceType(TOOLS_ROBDEF)
+        tools = ToolHost()
+        RRN.RegisterService("tools", "experimental.record_tools.ToolHost", tools)
         stop = threading.Event()
 
         def ticker():
             while not stop.wait(args.period_ms / 1000.0):
                 for s in device.all_signals():
                     s.tick()
+                for t in tools.tools_by_index:
+                    t.fire()
         t = threading.Thread(target=ticker, daemon=True)
         t.start()
-        ready(url=f"rr+tcp://127.0.0.1:{port}/?service=signals", port=port, groups=GROUPS, pid=os.getpid())
+        ready(url=f"rr+tcp://127.0.0.1:{port}/?service=signals", tools_url=f"rr+tcp://127.0.0.1:{port}/?service=tools",
+              port=port, groups=GROUPS, pid=os.getpid())
         wait_for_stop(args.max_lifetime)
         stop.set()
         t.join(2)
