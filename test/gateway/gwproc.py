@@ -14,6 +14,9 @@ import threading
 import time
 import urllib.request
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "interop"))
+from child_procs import threads_of  # noqa: E402,F401 (where a hung gateway's threads are)
+
 
 class Proc:
     """A child process whose first JSON line on stdout is `info`; later stdout lines are drained."""
@@ -69,31 +72,6 @@ class Proc:
         if self.p.poll() is None:
             self.p.kill()
         self.p.wait()
-
-
-def threads_of(pid):
-    """Where a live process's threads are, for a hang's report: each thread's name, wchan and CPU
-    ticks, then gdb's backtraces when gdb can attach (LeakSanitizer's exit check holds ptrace then)."""
-    lines = []
-    try:
-        for t in sorted(os.listdir("/proc/%d/task" % pid), key=int):
-            try:
-                comm = open("/proc/%d/task/%s/comm" % (pid, t)).read().strip()
-                wchan = open("/proc/%d/task/%s/wchan" % (pid, t)).read().strip() or "-"
-                f = open("/proc/%d/task/%s/stat" % (pid, t)).read().rsplit(")", 1)[1].split()
-                lines.append("  %s %s %s (state %s, cpu ticks %s)" % (t, comm, wchan, f[0], int(f[11]) + int(f[12])))
-            except OSError:
-                pass
-    except OSError as e:
-        return "  (no /proc entry: %s)" % e
-    try:
-        gdb = subprocess.run(["gdb", "-p", str(pid), "-batch", "-nx", "-ex", "thread apply all bt 20"],
-                             capture_output=True, text=True, timeout=60)
-        bt = [l for l in (gdb.stdout + gdb.stderr).splitlines() if l.startswith(("Thread ", "#", "ptrace", "warning: process"))]
-        lines += bt[:300]
-    except (OSError, subprocess.TimeoutExpired) as e:
-        lines.append("  (gdb: %s)" % e)
-    return "\n".join(lines)
 
 
 def gateway_env():

@@ -8,6 +8,7 @@ import os
 import selectors
 import signal
 import subprocess
+import sys
 import time
 
 
@@ -66,8 +67,35 @@ def proc_state(pid):
         return "no /proc entry (%s)" % e
 
 
-def stop(proc, wait_s=10):
-    """SIGTERM, wait up to `wait_s`, then SIGKILL. Returns the exit status (None for no process)."""
+def threads_of(pid):
+    """Where a live process's threads are, for a hang's report: each thread's name, wchan and CPU
+    ticks, then gdb's backtraces when gdb can attach (LeakSanitizer's exit check holds ptrace then)."""
+    lines = []
+    try:
+        for t in sorted(os.listdir("/proc/%d/task" % pid), key=int):
+            try:
+                comm = open("/proc/%d/task/%s/comm" % (pid, t)).read().strip()
+                wchan = open("/proc/%d/task/%s/wchan" % (pid, t)).read().strip() or "-"
+                f = open("/proc/%d/task/%s/stat" % (pid, t)).read().rsplit(")", 1)[1].split()
+                lines.append("  %s %s %s (state %s, cpu ticks %s)" % (t, comm, wchan, f[0], int(f[11]) + int(f[12])))
+            except OSError:
+                pass
+    except OSError as e:
+        return "  (no /proc entry: %s)" % e
+    try:
+        gdb = subprocess.run(["gdb", "-p", str(pid), "-batch", "-nx", "-ex", "thread apply all bt 20"],
+                             capture_output=True, text=True, timeout=60)
+        bt = [l for l in (gdb.stdout + gdb.stderr).splitlines() if l.startswith(("Thread ", "#", "ptrace", "warning: process"))]
+        lines += bt[:300]
+    except (OSError, subprocess.TimeoutExpired) as e:
+        lines.append("  (gdb: %s)" % e)
+    return "\n".join(lines)
+
+
+def stop(proc, wait_s=20):
+    """SIGTERM, wait up to `wait_s`, then SIGKILL (printing where the process's threads were). Returns
+    the exit status (None for no process). 20 s: ASan gateways beside a full CI run (load about 20) took
+    over 10 s to end twice in one run; a real hang still fails, and names itself."""
     if proc is None:
         return None
     if proc.poll() is None:
@@ -75,6 +103,9 @@ def stop(proc, wait_s=10):
         try:
             proc.wait(wait_s)
         except subprocess.TimeoutExpired:
+            # the test fails on the status; say where the process was, so a hang names itself
+            sys.stderr.write("pid %d (%s) still running %s s after SIGTERM; its threads:\n%s\n"
+                             % (proc.pid, os.path.basename(str(proc.args[0])), wait_s, threads_of(proc.pid)))
             proc.kill()
             try:
                 proc.wait(30)  # a loaded machine has taken over 5 s to end a killed official node
