@@ -31,7 +31,9 @@ PYTHON_PACKAGES=(python3-venv)
 # the reverse-proxy tests, podman & co. for the container image (docker/build.sh: no Docker daemon, the
 # base made with mmdebstrap; busybox-static for the image made from a build on this machine); libgl1
 # and libglib2.0-0, which the OpenCV wheel of the camera driver's browser test links (Chromium pulls
-# them in too; named here so they do not depend on that).
+# them in too; named here so they do not depend on that); iproute2 (`ip netns`: the discovery tests
+# between network namespaces) and procps (`sysctl`, `ps`), which a minimal image may lack; stress-ng,
+# the load beside the tests in scripts/flaky.sh.
 TEST_PACKAGES=(
   catch2
   umockdev libumockdev-dev
@@ -39,6 +41,7 @@ TEST_PACKAGES=(
   chromium fonts-liberation libgl1 libglib2.0-0
   nginx openssl apache2-utils haproxy
   testssl.sh
+  iproute2 procps stress-ng
   podman buildah runc mmdebstrap fuse-overlayfs slirp4netns uidmap busybox-static
 )
 APT_PACKAGES=()

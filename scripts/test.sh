@@ -5,8 +5,7 @@
 #   build            preset debug: clang-14 -O0, ASan + UBSan, every test program and the libFuzzer
 #                    targets linked from the same objects
 #   ctest            every test but the timing ones, RR_CTEST_JOBS at a time (default 4 per CPU: most
-#                    tests wait on sockets, timers and child processes); then the tests labelled
-#                    `timing` (they assert rates and latencies a crowded CPU blurs), two at a time
+#                    tests wait on sockets, timers and child processes)
 #   tsan             the server tests under ThreadSanitizer (preset tsan, built meanwhile)
 #   fuzz             every libFuzzer target briefly, two at a time (scripts/fuzz.sh): those that need no
 #                    server library from preset fuzz (-O1, built meanwhile), the server ones from the debug build
@@ -14,6 +13,9 @@
 #                    on a fresh Debian 12 root; the container image made from those binaries (no
 #                    second compile) and its test; the Containerfile's from-source build only when
 #                    its inputs changed (docker/from-source.verified)
+#   timing           the tests labelled `timing` (they assert rates and latencies), two at a time, last:
+#                    calm, with nothing built or fuzzed beside them, so their bounds can fail
+# At the end (pass or fail): every skipped test with its reason. A failed test is never retried.
 # Meanwhile = in the background at nice 19, one chain: the tsan build, the core fuzz targets, the package build, then
 # the fresh-Debian, container and from-source steps, so they take the CPU the tests leave idle.
 # Exits non-zero on any failure; prints how long each phase took, and warns, naming the slowest
@@ -31,6 +33,7 @@ bg_pid=
 finish() {
   local rc=$?
   if [ -n "$bg_pid" ]; then kill -- -"$bg_pid" 2>/dev/null || true; fi
+  report_skips
   echo "test: phases: ${phases[*]/%/,} total $SECONDS s"
   # CI's disk is finite (a landing failed with "No space left on device" while linking build/debug).
   echo "test: disk: build/ $(du -sh build 2>/dev/null | cut -f1), $(df -h --output=avail . | tail -1 | tr -d ' ') left"
@@ -45,7 +48,21 @@ finish() {
   fi
   exit $rc
 }
+# Every skipped test with its reason (from ctest's JUnit files; test/schedule/ctest_report.py).
+report_skips() {
+  local xml=(build/ctest-*.xml)
+  [ -f "${xml[0]}" ] || return 0
+  local list
+  list=$(python3 test/schedule/ctest_report.py skipped "${xml[@]}" 2>/dev/null || true)
+  if [ -n "$list" ]; then
+    echo "test: skipped tests ($(printf '%s\n' "$list" | wc -l)), with the reason each printed:"
+    printf '%s\n' "$list"
+  else
+    echo "test: no test was skipped"
+  fi
+}
 trap finish EXIT
+rm -f build/ctest-*.xml
 
 echo "test: disk: $(df -h --output=avail . | tail -1 | tr -d ' ') free at the start"
 ./scripts/setup.sh
@@ -143,10 +160,11 @@ await_step() {
 # --output-on-failure: a failed test's own output is in the CI log (the second ctest run overwrites
 # build/debug/Testing/Temporary/LastTest.log).
 excluded='^(docker: the image|install: the package on a fresh Debian 12 root)'
-status=0
-ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" --output-on-failure 2>&1 | tee build/ctest-main.log || status=1
-ctest --preset debug -j 2 -L timing -E "$excluded" --output-on-failure 2>&1 | tee build/ctest-timing.log || status=1
-((status == 0)) || { echo "test: FAILED: ctest (build/ctest-main.log, build/ctest-timing.log)"; exit 1; }
+# --output-junit: each test's outcome and output, for the list of skipped tests at the end.
+junit=(--test-output-size-passed 65536 --output-junit)
+ctest --preset debug -j "$ctest_jobs" -LE timing -E "$excluded" --output-on-failure \
+  "${junit[@]}" "$PWD/build/ctest-main.xml" 2>&1 | tee build/ctest-main.log ||
+  { echo "test: FAILED: ctest (build/ctest-main.log)"; exit 1; }
 phase_done ctest
 
 # ThreadSanitizer (issue 16): the threaded server tests ("server: " tests of rr_server_tests) built with
@@ -190,7 +208,8 @@ if [ "${RR_CONTAINER:-1}" != 0 ]; then
     grep -E '^build: ' build/bg-container-image.log || true
   fi
   # The container test on that image (reports skipped, with the reason, where podman cannot run).
-  RR_CONTAINER_PREBUILT=1 ctest --preset debug -R '^docker: the image' --output-on-failure 2>&1 |
+  RR_CONTAINER_PREBUILT=1 ctest --preset debug -R '^docker: the image' --output-on-failure \
+    "${junit[@]}" "$PWD/build/ctest-container.xml" 2>&1 |
     tee build/ctest-container.log || { echo "test: FAILED: the container test"; exit 1; }
   if [ -n "$container_ok" ] && [ "$from_source" = 1 ]; then
     await_step from-source "the Containerfile's from-source build (docker/build.sh --smoke)"
@@ -199,4 +218,15 @@ if [ "${RR_CONTAINER:-1}" != 0 ]; then
   fi
 fi
 phase_done package+container-wait
+
+# The calm phase: the tests that assert rates and latencies, two at a time, with nothing built, fuzzed or
+# installed beside them (every background step has ended above), so a bound they miss is a failure.
+if [ -n "$bg_pid" ] && kill -0 "$bg_pid" 2>/dev/null; then
+  echo "test: waiting for the background chain to end before the timing tests"
+  while kill -0 "$bg_pid" 2>/dev/null; do sleep 2; done
+fi
+ctest --preset debug -j 2 -L timing -E "$excluded" --output-on-failure \
+  "${junit[@]}" "$PWD/build/ctest-timing.xml" 2>&1 | tee build/ctest-timing.log ||
+  { echo "test: FAILED: the timing tests (build/ctest-timing.log)"; exit 1; }
+phase_done timing
 echo "test: all passed"
