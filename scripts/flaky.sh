@@ -15,9 +15,9 @@
 #   --load-nice K  the workers' nice value (default 0)
 #
 # Needs build/debug built (cmake --build --preset debug) and stress-ng (scripts/setup.sh installs it).
-# Output: build/flaky/<time>/run-<i>/ (ctest.xml, ctest.log, failed/<test>.log, tmp/ = the tests'
-# TMPDIR, kept) and a summary at the end; exits 1 when any test failed in any run. A failure is
-# fixed, never retried (docs/development.md).
+# Output: build/flaky/<time>/run-<i>/ (ctest.xml, ctest.log, failed/<test>.log, tmp -> the tests'
+# TMPDIR, a short folder under /tmp, kept) and a summary at the end; exits 1 when any test failed in
+# any run. A failure is fixed, never retried (docs/development.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -64,11 +64,14 @@ fi
 echo "flaky: $runs run(s), $jobs at once, load: $load CPU worker(s) at nice $load_nice; output in $out"
 for ((i = 1; i <= runs; i++)); do
   dir=$out/run-$i
-  mkdir -p "$dir/tmp"
+  mkdir -p "$dir"
+  # TMPDIR: the tests' temporary folders land in a folder of the run's and stay (a test that keeps its
+  # logs on failure leaves them there). Short, under /tmp: Unix socket paths (rr+local) hold 107 bytes.
+  tmp=$(mktemp -d /tmp/f$i.XXXX)
+  chmod 1777 "$tmp"  # as /tmp: tests run programs as other users (setpriv) in their folders
+  ln -s "$tmp" "$dir/tmp"
   t0=$SECONDS
-  # TMPDIR: the tests' temporary folders land in the run's folder and stay (a test that keeps its
-  # logs on failure leaves them there).
-  TMPDIR=$PWD/$dir/tmp ctest --test-dir build/debug -j "$jobs" "${select[@]}" --output-on-failure \
+  TMPDIR=$tmp ctest --test-dir build/debug -j "$jobs" "${select[@]}" --output-on-failure \
     --test-output-size-passed 65536 --test-output-size-failed 4194304 \
     --output-junit "$PWD/$dir/ctest.xml" >"$dir/ctest.log" 2>&1 || true
   summary=$(grep -E 'tests passed|tests failed' "$dir/ctest.log" | tail -n 1)
