@@ -5,8 +5,9 @@
 #
 #   scripts/build-lichtblick.sh SRC_DIR [OUT_DIR]
 #     SRC_DIR  a git work tree of Lichtblick (tested: 1.10.8, `git clone <lichtblick repo> SRC_DIR`)
-#     OUT_DIR  where the built app is copied (replaced if present); default SRC_DIR/web/.webpack only
-#   LICHTBLICK_WEB=OUT_DIR ctest --preset debug -R lichtblick
+#     OUT_DIR  where the built app is copied (replaced if present); default ~/.cache/rr-gateway/lichtblick-web,
+#              where the test finds it without LICHTBLICK_WEB
+#   ctest --preset debug -R lichtblick     (or LICHTBLICK_WEB=OUT_DIR ctest ... for another folder)
 #
 # What it does, in SRC_DIR (idempotent; about 2 min of yarn install and 2 min of webpack on 2 vCPUs):
 # - yarn 3 through corepack, fetched from the npm registry (COREPACK_NPM_REGISTRY), and packages from
@@ -20,8 +21,7 @@
 set -euo pipefail
 
 src=${1:?usage: scripts/build-lichtblick.sh SRC_DIR [OUT_DIR]}
-out=${2:-}
-[ -z "$out" ] || out=$(realpath -m "$out")
+out=$(realpath -m "${2:-$HOME/.cache/rr-gateway/lichtblick-web}")
 cd "$src"
 [ -f package.json ] && grep -q '"name": "lichtblick"' package.json || { echo "build-lichtblick: $src is not a Lichtblick source tree" >&2; exit 2; }
 
