@@ -84,7 +84,7 @@ try {
   for (const n of r.passed) console.log(`  ok   ${n}`);
   for (const f of r.failed) console.log(`  FAIL ${f.name}: ${f.error}`);
   console.log(`== chromium: ${r.passed.length} passed, ${r.failed.length} failed`);
-  code = r.failed.length ? 1 : 0;
+  code = r.failed.length || !r.passed.length ? 1 : 0;  // nothing run is not a pass
 } catch (e) {
   console.error(`browser test: ${e.message}`);
   code = 2;
