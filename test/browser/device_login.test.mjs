@@ -60,7 +60,7 @@ async function stopProc(proc) {
   if (!proc || proc.exitCode !== null || proc.signalCode !== null) return;
   const exited = new Promise((resolve) => proc.on("exit", resolve));
   proc.kill("SIGTERM");
-  const t = setTimeout(() => proc.kill("SIGKILL"), 8000);
+  const t = setTimeout(() => proc.kill("SIGKILL"), 20000);
   await exited;
   clearTimeout(t);
 }
