@@ -79,7 +79,7 @@ try {
   const url = `http://127.0.0.1:${port}/test/api.html?url=${encodeURIComponent(`rr+ws://127.0.0.1:${port}/?service=interop`)}${only}`;
   console.log(`== chromium ${browser.version()}: ${url}`);
   await page.goto(url);
-  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 540000 });
   const r = await page.evaluate(() => window.__result);
   for (const n of r.passed) console.log(`  ok   ${n}`);
   for (const f of r.failed) console.log(`  FAIL ${f.name}: ${f.error}`);

@@ -59,7 +59,7 @@ try {
     `&controls=${Object.keys(actions).join(",")}&reconnects=${arg("--reconnects", "100")}&checks=${checks}`;
   console.log(`== chromium ${browser.version()}, ${target}, ${checks} checks: ${url}`);
   await page.goto(url);
-  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 170000, polling: 200 });
+  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 450000, polling: 200 });
   const r = await page.evaluate(() => window.__result);
   if (process.env.SUBS_SNAPSHOT) {  // debugging aid: a heap snapshot of the page after the checks
     const cdp = await page.context().newCDPSession(page);
