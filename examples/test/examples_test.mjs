@@ -181,11 +181,16 @@ RRN.DisconnectService(c)
       ok(/^connected \(experimental\.create\.Create\)$/.test(await page.textContent("#state")), "the page connected");
       const before = Number(await page.textContent("#distance"));
       ok(Number.isInteger(before), `distance ${before}`);
-      // the button drives and then reads the distance: after a second press the robot has moved
-      await page.click("#drive");
-      await new Promise((r) => setTimeout(r, 500));
-      await page.click("#drive");
-      await page.waitForFunction((b) => Number(document.getElementById("distance").textContent) > b, before, { timeout: 10000 });
+      // the button drives and then reads the distance: pressed again (each press reads it anew) until the
+      // robot's move shows, bounded against a hang only (the demo's clock advances the robot, not the press)
+      const deadline = Date.now() + 30000;
+      for (;;) {
+        await page.click("#drive");
+        const moved = await page.waitForFunction((b) => Number(document.getElementById("distance").textContent) > b, before, { timeout: 1000 })
+          .then(() => true, () => false);
+        if (moved) break;
+        if (Date.now() > deadline) throw new Error(`Drive: the distance stayed ${await page.textContent("#distance")} mm for 30 s`);
+      }
       ok(true, `Drive moved the robot: ${before} -> ${await page.textContent("#distance")} mm`);
       ok(errors.length === 0, `no page errors ${errors.join("; ")}`);
     } finally {

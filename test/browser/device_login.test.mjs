@@ -60,7 +60,7 @@ async function stopProc(proc) {
   if (!proc || proc.exitCode !== null || proc.signalCode !== null) return;
   const exited = new Promise((resolve) => proc.on("exit", resolve));
   proc.kill("SIGTERM");
-  const t = setTimeout(() => proc.kill("SIGKILL"), 8000);
+  const t = setTimeout(() => proc.kill("SIGKILL"), 20000);
   await exited;
   clearTimeout(t);
 }
@@ -202,7 +202,7 @@ test("a lock taken through the gateway shows its holder on the card; the locking
 
 test("log out of the device: the form again; logged in as bob the page gets the device's lock error", async () => {
   await view("interop").locator("button.device-logout").click();
-  await form().waitFor({ state: "visible", timeout: 10000 });
+  await form().waitFor({ state: "visible", timeout: 20000 });
   assert.equal(await formError().isHidden(), true);
   assert.equal(await view("interop").locator(".member").count(), 0);
   assert.equal(await view("interop").locator(".device-user").isHidden(), true);

@@ -59,7 +59,7 @@ test("lists a local node's services and adds one as a device", async () => {
   await page.locator('.devices li[data-device="webcam"][data-state="connected"]').waitFor({ timeout: 20000 });
   await waitFor(async () => (await page.evaluate(() => location.hash)) === "#/webcam", "the page opened the new device");
   // The discovered list now names the device serving the service instead of offering "Add".
-  await webcam.locator("a.served-by", { hasText: "webcam" }).waitFor({ timeout: 10000 });
+  await webcam.locator("a.served-by", { hasText: "webcam" }).waitFor({ timeout: 20000 });
   assert.equal(await webcam.locator("button.add").count(), 0);
   await page.screenshot({ path: path.join(s.artifacts, "discovered-added.png"), fullPage: true });
   assert.deepEqual(pageErrors, []);

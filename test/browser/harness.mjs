@@ -87,7 +87,7 @@ class Child {
    * was needed it also has `stuck`: where the process's threads were (gdb backtraces, else each
    * thread's wchan) and its last stderr, so a shutdown hang names itself in the test's failure.
    */
-  async stop(graceMs = 8000) {
+  async stop(graceMs = 20000) {  // an ASan gateway beside a loaded CI run took over 10 s to exit
     if (this.proc.exitCode !== null || this.proc.signalCode !== null) return this.exited;
     this.proc.kill("SIGTERM");
     let stuck = null;

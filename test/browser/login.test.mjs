@@ -61,7 +61,7 @@ test("no session: login page; wrong password: error; right one: dashboard; log o
 
   await logIn(page, "alice", "not-her-password");
   const error = page.locator("#login-error");
-  await error.waitFor({ state: "visible", timeout: 10000 });
+  await error.waitFor({ state: "visible", timeout: 20000 });
   assert.match(await error.textContent(), /invalid username or password/i);
   assert.match(page.url(), /\/login\.html/);
   assert.equal((await context.cookies()).filter((c) => c.name === "rrgw_session").length, 0);

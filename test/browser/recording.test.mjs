@@ -50,6 +50,38 @@ async function openDevice(base, name) {
   await view(name).locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 30000 });
 }
 
+/**
+ * The replay's pace from two status reads, judged without trusting any latency: each read is bracketed
+ * by the test's clock (sent at a, answered at b), so at `speed` the position moved between
+ * speed·(a2 − b1) and speed·(b2 − a1) seconds of the file. A pair counts only when it can tell `speed`
+ * from speed 1 (the bracket's low end above what speed 1 could reach) and cannot hide a wrap (loop on:
+ * both reads playing, the second ahead of the first and short of the end, less than a whole pass
+ * between them). Other pairs are read again, the pause between the reads grown to outweigh the reads'
+ * own latency, for up to 30 s. Returns {ok, text}.
+ */
+async function measurePace(status, durationS, speed = 2) {
+  const tries = [];
+  let gap = 0.3;  // s between the reads
+  const deadline = Date.now() + 30000;
+  while (Date.now() < deadline) {
+    const a1 = performance.now() / 1000; const s1 = await status(); const b1 = performance.now() / 1000;
+    await new Promise((r) => setTimeout(r, gap * 1000));
+    const a2 = performance.now() / 1000; const s2 = await status(); const b2 = performance.now() / 1000;
+    const moved = s2.position_s - s1.position_s;
+    const low = speed * (a2 - b1), high = speed * (b2 - a1);
+    const note = `moved ${moved.toFixed(3)} s of the file in ${(a2 - b1).toFixed(3)}..${(b2 - a1).toFixed(3)} s`;
+    const clean = s1.state === "playing" && s2.state === "playing" && s1.speed === speed && s2.speed === speed
+      && moved > 0 && s2.position_s < durationS && high < durationS;
+    if (clean && (b2 - a1) < low - 0.01) {  // speed 1 could not have moved `low`: the pair decides
+      return { ok: moved >= low - 0.005 && moved <= high + 0.005, text: `${note} (want ${low.toFixed(3)}..${high.toFixed(3)})` };
+    }
+    tries.push(clean ? `${note}: the reads took too long to tell the speed` : `${note}: wrapped or not playing`);
+    const latency = (b1 - a1) + (b2 - a2);
+    gap = Math.min(Math.max(0.3, 2 * latency + 0.1), 0.4 * durationS / speed);
+  }
+  return { ok: false, text: `no pair of reads could tell in 30 s: ${tries.slice(-5).join("; ")}` };
+}
+
 /** "m:ss.s" → seconds. */
 const seconds = (text) => {
   const [m, sec] = text.trim().split(":");
@@ -102,7 +134,7 @@ test("records the create device's members from the page; the file reads", async 
   await c.locator('input[name="record-directory"]').fill(path.join(work, "rec"));
 
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
   assert.equal(await c.getAttribute("data-state"), "recording");
   // the live line grows: duration, size and messages
   const live = c.locator(".record-live");
@@ -112,10 +144,10 @@ test("records the create device's members from the page; the file reads", async 
     assert.ok(m, `live line "${t}"`);
     return { duration: seconds(m[1]), size: m[2], messages: Number(m[3]), drops: Number(m[4]) };
   };
-  await waitFor(async () => (await facts()).messages > 0, "messages counted on the page", 10000);
+  await waitFor(async () => (await facts()).messages > 0, "messages counted on the page", 20000);
   const first = await facts();
   await screenshot(view("create").locator(".device-tools"), "dashboard-recording.png");
-  await waitFor(async () => (await facts()).duration >= first.duration + 2, "the duration grows on the page", 10000);
+  await waitFor(async () => (await facts()).duration >= first.duration + 2, "the duration grows on the page", 20000);
   const second = await facts();
   assert.ok(second.messages > first.messages, `messages grow: ${first.messages} → ${second.messages}`);
   assert.equal(second.drops, 0);
@@ -124,7 +156,7 @@ test("records the create device's members from the page; the file reads", async 
   await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
   await callFunction(card("StopStreaming"));
   const item = c.locator(".recordings > li").first();
-  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 10000);
+  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 20000);
   const files = await item.locator(".recording-files code").allTextContents();
   assert.equal(files.length, 1, `one file: ${files}`);
   recordedFile = path.resolve(files[0]);
@@ -160,10 +192,10 @@ test("a directory the gateway cannot create: the reason on the page, the recordi
   await c.locator('input[name="record-directory"]').fill("/proc/no/such/dir");
   await c.locator(".record-button").click();
   const error = c.locator(".record-error");
-  await error.waitFor({ state: "visible", timeout: 10000 });
+  await error.waitFor({ state: "visible", timeout: 20000 });
   assert.match(await error.textContent(), /\/proc\/no\/such\/dir/);
   const item = c.locator(".recordings > li").first();
-  await waitFor(async () => (await item.getAttribute("data-state")) === "failed", "the recording listed as failed", 10000);
+  await waitFor(async () => (await item.getAttribute("data-state")) === "failed", "the recording listed as failed", 20000);
   assert.match(await item.locator(".recording-error").textContent(), /\/proc\/no\/such\/dir/);
   assert.equal(await c.locator(".record-button").textContent(), "Record", "nothing is recording");
 });
@@ -174,7 +206,7 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   const status = async () => (await api(replayGateway.base, "GET", "api/replays/create_replay")).body;
   await openDevice(replayGateway.base, "create_replay");
   const t = timeline();
-  await t.waitFor({ timeout: 10000 });
+  await t.waitFor({ timeout: 20000 });
   assert.equal(await view("create_replay").locator(".record-control").count(), 1, "a replayed device can be recorded too");
   // ... and its Record section says so (docs/recording.md "Recording a replay")
   const replayRecord = view("create_replay").locator(".record-control");
@@ -217,10 +249,13 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   await waitFor(async () => (await status()).speed === 2, "speed 2 at the gateway");
   await screenshot(view("create_replay").locator(".device-tools"), "dashboard-replay.png");
 
-  // play: the position moves on (at twice the recorded pace) and the page follows
+  // play: the position moves on at twice the recorded pace and the page follows
   await t.locator(".replay-play").click();
   await waitFor(async () => (await status()).state === "playing", "playing at the gateway");
-  await waitFor(async () => (await status()).position_s !== target, "the position moves on", 10000);
+  await waitFor(async () => (await status()).position_s !== target, "the position moves on", 20000);
+  const pace = await measurePace(status, st0.duration_s);
+  console.log(`# the replay's pace at speed 2: ${pace.text}`);
+  assert.ok(pace.ok, `the replay's pace at speed 2: ${pace.text}`);
   await waitFor(async () => (await t.locator(".replay-position").textContent()) !== shownAtSeek, "the page's position moves");
   await t.locator(".replay-loop").uncheck();
   await waitFor(async () => (await status()).loop === false, "loop off at the gateway");
@@ -274,7 +309,7 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.equal(await alice.t.locator(".replay-play").isDisabled(), false, "an operator may control the replay");
   assert.equal(await alice.t.locator(".hint").count(), 0);
   await alice.t.locator(".replay-play").click();
-  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 10000 });
+  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 20000 });
   assert.equal(await alice.p.locator('.device-view[data-device="create_replay"] .record-button').isDisabled(), false, "an operator may record");
   assert.equal(await alice.p.locator(".record-refused").count(), 0);
   await alice.context.close();
@@ -290,17 +325,17 @@ test("members below the root object typed into the Record control (the webcam's 
   // a name that leads nowhere: the gateway's reason on the page, nothing recorded
   await paths.fill("Webcams.Name");
   await c.locator(".record-button").click();
-  await waitFor(async () => /needs an index/.test(await c.locator(".record-error").textContent()), "the refusal on the page", 10000);
+  await waitFor(async () => /needs an index/.test(await c.locator(".record-error").textContent()), "the refusal on the page", 20000);
   assert.equal(await c.locator(".record-button").textContent(), "Record");
   await paths.fill("Webcams[0].Name, Webcams[1].Name");
   await c.locator('input[name="record-directory"]').fill(path.join(work, "sub"));
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
   await waitFor(async () => /[1-9]\d* messages/.test(await c.locator(".record-live").textContent()), "the cameras' names recorded", 15000);
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
   const item = c.locator(".recordings > li").first();
-  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 10000);
+  await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 20000);
   const id = Number(await item.getAttribute("data-id"));
   const listed = (await api(gateway.base, "GET", "api/recordings")).body.recordings.find((r) => r.id === id);
   assert.deepEqual(listed.members, ["Webcams[0].Name", "Webcams[1].Name"]);

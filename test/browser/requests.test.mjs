@@ -73,11 +73,22 @@ test("the dashboard asks for what each gateway serves, and nothing answers 404 o
   // The page's section follows: shown with discovery, hidden without (checked on fresh pages).
   for (const [g, shown] of [[withDiscovery, true], [withoutDiscovery, false]]) {
     const page = await browser.newPage();
+    // The section starts hidden, so "hidden" means something only once the page has read api/features:
+    // mark the moment its answer's JSON is read (the page acts on it in the same microtask run, before
+    // any poll of waitForFunction) rather than pausing for a while.
+    await page.addInitScript(() => {
+      const json = Response.prototype.json;
+      Response.prototype.json = async function () {
+        const v = await json.call(this);
+        if (new URL(this.url).pathname.endsWith("/api/features")) window.__featuresRead = true;
+        return v;
+      };
+    });
     await page.goto(`${g.base}/`);
     await page.locator('#device-list li[data-device="create"]').waitFor({ timeout: 20000 });
-    if (shown) await page.locator("section.discovered").waitFor({ state: "visible", timeout: 10000 });
+    if (shown) await page.locator("section.discovered").waitFor({ state: "visible", timeout: 20000 });
     else {
-      await page.waitForTimeout(3000);
+      await page.waitForFunction(() => window.__featuresRead === true, null, { timeout: 20000 });
       assert.ok(await page.locator("section.discovered").isHidden(), "the Discovered section is hidden without discovery");
     }
     await page.close();

@@ -24,7 +24,7 @@ const num = async (loc, name) => Number((await attr(loc, name)) || 0);
 
 /** Sends a case to the service (stdin) and resolves with its answer (reference picture and all). */
 async function send(name) {
-  const answer = service.child.jsonLine("sent", 10000);
+  const answer = service.child.jsonLine("sent", 20000);
   service.child.proc.stdin.write(`${JSON.stringify({ case: name })}\n`);
   const a = await answer;
   assert.equal(a.sent, name);

@@ -149,19 +149,29 @@ function lastMotion(j, from, clock = "t") {
 }
 
 /**
- * Waits (at most 5 s) until the official client saw joint j move within the last 100 ms, so that the
+ * Waits until the official client saw joint j move within the last 100 ms, so that the
  * event that follows happens while the robot moves: under load the page's calls can arrive more than
  * the 0.15 s they grant apart, and the robot then stops and starts again (docs/dashboard.md).
  */
 async function moving(j) {
-  await waitFor(() => lastMotion(j, Date.now() / 1000 - 0.1) !== null, `joint ${j} moving`, 5000, 10);
+  await waitFor(() => lastMotion(j, Date.now() / 1000 - 0.1) !== null, `joint ${j} moving`, 20000, 10);
+}
+
+/**
+ * Waits until the official client received a state the robot sent after `time` (s, its clock): the
+ * probe gets the states in order, so every state sent up to `time` is in `samples` then. Bounded
+ * against a hang only: under load the delivery is late, and the judgement waits for it.
+ */
+async function statesUntil(time, what) {
+  await waitFor(() => samples.length > 0 && samples.at(-1).sent > time, `${what}: the robot's states up to ${time.toFixed(3)}`, 30000, 10);
 }
 
 /** Asserts joint j moved in the 0.3 s before `t` (s), then stopped within `bound` s of it; returns the delay. */
 async function assertStopsAfter(j, t, bound, what) {
   const moving = lastMotion(j, t - 0.3);
   assert.ok(moving !== null, `${what}: joint ${j} was not moving when the hold ended`);
-  await sleep(1500);
+  // the whole window the bound allows and a second more, as the robot sent it
+  await statesUntil(t + bound + 1, what);
   // The bound is on the robot: the time it sent its last moving state. When the client received it is
   // logged too (under load the delivery to the client alone was seen to add 0.3 s and more).
   const delay = lastMotion(j, t - 0.3, "sent") - t;
@@ -180,10 +190,11 @@ async function assertStopsAfter(j, t, bound, what) {
   assert.ok(lastCall !== undefined, `${what}: the driver logged no jog call`);
   assert.ok(delay - (lastCall - t) <= ROBOT_STOP_S, `${what}: the robot moved ${((delay - (lastCall - t)) * 1000).toFixed(0)} ms after the last call reached it (bound ${ROBOT_STOP_S * 1000} ms)`);
   assert.ok(delay <= bound, `${what}: the robot still moved ${(delay * 1000).toFixed(0)} ms after (bound ${bound * 1000} ms; received ${(received * 1000).toFixed(0)} ms after)`);
-  // and it stays stopped
-  const q = latest().q[j];
-  await sleep(400);
-  assert.ok(Math.abs(latest().q[j] - q) < EPS, `${what}: moving again`);
+  // and it stays stopped: no motion in the robot's next 0.4 s of states
+  const from = samples.length - 1;
+  const last = samples[from];
+  await statesUntil(last.sent + 0.4, what);
+  assert.ok(samples.slice(from + 1).every((x) => Math.abs(x.q[j] - last.q[j]) < EPS), `${what}: moving again`);
   return delay;
 }
 
@@ -219,13 +230,13 @@ async function holdDown(page, joint, dir) {
   const b = jogButton(page, joint, dir);
   await waitFor(async () => !(await b.isDisabled()), `jog ${joint} ${dir} enabled`, 15000);
   const holds = Number((await panel(page).getAttribute("data-jog-holds")) ?? 0);
-  await b.hover({ timeout: 10000 });
+  await b.hover({ timeout: 20000 });
   // (evidence for the layout fix: a 3D view still loading here would once have pushed the button away)
   const view = await panel(page).locator(".robot-3d").evaluate((x) => (x.dataset.loading ? "loading" : "drawn")).catch(() => "?");
   console.log(`# press ${joint} ${dir}: the 3D view (below the buttons) was ${view}`);
   await page.mouse.down();
   try {
-    await waitFor(async () => Number((await panel(page).getAttribute("data-jog-holds")) ?? 0) > holds, "a hold started", 5000, 20);
+    await waitFor(async () => Number((await panel(page).getAttribute("data-jog-holds")) ?? 0) > holds, "a hold started", 20000, 20);
     assert.equal(await panel(page).getAttribute("data-jog"), "on", "the hold ended at once");
   } catch (e) {
     const pressed = await page.evaluate(() => {
@@ -274,8 +285,8 @@ test("status chips and joint table match the driver; the wrist warns near its up
   assert.ok(await jogButton(operator, "shoulder", "1").isDisabled());
   await p.locator('select[name="command-mode"]').selectOption("jog");
   await p.locator('button[data-action="command_mode"]').click();
-  await waitFor(async () => (await p.locator('dd[data-row="command_mode"]').textContent()) === "jog", "jog mode", 10000);
-  await waitFor(async () => !(await jogButton(operator, "shoulder", "1").isDisabled()), "jog buttons enabled", 5000);
+  await waitFor(async () => (await p.locator('dd[data-row="command_mode"]').textContent()) === "jog", "jog mode", 20000);
+  await waitFor(async () => !(await jogButton(operator, "shoulder", "1").isDisabled()), "jog buttons enabled", 20000);
   await screenshot(p, "dashboard-robot-jog.png");
 });
 
@@ -293,7 +304,7 @@ test("holding shoulder + for 1 s moves the shoulder only; releasing stops it wit
   assert.ok(after[0] - before[0] > 0.2, `the shoulder moved ${after[0] - before[0]} rad`);
   assert.ok(Math.abs(after[1] - before[1]) < EPS && Math.abs(after[2] - before[2]) < EPS, `only the shoulder: ${before} -> ${after}`);
   // the table follows
-  await waitFor(async () => (await panel(operator).locator('tr[data-joint="shoulder"] .joint-position').textContent()).endsWith(`(${after[0].toFixed(4)} rad)`), "table shows the new position", 5000);
+  await waitFor(async () => (await panel(operator).locator('tr[data-joint="shoulder"] .joint-position').textContent()).endsWith(`(${after[0].toFixed(4)} rad)`), "table shows the new position", 20000);
   assert.equal(await panel(operator).locator(".robot-error").isHidden(), true, await panel(operator).locator(".robot-error").textContent());
 });
 
@@ -325,14 +336,14 @@ test("lock offer: a hold takes the device's lock (holder shown on the panel and 
   await lockCheck.check();
   try {
     await holdDown(operator, "shoulder", "-1");
-    await waitFor(async () => /by alice$/.test((await p.getAttribute("data-locks")) ?? ""), "the panel shows alice holding the lock", 5000);
+    await waitFor(async () => /by alice$/.test((await p.getAttribute("data-locks")) ?? ""), "the panel shows alice holding the lock", 20000);
     assert.match(await p.locator(".robot-lock-holder").textContent(), /lock on .* by alice\)$/);
     assert.ok((await gatewayLocks()).some((l) => l.user === "alice"), JSON.stringify(await gatewayLocks()));
     await sleep(300);
     await operator.mouse.up();
     assert.equal(await holdEnd(operator), "release");
-    await waitFor(async () => (await gatewayLocks()).length === 0, "the gateway reports the lock released", 5000);
-    await waitFor(async () => (await p.getAttribute("data-locks")) === "", "the panel shows no lock", 5000);
+    await waitFor(async () => (await gatewayLocks()).length === 0, "the gateway reports the lock released", 20000);
+    await waitFor(async () => (await p.getAttribute("data-locks")) === "", "the panel shows no lock", 20000);
   } finally {
     await operator.mouse.up().catch(() => {});
     await lockCheck.uncheck();
@@ -376,7 +387,7 @@ test("Cartesian jog: the sim's driver has no jog_cartesian, so the first press r
   await box.locator('button.jog[data-axis="x"][data-dir="1"]').hover();
   await operator.mouse.down();
   try {
-    await waitFor(async () => (await box.getAttribute("data-missing")) === "true", "the Cartesian box says the driver has none", 5000);
+    await waitFor(async () => (await box.getAttribute("data-missing")) === "true", "the Cartesian box says the driver has none", 20000);
   } finally {
     await operator.mouse.up();
   }
@@ -384,7 +395,7 @@ test("Cartesian jog: the sim's driver has no jog_cartesian, so the first press r
   assert.match(await box.textContent(), /does not implement jog_cartesian/);
   assert.equal(await p.getAttribute("data-jog"), "off");
   assert.equal(await p.locator(".robot-error").isHidden(), true, await p.locator(".robot-error").textContent());
-  await sleep(400);
+  await statesUntil(Date.now() / 1000 + 0.4, "after the press");  // the robot's states for 0.4 s more
   assert.equal(lastMotion(0, from), null, "the robot moved");
   assert.deepEqual(latest().q, q0);
 });
@@ -429,7 +440,7 @@ test("a viewer sees no moving control; its page's jog_joint is refused and the r
   const p = panel(page);
   assert.equal(await p.getAttribute("data-access"), "checked");
   // the state is shown, no control that moves the robot or changes its mode
-  await waitFor(async () => (await p.getAttribute("data-flags")) === "enabled | ready", "viewer sees the flags", 10000);
+  await waitFor(async () => (await p.getAttribute("data-flags")) === "enabled | ready", "viewer sees the flags", 20000);
   for (const sel of ["button.jog", "button[data-action]", 'select[name="command-mode"]', "form.robot-move button"]) {
     assert.equal(await p.locator(sel).count(), 0, `a viewer sees ${sel}`);
   }
@@ -459,7 +470,7 @@ test("a viewer sees no moving control; its page's jog_joint is refused and the r
     }
   });
   assert.equal(answer, "RobotRaconteur.PermissionDenied");
-  await sleep(800);
+  await statesUntil(Date.now() / 1000 + 0.8, "after the refused call");  // the robot's states for 0.8 s more
   assert.equal(lastMotion(0, from), null, "the robot moved");
   assert.deepEqual(latest().q, q0);
   await page.context().close();
@@ -480,7 +491,7 @@ test("killing the page's connection (a TCP relay) while a button is held stops t
     dropped = true;
     await assertStopsAfter(0, killed, STOP_BOUND_S, "connection killed");
     // the page noticed: the hold ended
-    await waitFor(async () => (await panel(page).count()) === 0 || (await panel(page).getAttribute("data-jog")) === "off", "the page's hold ended", 5000);
+    await waitFor(async () => (await panel(page).count()) === 0 || (await panel(page).getAttribute("data-jog")) === "off", "the page's hold ended", 20000);
     await page.mouse.up();
   } finally {
     // a failure above must not leave the relay listening or the page connected: node would not exit

@@ -79,12 +79,12 @@ try {
   const url = `http://127.0.0.1:${port}/test/api.html?url=${encodeURIComponent(`rr+ws://127.0.0.1:${port}/?service=interop`)}${only}`;
   console.log(`== chromium ${browser.version()}: ${url}`);
   await page.goto(url);
-  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 540000 });
   const r = await page.evaluate(() => window.__result);
   for (const n of r.passed) console.log(`  ok   ${n}`);
   for (const f of r.failed) console.log(`  FAIL ${f.name}: ${f.error}`);
   console.log(`== chromium: ${r.passed.length} passed, ${r.failed.length} failed`);
-  code = r.failed.length ? 1 : 0;
+  code = r.failed.length || !r.passed.length ? 1 : 0;  // nothing run is not a pass
 } catch (e) {
   console.error(`browser test: ${e.message}`);
   code = 2;

@@ -5,9 +5,15 @@
 // device, restart the gateway, cut and restore the network, and drop connections (window.rrControl).
 //
 // With --target direct the RR WebSocket goes straight to rr_interop_service --websocket instead (the page
-// still comes from the gateway, both through the same proxy port).
+// still comes from the gateway, both through the same proxy port). With --checks timeouts the page runs
+// timeout_checks.mjs instead (heartbeats, receive and connect timeouts: their bounds are the checks, so
+// that run is labelled `timing`).
 //
-// Usage: node reconnect_browser_test.mjs --interop-service PATH --gateway PATH [--target gateway|direct] [--reconnects N]
+// Every check the page was asked for must have run: one that did not (e.g. the memory check without a
+// heap figure) fails the test rather than passing it by omission.
+//
+// Usage: node reconnect_browser_test.mjs --interop-service PATH --gateway PATH [--target gateway|direct]
+//        [--checks reconnect|timeouts] [--reconnects N]
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 Chromium, playwright-core or emscripten absent.
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
@@ -22,6 +28,7 @@ let browser;
 let code = 2;
 try {
   const target = arg("--target", "gateway");
+  const checks = arg("--checks", "reconnect");
   const svc = await interopService(arg("--interop-service"), await freePort());
   const gw = await gateway(arg("--gateway"), await freePort(), svc.tcpUrl);
   await gw.start(pkgRoot);
@@ -33,6 +40,10 @@ try {
   const actions = { restartDevice: () => svc.restart(), cut: () => proxy.cut(), restore: () => proxy.restore(),
     dropAll: () => proxy.dropAll() };
   if (target === "gateway") actions.restartGateway = () => gw.restart();
+  if (checks === "timeouts") for (const a of ["restartDevice", "restartGateway", "dropAll"]) delete actions[a];
+  // reconnect_checks.mjs: first connection, one per disruption (cut and restore make one), memory (dropAll), close()
+  const expected = checks === "timeouts" ? 4
+    : 2 + ["restartDevice", "restartGateway", "cut", "dropAll"].filter((a) => actions[a]).length;
   browser = await pw.launch({ executablePath: CHROMIUM, headless: true,
     args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
       "--disable-component-update", "--disable-sync", "--js-flags=--expose-gc", "--enable-precise-memory-info"] });
@@ -45,10 +56,10 @@ try {
   });
   const origin = `http://127.0.0.1:${proxy.port}`;
   const url = `${origin}/test/reconnect.html?url=${encodeURIComponent(`rr+ws://127.0.0.1:${proxy.port}/?service=interop`)}` +
-    `&controls=${Object.keys(actions).join(",")}&reconnects=${arg("--reconnects", "100")}`;
-  console.log(`== chromium ${browser.version()}, ${target}: ${url}`);
+    `&controls=${Object.keys(actions).join(",")}&reconnects=${arg("--reconnects", "100")}&checks=${checks}`;
+  console.log(`== chromium ${browser.version()}, ${target}, ${checks} checks: ${url}`);
   await page.goto(url);
-  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 170000, polling: 200 });
+  await page.waitForFunction(() => window.__result?.done === true, null, { timeout: 450000, polling: 200 });
   const r = await page.evaluate(() => window.__result);
   if (process.env.SUBS_SNAPSHOT) {  // debugging aid: a heap snapshot of the page after the checks
     const cdp = await page.context().newCDPSession(page);
@@ -60,8 +71,10 @@ try {
     (await import("node:fs")).writeFileSync(process.env.SUBS_SNAPSHOT, chunks.join(""));
   }
   for (const f of r.failed) console.log(`  FAIL ${f.name}: ${f.error}`);
-  console.log(`== chromium: ${r.passed.length} passed, ${r.failed.length} failed`);
-  code = r.failed.length || !r.passed.length ? 1 : 0;
+  const ran = r.passed.length + r.failed.length;
+  console.log(`== chromium: ${r.passed.length} passed, ${r.failed.length} failed` +
+    (ran === expected ? "" : `; FAIL: ${ran} checks ran, ${expected} expected`));
+  code = r.failed.length || ran !== expected ? 1 : 0;
 } catch (e) {
   console.error(`browser test: ${e.message}`);
   code = 2;

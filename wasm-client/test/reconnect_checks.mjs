@@ -4,21 +4,28 @@
 // restarted, network cut silently, connections dropped) every one of them must work again on the new
 // connection, each handler firing exactly once per value.
 //
+// Every wait here is for an event, bounded only against a hang (tens of seconds): these checks run in
+// ctest's crowded main phase. How fast a silent cut is noticed (receiveTimeoutMs), that heartbeats keep
+// an idle connection and that a connect into a silent network times out are timing checks:
+// timeout_checks.mjs, in tests labelled `timing`.
+//
 // runReconnectChecks(rr, {url, control, log, heap, reconnects}) → {passed: [names], failed: [{name, error}]}
 //   control: {restartDevice?, restartGateway?, cut?, restore?, dropAll?} async functions (the runner's)
-//   heap: () => bytes of live heap after a full GC (null: no memory check)
+//   heap: () => bytes of live heap after a full GC (null: none; with control.dropAll that fails the memory check)
 
 export const FAST = {
-  // Fast enough for a test; the defaults (0.5 s .. 10 s, 10 s / 15 s) are for real networks.
+  // Quick reconnects for a test; the defaults (0.5 s .. 10 s) are for real networks.
   backoff: { initialMs: 50, maxMs: 400, factor: 2, jitter: 0.25 },
-  heartbeatPeriodMs: 300,
-  receiveTimeoutMs: 2500,  // 8 heartbeats: 1.2 s saw a spurious timeout in a loaded CI run (Chromium stalled)
-  timeoutMs: 3000,
+  // A stall of the page, node or the gateway under CI load must not look like a dead peer: a spurious
+  // receive timeout is one reconnect too many (1.2 s, then 2.5 s, saw one in loaded CI runs).
+  heartbeatPeriodMs: 500,
+  receiveTimeoutMs: 6000,
+  timeoutMs: 20000,  // connect and each request: a bound on a hang, not an expected duration
 };
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
-async function until(cond, what, timeoutMs = 15000) {
+async function until(cond, what, timeoutMs = 30000) {
   const end = Date.now() + timeoutMs;
   while (!cond()) {
     if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
@@ -80,10 +87,16 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
     const n0 = seen.notifies;
     const r = await c.call_callbacks(1.5);
     assert(r === 1.5 * 2 + "\u03bb-label".length + 1, `${what}: call_callbacks gave ${r}`);
-    await sleep(300);  // room for a duplicate to show up
-    assert(JSON.stringify(seen.events) === "[0,1,2]", `${what}: events ${JSON.stringify(seen.events)} (each once)`);
-    assert(JSON.stringify(seen.packets) === "[0,1]", `${what}: packets ${JSON.stringify(seen.packets)} (each once)`);
+    // cb_notify is a request of the service's that call_callbacks waits for: counted by now
     assert(seen.notifies === n0 + 1, `${what}: cb_notify ran ${seen.notifies - n0} times`);
+    // A fence instead of a pause: one more event and one more packet, sent after the ones above on the
+    // same connection, arrive after any second copy of those; the lists are compared once they did.
+    await c.fire_events(1);
+    await until(() => seen.events.length >= 4, `${what}: the fence event`);
+    await c.send_stream(1);
+    await until(() => seen.packets.length >= 3, `${what}: the fence packet`);
+    assert(JSON.stringify(seen.events.slice(0, 4)) === "[0,1,2,0]", `${what}: events ${JSON.stringify(seen.events)} (each once, then the fence)`);
+    assert(JSON.stringify(seen.packets.slice(0, 3)) === "[0,1,0]", `${what}: packets ${JSON.stringify(seen.packets)} (each once, then the fence)`);
     assert(seen.wireDup === 0, `${what}: ${seen.wireDup} wire values delivered twice`);
     assert(sub.state === "connected" && sub.clients[0].state === "connected", `${what}: state ${sub.state}/${sub.clients[0].state}`);
   };
@@ -115,14 +128,13 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
   }
 
   if (control.cut) {
-    await check(`network cut silently: noticed within receiveTimeoutMs (${FAST.receiveTimeoutMs} ms), resumes after`, async () => {
+    await check("network cut silently: noticed (receive timeout), getDefaultClient refuses, resumes after", async () => {
       const d0 = seen.disconnects;
       const c0 = client().connectCount;
       const t0 = performance.now();
       await control.cut();
-      await until(() => seen.disconnects > d0, "onDisconnect after the cut", FAST.receiveTimeoutMs + 5000);
-      const noticed = performance.now() - t0;
-      assert(noticed <= FAST.receiveTimeoutMs + 500, `noticed after ${Math.round(noticed)} ms`);
+      await until(() => seen.disconnects > d0, "onDisconnect after the cut", FAST.receiveTimeoutMs + 30000);
+      const noticed = performance.now() - t0;  // logged; its bound is checked in timeout_checks.mjs (timing)
       assert(sub.state === "connecting" && sub.getConnectedClients().size === 0, `state during the cut: ${sub.state}`);
       let threw = null;
       try {
@@ -131,17 +143,18 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
         threw = e;
       }
       assert(threw?.errorName === "RobotRaconteur.ConnectionError", "getDefaultClient during the cut");
-      await sleep(FAST.timeoutMs + 500);  // connect attempts into the silent network time out
-      const failedAttempts = seen.errors.length;
+      // A connect attempt in flight now hangs in the silent network; restore() ends it and the next succeeds.
       await control.restore();
       await works("after the cut");
       assert(client().connectCount === c0 + 1, `connectCount ${c0} -> ${client().connectCount}`);
-      return `noticed after ${Math.round(noticed)} ms; ${failedAttempts} errors reported during the cut`;
+      return `noticed after ${Math.round(noticed)} ms (receiveTimeoutMs ${FAST.receiveTimeoutMs})`;
     });
   }
 
-  if (control.dropAll && heap) {
+  if (control.dropAll) {
     await check(`memory flat over ${reconnects} reconnects`, async () => {
+      // the runner asked for it: without a heap figure it did not run, which is a failure, not a pass
+      assert(heap, "no heap measurement here (node --expose-gc; Chromium --js-flags=--expose-gc --enable-precise-memory-info)");
       const reconnectOnce = async () => {
         const c0 = client().connectCount;
         await control.dropAll();

@@ -4,7 +4,8 @@
 //   gateway: rr+ws to rr-gateway in front of the service, through the proxy (device restarted, gateway
 //            restarted, network cut, 100 reconnects with the heap measured after a full GC)
 //   filter:  subscribe({gateway, serviceTypes}) found through the gateway's device list, across a gateway restart
-//   then: heartbeats keep an idle connect() alive past receiveTimeoutMs; a silent peer is dropped in time
+//   then: heartbeatPeriodMs >= receiveTimeoutMs is refused (how fast a silent peer is dropped, and that
+//         heartbeats keep an idle connection: timeouts_test.mjs, labelled timing)
 //
 // Usage: node --expose-gc reconnect_test.mjs --interop-service PATH --gateway PATH [--target NAME] [--reconnects N]
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 emscripten absent (package cannot be built).
@@ -95,23 +96,27 @@ if (chosen.includes("filter")) {
   const sub = rr.subscribe({ gateway: gw.http, serviceTypes: ["experimental.interop_test.Root"] }, { ...FAST, discoveryIntervalMs: 200 });
   const wire = sub.subscribeWire("w_state");
   try {
-    const c = await sub.getDefaultClientWait(15000);
+    const c = await sub.getDefaultClientWait(30000);
     ok(c.$type === "experimental.interop_test.Root" && sub.clients.length === 1 && sub.clients[0].serviceInfo.device === "interop",
       `matched the gateway's device: ${sub.clients.map((x) => `${x.id} ${x.url}`).join(", ")}`);
-    ok(await wire.waitInValueValid(5000), "wire value through the filter's connection");
+    ok(await wire.waitInValueValid(30000), "wire value through the filter's connection");
     await gw.restart();
-    const again = await sub.getDefaultClientWait(15000);
+    const again = await sub.getDefaultClientWait(30000);
     const v0 = wire.tryGetInValue();
-    await sleep(600);
-    ok(again.$type === "experimental.interop_test.Root" && sub.clients[0].connectCount === 2 && wire.tryGetInValue() !== v0,
-      `after a gateway restart: connectCount ${sub.clients[0].connectCount}, wire values again`);
+    // a value the new connection brought (the service ticks), not a pause
+    let fresh = false;
+    const offFresh = wire.onValueChanged(() => (fresh = true));
+    for (const end = Date.now() + 30000; !fresh && Date.now() < end;) await sleep(10);
+    offFresh?.();
+    ok(again.$type === "experimental.interop_test.Root" && sub.clients[0].connectCount === 2 && fresh && wire.tryGetInValue() !== v0,
+      `after a gateway restart: connectCount ${sub.clients[0].connectCount}, wire values again (${fresh ? "a new one came" : "none in 30 s"})`);
     ok(none.clients.length === 0 && none.state === "connecting", "a filter nothing matches connects to nothing");
     // Two URLs (the service through the gateway and directly): two clients, values from both.
     const two = rr.subscribe([gw.rrUrl, svc.wsUrl], FAST);
     const w2 = two.subscribeWire("w_state");
     const from = new Set();
     w2.onValueChanged((v, ts, client) => from.add(client.id));
-    for (let i = 0; i < 300 && (from.size < 2 || w2.activeWireConnectionCount < 2); i++) await sleep(20);
+    for (const end = Date.now() + 30000; (from.size < 2 || w2.activeWireConnectionCount < 2) && Date.now() < end;) await sleep(20);
     ok(two.clients.length === 2 && two.getConnectedClients().size === 2 && w2.activeWireConnectionCount === 2 && from.size === 2,
       `two URLs: ${two.getConnectedClients().size} connected, ${w2.activeWireConnectionCount} wire connections, values from ${from.size}`);
     await two.close();
@@ -131,35 +136,18 @@ if (chosen.includes("filter")) {
   ran++;
   stopAll();
 }
-// Heartbeats: an idle connection (nothing subscribed, no requests) outlives receiveTimeoutMs several
-// times over because the client's ConnectionTest gets an answer; a silent peer (proxy cut) is dropped.
+// Heartbeats are for a peer that answers them: a period that is not shorter than the receive timeout
+// would drop every idle connection, so connect() refuses it.
 if (!arg("--target")) {
-  const svc = await interopService(arg("--interop-service"), await freePort());
-  const proxy = await cutProxy(svc.port);
-  const url = `rr+ws://127.0.0.1:${proxy.port}/?service=interop`;
-  console.log(`== heartbeat: ${url}`);
-  const c = await rr.connect(url, { heartbeatPeriodMs: 300, receiveTimeoutMs: 1200 });
-  let closedAt = null;
-  c.$client.onClose(() => (closedAt = performance.now()));
-  await sleep(4000);
-  const idleOk = c.$client.state === "connected" && closedAt === null;
-  console.log(`  ${idleOk ? "ok  " : "FAIL"} idle for 4000 ms with receiveTimeoutMs 1200: state ${c.$client.state}`);
-  const t0 = performance.now();
-  proxy.cut();
-  await sleep(2500);
-  const cutOk = closedAt !== null && closedAt - t0 <= 1700;
-  console.log(`  ${cutOk ? "ok  " : "FAIL"} silent peer: closed after ${closedAt === null ? "never" : Math.round(closedAt - t0)} ms`);
   let bad = null;
   try {
-    await rr.connect(url, { heartbeatPeriodMs: 2000, receiveTimeoutMs: 1000 });
+    await rr.connect("rr+ws://127.0.0.1:9/?service=interop", { heartbeatPeriodMs: 2000, receiveTimeoutMs: 1000 });
   } catch (e) {
     bad = e;
   }
   const badOk = bad?.errorName === "RobotRaconteur.InvalidArgument";
   console.log(`  ${badOk ? "ok  " : "FAIL"} heartbeatPeriodMs >= receiveTimeoutMs refused: ${bad?.message}`);
-  failed += [idleOk, cutOk, badOk].filter((x) => !x).length;
-  proxy.close();
-  stopAll();
+  if (!badOk) failed++;
 }
 console.log(failed ? `FAILED: ${failed} checks` : `all checks passed (${ran} targets)`);
 process.exit(failed ? 1 : 0);

@@ -36,6 +36,14 @@ function standIn() {
 }
 
 const tick = () => new Promise((r) => setTimeout(r, 0));
+/** Waits for `cond` (an event the code under test causes), bounded only against a hang. */
+async function until(cond, what, timeoutMs = 20000) {
+  const end = Date.now() + timeoutMs;
+  while (!cond()) {
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await new Promise((r) => setTimeout(r, 5));
+  }
+}
 
 test("two views of one wire share one connection; it closes with the last of them", async () => {
   const { obj, wire } = standIn();
@@ -81,9 +89,9 @@ test("the far side closing the wire tells every view; the next one reconnects", 
 
 test("followWire: a panel and a card on the same wire both follow it and reconnect after a close", async () => {
   const { obj, wire } = standIn();
-  const panel = [], card = [], errors = [];
+  const panel = [], card = [], errors = [], cardErrors = [];
   const p = followWire(obj, "state", { onValue: (v) => panel.push(v), onError: (e) => errors.push(e?.message ?? null), reopenMs: 10 });
-  const c = followWire(obj, "state", { onValue: (v) => card.push(v), reopenMs: 10 });
+  const c = followWire(obj, "state", { onValue: (v) => card.push(v), onError: (e) => cardErrors.push(e?.message ?? null), reopenMs: 10 });
   await tick();
   await tick();
   assert.equal(wire.connects, 1, "one connection for both");
@@ -91,7 +99,9 @@ test("followWire: a panel and a card on the same wire both follow it and reconne
   assert.deepEqual([panel, card], [["x"], ["x"]]);
   wire.end(new Error("device gone"));
   assert.deepEqual(errors, [null, "device gone"]);
-  await new Promise((r) => setTimeout(r, 40));
+  // each follower says it is open again with onError(null): wait for both, then count the connections
+  await until(() => errors.length >= 3 && cardErrors.length >= 3, "both followers open again");
+  assert.deepEqual([errors, cardErrors], [[null, "device gone", null], [null, "device gone", null]]);
   assert.equal(wire.connects, 2, "reconnected once, for both");
   wire.send("y");
   assert.deepEqual([panel, card], [["x", "y"], ["x", "y"]]);
