@@ -443,7 +443,7 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
             body_ += "  " + m.name + ": " + namedarray_field_ts(m, element) + ";\n";
         else if (e.kind == EntryKind::pod)
             body_ += "  " + m.name + ": " + value_ts(m.type) + ";\n";
-        else if (m.name == "then") {
+        else if (e.kind == EntryKind::object && m.name == "then") {
             // A proxy never has a `then` property (it would be a thenable: `await` would call it); the
             // package gives such a member by $member("then").
             body_ += "  $member(name: \"then\"): " + member_type_ts(m) + ";\n";
