@@ -7,7 +7,8 @@
 //   write  property set, wire OutValue (sending wire values) and poke, memory write, pipe send
 //   call   functions, generator functions (and their next/close/abort), callbacks
 //   lock   object locks and monitor locks (RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock,
-//          MonitorEnter, MonitorContinueEnter, MonitorExit); for `lock` a rule's members name objects
+//          ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit: mirror_access.hpp
+//          is_lock_operation); for `lock` a rule's members name objects
 //          (object_key: the relative service path, "" for the root object), as a lock covers an object
 // A member of the device's root object is named by its member name (`Drive`); a member of an object
 // below the root by `<relative service path>.<member>` (`Webcams[0].Capture`), the path in RR's
