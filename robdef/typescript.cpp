@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "robdef/parser.hpp"
@@ -126,7 +127,11 @@ private:
     DataTypes namedarray_element(const ServiceEntryDefinition& na, int depth = 0) const;
     std::string namedarray_field_ts(const MemberDefinition& f, DataTypes element);
     std::string params_ts(const std::vector<TypeDefinition>& params, std::size_t count);
+    // A function member's parameter list and result type (a generator's parameter is the Generator's).
+    std::pair<std::string, std::string> function_ts(const MemberDefinition& m);
     std::string member_ts(const MemberDefinition& m);
+    // The type of member `m` alone, as $member(name) returns it (a function: an arrow type).
+    std::string member_type_ts(const MemberDefinition& m);
 
     void doc(const std::vector<std::string>& lines, std::string_view indent, const std::vector<std::string>& extra = {});
     void emit_enum(const EnumDefinition& e);
@@ -227,6 +232,23 @@ std::string Generator::params_ts(const std::vector<TypeDefinition>& params, std:
     return s;
 }
 
+std::pair<std::string, std::string> Generator::function_ts(const MemberDefinition& m) {
+    if (!m.is_generator()) return {params_ts(m.parameters, m.parameters.size()), "Promise<" + value_ts(m.type) + ">"};
+    const bool param_gen = !m.parameters.empty() && m.parameters.back().container == ContainerKind::generator;
+    std::size_t n = m.parameters.size() - (param_gen ? 1 : 0);
+    std::string ret = value_ts(m.type);
+    std::string param = param_gen ? value_ts(m.parameters.back()) : "undefined";
+    return {params_ts(m.parameters, n), "Promise<$rr.Generator<" + ret + ", " + param + ">>"};
+}
+
+std::string Generator::member_type_ts(const MemberDefinition& m) {
+    if (m.kind == MemberKind::function) {
+        auto [params, result] = function_ts(m);
+        return "(" + params + ") => " + result;
+    }
+    return member_ts(m).substr(m.name.size() + 2);  // "<name>: <type>"
+}
+
 std::string Generator::member_ts(const MemberDefinition& m) {
     const auto dir = m.direction();
     auto directed = [&](std::string_view both, std::string_view ro, std::string_view wo, const std::string& arg) {
@@ -266,13 +288,8 @@ std::string Generator::member_ts(const MemberDefinition& m) {
             return m.name + ": $rr.ObjRef<" + target + ">";
         }
         case MemberKind::function: {
-            if (!m.is_generator())
-                return m.name + "(" + params_ts(m.parameters, m.parameters.size()) + "): Promise<" + value_ts(m.type) + ">";
-            const bool param_gen = !m.parameters.empty() && m.parameters.back().container == ContainerKind::generator;
-            std::size_t n = m.parameters.size() - (param_gen ? 1 : 0);
-            std::string ret = value_ts(m.type);
-            std::string param = param_gen ? value_ts(m.parameters.back()) : "undefined";
-            return m.name + "(" + params_ts(m.parameters, n) + "): Promise<$rr.Generator<" + ret + ", " + param + ">>";
+            auto [params, result] = function_ts(m);
+            return m.name + "(" + params + "): " + result;
         }
         case MemberKind::field: return m.name + ": " + value_ts(m.type);
     }
@@ -407,6 +424,7 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
     doc(e.docstring, "", extra);
     body_ += "export interface " + e.name + (e.kind == EntryKind::object ? " extends $rr.ObjectBase" : "") + " {\n";
     const DataTypes element = e.kind == EntryKind::namedarray ? namedarray_element(e) : DataTypes::void_t;
+    bool then_member = false;
     for (const auto& m : e.members) {
         std::vector<std::string> mextra;
         std::string text = m.type.to_string();
@@ -425,9 +443,15 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
             body_ += "  " + m.name + ": " + namedarray_field_ts(m, element) + ";\n";
         else if (e.kind == EntryKind::pod)
             body_ += "  " + m.name + ": " + value_ts(m.type) + ";\n";
-        else
+        else if (e.kind == EntryKind::object && m.name == "then") {
+            // A proxy never has a `then` property (it would be a thenable: `await` would call it); the
+            // package gives such a member by $member("then").
+            body_ += "  $member(name: \"then\"): " + member_type_ts(m) + ";\n";
+            then_member = true;
+        } else
             body_ += "  " + member_ts(m) + ";\n";
     }
+    if (then_member) body_ += "  $member(name: string): any;\n";
     body_ += "}\n";
     if (!e.constants.empty()) {
         body_ += "/** Constants of `" + qualified + "`. */\n";

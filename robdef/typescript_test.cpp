@@ -222,6 +222,36 @@ end
     CHECK(has(d, "  /** `property double ro [readonly]` */\n"));
 }
 
+TEST_CASE("ts: a member named then is typed through $member, never as a property (a proxy is no thenable)") {
+    auto set = load({R"(service t.then
+
+stdver 0.10
+
+struct St
+    field double then
+end
+
+object F
+    function int32 then(int32 x)
+    property double value
+end
+
+object P
+    property St then
+end
+)"});
+    auto d = to_typescript(*set.find_service("t.then"), set).declarations;
+    INFO(d);
+    CHECK(has(d, "export interface F extends $rr.ObjectBase {"));
+    CHECK(has(d, "  $member(name: \"then\"): (x: number) => Promise<number>;\n"));
+    CHECK(has(d, "  value: $rr.Property<number>;\n"));
+    CHECK(has(d, "  $member(name: \"then\"): $rr.Property<St | null>;\n"));
+    CHECK(has(d, "  $member(name: string): any;\n"));
+    CHECK_FALSE(has(d, "  then("));
+    CHECK_FALSE(has(d, "  then: $rr."));
+    CHECK(has(d, "  then: number;\n"));  // a struct's field is a value, never called: it stays
+}
+
 TEST_CASE("ts: types of other definitions come from their modules (namespace imports)") {
     auto set = load({R"(service a.geo
 

@@ -364,12 +364,13 @@ void parse_auth(const YAML::Node& a, const Reader& r, GatewayAuthConfig& c) {
                 if (auto n = e["devices"]) rule.devices = patterns(n, r, rk + ".devices");
                 if (auto n = e["members"]) rule.members = patterns(n, r, rk + ".members");
                 auto allow = e["allow"];
-                if (!allow) r.error(e, rk + ".allow", "missing (a list of read, write, call)");
+                if (!allow) r.error(e, rk + ".allow", "missing (a list of read, write, call, lock)");
                 for (const auto& op : r.string_list(allow, rk + ".allow")) {
                     if (op == "read") rule.read = true;
                     else if (op == "write") rule.write = true;
                     else if (op == "call") rule.call = true;
-                    else r.error(allow, rk + ".allow", "\"" + op + "\" is not read, write or call");
+                    else if (op == "lock") rule.lock = true;
+                    else r.error(allow, rk + ".allow", "\"" + op + "\" is not read, write, call or lock");
                 }
                 rules.push_back(std::move(rule));
             }

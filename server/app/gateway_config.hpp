@@ -85,7 +85,7 @@ struct GatewayAuthConfig {
     } jwt;
     struct Rule {
         std::vector<std::string> devices{"*"}, members{"*"};
-        bool read = false, write = false, call = false;
+        bool read = false, write = false, call = false, lock = false;
     };
     std::vector<std::pair<std::string, std::vector<Rule>>> roles;
     unsigned max_failures = 5, window_s = 60, lockout_s = 300;

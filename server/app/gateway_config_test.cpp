@@ -421,7 +421,7 @@ gateway:
       driver:
         - devices: create
           members: [Drive, "Webcams[*].*"]
-          allow: [call, write]
+          allow: [call, write, lock]
     login_limit: {max_failures: 3, window_s: 10, lockout_s: 20}
     session_ttl_s: 600
 )", "auth.yaml");
@@ -438,10 +438,12 @@ gateway:
     CHECK(a.roles[0].second[0].devices == std::vector<std::string>{"*"});
     CHECK(a.roles[0].second[0].read);
     CHECK_FALSE(a.roles[0].second[0].write);
+    CHECK_FALSE(a.roles[0].second[0].lock);
     CHECK(a.roles[1].second[0].devices == std::vector<std::string>{"create"});
     CHECK(a.roles[1].second[0].members == std::vector<std::string>{"Drive", "Webcams[*].*"});
     CHECK(a.roles[1].second[0].call);
     CHECK(a.roles[1].second[0].write);
+    CHECK(a.roles[1].second[0].lock);
     CHECK(a.max_failures == 3);
     CHECK(a.lockout_s == 20);
     CHECK(a.session_ttl_s == 600);
@@ -450,7 +452,7 @@ gateway:
     for (auto [yaml, expect] : {
              std::pair{"gateway:\n  auth:\n    user: u.txt\n", "bad.yaml:3: gateway.auth.user: unknown key"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - allow: [read, delete]\n",
-                       "bad.yaml:6: gateway.auth.roles.r[0].allow: \"delete\" is not read, write or call"},
+                       "bad.yaml:6: gateway.auth.roles.r[0].allow: \"delete\" is not read, write, call or lock"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - devices: [a]\n",
                        "bad.yaml:6: gateway.auth.roles.r[0].allow: missing"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - alow: [read]\n",

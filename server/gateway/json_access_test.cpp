@@ -44,8 +44,8 @@ HttpReply request_as(std::uint16_t port, bhttp::verb method, const std::string& 
 }
 
 /// Device "interop" (auth: shared) and "pt" (auth: passthrough), both rr_interop_service, behind a
-/// gateway with users alice (operator: everything), victor (viewer: read everything) and dora (driver:
-/// call `add`, read `p_double` and `ro_*`, on both devices only).
+/// gateway with users alice (operator: everything, lock too), victor (viewer: read everything) and dora
+/// (driver: call `add`, read `p_double` and `ro_*`, lock the object `child`, on both devices only).
 struct AuthGateway {
     std::filesystem::path dir =
         std::filesystem::temp_directory_path() / ("rr_json_access_" + std::to_string(::getpid()));
@@ -76,10 +76,11 @@ struct AuthGateway {
         }
         using Rule = app::GatewayAuthConfig::Rule;
         cfg.auth.users = (dir / "users.txt").string();
-        cfg.auth.roles.push_back({"operator", {Rule{{"*"}, {"*"}, true, true, true}}});
+        cfg.auth.roles.push_back({"operator", {Rule{{"*"}, {"*"}, true, true, true, true}}});
         cfg.auth.roles.push_back({"viewer", {Rule{{"*"}, {"*"}, true, false, false}}});
         cfg.auth.roles.push_back({"driver", {Rule{{"interop", "pt"}, {"add"}, false, false, true},
-                                             Rule{{"interop", "pt"}, {"p_double", "ro_*"}, true, false, false}}});
+                                             Rule{{"interop", "pt"}, {"p_double", "ro_*"}, true, false, false},
+                                             Rule{{"interop", "pt"}, {"child"}, false, false, false, true}}});
         auto g = app::Gateway::start(cfg, {}, install_json_api);
         INFO((g ? std::string() : g.error().message));
         REQUIRE(g);
@@ -141,7 +142,7 @@ TEST_CASE("json access: without gateway logins the answer says the gateway check
     TestGateway gw(device.url());
     auto r = http_get(gw.port(), "/api/devices/interop/access");
     REQUIRE(r.status == 200);
-    CHECK(r.body == json{{"device", "interop"}, {"auth", false}, {"user", nullptr}, {"members", nullptr}});
+    CHECK(r.body == json{{"device", "interop"}, {"auth", false}, {"user", nullptr}, {"members", nullptr}, {"lock", nullptr}});
     CHECK(http_get(gw.port(), "/api/devices/interop/access?members=add").body["members"].is_null());
     auto missing = http_get(gw.port(), "/api/devices/nosuch/access");
     CHECK(missing.status == 404);
@@ -187,6 +188,7 @@ TEST_CASE("json access: each role's operations on every root member, ?members, e
             CHECK(it.value() == json{"read", "write", "call"});
         }
         CHECK(listed == names);
+        CHECK(r.body["lock"] == true);
     }
     SECTION("viewer: read only") {
         auto r = request_as(port, bhttp::verb::get, "/api/devices/interop/access", victor);
@@ -194,6 +196,7 @@ TEST_CASE("json access: each role's operations on every root member, ?members, e
         CHECK(r.body["user"] == "victor");
         CHECK(r.body["members"].size() == names.size());
         for (const auto& ops : r.body["members"]) CHECK(ops == json{"read"});
+        CHECK(r.body["lock"] == false);
     }
     SECTION("a role allowing some members: the others get an empty list") {
         auto r = request_as(port, bhttp::verb::get, "/api/devices/interop/access", dora);
@@ -206,6 +209,7 @@ TEST_CASE("json access: each role's operations on every root member, ?members, e
         CHECK(m["p_int32"] == json::array());
         CHECK(m["count_up"] == json::array());
         CHECK(r.body["roles"] == json{"driver", "objectlock"});
+        CHECK(r.body["lock"] == false);  // `lock` on the object child only, not on the root
     }
     SECTION("?members restricts the answer; an unknown or empty name is 400") {
         auto r = request_as(port, bhttp::verb::get, "/api/devices/interop/access?members=add,p_int32,add", dora);

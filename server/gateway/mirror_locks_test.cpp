@@ -85,12 +85,25 @@ struct LockGateway {
             s.users.add_user("bob", "b", {"operator", "objectlock"});
             s.users.add_user("carol", "c", {"operator"});
             s.users.add_user("root", "r", {"operator", "objectlockoverride"});
+            s.users.add_user("mallory", "m", {});                        // logs in, may do nothing
+            s.users.add_user("victor", "v", {"viewer", "objectlock"});   // reads, no lock
+            s.users.add_user("gus", "g", {"gripper", "objectlock"});     // locks the gripper only
             auto policy = std::make_shared<auth::AccessPolicy>();
             auth::AccessRule all;
             all.devices = {"*"};
             all.members = {"*"};
-            all.read = all.write = all.call = true;
+            all.read = all.write = all.call = all.lock = true;
             policy->add_role("operator", {all});
+            auth::AccessRule read;
+            read.devices = {"*"};
+            read.members = {"*"};
+            read.read = true;
+            policy->add_role("viewer", {read});
+            auth::AccessRule gripper_lock;  // for `lock`, members name objects by relative service path
+            gripper_lock.devices = {"dev"};
+            gripper_lock.members = {"gripper"};
+            gripper_lock.lock = true;
+            policy->add_role("gripper", {read, gripper_lock});
             s.policy = policy;
             mirror->mirror_service()->set_access(auth::MirrorAccess(std::make_shared<auth::GatewayAuth>(std::move(s)), "dev"));
         }
@@ -267,6 +280,46 @@ TEST_CASE("auth shared: a monitor at the gateway refuses other sessions and is h
     b.raw->close();  // the holder's session goes: its monitor with it
     CHECK(eventually([&] { return gw.locks().empty(); }));
     CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+}
+
+TEST_CASE("auth shared: locks need the roles' `lock`; a login without it is refused every lock operation") {
+    LockGateway gw;
+    auto a = gw.connect("alice", "a");
+    auto m = gw.connect("mallory", "m");
+    auto v = gw.connect("victor", "v");
+    auto g = gw.connect("gus", "g");
+
+    // A login with no role: every lock operation refused before it reaches the locks, nothing held, and
+    // the operator's requests are not blocked (the issue: a role-less MonitorEnter blocked everyone).
+    for (const char* op : {"MonitorEnter", "MonitorContinueEnter", "MonitorExit", "RequestObjectLock", "RequestClientObjectLock",
+                           "ReleaseObjectLock", "ReleaseClientObjectLock"}) {
+        INFO(op);
+        auto e = std::string(op) == "MonitorEnter" ? enter_op(-1) : shared_lock_op(op);
+        auto refused = m.error(std::move(e));
+        CHECK(refused.type == MessageErrorType::PermissionDenied);
+        CHECK(refused.message == "user mallory may not lock the root object of dev");
+    }
+    CHECK(m.error(enter_op(-1, "dev.gripper")).message == "user mallory may not lock object gripper of dev");
+    CHECK(gw.locks().empty());
+    CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
+    a.ok(set_req("pos", 2.0));
+    CHECK(gw.device.root->property_value("pos").value().as<double>().value() == 2.0);
+
+    // read without lock (the objectlock privilege alone is not enough through the gateway).
+    CHECK(v.error(shared_lock_op("RequestObjectLock")).message == "user victor may not lock the root object of dev");
+    CHECK(v.error(enter_op(-1)).type == MessageErrorType::PermissionDenied);
+    CHECK(scalar_of<double>(v.ok(get_req("pos")), "value") == 2.0);
+
+    // `lock` on one object: that object only (rule members name objects for lock).
+    CHECK(g.error(shared_lock_op("RequestObjectLock")).message == "user gus may not lock the root object of dev");
+    CHECK(op_result(g.ok(shared_lock_op("RequestObjectLock", "dev.gripper"))) == "OK");
+    CHECK(gw.locks() == HeldLocks{{"dev.gripper", "gus", "user"}});
+    CHECK(a.error(get_req("width", "dev.gripper")).message == "Object locked by gus");
+    CHECK(op_result(g.ok(shared_lock_op("ReleaseObjectLock", "dev.gripper"))) == "OK");
+    CHECK(op_result(g.ok(enter_op(-1, "dev.gripper"))) == "OK");
+    CHECK(a.error(get_req("width", "dev.gripper")).type == MessageErrorType::InvalidOperation);
+    CHECK(op_result(g.ok(shared_lock_op("MonitorExit", "dev.gripper"))) == "OK");
+    CHECK(scalar_of<double>(a.ok(get_req("width", "dev.gripper")), "value") == 0.25);
 }
 
 TEST_CASE("auth shared: [nolock] and [nolockread] members pass gateway-held object locks, not monitors") {

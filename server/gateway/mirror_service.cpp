@@ -449,7 +449,10 @@ void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry
     });
     if (!joined.ready) return ensure_upstream_wire(key);
     shared->respond(MessageEntry{});
-    if (joined.last) (void)session.send_wire_packet(joined.last);  // the newest value, at once
+    // The newest value, at once, under the same rule as live values: a session that may only send
+    // (auth: gateway, `write` without `read`) receives no InValue, cached or not.
+    if (joined.last && (!access_.active() || access_.may(session, key.first, key.second, auth::Operation::read)))
+        (void)session.send_wire_packet(joined.last);
 }
 
 void MirrorService::ensure_upstream_wire(const MemberKey& key) {

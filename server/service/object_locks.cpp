@@ -196,6 +196,15 @@ std::uint32_t ObjectLocks::monitor_holder(const std::string& path) const {
     return it == monitors_.end() ? 0 : it->second.holder;
 }
 
+std::optional<ObjectLocks::Clock::time_point> ObjectLocks::monitor_wait_deadline(const std::string& path,
+                                                                                 std::uint32_t endpoint) const {
+    auto it = monitors_.find(path);
+    if (it == monitors_.end()) return std::nullopt;
+    for (const auto& w : it->second.waiters)
+        if (w.endpoint == endpoint) return w.deadline;
+    return std::nullopt;
+}
+
 std::vector<std::pair<std::string, std::uint32_t>> ObjectLocks::monitor_holders(Clock::time_point now) const {
     std::vector<std::pair<std::string, std::uint32_t>> out;
     for (const auto& [path, m] : monitors_)

@@ -99,6 +99,9 @@ public:
     void monitor_session_closed(std::uint32_t endpoint, Clock::time_point now, std::vector<MonitorEvent>& events);
     /// The session holding the monitor of `path` (0: none).
     std::uint32_t monitor_holder(const std::string& path) const;
+    /// When `endpoint`'s wait for the monitor of `path` times out (nullopt: it does not wait, or
+    /// waits without a timeout).
+    std::optional<Clock::time_point> monitor_wait_deadline(const std::string& path, std::uint32_t endpoint) const;
     /// Every monitor held at `now` (path, holding session), by path; holders idle for kMonitorIdle
     /// are left out (they lose the monitor at its next use).
     std::vector<std::pair<std::string, std::uint32_t>> monitor_holders(Clock::time_point now) const;

@@ -175,6 +175,30 @@ TEST_CASE("object locks: monitor lock blocks other sessions and is handed over o
     CHECK(returned(a.ok(lock_op("MonitorExit"))) == "OK");
 }
 
+TEST_CASE("object locks: a MonitorEnter timeout past the 5 s Continue is answered when it passes, not 5 s later") {
+    LockFixture lf;
+    auto a = lf.f.connect(login("alice", "a"));
+    auto b = lf.f.connect(login("bob", "b"));
+    auto enter = [](std::int32_t timeout) {
+        auto m = lock_op("MonitorEnter");
+        m.elements.push_back(make_scalar_element<std::int32_t>("timeout", timeout));
+        return m;
+    };
+    CHECK(returned(a.ok(enter(-1))) == "OK");
+    const auto t0 = std::chrono::steady_clock::now();
+    CHECK(returned(b.ok(enter(6500))) == "Continue");  // after kMonitorWait
+    // The client asks again, as the official client does; the wait ends with the timeout (6.5 s after
+    // the MonitorEnter), not at the next "Continue" (10 s). A bound on a hang, generous: 3 s over.
+    auto timed_out = b.error(lock_op("MonitorContinueEnter"));
+    const auto took = std::chrono::steady_clock::now() - t0;
+    CHECK(timed_out.type == MessageErrorType::RequestTimeout);
+    CHECK(timed_out.message == "Timed out waiting for the monitor lock");
+    CHECK(took >= std::chrono::milliseconds(6500));
+    CHECK(took < std::chrono::milliseconds(9500));
+    CHECK(b.error(get_value()).type == MessageErrorType::InvalidOperation);  // a still holds it
+    CHECK(returned(a.ok(lock_op("MonitorExit"))) == "OK");
+}
+
 TEST_CASE("object locks: members marked [nolock] / [nolockread] pass object locks, not monitor locks") {
     ServiceFixture f;
     auto types = ServiceTypes::create({"service example.nolocktest\n\nstdver 0.10\n\nobject Obj\n"

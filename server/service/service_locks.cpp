@@ -59,6 +59,18 @@ void ServiceLocks::changed() const {
     if (f) f();
 }
 
+std::chrono::milliseconds ServiceLocks::wait_for_monitor(const std::string& path, std::uint32_t endpoint,
+                                                        std::chrono::steady_clock::time_point now) const {
+    auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(kMonitorWait);
+    // Parked no longer than the waiter's own timeout, which then answers RequestTimeout on time (parked
+    // for kMonitorWait each time, a 7 s timeout was answered at 10 s).
+    if (auto deadline = locks_.monitor_wait_deadline(path, endpoint)) {
+        const auto left = std::chrono::ceil<std::chrono::milliseconds>(*deadline - now) + std::chrono::milliseconds(1);
+        wait = std::clamp(left, std::chrono::milliseconds(1), wait);
+    }
+    return wait;
+}
+
 void ServiceLocks::update_any() { any_.store(!locks_.empty(), std::memory_order_release); }
 
 void ServiceLocks::handle_op(const Requester& who, Privileges privileges, const MessageEntry& entry, Responder responder) {
@@ -92,10 +104,12 @@ void ServiceLocks::handle_op(const Requester& who, Privileges privileges, const 
             return;
         }
         Result<bool> r = false;
+        std::chrono::milliseconds wait{};
         {
             std::lock_guard lock(mutex_);
             r = locks_.monitor_enter(path, who.endpoint, timeout, now, events);
             if (r) monitor_users_[who.endpoint] = who.username;
+            if (r && !*r) wait = wait_for_monitor(path, who.endpoint, now);
             update_any();
         }
         deliver(events);
@@ -105,18 +119,17 @@ void ServiceLocks::handle_op(const Requester& who, Privileges privileges, const 
             answer(responder, "OK");
             changed();
         } else {
-            auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(kMonitorWait);
-            if (timeout >= 0 && std::chrono::milliseconds(timeout) + std::chrono::milliseconds(1) < wait)
-                wait = std::chrono::milliseconds(timeout) + std::chrono::milliseconds(1);
             park(path, who.endpoint, std::move(responder), wait);
         }
         return;
     }
     if (op == "MonitorContinueEnter") {
         Result<bool> r = false;
+        std::chrono::milliseconds wait{};
         {
             std::lock_guard lock(mutex_);
             r = locks_.monitor_continue(path, who.endpoint, now, events);
+            if (r && !*r) wait = wait_for_monitor(path, who.endpoint, now);
             update_any();
         }
         deliver(events);
@@ -125,7 +138,7 @@ void ServiceLocks::handle_op(const Requester& who, Privileges privileges, const 
         else if (*r)
             answer(responder, "OK");
         else
-            park(path, who.endpoint, std::move(responder), std::chrono::duration_cast<std::chrono::milliseconds>(kMonitorWait));
+            park(path, who.endpoint, std::move(responder), wait);
         return;
     }
     if (op == "MonitorExit") {

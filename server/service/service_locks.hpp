@@ -103,6 +103,10 @@ private:
     void deliver(std::vector<ObjectLocks::MonitorEvent>& events);
     void changed() const;
     void update_any();  // mutex_ held
+    /// How long a MonitorEnter / MonitorContinueEnter of `endpoint` that must wait is parked: kMonitorWait,
+    /// or less when its timeout comes first (mutex_ held).
+    std::chrono::milliseconds wait_for_monitor(const std::string& path, std::uint32_t endpoint,
+                                               std::chrono::steady_clock::time_point now) const;
 
     mutable std::mutex mutex_;
     ObjectLocks locks_;

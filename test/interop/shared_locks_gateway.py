@@ -48,7 +48,8 @@ from gateway_logins import Http  # noqa: E402
 from passthrough_gateway import JsonSocket  # noqa: E402
 
 RRN = ll.RRN
-# The gateway's users: locks_logins' users and privileges, each with the role that may do everything.
+# The gateway's users: locks_logins' users and privileges, each with the role that may do everything
+# (locks too: `lock` lets a lock request reach the lock rules, where objectlock then decides).
 GATEWAY_USERS = {user: (pw, "operator" if priv == "_" else "operator," + priv) for user, (pw, priv) in ll.USERS.items()}
 
 
@@ -224,7 +225,7 @@ def write_config(path, device_url, users=None):
     with open(path, "w") as fh:
         fh.write("gateway:\n  listen: 127.0.0.1\n  port: 0\n  local: false\n")
         if users:
-            fh.write("  auth:\n    users: %s\n    roles:\n      operator:\n        - allow: [read, write, call]\n" % users)
+            fh.write("  auth:\n    users: %s\n    roles:\n      operator:\n        - allow: [read, write, call, lock]\n" % users)
             fh.write("    login_limit: {max_failures: 100, window_s: 60, lockout_s: 1}\n")
         fh.write("demo:\n  enabled: false\ndevices:\n  - name: interop\n    url: %s\n" % json.dumps(device_url))
 

@@ -146,12 +146,16 @@ export interface ObjectBase {
   /** Takes the object's monitor lock (timeoutMs −1: wait as long as it takes). */
   $monitorEnter(timeoutMs?: number): Promise<void>;
   $monitorExit(): Promise<void>;
+  /** The member `name`, as the proxy's property of that name would be. A member named `then` is
+   *  reached only this way: as a property it would make the proxy a thenable, which `await` calls.
+   *  Throws RRError `RobotRaconteur.MemberNotFound` for a name the object does not have. */
+  $member(name: string): any;
 }
 
 /** An object proxy without generated types: members by name are `any`. */
 export interface ObjectProxy extends ObjectBase {
   /** Members by name: PropertyMember, function, EventMember, ObjRefMember, PipeMember, CallbackMember,
-   *  WireMember or MemoryMember according to the member's kind. */
+   *  WireMember or MemoryMember according to the member's kind (a member named `then`: `$member("then")`). */
   [member: string]: any;
 }
 

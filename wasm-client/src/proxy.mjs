@@ -49,12 +49,28 @@ export function makeProxy(conn, desc) {
   // the object's hidden class, and a closure over `conn` there would keep a closed connection alive.
   Object.defineProperty(proxy, CONNECTION, { value: conn });
   Object.defineProperty(proxy, "$definitions", { get: definitionsOf, enumerable: true });
+  const members = new Map();
   for (const m of desc.members) {
     const make = MEMBER_KINDS[m.kind];
-    if (make) proxy[m.name] = make(conn, desc.path, m);
+    if (!make) continue;
+    const member = make(conn, desc.path, m);
+    members.set(m.name, member);
+    // A property named `then` would make the proxy a thenable: `await proxy`, or a promise resolved
+    // with it (connect(), objref get()), would call it and wait forever. Such a member is reached
+    // with proxy.$member("then") only (README "API").
+    if (!NOT_A_PROPERTY.has(m.name)) proxy[m.name] = member;
   }
+  /** The member `name` (every member, also one that is not a property of the proxy, such as `then`). */
+  proxy.$member = (name) => {
+    const member = members.get(name);
+    if (member === undefined) throw new RRError("RobotRaconteur.MemberNotFound", `${desc.type} has no member "${name}"`, 9);
+    return member;
+  };
   return proxy;
 }
+
+/** Member names that are never properties of a proxy (reached with $member). */
+const NOT_A_PROPERTY = new Set(["then"]);
 
 const MEMBER_KINDS = {
   property: (conn, path, m) => ({

@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import { JogRepeater, JOG_PERIOD_MS, JOG_TIMEOUT_S, JOG_MAX_IN_FLIGHT } from "../src/robot/jog_repeater.js";
 import { jointModel, jointRows, limitState, jogVelocity, positionText, toDisplay, fromDisplay, NEAR_LIMIT_FRACTION } from "../src/robot/joints.js";
 import { flagChips, flagTone, modeText, isStale, capabilitySet, STALE_MS } from "../src/robot/status.js";
-import { accessUrl, fetchAccess, allows } from "../src/robot/access.js";
+import { accessUrl, fetchAccess, allows, mayLock } from "../src/robot/access.js";
 import { jogKey, jogKeysText } from "../src/robot/hold.js";
 import { cartesianVelocity, isNotImplemented, CARTESIAN_LINEAR_MPS } from "../src/robot/cartesian.js";
 import { locksText } from "../src/robot/lock_text.js";
@@ -248,6 +248,11 @@ test("access: URL with the device user, allows() by member and operation, the en
   assert.equal(allows({ members: null }, "anything", "call"), true);
   assert.equal(allows(null, "jog_joint", "call"), false);
   assert.equal(allows({ members: { command_mode: ["read", "write"] } }, "command_mode", "write"), true);
+  assert.equal(mayLock({ ...viewer, lock: false }), false);
+  assert.equal(mayLock({ ...viewer, lock: true }), true);
+  assert.equal(mayLock({ auth: false, members: null, lock: null }), true);  // nothing checked
+  assert.equal(mayLock(viewer), true);  // a gateway that does not say: its refusal decides
+  assert.equal(mayLock(null), false);
   const reply = (status, body) => async (url) => ({ status, ok: status < 300, json: async () => body, url });
   assert.deepEqual(await fetchAccess("arm", null, reply(200, viewer)), viewer);
   assert.equal((await fetchAccess("arm", null, reply(404, null))).members, null);

@@ -7,6 +7,7 @@ std::string_view operation_name(Operation op) noexcept {
         case Operation::read: return "read";
         case Operation::write: return "write";
         case Operation::call: return "call";
+        case Operation::lock: return "lock";
     }
     return "?";
 }
@@ -16,6 +17,7 @@ bool AccessRule::allows(Operation op) const noexcept {
         case Operation::read: return read;
         case Operation::write: return write;
         case Operation::call: return call;
+        case Operation::lock: return lock;
     }
     return false;
 }
@@ -78,6 +80,11 @@ std::string member_key(std::string_view object, std::string_view member) {
     out.reserve(object.size() + 1 + member.size());
     out.append(object).append(".").append(member);
     return out;
+}
+
+std::string refused_target(std::string_view key, Operation op) {
+    if (op != Operation::lock) return std::string(key);
+    return key.empty() ? std::string("the root object") : "object " + std::string(key);
 }
 
 }  // namespace rr::server::gateway::auth

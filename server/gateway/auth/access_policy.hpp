@@ -6,6 +6,10 @@
 //   read   property get, wire InValue (receiving wire values) and peek, memory read, event and pipe receive
 //   write  property set, wire OutValue (sending wire values) and poke, memory write, pipe send
 //   call   functions, generator functions (and their next/close/abort), callbacks
+//   lock   object locks and monitor locks (RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock,
+//          ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit: mirror_access.hpp
+//          is_lock_operation); for `lock` a rule's members name objects
+//          (object_key: the relative service path, "" for the root object), as a lock covers an object
 // A member of the device's root object is named by its member name (`Drive`); a member of an object
 // below the root by `<relative service path>.<member>` (`Webcams[0].Capture`), the path in RR's
 // encoding as the JSON API's `object` parameter normalises it. Rules only allow: an operation is
@@ -21,15 +25,15 @@
 
 namespace rr::server::gateway::auth {
 
-enum class Operation { read, write, call };
+enum class Operation { read, write, call, lock };
 
-/// "read", "write", "call".
+/// "read", "write", "call", "lock".
 std::string_view operation_name(Operation op) noexcept;
 
 struct AccessRule {
     std::vector<std::string> devices;  ///< patterns
     std::vector<std::string> members;  ///< patterns
-    bool read = false, write = false, call = false;
+    bool read = false, write = false, call = false, lock = false;
 
     bool allows(Operation op) const noexcept;
 };
@@ -55,6 +59,10 @@ private:
 
 /// The member key of `member` on the object at relative service path `object` ("" = the root).
 std::string member_key(std::string_view object, std::string_view member);
+
+/// How a refusal names what was asked for: `<member key>` for read, write and call; for lock
+/// `the root object` or `object <relative service path>` (the key of Operation::lock is an object's).
+std::string refused_target(std::string_view key, Operation op);
 
 /// Who is asking: a user of the password file, a bearer token, a JWT subject. Immutable.
 struct Principal {

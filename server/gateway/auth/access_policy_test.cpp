@@ -41,6 +41,26 @@ TEST_CASE("gateway auth: rules allow per role, device and member, and deny every
     CHECK_FALSE(nobody.allows("create", "Drive", Operation::call));
 }
 
+TEST_CASE("gateway auth: lock is a right of its own, its members name objects") {
+    AccessPolicy p;
+    p.add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});  // read, write, call: no lock
+    p.add_role("locker", {AccessRule{{"arm"}, {"*"}, false, false, false, true}});
+    p.add_role("gripper", {AccessRule{{"arm"}, {"gripper", "tools[*]"}, false, false, false, true}});
+    CHECK_FALSE(p.allows({"operator"}, "arm", "", Operation::lock));
+    CHECK(p.allows({"locker"}, "arm", "", Operation::lock));           // the root object
+    CHECK(p.allows({"locker"}, "arm", "gripper", Operation::lock));    // any object below it
+    CHECK_FALSE(p.allows({"locker"}, "camera", "", Operation::lock));
+    CHECK_FALSE(p.allows({"locker"}, "arm", "pos", Operation::read));  // lock allows no member operation
+    CHECK_FALSE(p.allows({"gripper"}, "arm", "", Operation::lock));
+    CHECK(p.allows({"gripper"}, "arm", "gripper", Operation::lock));
+    CHECK(p.allows({"gripper"}, "arm", "tools[2]", Operation::lock));
+    CHECK_FALSE(p.allows({}, "arm", "", Operation::lock));
+    CHECK(operation_name(Operation::lock) == "lock");
+    CHECK(refused_target("", Operation::lock) == "the root object");
+    CHECK(refused_target("tools[2]", Operation::lock) == "object tools[2]");
+    CHECK(refused_target("Drive", Operation::call) == "Drive");
+}
+
 TEST_CASE("gateway auth: adding devices takes read, write and call on every device and member") {
     auto p = std::make_shared<AccessPolicy>();
     p->add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});  // the config's "left out"
@@ -63,6 +83,14 @@ TEST_CASE("gateway auth: member keys and the operation each RR request needs") {
     CHECK(member_key_for_path("cam", "cam", "Frame") == "Frame");
     CHECK(member_key_for_path("cam", "cam.Webcams[1]", "Frame") == "Webcams[1].Frame");
     CHECK(member_key_for_path("cam", "camera.x", "Frame") == "Frame");  // not below this device: root key
+    CHECK(object_key_for_path("cam", "cam") == "");
+    CHECK(object_key_for_path("cam", "cam.Webcams[1]") == "Webcams[1]");
+    CHECK(object_key_for_path("cam", "cam.Webcams[1].lens") == "Webcams[1].lens");
+    for (const char* op : {"RequestObjectLock", "RequestClientObjectLock", "ReleaseObjectLock", "ReleaseClientObjectLock",
+                           "MonitorEnter", "MonitorContinueEnter", "MonitorExit"})
+        CHECK(is_lock_operation(op));
+    CHECK_FALSE(is_lock_operation("AuthenticateUser"));
+    CHECK_FALSE(is_lock_operation("LogoutUser"));
     using T = rr::MessageEntryType;
     CHECK(operation_for_request(T::PropertyGetReq) == Operation::read);
     CHECK(operation_for_request(T::PropertySetReq) == Operation::write);

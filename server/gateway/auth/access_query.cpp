@@ -10,6 +10,10 @@ std::vector<Operation> allowed_operations(const Principal* who, std::string_view
     return out;
 }
 
+bool may_lock(const Principal* who, std::string_view device, std::string_view object_key) {
+    return who && who->allows(device, object_key, Operation::lock);
+}
+
 Result<PrincipalPtr> principal_for_device_user(const GatewayAuth& auth, const Principal& caller, std::string_view device_user) {
     const std::string own = caller.rr_user_name();
     if (device_user != own)

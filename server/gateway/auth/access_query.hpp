@@ -17,6 +17,10 @@ namespace rr::server::gateway::auth {
 /// when none, and for a null principal: an unknown user may do nothing).
 std::vector<Operation> allowed_operations(const Principal* who, std::string_view device, std::string_view member_key);
 
+/// Whether `who` may take object and monitor locks on the object at relative service path `object_key`
+/// of `device` ("" = the root object; false for a null principal).
+bool may_lock(const Principal* who, std::string_view device, std::string_view object_key);
+
 /// The principal whose roles apply to an RR session that logged in to an `auth: passthrough` device as
 /// `device_user` (MirrorAccess: principal_for_user of the name the device accepted), asked by `caller`.
 /// The gateway answers only for the caller's own name (Principal::rr_user_name): answering for any

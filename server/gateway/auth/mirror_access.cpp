@@ -23,11 +23,27 @@ std::optional<Operation> operation_for_request(MessageEntryType type) noexcept {
     }
 }
 
-std::string member_key_for_path(std::string_view service, std::string_view path, std::string_view member) {
-    std::string_view rel;
+bool is_lock_operation(std::string_view op) noexcept {
+    return op == "RequestObjectLock" || op == "RequestClientObjectLock" || op == "ReleaseObjectLock" ||
+           op == "ReleaseClientObjectLock" || op == "MonitorEnter" || op == "MonitorContinueEnter" || op == "MonitorExit";
+}
+
+namespace {
+
+std::string_view relative_path(std::string_view service, std::string_view path) {
     if (path.size() > service.size() + 1 && path.substr(0, service.size()) == service && path[service.size()] == '.')
-        rel = path.substr(service.size() + 1);
-    return member_key(rel, member);
+        return path.substr(service.size() + 1);
+    return {};
+}
+
+}  // namespace
+
+std::string object_key_for_path(std::string_view service, std::string_view path) {
+    return std::string(relative_path(service, path));
+}
+
+std::string member_key_for_path(std::string_view service, std::string_view path, std::string_view member) {
+    return member_key(relative_path(service, path), member);
 }
 
 bool MirrorAccess::may(const SessionRef& session, std::string_view path, std::string_view member, Operation op) const {
@@ -38,11 +54,13 @@ bool MirrorAccess::may(const SessionRef& session, std::string_view path, std::st
 
 std::optional<RRError> MirrorAccess::check(const SessionRef& session, const MessageEntry& entry) const {
     if (!active()) return std::nullopt;
-    auto op = operation_for_request(entry.entry_type);
+    const bool lock = entry.entry_type == MessageEntryType::ClientSessionOpReq && is_lock_operation(entry.member_name);
+    auto op = lock ? std::optional<Operation>(Operation::lock) : operation_for_request(entry.entry_type);
     if (!op) return std::nullopt;
     const std::string user = session.username();
     auto who = auth_->principal_for_user(user);
-    const std::string key = member_key_for_path(device_, entry.service_path, entry.member_name);
+    const std::string key = lock ? object_key_for_path(device_, entry.service_path)
+                                 : member_key_for_path(device_, entry.service_path, entry.member_name);
     if (who && who->allows(device_, key, *op)) return std::nullopt;
     // A pipe endpoint or wire connection is for receiving, sending, or both: either permission opens it
     // (what flows is checked packet by packet).
@@ -51,7 +69,7 @@ std::optional<RRError> MirrorAccess::check(const SessionRef& session, const Mess
     auth_->counters().denied.fetch_add(1);
     return make_error(MessageErrorType::PermissionDenied, (user.empty() ? std::string("anonymous") : "user " + user) +
                                                               " may not " + std::string(operation_name(*op)) + " " +
-                                                              key + " of " + device_);
+                                                              refused_target(key, *op) + " of " + device_);
 }
 
 }  // namespace rr::server::gateway::auth

@@ -24,11 +24,21 @@ namespace rr::server::gateway::auth {
 ///          PipePacket (sending)
 ///   call:  FunctionCallReq, GeneratorNextReq
 /// (MirrorAccess::check opens a pipe endpoint or wire connection for `read` or `write`.)
+/// ClientSessionOpReq is not a member operation: see is_lock_operation.
 std::optional<Operation> operation_for_request(MessageEntryType type) noexcept;
+
+/// Whether the ClientSessionOpReq member name `op` is a lock operation, which needs Operation::lock on
+/// the object at its service path: RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock,
+/// ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit.
+bool is_lock_operation(std::string_view op) noexcept;
 
 /// `<relative path>.<member>` for a downstream service path of device service `service`
 /// (`create` → `Drive`; `create.Webcams[0]` → `Webcams[0].Capture`).
 std::string member_key_for_path(std::string_view service, std::string_view service_path, std::string_view member);
+
+/// The object key (Operation::lock) of a downstream service path: the relative path below the device
+/// service (`create.Webcams[0]` → `Webcams[0]`), "" for the root object.
+std::string object_key_for_path(std::string_view service, std::string_view service_path);
 
 class MirrorAccess {
 public:
@@ -42,7 +52,9 @@ public:
     /// Whether `session`'s user may do `op` on `member` of the object at downstream `service_path`.
     bool may(const SessionRef& session, std::string_view service_path, std::string_view member, Operation op) const;
     /// The check for a request from a client: nothing when allowed, else PermissionDenied
-    /// "<user> may not <op> <member key> of <device>" (counted in LoginCounters::denied).
+    /// "<user> may not <op> <member key> of <device>" (counted in LoginCounters::denied). A lock
+    /// operation (is_lock_operation) needs `lock` on its object: "user bob may not lock the root object
+    /// of arm", "… may not lock object gripper of arm".
     std::optional<RRError> check(const SessionRef& session, const MessageEntry& entry) const;
 
 private:

@@ -18,7 +18,7 @@ import { followWire } from "../views/shared_wire.js";
 import { JogRepeater, JOG_TIMEOUT_S } from "../robot/jog_repeater.js";
 import { jointModel, jointRows, jogVelocity, toDisplay, fromDisplay, displayUnit } from "../robot/joints.js";
 import { flagChips, modeText, isStale, capabilitySet, STALE_MS } from "../robot/status.js";
-import { fetchAccess, allows } from "../robot/access.js";
+import { fetchAccess, allows, mayLock } from "../robot/access.js";
 import { holdButton, jogKey, jogKeysText } from "../robot/hold.js";
 import { CARTESIAN_AXES, cartesianVelocity, isNotImplemented } from "../robot/cartesian.js";
 import { locksText } from "../robot/lock_text.js";
@@ -229,7 +229,8 @@ export function createRobotPanel(parent, ctx) {
 
   function buildJog() {
     const jog = canJog() && model.length > 0;
-    jogBox.hidden = lockBox.hidden = !jog;
+    jogBox.hidden = !jog;
+    lockBox.hidden = !jog || !mayLock(access);  // the lock needs the roles' `lock` (docs/security.md)
     if (jog) {
       jogBox.replaceChildren(h("label", {}, "jog speed ", speed), speedText,
         h("span", { class: "hint", text: `hold a − / + button (keys ${model.slice(0, 7).map((_, i) => jogKeysText(i)).join(", ")} while the panel has focus)` }));

@@ -3,8 +3,8 @@
 // user may use its member. This only hides controls: the gateway still checks every request, and a
 // refused call is shown and ends the jog.
 //
-// Answer: 200 { device, auth: bool, user, members: { "<member>": ["read", "write", "call"] } }, or
-// { auth: false, members: null } when the gateway checks nothing.
+// Answer: 200 { device, auth: bool, user, members: { "<member>": ["read", "write", "call"] }, lock: bool },
+// or { auth: false, members: null, lock: null } when the gateway checks nothing.
 
 /** The relative URL of the access endpoint; `deviceUser`: the device's own login (auth: passthrough). */
 export function accessUrl(device, deviceUser = null) {
@@ -27,6 +27,17 @@ export async function fetchAccess(device, deviceUser = null, fetchImpl = globalT
     throw new Error(`access to ${device}: not an access answer`);
   }
   return body;
+}
+
+/**
+ * True when `access` lets the user take the device's locks (the roles' `lock` on its root object): the
+ * panel offers "take the device lock" only then. A gateway that checks nothing, or answers without
+ * `lock` (older gateways), leaves it to the gateway's own refusal.
+ */
+export function mayLock(access) {
+  if (!access) return false;
+  if (access.members === null || access.lock === undefined || access.lock === null) return true;
+  return access.lock === true;
 }
 
 /** True when `access` lets the user do `op` ("read" | "write" | "call") on `member`. */
