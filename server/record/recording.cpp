@@ -77,6 +77,32 @@ std::string without_null_members(std::string text) {
     return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+// The json message of a pipe packet or a polled property: {"value": …}, or {"error": …} for no value or
+// one that does not fit. Written straight from the element when the member's type has a text plan
+// (core/json/element_json_plan.hpp): a 320x240 camera frame is one pass over its bytes, not a tree of
+// 230,400 numbers built, walked for nulls and dumped; through element_json otherwise and for errors.
+std::string value_message_text(const gateway::JsonApi& api, const MessageElement* el, const gateway::MemberTarget& t) {
+    if (el && t.types && t.service) {
+        if (const auto* plan = t.types->json_text_plan(t.member->type, t.context(), api.options().limits)) {
+            std::string out = "{\"value\":";
+            if (plan->append(out, *el)) {
+                out += '}';
+                return without_null_members(std::move(out));
+            }
+        }
+    }
+    nlohmann::json body = nlohmann::json::object();
+    if (!el) {
+        body["error"] = {{"message", "no value"}};
+    } else {
+        auto j = api.element_json(*el, t.member->type, t);
+        if (j) body["value"] = std::move(j.value);
+        else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
+    }
+    drop_null_members(body);
+    return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 std::uint64_t now_ns() {
     return static_cast<std::uint64_t>(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
@@ -528,16 +554,7 @@ Result<void> Recording::write_item(const Item& item) {
             default: {
                 const MessageElement* el = m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
                                                                                 : e.find("value");
-                nlohmann::json body = nlohmann::json::object();
-                if (!el) {
-                    body["error"] = {{"message", "no value"}};
-                } else {
-                    auto j = api_->element_json(*el, t.member->type, t);
-                    if (j) body["value"] = std::move(j.value);
-                    else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
-                }
-                drop_null_members(body);
-                text = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+                text = value_message_text(*api_, el, t);
             }
         }
         if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event)
