@@ -27,6 +27,8 @@ def http(base, method, path, body=None, timeout=60):
             return r.status, json.loads(r.read() or b"null")
     except urllib.error.HTTPError as e:
         return e.code, json.loads(e.read() or b"null")
+    except TimeoutError as e:  # name the request that did not answer
+        raise CheckFailed("%s %s: no answer within %s s (%s)" % (method, path, timeout, e))
 
 
 def foxglove_check(paths, checks, max_messages=20):
