@@ -1,5 +1,6 @@
 #include "server/record/recording.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -48,6 +49,7 @@ nlohmann::json status_json(const RecordingStatus& s) {
     nlohmann::json j{{"id", s.id},           {"device", s.spec.device},   {"state", recording_state_name(s.state)},
                      {"files", s.files},     {"bytes", s.bytes},          {"messages", s.messages},
                      {"drops", s.drops},     {"queued_bytes", s.queued_bytes}, {"duration_s", s.duration_s},
+                     {"connecting", s.connecting},
                      {"members", s.members}, {"spec", spec_json(s.spec)}};
     if (!s.error.empty()) j["error"] = s.error;
     return j;
@@ -283,6 +285,13 @@ void Recording::offer(std::uint16_t member, SharedEntryPtr entry) { (void)queue_
 
 void Recording::subscribe_members() {
     std::weak_ptr<Recording> weak = weak_from_this();
+    {
+        // Before the first subscribe: its answer may come at once, on this thread.
+        std::lock_guard<std::mutex> lock(mutex_);
+        connecting_ = static_cast<std::size_t>(std::count_if(members_.begin(), members_.end(), [](const RecordedMember& m) {
+            return m.kind != RecordedMember::Kind::property;
+        }));
+    }
     for (std::size_t i = 0; i < members_.size(); ++i) {
         const auto& m = members_[i];
         const auto index = static_cast<std::uint16_t>(i);
@@ -295,7 +304,9 @@ void Recording::subscribe_members() {
                     if (e->entry().entry_type == MessageEntryType::WireClosed) return;
                     if (auto self = weak.lock()) self->offer(index, e);
                 },
-                [](Result<void>) {});  // a wire not connected now is connected when the device is back
+                [weak](Result<void>) {  // a wire not connected now is connected when the device is back
+                    if (auto self = weak.lock()) self->member_answered();
+                });
             std::lock_guard<std::mutex> lock(mutex_);
             subscriptions_.push_back(sid);
         } else if (m.kind == RecordedMember::Kind::pipe) {
@@ -316,7 +327,9 @@ void Recording::subscribe_members() {
                 t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
                 [weak](Result<std::uint64_t> id) {
                     auto self = weak.lock();
-                    if (!self || !id) return;
+                    if (!self) return;
+                    self->member_answered();
+                    if (!id) return;
                     std::unique_lock<std::mutex> lock(self->mutex_);
                     if (self->stopping_) {
                         lock.unlock();
@@ -327,6 +340,11 @@ void Recording::subscribe_members() {
                 });
         }
     }
+}
+
+void Recording::member_answered() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (connecting_) --connecting_;
 }
 
 void Recording::unsubscribe_members() {
@@ -696,6 +714,7 @@ RecordingStatus Recording::status() const {
     std::lock_guard<std::mutex> lock(mutex_);
     s.state = state_;
     s.error = error_;
+    s.connecting = connecting_;
     for (const auto& f : files_) {
         s.files.push_back(f.first);
         s.bytes += f.second;
