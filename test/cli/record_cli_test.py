@@ -118,7 +118,7 @@ def record_phase(rr, url, work, checks):
         client.send_stream(5)
         client.fire_events(3)
         for topic, n in (("interop/p_stream", 5), ("interop/ev_values", 3), ("interop/w_state", 10)):
-            wait_for("%d %s messages in %s" % (n, topic, path), lambda: recorded_so_far(path, topic) >= n, timeout=90, interval=0.3)
+            wait_for("%d %s messages in %s" % (n, topic, path), lambda: len(recorded_so_far(path, topic)) >= n, timeout=90, interval=0.3)
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=120)
         return check_recording(out, err, proc, checks, live, lock)

@@ -109,23 +109,23 @@ def wait_for(what, predicate, timeout=60, interval=0.2):
 
 
 def recorded_so_far(path, topic, encoding="json"):
-    """How many messages of channel `topic` (`encoding`) a recording being written holds on disk now:
-    the writer flushes a chunk at least every second, so the file grows while the recording runs. Read
-    with the reference reader's streaming mode up to the last complete record."""
+    """The messages (data bytes) of channel `topic` (`encoding`) a recording being written holds on disk
+    now: the writer flushes a chunk at least every second, so the file grows while the recording runs.
+    Read with the reference reader's streaming mode up to the last complete record."""
     from mcap.exceptions import EndOfFile
     from mcap.records import Channel, Message
     from mcap.stream_reader import StreamReader
-    channels, n = set(), 0
+    channels, data = set(), []
     try:
         with open(path, "rb") as f:
             for r in StreamReader(f, skip_magic=False).records:
                 if isinstance(r, Channel) and r.topic == topic and r.message_encoding == encoding:
                     channels.add(r.id)
                 elif isinstance(r, Message) and r.channel_id in channels:
-                    n += 1
+                    data.append(r.data)
     except EndOfFile:
         pass  # the end of what is written so far
-    return n
+    return data
 
 
 def stop_recording(base, rid, timeout=120):

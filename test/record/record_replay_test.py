@@ -199,8 +199,8 @@ def record_phase(exe, work, seconds, checks):
         # disk, what check_recording counts: more than 20 packets, 3 polled values.
         time.sleep(seconds)
         path = rec["files"][0]
-        wait_for("21 packets recorded", lambda: recorded_so_far(path, "create/packets") > 20, interval=0.5)
-        wait_for("3 DistanceTraveled values recorded", lambda: recorded_so_far(path, "create/DistanceTraveled") >= 3, interval=0.5)
+        wait_for("21 packets recorded", lambda: len(recorded_so_far(path, "create/packets")) > 20, interval=0.5)
+        wait_for("3 DistanceTraveled values recorded", lambda: len(recorded_so_far(path, "create/DistanceTraveled")) >= 3, interval=0.5)
         took, done = stop_recording(base, rec["id"])
         checks["recording"] = {k: done[k] for k in ("bytes", "messages", "drops", "duration_s", "files")}
         checks["stop_answered_s"] = round(took, 2)
@@ -225,7 +225,7 @@ def record_phase(exe, work, seconds, checks):
                              "chunk_bytes": 4096})
         expect(status == 201, "second recording")
         killed = rec2["files"][0]
-        wait_for("11 packets of the second recording on disk", lambda: recorded_so_far(killed, "create/packets") > 10, interval=0.3)
+        wait_for("11 packets of the second recording on disk", lambda: len(recorded_so_far(killed, "create/packets")) > 10, interval=0.3)
         client.StopStreaming()
         RRN.DisconnectService(client)
         proc.send_signal(signal.SIGKILL)

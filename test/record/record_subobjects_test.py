@@ -74,7 +74,7 @@ def record_phase(exe, work, checks):
         # Recorded on disk (the writer flushes a chunk at least every second): 3 frames and each name.
         path = rec["files"][-1]
         for topic, n in (("webcam/Webcams[0]/FrameStream", 3), ("webcam/Webcams[0]/Name", 1), ("webcam/Webcams[1]/Name", 1)):
-            wait_for("%d %s messages in %s" % (n, topic, path), lambda: recorded_so_far(path, topic) >= n, timeout=90, interval=0.5)
+            wait_for("%d %s messages in %s" % (n, topic, path), lambda: len(recorded_so_far(path, topic)) >= n, timeout=90, interval=0.5)
         took, done = stop_recording(base, rec["id"])
         checks["recording"] = {k: done[k] for k in ("messages", "drops", "files", "members")}
         checks["stop_answered_s"] = round(took, 2)
