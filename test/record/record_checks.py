@@ -95,6 +95,21 @@ def report_and_clean(checks, work, keep, failed=False):
         shutil.rmtree(work, ignore_errors=True)
 
 
+def exit_status(ok, checks):
+    """The test's exit status: 1 when a check failed; 77 (ctest: Skipped) when every check that ran
+    passed but a part could not run here (a value in `checks` starting with "SKIP", its reason; each is
+    printed); 0 otherwise. A part that ran and was not met is a failure, never a skip."""
+    if not ok:
+        return 1
+    skipped = ["%s: %s" % (k, v) for k, v in checks.items() if isinstance(v, str) and v.startswith("SKIP")]
+    for line in skipped:
+        print(line)
+    if skipped:
+        print("SKIP: every check that ran passed, %d part(s) could not run here (above)" % len(skipped))
+        return 77
+    return 0
+
+
 def wait_for(what, predicate, timeout=60, interval=0.2):
     """Polls `predicate()` until it returns a true value (returned) or `timeout` s pass (CheckFailed
     naming `what`). The timeout only bounds a hang: a test waits for the event, never for a duration."""
