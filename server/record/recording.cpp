@@ -72,7 +72,8 @@ void drop_null_members(nlohmann::json& j) {
 }
 
 std::string without_null_members(std::string text) {
-    if (text.find("null") == std::string::npos) return text;  // the common case: nothing to parse again
+    // The common case (a text plan's, null members already left out): nothing to parse again.
+    if (text.find("null") == std::string::npos) return text;
     auto j = nlohmann::json::parse(text, nullptr, false);
     if (j.is_discarded()) return text;
     drop_null_members(j);
@@ -80,14 +81,15 @@ std::string without_null_members(std::string text) {
 }
 
 // The json message of a pipe packet or a polled property: {"value": …}, or {"error": …} for no value or
-// one that does not fit. Written straight from the element when the member's type has a text plan
-// (core/json/element_json_plan.hpp): a 320x240 camera frame is one pass over its bytes, not a tree of
-// 230,400 numbers built, walked for nulls and dumped; through element_json otherwise and for errors.
+// one that does not fit. Written straight from the element, null members left out, when the member's
+// type has a text plan (core/json/element_json_plan.hpp): a 320x240 camera frame is one pass over its
+// bytes, not a tree of 230,400 numbers built, walked for nulls and dumped; through element_json
+// otherwise and for errors.
 std::string value_message_text(const gateway::JsonApi& api, const MessageElement* el, const gateway::MemberTarget& t) {
     if (el && t.types && t.service) {
         if (const auto* plan = t.types->json_text_plan(t.member->type, t.context(), api.options().limits)) {
             std::string out = "{\"value\":";
-            if (plan->append(out, *el)) {
+            if (plan->append(out, *el, /*omit_null_members=*/true)) {
                 out += '}';
                 return without_null_members(std::move(out));
             }
@@ -567,8 +569,8 @@ Result<void> Recording::write_item(const Item& item) {
     if (file_->json_channel[item.member] >= 0) {
         std::string text;
         switch (m.kind) {
-            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t); break;
-            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t); break;
+            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t, /*omit_null_members=*/true); break;
+            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t, /*omit_null_members=*/true); break;
             default: {
                 const MessageElement* el = m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
                                                                                 : e.find("value");
