@@ -238,10 +238,16 @@ def run(gateway_exe, work, seconds, checks):
         RRN.DisconnectService(c)
         with lock:
             live_s, live_f = list(live_states), set(live_frames)
-        live_set = set(live_s)
-        seen = sum(s in live_set for s in states)
-        checks["robot_state"] = {"recorded": len(states), "live": len(live_s), "recorded_seen_live": seen}
-        expect(seen >= len(states) - 2, "recorded robot_state values are those the official client received live")
+        # A wire keeps only the newest value for a client that is behind, so the live client may have
+        # skipped some of the recorded states (a few in a hundred beside a CI run): each state it did
+        # receive must be the recorded one of that seqno, and most must have been received.
+        live_by_seqno = {st[0]: st for st in live_s}
+        common = [st for st in states if st[0] in live_by_seqno]
+        differ = [(st, live_by_seqno[st[0]]) for st in common if live_by_seqno[st[0]] != st]
+        checks["robot_state"] = {"recorded": len(states), "live": len(live_s), "recorded_seen_live": len(common)}
+        expect(not differ, "recorded robot_state values equal the ones the official client received live: %s" % differ[:2])
+        expect(len(common) >= len(states) // 2, "most recorded robot_state values were received live (%d of %d)"
+               % (len(common), len(states)))
         expect(len(set(hashes)) == len(hashes), "recorded frames are distinct (seqno, bytes)")
         expect(len(frames) >= want["camera"][1], "frames recorded (%d)" % len(frames))
         expect(all(f["image_info"]["width"] == 160 and f["image_info"]["height"] == 120 for f in frames), "frame size")
