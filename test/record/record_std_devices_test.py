@@ -10,10 +10,12 @@ MCAP reader (PyPI `mcap`) and compared with what the official Python client rece
            the driver's root object, recorded while an official client streams it.
   checks   channels (json and robotraconteur per member), schemas (the standard service definitions),
            counts; the json messages parse and (the first few, the frames being large) validate against
-           their JSON Schema; every recorded robot_state value (seqno, joint_position, command_mode) and
-           every recorded frame (its seqno and
-           bytes) is one the official client received live; the robot's file
+           their JSON Schema; frames in the camera's order, no recorder drops; each recorded robot_state
+           value (joint_position, command_mode) and frame (bytes) whose seqno the official client
+           received live equals what it received, and it received most of them (a client that falls
+           behind beside a CI run may lose a few: the gateway does not wait for it); the robot's file
            replayed by `rr-gateway --replay` gives an official client recorded robot_state values.
+           Counts are waited for (in the file on disk, as received), never slept for.
 
 Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
 """
@@ -220,10 +222,11 @@ def run(gateway_exe, work, seconds, checks):
         # last recorded one (a wire may skip a value for a client that is behind).
         last_seqno = states[-1][0]
 
+        last_frame = max(h[0] for h in hashes)
+
         def live_caught_up():
             with lock:
-                live_f = set(live_frames)
-                return all(h in live_f for h in hashes) and any(st[0] >= last_seqno for st in live_states)
+                return any(f[0] >= last_frame for f in live_frames) and any(st[0] >= last_seqno for st in live_states)
         try:
             wait_for("the official client received what was recorded", live_caught_up, timeout=30)
         except CheckFailed:
@@ -249,11 +252,22 @@ def run(gateway_exe, work, seconds, checks):
         expect(len(common) >= len(states) // 2, "most recorded robot_state values were received live (%d of %d)"
                % (len(common), len(states)))
         expect(len(set(hashes)) == len(hashes), "recorded frames are distinct (seqno, bytes)")
+        seqnos = [h[0] for h in hashes]
+        expect(seqnos == sorted(seqnos), "recorded frames in the camera's order")
+        expect(all(b["drops"] == 0 for b in finals.values()), "no recorder drops: %s" % checks["recordings"])
         expect(len(frames) >= want["camera"][1], "frames recorded (%d)" % len(frames))
         expect(all(f["image_info"]["width"] == 160 and f["image_info"]["height"] == 120 for f in frames), "frame size")
-        fseen = sum(h in live_f for h in hashes)
-        checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": fseen}
-        expect(fseen == len(frames), "every recorded frame is one the official client received live")
+        # The live client is one more client of the gateway: beside a CI run it may fall behind and lose a
+        # few frames there (3 of 129 once). Each recorded frame it did get has the recorded bytes; most
+        # were received. What the recorder wrote is checked on its own above (order, no drops).
+        live_by_seqno = {}
+        for seqno, digest in live_f:
+            live_by_seqno.setdefault(seqno, set()).add(digest)
+        fcommon = [h for h in hashes if h[0] in live_by_seqno]
+        fdiffer = [h for h in fcommon if h[1] not in live_by_seqno[h[0]]]
+        checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": len(fcommon)}
+        expect(not fdiffer, "recorded frames have the bytes the official client received live (%d differ)" % len(fdiffer))
+        expect(len(fcommon) >= len(hashes) // 2, "most recorded frames were received live (%d of %d)" % (len(fcommon), len(hashes)))
         foxglove_check([robot_file, finals["camera"]["files"][0]], checks, max_messages=5)
         check_foxglove_images(finals["camera"]["files"][0], hashes, checks)
     finally:
