@@ -7,6 +7,9 @@ cameras behind the objref `Webcams{int32}`. Recorded through the JSON API: `Webc
 (a pipe, streaming) and the `Name` property of `Webcams[0]` and `Webcams[1]`, both encodings. Checked:
 - names that do not lead to a member get 400 naming the problem (no index, no such objref or member,
   a property used as an objref);
+- the status's `connecting` turns 0 once the pipe is connected; 3 frames and the names are waited for
+  in the file on disk, then the stop answers `stopped` (its time is reported: it took over 60 s under a
+  CI load while each frame's JSON was a tree of numbers);
 - the reference reader (PyPI mcap) lists channels `webcam/Webcams[0]/FrameStream`, ... with metadata
   `path`, `object_type` experimental.createwebcam.Webcam and `root_type`, and the frames;
 - `rr-gateway --replay FILE`: an official client (rr+tcp) gets `Webcams[0]` and `Webcams[1]` through
@@ -15,7 +18,8 @@ cameras behind the objref `Webcams{int32}`. Recorded through the JSON API: `Webc
   `Name?object=Webcams[1]`.
 
   record_subobjects_test.py --gateway build/debug/server/app/rr-gateway
-Prints a JSON summary; exit 0, 1 (a check failed) or 77 (the venv's packages are missing).
+Prints a JSON summary (on a failure also the gateways' logs, the work folder kept); exit 0, 1 (a check
+failed) or 77 (the venv's packages are missing).
 """
 import argparse
 import hashlib
@@ -71,6 +75,10 @@ def record_phase(exe, work, checks):
         for i in (0, 1):
             status, body = http(base, "GET", "/api/devices/webcam/properties/Name?object=Webcams%%5B%d%%5D" % i)
             live_names[i] = body["value"]
+        # "connecting": the pipe's connection not answered yet, then 0 (docs/recording.md "JSON API").
+        expect(isinstance(rec.get("connecting"), int) and 0 <= rec["connecting"] <= 1, "connecting in the status: %s" % rec)
+        wait_for("the recording's pipe connected (connecting 0)",
+                 lambda: http(base, "GET", "/api/recordings/%d" % rec["id"])[1]["connecting"] == 0)
         # Recorded on disk (the writer flushes a chunk at least every second): 3 frames and each name.
         path = rec["files"][-1]
         for topic, n in (("webcam/Webcams[0]/FrameStream", 3), ("webcam/Webcams[0]/Name", 1), ("webcam/Webcams[1]/Name", 1)):
