@@ -339,7 +339,8 @@ const NamedArrayItem* Compiler::namedarray_item(const NamedArrayShape& shape) {
 
 class Renderer {
 public:
-    Renderer(std::string& out, const Plan::Graph& g) : out_(out), g_(g), max_depth_(g.limits.max_nesting_depth) {}
+    Renderer(std::string& out, const Plan::Graph& g, bool omit_null_members)
+        : out_(out), g_(g), max_depth_(g.limits.max_nesting_depth), omit_null_members_(omit_null_members) {}
 
     bool render(const Node& n, const MessageElement& e);
 
@@ -362,10 +363,19 @@ private:
     bool map_int32(const Node& n, const MessageElement& e);
     bool map_string(const Node& n, const MessageElement& e);
 
+    /// After a member written from `mark` on (its ',' and key) with its value from `value_at` on: with
+    /// omit_null_members_ a null value takes the member out again. Returns whether the member stays.
+    bool keep_member(std::size_t mark, std::size_t value_at) {
+        if (!omit_null_members_ || out_.size() - value_at != 4 || out_.compare(value_at, 4, "null") != 0) return true;
+        out_.resize(mark);
+        return false;
+    }
+
     std::string& out_;
     const Plan::Graph& g_;
     std::size_t depth_ = 0;
     std::size_t max_depth_;
+    const bool omit_null_members_;
 };
 
 bool Renderer::render(const Node& n, const MessageElement& e) {
@@ -455,13 +465,17 @@ bool Renderer::structure(const Node& n, const MessageElement& e) {
 // `{"field":value,…}` of a struct or pod item: each field is the first child of its name.
 bool Renderer::object(const Body& b, const MessageElement& e) {
     out_ += '{';
+    bool first = true;
     for (std::size_t i = 0; i < b.fields.size(); ++i) {
         const Field& f = b.fields[i];
         const MessageElement* c = e.find(f.name);
         if (!c) return false;
-        if (i) out_ += ',';
+        const std::size_t mark = out_.size();
+        if (!first) out_ += ',';
         out_ += f.key;
+        const std::size_t value_at = out_.size();
         if (!field(f, *c)) return false;
+        if (keep_member(mark, value_at)) first = false;
     }
     out_ += '}';
     return true;
@@ -565,13 +579,17 @@ bool Renderer::map_int32(const Node& n, const MessageElement& e) {
     // nlohmann keeps the keys as strings, in their order ("10" before "9").
     std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.view() < b.view(); });
     out_ += '{';
+    bool first = true;
     for (std::size_t i = 0; i < keys.size(); ++i) {
         if (i && keys[i].view() == keys[i - 1].view()) return false;  // duplicate key: the general path refuses it
-        if (i) out_ += ',';
+        const std::size_t mark = out_.size();
+        if (!first) out_ += ',';
         out_ += '"';
         out_ += keys[i].view();
         out_ += "\":";
+        const std::size_t value_at = out_.size();
         if (!render(*n.item, *keys[i].item)) return false;
+        if (keep_member(mark, value_at)) first = false;
     }
     out_ += '}';
     return true;
@@ -587,12 +605,16 @@ bool Renderer::map_string(const Node& n, const MessageElement& e) {
     }
     std::sort(items.begin(), items.end(), [](const MessageElement* a, const MessageElement* b) { return a->name < b->name; });
     out_ += '{';
+    bool first = true;
     for (std::size_t i = 0; i < items.size(); ++i) {
         if (i && items[i]->name == items[i - 1]->name) return false;
-        if (i) out_ += ',';
+        const std::size_t mark = out_.size();
+        if (!first) out_ += ',';
         append_string(out_, items[i]->name);
         out_ += ':';
+        const std::size_t value_at = out_.size();
         if (!render(*n.item, *items[i])) return false;
+        if (keep_member(mark, value_at)) first = false;
     }
     out_ += '}';
     return true;
@@ -615,9 +637,9 @@ std::shared_ptr<const Plan> Plan::compile(const TypeDefinition& type, const robd
     return std::make_shared<const Plan>(std::move(g));
 }
 
-bool Plan::append(std::string& out, const MessageElement& element) const {
+bool Plan::append(std::string& out, const MessageElement& element, bool omit_null_members) const {
     const std::size_t at = out.size();
-    Renderer r(out, *graph_);
+    Renderer r(out, *graph_, omit_null_members);
     if (r.render(*graph_->root, element)) return true;
     out.resize(at);
     return false;

@@ -40,7 +40,11 @@ public:
 
     /// Appends the JSON text of `element` to `out` and returns true; returns false with `out`
     /// unchanged when the element does not match the type (above). Never throws but std::bad_alloc.
-    bool append(std::string& out, const MessageElement& element) const;
+    /// `omit_null_members`: a struct field or map entry whose value is null (an absent struct, list,
+    /// map or varvalue) is left out of its object, as the recorder's json channels want it; nulls in
+    /// arrays stay, and so does any null inside a part the general path writes (a caller that must
+    /// have none looks for "null" in the text).
+    bool append(std::string& out, const MessageElement& element, bool omit_null_members = false) const;
 
     struct Graph;  // the compiled nodes (element_json_plan.cpp)
     explicit Plan(std::unique_ptr<Graph> graph);

@@ -230,6 +230,57 @@ TEST_CASE("element JSON plan: structs, pods, namedarrays, enums, strings and con
     check_same(element_from_json({{"a", 1}, {"s", "x"}}, type_of("example.test.Inner")), "example.test.Inner");
 }
 
+// The general text with each null member of an object left out, recursively (nulls in arrays stay).
+void drop_null_members(nlohmann::json& j) {
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end();) {
+            if (it->is_null()) it = j.erase(it);
+            else drop_null_members(*it++);
+        }
+    } else if (j.is_array()) {
+        for (auto& x : j) drop_null_members(x);
+    }
+}
+
+void check_same_without_nulls(const MessageElement& e, std::string_view type) {
+    INFO(type);
+    const auto t = type_of(type);
+    auto plan = plan_of(t);
+    REQUIRE(plan);
+    auto general = general_text(e, t);
+    REQUIRE(general);
+    auto want = nlohmann::json::parse(*general);
+    drop_null_members(want);
+    std::string direct = "prefix:";
+    REQUIRE(plan->append(direct, e, /*omit_null_members=*/true));
+    CHECK(direct == "prefix:" + want.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+TEST_CASE("element JSON plan: omit_null_members leaves null struct fields and map entries out, as the recorder wants") {
+    const auto state = type_of("State");
+    auto inner = state_json(2, nullptr);  // next and maybe null
+    inner["inners"] = nullptr;
+    inner["labels"] = nullptr;
+    inner["by_id"] = nullptr;
+    const auto outer = state_json(7, inner);
+    check_same_without_nulls(element_from_json(outer, state), "State");
+    check_same_without_nulls(element_from_json(inner, state), "State");
+    check_same_without_nulls(element_from_json(nullptr, state), "State");  // the value itself: null stays
+    // the first, a middle and the last entry null: no stray comma
+    check_same_without_nulls(element_from_json({{"", nullptr}, {"k", inner}, {"m", nullptr}, {"z", nullptr}}, type_of("State{string}")),
+                             "State{string}");
+    check_same_without_nulls(element_from_json({{"1", nullptr}, {"2", nullptr}}, type_of("State{int32}")), "State{int32}");
+    // nulls in a list stay
+    check_same_without_nulls(element_from_json(nlohmann::json::array({nullptr, inner, nullptr}), type_of("State{list}")), "State{list}");
+    // a varvalue written by the general path: a null one is left out too
+    Structure loose{"example.plan.Loose", {{"anything", Value()}}};
+    auto e = pack_value(Value(loose), type_of("Loose"), "value", plan_lookup(), kPlanSvc);
+    REQUIRE(e);
+    check_same_without_nulls(*e, "Loose");
+    // without the option, nulls are written as the general path writes them
+    check_same(element_from_json(inner, state), "State");
+}
+
 TEST_CASE("element JSON plan: every byte of a string and of a map key is escaped as nlohmann escapes it") {
     std::string all;
     for (int c = 1; c < 0x80; ++c) all += static_cast<char>(c);

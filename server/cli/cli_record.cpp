@@ -92,11 +92,20 @@ ExitCode run_record(const CommandLine& cl, std::ostream& out, std::ostream& err,
         const auto code = recording.error().type == MessageErrorType::InvalidArgument ? ExitCode::usage_error : ExitCode::rr_error;
         return fail_with(err, code, recording.error());
     }
+    // "rr: recording" once the device has answered every wire, pipe and event connection: from that
+    // line on, what the device sends is recorded (a script may act on it); --timeout bounds the wait.
+    const auto subscribe_deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cl.timeout_s));
+    while ((*recording)->status().connecting > 0 && (*recording)->status().state == server::record::RecordingState::recording &&
+           !stop_or_elapsed(stop, subscribe_deadline))
+        std::this_thread::sleep_for(20ms);
     {
         auto s = (*recording)->status();
         err << "rr: recording " << dc.name << " (";
         for (std::size_t i = 0; i < s.members.size(); ++i) err << (i ? ", " : "") << s.members[i];
-        err << ") to " << (s.files.empty() ? cl.directory : s.files.back()) << std::endl;
+        err << ") to " << (s.files.empty() ? cl.directory : s.files.back());
+        if (s.connecting) err << " (" << s.connecting << " not connected yet)";
+        err << std::endl;
     }
 
     const auto end = cl.duration ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*cl.duration))

@@ -84,7 +84,8 @@ nlohmann::json wire_push_body(const JsonApi& api, const MessageEntry& packet, co
     return msg;
 }
 
-std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target) {
+std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target,
+                           bool omit_null_members) {
     // The direct path writes what json_text(wire_push_body(…)) would: nlohmann sorts an object's keys.
     const auto* p = packet.find("packet");
     const auto* ts = packet.find("packettime");
@@ -96,7 +97,7 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
             out += ",\"seconds\":";
             append_integer(out, time->seconds);
             out += "},\"value\":";
-            if (plan->append(out, *p)) {
+            if (plan->append(out, *p, omit_null_members)) {
                 out += '}';
                 return out;
             }
@@ -105,7 +106,8 @@ std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const
     return json_text(wire_push_body(api, packet, target));
 }
 
-std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target) {
+std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,
+                            bool omit_null_members) {
     const auto& params = target.member->parameters;
     std::vector<std::pair<const robdef::TypeDefinition*, const element_json_text::Plan*>> sorted;
     sorted.reserve(params.size());
@@ -126,7 +128,7 @@ std::string event_push_text(const JsonApi& api, const MessageEntry& event, const
         out += '"';
         out += p->name;
         out += "\":";
-        if (!plan->append(out, *el)) return json_text(event_push_body(api, event, target));
+        if (!plan->append(out, *el, omit_null_members)) return json_text(event_push_body(api, event, target));
     }
     out += "}}";
     return out;

@@ -49,12 +49,17 @@ nlohmann::json event_push_body(const JsonApi& api, const MessageEntry& event, co
 /// json_text(wire_push_body(api, packet, target)), written straight from the packet's element when the
 /// member's type is one core/json/element_json_plan.hpp covers (DeviceTypes::json_text_plan: numbers,
 /// strings, enums, structs, pods, namedarrays and containers of them), without the Value and
-/// nlohmann::json trees; through wire_push_body otherwise and for every error.
-std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target);
+/// nlohmann::json trees; through wire_push_body otherwise and for every error. `omit_null_members`
+/// (the recorder's json channels): the direct path leaves null struct fields and map entries out
+/// (Plan::append); the general path keeps them.
+std::string wire_push_text(const JsonApi& api, const MessageEntry& packet, const MemberTarget& target,
+                           bool omit_null_members = false);
 
 /// json_text(event_push_body(api, event, target)), written straight from the elements when the plan
-/// covers every parameter's type; through event_push_body otherwise.
-std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target);
+/// covers every parameter's type; through event_push_body otherwise. `omit_null_members`: as above,
+/// inside the arguments.
+std::string event_push_text(const JsonApi& api, const MessageEntry& event, const MemberTarget& target,
+                            bool omit_null_members = false);
 
 /// A pipe packet's push: {"subscription", "kind": "pipe", "value" | "error"[, "dropped"]}; with the
 /// arrays part (and the text already binary_push_head's) when `binary` set any aside for a value. A text

@@ -1,5 +1,6 @@
 #include "server/record/recording.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -48,6 +49,7 @@ nlohmann::json status_json(const RecordingStatus& s) {
     nlohmann::json j{{"id", s.id},           {"device", s.spec.device},   {"state", recording_state_name(s.state)},
                      {"files", s.files},     {"bytes", s.bytes},          {"messages", s.messages},
                      {"drops", s.drops},     {"queued_bytes", s.queued_bytes}, {"duration_s", s.duration_s},
+                     {"connecting", s.connecting},
                      {"members", s.members}, {"spec", spec_json(s.spec)}};
     if (!s.error.empty()) j["error"] = s.error;
     return j;
@@ -70,11 +72,39 @@ void drop_null_members(nlohmann::json& j) {
 }
 
 std::string without_null_members(std::string text) {
-    if (text.find("null") == std::string::npos) return text;  // the common case: nothing to parse again
+    // The common case (a text plan's, null members already left out): nothing to parse again.
+    if (text.find("null") == std::string::npos) return text;
     auto j = nlohmann::json::parse(text, nullptr, false);
     if (j.is_discarded()) return text;
     drop_null_members(j);
     return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// The json message of a pipe packet or a polled property: {"value": …}, or {"error": …} for no value or
+// one that does not fit. Written straight from the element, null members left out, when the member's
+// type has a text plan (core/json/element_json_plan.hpp): a 320x240 camera frame is one pass over its
+// bytes, not a tree of 230,400 numbers built, walked for nulls and dumped; through element_json
+// otherwise and for errors.
+std::string value_message_text(const gateway::JsonApi& api, const MessageElement* el, const gateway::MemberTarget& t) {
+    if (el && t.types && t.service) {
+        if (const auto* plan = t.types->json_text_plan(t.member->type, t.context(), api.options().limits)) {
+            std::string out = "{\"value\":";
+            if (plan->append(out, *el, /*omit_null_members=*/true)) {
+                out += '}';
+                return without_null_members(std::move(out));
+            }
+        }
+    }
+    nlohmann::json body = nlohmann::json::object();
+    if (!el) {
+        body["error"] = {{"message", "no value"}};
+    } else {
+        auto j = api.element_json(*el, t.member->type, t);
+        if (j) body["value"] = std::move(j.value);
+        else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
+    }
+    drop_null_members(body);
+    return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::uint64_t now_ns() {
@@ -257,6 +287,13 @@ void Recording::offer(std::uint16_t member, SharedEntryPtr entry) { (void)queue_
 
 void Recording::subscribe_members() {
     std::weak_ptr<Recording> weak = weak_from_this();
+    {
+        // Before the first subscribe: its answer may come at once, on this thread.
+        std::lock_guard<std::mutex> lock(mutex_);
+        connecting_ = static_cast<std::size_t>(std::count_if(members_.begin(), members_.end(), [](const RecordedMember& m) {
+            return m.kind != RecordedMember::Kind::property;
+        }));
+    }
     for (std::size_t i = 0; i < members_.size(); ++i) {
         const auto& m = members_[i];
         const auto index = static_cast<std::uint16_t>(i);
@@ -269,7 +306,9 @@ void Recording::subscribe_members() {
                     if (e->entry().entry_type == MessageEntryType::WireClosed) return;
                     if (auto self = weak.lock()) self->offer(index, e);
                 },
-                [](Result<void>) {});  // a wire not connected now is connected when the device is back
+                [weak](Result<void>) {  // a wire not connected now is connected when the device is back
+                    if (auto self = weak.lock()) self->member_answered();
+                });
             std::lock_guard<std::mutex> lock(mutex_);
             subscriptions_.push_back(sid);
         } else if (m.kind == RecordedMember::Kind::pipe) {
@@ -290,7 +329,9 @@ void Recording::subscribe_members() {
                 t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
                 [weak](Result<std::uint64_t> id) {
                     auto self = weak.lock();
-                    if (!self || !id) return;
+                    if (!self) return;
+                    self->member_answered();
+                    if (!id) return;
                     std::unique_lock<std::mutex> lock(self->mutex_);
                     if (self->stopping_) {
                         lock.unlock();
@@ -301,6 +342,11 @@ void Recording::subscribe_members() {
                 });
         }
     }
+}
+
+void Recording::member_answered() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (connecting_) --connecting_;
 }
 
 void Recording::unsubscribe_members() {
@@ -523,21 +569,12 @@ Result<void> Recording::write_item(const Item& item) {
     if (file_->json_channel[item.member] >= 0) {
         std::string text;
         switch (m.kind) {
-            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t); break;
-            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t); break;
+            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t, /*omit_null_members=*/true); break;
+            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t, /*omit_null_members=*/true); break;
             default: {
                 const MessageElement* el = m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
                                                                                 : e.find("value");
-                nlohmann::json body = nlohmann::json::object();
-                if (!el) {
-                    body["error"] = {{"message", "no value"}};
-                } else {
-                    auto j = api_->element_json(*el, t.member->type, t);
-                    if (j) body["value"] = std::move(j.value);
-                    else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
-                }
-                drop_null_members(body);
-                text = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+                text = value_message_text(*api_, el, t);
             }
         }
         if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event)
@@ -679,6 +716,7 @@ RecordingStatus Recording::status() const {
     std::lock_guard<std::mutex> lock(mutex_);
     s.state = state_;
     s.error = error_;
+    s.connecting = connecting_;
     for (const auto& f : files_) {
         s.files.push_back(f.first);
         s.bytes += f.second;

@@ -65,9 +65,12 @@ struct RecordingStatus {
     std::uint64_t queued_bytes = 0;    ///< waiting for the writer now
     double duration_s = 0;             ///< since start (until the end, once ended)
     std::vector<std::string> members;  ///< the members recorded
+    /// Recorded wires, pipes and events whose connection the device has not answered yet: their values
+    /// are recorded from the answer on (0 once each is connected, or refused; properties are polled).
+    std::size_t connecting = 0;
 };
 /// {"id", "device", "state", "error"?, "files", "bytes", "messages", "drops", "queued_bytes",
-///  "duration_s", "members", "spec"} (docs/recording.md "JSON API").
+///  "duration_s", "connecting", "members", "spec"} (docs/recording.md "JSON API").
 nlohmann::json status_json(const RecordingStatus& s);
 
 class Recording : public std::enable_shared_from_this<Recording> {
@@ -106,6 +109,8 @@ private:
     /// The open file's size into files_ (once per batch: the writer does not take mutex_ per item).
     void note_file_size();
     void subscribe_members();
+    /// The device answered one member's connection (wire, pipe) or subscription (event).
+    void member_answered();
     void unsubscribe_members();
     void poll_loop();
     void writer_loop();
@@ -137,6 +142,7 @@ private:
     // Subscriptions (guarded by mutex_).
     std::vector<std::uint64_t> subscriptions_;  // DeviceMirror::subscribe ids
     std::vector<std::uint64_t> pipes_;          // shared_endpoints pipe ids
+    std::size_t connecting_ = 0;                // members not answered yet (RecordingStatus::connecting)
 
     // Writer thread only.
     std::unique_ptr<File> file_;

@@ -115,9 +115,10 @@ def without_service(url):
     return re.sub(r"[?&]service=[^&]*", "", url)
 
 
-def watch_while(rr, args, trigger, limit=20):
+def watch_while(rr, args, trigger, limit=90):
     """Runs `rr watch ...` and calls trigger() every 0.5 s until it exits (events and pipe packets
-    only reach a client connected when they are sent). Returns (rc, stdout lines, stderr)."""
+    only reach a client connected when they are sent); `limit` only bounds a hang (an ASan rr beside a CI
+    run takes seconds to connect). Returns (rc, stdout lines, stderr)."""
     p = rr.popen("watch", *args)
     deadline = time.time() + limit
     while p.poll() is None and time.time() < deadline:

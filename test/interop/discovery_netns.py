@@ -313,7 +313,16 @@ def main():
         # --- hostile datagrams from B: counted, the table stays within its cap --------------------
         before = http(net, args.python, "http://[::1]:%d/metrics" % port)["body"]
         run(net.cmd(net.b, [args.python, official_py, "hostile", "--iface", net.vb, "--flood", "600"]), timeout=60)
-        time.sleep(1.0)
+        reasons = ("truncated", "oversized", "bad_node_id", "node_id_mismatch", "not_link_local", "not_ip_literal")
+
+        def all_counted():
+            t = http(net, args.python, "http://[::1]:%d/metrics" % port)["body"]
+            return t if all(metric(t, 'rr_gateway_discovery_packets_rejected_total{reason="%s"}' % r) >= 1 for r in reasons) else None
+        # The datagrams are counted as the gateway reads them: wait for each reason (bounded), then judge.
+        try:
+            wait_until("every hostile datagram's reason counted", all_counted, 30)
+        except Failed:
+            pass  # said below, with the metrics
         text = http(net, args.python, "http://[::1]:%d/metrics" % port)["body"]
         for reason in ("truncated", "oversized", "bad_node_id", "node_id_mismatch", "not_link_local", "not_ip_literal"):
             if metric(text, 'rr_gateway_discovery_packets_rejected_total{reason="%s"}' % reason) < 1:

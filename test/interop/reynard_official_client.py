@@ -232,14 +232,17 @@ class Runner:
         t0 = time.monotonic()
         wait_for(lambda: self.state.latest(), what="first state value")
         self.facts["first_state_value_s"] = round(time.monotonic() - t0, 3)
-        time.sleep(1.5)
+        # Reynard sends ~20/s; a loaded CI machine slows its Python loop: wait for 10 values (bounded).
+        try:
+            wait_for(lambda: len(self.state.since(t0)) >= 10, timeout=30, what="10 state values")
+        except CheckFailed:
+            pass  # said below
         vals = self.state.since(t0)
         n = len(vals)
-        # Reynard sends ~20/s; a loaded CI machine slows its Python loop, so only liveness is asserted.
-        expect(n >= 3, "only %d state values in ~1.5 s" % n)
+        expect(n >= 10, "only %d state values" % n)
         rx = np.diff([v[0] for v in vals])
         st = np.diff([v[1].time for v in vals])
-        self.facts["state_values_1_5s"] = n
+        self.facts["state_values"] = n
         self.facts["state_interval_s"] = {"mean": round(float(rx.mean()), 4), "min": round(float(rx.min()), 4),
                                           "max": round(float(rx.max()), 4)}
         expect(0.02 <= rx.mean() <= 0.5, "state interval %.3f s (expected ~0.05)" % rx.mean())

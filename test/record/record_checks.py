@@ -1,8 +1,10 @@
-"""What the recording tests share: a failed check and a JSON API request (stdlib only)."""
+"""What the recording tests share: a failed check, a JSON API request, waiting for an event, a failed
+test's logs (stdlib only; recorded_so_far imports PyPI mcap when called)."""
 import json
 import os
 import shutil
 import subprocess
+import time
 import urllib.error
 import urllib.request
 
@@ -25,6 +27,8 @@ def http(base, method, path, body=None, timeout=60):
             return r.status, json.loads(r.read() or b"null")
     except urllib.error.HTTPError as e:
         return e.code, json.loads(e.read() or b"null")
+    except TimeoutError as e:  # name the request that did not answer
+        raise CheckFailed("%s %s: no answer within %s s (%s)" % (method, path, timeout, e))
 
 
 def foxglove_check(paths, checks, max_messages=20):
@@ -60,10 +64,96 @@ def official_foxglove_schemas():
     return json.loads(r.stdout)
 
 
-def report_and_clean(checks, work, keep):
-    """Prints the test's checks as JSON, then removes its work folder (or says where it was kept)."""
+def print_log_tails(work, lines=60):
+    """The end of every log the test's processes wrote in `work` (gateway.log, *.err, ...), so that a
+    failure in CI says what the gateway saw, not only what the test asserted."""
+    for root, _, files in os.walk(work):
+        for name in sorted(files):
+            if not name.endswith((".log", ".err")):
+                continue
+            path = os.path.join(root, name)
+            try:
+                with open(path, "rb") as f:
+                    f.seek(0, os.SEEK_END)
+                    f.seek(max(0, f.tell() - 64 * 1024))
+                    tail = f.read().decode(errors="replace").splitlines()[-lines:]
+            except OSError as e:
+                tail = ["(cannot read: %s)" % e]
+            print("---- %s (last %d lines) ----" % (path, len(tail)))
+            print("\n".join(tail))
+
+
+def report_and_clean(checks, work, keep, failed=False):
+    """Prints the test's checks as JSON, then removes its work folder (or says where it was kept). A
+    failed test prints its processes' logs and keeps the folder, logs and recordings included."""
     print(json.dumps(checks, indent=1, default=str))
-    if keep:
+    if failed:
+        print_log_tails(work)
+    if keep or failed:
         print("kept", work)
     else:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def exit_status(ok, checks):
+    """The test's exit status: 1 when a check failed; 77 (ctest: Skipped) when every check that ran
+    passed but a part could not run here (a value in `checks` starting with "SKIP", its reason; each is
+    printed); 0 otherwise. A part that ran and was not met is a failure, never a skip."""
+    if not ok:
+        return 1
+    skipped = ["%s: %s" % (k, v) for k, v in checks.items() if isinstance(v, str) and v.startswith("SKIP")]
+    for line in skipped:
+        print(line)
+    if skipped:
+        print("SKIP: every check that ran passed, %d part(s) could not run here (above)" % len(skipped))
+        return 77
+    return 0
+
+
+def wait_for(what, predicate, timeout=60, interval=0.2):
+    """Polls `predicate()` until it returns a true value (returned) or `timeout` s pass (CheckFailed
+    naming `what`). The timeout only bounds a hang: a test waits for the event, never for a duration."""
+    deadline = time.monotonic() + timeout
+    while True:
+        got = predicate()
+        if got:
+            return got
+        if time.monotonic() > deadline:
+            raise CheckFailed("%s: not within %.0f s" % (what, timeout))
+        time.sleep(interval)
+
+
+def recorded_so_far(path, topic, encoding="json"):
+    """The messages (data bytes) of channel `topic` (`encoding`) a recording being written holds on disk
+    now: the writer flushes a chunk at least every second, so the file grows while the recording runs.
+    Read with the reference reader's streaming mode up to the last complete record."""
+    from mcap.exceptions import EndOfFile
+    from mcap.records import Channel, Message
+    from mcap.stream_reader import StreamReader
+    channels, data = set(), []
+    try:
+        with open(path, "rb") as f:
+            for r in StreamReader(f, skip_magic=False).records:
+                if isinstance(r, Channel) and r.topic == topic and r.message_encoding == encoding:
+                    channels.add(r.id)
+                elif isinstance(r, Message) and r.channel_id in channels:
+                    data.append(r.data)
+    except EndOfFile:
+        pass  # the end of what is written so far
+    return data
+
+
+def stop_recording(base, rid, timeout=120):
+    """POST /api/recordings/{id}/stop; returns (seconds the answer took, the final status). The answer
+    comes once the file is closed (docs/recording.md); a recording still `stopping` in it is waited for
+    through GET. Fails unless it ends `stopped`."""
+    t0 = time.monotonic()
+    status, done = http(base, "POST", "/api/recordings/%d/stop" % rid, {}, timeout=timeout)
+    took = time.monotonic() - t0
+    expect(status == 200, "stop %d: %s %s" % (rid, status, done))
+    if done.get("state") == "stopping":
+        done = wait_for("recording %d stopped" % rid,
+                        lambda: (lambda s: s if s.get("state") != "stopping" else None)(http(base, "GET", "/api/recordings/%d" % rid)[1]),
+                        timeout)
+    expect(done.get("state") == "stopped", "stop %d: state %s (%s)" % (rid, done.get("state"), done.get("error")))
+    return took, done

@@ -7,7 +7,7 @@ and the reference MCAP reader (PyPI `mcap`):
            recording of packets, Bump and DistanceTraveled (polled) is made through the JSON API for
            --seconds; the reference reader lists its channels, schemas and counts, every `json` message
            validates against its channel's JSON Schema, and the recorded packets are the ones the
-           official client received live (same sequence numbers, same bytes).
+           official client received live (same bytes for each sequence number it received, most received).
   killed   a second recording, the gateway killed with SIGKILL mid-recording: the reference reader
            still reads the file up to its last chunk.
   replay   `rr-gateway --no-demo --replay FILE`: an official client through the gateway receives the
@@ -15,12 +15,15 @@ and the reference MCAP reader (PyPI `mcap`):
            --tolerance-ms); a seek lands on the right wire and property value; a function is refused
            with a clear error; the replay's JSON API status moves.
   failures a directory that cannot be created: 507 and a failed recording with the reason; a full disk
-           (a small tmpfs, mounted here as root; SKIP of that part otherwise): the recording fails with
-           "No space left on device" while the gateway goes on serving; corrupt files handed to
-           --replay: a clear error and exit status 2 (a start error), no crash.
+           (a small tmpfs, mounted here as root): the recording fails with "No space left on device"
+           while the gateway goes on serving; corrupt files handed to --replay: a clear error and exit
+           status 2 (a start error), no crash.
 
-Prints one JSON summary; exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's
-packages.
+Every step waits for the event it checks (a count on disk, a value received), bounded only against a
+hang. The replay's spacing is judged with --spacing judge (the run labelled timing, in the calm phase):
+a miss fails there. Prints one JSON summary (and, on a failure, the gateways' logs; the work folder is
+kept); exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages or when
+the tmpfs cannot be mounted (not root, no CAP_SYS_ADMIN) after every other check passed.
 """
 
 import argparse
@@ -38,7 +41,8 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, foxglove_check, http  # noqa: E402
+from record_checks import (CheckFailed, exit_status, expect, foxglove_check, http, recorded_so_far, report_and_clean,  # noqa: E402
+                           stop_recording, wait_for)
 
 try:
     import jsonschema
@@ -120,7 +124,7 @@ def read_channels(path):
     return out
 
 
-def check_recording(path, live, checks):
+def check_recording(path, listener, checks):
     with open(path, "rb") as f:
         summary = make_reader(f).get_summary()
     expect(summary is not None, "recording has a summary (closed file)")
@@ -158,12 +162,19 @@ def check_recording(path, live, checks):
         v = json.loads(m.data)["value"]
         data = bytes(v["Data"])
         recorded[data[2] | (data[3] << 8)] = data
+    # The official client's callbacks run on its own threads, behind the recorder on a busy machine: wait
+    # until it has received the last recorded packet or a later one (the stream goes on).
+    last = max(recorded)
+    live = wait_for("the official client received packet %d live" % last,
+                    lambda: (lambda got: got if any(seq_of(v)[0] >= last for _, v in got) else None)(listener.snapshot()))
     live_seqs = {seq_of(v)[0]: seq_of(v)[1] for _, v in live}
     common = set(recorded) & set(live_seqs)
     checks["live_packets"] = len(live_seqs)
     checks["recorded_packets_seen_live"] = len(common)
-    expect(len(common) >= min(len(recorded), len(live_seqs)) - 3, "recorded packets are those received live")
+    # A wire keeps only the newest value for a client that is behind: the live client may have skipped
+    # some recorded packets beside a CI run. Each it received has the recorded bytes; most were received.
     expect(all(recorded[s] == live_seqs[s] for s in common), "recorded packet bytes equal the live ones")
+    expect(len(common) >= len(recorded) // 2, "most recorded packets were received live (%d of %d)" % (len(common), len(recorded)))
     # log_time spacing and publish_time (the device's packettime) present.
     times = [m.log_time for m in rr_packets[2]]
     expect(times == sorted(times), "log times increase")
@@ -185,18 +196,19 @@ def record_phase(exe, work, seconds, checks):
                             "property_period_ms": 200, "directory": os.path.join(work, "rec"), "chunk_bytes": 16384})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["state"] == "recording", "state recording")
-        time.sleep(1.0)
-        status, listed = http(base, "GET", "/api/recordings")
-        expect(status == 200 and listed["recordings"][0]["messages"] > 0, "GET /api/recordings counts messages")
-        time.sleep(max(0.0, seconds - 1.0))
-        status, done = http(base, "POST", "/api/recordings/%d/stop" % rec["id"])
-        expect(status == 200 and done["state"] == "stopped", "stop: %s %s" % (status, done))
+        wait_for("GET /api/recordings counts messages", lambda: http(base, "GET", "/api/recordings")[1]["recordings"][0]["messages"] > 0)
+        # The recording spans `seconds` (the replay below seeks 1.5 s and 2 s into it) and holds, on
+        # disk, what check_recording counts: more than 20 packets, 3 polled values.
+        time.sleep(seconds)
+        path = rec["files"][0]
+        wait_for("21 packets recorded", lambda: len(recorded_so_far(path, "create/packets")) > 20, interval=0.5)
+        wait_for("3 DistanceTraveled values recorded", lambda: len(recorded_so_far(path, "create/DistanceTraveled")) >= 3, interval=0.5)
+        took, done = stop_recording(base, rec["id"])
         checks["recording"] = {k: done[k] for k in ("bytes", "messages", "drops", "duration_s", "files")}
+        checks["stop_answered_s"] = round(took, 2)
         expect(done["drops"] == 0, "no drops")
-        time.sleep(0.3)
-        live = listener.snapshot()
-        path = done["files"][0]
-        rr_packets, props, json_packets = check_recording(path, live, checks)
+        expect(done["files"] == [path], "one file: %s" % done["files"])
+        rr_packets, props, json_packets = check_recording(path, listener, checks)
 
         # Unwritable directory: a clear error, listed as failed; the gateway goes on.
         status, err = http(base, "POST", "/api/recordings", {"device": "create", "directory": "/proc/no/such/dir"})
@@ -214,12 +226,12 @@ def record_phase(exe, work, seconds, checks):
                             {"device": "create", "members": ["packets"], "directory": os.path.join(work, "killed"),
                              "chunk_bytes": 4096})
         expect(status == 201, "second recording")
-        time.sleep(2.5)
+        killed = rec2["files"][0]
+        wait_for("11 packets of the second recording on disk", lambda: len(recorded_so_far(killed, "create/packets")) > 10, interval=0.3)
         client.StopStreaming()
         RRN.DisconnectService(client)
         proc.send_signal(signal.SIGKILL)
-        proc.wait(10)
-        killed = rec2["files"][0]
+        proc.wait(30)
         n, end = read_stream(killed)
         checks["killed_file"] = {"messages": n, "end": end}
         expect(n > 10, "a killed gateway's file reads up to its last chunk (%d messages)" % n)
@@ -233,7 +245,9 @@ def disk_full(base, work):
     os.makedirs(mnt)
     r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", mnt], capture_output=True, text=True)
     if r.returncode != 0:
-        return "SKIP: cannot mount a tmpfs (%s)" % r.stderr.strip()
+        # Not root, or no CAP_SYS_ADMIN (a container): main() reports the test skipped (77) with this
+        # reason once every other check passed.
+        return "SKIP: cannot mount a tmpfs (%s)" % (r.stderr.strip() or "mount exit status %d" % r.returncode)
     try:
         # Leave about 24 KiB free, so that the recording fills it within a few seconds.
         with open(os.path.join(mnt, "filler"), "wb") as f:
@@ -245,12 +259,8 @@ def disk_full(base, work):
                            {"device": "create", "members": ["packets"], "directory": mnt, "chunk_bytes": 4096,
                             "compression": "none"})
         expect(status == 201, "recording on the small tmpfs starts: %s %s" % (status, rec))
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            status, s = http(base, "GET", "/api/recordings/%d" % rec["id"])
-            if s["state"] == "failed":
-                break
-            time.sleep(0.2)
+        s = wait_for("the recording on the full tmpfs ends",
+                     lambda: (lambda st: st if st["state"] in ("failed", "stopped") else None)(http(base, "GET", "/api/recordings/%d" % rec["id"])[1]))
         expect(s["state"] == "failed", "a full disk fails the recording (state %s)" % s["state"])
         expect("No space left on device" in s.get("error", ""), "the error says the disk is full: %r" % s.get("error"))
         return s["error"]
@@ -264,17 +274,6 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
     try:
         status, st = http(base, "GET", "/api/replays/create")
         expect(status == 200 and st["state"] == "playing", "replay status: %s %s" % (status, st))
-        # Start over with the listener connected, so every packet is seen.
-        http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 0})
-        client = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
-        listener = WireListener(client, "packets")
-        time.sleep(0.5)
-        skip = len(listener.snapshot())
-        http(base, "POST", "/api/replays/create", {"state": "playing"})
-        span = (rr_packets[-1].log_time - rr_packets[0].log_time) / 1e9
-        time.sleep(min(span, 4.0) + 0.5)
-        got = listener.snapshot()[skip:]
-        expect(len(got) > 10, "replayed packets received (%d)" % len(got))
         recorded_seq = []
         # The recorded order (by sequence number, from the json channel of the same file).
         with open(path, "rb") as f:
@@ -282,6 +281,24 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
                 if ch.message_encoding == "json":
                     d = bytes(json.loads(m.data)["value"]["Data"])
                     recorded_seq.append((m.log_time, d[2] | (d[3] << 8)))
+        # Start over with the listener connected, so every packet is seen.
+        status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 0})
+        expect(status == 200 and st["state"] == "paused", "pause at 0: %s %s" % (status, st))
+        client = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
+        listener = WireListener(client, "packets")
+        played_at = time.monotonic()
+        status, st = http(base, "POST", "/api/replays/create", {"state": "playing"})
+        expect(status == 200 and st["state"] == "playing", "play: %s %s" % (status, st))
+        # Played up to the packet recorded min(span, 4) s after the first one (or a later one): the
+        # packets received since play are judged (a value from the pause at 0 that arrives late is the
+        # first recorded one, in order too).
+        first_ns = recorded_seq[0][0]
+        upto = max(i for i, (t, _) in enumerate(recorded_seq) if t - first_ns <= 4e9)
+        later = {s for _, s in recorded_seq[upto:]}
+        wait_for("the replay played the packet recorded %.1f s in" % ((recorded_seq[upto][0] - first_ns) / 1e9),
+                 lambda: any(seq_of(v)[0] in later for t, v in listener.snapshot() if t >= played_at), timeout=90)
+        got = [(t, v) for t, v in listener.snapshot() if t >= played_at]
+        expect(len(got) > 10, "replayed packets received (%d)" % len(got))
         # A wire keeps only the newest value for a client that is behind (docs/json-api.md), so the
         # received packets are the recorded ones in order, possibly with some skipped.
         seqs = [s for _, s in recorded_seq]
@@ -295,7 +312,10 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
             pos += 1
         skipped = index[-1] - index[0] + 1 - len(index)
         checks["replayed_packets"] = {"received": len(got), "skipped": skipped}
-        expect(skipped <= len(got) // 10, "at most 10%% of the packets skipped by the wire (%d)" % skipped)
+        if tolerance_ms is not None:
+            # The timing run: a client that keeps up (a calm machine) gets nearly every packet. Beside a CI
+            # run the official client falls behind and its wire skips more: the order alone is judged there.
+            expect(skipped <= len(got) // 10, "at most 10%% of the packets skipped by the wire (%d)" % skipped)
         # Spacing: each interval between received packets against the recorded one.
         errors = []
         for i in range(1, len(got)):
@@ -305,28 +325,30 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         errors.sort()
         checks["spacing_error_ms"] = {"median": errors[len(errors) // 2], "p95": errors[int(len(errors) * 0.95)],
                                       "max": errors[-1], "intervals": len(errors)}
-        within = sum(1 for e in errors if tolerance_ms is not None and e <= tolerance_ms)
         if tolerance_ms is None:
             checks["spacing_judged"] = "no (--spacing report): judged by the test labelled timing"
-        elif within < 0.95 * len(errors):
-            # Timing is judged only on a machine that is not overloaded (the 1-minute load average at
-            # most the number of CPUs): elsewhere the delays measured are the scheduler's, not the
-            # replay's, and the check reports SKIP instead of passing or failing.
-            load, cpus = os.getloadavg()[0], os.cpu_count() or 1
-            expect(load > cpus, "95%% of intervals within %.0f ms: %s" % (tolerance_ms, checks["spacing_error_ms"]))
-            checks["spacing_skipped"] = "load average %.1f on %d CPUs: spacing not judged" % (load, cpus)
+        else:
+            # The run labelled timing: the calm phase of scripts/test.sh (nothing built or tested beside
+            # it), so a miss is the replay's and fails.
+            within = sum(1 for e in errors if e <= tolerance_ms)
+            checks["spacing_judged"] = "load average %.1f on %d CPUs" % (os.getloadavg()[0], os.cpu_count() or 1)
+            expect(within >= 0.95 * len(errors), "95%% of intervals within %.0f ms: %s (%s)"
+                   % (tolerance_ms, checks["spacing_error_ms"], checks["spacing_judged"]))
 
         # Seek lands on the right value: the wire and the property at 1.5 s.
         status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 1.5})
         expect(status == 200, "seek: %s %s" % (status, st))
-        time.sleep(0.5)
         target = st["start_ns"] + 1_500_000_000
         want_seq = [s for t, s in recorded_seq if t <= target][-1]
-        status, w = http(base, "GET", "/api/devices/create/wires/packets")
-        d = bytes(w["value"]["Data"])
-        expect((d[2] | (d[3] << 8)) == want_seq, "seek: wire value %d, want %d" % (d[2] | (d[3] << 8), want_seq))
-        peek = client.packets.PeekInValue()[0]
-        expect(seq_of(peek)[0] == want_seq, "seek: official client's PeekInValue")
+
+        def wire_seq():
+            status, w = http(base, "GET", "/api/devices/create/wires/packets")
+            d = bytes(w["value"]["Data"]) if status == 200 else b"\0\0\0\0"
+            return d[2] | (d[3] << 8)
+        # The seek's values reach the gateway's wire and the client's InValue as messages: waited for.
+        wait_for("seek: wire value %d" % want_seq, lambda: wire_seq() == want_seq, timeout=30)
+        wait_for("seek: official client's PeekInValue %d" % want_seq,
+                 lambda: seq_of(client.packets.PeekInValue()[0])[0] == want_seq, timeout=30)
         want_prop = [json.loads(m.data)["value"] for m in props if m.log_time <= target][-1]
         status, p = http(base, "GET", "/api/devices/create/properties/DistanceTraveled")
         expect(status == 200 and p["value"] == want_prop, "seek: property %s, want %s" % (p, want_prop))
@@ -363,7 +385,6 @@ def mcap_core_phase(exe, work, path, checks):
     try:
         status, st = http(base, "POST", "/api/replays/ts_create", {"state": "paused", "position_s": 2.0})
         expect(status == 200, "seek in the @mcap/core file: %s %s" % (status, st))
-        time.sleep(0.5)
         target = st["start_ns"] + 2_000_000_000
         want = None
         with open(path, "rb") as f:
@@ -371,10 +392,13 @@ def mcap_core_phase(exe, work, path, checks):
                 if ch.message_encoding == "json" and m.log_time <= target:
                     d = bytes(json.loads(m.data)["value"]["Data"])
                     want = d[2] | (d[3] << 8)
-        status, w = http(base, "GET", "/api/devices/ts_create/wires/packets")
-        expect(status == 200, "wire of the @mcap/core file's device: %s %s" % (status, w))
-        d = bytes(w["value"]["Data"])
-        expect((d[2] | (d[3] << 8)) == want, "the @mcap/core file replays the recorded value")
+
+        def wire_seq():
+            status, w = http(base, "GET", "/api/devices/ts_create/wires/packets")
+            expect(status == 200, "wire of the @mcap/core file's device: %s %s" % (status, w))
+            d = bytes(w["value"]["Data"])
+            return d[2] | (d[3] << 8)
+        wait_for("the @mcap/core file replays the recorded value %d" % want, lambda: wire_seq() == want, timeout=30)
         checks["mcap_core_file"] = {"rewrite": json.loads(r.stdout), "wire_seq_at_2s": want}
     finally:
         stop(proc)
@@ -425,12 +449,8 @@ def corrupt_phase(exe, work, path, checks):
     proc, port, base = start_gateway(exe, ["--no-demo", "--replay", flipped], os.path.join(work, "gateway4.log"))
     try:
         http(base, "POST", "/api/replays/create", {"speed": 20})
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            status, st = http(base, "GET", "/api/replays/create")
-            if st["state"] in ("failed", "ended"):
-                break
-            time.sleep(0.2)
+        st = wait_for("the replay of the flipped file ends",
+                      lambda: (lambda st: st if st["state"] in ("failed", "ended") else None)(http(base, "GET", "/api/replays/create")[1]))
         cases["flipped"] = {"state": st["state"], "error": st.get("error", "")}
         expect(st["state"] == "failed" and flipped in st.get("error", ""), "flipped chunk: replay failed naming the file: %s" % st)
         status, _ = http(base, "GET", "/api/devices")
@@ -464,16 +484,9 @@ def main():
             OSError, KeyError, ValueError, IndexError) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        print(json.dumps(checks, indent=1, default=str))
-        if not a.keep:
-            subprocess.run(["umount", "-l", os.path.join(work, "tiny")], capture_output=True)
-            shutil.rmtree(work, ignore_errors=True)
-        else:
-            print("kept", work)
-    if ok and "spacing_skipped" in checks:
-        print("SKIP: every other check passed; replay spacing not judged (%s)" % checks["spacing_skipped"])
-        sys.exit(77)
-    sys.exit(0 if ok else 1)
+        subprocess.run(["umount", "-l", os.path.join(work, "tiny")], capture_output=True)
+        report_and_clean(checks, work, a.keep, failed=not ok)
+    sys.exit(exit_status(ok, checks))
 
 
 if __name__ == "__main__":

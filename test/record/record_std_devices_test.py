@@ -10,10 +10,12 @@ MCAP reader (PyPI `mcap`) and compared with what the official Python client rece
            the driver's root object, recorded while an official client streams it.
   checks   channels (json and robotraconteur per member), schemas (the standard service definitions),
            counts; the json messages parse and (the first few, the frames being large) validate against
-           their JSON Schema; every recorded robot_state value (seqno, joint_position, command_mode) and
-           every recorded frame (its seqno and
-           bytes) is one the official client received live; the robot's file
+           their JSON Schema; frames in the camera's order, no recorder drops; each recorded robot_state
+           value (joint_position, command_mode) and frame (bytes) whose seqno the official client
+           received live equals what it received, and it received most of them (a client that falls
+           behind beside a CI run may lose a few: the gateway does not wait for it); the robot's file
            replayed by `rr-gateway --replay` gives an official client recorded robot_state values.
+           Counts are waited for (in the file on disk, as received), never slept for.
 
 Exit 0 when every check passed, 1 when one failed, 77 (SKIP) without the venv's packages.
 """
@@ -35,7 +37,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEVICES = os.path.join(HERE, "..", "browser", "devices")
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, foxglove_check, http, official_foxglove_schemas, report_and_clean  # noqa: E402
+from record_checks import (CheckFailed, exit_status, expect, foxglove_check, http, official_foxglove_schemas,  # noqa: E402
+                           recorded_so_far, report_and_clean, stop_recording, wait_for)
 
 try:
     import jsonschema
@@ -184,20 +187,50 @@ def run(gateway_exe, work, seconds, checks):
             c.start_streaming()
         except RR.RobotRaconteurException as e:  # already streaming is fine
             checks["start_streaming"] = str(e)
-        time.sleep(1.0)
-        ids = {}
+
+        def live_started():
+            with lock:
+                return bool(live_states and live_frames)
+        wait_for("the official client receives states and frames live", live_started)
+        ids, files = {}, {}
         for device, member in (("robot", "robot_state"), ("camera", "frame_stream")):
             st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member], "directory": work})
             expect(st == 201, "POST /api/recordings %s: %s %s" % (device, st, body))
-            ids[device] = body["id"]
-        time.sleep(seconds)
+            ids[device], files[device] = body["id"], body["files"][0]
+        # --seconds worth of values (the robot's state at 10 Hz or more, frames at 10 fps) on disk, then stop.
+        want = {"robot": ("robot/robot_state", int(seconds * 10)), "camera": ("camera/frame_stream", int(seconds * 5))}
+        for device, (topic, n) in want.items():
+            wait_for("%d %s values recorded" % (n, topic), lambda: len(recorded_so_far(files[device], topic, "robotraconteur")) >= n,
+                     timeout=120, interval=0.5)
         finals = {}
         for device, rid in ids.items():
-            st, body = http(base, "POST", "/api/recordings/%d/stop" % rid, {})
-            expect(st == 200 and body["state"] == "stopped", "stop %s: %s %s" % (device, st, body))
-            finals[device] = body
+            took, finals[device] = stop_recording(base, rid)
+            checks.setdefault("stop_answered_s", {})[device] = round(took, 2)
         checks["recordings"] = {d: {k: b[k] for k in ("messages", "drops", "bytes")} for d, b in finals.items()}
-        time.sleep(1.0)
+
+        robot_file = finals["robot"]["files"][0]
+        states = [state_key(v) for v in check_file(robot_file, "robot", "robot_state",
+                                                     "com.robotraconteur.robotics.robot", checks)]
+        expect(len(states) >= want["robot"][1], "robot_state recorded (%d values)" % len(states))
+        frames = check_file(finals["camera"]["files"][0], "camera", "frame_stream", "com.robotraconteur.imaging",
+                            checks, validate_max=3)
+        # A frame is its sequence number (the driver's data_header.seqno) and its bytes (the synthetic
+        # pattern repeats, so the bytes alone would not tell frames apart).
+        hashes = [(int(f["image_info"]["data_header"]["seqno"]), hashlib.sha256(bytes(f["data"])).hexdigest()) for f in frames]
+        # The official client's callbacks run on its own threads, behind the recorder on a busy machine:
+        # wait (bounded) until it has received every recorded frame and a state at least as new as the
+        # last recorded one (a wire may skip a value for a client that is behind).
+        last_seqno = states[-1][0]
+
+        last_frame = max(h[0] for h in hashes)
+
+        def live_caught_up():
+            with lock:
+                return any(f[0] >= last_frame for f in live_frames) and any(st[0] >= last_seqno for st in live_states)
+        try:
+            wait_for("the official client received what was recorded", live_caught_up, timeout=30)
+        except CheckFailed:
+            pass  # the checks below say what is missing
         try:
             c.stop_streaming()
         except RR.RobotRaconteurException:
@@ -208,26 +241,33 @@ def run(gateway_exe, work, seconds, checks):
         RRN.DisconnectService(c)
         with lock:
             live_s, live_f = list(live_states), set(live_frames)
-
-        robot_file = finals["robot"]["files"][0]
-        states = [state_key(v) for v in check_file(robot_file, "robot", "robot_state",
-                                                     "com.robotraconteur.robotics.robot", checks)]
-        expect(len(states) >= seconds * 10, "robot_state recorded (%d values in %s s)" % (len(states), seconds))
-        live_set = set(live_s)
-        seen = sum(s in live_set for s in states)
-        checks["robot_state"] = {"recorded": len(states), "live": len(live_s), "recorded_seen_live": seen}
-        expect(seen >= len(states) - 2, "recorded robot_state values are those the official client received live")
-        frames = check_file(finals["camera"]["files"][0], "camera", "frame_stream", "com.robotraconteur.imaging",
-                            checks, validate_max=3)
-        # A frame is its sequence number (the driver's data_header.seqno) and its bytes (the synthetic
-        # pattern repeats, so the bytes alone would not tell frames apart).
-        hashes = [(int(f["image_info"]["data_header"]["seqno"]), hashlib.sha256(bytes(f["data"])).hexdigest()) for f in frames]
+        # A wire keeps only the newest value for a client that is behind, so the live client may have
+        # skipped some of the recorded states (a few in a hundred beside a CI run): each state it did
+        # receive must be the recorded one of that seqno, and most must have been received.
+        live_by_seqno = {st[0]: st for st in live_s}
+        common = [st for st in states if st[0] in live_by_seqno]
+        differ = [(st, live_by_seqno[st[0]]) for st in common if live_by_seqno[st[0]] != st]
+        checks["robot_state"] = {"recorded": len(states), "live": len(live_s), "recorded_seen_live": len(common)}
+        expect(not differ, "recorded robot_state values equal the ones the official client received live: %s" % differ[:2])
+        expect(len(common) >= len(states) // 2, "most recorded robot_state values were received live (%d of %d)"
+               % (len(common), len(states)))
         expect(len(set(hashes)) == len(hashes), "recorded frames are distinct (seqno, bytes)")
-        expect(len(frames) >= seconds * 10 * 0.5, "frames recorded (%d in %s s at 10 fps)" % (len(frames), seconds))
+        seqnos = [h[0] for h in hashes]
+        expect(seqnos == sorted(seqnos), "recorded frames in the camera's order")
+        expect(all(b["drops"] == 0 for b in finals.values()), "no recorder drops: %s" % checks["recordings"])
+        expect(len(frames) >= want["camera"][1], "frames recorded (%d)" % len(frames))
         expect(all(f["image_info"]["width"] == 160 and f["image_info"]["height"] == 120 for f in frames), "frame size")
-        fseen = sum(h in live_f for h in hashes)
-        checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": fseen}
-        expect(fseen == len(frames), "every recorded frame is one the official client received live")
+        # The live client is one more client of the gateway: beside a CI run it may fall behind and lose a
+        # few frames there (3 of 129 once). Each recorded frame it did get has the recorded bytes; most
+        # were received. What the recorder wrote is checked on its own above (order, no drops).
+        live_by_seqno = {}
+        for seqno, digest in live_f:
+            live_by_seqno.setdefault(seqno, set()).add(digest)
+        fcommon = [h for h in hashes if h[0] in live_by_seqno]
+        fdiffer = [h for h in fcommon if h[1] not in live_by_seqno[h[0]]]
+        checks["frames"] = {"recorded": len(frames), "live": len(live_f), "recorded_seen_live": len(fcommon)}
+        expect(not fdiffer, "recorded frames have the bytes the official client received live (%d differ)" % len(fdiffer))
+        expect(len(fcommon) >= len(hashes) // 2, "most recorded frames were received live (%d of %d)" % (len(fcommon), len(hashes)))
         foxglove_check([robot_file, finals["camera"]["files"][0]], checks, max_messages=5)
         check_foxglove_images(finals["camera"]["files"][0], hashes, checks)
     finally:
@@ -242,9 +282,10 @@ def run(gateway_exe, work, seconds, checks):
         got = []
         wire = r.robot_state.Connect()
         wire.WireValueChanged += lambda _c, v, _t: got.append(state_key(v))
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline and len(got) < 20:
-            time.sleep(0.1)
+        try:
+            wait_for("20 replayed robot_state values", lambda: len(got) >= 20, timeout=60, interval=0.1)
+        except CheckFailed:
+            pass  # said below
         wire.Close()
         RRN.DisconnectService(r)
         recorded = set(states)
@@ -272,8 +313,8 @@ def main():
             ValueError, IndexError, StepFailed, subprocess.TimeoutExpired) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        report_and_clean(checks, work, a.keep)
-    sys.exit(0 if ok else 1)
+        report_and_clean(checks, work, a.keep, failed=not ok)
+    sys.exit(exit_status(ok, checks))
 
 
 if __name__ == "__main__":

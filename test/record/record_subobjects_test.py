@@ -7,6 +7,9 @@ cameras behind the objref `Webcams{int32}`. Recorded through the JSON API: `Webc
 (a pipe, streaming) and the `Name` property of `Webcams[0]` and `Webcams[1]`, both encodings. Checked:
 - names that do not lead to a member get 400 naming the problem (no index, no such objref or member,
   a property used as an objref);
+- the status's `connecting` turns 0 once the pipe is connected; 3 frames and the names are waited for
+  in the file on disk, then the stop answers `stopped` (its time is reported: it took over 60 s under a
+  CI load while each frame's JSON was a tree of numbers);
 - the reference reader (PyPI mcap) lists channels `webcam/Webcams[0]/FrameStream`, ... with metadata
   `path`, `object_type` experimental.createwebcam.Webcam and `root_type`, and the frames;
 - `rr-gateway --replay FILE`: an official client (rr+tcp) gets `Webcams[0]` and `Webcams[1]` through
@@ -15,13 +18,13 @@ cameras behind the objref `Webcams{int32}`. Recorded through the JSON API: `Webc
   `Name?object=Webcams[1]`.
 
   record_subobjects_test.py --gateway build/debug/server/app/rr-gateway
-Prints a JSON summary; exit 0, 1 (a check failed) or 77 (the venv's packages are missing).
+Prints a JSON summary (on a failure also the gateways' logs, the work folder kept); exit 0, 1 (a check
+failed) or 77 (the venv's packages are missing).
 """
 import argparse
 import hashlib
 import json
 import os
-import shutil
 import sys
 import tempfile
 import threading
@@ -30,7 +33,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "interop"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import stop  # noqa: E402
-from record_checks import CheckFailed, expect, http  # noqa: E402
+from record_checks import CheckFailed, expect, http, recorded_so_far, report_and_clean, stop_recording, wait_for  # noqa: E402
 from record_replay_test import start_gateway  # noqa: E402
 
 try:
@@ -50,12 +53,8 @@ def frame_digest(width, height, data):
 def record_phase(exe, work, checks):
     proc, port, base = start_gateway(exe, [], os.path.join(work, "gateway.log"))
     try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            status, devices = http(base, "GET", "/api/devices")
-            if any(d["name"] == "webcam" and d["state"] == "connected" for d in devices or []):
-                break
-            time.sleep(0.2)
+        wait_for("the webcam device connected",
+                 lambda: any(d["name"] == "webcam" and d["state"] == "connected" for d in http(base, "GET", "/api/devices")[1] or []))
         bad = {}
         for name, want in (("Webcams.FrameStream", "needs an index"), ("Webcams[0].Nope", "has no member \"Nope\""),
                            ("Nothing[0].Name", "has no member \"Nothing\""),
@@ -76,10 +75,17 @@ def record_phase(exe, work, checks):
         for i in (0, 1):
             status, body = http(base, "GET", "/api/devices/webcam/properties/Name?object=Webcams%%5B%d%%5D" % i)
             live_names[i] = body["value"]
-        time.sleep(3)
-        status, done = http(base, "POST", "/api/recordings/%d/stop" % rec["id"], {})
-        expect(status == 200 and done["state"] == "stopped", "stop: %s %s" % (status, done))
+        # "connecting": the pipe's connection not answered yet, then 0 (docs/recording.md "JSON API").
+        expect(isinstance(rec.get("connecting"), int) and 0 <= rec["connecting"] <= 1, "connecting in the status: %s" % rec)
+        wait_for("the recording's pipe connected (connecting 0)",
+                 lambda: http(base, "GET", "/api/recordings/%d" % rec["id"])[1]["connecting"] == 0)
+        # Recorded on disk (the writer flushes a chunk at least every second): 3 frames and each name.
+        path = rec["files"][-1]
+        for topic, n in (("webcam/Webcams[0]/FrameStream", 3), ("webcam/Webcams[0]/Name", 1), ("webcam/Webcams[1]/Name", 1)):
+            wait_for("%d %s messages in %s" % (n, topic, path), lambda: len(recorded_so_far(path, topic)) >= n, timeout=90, interval=0.5)
+        took, done = stop_recording(base, rec["id"])
         checks["recording"] = {k: done[k] for k in ("messages", "drops", "files", "members")}
+        checks["stop_answered_s"] = round(took, 2)
         return done["files"][-1], live_names
     finally:
         stop(proc)
@@ -132,9 +138,7 @@ def replay_phase(exe, work, path, recorded_frames, live_names, checks):
                     return True
                 except RR.RobotRaconteurException:  # ValueNotSet until the first polled value is played
                     return False
-            deadline = time.monotonic() + 10
-            while not names_read() and time.monotonic() < deadline:
-                time.sleep(0.2)
+            wait_for("the recorded names played", names_read, timeout=60)
             expect(got == live_names, "recorded names through the objref: %s, live %s" % (got, live_names))
             status, body = http(base, "GET", "/api/devices/webcam/properties/Name?object=Webcams%5B1%5D")
             expect(status == 200 and body["value"] == live_names[1], "JSON API Name?object=Webcams[1]: %s %s" % (status, body))
@@ -150,7 +154,7 @@ def replay_phase(exe, work, path, recorded_frames, live_names, checks):
                         if len(received) >= 3:
                             arrived.set()
             ep.PacketReceivedEvent += on_packet
-            expect(arrived.wait(20), "frames through Webcams[0].FrameStream: %d" % len(received))
+            expect(arrived.wait(60), "frames through Webcams[0].FrameStream: %d" % len(received))
             ep.Close()
             with lock:
                 unknown = [d for d in received if d not in recorded_frames]
@@ -195,11 +199,7 @@ def main():
     except (CheckFailed, AssertionError, RR.RobotRaconteurException, OSError, KeyError, ValueError, TypeError) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        print(json.dumps(checks, indent=1, default=str))
-        if not a.keep:
-            shutil.rmtree(work, ignore_errors=True)
-        else:
-            print("kept", work)
+        report_and_clean(checks, work, a.keep, failed=not ok)
     sys.exit(0 if ok else 1)
 
 

@@ -2,10 +2,11 @@
 """A replayed device served to every kind of client (docs/recording.md "Replay", "Which clients were
 tested against a replay"):
 
-  record   `rr record` of rr_interop_service for --seconds: its w_state wire (a tick every 200 ms), the
-           p_stream pipe (5 packets asked for by an official client), the ev_values event (3 fired) and
-           the p_int32 property (polled every second; the official client sets it from A to B halfway).
-           The reference reader (PyPI `mcap`) gives what was recorded.
+  record   `rr record` of rr_interop_service: its w_state wire (a tick every 200 ms), the p_stream pipe
+           (5 packets asked for by an official client), the ev_values event (3 fired) and the p_int32
+           property (polled every second; the official client sets it from A to B halfway). Each step
+           waits for the previous one's messages in the file on disk; SIGINT ends the recording once B
+           is recorded. The reference reader (PyPI `mcap`) gives what was recorded.
   replay   `rr-gateway --no-demo --replay interop=FILE`, paused at 0 while four clients connect:
              rr+tcp  the official Python client to the gateway's TCP port,
              rr+ws   the official Python client over WebSocket to the same port,
@@ -28,6 +29,7 @@ import argparse
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -38,7 +40,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
-from record_checks import CheckFailed, expect, http, report_and_clean  # noqa: E402
+from record_checks import CheckFailed, expect, http, recorded_so_far, report_and_clean, wait_for  # noqa: E402
 
 try:
     import websocket
@@ -61,38 +63,54 @@ def inner_id(v):
 
 # ---- record ----------------------------------------------------------------------------------------
 
-def record(rr, service_exe, work, seconds, checks):
+def record(rr, service_exe, work, checks):
     """Records rr_interop_service with `rr record`; returns the file's path."""
     service = subprocess.Popen([service_exe, "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                                stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
+    proc = None
     try:
         url = read_json_line(service, 60, "rr_interop_service")["url"]
         client = RRN.ConnectService(url)
-        proc = subprocess.Popen([rr, "record", url, "--duration", str(seconds), "--dir", os.path.join(work, "rec"),
+        proc = subprocess.Popen([rr, "record", url, "--dir", os.path.join(work, "rec"),
                                  "--members", "w_state,p_stream,ev_values,p_int32"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL,
                                 preexec_fn=die_with_parent)
-        # The recorder says what it records once its wire, pipe and event are connected.
+        # The recorder says what it records (and its file) once its wire, pipe and event are connected.
         seen = []
         for line in proc.stderr:
             seen.append(line)
             if line.startswith("rr: recording"):
                 break
-        expect(seen and seen[-1].startswith("rr: recording"), "rr record started: %r" % seen[-5:])
-        time.sleep(seconds * 0.25)
+        expect(seen and seen[-1].startswith("rr: recording") and seen[-1].rstrip().endswith(".mcap"),
+               "rr record started: %r" % seen[-5:])
+        path = seen[-1].rstrip().rsplit(" to ", 1)[1]
+
+        def on_disk(topic, n):
+            wait_for("%d %s messages in %s" % (n, topic, path), lambda: len(recorded_so_far(path, "interop/" + topic)) >= n,
+                     timeout=90, interval=0.3)
+        # Each step after the previous one is in the file, so the recording holds them in this order.
+        on_disk("w_state", 5)
+        on_disk("p_int32", 1)  # A
         client.send_stream(5)
-        time.sleep(0.3)
+        on_disk("p_stream", 5)
         client.fire_events(3)
-        time.sleep(seconds * 0.25)
+        on_disk("ev_values", 3)
+        on_disk("w_state", len(recorded_so_far(path, "interop/w_state")) + 3)
         client.p_int32 = P_INT32_B
-        out, err = proc.communicate(timeout=seconds + 120)
-        expect(proc.returncode == 0, "rr record exits 0 (rc=%s, %s)" % (proc.returncode, err[-1000:]))
+        wait_for("p_int32 = B recorded", lambda: any(json.loads(d)["value"] == P_INT32_B
+                                                       for d in recorded_so_far(path, "interop/p_int32")), timeout=90, interval=0.3)
+        on_disk("w_state", len(recorded_so_far(path, "interop/w_state")) + 3)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+        expect(proc.returncode == 0, "rr record ends on SIGINT with 0 (rc=%s, %s)" % (proc.returncode, err[-1000:]))
         status = json.loads(out.strip().splitlines()[-1])
         RRN.DisconnectService(client)
-        expect(status["drops"] == 0 and len(status["files"]) == 1, "one file, no drops: %r" % status)
+        expect(status["drops"] == 0 and status["files"] == [path], "one file, no drops: %r" % status)
         checks["recording"] = {k: status[k] for k in ("messages", "bytes", "members")}
-        return status["files"][0]
+        return path
     finally:
+        if proc is not None and proc.poll() is None:
+            stop(proc)
         stop(service)
 
 
@@ -332,18 +350,29 @@ def replay(gateway, path, rec, work, checks):
         if node:
             clients["wasm"] = WasmClient(node, "rr+ws://127.0.0.1:%d/?service=interop" % port, os.path.join(work, "wasm.log"))
         clients["json"] = JsonClient(port, "interop")
-        time.sleep(0.5)
         status, st = http(base, "POST", "/api/replays/interop", {"state": "playing"})
         expect(status == 200 and st["state"] == "playing", "play: %s %r" % (status, st))
-        deadline = time.monotonic() + duration_s + 30
+        deadline = time.monotonic() + 2 * duration_s + 60  # a bound on a hang
         while st["state"] == "playing" and time.monotonic() < deadline:
             time.sleep(0.2)
             _, st = http(base, "GET", "/api/replays/interop")
         expect(st["state"] == "ended", "the replay ends (state %s after %.1f s)" % (st["state"], duration_s))
-        time.sleep(1.0)  # the last values on their way to the clients
         played = {}
+        last_id, n_events = rec["wire"][-1][1], len(rec["events"])
         for name, c in clients.items():
-            played[name] = check_played(name, c.report(), rec)
+            # The last values may still be on their way to a client: wait (bounded) for the last recorded
+            # w_state value, the pipe packets and the events, then judge that report.
+            box = {}
+
+            def arrived():
+                box["got"] = c.report()
+                got = box["got"]
+                return got["wire"] and got["wire"][-1] == last_id and len(got["pipe"]) >= len(rec["pipe"]) and len(got["events"]) >= n_events
+            try:
+                wait_for("%s: the last recorded values arrive" % name, arrived, timeout=30, interval=0.3)
+            except CheckFailed:
+                pass  # check_played says what is missing
+            played[name] = check_played(name, box["got"], rec)
         checks["played"] = played
 
         # Seek back to just after the last p_int32 poll that read A (before the set to B), paused: every
@@ -359,7 +388,7 @@ def replay(gateway, path, rec, work, checks):
         status, st = http(base, "POST", "/api/replays/interop", {"position_s": position_s, "state": "paused"})
         expect(status == 200, "seek: %s %r" % (status, st))
         seek = {"position_s": round(position_s, 3), "w_state": want_wire[-1]}
-        deadline = time.monotonic() + 15
+        deadline = time.monotonic() + 30
         for name, c in clients.items():
             while True:
                 got = c.report()
@@ -383,7 +412,6 @@ def main():
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--rr", required=True)
     ap.add_argument("--service", required=True, help="rr_interop_service")
-    ap.add_argument("--seconds", type=float, default=5.0)
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-replay-clients-")
@@ -391,7 +419,7 @@ def main():
     checks = {}
     ok, wasm_skip = False, None
     try:
-        path = record(a.rr, a.service, work, a.seconds, checks)
+        path = record(a.rr, a.service, work, checks)
         rec = recorded(path)
         checks["recorded"] = {"w_state": len(rec["wire"]), "pipe": len(rec["pipe"]), "events": len(rec["events"]),
                               "p_int32": [v for _, v in rec["property"]]}
@@ -401,7 +429,7 @@ def main():
             IndexError, TypeError, subprocess.TimeoutExpired, websocket.WebSocketException) as e:
         checks["failed"] = "%s: %s" % (type(e).__name__, str(e)[:2000])
     finally:
-        report_and_clean(checks, work, a.keep)
+        report_and_clean(checks, work, a.keep, failed=not ok)
     if ok and wasm_skip:
         print("SKIP: every other client passed; the wasm client was not run: %s" % wasm_skip)
         sys.exit(77)

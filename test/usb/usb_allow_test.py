@@ -67,7 +67,10 @@ def run(args, tmp, allow):
                 fail("allow-listed board: DistanceTraveled %r" % value)
             print("usb.allow: a board without the BOS capability connects and answers", flush=True)
         else:
-            time.sleep(4)
+            # The board was looked at once the gateway says why it is not an RR device (bounded wait).
+            t_end = time.monotonic() + 30
+            while "usb_demo" not in (device()["reason"] or "") and time.monotonic() < t_end:
+                time.sleep(0.2)
             d = device()
             if d["state"] == "connected" or "usb_demo" not in (d["reason"] or ""):
                 fail("board without BOS and no allow entry: create is %s (%r)" % (d["state"], d["reason"]))
