@@ -368,6 +368,22 @@ Result<void> McapReader::State::check_chunk_indexes(const std::vector<ChunkIndex
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
         return indexes[a].chunk_start_offset < indexes[b].chunk_start_offset;
     });
+    // Each chunk indexed once, chunks apart: checked first, it is the more telling error.
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        const auto& ci = indexes[order[k]];
+        const auto at = record_offsets[order[k]];
+        const auto& prev = indexes[order[k - 1]];
+        if (ci.chunk_start_offset == prev.chunk_start_offset)
+            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
+                                "a second index of the chunk at offset " + std::to_string(ci.chunk_start_offset) +
+                                    " (the ChunkIndex at offset " + std::to_string(record_offsets[order[k - 1]]) +
+                                    " names it too; each chunk is indexed once)");
+        if (ci.chunk_start_offset < prev.chunk_start_offset + prev.chunk_length)
+            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
+                                "the chunk at offset " + std::to_string(ci.chunk_start_offset) +
+                                    " begins inside the chunk at offset " + std::to_string(prev.chunk_start_offset) +
+                                    " (length " + std::to_string(prev.chunk_length) + ")");
+    }
     for (std::size_t k = 0; k < order.size(); ++k) {
         const auto& ci = indexes[order[k]];
         const auto at = record_offsets[order[k]];
@@ -380,18 +396,6 @@ Result<void> McapReader::State::check_chunk_indexes(const std::vector<ChunkIndex
                                     " bytes uncompressed) can never be read within the reader's memory limit of " +
                                     std::to_string(budget.limit) + " bytes (" + std::to_string(budget.held) +
                                     " held by the summary)");
-        if (k == 0) continue;
-        const auto& prev = indexes[order[k - 1]];
-        if (ci.chunk_start_offset == prev.chunk_start_offset)
-            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
-                                "a second index of the chunk at offset " + std::to_string(ci.chunk_start_offset) +
-                                    " (the ChunkIndex at offset " + std::to_string(record_offsets[order[k - 1]]) +
-                                    " names it too; each chunk is indexed once)");
-        if (ci.chunk_start_offset < prev.chunk_start_offset + prev.chunk_length)
-            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
-                                "the chunk at offset " + std::to_string(ci.chunk_start_offset) +
-                                    " begins inside the chunk at offset " + std::to_string(prev.chunk_start_offset) +
-                                    " (length " + std::to_string(prev.chunk_length) + ")");
     }
     return {};
 }
