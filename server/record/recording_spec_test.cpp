@@ -14,12 +14,12 @@ TEST_CASE("record spec: defaults and every key") {
     REQUIRE(d);
     CHECK(d->json);
     CHECK(d->robotraconteur);
-    CHECK(d->directory == "recordings");
+    CHECK(d->directory.empty());  // the recordings root itself
     CHECK(d->max_file_bytes == 256ull << 20);
     auto s = record::spec_from_json(json{{"device", "cam"},
                                          {"members", {"frames", "pos"}},
                                          {"encoding", "robotraconteur"},
-                                         {"directory", "/tmp/x"},
+                                         {"directory", "lab/run-1.a"},
                                          {"prefix", "p"},
                                          {"property_period_ms", 250},
                                          {"max_file_bytes", 1000000},
@@ -30,6 +30,7 @@ TEST_CASE("record spec: defaults and every key") {
     INFO((s ? std::string() : s.error().message));
     REQUIRE(s);
     CHECK(s->members == std::vector<std::string>{"frames", "pos"});
+    CHECK(s->directory == "lab/run-1.a");
     CHECK_FALSE(s->json);
     CHECK(s->robotraconteur);
     CHECK(s->property_period == std::chrono::milliseconds(250));
@@ -98,4 +99,55 @@ TEST_CASE("record spec: foxglove_images, on by default") {
     auto bad = record::spec_from_json(json{{"device", "cam"}, {"foxglove_images", "no"}});
     REQUIRE_FALSE(bad);
     CHECK(bad.error().message == "record: foxglove_images: expected true or false");
+}
+
+TEST_CASE("record spec: a directory names a sub-folder of the root, a prefix a plain name (400 otherwise)") {
+    auto refused = [](json body, const std::string& expected) {
+        body["device"] = "create";
+        auto s = record::spec_from_json(body);
+        INFO(body.dump());
+        REQUIRE_FALSE(s);
+        CHECK(s.error().type == MessageErrorType::InvalidArgument);
+        CHECK_THAT(s.error().message, Catch::Contains(expected));
+    };
+    // issue 52: the prefix was cut at the NUL and the file opened without O_EXCL, replacing /tmp/victim.txt
+    refused(json{{"directory", "/tmp"}}, "record: directory: \"/tmp\" is an absolute path");
+    refused(json{{"prefix", std::string("victim.txt\0", 11)}}, "record: prefix: \"victim.txt\\u0000\" has the character \"\\u0000\"");
+    refused(json{{"directory", ".."}}, "a part starting with a dot (\"..\"");
+    refused(json{{"directory", "a/../../etc"}}, "a part starting with a dot (\"..\"");
+    refused(json{{"directory", "a/./b"}}, "a part starting with a dot");
+    refused(json{{"directory", "a//b"}}, "an empty part");
+    refused(json{{"directory", "a/"}}, "an empty part");
+    refused(json{{"directory", "a\\b"}}, "the character \"\\\\\"");
+    refused(json{{"directory", std::string(65, 'x')}}, "at most 64");
+    refused(json{{"directory", "a/b/c/d/e/f/g/h/i"}}, "more than 8 levels");
+    refused(json{{"prefix", "a/b"}}, "the character \"/\"");
+    refused(json{{"prefix", ".hidden"}}, "starting with a dot");
+    refused(json{{"prefix", "sp ace"}}, "the character \" \"");
+    refused(json{{"prefix", std::string(65, 'p')}}, "at most 64");
+    for (const char* ok : {"", "a", "lab/run1", "A-b_c.d/e.f", "x/y/z/1/2/3/4/5"}) {
+        auto s = record::spec_from_json(json{{"device", "create"}, {"directory", ok}, {"prefix", "cam_1.front-left"}});
+        INFO(ok);
+        CHECK(s);
+    }
+}
+
+TEST_CASE("record spec: queue_bytes over recordings.max_queue_bytes is refused, naming the bound") {
+    record::RecordingsSettings settings;
+    CHECK(settings.max_queue_bytes == 256u << 20);
+    auto s = record::spec_from_json(json{{"device", "create"}, {"queue_bytes", 1000000000000ull}});
+    REQUIRE(s);  // the syntax is fine: the gateway's bound is its own
+    auto r = record::check_spec_bounds(*s, settings);
+    REQUIRE_FALSE(r);
+    CHECK_THAT(r.error().message, Catch::Contains("queue_bytes: 1000000000000 is over the gateway's limit of 268435456 (recordings.max_queue_bytes)"));
+    s->queue_bytes = 256u << 20;
+    CHECK(record::check_spec_bounds(*s, settings));
+}
+
+TEST_CASE("record spec: the default root is the state directory's recordings folder, else the working directory's") {
+    CHECK(record::default_recordings_root(nullptr) == "recordings");
+    CHECK(record::default_recordings_root("") == "recordings");
+    CHECK(record::default_recordings_root("/var/lib/rr-gateway") == "/var/lib/rr-gateway/recordings");
+    CHECK(record::default_recordings_root("/var/lib/rr-gateway/") == "/var/lib/rr-gateway/recordings");
+    CHECK(record::default_recordings_root("/var/lib/a:/var/lib/b") == "/var/lib/a/recordings");
 }

@@ -7,6 +7,7 @@ std::string_view operation_name(Operation op) noexcept {
         case Operation::read: return "read";
         case Operation::write: return "write";
         case Operation::call: return "call";
+        case Operation::record: return "record";
     }
     return "?";
 }
@@ -16,6 +17,7 @@ bool AccessRule::allows(Operation op) const noexcept {
         case Operation::read: return read;
         case Operation::write: return write;
         case Operation::call: return call;
+        case Operation::record: return record;
     }
     return false;
 }

@@ -6,6 +6,8 @@
 //   read   property get, wire InValue (receiving wire values) and peek, memory read, event and pipe receive
 //   write  property set, wire OutValue (sending wire values) and poke, memory write, pipe send
 //   call   functions, generator functions (and their next/close/abort), callbacks
+//   record starting, stopping and seeing the files of the device's recordings (asked with member `*`:
+//          a rule's `members` must match `*`, i.e. be `*` or left out; docs/recording.md)
 // A member of the device's root object is named by its member name (`Drive`); a member of an object
 // below the root by `<relative service path>.<member>` (`Webcams[0].Capture`), the path in RR's
 // encoding as the JSON API's `object` parameter normalises it. Rules only allow: an operation is
@@ -21,15 +23,16 @@
 
 namespace rr::server::gateway::auth {
 
-enum class Operation { read, write, call };
+enum class Operation { read, write, call, record };
 
-/// "read", "write", "call".
+/// "read", "write", "call", "record".
 std::string_view operation_name(Operation op) noexcept;
 
 struct AccessRule {
     std::vector<std::string> devices;  ///< patterns
     std::vector<std::string> members;  ///< patterns
     bool read = false, write = false, call = false;
+    bool record = false;
 
     bool allows(Operation op) const noexcept;
 };
