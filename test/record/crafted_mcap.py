@@ -16,6 +16,7 @@ messages) or uses a small built-in pair.
 
   crafted_mcap.py OUT_DIR      writes the four files (the fuzz seeds in test/fuzz/seeds/fuzz_mcap_reader)
 """
+import functools
 import os
 import struct
 import sys
@@ -83,6 +84,7 @@ def default_records():
         channel(0, 1, "crafted/value", "robotraconteur", meta), 0
 
 
+@functools.lru_cache(maxsize=4)
 def zeros_chunk_records(cid, t):
     """(zstd frame of one Message record of ZEROS zero bytes, its uncompressed size)."""
     cobj = zstandard.ZstdCompressor(level=3, write_content_size=False).compressobj()

@@ -14,7 +14,7 @@ and the reference MCAP reader (PyPI `mcap`):
            recorded packets in order with the recorded spacing (each interval within +-5 ms, see
            --tolerance-ms); a seek lands on the right wire and property value; a function is refused
            with a clear error; the replay's JSON API status moves.
-  failures a directory that cannot be created: 507 and a failed recording with the reason; a full disk
+  failures a sub-folder that cannot be created: 507 and a failed recording with the reason; a full disk
            (a small tmpfs, mounted here as root; SKIP of that part otherwise): the recording fails with
            "No space left on device" while the gateway goes on serving; corrupt files handed to
            --replay: a clear error and exit status 2 (a start error), no crash.
@@ -173,7 +173,7 @@ def check_recording(path, live, checks):
 
 def record_phase(exe, work, seconds, checks):
     log = os.path.join(work, "gateway1.log")
-    proc, port, base = start_gateway(exe, [], log)
+    proc, port, base = start_gateway(exe, ["--recordings-root", work], log)  # requests name sub-folders of it
     try:
         client = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
         listener = WireListener(client, "packets")
@@ -182,7 +182,7 @@ def record_phase(exe, work, seconds, checks):
         client.Drive(200, 32767)  # DistanceTraveled changes while recorded
         status, rec = http(base, "POST", "/api/recordings",
                            {"device": "create", "members": ["packets", "Bump", "DistanceTraveled"],
-                            "property_period_ms": 200, "directory": os.path.join(work, "rec"), "chunk_bytes": 16384})
+                            "property_period_ms": 200, "directory": "rec", "chunk_bytes": 16384})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["state"] == "recording", "state recording")
         time.sleep(1.0)
@@ -198,9 +198,10 @@ def record_phase(exe, work, seconds, checks):
         path = done["files"][0]
         rr_packets, props, json_packets = check_recording(path, live, checks)
 
-        # Unwritable directory: a clear error, listed as failed; the gateway goes on.
-        status, err = http(base, "POST", "/api/recordings", {"device": "create", "directory": "/proc/no/such/dir"})
-        expect(status == 507 and "/proc/no/such/dir" in err["error"]["message"], "unwritable directory: %s %s" % (status, err))
+        # A sub-folder that cannot be made (a file in its way): a clear error, listed as failed; the gateway goes on.
+        open(os.path.join(work, "blocked"), "w").close()
+        status, err = http(base, "POST", "/api/recordings", {"device": "create", "directory": "blocked/dir"})
+        expect(status == 507 and "blocked is not a folder" in err["error"]["message"], "unwritable directory: %s %s" % (status, err))
         status, listed = http(base, "GET", "/api/recordings")
         expect(any(r["state"] == "failed" and r["error"] for r in listed["recordings"]), "the failed recording is listed")
 
@@ -211,7 +212,7 @@ def record_phase(exe, work, seconds, checks):
 
         # Killed mid-recording: the file reads up to its last chunk.
         status, rec2 = http(base, "POST", "/api/recordings",
-                            {"device": "create", "members": ["packets"], "directory": os.path.join(work, "killed"),
+                            {"device": "create", "members": ["packets"], "directory": "killed",
                              "chunk_bytes": 4096})
         expect(status == 201, "second recording")
         time.sleep(2.5)
@@ -242,7 +243,7 @@ def disk_full(base, work):
             except OSError:
                 pass
         status, rec = http(base, "POST", "/api/recordings",
-                           {"device": "create", "members": ["packets"], "directory": mnt, "chunk_bytes": 4096,
+                           {"device": "create", "members": ["packets"], "directory": "tiny", "chunk_bytes": 4096,
                             "compression": "none"})
         expect(status == 201, "recording on the small tmpfs starts: %s %s" % (status, rec))
         deadline = time.monotonic() + 30

@@ -163,7 +163,7 @@ def run(gateway_exe, work, seconds, checks):
     gw = None
     try:
         gw, port, base = start_gateway(gateway_exe, ["--device", "robot=" + robot_info["url"], "--device",
-                                                     "camera=" + cam_info["url"]], work, "gateway1")
+                                                     "camera=" + cam_info["url"], "--recordings-root", work], work, "gateway1")
         r = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=robot" % port)
         c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=camera" % port)
         lock = threading.Lock()
@@ -187,7 +187,7 @@ def run(gateway_exe, work, seconds, checks):
         time.sleep(1.0)
         ids = {}
         for device, member in (("robot", "robot_state"), ("camera", "frame_stream")):
-            st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member], "directory": work})
+            st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member]})  # into the root
             expect(st == 201, "POST /api/recordings %s: %s %s" % (device, st, body))
             ids[device] = body["id"]
         time.sleep(seconds)
