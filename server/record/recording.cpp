@@ -650,8 +650,8 @@ bool Recording::note_file_size() {
     return admission_->note(delta);
 }
 
-Unexpected Recording::root_full() const {
-    return fail(MessageErrorType::IOError, "record: the recordings root " + root_->path() + " is full: its files reached " +
+RRError Recording::root_full() const {
+    return make_error(MessageErrorType::IOError, "record: the recordings root " + root_->path() + " is full: its files reached " +
                                                std::to_string(root_->max_total_bytes()) +
                                                " bytes with what running recordings set aside (recordings.max_total_bytes)");
 }
@@ -708,13 +708,13 @@ void Recording::writer_loop() {
             if (auto r = write_item(item); !r) return end_failed(r.error(), true);
         }
         batch.clear();  // the entries' last references usually go here, off the live path
-        if (!note_file_size()) return end_failed(root_full().error(), true);
+        if (!note_file_size()) return end_failed(root_full(), true);
         // A chunk at least every second: a killed gateway loses at most about a second.
         if (clock::now() - last_flush >= std::chrono::seconds(1)) {
             last_flush = clock::now();
             if (auto r = file_->writer->flush(); !r)
                 return end_failed(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message), true);
-            if (!note_file_size()) return end_failed(root_full().error(), true);
+            if (!note_file_size()) return end_failed(root_full(), true);
         }
         if (spec_.duration.count() && clock::now() - started_ >= spec_.duration && !closed && !ending_requested) {
             // Ends itself: taps go, then the queue is drained on the next rounds.

@@ -131,7 +131,7 @@ private:
     /// The open file's size into files_ and the root's budget (once per batch: the writer does not take
     /// mutex_ per item). False: the root's budget is used up.
     bool note_file_size();
-    Unexpected root_full() const;
+    RRError root_full() const;
     void subscribe_members();
     void unsubscribe_members();
     void poll_loop();

@@ -89,9 +89,12 @@ Result<std::unique_ptr<RecordingsFolder>> RecordingsRoot::open_folder(std::strin
         }
         const int next = ::openat(dir, part.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
         const int err = errno;
+        // A link fails with ELOOP or, as O_DIRECTORY is checked first on some kernels, ENOTDIR: tell which.
+        struct stat st {};
+        const bool link = next < 0 && ::fstatat(dir, part.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISLNK(st.st_mode);
         ::close(dir);
         if (next < 0) {
-            if (err == ELOOP)
+            if (link || err == ELOOP)
                 return fail(MessageErrorType::IOError,
                             "record: " + shown + " is a symbolic link (links below the recordings root are not followed)");
             if (err == ENOTDIR) return fail(MessageErrorType::IOError, "record: " + shown + " is not a folder");
