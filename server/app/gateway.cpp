@@ -295,7 +295,12 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             login = DemoLogin{std::string(kDemoUser), std::move(*password)};
         }
         for (const auto& rc : c.replays) {
-            record::ReplayOptions ro{rc.file, rc.name, rc.speed, rc.loop, rc.paused};
+            record::ReplayOptions ro;
+            ro.file = rc.file;
+            ro.name = rc.name;
+            ro.speed = rc.speed;
+            ro.loop = rc.loop;
+            ro.paused = rc.paused;
             ro.memory_bytes = c.recordings.replay_memory_bytes;
             ro.on_error = [](const std::string& device, const std::string& error) {
                 log(LogLevel::error, "replay of " + device + " failed: " + error, LogContext{.device = device});

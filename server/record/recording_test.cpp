@@ -171,7 +171,10 @@ TEST_CASE("recording: members below the root by path, read back, and served agai
     CHECK(path_of[name_topic] == "child_by_int[%2d1]");
 
     // The replay serves the recorded objects through the objrefs, and only those.
-    auto replay = rr::server::record::ReplayDevice::open({file, "again"});
+    rr::server::record::ReplayOptions replay_options;
+    replay_options.file = file;
+    replay_options.name = "again";
+    auto replay = rr::server::record::ReplayDevice::open(replay_options);
     REQUIRE(replay);
     auto members = (*replay)->status().members;
     std::sort(members.begin(), members.end());
@@ -315,7 +318,7 @@ TEST_CASE("recording: a symbolic link planted in the root is not followed, folde
     read_recording(file);
 }
 
-TEST_CASE("recording: one prefix started in the same second never shares a file; past max_active: 429") {
+TEST_CASE("recording: one prefix started in the same second never shares a file, and past max_active it is 429") {
     if (!interop_service_built()) return;
     InteropProcess device;
     RecordingDir dir;
