@@ -80,7 +80,7 @@ Result<RecordingSpec> spec_from_json(const json& j) {
     if (auto r = number("max_file_seconds", [&](std::uint64_t v) { s.max_file_duration = std::chrono::seconds(v); }); !r) return r.take_error();
     if (auto r = number("max_total_bytes", [&](std::uint64_t v) { s.max_total_bytes = v; }); !r) return r.take_error();
     if (auto r = number("duration_s", [&](std::uint64_t v) { s.duration = std::chrono::seconds(v); }); !r) return r.take_error();
-    if (auto r = number("queue_bytes", [&](std::uint64_t v) { s.queue_bytes = v; }); !r) return r.take_error();
+    if (auto r = number("queue_bytes", [&](std::uint64_t v) { s.queue_bytes = v; s.queue_bytes_given = true; }); !r) return r.take_error();
     if (auto r = number("chunk_bytes", [&](std::uint64_t v) { s.chunk_bytes = v; }); !r) return r.take_error();
     if (j.contains("compression")) {
         if (j["compression"] == "zstd") s.compress = true;
@@ -158,7 +158,7 @@ Result<void> check_prefix(std::string_view p) {
 }
 
 Result<void> check_spec_bounds(const RecordingSpec& spec, const RecordingsSettings& settings) {
-    if (spec.queue_bytes > settings.max_queue_bytes)
+    if (spec.queue_bytes_given && spec.queue_bytes > settings.max_queue_bytes)
         return fail(MessageErrorType::InvalidArgument, "record: queue_bytes: " + std::to_string(spec.queue_bytes) +
                                                            " is over the gateway's limit of " + std::to_string(settings.max_queue_bytes) +
                                                            " (recordings.max_queue_bytes)");

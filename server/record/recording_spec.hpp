@@ -44,6 +44,9 @@ struct RecordingSpec {
     std::chrono::seconds duration{0};
     /// Entries waiting for the writer thread, bytes (over it: dropped and counted).
     std::size_t queue_bytes = 64u << 20;
+    /// queue_bytes was asked for (a JSON key). The default is lowered to recordings.max_queue_bytes
+    /// when that is smaller; a value asked for over it is refused (check_spec_bounds).
+    bool queue_bytes_given = false;
     /// Uncompressed chunk size (a killed gateway loses at most the chunk being filled).
     std::size_t chunk_bytes = 1u << 20;
     bool compress = true;              ///< zstd chunks
@@ -85,8 +88,8 @@ std::string default_recordings_root(const char* state_directory);
 Result<void> check_subfolder(std::string_view directory);
 /// A `prefix`: "" or 1..64 letters, digits and `-_.`, not starting with a dot. Errors: InvalidArgument.
 Result<void> check_prefix(std::string_view prefix);
-/// The bounds of `settings` a spec must keep: queue_bytes at most max_queue_bytes. Errors:
-/// InvalidArgument naming the key and the bound.
+/// The bounds of `settings` a spec must keep: queue_bytes, when asked for, at most max_queue_bytes.
+/// Errors: InvalidArgument naming the key and the bound.
 Result<void> check_spec_bounds(const RecordingSpec& spec, const RecordingsSettings& settings);
 
 /// The spec from JSON (POST /api/recordings, docs/recording.md), the same keys as a `record:` entry:

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "server/app/gateway_config.hpp"
+#include "server/gateway/auth/access_policy.hpp"
 #include "server/record/recording_spec.hpp"
 
 using namespace rr;
@@ -142,6 +143,12 @@ TEST_CASE("record spec: queue_bytes over recordings.max_queue_bytes is refused, 
     CHECK_THAT(r.error().message, Catch::Contains("queue_bytes: 1000000000000 is over the gateway's limit of 268435456 (recordings.max_queue_bytes)"));
     s->queue_bytes = 256u << 20;
     CHECK(record::check_spec_bounds(*s, settings));
+    // The default (64 MiB) is not refused under a smaller bound: the gateway lowers it.
+    settings.max_queue_bytes = 1u << 20;
+    auto d = record::spec_from_json(json{{"device", "create"}});
+    REQUIRE(d);
+    CHECK_FALSE(d->queue_bytes_given);
+    CHECK(record::check_spec_bounds(*d, settings));
 }
 
 TEST_CASE("record spec: the default root is the state directory's recordings folder, else the working directory's") {
@@ -150,4 +157,88 @@ TEST_CASE("record spec: the default root is the state directory's recordings fol
     CHECK(record::default_recordings_root("/var/lib/rr-gateway") == "/var/lib/rr-gateway/recordings");
     CHECK(record::default_recordings_root("/var/lib/rr-gateway/") == "/var/lib/rr-gateway/recordings");
     CHECK(record::default_recordings_root("/var/lib/a:/var/lib/b") == "/var/lib/a/recordings");
+}
+
+TEST_CASE("gateway config: recordings bounds, --recordings-root, and the record right in roles") {
+    auto c = server::app::parse_gateway_config(R"(
+gateway:
+  auth:
+    tokens: /etc/rr-gateway/tokens.txt
+    roles:
+      recorder:
+        - devices: [create]
+          allow: [read, record]
+recordings:
+  root: /data/rec
+  max_total_bytes: 10485760
+  max_active: 2
+  max_queue_bytes: 1048576
+  keep_ended: 5
+  replay_memory_bytes: 33554432
+record:
+  - device: create
+    directory: lab/daily
+)", "rec.yaml");
+    INFO((c ? std::string() : c.error().message));
+    REQUIRE(c);
+    CHECK(c->recordings.root == "/data/rec");
+    CHECK(c->recordings.max_total_bytes == 10485760);
+    CHECK(c->recordings.max_active == 2);
+    CHECK(c->recordings.max_queue_bytes == 1048576);
+    CHECK(c->recordings.keep_ended == 5);
+    CHECK(c->recordings.replay_memory_bytes == 33554432);
+    CHECK(c->record.at(0).directory == "lab/daily");
+    const auto& rule = c->auth.roles.at(0).second.at(0);
+    CHECK(rule.record);
+    CHECK(rule.read);
+    CHECK_FALSE(rule.write);
+
+    // Defaults: the documented ones.
+    auto d = server::app::parse_gateway_config("demo:\n  enabled: true\n", "d.yaml");
+    REQUIRE(d);
+    CHECK(d->recordings.root.empty());
+    CHECK(d->recordings.max_total_bytes == 2ull << 30);
+    CHECK(d->recordings.max_active == 8);
+    CHECK(d->recordings.max_queue_bytes == 256u << 20);
+    CHECK(d->recordings.replay_memory_bytes == 256ull << 20);
+
+    for (auto [yaml, expect] : std::vector<std::pair<std::string, std::string>>{
+             {"recordings:\n  roots: /x\n", "recordings.roots: unknown key"},
+             {"recordings:\n  max_active: 0\n", "recordings.max_active: must be at least 1"},
+             {"recordings:\n  max_total_bytes: 1000\n", "recordings.max_total_bytes: must be at least 1048576"},
+             {"record:\n  - device: create\n    directory: /tmp\n", "record: directory: \"/tmp\" is an absolute path"},
+             {"record:\n  - device: create\n    directory: ../x\n", "starting with a dot"},
+             {"recordings:\n  max_queue_bytes: 65536\nrecord:\n  - device: create\n    queue_bytes: 1048576\n",
+              "bad.yaml:4: record[]: record: queue_bytes: 1048576 is over the gateway's limit of 65536 (recordings.max_queue_bytes)"}}) {
+        auto bad = server::app::parse_gateway_config(yaml, "bad.yaml");
+        INFO(yaml);
+        REQUIRE_FALSE(bad);
+        CHECK_THAT(bad.error().message, Catch::Contains(expect));
+    }
+
+    // The flag sets the root.
+    const char* argv[] = {"rr-gateway", "--recordings-root", "/srv/rec"};
+    auto cmd = server::app::parse_command_line(3, argv);
+    REQUIRE(cmd);
+    server::app::GatewayConfig flagged;
+    REQUIRE(server::app::apply_overrides(flagged, *cmd));
+    CHECK(flagged.recordings.root == "/srv/rec");
+}
+
+TEST_CASE("access policy: record is a right of its own, not implied by write") {
+    using server::gateway::auth::AccessPolicy;
+    using server::gateway::auth::AccessRule;
+    using server::gateway::auth::Operation;
+    AccessPolicy policy;
+    policy.add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});
+    policy.add_role("recorder", {AccessRule{{"create"}, {"*"}, true, false, false, true}});
+    policy.add_role("member_only", {AccessRule{{"*"}, {"packets"}, false, false, false, true}});
+    CHECK_FALSE(policy.allows({"operator"}, "create", "*", Operation::record));
+    CHECK(policy.allows({"operator"}, "create", "*", Operation::write));
+    CHECK(policy.allows({"recorder"}, "create", "*", Operation::record));
+    CHECK_FALSE(policy.allows({"recorder"}, "webcam", "*", Operation::record));
+    CHECK_FALSE(policy.allows({"recorder"}, "create", "*", Operation::write));
+    // Asked on member `*`: a rule naming members does not give it.
+    CHECK_FALSE(policy.allows({"member_only"}, "create", "*", Operation::record));
+    CHECK(server::gateway::auth::operation_name(Operation::record) == "record");
 }

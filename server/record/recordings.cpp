@@ -1,5 +1,6 @@
 #include "server/record/recordings.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdlib>
 #include <thread>
@@ -95,6 +96,7 @@ void Recordings::start_impl(RecordingSpec spec, bool from_config, StartDone done
     auto device = api_->find_device(spec.device);
     if (!device) return refuse(api_error(404, MessageErrorType::ServiceNotFound, "no device \"" + spec.device + "\""));
     if (auto b = check_spec_bounds(spec, settings_); !b) return refuse(api_error(400, b.error().type, b.error().message));
+    if (!spec.queue_bytes_given) spec.queue_bytes = std::min(spec.queue_bytes, settings_.max_queue_bytes);
     std::uint64_t id = 0;
     {
         std::unique_lock<std::mutex> lock(mutex_);
