@@ -295,7 +295,16 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             login = DemoLogin{std::string(kDemoUser), std::move(*password)};
         }
         for (const auto& rc : c.replays) {
-            record::ReplayOptions ro{rc.file, rc.name, rc.speed, rc.loop, rc.paused};
+            record::ReplayOptions ro;
+            ro.file = rc.file;
+            ro.name = rc.name;
+            ro.speed = rc.speed;
+            ro.loop = rc.loop;
+            ro.paused = rc.paused;
+            ro.memory_bytes = c.recordings.replay_memory_bytes;
+            ro.on_error = [](const std::string& device, const std::string& error) {
+                log(LogLevel::error, "replay of " + device + " failed: " + error, LogContext{.device = device});
+            };
             auto replay = record::ReplayDevice::open(ro);
             if (!replay) return fail(MessageErrorType::InvalidConfiguration, replay.error().message);
             const auto& name = (*replay)->name();
@@ -381,13 +390,14 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     if (api) json_api = api(*g->http_, g->devices_, g->auth_);
     // Recording (docs/recording.md): from the JSON API and the configuration's `record:` entries.
     if (json_api) {
-        g->recordings_ = std::make_shared<record::Recordings>(json_api, [](const record::RecordingStatus& s, std::string_view what) {
-            const bool failed = what == "failed";
-            log(failed ? LogLevel::error : LogLevel::info,
-                "recording " + std::to_string(s.id) + " of " + s.spec.device + ": " + std::string(what) +
-                    (failed ? " (" + s.error + ")" : s.files.empty() ? "" : " (" + s.files.back() + ")"),
+        g->recordings_ = std::make_shared<record::Recordings>(json_api, c.recordings, [](const record::RecordingStatus& s, std::string_view what) {
+            const bool failed = what == "failed", refused = what == "refused";
+            log(failed ? LogLevel::error : refused ? LogLevel::warning : LogLevel::info,
+                (refused ? "recording of " + s.spec.device + " refused" : "recording " + std::to_string(s.id) + " of " + s.spec.device + ": " + std::string(what)) +
+                    (failed || refused ? " (" + s.error + ")" : s.files.empty() ? "" : " (" + s.files.back() + ")"),
                 LogContext{.device = s.spec.device});
         });
+        log(LogLevel::debug, "recordings go below " + g->recordings_->root()->path());
         record::install_recording_routes(*g->http_, json_api, g->recordings_);
         record::install_replay_routes(*g->http_, json_api, g->replays_);
     }

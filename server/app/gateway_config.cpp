@@ -119,6 +119,9 @@ void validate(const GatewayConfig& c, const std::function<void(const std::string
     for (const auto& d : c.devices) {
         if (!names.insert(d.name).second) error("devices." + d.name, "duplicate device name");
     }
+    for (std::size_t i = 0; i < c.record.size(); ++i)
+        if (auto r = record::check_spec_bounds(c.record[i], c.recordings); !r)
+            error("record[" + std::to_string(i) + "]", r.error().message);
     const auto& t = c.tls;
     if (!t.certificate.empty() && t.private_key.empty()) error("gateway.tls.private_key", "missing (the certificate's key)");
     if (t.certificate.empty() && (!t.private_key.empty() || !t.client_ca.empty() || !t.node_certificate.empty() || t.required))
@@ -364,13 +367,14 @@ void parse_auth(const YAML::Node& a, const Reader& r, GatewayAuthConfig& c) {
                 if (auto n = e["devices"]) rule.devices = patterns(n, r, rk + ".devices");
                 if (auto n = e["members"]) rule.members = patterns(n, r, rk + ".members");
                 auto allow = e["allow"];
-                if (!allow) r.error(e, rk + ".allow", "missing (a list of read, write, call, lock)");
+                if (!allow) r.error(e, rk + ".allow", "missing (a list of read, write, call, lock, record)");
                 for (const auto& op : r.string_list(allow, rk + ".allow")) {
                     if (op == "read") rule.read = true;
                     else if (op == "write") rule.write = true;
                     else if (op == "call") rule.call = true;
                     else if (op == "lock") rule.lock = true;
-                    else r.error(allow, rk + ".allow", "\"" + op + "\" is not read, write, call or lock");
+                    else if (op == "record") rule.record = true;
+                    else r.error(allow, rk + ".allow", "\"" + op + "\" is not read, write, call, lock or record");
                 }
                 rules.push_back(std::move(rule));
             }
@@ -475,7 +479,7 @@ nlohmann::json yaml_to_json(const YAML::Node& n) {
     return s;
 }
 
-// record: a list of recordings (docs/recording.md "Configuration").
+// record: a list of recordings (docs/recording.md "Configuration"), after `recordings:` (its bounds).
 void parse_record(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
     auto rec = root["record"];
     if (!rec) return;
@@ -484,7 +488,34 @@ void parse_record(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
         if (!e.IsMap()) r.error(e, "record[]", "expected a mapping");
         auto spec = record::spec_from_json(yaml_to_json(e));
         if (!spec) r.error(e, "record[]", spec.error().message);
+        if (auto b = record::check_spec_bounds(*spec, c.recordings); !b) r.error(e, "record[]", b.error().message);
         c.record.push_back(std::move(*spec));
+    }
+}
+
+// recordings: (docs/recording.md "Where recordings go").
+void parse_recordings(const YAML::Node& n, const Reader& r, record::RecordingsSettings& s) {
+    r.check_keys(n, "recordings", {"root", "max_total_bytes", "max_active", "max_queue_bytes", "keep_ended", "replay_memory_bytes"});
+    if (auto v = n["root"]) {
+        s.root = r.string(v, "recordings.root");
+        if (s.root.empty()) r.error(v, "recordings.root", "empty (leave the key out for the default)");
+    }
+    if (auto v = n["max_total_bytes"]) {
+        s.max_total_bytes = r.unsigned_int(v, "recordings.max_total_bytes", std::uint64_t{1} << 50);
+        if (s.max_total_bytes < (1u << 20)) r.error(v, "recordings.max_total_bytes", "must be at least 1048576 (1 MiB)");
+    }
+    if (auto v = n["max_active"]) {
+        s.max_active = r.unsigned_int(v, "recordings.max_active", 1000);
+        if (s.max_active == 0) r.error(v, "recordings.max_active", "must be at least 1");
+    }
+    if (auto v = n["max_queue_bytes"]) {
+        s.max_queue_bytes = r.unsigned_int(v, "recordings.max_queue_bytes", std::uint64_t{16} << 30);
+        if (s.max_queue_bytes < 4096) r.error(v, "recordings.max_queue_bytes", "must be at least 4096");
+    }
+    if (auto v = n["keep_ended"]) s.keep_ended = r.unsigned_int(v, "recordings.keep_ended", 100000);
+    if (auto v = n["replay_memory_bytes"]) {
+        s.replay_memory_bytes = r.unsigned_int(v, "recordings.replay_memory_bytes", std::uint64_t{64} << 30);
+        if (s.replay_memory_bytes < (1u << 20)) r.error(v, "recordings.replay_memory_bytes", "must be at least 1048576 (1 MiB)");
     }
 }
 
@@ -512,7 +543,8 @@ void parse_replay_device(const YAML::Node& d, const Reader& r, GatewayConfig& c,
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings"});
+    if (auto n = root["recordings"]) parse_recordings(n, r, c.recordings);
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
@@ -672,7 +704,7 @@ Result<GatewayConfig> load_gateway_config(const std::string& path) {
 namespace {
 
 // Flags that take a value, with their official RR spellings mapped to ours.
-const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",
+const std::set<std::string> kValueFlags{"--config",      "--port",       "--listen",    "--web-root",      "--recordings-root",
                                         "--allow-origin", "--device",     "--replay",    "--demo-port", "--threads", "--trusted-proxy",
                                         "--log-level",   "--log-format", "--robotraconteur-tcp-port", "--robotraconteur-nodename",
                                         "--robotraconteur-nodeid", "--robotraconteur-log-level", "--tls-certificate",
@@ -747,6 +779,9 @@ Result<void> apply_overrides(GatewayConfig& c, const CommandLine& cmd) {
             c.listen = v;
         } else if (flag == "--web-root") {
             c.web_root = v;
+        } else if (flag == "--recordings-root") {
+            if (v.empty()) return fail(MessageErrorType::InvalidConfiguration, flag + ": expected a folder");
+            c.recordings.root = v;
         } else if (flag == "--allow-origin") {
             if (auto why = origin_problem(v); !why.empty())
                 return fail(MessageErrorType::InvalidConfiguration, flag + ": \"" + v + "\" " + why);
@@ -839,6 +874,8 @@ Options (override the configuration file):
                              or cam=rr+local:///?nodename=camera.driver&service=cam
   --replay [NAME=]FILE       serve an MCAP recording as a device (docs/recording.md); NAME
                              defaults to the recorded device's name
+  --recordings-root DIR      the folder every recording goes below (recordings.root; default:
+                             $STATE_DIRECTORY/recordings under systemd, else ./recordings)
   --no-demo                  do not start the demo devices
   --no-local                 do not serve rr+local (the gateway's NodeName on this computer)
   --no-discovery             no node discovery: do not announce the gateway (nor its demo node),

@@ -86,6 +86,7 @@ struct GatewayAuthConfig {
     struct Rule {
         std::vector<std::string> devices{"*"}, members{"*"};
         bool read = false, write = false, call = false, lock = false;
+        bool record = false;  ///< recordings of the device (docs/recording.md)
     };
     std::vector<std::pair<std::string, std::vector<Rule>>> roles;
     unsigned max_failures = 5, window_s = 60, lockout_s = 300;
@@ -157,6 +158,8 @@ struct GatewayConfig {
     std::vector<ReplayDeviceConfig> replays;
     // record: (docs/recording.md): recordings started when their device connects
     std::vector<record::RecordingSpec> record;
+    // recordings: where recordings go and the bounds on them (docs/recording.md "Where recordings go")
+    record::RecordingsSettings recordings;
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;
@@ -186,7 +189,7 @@ struct CommandLine {
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
-/// --device NAME=URL (repeat), --replay FILE (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
+/// --device NAME=URL (repeat), --replay FILE (repeat), --recordings-root DIR, --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
 /// --no-discovery, --discovery (the default; overrides a file's `discovery.enabled: false`), --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).

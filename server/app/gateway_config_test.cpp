@@ -452,7 +452,7 @@ gateway:
     for (auto [yaml, expect] : {
              std::pair{"gateway:\n  auth:\n    user: u.txt\n", "bad.yaml:3: gateway.auth.user: unknown key"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - allow: [read, delete]\n",
-                       "bad.yaml:6: gateway.auth.roles.r[0].allow: \"delete\" is not read, write, call or lock"},
+                       "bad.yaml:6: gateway.auth.roles.r[0].allow: \"delete\" is not read, write, call, lock or record"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - devices: [a]\n",
                        "bad.yaml:6: gateway.auth.roles.r[0].allow: missing"},
              std::pair{"gateway:\n  auth:\n    users: u.txt\n    roles:\n      r:\n        - alow: [read]\n",

@@ -142,7 +142,8 @@ TEST_CASE("json access: without gateway logins the answer says the gateway check
     TestGateway gw(device.url());
     auto r = http_get(gw.port(), "/api/devices/interop/access");
     REQUIRE(r.status == 200);
-    CHECK(r.body == json{{"device", "interop"}, {"auth", false}, {"user", nullptr}, {"members", nullptr}, {"lock", nullptr}});
+    CHECK(r.body == json{{"device", "interop"}, {"auth", false}, {"user", nullptr}, {"members", nullptr},
+                         {"lock", nullptr}, {"record", true}});
     CHECK(http_get(gw.port(), "/api/devices/interop/access?members=add").body["members"].is_null());
     auto missing = http_get(gw.port(), "/api/devices/nosuch/access");
     CHECK(missing.status == 404);

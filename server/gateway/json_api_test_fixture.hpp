@@ -2,6 +2,7 @@
 // started with the JSON API, plus small HTTP and WebSocket clients.
 #pragma once
 
+#include <functional>
 #include <filesystem>
 #include <catch2/catch.hpp>
 
@@ -121,7 +122,9 @@ private:
 /// A Gateway (demo off) with device "interop" at `url`, the JSON API installed; waits until connected.
 class TestGateway {
 public:
-    explicit TestGateway(const std::string& url, bool wait = true, JsonSocketOptions ws_options = {}) {
+    /// `configure` (optional) changes the configuration before the gateway starts (e.g. recordings.root).
+    explicit TestGateway(const std::string& url, bool wait = true, JsonSocketOptions ws_options = {},
+                         const std::function<void(app::GatewayConfig&)>& configure = {}) {
         app::GatewayConfig cfg;
         cfg.local = false;  // tests run side by side: no shared NodeName on this computer
         cfg.port = 0;
@@ -135,6 +138,7 @@ public:
         d.backoff_initial = 100ms;
         d.backoff_max = 200ms;
         cfg.devices.push_back(d);
+        if (configure) configure(cfg);
         auto installer = [this, ws_options](http::HttpServer& http, const std::vector<std::shared_ptr<DeviceMirror>>& devices,
                                                    std::shared_ptr<auth::GatewayAuth>) {
             api_ = std::make_shared<JsonApi>(devices);
@@ -166,6 +170,7 @@ public:
 
     std::uint16_t port() const { return gateway_->port(); }
     app::Gateway& gateway() { return *gateway_; }
+    const std::shared_ptr<JsonApi>& api() const { return api_; }
     JsonSocketServer& sockets() { return *sockets_; }
 
 private:

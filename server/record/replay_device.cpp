@@ -60,7 +60,9 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     auto src = mcap::FileSource::open(file);
     if (!src) return fail(src.error().type, "replay: " + src.error().message);
     d->playback_->source = std::move(*src);
-    auto reader = mcap::McapReader::open(*d->playback_->source);
+    mcap::ReaderLimits limits;
+    limits.max_memory_bytes = options.memory_bytes;
+    auto reader = mcap::McapReader::open(*d->playback_->source, limits);
     if (!reader) return err(reader.error().type, reader.error().message);
     d->playback_->reader.emplace(std::move(*reader));
     const auto& summary = d->playback_->reader->summary();
@@ -429,6 +431,8 @@ void ReplayDevice::run() {
             const std::uint64_t t = *seek_to_;
             seek_to_.reset();
             lock.unlock();
+            iter.reset();  // its decoded chunks count in the reader's memory: gone before restore_state reads
+            next.reset();
             restore_state(t);
             mcap::MessageQuery q;
             q.start_time = t;
@@ -451,6 +455,12 @@ void ReplayDevice::run() {
             lock.lock();
             if (!m) {
                 error_ = "replay " + options_.file + ": " + m.error().message;
+                if (options_.on_error) {
+                    const auto error = error_;
+                    lock.unlock();
+                    options_.on_error(name_, error);
+                    lock.lock();
+                }
                 continue;
             }
             if (!*m) {
