@@ -282,7 +282,7 @@ TEST_CASE("auth shared: a monitor at the gateway refuses other sessions and is h
     CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
 }
 
-TEST_CASE("auth shared: locks need the roles' `lock`; a login without it is refused every lock operation") {
+TEST_CASE("auth shared: locks need the roles' `lock`, a login without it is refused every lock operation") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto m = gw.connect("mallory", "m");
