@@ -268,7 +268,7 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         const MotionClient who = motion_client(session, passthrough_ != nullptr);
         auto ticket = motion_->admit(who, entry);
         if (!ticket) {
-            if (!responder.done()) responder.fail(ticket.take_error());
+            if (!responder.done()) responder.fail(ticket.error());
             return;
         }
         stop = ticket->kind == MotionGuard::Ticket::Kind::stop;
@@ -296,7 +296,7 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
             return;
         }
         if (!ok) {
-            if (observe) observe(ok.error());
+            if (observe) observe(fail(ok.error()));
             responder.fail(ok.error());
             return;
         }
@@ -385,7 +385,7 @@ void MirrorService::recheck_nolock(const SessionRef& session, MessageEntry&& ent
         if (type) nolock = passes_object_locks(self->member_modifiers(type->object_type, request->member_name), request->entry_type);
         auto ok = self->locks_->check(request->service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, nolock);
         if (!ok) {
-            if (observe) observe(ok.error());
+            if (observe) observe(fail(ok.error()));
             shared->fail(ok.error());
             return;
         }
@@ -432,7 +432,7 @@ std::vector<DeviceLockInfo> MirrorService::gateway_locks() const {
 void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe) {
     auto c = client();
     if (!c) {
-        if (observe) observe(not_connected(name_));
+        if (observe) observe(fail(not_connected(name_)));
         if (!responder.done()) responder.fail(not_connected(name_));
         return;
     }

@@ -108,11 +108,14 @@ Result<MotionGuard::Ticket> MotionGuard::admit(const MotionClient& client, Messa
                         out = ok.take_error();
                         break;
                     }
-                    holds_.timed(now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*seconds)));
+                    const auto before =
+                        holds_.timed(now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*seconds)));
                     if (asked && *asked * h->unit_s != *seconds)
                         note = member + " from " + client.who() + ": timeout " + seconds_text(*asked * h->unit_s) +
                                " clamped to " + seconds_text(*seconds) + " (safety.hold_to_run_max_s)";
-                    out = Ticket{Ticket::Kind::timed};
+                    Ticket t{Ticket::Kind::timed};
+                    t.timed_before = before;
+                    out = t;
                     break;
                 }
                 if (const auto* u = rules->untimed(member)) {
@@ -160,7 +163,8 @@ Result<MotionGuard::Ticket> MotionGuard::admit(const MotionClient& client, Messa
             case MessageEntryType::WireConnectReq: {
                 if (!rules->stream(member)) break;
                 const auto* h = holds_.holder(now);
-                if (h && h->key != client.key) out = take().take_error();
+                if (h && h->key != client.key)
+                    if (auto r = take(); !r) out = r.take_error();
                 break;
             }
             default: break;
@@ -184,6 +188,10 @@ void MotionGuard::on_reply(const MotionClient& client, const Ticket& ticket, con
             motions_.erase(token);
         };
         switch (ticket.kind) {
+            case Ticket::Kind::timed:
+                // Refused (a lock, the device): the call moves nothing and holds nothing.
+                if (!answered_ok(reply)) holds_.undo_timed(client.key, ticket.timed_before, Clock::now());
+                break;
             case Ticket::Kind::untimed:
                 // A call that waits is over with its answer; one that does not keeps moving until a stop
                 // or its client's end. An error: nothing started.

@@ -55,6 +55,8 @@ public:
         bool waits = false;             ///< untimed: the call returns when the motion is done
         std::int32_t generator = -1;    ///< generator_next: the generator's index
         bool closes = false;            ///< generator_next: the request closes or aborts it
+        /// timed: the holder's hold before this call, restored when the call does not run
+        std::optional<std::chrono::steady_clock::time_point> timed_before;
     };
 
     /// A request of `client` on its way to the device (FunctionCallReq, PropertySetReq, WirePacket,

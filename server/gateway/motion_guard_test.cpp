@@ -287,3 +287,26 @@ TEST_CASE("motion guard: a device that is no robot and has nothing configured is
     auto j = jog(60);
     CHECK_FALSE(fresh->concerns(j));
 }
+
+TEST_CASE("motion guard: a hold-to-run call refused by a lock or the device holds nothing", "[motion]") {
+    Fixture f;
+    auto alice = client("ws:1", "alice");
+    auto bob = client("rr:2", "bob");
+    auto e = jog(0.4);
+    auto t = f.guard->admit(bob, e);
+    REQUIRE(t);
+    REQUIRE(f.guard->holder());
+    f.guard->on_reply(bob, *t, fail(MessageErrorType::ObjectLockedError, "Object locked by alice"));
+    CHECK_FALSE(f.guard->holder());
+    auto e2 = jog(0.4);
+    auto ta = f.guard->admit(alice, e2);
+    REQUIRE(ta);
+    f.guard->on_reply(alice, *ta, MessageEntry{});
+    // A renewal the device refuses leaves the earlier call's hold as it was.
+    auto e3 = jog(0.4);
+    auto tb = f.guard->admit(alice, e3);
+    REQUIRE(tb);
+    f.guard->on_reply(alice, *tb, fail(MessageErrorType::InvalidOperation, "Robot not in jog mode"));
+    REQUIRE(f.guard->holder());
+    CHECK(f.guard->holder()->user == "alice");
+}

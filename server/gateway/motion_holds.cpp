@@ -32,9 +32,17 @@ Result<void> MotionHolds::take(const MotionClient& client, Time now, const std::
     return {};
 }
 
-void MotionHolds::timed(Time until) {
-    if (!holder_) return;
+std::optional<MotionHolds::Time> MotionHolds::timed(Time until) {
+    if (!holder_) return std::nullopt;
+    const auto before = holder_->timed_until;
     if (!holder_->timed_until || *holder_->timed_until < until) holder_->timed_until = until;
+    return before;
+}
+
+void MotionHolds::undo_timed(const std::string& key, std::optional<Time> before, Time now) {
+    if (!holder_ || holder_->client.key != key) return;
+    holder_->timed_until = before;
+    if (!active(*holder_, now)) holder_.reset();
 }
 
 std::uint64_t MotionHolds::begin_untimed(const std::string& owner, std::string member) {

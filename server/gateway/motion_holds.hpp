@@ -55,8 +55,11 @@ public:
     /// Makes `client` the holder unless another holds at `now`; `since` (wall-clock text) is shown in
     /// refusals. Errors: ObjectLockedError "motion of <device> is held by <who> since <since>; …".
     Result<void> take(const MotionClient& client, Time now, const std::string& since, std::string_view device);
-    /// The holder's hold-to-run call runs until `until` (after take()).
-    void timed(Time until);
+    /// The holder's hold-to-run call runs until `until` (after take()); returns what it ran until before.
+    std::optional<Time> timed(Time until);
+    /// A hold-to-run call of `key` did not run (refused by a lock or by the device): its hold is what it
+    /// was before (`before`, timed() returned it), and an idle holder is released.
+    void undo_timed(const std::string& key, std::optional<Time> before, Time now);
     /// A motion without a timeout of its own began (after take()); its token.
     std::uint64_t begin_untimed(const std::string& owner, std::string member);
     /// The motion ended (a waiting call answered, a generator finished). Unknown tokens are ignored.

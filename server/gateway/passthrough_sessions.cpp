@@ -248,7 +248,7 @@ void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&&
                                        std::function<void(const Result<MessageEntry>&)> observe, bool stop) {
     auto client = open_client(session.endpoint());
     if (!client) {
-        if (observe) observe(session_gone());
+        if (observe) observe(fail(session_gone()));
         if (!responder.done()) responder.fail(session_gone());
         return;
     }

@@ -65,7 +65,7 @@ BOUND_S = 0.5
 MARGIN_S = 1.5
 # The robot counts as stopped when its joints did not move for this long (its loop runs every 20 ms).
 QUIET_S = 2.0
-MODE = {"halt": 0, "jog": 1, "position_command": 2, "velocity_command": 3, "trajectory": 4}
+MODE = {"halt": 0, "jog": 1, "trajectory": 2, "position_command": 3, "velocity_command": 4}  # RobotCommandMode
 RR_FLAGS = ["--robotraconteur-local-enable=false", "--robotraconteur-tcp-ipv4-discovery=false",
             "--robotraconteur-tcp-ipv6-discovery=false"]
 
@@ -83,19 +83,29 @@ def expect(cond, what):
 # --- the robot and its own joint log -------------------------------------------------------------
 
 class Robot:
-    def __init__(self, work, extra=()):
+    def __init__(self, work, extra=(), login=None):
         self.errf = open(os.path.join(work, "robot.log"), "ab")
         self.proc = subprocess.Popen([sys.executable, os.path.join(DEVICES, "sim_robot.py"), "--enabled", "--log-joints",
                                       "--max-lifetime", "600"] + list(extra),
                                      stdout=subprocess.PIPE, stderr=self.errf, stdin=subprocess.DEVNULL,
                                      preexec_fn=die_with_parent)
-        self.info = read_json_line(self.proc, 120, "sim_robot.py")
-        self.url = self.info["url"]
         self.lock = threading.Lock()
         self.cond = threading.Condition(self.lock)
         self.moves = []  # (time.time(), q) of each step in which a joint moved
+        self.info = None
         threading.Thread(target=self._read, daemon=True).start()
-        self.direct = RRN.ConnectService(self.url)  # the test's own session, straight to the robot
+        end = time.monotonic() + 120
+        with self.cond:  # the joint log may begin before the ready line
+            while self.info is None:
+                if time.monotonic() > end or self.proc.poll() is not None:
+                    raise CheckFailed("sim_robot.py: no ready line after %.0f s (exit %s)" % (120 - (end - time.monotonic()), self.proc.poll()))
+                self.cond.wait(0.5)
+        self.url = self.info["url"]
+        # the test's own session, straight to the robot
+        if login:
+            self.direct = RRN.ConnectService(self.url, login[0], {"password": RR.VarValue(login[1], "string")})
+        else:
+            self.direct = RRN.ConnectService(self.url)
 
     def _read(self):
         for line in self.proc.stdout:
@@ -106,6 +116,10 @@ class Robot:
             if isinstance(v, dict) and "joints" in v:
                 with self.cond:
                     self.moves.append((v["joints"], v["q"]))
+                    self.cond.notify_all()
+            elif isinstance(v, dict) and "url" in v:
+                with self.cond:
+                    self.info = v
                     self.cond.notify_all()
 
     def mode(self, name):
@@ -281,7 +295,7 @@ def client_main(args):
     if kind.startswith("rest-"):
         conn = http.client.HTTPConnection("127.0.0.1", args.port, timeout=600)
         body = {"jog": {"args": {"joint_velocity": [0.1, 0, 0], "timeout": 60, "wait": False}},
-                "freespace": {"args": {"joint_position": args.target, "max_velocity": [0.05, 0.05, 0.05], "wait": True}},
+                "freespace": {"args": {"joint_position": args.target, "max_velocity": [0.015, 0.015, 0.015], "wait": True}},
                 }[kind[5:]]
         member = {"jog": "jog_joint", "freespace": "jog_freespace"}[kind[5:]]
         out(sending=time.time())
@@ -296,7 +310,7 @@ def client_main(args):
             ws.send(json.dumps({"id": "login", "op": "login", "username": args.user, "password": args.user + "-pw"}))
         call = {"jog": ("jog_joint", {"joint_velocity": [0.1, 0, 0], "timeout": 60, "wait": False}),
                 "jog-short": ("jog_joint", {"joint_velocity": [0.1, 0, 0], "timeout": 0.15, "wait": False}),
-                "freespace": ("jog_freespace", {"joint_position": args.target, "max_velocity": [0.05, 0.05, 0.05],
+                "freespace": ("jog_freespace", {"joint_position": args.target, "max_velocity": [0.015, 0.015, 0.015],
                                                 "wait": False})}[kind[3:]]
         ws.send(json.dumps({"id": 1, "op": "call", "device": "robot", "member": call[0], "args": call[1]}))
         while True:
@@ -318,7 +332,7 @@ def client_main(args):
             if kind == "rr-jog":
                 robot.jog_joint(np.array([0.1, 0, 0]), 60.0, False)
             elif kind == "rr-freespace":
-                robot.jog_freespace(np.array(args.target), np.array([0.05, 0.05, 0.05]), False)
+                robot.jog_freespace(np.array(args.target), np.array([0.015, 0.015, 0.015]), False)
             elif kind == "rr-trajectory":
                 gen = robot.execute_trajectory(trajectory(robot, args.start, args.target, 20.0))
                 gen_thread = threading.Thread(target=lambda: [gen.Next() for _ in range(100000)], daemon=True)
@@ -346,11 +360,13 @@ def client_main(args):
 
 
 def trajectory(robot, start, target, duration):
-    """A JointTrajectory from `start` to `target` in `duration` s (two waypoints)."""
+    """A JointTrajectory from `start` to `target` in `duration` s (one waypoint every 50 ms)."""
     traj_t = RRN.GetStructureType("com.robotraconteur.robotics.trajectory.JointTrajectory", robot)
     wp_t = RRN.GetStructureType("com.robotraconteur.robotics.trajectory.JointTrajectoryWaypoint", robot)
     waypoints = []
-    for t, q in ((0.0, start), (duration, target)):
+    n = int(duration / 0.05)  # the interpolator wants waypoints at most 100 ms apart
+    points = [(duration * i / n, [a + (b - a) * i / n for a, b in zip(start, target)]) for i in range(n + 1)]
+    for t, q in points:
         wp = wp_t()
         wp.joint_position = np.array(q, dtype=np.float64)
         wp.joint_velocity = np.zeros((3,))
@@ -374,9 +390,9 @@ class Client:
         if url:
             argv += ["--url", url]
         if target:
-            argv += ["--target", ",".join(str(x) for x in target)]
+            argv += ["--target=" + ",".join(str(x) for x in target)]
         if start:
-            argv += ["--start", ",".join(str(x) for x in start)]
+            argv += ["--start=" + ",".join(str(x) for x in start)]
         if user:
             argv += ["--user", user]
         self.errf = open(os.path.join(work, "client-%s.log" % kind), "ab")
@@ -453,17 +469,17 @@ def case_rest(exe, work):
         robot.mode("jog")
         q = robot.position()
         status, body = rest(gw.base, "POST", "/api/devices/robot/functions/jog_freespace",
-                            {"args": {"joint_position": [q[0] + 0.2, q[1], q[2]], "max_velocity": [0.05] * 3, "wait": False}})
+                            {"args": {"joint_position": [q[0] + 0.25, q[1], q[2]], "max_velocity": [0.05] * 3, "wait": False}})
         expect(status == 409 and "wait true" in body["error"]["message"],
                "REST jog_freespace with wait false refused (409, names wait true): %s %s" % (status, body))
         robot.mode("jog")
         q = robot.position()
-        c = Client(work, "rest-freespace", port=gw.port, target=[q[0] + 0.2, q[1], q[2]])
+        c = Client(work, "rest-freespace", port=gw.port, target=[q[0] + 0.25, q[1], q[2]])
         sending = c.wait_line("sending")
         robot.wait_moving(sending["sending"], "REST jog_freespace wait true")
         event = take_away(c, None, "kill")
-        stopped_within_bound(robot, event, "REST jog_freespace (wait true, 4 s move), client killed")
-        expect(robot.position()[0] < q[0] + 0.19, "the move did not reach its target (%.3f of %.3f)" % (robot.position()[0], q[0] + 0.2))
+        stopped_within_bound(robot, event, "REST jog_freespace (wait true, a 17 s move), client killed")
+        expect(robot.position()[0] < q[0] + 0.24, "the move did not reach its target (%.3f of %.3f)" % (robot.position()[0], q[0] + 0.25))
     finally:
         gw.stop()
         robot.stop()
@@ -490,13 +506,15 @@ def case_ws(exe, work):
             ws_case(robot, gw, work, "ws-jog", how, "JSON WebSocket jog_joint 60 s")
         for how in ("kill", "cut"):
             q = robot.position()
-            ws_case(robot, gw, work, "ws-freespace", how, "JSON WebSocket jog_freespace (wait false, 4 s move)",
-                    target=[q[0] - 0.2, q[1], q[2]])
+            ws_case(robot, gw, work, "ws-freespace", how, "JSON WebSocket jog_freespace (wait false, a 17 s move)",
+                    target=[q[0] - 0.25, q[1], q[2]])
         # two sockets: the second one's jog is refused naming the first while it holds
         robot.mode("jog")
         q = robot.position()
-        first = Client(work, "ws-freespace", port=gw.port, target=[q[0] + 0.2, q[1], q[2]])
-        expect("result" in first.wait_line("started")["reply"], "the first socket's move started")
+        first = Client(work, "ws-freespace", port=gw.port, target=[q[0] + 0.25, q[1], q[2]])
+        started = first.wait_line("started")
+        expect("result" in started["reply"], "the first socket's move started")
+        robot.wait_moving(started["started"] - 1, "the first socket's move")
         second = Client(work, "ws-jog-short", port=gw.port)
         reply = second.wait_line("started")["reply"]
         msg = reply.get("error", {}).get("message", "")
@@ -504,6 +522,7 @@ def case_ws(exe, work):
                "motion of robot is held by JSON WebSocket from 127.0.0.1" in msg,
                "the second socket's jog refused, naming the holder: %s" % reply)
         second.kill()
+        robot.wait_moving(time.time(), "the first socket's move, after the refusal")
         event = take_away(first, None, "kill")
         stopped_within_bound(robot, event, "the holder's socket closed")
     finally:
@@ -535,7 +554,7 @@ def case_rr(exe, work):
             relay = Relay(gw.port)
             q = robot.position()
             rr_case(robot, work, url(relay.port), "rr-freespace", how, relay,
-                    "official client jog_freespace (wait false, 4 s move)", target=[q[0] + 0.2, q[1], q[2]])
+                    "official client jog_freespace (wait false, a 17 s move)", target=[q[0] + 0.25, q[1], q[2]])
             relay.close()
         q = robot.position()
         rr_case(robot, work, url(gw.port), "rr-trajectory", "kill", None, "official client execute_trajectory (20 s)",
@@ -543,7 +562,7 @@ def case_rr(exe, work):
         # two clients: the second one's jog refused naming the first while it holds, allowed after its end
         robot.mode("jog")
         q = robot.position()
-        first = Client(work, "rr-freespace", url=url(gw.port), target=[q[0] + 0.2, q[1], q[2]])
+        first = Client(work, "rr-freespace", url=url(gw.port), target=[q[0] + 0.25, q[1], q[2]])
         first.wait_line("started")
         second = Client(work, "rr-jog", url=url(gw.port))
         refused = second.wait_line("refused")
@@ -657,26 +676,34 @@ def case_locks(exe, work):
         RRN.DisconnectService(bob)
     finally:
         gw.stop()
-    # passthrough: a client's monitor on the device itself; another client's halt still reaches it
-    gw = Gateway(exe, work, robot_config(robot, "    auth: passthrough\n"), name="gateway-passthrough")
+        robot.stop()
+    device_users = os.path.join(work, "device-users.txt")
+    with open(device_users, "w") as f:
+        for u, privileges in (("alice", "objectlock"), ("bob", "_"), ("gw", "_"), ("test", "_")):
+            f.write("%s %s %s\n" % (u, hashlib.md5((u + "-pw").encode()).hexdigest(), privileges))
+    robot = Robot(work, ["--users", device_users], login=("test", "test-pw"))
+    # passthrough: the device holds the locks (its own users); alice's object lock on the device, taken
+    # through the gateway, does not keep bob's halt() from the robot
+    gw = Gateway(exe, work, robot_config(robot, "    auth: passthrough\n    username: gw\n    password: gw-pw\n"),
+                 name="gateway-passthrough")
     try:
         url = "rr+tcp://127.0.0.1:%d/?service=robot" % gw.port
-        a = RRN.ConnectService(url)
-        b = RRN.ConnectService(url)
+        a = RRN.ConnectService(url, "alice", {"password": RR.VarValue("alice-pw", "string")})
+        b = RRN.ConnectService(url, "bob", {"password": RR.VarValue("bob-pw", "string")})
         robot.mode("jog")
-        RRN.MonitorEnter(a)
+        RRN.RequestObjectLock(a, RR.RobotRaconteurObjectLockFlags_USER_LOCK)
         t0 = time.time()
-        a.jog_freespace(np.array([robot.position()[0] + 0.2, 0, 0]), np.array([0.05] * 3), False)
-        robot.wait_moving(t0, "a's move under its monitor")
+        a.jog_freespace(np.array([robot.position()[0] + 0.25, 0, 0]), np.array([0.015] * 3), False)
+        robot.wait_moving(t0, "alice's move under her lock on the device")
         try:
             b.jog_joint(np.array([0.1, 0, 0]), 0.15, False)
-            expect(False, "b's jog refused by a's monitor on the device")
+            expect(False, "bob's jog refused")
         except RR.RobotRaconteurException as e:
-            expect("monitor" in str(e) or "held by" in str(e), "b's jog refused (%s)" % e)
+            expect("held by" in str(e) or "locked" in str(e), "bob's jog refused (%s)" % e)
         event = time.time()
         b.halt()
-        stopped_within_bound(robot, event, "b's halt() under a's monitor lock on the device (passthrough)")
-        RRN.MonitorExit(a)
+        stopped_within_bound(robot, event, "bob's halt() under alice's object lock on the device (passthrough)")
+        RRN.ReleaseObjectLock(a)
         RRN.DisconnectService(a)
         RRN.DisconnectService(b)
     finally:

@@ -27,7 +27,7 @@ Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=robot", "port": P, "device_uu
 "joint_names": [...]}.
 
 Usage: sim_robot.py [--info FILE] [--enabled] [--start-position Q0,Q1,...] [--joints-stdin] [--period 0.02]
-                    [--log-joints] [--velocity-command] [--max-lifetime 300]
+                    [--log-joints] [--velocity-command] [--users FILE] [--max-lifetime 300]
 """
 
 import argparse
@@ -190,6 +190,8 @@ def main():
     ap.add_argument("--log-jog", action="store_true", help="print a JSON line as each jog_joint call arrives")
     ap.add_argument("--log-joints", action="store_true", help="print the joints each loop step in which they moved")
     ap.add_argument("--velocity-command", action="store_true", help="offer the velocity_command capability")
+    ap.add_argument("--users", help="require logins: an official password file (user, MD5, privileges; objectlock "
+                                    "lets a user take object locks)")
     args = ap.parse_args()
     port = free_port()
     with RR.ServerNodeSetup("experimental.sim_arm", port, argv=["sim_robot"] + node_flags(port)):
@@ -200,7 +202,12 @@ def main():
         robot._log_jog = args.log_jog
         robot._log_joints = args.log_joints
         robot._start_robot()
-        ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot)
+        security = None
+        if args.users:
+            with open(args.users) as f:
+                security = RR.ServiceSecurityPolicy(RR.PasswordFileUserAuthenticator(f.read()),
+                                                    {"requirevaliduser": "true", "allowobjectlock": "true"})
+        ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot, security)
         ctx.SetServiceAttributes(attributes)
         device_uuid = str(uuid.UUID(bytes=bytes(robot_info.device_info.device.uuid["uuid_bytes"].tobytes())))
         ready(url=f"rr+tcp://127.0.0.1:{port}/?service=robot", port=port, device_uuid=device_uuid,
