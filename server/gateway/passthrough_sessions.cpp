@@ -264,7 +264,8 @@ void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&&
     std::weak_ptr<PassthroughSessions> weak = weak_from_this();
     forward(endpoint, client, std::move(entry),
             [shared, observe = std::move(observe), again = std::move(again), weak, endpoint](Result<MessageEntry> r) mutable {
-                auto answer = [&](Result<MessageEntry> reply) {
+                // By value: it may run later, from stop_as_lock_holder's own request.
+                auto answer = [shared, observe](Result<MessageEntry> reply) {
                     if (observe) observe(reply);
                     if (!reply)
                         shared->fail(reply.error());
