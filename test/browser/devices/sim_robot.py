@@ -50,6 +50,14 @@ from RobotRaconteurCompanion.Util.AttributesUtil import AttributesUtil  # noqa: 
 from robotraconteur_abstract_robot import AbstractRobot  # noqa: E402
 
 RRN = RR.RobotRaconteurNode.s
+_stdout_lock = threading.Lock()
+
+
+def emit(value):
+    """One JSON line on stdout in one piece: the loop thread's and the RR threads' lines never interleave."""
+    with _stdout_lock:
+        sys.stdout.write(json.dumps(value) + "\n")
+        sys.stdout.flush()
 
 
 class SimArm(AbstractRobot):
@@ -91,7 +99,7 @@ class SimArm(AbstractRobot):
             on = self._motors_on
         if self._log_joints and (self._logged_q is None or np.any(q != self._logged_q)):
             self._logged_q = q
-            print(json.dumps({"joints": time.time(), "q": [float(x) for x in q]}), flush=True)
+            emit({"joints": time.time(), "q": [float(x) for x in q]})
         pose = rox.fwdkin(self._rox_robots[0], q)
         with self._lock:
             self._joint_position = q
@@ -120,7 +128,7 @@ class SimArm(AbstractRobot):
         # --log-jog: one stdout line per jog call as it reaches the driver, so a test can tell a late
         # call (starved delivery) from a robot that kept moving past the call's timeout.
         if self._log_jog:
-            print(json.dumps({"jog_joint": time.time(), "timeout": timeout}), flush=True)
+            emit({"jog_joint": time.time(), "timeout": timeout})
         return super().async_jog_joint(joint_velocity, timeout, wait, handler)
 
     def halt(self):
@@ -200,7 +208,6 @@ def main():
         attributes = AttributesUtil(RRN).GetDefaultServiceAttributesFromDeviceInfo(robot_info.device_info)
         robot = SimArm(robot_info, args.period, args.enabled, args.start_position, args.velocity_command)
         robot._log_jog = args.log_jog
-        robot._log_joints = args.log_joints
         robot._start_robot()
         security = None
         if args.users:
@@ -210,8 +217,10 @@ def main():
         ctx = RRN.RegisterService("robot", "com.robotraconteur.robotics.robot.Robot", robot, security)
         ctx.SetServiceAttributes(attributes)
         device_uuid = str(uuid.UUID(bytes=bytes(robot_info.device_info.device.uuid["uuid_bytes"].tobytes())))
-        ready(url=f"rr+tcp://127.0.0.1:{port}/?service=robot", port=port, device_uuid=device_uuid,
-              joint_names=list(robot._joint_names), pid=os.getpid())
+        with _stdout_lock:
+            ready(url=f"rr+tcp://127.0.0.1:{port}/?service=robot", port=port, device_uuid=device_uuid,
+                  joint_names=list(robot._joint_names), pid=os.getpid())
+        robot._log_joints = args.log_joints  # after the ready line, which must stay the first one
         if args.joints_stdin:
             threading.Thread(target=teleport_from_stdin, args=(robot,), daemon=True).start()
         wait_for_stop(args.max_lifetime)
