@@ -77,8 +77,9 @@ MotionHolds::Gone MotionHolds::gone(const std::string& owner, Time now) {
     }
     out.stop = !out.tokens.empty();
     if (holder_->client.owner_key() == owner) {
-        for (const auto& [member, last] : holder_->streams)
-            if (now - last < silence_) out.stop = true;
+        // A stream still listed was not reported silent by expire(): its motion may run (the connection
+        // can close just as the stream goes quiet, a liveness probe's close after the same bound).
+        if (!holder_->streams.empty()) out.stop = true;
         holder_->streams.clear();
         holder_->timed_until.reset();
     }

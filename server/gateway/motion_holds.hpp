@@ -77,7 +77,8 @@ public:
         std::vector<std::uint64_t> tokens;  ///< motions it owned (ended now)
     };
     /// `owner` (a MotionClient::owner_key()) went away: its motions without a timeout end (a stop is
-    /// needed when it owned any, or when it was the holder with a live stream); a hold-to-run hold of
+    /// needed when it owned any, or when it was the holder with a stream expire() has not reported silent);
+    /// a hold-to-run hold of
     /// the holder's own ends with it too (its device timeout ends the motion).
     Gone gone(const std::string& owner, Time now);
 

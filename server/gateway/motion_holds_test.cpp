@@ -130,6 +130,10 @@ TEST_CASE("motion holds: the streamer's departure while streaming asks for a sto
     auto g = h.gone("rr:3", t0 + 100ms);
     CHECK(g.stop);
     CHECK(g.tokens.empty());
+    // Its connection closing just as the stream goes quiet (before the timer reported it): still a stop.
+    REQUIRE(h.take(streamer, t0 + 200ms, "s", "arm"));
+    h.stream_packet("velocity_command", t0 + 200ms);
+    CHECK(h.gone("rr:3", t0 + 800ms).stop);
     // A stream that had gone silent already needs no second stop when its sender leaves.
     REQUIRE(h.take(streamer, t0 + 1s, "s", "arm"));
     h.stream_packet("velocity_command", t0 + 1s);

@@ -77,6 +77,8 @@ class SimArm(AbstractRobot):
             self._q[:len(given)] = given
         self._q_target = None
         self._max_speed = np.array([j.joint_limits.velocity for j in robot_info.joint_info])
+        self._q_min = np.array([j.joint_limits.lower for j in robot_info.joint_info])
+        self._q_max = np.array([j.joint_limits.upper for j in robot_info.joint_info])
         self._sim_lock = threading.Lock()
         self._motors_on = enabled
         self._last_step = None
@@ -91,7 +93,9 @@ class SimArm(AbstractRobot):
             dt = 0.0 if self._last_step is None else now - self._last_step
             self._last_step = now
             if self._q_velocity is not None and self._motors_on:
-                self._q = self._q + np.clip(self._q_velocity, -self._max_speed, self._max_speed) * dt
+                # at a joint limit the joint stops there (the controller's end stop)
+                self._q = np.clip(self._q + np.clip(self._q_velocity, -self._max_speed, self._max_speed) * dt,
+                                  self._q_min, self._q_max)
             elif self._q_target is not None and self._motors_on:
                 step = np.clip(self._q_target - self._q, -self._max_speed * dt, self._max_speed * dt)
                 self._q = self._q + step
