@@ -154,6 +154,14 @@ public:
     std::optional<MonoTime> next_deadline() const;
     void on_timer(MonoTime now);
 
+    /// A short liveness probe of the peer (the gateway while a client holds a motion without a timeout
+    /// of its own: docs/security.md "Motion safety"): from `now` on, a ConnectionTest is sent every
+    /// `timeout` / 5 whatever else is sent (a peer answers each with ConnectionTestRet, wire.md §6.3),
+    /// and the connection closes (ConnectionError "no answer to the liveness probe …") when nothing at
+    /// all arrives for `timeout`, counted from `now` at the earliest. nullopt: off (the heartbeat and
+    /// receive timeout of the config apply again). Ignored unless connected.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout, MonoTime now);
+
     bool is_connected() const noexcept { return state_ == State::connected; }
     bool is_closed() const noexcept { return state_ == State::closed; }
     const StreamConnected& negotiated() const noexcept { return negotiated_; }
@@ -210,6 +218,9 @@ private:
     MonoTime started_;
     MonoTime last_send_;
     MonoTime last_receive_;
+    std::optional<std::chrono::milliseconds> probe_timeout_;  // set_liveness_probe
+    MonoTime probe_started_{};
+    MonoTime last_probe_{};
     bool session_established_ = false;
     std::uint32_t local_endpoint_ = 0;
     std::uint32_t remote_endpoint_ = 0;

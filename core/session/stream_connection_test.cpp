@@ -183,6 +183,74 @@ TEST_CASE("heartbeats keep a connection alive, silence closes it") {
     CHECK(client.is_closed());
 }
 
+TEST_CASE("the liveness probe: a ConnectionTest every bound / 5 whatever else is sent, closed without answers") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    REQUIRE(server.is_connected());
+    const MonoTime t1 = t0 + 1s;
+    server.set_liveness_probe(500ms, t1);
+    // The first probe at once, then every 100 ms; the client answers each.
+    MonoTime now = t1;
+    for (int i = 0; i < 10; ++i) {
+        auto d = server.next_deadline();
+        REQUIRE(d);
+        CHECK(*d <= now + 100ms);
+        now = std::max(now, *d);
+        server.on_timer(now);
+        auto ping = drain(server);
+        REQUIRE_FALSE(ping.empty());
+        REQUIRE(client.feed(ping, now));
+        auto pong = drain(client);
+        REQUIRE_FALSE(pong.empty());
+        REQUIRE(server.feed(pong, now + 5ms));
+        CHECK(server.is_connected());
+    }
+    // Busy sending (a wire value each 10 ms) does not hold the probe back.
+    const MonoTime t2 = now;
+    Message m;
+    m.header.sender_node_id = kServerId;
+    server.set_session_established(1, 2);
+    MessageEntry e;
+    e.entry_type = MessageEntryType::EventReq;
+    e.service_path = "svc";
+    e.member_name = "ev";
+    m.entries.push_back(e);
+    int probes = 0;
+    for (auto t = t2 + 10ms; t <= t2 + 400ms; t += 10ms) {
+        REQUIRE(server.send(m, t));
+        (void)drain(server);
+        if (server.next_deadline() && *server.next_deadline() <= t) {
+            server.on_timer(t);
+            auto out = drain(server);
+            if (!out.empty()) ++probes;
+        }
+        if (server.is_closed()) break;
+    }
+    CHECK(probes >= 3);
+    // No answer for the bound after the last one: closed, naming the probe.
+    server.on_timer(t2 + 5ms + 500ms);
+    auto closed = next_event<StreamClosed>(server);
+    REQUIRE(closed);
+    CHECK(closed->error.type == MessageErrorType::ConnectionError);
+    CHECK(closed->error.message.find("liveness probe") != std::string::npos);
+}
+
+TEST_CASE("the liveness probe off: the usual heartbeat and receive timeout again") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    server.set_liveness_probe(500ms, t0);
+    server.set_liveness_probe(std::nullopt, t0 + 100ms);
+    server.on_timer(t0 + 5s);
+    CHECK(server.is_connected());
+    CHECK(drain(server).empty());  // no probe, no heartbeat before 12 s
+    REQUIRE(server.next_deadline());
+    CHECK(*server.next_deadline() == t0 + 12s);
+}
+
 TEST_CASE("an unanswered CreateConnection times out") {
     MonoTime t0{};
     StreamConnection client(StreamRole::client, client_config(), t0);
