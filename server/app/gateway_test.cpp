@@ -18,6 +18,7 @@
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/local/local_test_support.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -132,7 +133,7 @@ TEST_CASE("gateway health endpoints follow the required devices") {
     CHECK_THAT(notready.body(), Catch::Contains("dev:"));
 
     REQUIRE(listen_tcp(device, "127.0.0.1", port));
-    for (int i = 0; i < 300 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*gw)->ready(); });
     REQUIRE((*gw)->ready());
     CHECK(gateway_http_get(gport, "/readyz").result() == bhttp::status::ok);
 
@@ -173,7 +174,7 @@ TEST_CASE("gateway: the default listen address takes IPv4 and IPv6 on one port, 
         WARN("no IPv6 loopback here: only the IPv4 side is checked");
     }
     // The demo devices are reached over 127.0.0.1 (IPv4), and the demo node takes IPv6 too.
-    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*gw)->ready(); });
     REQUIRE((*gw)->ready());
     const auto demo_port = url_port((*gw)->device("create")->config().url);
     CHECK(tcp_connects("127.0.0.1", demo_port));
@@ -189,7 +190,7 @@ TEST_CASE("gateway: the default listen address takes IPv4 and IPv6 on one port, 
     INFO((secured ? std::string() : secured.error().message));
     REQUIRE(secured);
     if (v6) CHECK(gateway_http_get((*secured)->port(), "/livez", "::1").result() == bhttp::status::ok);
-    for (int i = 0; i < 500 && !(*secured)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*secured)->ready(); });
     REQUIRE((*secured)->ready());
     const auto secured_demo = url_port((*secured)->device("create")->config().url);
     CHECK(tcp_connects("127.0.0.1", secured_demo));
@@ -240,7 +241,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     DemoStarter demo = demo_starter();
     auto gw = Gateway::start(cfg, demo);
     REQUIRE(gw);
-    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*gw)->ready(); });
     REQUIRE((*gw)->ready());
 
     client::IoThreads io(1);
@@ -281,7 +282,7 @@ TEST_CASE("gateway: serves rr+local under its NodeName (and the demo node under 
     auto quiet = Gateway::start(cfg, demo);
     INFO((quiet ? std::string() : quiet.error().message));
     REQUIRE(quiet);
-    for (int i = 0; i < 500 && !(*quiet)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*quiet)->ready(); });
     REQUIRE((*quiet)->ready());
     // (The run directories hold the by-nodename / by-nodeid entries and sockets. The NodeID cache and
     // the NodeName lock files, nodeids/NAME.pid, of the earlier gateways stay, as the official node's do.)
@@ -320,7 +321,7 @@ TEST_CASE("gateway: with gateway.auth the demo node requires a login only the ga
     INFO((gw ? std::string() : gw.error().message));
     REQUIRE(gw);
     // Ready: the gateway's own sessions logged in to the demo devices.
-    for (int i = 0; i < 500 && !(*gw)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*gw)->ready(); });
     REQUIRE((*gw)->ready());
 
     auto create = (*gw)->device("create");
@@ -409,7 +410,7 @@ TEST_CASE("gateway: with gateway.auth the demo node requires a login only the ga
     REQUIRE(open);
     CHECK((*open)->device("create")->config().username.empty());
     CHECK((*open)->device("create")->config().password.empty());
-    for (int i = 0; i < 500 && !(*open)->ready(); ++i) std::this_thread::sleep_for(10ms);
+    rr::testing::eventually([&] { return (*open)->ready(); });
     REQUIRE((*open)->ready());
     auto anon = client::Client::connect(io.executor(), (*open)->device("create")->config().url);
     INFO((anon ? std::string() : anon.error().message));
