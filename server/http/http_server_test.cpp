@@ -353,7 +353,7 @@ TEST_CASE("a JSON WebSocket writes a shared body after each message's own head, 
 TEST_CASE("a JSON WebSocket keeps each sending thread's order and loses nothing below its limit") {
     Fixture f;
     SubprotocolClient client(f.port, "test.push.threads.v1", "go");
-    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
+    beast::get_lowest_layer(client.ws).expires_after(60s);  // a lost message fails the read, not the suite (a bound on a hang)
     std::array<int, 4> next{};
     bool in_order = true;
     for (int i = 0; i < 4 * 200; ++i) {
@@ -381,7 +381,7 @@ TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and 
     const auto dropped = socket->dropped();
     CHECK(dropped >= 100 - 2 * 16);
     // What is left arrives in order and ends with the newest.
-    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
+    beast::get_lowest_layer(client.ws).expires_after(60s);  // a lost message fails the read, not the suite (a bound on a hang)
     int last = -1, received = 0;
     bool in_order = true;
     while (last < 99) {
