@@ -18,8 +18,8 @@ using namespace rr;
 using namespace rr::server;
 using namespace rr::server::gateway;
 using namespace std::chrono_literals;
-using testing::RawTestService;
-using testing::test_node;
+using rr::server::testing::RawTestService;
+using rr::server::testing::test_node;
 
 namespace {
 

@@ -28,8 +28,8 @@ using namespace std::chrono_literals;
 
 namespace {
 
-using testing::RawTestService;
-using testing::kDef;
+using rr::server::testing::RawTestService;
+using rr::server::testing::kDef;
 
 struct Fixture {
     std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "rawtest.node", 2, {}, 0, 5000ms});

@@ -40,13 +40,13 @@ std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> se
 }
 
 // A raw client-role stream to the node's TCP port.
-struct RawStream : testing::RawStream<asio::ip::tcp> {
+struct RawStream : rr::server::testing::RawStream<asio::ip::tcp> {
     RawStream(std::uint16_t port, StreamConfig config)
-        : testing::RawStream<asio::ip::tcp>({asio::ip::make_address("127.0.0.1"), port}, std::move(config)) {}
+        : rr::server::testing::RawStream<asio::ip::tcp>({asio::ip::make_address("127.0.0.1"), port}, std::move(config)) {}
 };
-using testing::framed;
-using testing::is_closed_event;
-using testing::reply_entry;
+using rr::server::testing::framed;
+using rr::server::testing::is_closed_event;
+using rr::server::testing::reply_entry;
 
 Result<MessageEntry> call(RawClient& c, MessageEntry e) {
     std::promise<Result<MessageEntry>> p;
@@ -61,13 +61,13 @@ Result<std::shared_ptr<RawClient>> raw_connect(asio::any_io_executor ex, std::ui
     return p.get_future().get();
 }
 
-using testing::padded_get;
+using rr::server::testing::padded_get;
 
 }  // namespace
 
 TEST_CASE("limits: a message over 512 KiB before the client session exists closes the connection") {
     std::uint16_t port = 0;
-    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node({}, std::make_shared<rr::server::testing::RawTestService>(), port);
     StreamConfig big;
     big.limits.max_pre_session_message_size = 4u << 20;  // our side may send it; the node must refuse
 
@@ -89,7 +89,7 @@ TEST_CASE("limits: max_message_size is configurable and applies once the session
     std::uint16_t port = 0;
     NodeOptions options;
     options.server.stream.limits.max_message_size = 1u << 20;
-    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node(options, std::make_shared<rr::server::testing::RawTestService>(), port);
     client::IoThreads io{1};
 
     auto c = raw_connect(io.executor(), port);
@@ -115,7 +115,7 @@ TEST_CASE("limits: max_connections refuses further connections until one closes"
     std::uint16_t port = 0;
     NodeOptions options;
     options.max_connections = 2;
-    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node(options, std::make_shared<rr::server::testing::RawTestService>(), port);
     client::IoThreads io{1};
     RawClientOptions quick;  // the refused connection is closed at once: these are bounds on a hang
     quick.connect_timeout = rr::testing::kHangBound;
@@ -140,7 +140,7 @@ TEST_CASE("limits: max_connections refuses further connections until one closes"
 
 TEST_CASE("limits: wrong magic or a truncated message inside an established stream closes it") {
     std::uint16_t port = 0;
-    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node({}, std::make_shared<rr::server::testing::RawTestService>(), port);
 
     SECTION("wrong magic") {
         RawStream s(port, {});
@@ -177,7 +177,7 @@ TEST_CASE("limits: wrong magic or a truncated message inside an established stre
 namespace {
 
 // A service that never answers function calls (the responder is kept), for client timeouts.
-class SilentService : public testing::RawTestService {
+class SilentService : public rr::server::testing::RawTestService {
 public:
     void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
         if (e.entry_type == MessageEntryType::FunctionCallReq) {
