@@ -97,7 +97,7 @@ unsigned mode_of(const std::string& p) {
 
 Result<std::shared_ptr<Client>> connect(client::IoThreads& io, const std::string& url) {
     client::ClientOptions o;
-    o.request_timeout = 5000ms;
+    o.request_timeout = 30000ms;  // a bound on a hang
     return Client::connect(io.executor(), url, o);
 }
 
