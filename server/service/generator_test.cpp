@@ -1,6 +1,7 @@
 // Generator functions at the entry level: index, Next with and without parameter, StopIteration,
 // close (request with Error 109), abort (Error 107), and requests after the end.
 #include "server/service/object_service_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 #include <thread>
 
@@ -169,6 +170,5 @@ TEST_CASE("generators: dropped when their session ends") {
         CHECK(c.error(next("count", g)).type == MessageErrorType::StopIteration);
         c.raw->close();
     }
-    for (int i = 0; i < 200 && alive != 0; ++i) std::this_thread::sleep_for(10ms);
-    CHECK(alive == 0);
+    CHECK(rr::testing::eventually([&] { return alive == 0; }));
 }
