@@ -565,6 +565,8 @@ DecodeContext StreamConnection::decode_context() const noexcept {
     c.remote_node_id = negotiated_.remote_node_id;
     c.local_endpoint = local_endpoint_;
     c.remote_endpoint = remote_endpoint_;
+    // Codes are the sending connection's business: entries handed up hold plain strings (wire.md §2.6).
+    c.keep_string_table_codes = false;
     return c;
 }
 

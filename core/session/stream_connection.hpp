@@ -82,8 +82,9 @@ struct StreamConnected {
     bool connect_combined = false;  ///< the peer supports ConnectClientCombined
 };
 
-/// A message for the layer above (never transport-internal entries). `frame` holds the exact bytes
-/// received, for zero-copy forwarding.
+/// A message for the layer above (never transport-internal entries), its names resolved from string-table
+/// codes. `frame` holds the exact bytes received, for zero-copy forwarding; they may hold string-table
+/// codes (wire.md §2.6), which only a peer that negotiated the same tables may be sent.
 struct StreamMessage {
     Message message;
     SharedBytes frame;
@@ -167,7 +168,8 @@ public:
     const StreamConnected& negotiated() const noexcept { return negotiated_; }
     StreamRole role() const noexcept { return role_; }
     const StreamConfig& config() const noexcept { return config_; }
-    /// DecodeContext for v4 messages without routing info.
+    /// DecodeContext for v4 messages without routing info; string-table codes are resolved and not
+    /// kept (DecodeContext::keep_string_table_codes), so received entries can go to any connection.
     DecodeContext decode_context() const noexcept;
     std::uint16_t send_version() const noexcept { return negotiated_.message4 ? 4 : 2; }
 

@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "core/message/message_writer.hpp"
+#include "core/message/string_table.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/stream_connection.hpp"
 #include "test/support/skip.hpp"
@@ -410,4 +411,87 @@ TEST_CASE("a large payload leaves a connection spliced into its output and arriv
         REQUIRE(got->message.entries.size() == 1);
         CHECK(got->message.entries[0] == wire);
     }
+}
+
+TEST_CASE("entries from a peer that uses string-table codes can be sent on another connection (wire.md 2.6)") {
+    MonoTime t0{};
+    // Upstream: a device that leaves the string table on (as the official TcpTransport can): both
+    // sides negotiate it, and the device sends names as standard and message-local codes.
+    StreamConfig device_config = server_config();
+    device_config.enable_string_table = true;
+    StreamConnection upstream(StreamRole::client, client_config(), t0);
+    StreamConnection device(StreamRole::server, device_config, t0);
+    pump(upstream, device, t0);
+    auto negotiated = next_event<StreamConnected>(upstream);
+    REQUIRE(negotiated);
+    CHECK(negotiated->string_table);
+    upstream.set_session_established(5, 9);
+    device.set_session_established(9, 5);
+
+    Message event;
+    event.header.sender_node_id = kServerId;
+    event.header.receiver_node_id = kClientId;
+    event.header.sender_endpoint = 9;
+    event.header.receiver_endpoint = 5;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::EventReq;
+    e.service_path = "svc.child";
+    e.member_name = "thenable";
+    MessageElement value = make_array_element("value", std::span<const double>(std::vector<double>{1.5}));
+    MessageElement s;
+    s.name = "point";
+    s.type = DataTypes::structure_t;
+    s.type_name = "experimental.demo.Point";
+    s.elements.push_back(make_array_element("x", std::span<const double>(std::vector<double>{2.5})));
+    e.elements.push_back(value);
+    e.elements.push_back(s);
+    event.entries.push_back(e);
+    Message coded = event;
+    apply_string_table(coded, StringTableOptions{});
+    REQUIRE(coded.entries[0].member_name_code);
+    REQUIRE_FALSE(coded.header.string_table.empty());
+    REQUIRE(device.send(coded, t0));
+    REQUIRE(upstream.feed(drain(device), t0));
+    auto got = next_event<StreamMessage>(upstream);
+    REQUIRE(got);
+    REQUIRE(got->message.entries.size() == 1);
+    const MessageEntry& received = got->message.entries[0];
+    CHECK(received.member_name == "thenable");
+    CHECK(received.service_path == "svc.child");
+    CHECK_FALSE(received.member_name_code);
+    CHECK_FALSE(received.service_path_code);
+    CHECK_FALSE(received.elements[1].type_name_code);
+    CHECK(got->message.header.string_table.empty());
+    CHECK(received.elements == e.elements);
+
+    // Downstream: a client of ours (a stock server side: no string table) gets the entry re-addressed.
+    StreamConnection downstream(StreamRole::server, server_config(), t0);
+    StreamConnection browser(StreamRole::client, client_config(), t0);
+    pump(browser, downstream, t0);
+    REQUIRE(downstream.is_connected());
+    downstream.set_session_established(9, 5);
+    browser.set_session_established(5, 9);
+    Message forward;
+    forward.header.sender_node_id = kServerId;
+    forward.header.receiver_node_id = kClientId;
+    forward.header.sender_endpoint = 9;
+    forward.header.receiver_endpoint = 5;
+    forward.entries.push_back(received);
+    forward.entries[0].service_path = "gateway.child";
+    REQUIRE(downstream.send(forward, t0));
+    // Fanned out as one encoded entry as well.
+    Message header = forward;
+    header.entries.clear();
+    EncodedEntry shared(received);
+    REQUIRE(downstream.send(std::move(header), shared, t0));
+    REQUIRE(browser.feed(drain(downstream), t0));
+    auto first = next_event<StreamMessage>(browser);
+    auto second = next_event<StreamMessage>(browser);
+    REQUIRE(first);
+    REQUIRE(second);
+    CHECK(first->message.entries.at(0).service_path == "gateway.child");
+    CHECK(first->message.entries.at(0).member_name == "thenable");
+    CHECK(first->message.entries.at(0).elements == e.elements);
+    CHECK(second->message.entries.at(0).service_path == "svc.child");
+    CHECK(second->message.entries.at(0).elements == e.elements);
 }

@@ -25,13 +25,16 @@ nlohmann::json replay_status_json(const ReplayStatus& s) {
 namespace {
 
 // A recorded `robotraconteur` message: one RR message entry in message format 4 (recording.cpp). The
-// entry is decoded inside a message of its own, as a session would receive it.
+// entry is decoded inside a message of its own, as a session would receive it: standard string-table
+// codes (in files recorded before entries were kept free of them) are resolved, not replayed.
 Result<MessageEntry> decode_entry(std::span<const std::byte> bytes) {
     Message m;
     m.version = 4;
     std::vector<std::byte> out;
     if (auto r = encode_message(m, bytes, out); !r) return r.take_error();
-    auto decoded = decode_message(SharedBytes::adopt(std::move(out)));
+    DecodeContext plain;
+    plain.keep_string_table_codes = false;
+    auto decoded = decode_message(SharedBytes::adopt(std::move(out)), {}, &plain);
     if (!decoded) return decoded.take_error();
     if (decoded->entries.size() != 1) return fail(MessageErrorType::DataSerializationError, "not one message entry");
     return std::move(decoded->entries[0]);
