@@ -432,6 +432,29 @@ void ObjectService::handle_entry(const SessionRef& session, MessageEntry&& entry
 
 void ObjectService::attach(boost::asio::io_context& io) { locks_->attach(io); }
 
+namespace {
+
+/// `path` is the service's root path or an object below it.
+bool in_service(const std::string& service_name, const std::string& path) {
+    return path == service_name ||
+           (path.size() > service_name.size() && path.compare(0, service_name.size(), service_name) == 0 &&
+            (path[service_name.size()] == '.' || path[service_name.size()] == '['));
+}
+
+}  // namespace
+
+Result<void> ObjectService::request_object_lock(const std::string& path, const std::string& username) {
+    if (!in_service(name_, path))
+        return fail(MessageErrorType::InvalidArgument, "\"" + path + "\" is not a path of service " + name_);
+    return locks_->lock_for_user(path, username);
+}
+
+Result<void> ObjectService::release_object_lock(const std::string& path) {
+    if (!in_service(name_, path))
+        return fail(MessageErrorType::InvalidArgument, "\"" + path + "\" is not a path of service " + name_);
+    return locks_->release_user_lock(path);
+}
+
 std::optional<ObjectLocks::Holder> ObjectService::lock_holder(const std::string& path) const { return locks_->holder(path); }
 
 bool ObjectService::has_privilege(const std::string& username, std::string_view privilege) const {
