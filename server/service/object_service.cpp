@@ -311,8 +311,23 @@ void ObjectService::handle_generator_next(const SessionRef& session, MessageEntr
             return;
         }
         generator = it->second.generator;
-        it->second.last_access = std::chrono::steady_clock::now();
-        if (ending) generators_.erase(it);
+        if (it->second.ended != MessageErrorType::None) {
+            // Closed or aborted: official clients expect StopIteration / OperationAborted from a Next
+            // that follows (CORE keeps the generator, whose own next() says so); then the index goes.
+            const auto ended = it->second.ended;
+            if (!ending) {
+                generators_.erase(it);
+                responder.fail(make_error(ended, ended == MessageErrorType::StopIteration ? "Generator closed"
+                                                                                        : "Generator aborted"));
+                return;
+            }
+        } else if (ending) {
+            it->second.ended = entry.error == MessageErrorType::StopIteration ? MessageErrorType::StopIteration
+                                                                               : MessageErrorType::OperationAborted;
+            it->second.last_access = std::chrono::steady_clock::now() - (kGeneratorIdleTimeout - kEndedGeneratorGrace);
+        } else {
+            it->second.last_access = std::chrono::steady_clock::now();
+        }
     }
     if (ending) {
         auto r = entry.error == MessageErrorType::StopIteration ? generator->close() : generator->abort();

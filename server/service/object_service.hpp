@@ -95,6 +95,9 @@ public:
     /// untouched generator is dropped.
     static constexpr std::size_t kMaxGeneratorsPerSession = 1024;
     static constexpr std::chrono::minutes kGeneratorIdleTimeout{10};
+    /// How long a closed or aborted generator's index stays known (CORE: 30 s): its next Next is
+    /// answered StopIteration (closed) or OperationAborted (aborted), then the index goes.
+    static constexpr std::chrono::seconds kEndedGeneratorGrace{30};
     /// A waiting MonitorEnter / MonitorContinueEnter is answered "Continue" after this (CORE: 5 s).
     static constexpr std::chrono::seconds kMonitorWait = ServiceLocks::kMonitorWait;
 
@@ -137,6 +140,9 @@ private:
         std::string path, member;
         std::shared_ptr<Generator> generator;
         std::chrono::steady_clock::time_point last_access;
+        /// StopIteration after a close, OperationAborted after an abort: the answer to the next Next,
+        /// within kEndedGeneratorGrace (requests do not refresh last_access then).
+        MessageErrorType ended = MessageErrorType::None;
     };
 
     const std::string name_;

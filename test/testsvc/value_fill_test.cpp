@@ -71,7 +71,7 @@ TEST_CASE("testsvc values: every property of the test objects gets an LFSR value
             ++checked;
         }
     }
-    CHECK(checked > 100);
+    CHECK(checked >= 90);  // 97 in the definitions of commit 018ccf2
 }
 
 TEST_CASE("testsvc values: same_value takes NaN as NaN, maps in any order, and tells other values apart") {
@@ -118,9 +118,11 @@ TEST_CASE("testsvc recipes: TestService3 values pack as their types, and seeds t
     CHECK_FALSE(same_value(ts3.testpod1(563921043), ts3.testpod1(85932659)));
     CHECK_FALSE(same_value(ts3.teststruct3(858362), ts3.teststruct3(16483675)));
 
-    // The counter walk: seed 100 starts at 100 and steps 100 mod 17 + 7 = 16.
+    // The counter walk: seed 100 starts at 100 and steps 100 mod 17 + 7 = 22.
     SequenceGen g(tables, 100);
-    CHECK(g.next_double() == tables.doubles[116]);
-    CHECK(g.next_uint32() == tables.uint32s[132]);
-    CHECK(g.next_int8() == static_cast<std::int8_t>(148 % 255 - 128));
+    CHECK(g.next_double() == tables.doubles[122]);
+    CHECK(g.next_uint32() == tables.uint32s[144]);
+    CHECK(g.next_int8() == 166 - 128);
+    SequenceGen far(tables, 7823 + 100);  // the same start, another step: 7923 mod 17 + 7 = 8
+    CHECK(far.next_double() == tables.doubles[108]);
 }
