@@ -548,11 +548,12 @@ def to_json(types, v, t):
     if t.base == "string":
         return v
     if t.base in NUMERIC.values():
+        # with the dtype: a list of large uint64 would become float64 (and lose digits) otherwise
         if t.array == MULTI:
-            a = np.asarray(v)
+            a = np.asarray(v, dtype=NP_DTYPE[t.base])
             return {"dims": list(a.shape), "array": [num(x, t.base) for x in a.flatten(order="F")]}
         if t.array == ARRAY:
-            return [num(x, t.base) for x in np.atleast_1d(np.asarray(v)).flatten()]
+            return [num(x, t.base) for x in np.atleast_1d(np.asarray(v, dtype=NP_DTYPE[t.base])).flatten()]
         return num(np.asarray(v).flatten()[0] if isinstance(v, np.ndarray) else v, t.base)
     if t.kind == "enum":
         return int(v)
