@@ -102,18 +102,18 @@ def start_gateway(args, logdir, urls, name):
     return p, port
 
 
-def run_suite(args, logdir, name, url, env_extra=None):
+def run_suite(args, logdir, name, url, env_extra=None, plugins=()):
     junit = os.path.join(logdir, name + ".xml")
     env = dict(os.environ)
     env.pop("ROBOTRACONTEUR_TEST_SERVER_URL", None)
     if url is not None:
         env["ROBOTRACONTEUR_TEST_SERVER_URL"] = url
-    env["PYTHONPATH"] = os.pathsep.join(x for x in (args.pytest_path, os.path.join(args.repo, "test", "python"),
+    env["PYTHONPATH"] = os.pathsep.join(x for x in (args.pytest_path, os.path.join(args.repo, "test", "python"), HERE,
                                                     env.get("PYTHONPATH")) if x)
     env.update(env_extra or {})
     with open(os.path.join(logdir, name + ".pytest.log"), "w") as out:
         subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-rA", "--junitxml", junit]
-                       + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
+                       + [a for p in plugins for a in ("-p", p)] + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
                        stderr=subprocess.STDOUT, timeout=1800)
     results = {}
     for case in ET.parse(junit).getroot().iter("testcase"):
@@ -175,6 +175,9 @@ def main():
                 url = ("rr+tcp://127.0.0.1:%d/" if config == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
             print("%s: %s" % (config, url), flush=True)
             table[config] = run_suite(args, logdir, config, url, env)
+            if config == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
+                table["local (URL joined with &)"] = run_suite(args, logdir, "local-joined", url, env,
+                                                               plugins=["official_suite_local_url"])
         except Exception as e:
             table[config] = {"(setup)": "failed: %s" % e}
         finally:
