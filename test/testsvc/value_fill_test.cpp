@@ -7,10 +7,13 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "core/value/pack_value.hpp"
 #include "server/service/service_types.hpp"
 #include "test/support/skip.hpp"
 #include "test/testsvc/sequence_gen.hpp"
+#include "test/testsvc/test_values.hpp"
 #include "test/testsvc/value_fill.hpp"
 
 using namespace rr;
@@ -125,4 +128,50 @@ TEST_CASE("testsvc recipes: TestService3 values pack as their types, and seeds t
     CHECK(g.next_int8() == 166 - 128);
     SequenceGen far(tables, 7823 + 100);  // the same start, another step: 7923 mod 17 + 7 = 8
     CHECK(far.next_double() == tables.doubles[108]);
+}
+
+TEST_CASE("testsvc values: an official values file replaces the values it names, and bad files are refused", "[shared]") {
+    auto types = testing_types();
+    if (!types) RR_SKIP("no " + (rr::test::shared_dir() / "robdef-testing").string());
+    const auto dir = std::filesystem::temp_directory_path() / ("testsvc-values-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir / name) << text;
+        return (dir / name).string();
+    };
+    const std::string root = "com.robotraconteur.testing.TestService1.testroot";
+    const auto good = write("good.json", R"({"format": "rr-testsvc-official-values 1", "objects": {
+        "com.robotraconteur.testing.TestService1.testroot": {
+            "properties": {"d1": {"get": 12.5, "set": 3.25}, "str1": {"get": "hello"}},
+            "memories": {"m1": [1.0, 2.0]}}},
+        "sequence": {"doubles": [0.5, 0.25], "uint32s": [7, 9, 11]}})");
+    auto v = TestValues::load_official(types, good);
+    INFO((v ? std::string() : v.error().message));
+    REQUIRE(v);
+    CHECK(v->official());
+    CHECK(same_value(*v->get(root, "d1"), Value::scalar(12.5)));
+    CHECK(same_value(**v->expected_set(root, "d1"), Value::scalar(3.25)));
+    CHECK(same_value(*v->get(root, "str1"), Value("hello")));
+    CHECK_FALSE(v->expected_set(root, "str1")->has_value());  // named without a set value: any value
+    Lfsr g(TestValues::kSeed, "d2_get");  // not named: the LFSR value
+    CHECK(same_value(*v->get(root, "d2"), *lfsr_value(types->find_object(root)->find_member("d2")->type, g, types->set(),
+                                                      "com.robotraconteur.testing.TestService1")));
+    REQUIRE(v->memory(root, "m1"));
+    CHECK(v->memory(root, "m1")->get_if<NumericArray>()->size() == 2);
+    CHECK(v->sequence().uint32s.size() == 3);
+    CHECK(v->get(root, "nosuch").error().type == MessageErrorType::MemberNotFound);
+
+    for (const char* text : {R"({"format": "other"})", R"(not json)",
+                             R"({"format": "rr-testsvc-official-values 1", "objects": {"x.y.z": {}}})",
+                             R"({"format": "rr-testsvc-official-values 1", "objects": {"com.robotraconteur.testing.TestService1.testroot": {"properties": {"func1": {"get": 1}}}}})",
+                             R"({"format": "rr-testsvc-official-values 1", "objects": {"com.robotraconteur.testing.TestService1.testroot": {"properties": {"d1": {"get": "text"}}}}})",
+                             R"({"format": "rr-testsvc-official-values 1", "sequence": {"doubles": [], "uint32s": [1]}})"}) {
+        INFO(text);
+        auto bad = TestValues::load_official(types, write("bad.json", text));
+        REQUIRE_FALSE(bad);
+        CHECK(bad.error().type == MessageErrorType::InvalidArgument);
+        CHECK(bad.error().message.find("bad.json") != std::string::npos);
+    }
+    CHECK(TestValues::load_official(types, (dir / "missing.json").string()).error().type == MessageErrorType::IOError);
+    std::filesystem::remove_all(dir);
 }
