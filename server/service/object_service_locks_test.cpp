@@ -253,3 +253,35 @@ TEST_CASE("object locks: members marked [nolock] / [nolockread] pass object lock
     b.raw->close();
     service->shutdown();
 }
+
+TEST_CASE("object locks: a lock the service takes for a user blocks other sessions except [nolock] members") {
+    LockFixture lf;
+    auto& f = lf.f;
+    const std::string sub_path = std::string(kTestService) + ".sub";
+    CHECK(f.service->request_object_lock("elsewhere.sub", "server").error().type == MessageErrorType::InvalidArgument);
+    CHECK(f.service->request_object_lock(std::string(kTestService) + "x", "server").error().type == MessageErrorType::InvalidArgument);
+    REQUIRE(f.service->request_object_lock(sub_path, "server"));  // before any client resolved it
+    CHECK(f.service->request_object_lock(sub_path, "other").error().type == MessageErrorType::ObjectLockedError);
+    REQUIRE(f.service->lock_holder(sub_path));
+    CHECK(f.service->lock_holder(sub_path)->username == "server");
+
+    auto alice = f.connect(login("alice", "a"));
+    auto e = alice.error(get_n());
+    CHECK(e.type == MessageErrorType::ObjectLockedError);
+    CHECK(e.message == "Object locked by server");
+    alice.ok(get_value());  // the root is not covered
+    // another user without override cannot release it; a user with objectlockoverride can
+    CHECK(alice.error(lock_op("ReleaseObjectLock", sub_path)).type == MessageErrorType::ObjectLockedError);
+
+    SECTION("released by the service") {
+        REQUIRE(f.service->release_object_lock(sub_path));
+        alice.ok(get_n());
+        CHECK_FALSE(f.service->lock_holder(sub_path));
+        REQUIRE(f.service->release_object_lock(sub_path));  // nothing held: OK
+    }
+    SECTION("released by a client with objectlockoverride") {
+        auto root = f.connect(login("root", "r"));
+        root.ok(lock_op("ReleaseObjectLock", sub_path));
+        alice.ok(get_n());
+    }
+}
