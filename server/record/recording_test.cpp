@@ -76,6 +76,8 @@ std::function<void(rr::server::app::GatewayConfig&)> root_in(const RecordingDir&
 std::string file_text(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
 // Waits until `n` pipe endpoints of the gateway itself (a recording's) are connected to the device:
 // packets the device sends before that are not recorded.
 bool gateway_pipes_open(TestGateway& gw, std::size_t n) {
