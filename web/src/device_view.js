@@ -9,7 +9,7 @@
 
 import { h, errorText } from "./dom.js";
 import { DeviceSession, deviceUrl } from "./device_session.js";
-import { RobdefOutline } from "./robdef_outline.js";
+import { RobdefOutline } from "./std/robdef_outline.js";
 import { DefinitionView } from "./definition_view.js";
 import { ObjectPanel } from "./object_panel.js";
 import { EventLog } from "./event_log.js";

@@ -24,4 +24,4 @@ export { plotRole, leaveOutOfPlot, typedNumericFields, sensorTimestamp } from ".
 export { deviceInfoRows } from "./device_info.js";
 export { formatDataType } from "./datatype.js";
 export { FrameDecoder } from "./frame_decoder.js";
-export { RobdefOutline } from "../robdef_outline.js";
+export { RobdefOutline } from "./robdef_outline.js";
