@@ -29,8 +29,10 @@ private:
 };
 
 /// Decompresses a chunk's `records` into exactly `uncompressed_size` bytes. The caller has checked
-/// uncompressed_size against its limit. compression "" copies. Errors (DataSerializationError):
-/// an unknown compression, bad zstd data, or output of another size than announced.
+/// uncompressed_size against its limit; the output buffer grows with what zstd produces (it is never
+/// allocated at the announced size up front), and a zstd window over 32 MiB is refused. compression ""
+/// copies. Errors (DataSerializationError): an unknown compression, bad or cut zstd data, a window
+/// too large, or output of another size than announced.
 Result<std::vector<std::byte>> decompress_chunk(std::string_view compression, std::span<const std::byte> records,
                                                 std::uint64_t uncompressed_size);
 

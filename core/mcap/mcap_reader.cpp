@@ -23,24 +23,80 @@ constexpr auto kCorrupt = MessageErrorType::DataSerializationError;
 
 std::uint8_t op(Opcode o) { return static_cast<std::uint8_t>(o); }
 
+// The file must hold the bytes before memory is allocated for them.
 Result<Bytes> read_bytes(Source& source, std::uint64_t offset, std::uint64_t n) {
+    const std::uint64_t size = source.size();
+    if (offset > size || n > size - offset)
+        return fail(MessageErrorType::IOError, "mcap: " + std::to_string(n) + " bytes at offset " + std::to_string(offset) +
+                                                   " are past the end of the file (" + std::to_string(size) + " bytes)");
     Bytes out(static_cast<std::size_t>(n));
     if (auto r = source.read_at(offset, out); !r) return r.take_error();
     return out;
 }
 
+// What the reader holds, counted against ReaderLimits::max_memory_bytes (mcap_reader.hpp).
+struct MemoryBudget {
+    std::uint64_t limit = 0;
+    std::uint64_t held = 0;
+};
+
+// Bytes counted in a MemoryBudget for as long as this lives (or until sub/release).
+class Charge {
+public:
+    Charge() = default;
+    explicit Charge(MemoryBudget* budget) : budget_(budget) {}
+    Charge(Charge&& o) noexcept : budget_(std::exchange(o.budget_, nullptr)), bytes_(std::exchange(o.bytes_, 0)) {}
+    Charge& operator=(Charge&& o) noexcept {
+        if (this != &o) {
+            release();
+            budget_ = std::exchange(o.budget_, nullptr);
+            bytes_ = std::exchange(o.bytes_, 0);
+        }
+        return *this;
+    }
+    ~Charge() { release(); }
+
+    // Counts `n` more bytes, or fails (counting nothing) when that would pass the limit.
+    Result<void> add(std::uint64_t n, std::uint8_t opcode, std::uint64_t offset, std::string_view what) {
+        if (n > budget_->limit || budget_->held > budget_->limit - n)
+            return detail::record_error(opcode, offset, MessageErrorType::BufferLimitViolation,
+                                        std::string(what) + " (" + std::to_string(n) +
+                                            " bytes) would take the reader over its memory limit of " +
+                                            std::to_string(budget_->limit) + " bytes (" + std::to_string(budget_->held) +
+                                            " held)");
+        budget_->held += n;
+        bytes_ += n;
+        return {};
+    }
+    void sub(std::uint64_t n) {
+        if (!budget_) return;
+        n = std::min(n, bytes_);
+        budget_->held -= n;
+        bytes_ -= n;
+    }
+    void release() {
+        if (budget_) budget_->held -= bytes_;
+        bytes_ = 0;
+    }
+
+private:
+    MemoryBudget* budget_ = nullptr;
+    std::uint64_t bytes_ = 0;
+};
+
 struct RawRecord {
     std::uint8_t opcode = 0;
     std::uint64_t offset = 0;  // file offset of the opcode
     Bytes content;
+    Charge charge;  // for content
 };
 
 // Reads the data section record by record, from `pos` to Data End or the end of the file. A record
 // cut off by the end of the file ends the read and is reported in truncated, not as an error.
 class LinearScanner {
 public:
-    LinearScanner(Source& source, const ReaderLimits& limits, std::uint64_t pos)
-        : source_(source), limits_(limits), pos_(pos) {}
+    LinearScanner(Source& source, const ReaderLimits& limits, MemoryBudget& budget, std::uint64_t pos)
+        : source_(source), limits_(limits), budget_(budget), pos_(pos) {}
 
     Result<std::optional<RawRecord>> next() {
         if (done_) return std::optional<RawRecord>{};
@@ -57,7 +113,7 @@ public:
             return stop("file ends inside " + opcode_name(opcode) + " at offset " + std::to_string(pos_) +
                         " (content length " + std::to_string(length) + ", " +
                         std::to_string(size - pos_ - kRecordPrefixBytes) + " bytes left)");
-        RawRecord rec{opcode, pos_, {}};
+        RawRecord rec{opcode, pos_, {}, Charge(&budget_)};
         if (opcode == op(Opcode::DataEnd) || opcode == op(Opcode::Footer)) done_ = true;
         if (!wanted_content(opcode)) {  // attachments, metadata, indexes, private records: skipped unread
             pos_ += kRecordPrefixBytes + length;
@@ -67,6 +123,7 @@ public:
             return record_error(opcode, pos_, MessageErrorType::BufferLimitViolation,
                                 "content length " + std::to_string(length) + " over the limit of " +
                                     std::to_string(limits_.max_record_bytes) + " bytes");
+        if (auto r = rec.charge.add(length, opcode, pos_, "its content"); !r) return r.take_error();
         auto content = read_bytes(source_, pos_ + kRecordPrefixBytes, length);
         if (!content) return content.take_error();
         rec.content = std::move(*content);
@@ -92,20 +149,31 @@ private:
 
     Source& source_;
     const ReaderLimits& limits_;
+    MemoryBudget& budget_;
     std::uint64_t pos_;
     bool done_ = false;
     std::optional<std::string> truncated_;
 };
 
-// Decompresses and CRC-checks a Chunk record's records.
-Result<Bytes> load_chunk(std::span<const std::byte> content, std::uint64_t offset, const ReaderLimits& limits,
-                         detail::ChunkRecord* fields = nullptr) {
+// A chunk's decompressed records and their place in the memory budget.
+struct LoadedChunk {
+    Bytes records;
+    Charge charge;
+};
+
+// Decompresses and CRC-checks a Chunk record's records; their announced size is counted in `budget`
+// before decompressing.
+Result<LoadedChunk> load_chunk(std::span<const std::byte> content, std::uint64_t offset, const ReaderLimits& limits,
+                               MemoryBudget& budget, detail::ChunkRecord* fields = nullptr) {
     auto chunk = detail::decode_chunk(content);
     if (!chunk) return record_error(op(Opcode::Chunk), offset, chunk.error());
     if (chunk->uncompressed_size > limits.max_chunk_uncompressed_bytes)
         return record_error(op(Opcode::Chunk), offset, MessageErrorType::BufferLimitViolation,
                             "uncompressed_size " + std::to_string(chunk->uncompressed_size) + " over the limit of " +
                                 std::to_string(limits.max_chunk_uncompressed_bytes) + " bytes");
+    LoadedChunk loaded{{}, Charge(&budget)};
+    if (auto r = loaded.charge.add(chunk->uncompressed_size, op(Opcode::Chunk), offset, "its uncompressed records"); !r)
+        return r.take_error();
     auto records = detail::decompress_chunk(chunk->compression, chunk->records, chunk->uncompressed_size);
     if (!records) return record_error(op(Opcode::Chunk), offset, records.error());
     if (chunk->uncompressed_crc != 0) {
@@ -118,7 +186,8 @@ Result<Bytes> load_chunk(std::span<const std::byte> content, std::uint64_t offse
         }
     }
     if (fields) *fields = *chunk;  // its records view points into `content`
-    return std::move(*records);
+    loaded.records = std::move(*records);
+    return loaded;
 }
 
 // Walks the records inside a decompressed chunk (or a summary section). A record that does not fit is
@@ -179,8 +248,13 @@ struct McapReader::State {
     bool indexed = false;
     std::optional<std::string> truncated;
     std::uint64_t data_start = 0;
+    MemoryBudget budget;
+    Charge summary_charge{&budget};  // the decoded summary's records
 
     Result<void> read_footer_and_summary();
+    // Refuses Chunk Index records that name one chunk twice or overlapping chunks, and chunks that could
+    // never be read within the memory limit. `record_offsets`: each ChunkIndex record's file offset.
+    Result<void> check_chunk_indexes(const std::vector<ChunkIndex>& indexes, const std::vector<std::uint64_t>& record_offsets);
     Result<void> scan_linear();
     // Adds a Schema/Channel seen in the data; returns an error for a message on an unknown channel.
     Result<void> note_record(std::uint8_t opcode, std::uint64_t offset, std::span<const std::byte> content,
@@ -212,6 +286,10 @@ Result<void> McapReader::State::read_footer_and_summary() {
                                 std::to_string(limits.max_summary_bytes));
     // The CRC covers the summary, the summary offsets and the footer up to summary_crc.
     constexpr std::uint64_t kFooterCovered = kRecordPrefixBytes + 16;
+    Charge covered_charge(&budget);
+    if (auto r = covered_charge.add(footer_at - f.summary_start + kFooterCovered, op(Opcode::Footer), footer_at, "the summary section");
+        !r)
+        return r;
     auto covered = read_bytes(*source, f.summary_start, footer_at - f.summary_start + kFooterCovered);
     if (!covered) return covered.take_error();
     if (f.summary_crc != 0) {
@@ -230,6 +308,8 @@ Result<void> McapReader::State::read_footer_and_summary() {
     Summary s;
     s.from_summary_section = true;
     bool have_statistics = false;
+    std::vector<std::uint64_t> chunk_index_offsets;
+    summary_charge.release();
     for (;;) {
         auto item = walk.next();
         if (!item) return item.take_error();
@@ -238,10 +318,15 @@ Result<void> McapReader::State::read_footer_and_summary() {
         if (opcode == op(Opcode::Schema)) {
             auto x = detail::decode_schema(content);
             if (!x) return record_error(opcode, at, x.error());
-            if (x->id != 0) s.schemas[x->id] = std::move(*x);
+            if (x->id == 0) continue;
+            if (auto r = summary_charge.add(memory_of(*x), opcode, at, "the decoded summary"); !r) return r;
+            if (auto old = s.schemas.find(x->id); old != s.schemas.end()) summary_charge.sub(memory_of(old->second));
+            s.schemas[x->id] = std::move(*x);
         } else if (opcode == op(Opcode::Channel)) {
             auto x = detail::decode_channel(content);
             if (!x) return record_error(opcode, at, x.error());
+            if (auto r = summary_charge.add(memory_of(*x), opcode, at, "the decoded summary"); !r) return r;
+            if (auto old = s.channels.find(x->id); old != s.channels.end()) summary_charge.sub(memory_of(old->second));
             s.channels[x->id] = std::move(*x);
         } else if (opcode == op(Opcode::ChunkIndex)) {
             auto x = detail::decode_chunk_index(content);
@@ -251,7 +336,9 @@ Result<void> McapReader::State::read_footer_and_summary() {
                 return record_error(opcode, at, kCorrupt,
                                     "chunk at offset " + std::to_string(x->chunk_start_offset) + " length " +
                                         std::to_string(x->chunk_length) + " is outside the file");
+            if (auto r = summary_charge.add(memory_of(*x), opcode, at, "the decoded summary"); !r) return r;
             s.chunk_indexes.push_back(std::move(*x));
+            chunk_index_offsets.push_back(at);
         } else if (opcode == op(Opcode::Statistics)) {
             auto x = detail::decode_statistics(content);
             if (!x) return record_error(opcode, at, x.error());
@@ -264,9 +351,52 @@ Result<void> McapReader::State::read_footer_and_summary() {
         s.statistics.channel_count = static_cast<std::uint32_t>(s.channels.size());
         s.statistics.chunk_count = static_cast<std::uint32_t>(s.chunk_indexes.size());
     }
-    if (s.chunk_indexes.empty()) return {};  // no index: read linearly
+    if (s.chunk_indexes.empty()) {  // no index: read linearly
+        summary_charge.release();
+        return {};
+    }
+    if (auto r = check_chunk_indexes(s.chunk_indexes, chunk_index_offsets); !r) return r;
     summary = std::move(s);
     indexed = true;
+    return {};
+}
+
+Result<void> McapReader::State::check_chunk_indexes(const std::vector<ChunkIndex>& indexes,
+                                                    const std::vector<std::uint64_t>& record_offsets) {
+    std::vector<std::size_t> order(indexes.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return indexes[a].chunk_start_offset < indexes[b].chunk_start_offset;
+    });
+    // Each chunk indexed once, chunks apart: checked first, it is the more telling error.
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        const auto& ci = indexes[order[k]];
+        const auto at = record_offsets[order[k]];
+        const auto& prev = indexes[order[k - 1]];
+        if (ci.chunk_start_offset == prev.chunk_start_offset)
+            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
+                                "a second index of the chunk at offset " + std::to_string(ci.chunk_start_offset) +
+                                    " (the ChunkIndex at offset " + std::to_string(record_offsets[order[k - 1]]) +
+                                    " names it too; each chunk is indexed once)");
+        if (ci.chunk_start_offset < prev.chunk_start_offset + prev.chunk_length)
+            return record_error(op(Opcode::ChunkIndex), at, kCorrupt,
+                                "the chunk at offset " + std::to_string(ci.chunk_start_offset) +
+                                    " begins inside the chunk at offset " + std::to_string(prev.chunk_start_offset) +
+                                    " (length " + std::to_string(prev.chunk_length) + ")");
+    }
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const auto& ci = indexes[order[k]];
+        const auto at = record_offsets[order[k]];
+        // The chunk's compressed content and its records decompressed are held at once while it is read.
+        const std::uint64_t need = ci.chunk_length + ci.uncompressed_size;
+        if (ci.uncompressed_size > budget.limit || need > budget.limit || budget.held > budget.limit - need)
+            return record_error(op(Opcode::ChunkIndex), at, MessageErrorType::BufferLimitViolation,
+                                "the chunk at offset " + std::to_string(ci.chunk_start_offset) + " (" +
+                                    std::to_string(ci.uncompressed_size) +
+                                    " bytes uncompressed) can never be read within the reader's memory limit of " +
+                                    std::to_string(budget.limit) + " bytes (" + std::to_string(budget.held) +
+                                    " held by the summary)");
+    }
     return {};
 }
 
@@ -277,10 +407,15 @@ Result<void> McapReader::State::note_record(std::uint8_t opcode, std::uint64_t o
     if (opcode == op(Opcode::Schema)) {
         auto x = detail::decode_schema(content);
         if (!x) return record_error(opcode, offset, kCorrupt, x.error().message + where());
-        if (x->id != 0) summary.schemas[x->id] = std::move(*x);
+        if (x->id == 0) return {};
+        if (auto r = summary_charge.add(memory_of(*x), opcode, offset, "the summary gathered so far"); !r) return r;
+        if (auto old = summary.schemas.find(x->id); old != summary.schemas.end()) summary_charge.sub(memory_of(old->second));
+        summary.schemas[x->id] = std::move(*x);
     } else if (opcode == op(Opcode::Channel)) {
         auto x = detail::decode_channel(content);
         if (!x) return record_error(opcode, offset, kCorrupt, x.error().message + where());
+        if (auto r = summary_charge.add(memory_of(*x), opcode, offset, "the summary gathered so far"); !r) return r;
+        if (auto old = summary.channels.find(x->id); old != summary.channels.end()) summary_charge.sub(memory_of(old->second));
         summary.channels[x->id] = std::move(*x);
     } else if (opcode == op(Opcode::Message)) {
         // Only the fixed fields: the data is not needed to count.
@@ -305,7 +440,8 @@ Result<void> McapReader::State::note_record(std::uint8_t opcode, std::uint64_t o
 
 Result<void> McapReader::State::scan_linear() {
     summary = Summary{};
-    LinearScanner scan(*source, limits, data_start);
+    summary_charge.release();
+    LinearScanner scan(*source, limits, budget, data_start);
     for (;;) {
         auto rec = scan.next();
         if (!rec) return rec.take_error();
@@ -316,9 +452,9 @@ Result<void> McapReader::State::scan_linear() {
             continue;
         }
         detail::ChunkRecord fields;
-        auto records = load_chunk(r.content, r.offset, limits, &fields);
+        auto records = load_chunk(r.content, r.offset, limits, budget, &fields);
         if (!records) return records.take_error();
-        RecordWalker walk(*records, 0, in_chunk(r.offset));
+        RecordWalker walk(records->records, 0, in_chunk(r.offset));
         for (;;) {
             auto item = walk.next();
             if (!item) return item.take_error();
@@ -333,6 +469,7 @@ Result<void> McapReader::State::scan_linear() {
         ci.compression = fields.compression;
         ci.compressed_size = fields.records.size();
         ci.uncompressed_size = fields.uncompressed_size;
+        if (auto x = summary_charge.add(memory_of(ci), op(Opcode::Chunk), r.offset, "the summary gathered so far"); !x) return x;
         summary.chunk_indexes.push_back(std::move(ci));
         ++summary.statistics.chunk_count;
     }
@@ -346,6 +483,7 @@ Result<McapReader> McapReader::open(Source& source, ReaderLimits limits) {
     auto s = std::make_unique<State>();
     s->source = &source;
     s->limits = limits;
+    s->budget.limit = limits.max_memory_bytes;
     const std::uint64_t size = source.size();
     if (size < kMagic.size())
         return fail(kCorrupt, "mcap: not an MCAP file: " + std::to_string(size) + " bytes, shorter than the magic");
@@ -366,6 +504,8 @@ Result<McapReader> McapReader::open(Source& source, ReaderLimits limits) {
         return record_error(opcode, at, kCorrupt, "file ends inside the Header record");
     if (length > limits.max_record_bytes)
         return record_error(opcode, at, MessageErrorType::BufferLimitViolation, "Header over the record limit");
+    Charge header_charge(&s->budget);
+    if (auto r = header_charge.add(length, opcode, at, "its content"); !r) return r.take_error();
     auto content = read_bytes(source, at + kRecordPrefixBytes, length);
     if (!content) return content.take_error();
     auto header = detail::decode_header(*content);
@@ -389,6 +529,7 @@ const Header& McapReader::header() const noexcept { return s_->header; }
 const Summary& McapReader::summary() const noexcept { return s_->summary; }
 bool McapReader::indexed() const noexcept { return s_->indexed; }
 const std::optional<std::string>& McapReader::truncated() const noexcept { return s_->truncated; }
+std::uint64_t McapReader::memory_bytes() const noexcept { return s_->budget.held; }
 
 // ---------------------------------------------------------------------------------------------------
 
@@ -400,7 +541,7 @@ struct MessageIterator::State {
 
     // Linear: the scanner, and the chunk being walked.
     std::optional<LinearScanner> scanner;
-    Bytes chunk;
+    LoadedChunk chunk;
     std::optional<RecordWalker> walker;
     std::uint64_t chunk_offset = 0;
 
@@ -414,6 +555,8 @@ struct MessageIterator::State {
     std::vector<const ChunkIndex*> chunks;
     std::size_t next_chunk = 0;
     std::vector<Pending> heap;
+    Charge heap_charge;  // the messages in `heap`
+    static std::uint64_t weight(const Message& m) { return sizeof(Pending) + m.data.size(); }
 
     static bool later(const Pending& a, const Pending& b) {
         if (a.log_time != b.log_time) return a.log_time > b.log_time;
@@ -463,6 +606,7 @@ Result<std::optional<Message>> MessageIterator::State::next_linear() {
             if (!item) return fail_with(item.take_error());
             if (!*item) {
                 walker.reset();
+                chunk = LoadedChunk{};
                 continue;
             }
             if ((*item)->opcode != op(Opcode::Message)) continue;
@@ -483,11 +627,11 @@ Result<std::optional<Message>> MessageIterator::State::next_linear() {
             if (!m) return fail_with(m.take_error());
             if (*m) return m;
         } else if (r.opcode == op(Opcode::Chunk)) {
-            auto records = load_chunk(r.content, r.offset, reader->limits);
+            auto records = load_chunk(r.content, r.offset, reader->limits, reader->budget);
             if (!records) return fail_with(records.take_error());
             chunk = std::move(*records);
             chunk_offset = r.offset;
-            walker.emplace(chunk, 0, in_chunk(r.offset));
+            walker.emplace(chunk.records, 0, in_chunk(r.offset));
         }
     }
 }
@@ -507,11 +651,15 @@ Result<void> MessageIterator::State::load_indexed_chunk(const ChunkIndex& ci) {
     if (length > limits.max_record_bytes)
         return record_error(opcode, at, MessageErrorType::BufferLimitViolation,
                             "content length " + std::to_string(length) + " over the record limit");
+    Charge content_charge(&reader->budget);
+    if (auto r = content_charge.add(length, opcode, at, "its content"); !r) return r;
     auto content = read_bytes(*reader->source, at + kRecordPrefixBytes, length);
     if (!content) return content.take_error();
-    auto records = load_chunk(*content, at, limits);
+    auto records = load_chunk(*content, at, limits, reader->budget);
     if (!records) return records.take_error();
-    RecordWalker walk(*records, 0, in_chunk(at));
+    Bytes().swap(*content);  // the compressed bytes are done with
+    content_charge.release();
+    RecordWalker walk(records->records, 0, in_chunk(at));
     for (;;) {
         auto item = walk.next();
         if (!item) return item.take_error();
@@ -530,6 +678,9 @@ Result<void> MessageIterator::State::load_indexed_chunk(const ChunkIndex& ci) {
         if (!m) return m.take_error();
         if (!*m) continue;
         const auto t = (**m).log_time;
+        if (auto r = heap_charge.add(weight(**m), op(Opcode::Message), (*item)->offset, "the messages waiting to be read");
+            !r)
+            return r;
         heap.push_back(Pending{t, at, (*item)->offset, std::move(**m)});
         std::push_heap(heap.begin(), heap.end(), later);
     }
@@ -549,6 +700,7 @@ Result<std::optional<Message>> MessageIterator::State::next_indexed() {
     std::pop_heap(heap.begin(), heap.end(), later);
     Message m = std::move(heap.back().message);
     heap.pop_back();
+    heap_charge.sub(weight(m));
     return std::optional<Message>(std::move(m));
 }
 
@@ -567,6 +719,7 @@ MessageIterator McapReader::messages(MessageQuery query) {
     auto it = std::make_unique<MessageIterator::State>();
     it->reader = s_.get();
     it->query = std::move(query);
+    it->heap_charge = Charge(&s_->budget);
     if (s_->indexed) {
         for (const auto& ci : s_->summary.chunk_indexes)
             if (it->chunk_wanted(ci)) it->chunks.push_back(&ci);
@@ -574,7 +727,7 @@ MessageIterator McapReader::messages(MessageQuery query) {
             return a->message_start_time < b->message_start_time;
         });
     } else {
-        it->scanner.emplace(*s_->source, s_->limits, s_->data_start);
+        it->scanner.emplace(*s_->source, s_->limits, s_->budget, s_->data_start);
     }
     return MessageIterator(std::move(it));
 }

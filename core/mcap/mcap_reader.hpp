@@ -12,18 +12,24 @@
 //
 // Checks: every length is checked against the bytes left in its record, the file and
 // ReaderLimits before anything is allocated; chunk CRCs (when not 0) are verified; zstd output must
-// have exactly the announced size. A record cut off by the end of the file ends a linear read (that is
+// have exactly the announced size, and its buffer grows with what zstd produces (a chunk's announced
+// size is never allocated up front). Everything the reader holds counts against
+// ReaderLimits::max_memory_bytes. An indexed file whose Chunk Index records name one chunk twice, or
+// chunks whose bytes overlap, is refused at open() (each chunk would be decoded once per index). A record cut off by the end of the file ends a linear read (that is
 // truncation, not an error); anything malformed inside the readable part is an error.
 //
 // Errors (RRError.message always names the record and its file offset, e.g.
 // "mcap: Chunk at offset 1234: uncompressed_crc mismatch (file 0x..., computed 0x...)"):
 //   DataSerializationError: bad magic, malformed record, CRC mismatch, bad compressed data, unknown
 //     compression, a message on a channel never defined, (indexed) a message whose log_time is outside
-//     its ChunkIndex's time range (the log-time merge relies on those ranges);
-//   BufferLimitViolation: a record or a chunk's uncompressed size over ReaderLimits;
+//     its ChunkIndex's time range (the log-time merge relies on those ranges), (indexed) two Chunk
+//     Index records naming one chunk or overlapping chunks;
+//   BufferLimitViolation: a record or a chunk's uncompressed size over ReaderLimits, or a step that
+//     would take the reader's memory over max_memory_bytes;
 //   IOError: the Source's own errors, unchanged.
-// Not thread-safe. The Source must outlive the reader, and the reader its MessageIterators (moving the
-// reader is fine: iterators refer to state that stays put).
+// Not thread-safe (an iterator counts its memory in its reader's total). The Source must outlive the
+// reader, and the reader its MessageIterators (moving the reader is fine: iterators refer to state
+// that stays put).
 #pragma once
 
 #include <cstddef>
@@ -47,6 +53,12 @@ struct ReaderLimits {
     std::uint64_t max_chunk_uncompressed_bytes = 512ull * 1024 * 1024;
     /// Largest Summary section read at open().
     std::uint64_t max_summary_bytes = 256ull * 1024 * 1024;
+    /// The most memory the reader holds at once, iterators included: the decoded summary (schemas,
+    /// channels, one entry per chunk), the record being read, a chunk's compressed and decompressed
+    /// records, and the messages an iterator has decoded but not yet yielded. A step that would pass it
+    /// fails with BufferLimitViolation instead of allocating (the gateway's replay: 256 MiB by default,
+    /// recordings.replay_memory_bytes).
+    std::uint64_t max_memory_bytes = 256ull * 1024 * 1024;
 };
 
 /// Which messages messages() yields.
@@ -97,6 +109,8 @@ public:
     /// why ("file ends inside Chunk at offset 1234"). nullopt when the file was read to its Data End
     /// (or is indexed).
     const std::optional<std::string>& truncated() const noexcept;
+    /// Bytes the reader and its iterators hold now, as counted against ReaderLimits::max_memory_bytes.
+    std::uint64_t memory_bytes() const noexcept;
 
     /// Messages matching `query`: indexed files in log_time order, linear ones in file order.
     MessageIterator messages(MessageQuery query = {});

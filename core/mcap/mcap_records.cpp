@@ -18,4 +18,19 @@ std::string opcode_name(std::uint8_t opcode) {
     return buf;
 }
 
+// A map or vector node of a few words, and the allocator's own overhead: an estimate, not a count.
+constexpr std::size_t kNodeBytes = 64;
+
+std::size_t memory_of(const Schema& s) noexcept { return sizeof(Schema) + kNodeBytes + s.name.size() + s.encoding.size() + s.data.size(); }
+
+std::size_t memory_of(const Channel& c) noexcept {
+    std::size_t n = sizeof(Channel) + kNodeBytes + c.topic.size() + c.message_encoding.size();
+    for (const auto& [k, v] : c.metadata) n += kNodeBytes + k.size() + v.size();
+    return n;
+}
+
+std::size_t memory_of(const ChunkIndex& i) noexcept {
+    return sizeof(ChunkIndex) + i.compression.size() + kNodeBytes * i.message_index_offsets.size();
+}
+
 }  // namespace rr::mcap

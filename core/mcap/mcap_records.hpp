@@ -124,4 +124,11 @@ struct Summary {
     bool from_summary_section = false;
 };
 
+/// About how many bytes of memory a record takes once decoded (its struct, strings, bytes and map
+/// nodes): what the reader charges against ReaderLimits::max_memory_bytes and the writer reports in
+/// McapWriter::summary_memory_bytes().
+std::size_t memory_of(const Schema& schema) noexcept;
+std::size_t memory_of(const Channel& channel) noexcept;
+std::size_t memory_of(const ChunkIndex& index) noexcept;
+
 }  // namespace rr::mcap

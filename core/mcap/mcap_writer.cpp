@@ -29,6 +29,7 @@ struct McapWriter::State {
     std::vector<Schema> schemas;    // id = index + 1
     std::vector<Channel> channels;  // id = index
     std::vector<ChunkIndex> chunk_indexes;
+    std::size_t summary_memory = 0;  // memory_of() the schemas, channels and chunk indexes kept for the summary
     Statistics stats;
 
     // The open chunk.
@@ -100,6 +101,7 @@ struct McapWriter::State {
         index.message_index_length = scratch.size();
         if (auto r = emit(scratch, true); !r) return r;
 
+        summary_memory += memory_of(index);
         chunk_indexes.push_back(std::move(index));
         ++stats.chunk_count;
         chunk.clear();
@@ -143,6 +145,7 @@ Result<std::uint16_t> McapWriter::add_schema(std::string_view name, std::string_
     Schema schema{static_cast<std::uint16_t>(s_->schemas.size() + 1), std::string(name), std::string(encoding),
                   Bytes(data.begin(), data.end())};
     detail::encode_schema(s_->chunk, schema);
+    s_->summary_memory += memory_of(schema);
     s_->schemas.push_back(std::move(schema));
     ++s_->stats.schema_count;
     if (auto r = s_->chunk_filled(); !r) return r.take_error();
@@ -166,6 +169,7 @@ Result<std::uint16_t> McapWriter::add_channel(std::uint16_t schema_id, std::stri
     Channel channel{static_cast<std::uint16_t>(s_->channels.size()), schema_id, std::string(topic),
                     std::string(message_encoding), metadata};
     detail::encode_channel(s_->chunk, channel);
+    s_->summary_memory += memory_of(channel);
     s_->channels.push_back(std::move(channel));
     ++s_->stats.channel_count;
     if (auto r = s_->chunk_filled(); !r) return r.take_error();
@@ -248,6 +252,7 @@ Result<void> McapWriter::close() {
 }
 
 std::uint64_t McapWriter::bytes_written() const noexcept { return s_->offset; }
+std::size_t McapWriter::summary_memory_bytes() const noexcept { return s_->summary_memory; }
 const Statistics& McapWriter::statistics() const noexcept { return s_->stats; }
 bool McapWriter::is_open() const noexcept { return s_->opened && !s_->closed && !s_->failure; }
 bool McapWriter::is_closed() const noexcept { return s_->closed; }

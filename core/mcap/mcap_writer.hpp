@@ -18,7 +18,7 @@
 //
 // Memory: the open chunk's records (about chunk_size, more only by one message larger than that),
 // its compressed copy when it is written, its message indexes (16 bytes a message), and for the
-// summary every schema, channel and one Chunk Index per chunk.
+// summary every schema, channel and one Chunk Index per chunk (summary_memory_bytes()).
 //
 // Errors: InvalidArgument (unknown schema or channel id, more than 65535 schemas or channels, a string
 // or schema over 4 GiB), InvalidState (a call before open(), after close() or after an error),
@@ -100,6 +100,11 @@ public:
 
     /// Bytes written to the sink so far.
     std::uint64_t bytes_written() const noexcept;
+    /// About how much memory the writer keeps for the summary it writes at close (every schema, channel
+    /// and Chunk Index, memory_of() in mcap_records.hpp): it grows by one Chunk Index per chunk for the
+    /// life of the file, so a long recording rotates its file when this passes a bound
+    /// (docs/recording.md "Rotation and budget").
+    std::size_t summary_memory_bytes() const noexcept;
     /// Counts so far (messages, chunks written, time range, per-channel counts).
     const Statistics& statistics() const noexcept;
     bool is_open() const noexcept;

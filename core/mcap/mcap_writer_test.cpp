@@ -202,3 +202,32 @@ TEST_CASE("mcap: each completed chunk is flushed to the sink") {
     CHECK(chunks > 2);
     CHECK(sink.flushes == chunks + 1);  // + the one after the header
 }
+
+TEST_CASE("mcap: the writer's summary memory grows by one chunk index a chunk, as counted") {
+    std::vector<std::byte> file;
+    VectorSink sink(file);
+    McapWriter w(sink);
+    REQUIRE(w.open());
+    auto a = *w.add_channel(0, "a", "json", {{"k", "v"}});
+    auto b = *w.add_channel(0, "b", "json");
+    const auto channels_only = w.summary_memory_bytes();
+    CHECK(channels_only > 0);
+    std::vector<std::byte> data(10);
+    std::size_t last = channels_only;
+    for (std::uint32_t i = 0; i < 50; ++i) {
+        REQUIRE(w.write({a, i, i, i, data}));
+        REQUIRE(w.write({b, i, i, i, data}));
+        REQUIRE(w.flush());  // one chunk
+        CHECK(w.summary_memory_bytes() > last);
+        last = w.summary_memory_bytes();
+    }
+    REQUIRE(w.close());
+    SpanSource source(file);
+    auto r = McapReader::open(source);
+    REQUIRE(r);
+    std::size_t expected = 0;
+    for (const auto& [id, c] : r->summary().channels) expected += memory_of(c);
+    for (const auto& ci : r->summary().chunk_indexes) expected += memory_of(ci);
+    CHECK(r->summary().chunk_indexes.size() == 50);
+    CHECK(w.summary_memory_bytes() == expected);
+}

@@ -1,4 +1,6 @@
 #include "server/app/gateway.hpp"
+
+#include "server/gateway/motion_guard.hpp"
 #include "server/app/gateway_auth_config.hpp"
 #include "server/record/replay_routes.hpp"
 #include "server/gateway/mirror_service.hpp"
@@ -295,7 +297,16 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
             login = DemoLogin{std::string(kDemoUser), std::move(*password)};
         }
         for (const auto& rc : c.replays) {
-            record::ReplayOptions ro{rc.file, rc.name, rc.speed, rc.loop, rc.paused};
+            record::ReplayOptions ro;
+            ro.file = rc.file;
+            ro.name = rc.name;
+            ro.speed = rc.speed;
+            ro.loop = rc.loop;
+            ro.paused = rc.paused;
+            ro.memory_bytes = c.recordings.replay_memory_bytes;
+            ro.on_error = [](const std::string& device, const std::string& error) {
+                log(LogLevel::error, "replay of " + device + " failed: " + error, LogContext{.device = device});
+            };
             auto replay = record::ReplayDevice::open(ro);
             if (!replay) return fail(MessageErrorType::InvalidConfiguration, replay.error().message);
             const auto& name = (*replay)->name();
@@ -323,7 +334,8 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         for (const auto& r : g->replays_) r->start();
     }
 
-    for (const auto& d : devices) {
+    for (auto d : devices) {
+        d.safety = c.safety.for_device(d.name);  // motion safety (docs/security.md "Motion safety")
         auto m = gateway::DeviceMirror::create(g->node_, d);
         if (!m) return m.take_error();
         // The gateway's roles apply to every device. A passthrough device checks its clients' passwords
@@ -381,13 +393,14 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     if (api) json_api = api(*g->http_, g->devices_, g->auth_);
     // Recording (docs/recording.md): from the JSON API and the configuration's `record:` entries.
     if (json_api) {
-        g->recordings_ = std::make_shared<record::Recordings>(json_api, [](const record::RecordingStatus& s, std::string_view what) {
-            const bool failed = what == "failed";
-            log(failed ? LogLevel::error : LogLevel::info,
-                "recording " + std::to_string(s.id) + " of " + s.spec.device + ": " + std::string(what) +
-                    (failed ? " (" + s.error + ")" : s.files.empty() ? "" : " (" + s.files.back() + ")"),
+        g->recordings_ = std::make_shared<record::Recordings>(json_api, c.recordings, [](const record::RecordingStatus& s, std::string_view what) {
+            const bool failed = what == "failed", refused = what == "refused";
+            log(failed ? LogLevel::error : refused ? LogLevel::warning : LogLevel::info,
+                (refused ? "recording of " + s.spec.device + " refused" : "recording " + std::to_string(s.id) + " of " + s.spec.device + ": " + std::string(what)) +
+                    (failed || refused ? " (" + s.error + ")" : s.files.empty() ? "" : " (" + s.files.back() + ")"),
                 LogContext{.device = s.spec.device});
         });
+        log(LogLevel::debug, "recordings go below " + g->recordings_->root()->path());
         record::install_recording_routes(*g->http_, json_api, g->recordings_);
         record::install_replay_routes(*g->http_, json_api, g->replays_);
     }
@@ -410,6 +423,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
                                                    [self](const std::string& name) { return self->device(name) != nullptr; });
         g->discovered_->set_api(json_api);
         g->discovered_->set_auth(g->auth_);
+        g->discovered_->set_safety(c.safety);
         if (json_api) {
             std::weak_ptr<DiscoveredDevices> weak = g->discovered_;
             gateway::JsonApi::DiscoveryHooks hooks;
@@ -456,6 +470,11 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
                 "device " + s.name + ": " + std::string(gateway::device_state_name(s.state)) +
                     (s.reason.empty() ? "" : " (" + s.reason + ")"), LogContext{.device = s.name});
         });
+        // What the motion guard did (a clamp, a refusal, a stop of its own): docs/security.md "Motion safety".
+        if (const auto& guard = d->motion())
+            guard->set_event_listener([name = d->config().name](const std::string& what) {
+                log(LogLevel::info, "motion safety: " + what, LogContext{.device = name});
+            });
         d->start();
     }
     if (g->recordings_)

@@ -60,7 +60,8 @@ Result<std::optional<ga::GatewayAuthSettings>> load_gateway_auth_settings(const 
     auto policy = std::make_shared<ga::AccessPolicy>();
     for (const auto& [name, rules] : c.roles) {
         std::vector<ga::AccessRule> out;
-        for (const auto& r : rules) out.push_back(ga::AccessRule{r.devices, r.members, r.read, r.write, r.call, r.lock});
+        for (const auto& r : rules)
+            out.push_back(ga::AccessRule{r.devices, r.members, r.read, r.write, r.call, r.lock, r.record});
         policy->add_role(name, std::move(out));
     }
     s.policy = std::move(policy);

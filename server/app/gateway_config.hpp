@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -86,6 +87,7 @@ struct GatewayAuthConfig {
     struct Rule {
         std::vector<std::string> devices{"*"}, members{"*"};
         bool read = false, write = false, call = false, lock = false;
+        bool record = false;  ///< recordings of the device (docs/recording.md)
     };
     std::vector<std::pair<std::string, std::vector<Rule>>> roles;
     unsigned max_failures = 5, window_s = 60, lockout_s = 300;
@@ -116,6 +118,31 @@ struct ReplayDeviceConfig {
     double speed = 1.0;  ///< playback speed factor (> 0)
     bool loop = false;   ///< start again at the end
     bool paused = false; ///< start paused (play from the API or the dashboard)
+};
+
+/// `safety:` (docs/gateway-config.md, docs/security.md "Motion safety"): the gateway as the dead-man
+/// of the devices' motion. Gateway-wide settings, members of named devices, and per-device overrides
+/// (`devices[].safety`).
+struct SafetyConfig {
+    std::chrono::milliseconds hold_to_run_max{500};  ///< hold_to_run_max_s (0.05 … 10 s)
+    bool standard_robot = true;  ///< guard the standard robot's members where a device is one
+    template <class T>
+    struct ForDevice {
+        std::string device;
+        T rule;
+    };
+    std::vector<ForDevice<gateway::HoldToRunMember>> hold_to_run;
+    std::vector<ForDevice<gateway::UntimedMotionMember>> motions;
+    std::vector<ForDevice<std::string>> streams;
+    std::vector<ForDevice<gateway::StopMember>> stops;
+    struct Override {
+        std::optional<std::chrono::milliseconds> hold_to_run_max;
+        std::optional<bool> standard_robot;
+    };
+    std::map<std::string, Override> overrides;  ///< by device name (devices[].safety)
+
+    /// The settings of device `name`: the gateway's, its override, and the members named for it.
+    gateway::MotionSafety for_device(std::string_view name) const;
 };
 
 struct GatewayConfig {
@@ -157,11 +184,15 @@ struct GatewayConfig {
     std::vector<ReplayDeviceConfig> replays;
     // record: (docs/recording.md): recordings started when their device connects
     std::vector<record::RecordingSpec> record;
+    // recordings: where recordings go and the bounds on them (docs/recording.md "Where recordings go")
+    record::RecordingsSettings recordings;
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;
     // usb:
     UsbSettings usb;
+    // safety:
+    SafetyConfig safety;
 };
 
 /// Whether the configuration needs the rr+usb host transport (UsbSettings::enabled).
@@ -186,7 +217,7 @@ struct CommandLine {
 /// Splits argv into CommandLine. Unknown flags are errors (InvalidConfiguration "unknown flag …").
 /// Accepted: --config FILE, --port N, --listen ADDR, --web-root DIR, --allow-origin ORIGIN (repeat),
 /// --trusted-proxy ADDR[/BITS] (repeat),
-/// --device NAME=URL (repeat), --replay FILE (repeat), --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
+/// --device NAME=URL (repeat), --replay FILE (repeat), --recordings-root DIR, --no-demo, --demo-port N, --threads N, --log-level LEVEL, --log-format text|json, --no-local,
 /// --no-discovery, --discovery (the default; overrides a file's `discovery.enabled: false`), --check, --tls-certificate FILE, --tls-private-key FILE, --tls-client-ca FILE, --tls-required,
 /// --help, and the official --robotraconteur-tcp-port=N, --robotraconteur-nodename=NAME,
 /// --robotraconteur-nodeid=ID, --robotraconteur-log-level=LEVEL (both `--flag=value` and `--flag value`).

@@ -84,9 +84,11 @@ ExitCode run_record(const CommandLine& cl, std::ostream& out, std::ostream& err,
     spec.members = cl.record_members;
     spec.json = cl.encoding != "robotraconteur";
     spec.robotraconteur = cl.encoding != "json";
-    spec.directory = cl.directory;
     spec.prefix = cl.prefix;
-    auto recording = server::record::Recording::start(1, spec, *device, api);
+    // The CLI writes on its user's own computer, where its user chose: --dir is its root (no budget),
+    // the files go into it (made new, O_EXCL, as the gateway makes them).
+    auto root = std::make_shared<server::record::RecordingsRoot>(cl.directory, 0);
+    auto recording = server::record::Recording::start(1, spec, *device, api, root);
     if (!recording) {
         shutdown();
         const auto code = recording.error().type == MessageErrorType::InvalidArgument ? ExitCode::usage_error : ExitCode::rr_error;

@@ -46,7 +46,8 @@ ApiResult member_access(const JsonApi& api, std::string_view name, const auth::P
     }
     const auto& a = api.auth();
     if (!a || !a->enabled())
-        return ApiResult::ok({{"device", name}, {"auth", false}, {"user", nullptr}, {"members", nullptr}, {"lock", nullptr}});
+        return ApiResult::ok({{"device", name}, {"auth", false}, {"user", nullptr}, {"members", nullptr},
+                              {"lock", nullptr}, {"record", true}});
     if (!caller) return ApiResult::failed(api_error(401, MessageErrorType::AuthenticationError, "login required"));
 
     // Whose roles: the caller's (REST and JSON WebSocket requests), or those an RR session logged in to
@@ -90,7 +91,8 @@ ApiResult member_access(const JsonApi& api, std::string_view name, const auth::P
                           {"roles", who ? nlohmann::json(who->roles) : nlohmann::json::array()},
                           {"device_user", device_user ? nlohmann::json(*device_user) : nlohmann::json(nullptr)},
                           {"members", std::move(out)},
-                          {"lock", auth::may_lock(who.get(), name, "")}});
+                          {"lock", auth::may_lock(who.get(), name, "")},
+                          {"record", who != nullptr && who->allows(name, "*", auth::Operation::record)}});
 }
 
 }  // namespace rr::server::gateway

@@ -22,6 +22,10 @@ Result<std::unique_ptr<FileSink>> FileSink::create(const std::string& path, bool
     return std::unique_ptr<FileSink>(new FileSink(fd, path, fsync_on_flush));
 }
 
+std::unique_ptr<FileSink> FileSink::adopt(int fd, std::string path, bool fsync_on_flush) {
+    return std::unique_ptr<FileSink>(new FileSink(fd, std::move(path), fsync_on_flush));
+}
+
 FileSink::~FileSink() {
     if (fd_ >= 0) ::close(fd_);
 }

@@ -20,6 +20,9 @@ class FileSink final : public Sink {
 public:
     /// Creates (or truncates) `path`. With `fsync_on_flush`, flush() also waits for the disk.
     static Result<std::unique_ptr<FileSink>> create(const std::string& path, bool fsync_on_flush = false);
+    /// Takes an open, writable descriptor (the recorder opens its files itself: openat with O_EXCL and
+    /// O_NOFOLLOW, server/record/recordings_root.hpp); `path` names it in messages.
+    static std::unique_ptr<FileSink> adopt(int fd, std::string path, bool fsync_on_flush = false);
     ~FileSink() override;
     Result<void> write(std::span<const std::byte> bytes) override;
     Result<void> flush() override;

@@ -36,9 +36,11 @@ RecordQueue::Offered RecordQueue::offer(std::uint16_t member, std::uint64_t log_
 
 bool RecordQueue::take(std::vector<Item>& batch, std::chrono::milliseconds period) {
     std::unique_lock<std::mutex> lock(mutex_);
+    queued_bytes_ -= taken_bytes_;  // the writer is done with its last batch
+    taken_bytes_ = 0;
     wake_.wait_for(lock, period, [&] { return closed_ || queued_bytes_ >= budget_ / 2; });
     batch.swap(items_);
-    queued_bytes_ = 0;
+    taken_bytes_ = queued_bytes_;
     return closed_;
 }
 
@@ -56,7 +58,7 @@ void RecordQueue::close_and_clear() {
         std::lock_guard<std::mutex> lock(mutex_);
         closed_ = true;
         gone.swap(items_);
-        queued_bytes_ = 0;
+        queued_bytes_ = taken_bytes_;
     }
     wake_.notify_all();
     // `gone` releases its entries here, outside the lock.

@@ -3,7 +3,9 @@
 // The live path hands over the reference it already has: the SharedEntry the gateway fans out to its
 // clients (one atomic increment, no copy of the entry's bytes). Each item weighs its payload bytes plus a
 // fixed overhead; when the items waiting would exceed the budget the new one is dropped and counted, so
-// the live path never waits for the disk. The items live in a vector whose capacity is kept from batch
+// the live path never waits for the disk. The items the writer has taken count until it comes back for
+// more (its batch written and released): the queue and the writer's batch together never hold more
+// than the budget. The items live in a vector whose capacity is kept from batch
 // to batch (swapped with the writer's), so a warmed-up queue allocates nothing per value, and the writer
 // is not woken per value: it takes what waits every `period`, or early once the queue is half full or
 // closed (one notify per crossing), so the live path makes no futex call per value either.
@@ -39,8 +41,9 @@ public:
     /// it (counted in drops()) when it would exceed the budget, or ignores it once closed.
     Offered offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry);
 
-    /// From the writer: waits until `period` has passed, the queue is half full or closed, then swaps
-    /// what waits into `batch` (which must be empty; its capacity is reused). Returns true when the
+    /// From the writer: the previous batch is done (its weight leaves the budget; `batch` must be empty,
+    /// its capacity is reused); waits until `period` has passed, the queue is half full or closed, then
+    /// swaps what waits into `batch`, whose weight counts until the next take(). Returns true when the
     /// queue was closed at the swap: `batch` then holds the last items there will be.
     bool take(std::vector<Item>& batch, std::chrono::milliseconds period);
 
@@ -50,6 +53,7 @@ public:
     void close_and_clear();
 
     std::uint64_t drops() const;
+    /// The weight waiting plus the weight of the batch the writer holds.
     std::size_t queued_bytes() const;
     std::size_t budget_bytes() const noexcept { return budget_; }
 
@@ -61,7 +65,8 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::vector<Item> items_;
-    std::size_t queued_bytes_ = 0;
+    std::size_t queued_bytes_ = 0;  // items_ and the writer's batch
+    std::size_t taken_bytes_ = 0;   // the writer's batch
     std::uint64_t drops_ = 0;
     bool closed_ = false;
 };

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <pthread.h>
 #include <system_error>
 
@@ -167,12 +168,25 @@ struct Recording::File {
     std::vector<FoxgloveImageKind> foxglove_kind;
     std::vector<std::uint32_t> foxglove_sequence;
     std::chrono::steady_clock::time_point opened = std::chrono::steady_clock::now();
+    std::size_t summary_base = 0;  // the writer's summary memory once schemas and channels were added
 };
 
-Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingSpec spec,
-                                                    std::shared_ptr<gateway::DeviceMirror> device,
-                                                    std::shared_ptr<gateway::JsonApi> api, ErrorListener on_error) {
+// The default file name prefix: the device's name with the characters a prefix may not have as '_'.
+static std::string prefix_of_device(const std::string& device) {
+    std::string p = device.substr(0, 64);
+    for (auto& c : p)
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.')) c = '_';
+    if (p.empty() || p.front() == '.') p.insert(p.begin(), '_');
+    return p.substr(0, 64);
+}
+
+Result<std::shared_ptr<Recording>> Recording::create(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+                                                     std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
+                                                     RecordingListeners listeners) {
     if (!device || !api) return fail(MessageErrorType::InvalidArgument, "record: no such device \"" + spec.device + "\"");
+    if (!root) return fail(MessageErrorType::InvalidState, "record: no recordings root");
+    if (auto r = check_subfolder(spec.directory); !r) return r.take_error();
+    if (auto r = check_prefix(spec.prefix); !r) return r.take_error();
     if (!device->upstream())
         return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\" is not connected (its definitions are needed)");
     gateway::ApiError type_error;
@@ -242,28 +256,49 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
     if (members.empty()) return fail(MessageErrorType::InvalidArgument, "record: " + object_type + ": nothing to record");
     if (members.size() > 30000) return fail(MessageErrorType::InvalidArgument, "record: too many members");
 
-    std::error_code ec;
-    fs::create_directories(spec.directory, ec);
-    if (ec) return fail(MessageErrorType::IOError, "record: cannot create directory " + spec.directory + ": " + ec.message());
-    if (spec.prefix.empty()) spec.prefix = spec.device;
+    if (spec.prefix.empty()) spec.prefix = prefix_of_device(spec.device);
 
-    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(members)));
-    r->on_error_ = std::move(on_error);
+    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(members)));
+    r->listeners_ = std::move(listeners);
     r->sequence_.assign(r->members_.size() * 2, 0);
-    if (auto opened = r->open_file(); !opened) return opened.take_error();
-    r->writer_ = std::thread([r = r.get()] { r->writer_loop(); });
-    r->subscribe_members();
-    if (std::any_of(r->members_.begin(), r->members_.end(), [](const RecordedMember& m) { return m.kind == RecordedMember::Kind::property; }))
-        r->poller_ = std::thread([r = r.get()] { r->poll_loop(); });
+    // The thread keeps the recording alive until it has ended; the disk work is all done there.
+    r->writer_ = std::thread([self = r] { self->writer_loop(); });
+    return r;
+}
+
+Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root) {
+    struct Outcome {
+        std::mutex mutex;
+        std::condition_variable cv;
+        std::optional<Result<void>> result;
+    };
+    auto outcome = std::make_shared<Outcome>();
+    RecordingListeners l;
+    l.started = [outcome](Recording&, const Result<void>& started) {
+        std::lock_guard<std::mutex> lock(outcome->mutex);
+        outcome->result = started;
+        outcome->cv.notify_all();
+    };
+    auto r = create(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(l));
+    if (!r) return r;
+    std::unique_lock<std::mutex> lock(outcome->mutex);
+    outcome->cv.wait(lock, [&] { return outcome->result.has_value(); });
+    if (!*outcome->result) {
+        lock.unlock();
+        (*r)->wait();
+        return fail(outcome->result->error());
+    }
     return r;
 }
 
 Recording::Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-                     std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members)
+                     std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members)
     : id_(id),
       spec_(std::move(spec)),
       device_(std::move(device)),
       api_(std::move(api)),
+      root_(std::move(root)),
       members_(std::move(members)),
       queue_(spec_.queue_bytes) {}
 
@@ -273,12 +308,10 @@ Recording::~Recording() {
 }
 
 void Recording::wait() {
-    // The last reference may go on one of these threads (a listener's): it cannot join itself.
-    for (auto* t : {&writer_, &poller_}) {
-        if (!t->joinable()) continue;
-        if (t->get_id() == std::this_thread::get_id()) t->detach();
-        else t->join();
-    }
+    // The last reference may go on the writer thread itself (it holds one): it cannot join itself.
+    if (!writer_.joinable()) return;
+    if (writer_.get_id() == std::this_thread::get_id()) writer_.detach();
+    else writer_.join();
 }
 
 // --- the live path -------------------------------------------------------------------------------
@@ -309,7 +342,12 @@ void Recording::subscribe_members() {
                 [weak](Result<void>) {  // a wire not connected now is connected when the device is back
                     if (auto self = weak.lock()) self->member_answered();
                 });
-            std::lock_guard<std::mutex> lock(mutex_);
+            std::unique_lock<std::mutex> lock(mutex_);
+            if (stopping_) {  // stopped while subscribing: unsubscribe_members has run already
+                lock.unlock();
+                device_->unsubscribe(sid);
+                continue;
+            }
             subscriptions_.push_back(sid);
         } else if (m.kind == RecordedMember::Kind::pipe) {
             gateway::GatewayPipeHandlers h;
@@ -393,15 +431,42 @@ void Recording::poll_loop() {
 
 // --- the writer thread ------------------------------------------------------------------------------
 
+Result<void> Recording::begin() {
+    // At least room for the first chunk when the recording has no budget of its own.
+    const std::uint64_t at_least = std::max<std::uint64_t>(spec_.chunk_bytes, 1u << 20);
+    auto admitted = root_->admit(spec_.max_total_bytes, at_least);
+    if (!admitted) return admitted.take_error();
+    admission_ = std::move(*admitted);
+    auto folder = root_->open_folder(spec_.directory);
+    if (!folder) return folder.take_error();
+    folder_ = std::move(*folder);
+    if (auto r = open_file(); !r) return r;
+    subscribe_members();
+    if (std::any_of(members_.begin(), members_.end(), [](const RecordedMember& m) { return m.kind == RecordedMember::Kind::property; }))
+        poller_ = std::thread([this] { poll_loop(); });
+    return {};
+}
+
 Result<void> Recording::open_file() {
     enforce_budget();
     auto f = std::make_unique<File>();
-    char suffix[32];
-    std::snprintf(suffix, sizeof suffix, "-%03llu.mcap", static_cast<unsigned long long>(++file_counter_));
-    f->path = (fs::path(spec_.directory) / (spec_.prefix + "-" + utc_stamp() + suffix)).string();
-    auto sink = mcap::FileSink::create(f->path);
-    if (!sink) return fail(MessageErrorType::IOError, "record: " + sink.error().message);
-    f->sink = std::move(*sink);
+    char number[24];
+    std::snprintf(number, sizeof number, "-%03llu", static_cast<unsigned long long>(++file_counter_));
+    const std::string stem = spec_.prefix + "-" + utc_stamp() + number;
+    // A name already taken (a recording of the same prefix started in the same second, a file left
+    // there) is never opened: the next one is tried.
+    std::string name;
+    for (int k = 1;; ++k) {
+        name = k == 1 ? stem + ".mcap" : stem + "-" + std::to_string(k) + ".mcap";
+        bool exists = false;
+        auto sink = folder_->create_file(name, &exists);
+        if (sink) {
+            f->sink = std::move(*sink);
+            break;
+        }
+        if (!exists || k >= 1000) return sink.take_error();
+    }
+    f->path = folder_->path_of(name);
     mcap::WriterOptions wo;
     wo.library = "rr-gateway recorder";
     wo.chunk_size = spec_.chunk_bytes;
@@ -497,13 +562,15 @@ Result<void> Recording::open_file() {
         f->foxglove_kind.push_back(foxglove_kind);
         f->foxglove_sequence.push_back(0);
     }
+    f->summary_base = f->writer->summary_memory_bytes();
     // Schemas and channels on disk at once: a file killed before its first full chunk still names them.
     if (auto r = check(f->writer->flush()); !r) return r;
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        files_.emplace_back(f->path, f->writer->bytes_written());
+        files_.push_back(FileEntry{name, f->path, f->writer->bytes_written()});
     }
     file_ = std::move(f);
+    note_file_size();
     return {};
 }
 
@@ -513,7 +580,7 @@ Result<void> Recording::close_file() {
     auto r = f->writer->close();
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (!files_.empty()) files_.back().second = f->writer->bytes_written();
+        if (!files_.empty()) files_.back().size = f->writer->bytes_written();
     }
     auto c = f->sink->close();
     if (!r) return fail(r.error().type, "record: " + f->path + ": " + r.error().message);
@@ -521,20 +588,27 @@ Result<void> Recording::close_file() {
     return {};
 }
 
-// The disk budget: the oldest closed files go while the files and a full new one would exceed it.
+// The disk budget: the oldest closed files go while the files and a full new one would exceed it. Only
+// files this recording made are removed, by name, in its own folder (RecordingsFolder::remove_file).
 void Recording::enforce_budget() {
     if (!spec_.max_total_bytes) return;
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
     auto total = [&] {
         std::uint64_t n = 0;
-        for (const auto& f : files_) n += f.second;
+        for (const auto& f : files_) n += f.size;
         return n;
     };
     const std::uint64_t next = spec_.max_file_bytes ? spec_.max_file_bytes : 0;
+    std::uint64_t removed = 0;
     while (!files_.empty() && total() + next > spec_.max_total_bytes) {
-        std::error_code ec;
-        fs::remove(files_.front().first, ec);
+        (void)folder_->remove_file(files_.front().name);  // already gone (removed by hand): forgotten all the same
+        removed += files_.front().size;
         files_.erase(files_.begin());
+    }
+    lock.unlock();
+    if (removed) {
+        noted_bytes_ -= std::min(noted_bytes_, removed);
+        (void)admission_->note(-static_cast<std::int64_t>(removed));
     }
 }
 
@@ -600,14 +674,26 @@ Result<void> Recording::write_item(const Item& item) {
     return {};
 }
 
-void Recording::note_file_size() {
-    if (!file_) return;
-    const auto n = file_->writer->bytes_written();
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!files_.empty()) files_.back().second = n;
+bool Recording::note_file_size() {
+    std::uint64_t total = 0;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (file_ && !files_.empty()) files_.back().size = file_->writer->bytes_written();
+        for (const auto& f : files_) total += f.size;
+    }
+    if (!admission_) return true;
+    const auto delta = static_cast<std::int64_t>(total) - static_cast<std::int64_t>(noted_bytes_);
+    noted_bytes_ = total;
+    return admission_->note(delta);
 }
 
-void Recording::fail_with(const RRError& error) {
+RRError Recording::root_full() const {
+    return make_error(MessageErrorType::IOError, "record: the recordings root " + root_->path() + " is full: its files reached " +
+                                               std::to_string(root_->max_total_bytes()) +
+                                               " bytes with what running recordings set aside (recordings.max_total_bytes)");
+}
+
+void Recording::end_failed(const RRError& error, bool started_ok) {
     std::vector<std::function<void(const RecordingStatus&)>> listeners;
     {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -620,19 +706,26 @@ void Recording::fail_with(const RRError& error) {
     queue_.close_and_clear();
     poll_wake_.notify_all();
     unsubscribe_members();
+    if (poller_.joinable()) poller_.join();
     // What was written stays: its complete chunks are readable; a close that fails again changes nothing.
     if (file_) {
         (void)file_->writer->close();
         (void)file_->sink->close();
+        if (admission_) (void)note_file_size();
         file_.reset();
     }
+    admission_.reset();  // its share of the root's budget goes back
+    folder_.reset();
     auto s = status();
-    if (on_error_) on_error_(s);
+    if (!started_ok && listeners_.started) listeners_.started(*this, Result<void>(fail(error)));
     for (auto& l : listeners) l(s);
+    if (started_ok && listeners_.ended) listeners_.ended(s);
 }
 
 void Recording::writer_loop() {
     name_recorder_thread("rr-record");
+    if (auto r = begin(); !r) return end_failed(r.error(), false);
+    if (listeners_.started) listeners_.started(*this, Result<void>());
     using clock = std::chrono::steady_clock;
     auto last_flush = clock::now();
     std::vector<Item> batch;  // swapped with the queue's: both keep their capacity
@@ -643,19 +736,22 @@ void Recording::writer_loop() {
             const auto now = clock::now();
             const bool too_big = spec_.max_file_bytes && file_->writer->bytes_written() >= spec_.max_file_bytes;
             const bool too_old = spec_.max_file_duration.count() && now - file_->opened >= spec_.max_file_duration;
-            if (too_big || too_old) {
-                if (auto r = close_file(); !r) return fail_with(r.error());
-                if (auto r = open_file(); !r) return fail_with(r.error());
+            // The writer keeps one Chunk Index per chunk for the file's summary: a new file bounds it.
+            const bool too_indexed = file_->writer->summary_memory_bytes() - file_->summary_base >= spec_.max_index_bytes;
+            if (too_big || too_old || too_indexed) {
+                if (auto r = close_file(); !r) return end_failed(r.error(), true);
+                if (auto r = open_file(); !r) return end_failed(r.error(), true);
             }
-            if (auto r = write_item(item); !r) return fail_with(r.error());
+            if (auto r = write_item(item); !r) return end_failed(r.error(), true);
         }
         batch.clear();  // the entries' last references usually go here, off the live path
-        note_file_size();
+        if (!note_file_size()) return end_failed(root_full(), true);
         // A chunk at least every second: a killed gateway loses at most about a second.
         if (clock::now() - last_flush >= std::chrono::seconds(1)) {
             last_flush = clock::now();
-            if (auto r = file_->writer->flush(); !r) return fail_with(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message));
-            note_file_size();
+            if (auto r = file_->writer->flush(); !r)
+                return end_failed(make_error(r.error().type, "record: " + file_->path + ": " + r.error().message), true);
+            if (!note_file_size()) return end_failed(root_full(), true);
         }
         if (spec_.duration.count() && clock::now() - started_ >= spec_.duration && !closed && !ending_requested) {
             // Ends itself: taps go, then the queue is drained on the next rounds.
@@ -665,7 +761,11 @@ void Recording::writer_loop() {
         if (closed) {
             // Closed before the swap: `batch` held the last items.
             auto r = close_file();
-            if (!r) return fail_with(r.error());
+            if (!r) return end_failed(r.error(), true);
+            if (poller_.joinable()) poller_.join();  // stopping_ is set: it has ended or is ending
+            (void)note_file_size();
+            admission_.reset();
+            folder_.reset();
             std::vector<std::function<void(const RecordingStatus&)>> listeners;
             {
                 std::lock_guard<std::mutex> l2(mutex_);
@@ -675,6 +775,7 @@ void Recording::writer_loop() {
             }
             auto s = status();
             for (auto& l : listeners) l(s);
+            if (listeners_.ended) listeners_.ended(s);
             return;
         }
     }
@@ -718,8 +819,8 @@ RecordingStatus Recording::status() const {
     s.error = error_;
     s.connecting = connecting_;
     for (const auto& f : files_) {
-        s.files.push_back(f.first);
-        s.bytes += f.second;
+        s.files.push_back(f.path);
+        s.bytes += f.size;
     }
     const auto end = (state_ == RecordingState::stopped || state_ == RecordingState::failed) ? ended_ : std::chrono::steady_clock::now();
     s.duration_s = std::chrono::duration<double>(end - started_).count();

@@ -8,15 +8,24 @@
 // value once warm and does not wake the writer per value) and one writer thread per recording (named
 // "rr-record"; the property poller "rr-record-poll") encodes them (`robotraconteur`: the entry's bytes in RR
 // message format 4, cached and shared with the native clients' sends; `json`: the JSON API's mapping)
-// and writes them with McapWriter (core/mcap), rotating files by size and time, deleting the oldest
-// files over the disk budget.
+// and writes them with McapWriter (core/mcap), rotating files by size, time and the size of the index the
+// writer keeps for the file's summary, deleting the oldest files over the disk budget.
+//
+// Where: below a RecordingsRoot (recordings_root.hpp), in the spec's sub-folder, each file made new with
+// O_EXCL|O_NOFOLLOW (a name taken, e.g. by a recording of the same prefix started in the same second,
+// gets a `-2`, `-3`… before `.mcap`). The writer thread does all of the disk work, the first file
+// included: start() only checks the spec and starts it; the start's outcome is told to
+// RecordingListeners::started.
 //
 // Times: log_time = the gateway's receive time (system clock, ns since the Unix epoch); publish_time =
 // the device's own time stamp where the value carries one (a wire value's `packettime`), else log_time.
 //
-// Failure: an I/O error (an unwritable directory, a full disk) ends the recording in state `failed`
-// with the error (status(), the log through the error listener); the file written so far keeps its
-// complete chunks. The gateway goes on serving.
+// Failure: an I/O error (an unwritable directory, a full disk, the recordings root's budget used up)
+// ends the recording in state `failed` with the error (status(), RecordingListeners::ended); the file
+// written so far keeps its complete chunks. The gateway goes on serving.
+//
+// Lifetime: the writer thread keeps its Recording alive until it has ended (stopped or failed); the
+// last reference may go with it.
 //
 // Thread-safe. stop() may be called from any thread, including the device's strand.
 #pragma once
@@ -39,6 +48,7 @@
 #include "server/gateway/shared_entry.hpp"
 #include "server/record/record_queue.hpp"
 #include "server/record/recording_spec.hpp"
+#include "server/record/recordings_root.hpp"
 
 namespace rr::server::record {
 
@@ -58,7 +68,7 @@ struct RecordingStatus {
     RecordingSpec spec;
     RecordingState state = RecordingState::recording;
     std::string error;                 ///< why it failed ("" otherwise)
-    std::vector<std::string> files;    ///< this recording's files still on disk, oldest first
+    std::vector<std::string> files;    ///< this recording's files still on disk (full paths), oldest first
     std::uint64_t bytes = 0;           ///< their size now
     std::uint64_t messages = 0;        ///< messages written (all channels, all files)
     std::uint64_t drops = 0;           ///< entries dropped because the queue was full
@@ -73,21 +83,36 @@ struct RecordingStatus {
 ///  "duration_s", "connecting", "members", "spec"} (docs/recording.md "JSON API").
 nlohmann::json status_json(const RecordingStatus& s);
 
+class Recording;
+
+/// What a recording tells its owner, each from the writer thread.
+struct RecordingListeners {
+    /// Once: the first file is open and the members subscribed (ok), or the start failed (the error;
+    /// the recording has then ended, `failed`, and `ended` is not called). `recording.status()` and
+    /// `recording.shared_from_this()` may be called.
+    std::function<void(Recording& recording, const Result<void>& started)> started;
+    /// Once, when a recording that started has ended (stopped or failed): its final status.
+    std::function<void(const RecordingStatus&)> ended;
+};
+
 class Recording : public std::enable_shared_from_this<Recording> {
 public:
-    using ErrorListener = std::function<void(const RecordingStatus&)>;
-
-    /// Starts recording `spec.device` (`device`, connected: its definitions are needed). Creates the
-    /// directory and the first file before returning. `spec.members` names root members (`packets`) or
-    /// members below the root by path (`Webcams[0].FrameStream`, object_path.hpp); empty: every wire,
-    /// pipe and event of the root. Errors: InvalidArgument (a member the root object, or the object at
-    /// the path, does not have; a path that does not follow objrefs, object_path.hpp; a member of a kind
-    /// that cannot be recorded: functions, callbacks, objrefs, memories),
-    /// InvalidState (device not connected), IOError (directory or file not writable; the message names
-    /// the path and the reason).
-    static Result<std::shared_ptr<Recording>> start(std::uint64_t id, RecordingSpec spec,
-                                                    std::shared_ptr<gateway::DeviceMirror> device,
-                                                    std::shared_ptr<gateway::JsonApi> api, ErrorListener on_error = {});
+    /// Checks the spec against `spec.device` (`device`, connected: its definitions are needed) and starts
+    /// the writer thread, which is admitted by `root`'s budget, opens the sub-folder `spec.directory` and
+    /// the first file, subscribes the members, then tells `listeners.started`. `spec.members` names root
+    /// members (`packets`) or members below the root by path (`Webcams[0].FrameStream`, object_path.hpp);
+    /// empty: every wire, pipe and event of the root. Errors here: InvalidArgument (a member the root
+    /// object, or the object at the path, does not have; a path that does not follow objrefs,
+    /// object_path.hpp; a member of a kind that cannot be recorded: functions, callbacks, objrefs,
+    /// memories; a bad directory or prefix), InvalidState (device not connected). Errors told to
+    /// `started`: OutOfSystemResource (the root's budget, RecordingsRoot::admit), IOError (a folder or
+    /// file that cannot be made; the message names the path and the reason).
+    static Result<std::shared_ptr<Recording>> create(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+                                                     std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
+                                                     RecordingListeners listeners = {});
+    /// create(), then waits for the start's outcome: every error above is returned (`rr record`, tests).
+    static Result<std::shared_ptr<Recording>> start(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
+                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root);
     ~Recording();
 
     /// Stops taking entries, writes what is queued, closes the file (summary and index); `done` (may be
@@ -103,30 +128,36 @@ private:
     struct File;
 
     Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-              std::shared_ptr<gateway::JsonApi> api, std::vector<RecordedMember> members);
+              std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members);
     /// From the live path: queue (the reference) or drop.
     void offer(std::uint16_t member, gateway::SharedEntryPtr entry);
-    /// The open file's size into files_ (once per batch: the writer does not take mutex_ per item).
-    void note_file_size();
+    /// The open file's size into files_ and the root's budget (once per batch: the writer does not take
+    /// mutex_ per item). False: the root's budget is used up.
+    bool note_file_size();
+    RRError root_full() const;
     void subscribe_members();
     /// The device answered one member's connection (wire, pipe) or subscription (event).
     void member_answered();
     void unsubscribe_members();
     void poll_loop();
     void writer_loop();
+    /// The writer's first steps: admission, folder, first file, subscriptions, poller.
+    Result<void> begin();
+    /// Ends the recording `failed` with `error` (listeners told); `started_ok`: whether it had started.
+    void end_failed(const RRError& error, bool started_ok);
     Result<void> open_file();
     Result<void> write_item(const Item& item);
     Result<void> close_file();
-    void fail_with(const RRError& error);
     void enforce_budget();
 
     const std::uint64_t id_;
     const RecordingSpec spec_;
     const std::shared_ptr<gateway::DeviceMirror> device_;
     const std::shared_ptr<gateway::JsonApi> api_;
+    const std::shared_ptr<RecordingsRoot> root_;
     const std::vector<RecordedMember> members_;
     const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
-    ErrorListener on_error_;
+    RecordingListeners listeners_;
 
     mutable std::mutex mutex_;
     std::condition_variable poll_wake_;  // the property poller's
@@ -135,7 +166,12 @@ private:
     std::string error_;
     std::chrono::steady_clock::time_point ended_;
     std::vector<std::function<void(const RecordingStatus&)>> stop_listeners_;
-    std::vector<std::pair<std::string, std::uint64_t>> files_;  // path, size (the open one: updated as written)
+    struct FileEntry {
+        std::string name;    // in folder_
+        std::string path;    // shown (folder_->path_of(name))
+        std::uint64_t size;  // the open one's: updated as written
+    };
+    std::vector<FileEntry> files_;
     std::atomic<std::uint64_t> messages_{0};
     RecordQueue queue_;  // its own lock: the live path never takes mutex_
 
@@ -146,10 +182,14 @@ private:
 
     // Writer thread only.
     std::unique_ptr<File> file_;
+    std::unique_ptr<RecordingsFolder> folder_;
+    std::shared_ptr<RecordingsRoot::Admission> admission_;
+    std::uint64_t noted_bytes_ = 0;  // what the admission was told the files hold
     std::vector<std::uint32_t> sequence_;
     std::uint64_t file_counter_ = 0;
+    std::thread poller_;  // started and joined by the writer thread
 
-    std::thread writer_, poller_;
+    std::thread writer_;
 };
 
 }  // namespace rr::server::record

@@ -59,13 +59,13 @@ Result<RecordingSpec> spec_from_json(const json& j) {
     if (j.contains("directory")) {
         auto d = string_of(j["directory"], "directory");
         if (!d) return d.take_error();
-        if (d->empty()) return fail(MessageErrorType::InvalidArgument, "record: directory: empty");
+        if (auto r = check_subfolder(*d); !r) return r.take_error();
         s.directory = *d;
     }
     if (j.contains("prefix")) {
         auto p = string_of(j["prefix"], "prefix");
         if (!p) return p.take_error();
-        if (p->find('/') != std::string::npos) return fail(MessageErrorType::InvalidArgument, "record: prefix: must not contain '/'");
+        if (auto r = check_prefix(*p); !r) return r.take_error();
         s.prefix = *p;
     }
     auto number = [&](const char* key, auto apply) -> Result<void> {
@@ -80,7 +80,7 @@ Result<RecordingSpec> spec_from_json(const json& j) {
     if (auto r = number("max_file_seconds", [&](std::uint64_t v) { s.max_file_duration = std::chrono::seconds(v); }); !r) return r.take_error();
     if (auto r = number("max_total_bytes", [&](std::uint64_t v) { s.max_total_bytes = v; }); !r) return r.take_error();
     if (auto r = number("duration_s", [&](std::uint64_t v) { s.duration = std::chrono::seconds(v); }); !r) return r.take_error();
-    if (auto r = number("queue_bytes", [&](std::uint64_t v) { s.queue_bytes = v; }); !r) return r.take_error();
+    if (auto r = number("queue_bytes", [&](std::uint64_t v) { s.queue_bytes = v; s.queue_bytes_given = true; }); !r) return r.take_error();
     if (auto r = number("chunk_bytes", [&](std::uint64_t v) { s.chunk_bytes = v; }); !r) return r.take_error();
     if (j.contains("compression")) {
         if (j["compression"] == "zstd") s.compress = true;
@@ -98,6 +98,71 @@ Result<RecordingSpec> spec_from_json(const json& j) {
     if (s.max_total_bytes && s.max_file_bytes && s.max_total_bytes < s.max_file_bytes)
         return fail(MessageErrorType::InvalidArgument, "record: max_total_bytes: smaller than max_file_bytes");
     return s;
+}
+
+namespace {
+
+bool name_char(char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+}
+
+// JSON text of a value, so a NUL or a control character is visible in a message.
+std::string shown(std::string_view v) { return json(std::string(v)).dump(-1, ' ', true, json::error_handler_t::replace); }
+
+// What is wrong with one name (a prefix, or a part of a directory); "" when nothing.
+std::string name_problem(std::string_view name) {
+    if (name.empty()) return "an empty part";
+    if (name.size() > 64) return "a part of " + std::to_string(name.size()) + " characters (at most 64)";
+    if (name.front() == '.') return "a part starting with a dot (" + shown(name) + ": no \".\", \"..\" or hidden names)";
+    for (char c : name)
+        if (!name_char(c)) return "the character " + shown(std::string(1, c)) + " (letters, digits, '-', '_' and '.' only)";
+    return {};
+}
+
+}  // namespace
+
+std::string default_recordings_root(const char* state_directory) {
+    if (state_directory && *state_directory) {
+        std::string_view dirs(state_directory);
+        const std::string first(dirs.substr(0, dirs.find(':')));
+        if (!first.empty()) return first + (first.back() == '/' ? "" : "/") + "recordings";
+    }
+    return "recordings";
+}
+
+Result<void> check_subfolder(std::string_view d) {
+    if (d.empty()) return {};
+    if (d.front() == '/')
+        return fail(MessageErrorType::InvalidArgument, "record: directory: " + shown(d) +
+                                                           " is an absolute path; name a sub-folder of the recordings root (e.g. \"lab/run1\")");
+    if (d.size() > 255) return fail(MessageErrorType::InvalidArgument, "record: directory: longer than 255 characters");
+    std::size_t parts = 0;
+    for (std::size_t pos = 0;;) {
+        const auto slash = d.find('/', pos);
+        const auto part = d.substr(pos, slash == std::string_view::npos ? std::string_view::npos : slash - pos);
+        if (auto p = name_problem(part); !p.empty())
+            return fail(MessageErrorType::InvalidArgument,
+                        "record: directory: " + shown(d) + " has " + p + "; name a sub-folder of the recordings root");
+        if (++parts > 8) return fail(MessageErrorType::InvalidArgument, "record: directory: more than 8 levels of folders");
+        if (slash == std::string_view::npos) break;
+        pos = slash + 1;
+    }
+    return {};
+}
+
+Result<void> check_prefix(std::string_view p) {
+    if (p.empty()) return {};
+    if (auto problem = name_problem(p); !problem.empty())
+        return fail(MessageErrorType::InvalidArgument, "record: prefix: " + shown(p) + " has " + problem);
+    return {};
+}
+
+Result<void> check_spec_bounds(const RecordingSpec& spec, const RecordingsSettings& settings) {
+    if (spec.queue_bytes_given && spec.queue_bytes > settings.max_queue_bytes)
+        return fail(MessageErrorType::InvalidArgument, "record: queue_bytes: " + std::to_string(spec.queue_bytes) +
+                                                           " is over the gateway's limit of " + std::to_string(settings.max_queue_bytes) +
+                                                           " (recordings.max_queue_bytes)");
+    return {};
 }
 
 json spec_json(const RecordingSpec& s) {

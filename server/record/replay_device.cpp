@@ -25,13 +25,16 @@ nlohmann::json replay_status_json(const ReplayStatus& s) {
 namespace {
 
 // A recorded `robotraconteur` message: one RR message entry in message format 4 (recording.cpp). The
-// entry is decoded inside a message of its own, as a session would receive it.
+// entry is decoded inside a message of its own, as a session would receive it: standard string-table
+// codes (in files recorded before entries were kept free of them) are resolved, not replayed.
 Result<MessageEntry> decode_entry(std::span<const std::byte> bytes) {
     Message m;
     m.version = 4;
     std::vector<std::byte> out;
     if (auto r = encode_message(m, bytes, out); !r) return r.take_error();
-    auto decoded = decode_message(SharedBytes::adopt(std::move(out)));
+    DecodeContext plain;
+    plain.keep_string_table_codes = false;
+    auto decoded = decode_message(SharedBytes::adopt(std::move(out)), {}, &plain);
     if (!decoded) return decoded.take_error();
     if (decoded->entries.size() != 1) return fail(MessageErrorType::DataSerializationError, "not one message entry");
     return std::move(decoded->entries[0]);
@@ -60,7 +63,9 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     auto src = mcap::FileSource::open(file);
     if (!src) return fail(src.error().type, "replay: " + src.error().message);
     d->playback_->source = std::move(*src);
-    auto reader = mcap::McapReader::open(*d->playback_->source);
+    mcap::ReaderLimits limits;
+    limits.max_memory_bytes = options.memory_bytes;
+    auto reader = mcap::McapReader::open(*d->playback_->source, limits);
     if (!reader) return err(reader.error().type, reader.error().message);
     d->playback_->reader.emplace(std::move(*reader));
     const auto& summary = d->playback_->reader->summary();
@@ -429,6 +434,8 @@ void ReplayDevice::run() {
             const std::uint64_t t = *seek_to_;
             seek_to_.reset();
             lock.unlock();
+            iter.reset();  // its decoded chunks count in the reader's memory: gone before restore_state reads
+            next.reset();
             restore_state(t);
             mcap::MessageQuery q;
             q.start_time = t;
@@ -451,6 +458,12 @@ void ReplayDevice::run() {
             lock.lock();
             if (!m) {
                 error_ = "replay " + options_.file + ": " + m.error().message;
+                if (options_.on_error) {
+                    const auto error = error_;
+                    lock.unlock();
+                    options_.on_error(name_, error);
+                    lock.lock();
+                }
                 continue;
             }
             if (!*m) {

@@ -19,6 +19,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -41,6 +42,12 @@ struct ReplayOptions {
     double speed = 1.0;    ///< > 0
     bool loop = false;
     bool paused = false;
+    /// The most memory the file's reader holds at once (mcap::ReaderLimits::max_memory_bytes; the
+    /// gateway's recordings.replay_memory_bytes): a file that needs more is refused at open or fails.
+    std::uint64_t memory_bytes = 256ull << 20;
+    /// Told (from the playback thread) when playing fails: the device's name and the error (the state is
+    /// then "failed"; the gateway logs it).
+    std::function<void(const std::string& device, const std::string& error)> on_error;
 };
 
 struct ReplayStatus {

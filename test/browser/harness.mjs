@@ -136,7 +136,7 @@ export async function startGateway(s, devices = {}, listenPort = 0, extraArgs = 
 
 /**
  * Writes a gateway configuration with logins into folder `dir`: users alice (password alice-pw, role
- * operator: read, write, call and lock everything, and objectlock) and bob (bob-pw, role viewer: read only),
+ * operator: read, write, call and lock everything, record every device, and objectlock) and bob (bob-pw, role viewer: read only),
  * then the YAML lines `rest` (devices:, demo:, ...). Returns the configuration file's path.
  */
 export function writeOperatorViewerConfig(dir, rest) {
@@ -150,7 +150,7 @@ export function writeOperatorViewerConfig(dir, rest) {
     `    users: ${users}`,
     "    roles:",
     "      operator:",
-    "        - allow: [read, write, call, lock]",
+    "        - allow: [read, write, call, lock, record]",
     "      viewer:",
     "        - devices: \"*\"",
     "          members: \"*\"",

@@ -4,8 +4,8 @@
 //     the page for a few seconds (live duration, size and message count shown and growing), stopped,
 //     and the file is read by the reference reader (PyPI `mcap` in the venv): the channels of both
 //     encodings and as many messages as the page said;
-// (2) a recording into a directory that cannot be created shows the gateway's reason on the page and
-//     lists the recording as failed;
+// (2) a recording into a sub-folder of the recordings root that cannot be created shows the gateway's
+//     reason on the page and lists the recording as failed; a directory outside the root is refused;
 // (3) a second gateway replays that file (`--replay create_replay=FILE`): the page shows a timeline
 //     under the device; pause, seek, speed, loop and play from the page change what GET
 //     api/replays/create_replay reports, and the page shows the values the gateway reports;
@@ -91,7 +91,8 @@ const seconds = (text) => {
 before(async () => {
   assert.ok(s.gateway, "RR_GATEWAY (path of rr-gateway) must be set");
   work = fs.mkdtempSync(path.join(os.tmpdir(), "rr-recui-"));
-  gateway = await startGateway(s, {}, 0, ["--no-discovery"]);
+  // the recordings go below a root of the test's own; the page names sub-folders of it
+  gateway = await startGateway(s, {}, 0, ["--no-discovery", "--recordings-root", path.join(work, "root")]);
   await waitFor(async () => (await apiDevices(gateway.base)).every((d) => d.state === "connected"), "the demo devices connected", 30000);
   browser = await launchChromium();
   page = await (await browser.newContext({ viewport: { width: 1366, height: 1000 } })).newPage();
@@ -131,7 +132,7 @@ test("records the create device's members from the page; the file reads", async 
   assert.equal(await boxes.evaluateAll((bs) => bs.filter((b) => b.checked).length), 0);
   for (const m of ["packets", "Bump", "DistanceTraveled"]) await c.locator(`input[value="${m}"]`).check();
   await c.locator('select[name="record-encoding"]').selectOption("both");
-  await c.locator('input[name="record-directory"]').fill(path.join(work, "rec"));
+  await c.locator('input[name="record-directory"]').fill("rec");
 
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
@@ -160,7 +161,7 @@ test("records the create device's members from the page; the file reads", async 
   const files = await item.locator(".recording-files code").allTextContents();
   assert.equal(files.length, 1, `one file: ${files}`);
   recordedFile = path.resolve(files[0]);
-  assert.ok(recordedFile.startsWith(path.join(work, "rec")), `${recordedFile} in the chosen directory`);
+  assert.ok(recordedFile.startsWith(path.join(work, "root", "rec") + path.sep), `${recordedFile} in the chosen sub-folder of the root`);
   assert.ok(fs.statSync(recordedFile).size > 0);
   const id = Number(await item.getAttribute("data-id"));
   const listed = (await api(gateway.base, "GET", "api/recordings")).body.recordings.find((r) => r.id === id);
@@ -189,15 +190,22 @@ test("records the create device's members from the page; the file reads", async 
 
 test("a directory the gateway cannot create: the reason on the page, the recording failed", async () => {
   const c = control();
-  await c.locator('input[name="record-directory"]').fill("/proc/no/such/dir");
+  // a file where the sub-folder's first part would go
+  fs.mkdirSync(path.join(work, "root"), { recursive: true });
+  fs.writeFileSync(path.join(work, "root", "blocked"), "");
+  await c.locator('input[name="record-directory"]').fill("blocked/dir");
   await c.locator(".record-button").click();
   const error = c.locator(".record-error");
   await error.waitFor({ state: "visible", timeout: 20000 });
-  assert.match(await error.textContent(), /\/proc\/no\/such\/dir/);
+  assert.match(await error.textContent(), /blocked is not a folder/);
   const item = c.locator(".recordings > li").first();
   await waitFor(async () => (await item.getAttribute("data-state")) === "failed", "the recording listed as failed", 20000);
-  assert.match(await item.locator(".recording-error").textContent(), /\/proc\/no\/such\/dir/);
+  assert.match(await item.locator(".recording-error").textContent(), /blocked is not a folder/);
   assert.equal(await c.locator(".record-button").textContent(), "Record", "nothing is recording");
+  // outside the root: refused at once (400), not listed
+  await c.locator('input[name="record-directory"]').fill("/tmp");
+  await c.locator(".record-button").click();
+  await waitFor(async () => /is an absolute path/.test(await error.textContent()), "the refusal on the page", 10000);
 });
 
 test("a replayed file: play, pause, seek, speed and loop from the timeline", async () => {
@@ -328,7 +336,7 @@ test("members below the root object typed into the Record control (the webcam's 
   await waitFor(async () => /needs an index/.test(await c.locator(".record-error").textContent()), "the refusal on the page", 20000);
   assert.equal(await c.locator(".record-button").textContent(), "Record");
   await paths.fill("Webcams[0].Name, Webcams[1].Name");
-  await c.locator('input[name="record-directory"]').fill(path.join(work, "sub"));
+  await c.locator('input[name="record-directory"]').fill("sub");
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
   await waitFor(async () => /[1-9]\d* messages/.test(await c.locator(".record-live").textContent()), "the cameras' names recorded", 15000);

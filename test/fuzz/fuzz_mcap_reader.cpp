@@ -5,7 +5,10 @@
 //  - a linear read (no index) yields as many messages as open() counted in its statistics;
 //  - what reads back writes again with McapWriter and reads back equal (same messages, sorted by time).
 // Seeds: test/fuzz/seeds/fuzz_mcap_reader (files written by rr_mcap_tool and by the Python and
-// TypeScript reference writers, some cut off, test/mcap/mcap_interop.py describes them).
+// TypeScript reference writers, some cut off, test/mcap/mcap_interop.py describes them; and the
+// crafted_*.mcap of test/record/crafted_mcap.py: Chunk Index records naming one 500 MiB chunk 16
+// times, a chunk larger than the memory limit, an index understating it, a chunk announcing more than
+// its data holds).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +38,7 @@ ReaderLimits small_limits() {
     l.max_record_bytes = 1 << 20;
     l.max_chunk_uncompressed_bytes = 4 << 20;
     l.max_summary_bytes = 1 << 20;
+    l.max_memory_bytes = 16 << 20;
     return l;
 }
 

@@ -62,8 +62,9 @@ echo "ok: user rr-gateway, gateway.yaml 640 root:rr-gateway, the unit"
 mount -t proc proc "$root/proc"
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 # As the unit runs it: user rr-gateway, the installed configuration (a free port instead of 8080), the
-# unit's RuntimeDirectory and StateDirectory (systemd makes them, owned by the user) and its
-# Environment= line with systemd's %t (/run) and %S (/var/lib) filled in. No systemd runs in the root.
+# unit's RuntimeDirectory and StateDirectory (systemd makes them, owned by the user, and sets
+# STATE_DIRECTORY: the recordings root's default) and its Environment= line with systemd's %t (/run) and
+# %S (/var/lib) filled in. No systemd runs in the root.
 unit="$root/lib/systemd/system/rr-gateway.service"
 run_dir=$(sed -n 's/^RuntimeDirectory=//p' "$unit")
 state_dir=$(sed -n 's/^StateDirectory=//p' "$unit")
@@ -72,7 +73,7 @@ unit_env=$(sed -n 's/^Environment=//p' "$unit" | sed -e 's#%t#/run#g' -e 's#%S#/
 chroot "$root" install -d -o rr-gateway -g rr-gateway -m 0755 "/run/$run_dir" "/var/lib/$state_dir"
 # shellcheck disable=SC2086  # the unit's VAR=value words, split as systemd does (no quotes in them)
 chroot "$root" setpriv --reuid=rr-gateway --regid=rr-gateway --init-groups \
-  env HOME=/nonexistent $unit_env \
+  env HOME=/nonexistent STATE_DIRECTORY="/var/lib/$state_dir" $unit_env \
   /usr/bin/rr-gateway --config /etc/rr-gateway/gateway.yaml --port "$port" --log-level warning >"$work/gw.out" 2>&1 &
 gw=$!
 for _ in $(seq 150); do
@@ -81,11 +82,21 @@ for _ in $(seq 150); do
 done
 curl -fsS "http://127.0.0.1:$port/api/devices" | grep -q '"create"' || { cat "$work/gw.out"; fail "the installed gateway does not serve its demo devices"; }
 chroot "$root" find "/run/$run_dir" -type s | grep -q . || fail "no rr+local socket in /run/$run_dir (the unit's Environment=)"
+# A recording goes below the state directory's recordings folder (docs/recording.md "Where recordings go").
+for _ in $(seq 50); do
+  code=$(curl -sS -o "$work/rec.json" -w '%{http_code}' -X POST "http://127.0.0.1:$port/api/recordings" \
+    -d '{"device": "create", "members": ["packets"], "directory": "check", "duration_s": 1}' 2>/dev/null) || code=000
+  [ "$code" = 201 ] && break
+  sleep 0.2
+done
+[ "$code" = 201 ] || { cat "$work/rec.json" "$work/gw.out"; fail "a recording does not start (HTTP $code)"; }
+chroot "$root" find "/var/lib/$state_dir/recordings/check" -name 'create-*.mcap' | grep -q . ||
+  fail "no recording in /var/lib/$state_dir/recordings/check"
 kill "$gw"
 wait "$gw" || fail "the gateway exited with $? on SIGTERM"
 gw=
 umount "$root/proc"
-echo "ok: the installed gateway ran as rr-gateway with /etc/rr-gateway/gateway.yaml and the unit's environment"
+echo "ok: the installed gateway ran as rr-gateway with /etc/rr-gateway/gateway.yaml and the unit's environment, recording into /var/lib/$state_dir/recordings"
 
 chroot "$root" sh -c 'DEBIAN_FRONTEND=noninteractive apt-get purge -y rr-gateway' >/dev/null 2>&1 || fail "apt-get purge"
 [ ! -e "$root/etc/rr-gateway" ] && [ ! -e "$root/usr/bin/rr-gateway" ] || fail "files left after purge"

@@ -132,7 +132,7 @@ before(async () => {
   camera = await startDevice("camera_synthetic.py",
     ["--camera-info", path.join(DEVICES, "synthetic_camera_info.yml"), "--width", "160", "--height", "120", "--fps", "10",
       "--max-lifetime", "240"]);
-  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-discovery"]);
+  gateway = await startGateway(s, { camera: camera.info.url }, 0, ["--no-discovery", "--recordings-root", work]);
   await waitFor(async () => {
     const d = await apiDevices(gateway.base);
     return ["camera", "create"].every((n) => d.find((x) => x.name === n)?.state === "connected");
@@ -146,7 +146,7 @@ before(async () => {
   page.on("response", (r) => { if (r.status() >= 400) console.log(`# HTTP ${r.status()} ${r.url()}`); });
 
   // The camera through the JSON API, json alone (what a file meant for Foxglove needs) ...
-  const cam = await api("POST", "/api/recordings", { device: "camera", directory: work, members: ["frame_stream"], encoding: "json" });
+  const cam = await api("POST", "/api/recordings", { device: "camera", members: ["frame_stream"], encoding: "json" });
   assert.equal(cam.status, 201, `POST /api/recordings camera: ${JSON.stringify(cam.body)}`);
   // ... and create from the dashboard's Record control, both encodings (its default members + the property)
   await page.goto(`${gateway.base}/#/create`);
@@ -157,7 +157,6 @@ before(async () => {
   await c.locator("button", { hasText: "none" }).click();
   for (const m of ["packets", "Bump", "DistanceTraveled"]) await c.locator(`input[value="${m}"]`).check();
   await c.locator('select[name="record-encoding"]').selectOption("both");
-  await c.locator('input[name="record-directory"]').fill(work);
   await c.locator(".record-button").click();
   await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
   // Driven once the recording runs, so the recorded distance rises (the demo Create stops at a wall

@@ -14,10 +14,10 @@ and the reference MCAP reader (PyPI `mcap`):
            recorded packets in order with the recorded spacing (each interval within +-5 ms, see
            --tolerance-ms); a seek lands on the right wire and property value; a function is refused
            with a clear error; the replay's JSON API status moves.
-  failures a directory that cannot be created: 507 and a failed recording with the reason; a full disk
-           (a small tmpfs, mounted here as root): the recording fails with "No space left on device"
-           while the gateway goes on serving; corrupt files handed to --replay: a clear error and exit
-           status 2 (a start error), no crash.
+  failures a sub-folder that cannot be created: 507 and a failed recording with the reason; a full disk
+           (a small tmpfs, mounted here as root; the test exits 77 when it cannot be mounted): the
+           recording fails with "No space left on device" while the gateway goes on serving; corrupt
+           files handed to --replay: a clear error and exit status 2 (a start error), no crash.
 
 Every step waits for the event it checks (a count on disk, a value received), bounded only against a
 hang. The replay's spacing is judged with --spacing judge (the run labelled timing, in the calm phase):
@@ -184,7 +184,7 @@ def check_recording(path, listener, checks):
 
 def record_phase(exe, work, seconds, checks):
     log = os.path.join(work, "gateway1.log")
-    proc, port, base = start_gateway(exe, [], log)
+    proc, port, base = start_gateway(exe, ["--recordings-root", work], log)  # requests name sub-folders of it
     try:
         client = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
         listener = WireListener(client, "packets")
@@ -193,7 +193,7 @@ def record_phase(exe, work, seconds, checks):
         client.Drive(200, 32767)  # DistanceTraveled changes while recorded
         status, rec = http(base, "POST", "/api/recordings",
                            {"device": "create", "members": ["packets", "Bump", "DistanceTraveled"],
-                            "property_period_ms": 200, "directory": os.path.join(work, "rec"), "chunk_bytes": 16384})
+                            "property_period_ms": 200, "directory": "rec", "chunk_bytes": 16384})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["state"] == "recording", "state recording")
         wait_for("GET /api/recordings counts messages", lambda: http(base, "GET", "/api/recordings")[1]["recordings"][0]["messages"] > 0)
@@ -210,9 +210,10 @@ def record_phase(exe, work, seconds, checks):
         expect(done["files"] == [path], "one file: %s" % done["files"])
         rr_packets, props, json_packets = check_recording(path, listener, checks)
 
-        # Unwritable directory: a clear error, listed as failed; the gateway goes on.
-        status, err = http(base, "POST", "/api/recordings", {"device": "create", "directory": "/proc/no/such/dir"})
-        expect(status == 507 and "/proc/no/such/dir" in err["error"]["message"], "unwritable directory: %s %s" % (status, err))
+        # A sub-folder that cannot be made (a file in its way): a clear error, listed as failed; the gateway goes on.
+        open(os.path.join(work, "blocked"), "w").close()
+        status, err = http(base, "POST", "/api/recordings", {"device": "create", "directory": "blocked/dir"})
+        expect(status == 507 and "blocked is not a folder" in err["error"]["message"], "unwritable directory: %s %s" % (status, err))
         status, listed = http(base, "GET", "/api/recordings")
         expect(any(r["state"] == "failed" and r["error"] for r in listed["recordings"]), "the failed recording is listed")
 
@@ -223,7 +224,7 @@ def record_phase(exe, work, seconds, checks):
 
         # Killed mid-recording: the file reads up to its last chunk.
         status, rec2 = http(base, "POST", "/api/recordings",
-                            {"device": "create", "members": ["packets"], "directory": os.path.join(work, "killed"),
+                            {"device": "create", "members": ["packets"], "directory": "killed",
                              "chunk_bytes": 4096})
         expect(status == 201, "second recording")
         killed = rec2["files"][0]
@@ -256,7 +257,7 @@ def disk_full(base, work):
             except OSError:
                 pass
         status, rec = http(base, "POST", "/api/recordings",
-                           {"device": "create", "members": ["packets"], "directory": mnt, "chunk_bytes": 4096,
+                           {"device": "create", "members": ["packets"], "directory": "tiny", "chunk_bytes": 4096,
                             "compression": "none"})
         expect(status == 201, "recording on the small tmpfs starts: %s %s" % (status, rec))
         s = wait_for("the recording on the full tmpfs ends",

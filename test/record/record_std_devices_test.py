@@ -166,7 +166,7 @@ def run(gateway_exe, work, seconds, checks):
     gw = None
     try:
         gw, port, base = start_gateway(gateway_exe, ["--device", "robot=" + robot_info["url"], "--device",
-                                                     "camera=" + cam_info["url"]], work, "gateway1")
+                                                     "camera=" + cam_info["url"], "--recordings-root", work], work, "gateway1")
         r = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=robot" % port)
         c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=camera" % port)
         lock = threading.Lock()
@@ -194,7 +194,7 @@ def run(gateway_exe, work, seconds, checks):
         wait_for("the official client receives states and frames live", live_started)
         ids, files = {}, {}
         for device, member in (("robot", "robot_state"), ("camera", "frame_stream")):
-            st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member], "directory": work})
+            st, body = http(base, "POST", "/api/recordings", {"device": device, "members": [member]})  # into the root
             expect(st == 201, "POST /api/recordings %s: %s %s" % (device, st, body))
             ids[device], files[device] = body["id"], body["files"][0]
         # --seconds worth of values (the robot's state at 10 Hz or more, frames at 10 fps) on disk, then stop.

@@ -159,8 +159,8 @@ def record_phase(exe, work, checks, rr_exe=None):
     dev, info = start_device(work)
     gw = None
     try:
-        gw, port, base = start_gateway(exe, ["--device", "signals=" + info["url"], "--device", "tools=" + info["tools_url"]],
-                                       work, "gateway")
+        gw, port, base = start_gateway(exe, ["--device", "signals=" + info["url"], "--device", "tools=" + info["tools_url"],
+                                             "--recordings-root", work], work, "gateway")
         for device in ("signals", "tools"):
             deadline = time.monotonic() + 30
             while time.monotonic() < deadline:
@@ -173,15 +173,15 @@ def record_phase(exe, work, checks, rr_exe=None):
         for name, want in (("signal_groups.signals[0].signal_value_vec", "needs an index"),
                            ("signal_groups[arm].signals[0].nope", "has no member \"nope\""),
                            ("signal_groups[arm].signals[0].signal_value_vec.x", "is a wire, not an objref")):
-            status, body = http(base, "POST", "/api/recordings", {"device": "signals", "members": [name], "directory": work})
+            status, body = http(base, "POST", "/api/recordings", {"device": "signals", "members": [name]})
             message = (body or {}).get("error", {}).get("message", "")
             bad[name] = [status, message]
             expect(status == 400 and want in message, "%s: 400 with \"%s\", got %s %s" % (name, want, status, message))
         checks["refused_names"] = bad
-        status, rec = http(base, "POST", "/api/recordings", {"device": "signals", "members": MEMBERS, "directory": work})
+        status, rec = http(base, "POST", "/api/recordings", {"device": "signals", "members": MEMBERS})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["members"] == MEMBERS, "the status names the members with their objects: %s" % rec["members"])
-        status, tools_rec = http(base, "POST", "/api/recordings", {"device": "tools", "members": TOOL_MEMBERS, "directory": work,
+        status, tools_rec = http(base, "POST", "/api/recordings", {"device": "tools", "members": TOOL_MEMBERS,
                                                                    "property_period_ms": 200})
         expect(status == 201, "POST /api/recordings (tools): %s %s" % (status, tools_rec))
         # What read_file and read_tools_file count, on disk (the writer flushes every second): 20 values of

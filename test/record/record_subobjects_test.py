@@ -51,7 +51,7 @@ def frame_digest(width, height, data):
 
 
 def record_phase(exe, work, checks):
-    proc, port, base = start_gateway(exe, [], os.path.join(work, "gateway.log"))
+    proc, port, base = start_gateway(exe, ["--recordings-root", work], os.path.join(work, "gateway.log"))
     try:
         wait_for("the webcam device connected",
                  lambda: any(d["name"] == "webcam" and d["state"] == "connected" for d in http(base, "GET", "/api/devices")[1] or []))
@@ -59,7 +59,7 @@ def record_phase(exe, work, checks):
         for name, want in (("Webcams.FrameStream", "needs an index"), ("Webcams[0].Nope", "has no member \"Nope\""),
                            ("Nothing[0].Name", "has no member \"Nothing\""),
                            ("WebcamNames.Name", "is a property, not an objref"), ("Webcams[0.Name", "without ']'")):
-            status, body = http(base, "POST", "/api/recordings", {"device": "webcam", "members": [name], "directory": work})
+            status, body = http(base, "POST", "/api/recordings", {"device": "webcam", "members": [name]})
             message = (body or {}).get("error", {}).get("message", "")
             bad[name] = [status, message]
             expect(status == 400 and want in message, "%s: 400 with \"%s\", got %s %s" % (name, want, status, message))
@@ -68,7 +68,7 @@ def record_phase(exe, work, checks):
         expect(status == 200, "StartStreaming on Webcams[0]: %s %s" % (status, body))
         members = ["Webcams[0].FrameStream", "Webcams[0].Name", "Webcams[1].Name"]
         status, rec = http(base, "POST", "/api/recordings",
-                           {"device": "webcam", "members": members, "directory": work, "property_period_ms": 200})
+                           {"device": "webcam", "members": members, "property_period_ms": 200})
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["members"] == members, "the status names the members with their objects: %s" % rec["members"])
         live_names = {}

@@ -89,8 +89,8 @@ export class DeviceView {
   }
 
   /**
-   * Whether this login may write the whole device (write on every member), which replay control and
-   * recording need (POST api/replays/<name>, POST api/recordings: docs/security.md). Asked once per page.
+   * Whether this login may write the whole device (write on every member), which replay control
+   * needs (POST api/replays/<name>: docs/security.md). Asked once per page.
    * @returns {Promise<boolean>}
    */
   mayWriteDevice() {
@@ -99,6 +99,16 @@ export class DeviceView {
         (Object.keys(access.members).length > 0 && Object.values(access.members).every((ops) => Array.isArray(ops) && ops.includes("write"))),
       () => false);
     return this.writeAccess;
+  }
+
+  /**
+   * Whether this login has the `record` right on the device (POST api/recordings: docs/recording.md);
+   * true without logins. Asked once per page.
+   * @returns {Promise<boolean>}
+   */
+  mayRecordDevice() {
+    this.recordAccess ??= fetchAccess(this.name).then((access) => access.members === null || access.record === true, () => false);
+    return this.recordAccess;
   }
 
   /** The form asking for the device's own login: user, password, "Log in", the device's error. */
@@ -210,7 +220,7 @@ export class DeviceView {
     this.typeEl.textContent = client.$type;
     const recorder = this.recorder = new RecordControl(this.tools, { device: this.name, members: client.$members });
     if (this.replayFile) recorder.markReplay(this.replayFile);
-    this.mayWriteDevice().then((may) => { if (!may) recorder.refuse("Your login may not record this device (it needs write on the device)."); });
+    this.mayRecordDevice().then((may) => { if (!may) recorder.refuse("Your login may not record this device (it needs the record right on the device)."); });
     // the device's types described once, from the definitions it sent (views/context.js)
     const view = viewContext(outline);
     this.panel = new ObjectPanel(this.members, {

@@ -8,6 +8,7 @@ std::string_view operation_name(Operation op) noexcept {
         case Operation::write: return "write";
         case Operation::call: return "call";
         case Operation::lock: return "lock";
+        case Operation::record: return "record";
     }
     return "?";
 }
@@ -18,6 +19,7 @@ bool AccessRule::allows(Operation op) const noexcept {
         case Operation::write: return write;
         case Operation::call: return call;
         case Operation::lock: return lock;
+        case Operation::record: return record;
     }
     return false;
 }

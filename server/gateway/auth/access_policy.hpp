@@ -10,6 +10,8 @@
 //          ReleaseClientObjectLock, MonitorEnter, MonitorContinueEnter, MonitorExit: mirror_access.hpp
 //          is_lock_operation); for `lock` a rule's members name objects
 //          (object_key: the relative service path, "" for the root object), as a lock covers an object
+//   record starting, stopping and seeing the files of the device's recordings (asked with member `*`:
+//          a rule's `members` must match `*`, i.e. be `*` or left out; docs/recording.md)
 // A member of the device's root object is named by its member name (`Drive`); a member of an object
 // below the root by `<relative service path>.<member>` (`Webcams[0].Capture`), the path in RR's
 // encoding as the JSON API's `object` parameter normalises it. Rules only allow: an operation is
@@ -25,15 +27,15 @@
 
 namespace rr::server::gateway::auth {
 
-enum class Operation { read, write, call, lock };
+enum class Operation { read, write, call, lock, record };
 
-/// "read", "write", "call", "lock".
+/// "read", "write", "call", "lock", "record".
 std::string_view operation_name(Operation op) noexcept;
 
 struct AccessRule {
     std::vector<std::string> devices;  ///< patterns
     std::vector<std::string> members;  ///< patterns
-    bool read = false, write = false, call = false, lock = false;
+    bool read = false, write = false, call = false, lock = false, record = false;
 
     bool allows(Operation op) const noexcept;
 };

@@ -38,7 +38,7 @@ export class RecordControl {
       h("option", { value: "both", text: "json + robotraconteur" }),
       h("option", { value: "json", text: "json (Foxglove)" }),
       h("option", { value: "robotraconteur", text: "robotraconteur (replay)" }));
-    this.directory = h("input", { name: "record-directory", placeholder: "recordings (the gateway's default)", size: 28 });
+    this.directory = h("input", { name: "record-directory", placeholder: "a sub-folder of the recordings root (optional)", size: 28 });
     // members of objects below the root, by path: offered when the device has objrefs
     const objref = (members || []).find((m) => m.kind === "objref");
     this.paths = objref ? h("input", { name: "record-paths", size: 28, placeholder: `e.g. ${objref.name}[0].member, …` }) : null;
