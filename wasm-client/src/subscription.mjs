@@ -3,7 +3,7 @@
 // connect again with a jittered backoff after any drop, and restore on the new connection the wires,
 // pipe endpoints, event handlers and callbacks the app asked for.
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
@@ -100,8 +100,9 @@ class SubscriptionClient {
  * ServiceSubscription: see subscribe() in robotraconteur.mjs for the target and options.
  * `connectFn(url, options)` is robotraconteur.mjs connect (injected: no import cycle).
  */
-export class ServiceSubscription {
+export class ServiceSubscription extends ConnectionEvents {
   constructor(target, options, connectFn) {
+    super();
     this.options = options;
     this.connectFn = connectFn;
     this.backoff = backoffOptions(options.backoff);
@@ -114,9 +115,6 @@ export class ServiceSubscription {
     this.events = new Set();
     this.callbacks = new Map();
     this.connectingListeners = new Listeners();
-    this.connectListeners = new Listeners();
-    this.disconnectListeners = new Listeners();
-    this.errorListeners = new Listeners();
     this.defaultWaiters = [];
     if (typeof target === "string" || Array.isArray(target)) {
       const urls = typeof target === "string" ? [target] : target;
@@ -347,20 +345,9 @@ export class ServiceSubscription {
     return this.connectingListeners.add(fn);
   }
 
-  /** `fn(client, proxy)` after every (re)connection. Returns the remover. */
-  onConnect(fn) {
-    return this.connectListeners.add(fn);
-  }
-
-  /** `fn(client, error)` after every lost connection (error null after a clean close). Returns the remover. */
-  onDisconnect(fn) {
-    return this.disconnectListeners.add(fn);
-  }
-
-  /** `fn(error, client | null)`: a failed connect or restore, or a failed discovery request. Returns the remover. */
-  onError(fn) {
-    return this.errorListeners.add(fn);
-  }
+  // onConnect(fn(client, proxy)) after every (re)connection; onDisconnect(fn(client, error)) after every
+  // lost connection (error null after a clean close); onError(fn(error, client | null)): a failed connect
+  // or restore, or a failed discovery request (ConnectionEvents).
 
   /** A WireSubscription on wire `name` of the object at `servicePath` (relative objref path, "" = root). */
   subscribeWire(name, servicePath = "") {
@@ -433,16 +420,14 @@ export class ServiceSubscription {
  * member connection opens, closes or fails to open (onConnect, onDisconnect, onError), so a view can
  * show the state of the one member it shows.
  */
-class MemberSubscription {
+class MemberSubscription extends ConnectionEvents {
   constructor(sub, member, servicePath) {
+    super();
     this.sub = sub;
     this.member = member;
     this.servicePath = servicePath;
     this.closed = false;
     this.links = new Map();  // client → connected wire connection / pipe endpoint
-    this.connectListeners = new Listeners();
-    this.disconnectListeners = new Listeners();
-    this.errorListeners = new Listeners();
   }
 
   attach(c, proxy, gen, attempt = 0) {
@@ -483,20 +468,9 @@ class MemberSubscription {
     if (this.links.delete(c) && !this.closed) this.disconnectListeners.emit(c, error ? keepable(toRRError(error)) : null);
   }
 
-  /** `fn(client)` each time the member connection to a service opens (first time and after each reconnect); returns the remover. */
-  onConnect(fn) {
-    return this.connectListeners.add(fn);
-  }
-
-  /** `fn(client, error)` each time an open member connection closes (error null when closed cleanly); returns the remover. */
-  onDisconnect(fn) {
-    return this.disconnectListeners.add(fn);
-  }
-
-  /** `fn(error, client)` each time opening the member connection fails (it is tried again with backoff); returns the remover. */
-  onError(fn) {
-    return this.errorListeners.add(fn);
-  }
+  // onConnect(fn(client)) each time the member connection to a service opens (first time and after each
+  // reconnect); onDisconnect(fn(client, error)) each time an open one closes (error null when closed
+  // cleanly); onError(fn(error, client)) each time opening it fails (tried again with backoff): ConnectionEvents.
 
   closeLocal() {
     this.closed = true;
