@@ -1,5 +1,5 @@
 // A page of its own on the dashboard (custom_registry.test.mjs): the standard panels, the standard
-// renderers plus two for the demo webcam's types (experimental.createwebcam2), registered the way
+// renderers plus two for the demo webcam's types (experimental.createwebcam), registered the way
 // docs/dashboard.md "A page of your own" describes.
 //   WebcamImage_size  a custom type: its own one-line text
 //   WebcamImage       a custom picture format: its own text and an `image` hook (RGB bytes to RGBA
@@ -8,7 +8,7 @@
 import { startDashboard } from "../src/dashboard.js";
 import { standardRegistry } from "../src/std/standard.js";
 
-const W = "experimental.createwebcam2";
+const W = "experimental.createwebcam";
 const size = { width: "int32", height: "int32", step: "int32" };
 
 function webcamPixels(v) {
