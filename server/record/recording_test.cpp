@@ -277,7 +277,7 @@ TEST_CASE("recording: bad requests are clear errors") {
 // --- issue 52: recordings stay in their place, and their memory is bounded ----------------------------
 
 TEST_CASE("recording: a request's directory and prefix stay inside the recordings root") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir, outside;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -309,7 +309,7 @@ TEST_CASE("recording: a request's directory and prefix stay inside the recording
 }
 
 TEST_CASE("recording: a symbolic link planted in the root is not followed, folder or file") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir, outside;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -350,7 +350,7 @@ TEST_CASE("recording: a symbolic link planted in the root is not followed, folde
 }
 
 TEST_CASE("recording: one prefix started in the same second never shares a file, and past max_active it is 429") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.max_active = 6; }));
@@ -396,7 +396,7 @@ TEST_CASE("recording: one prefix started in the same second never shares a file,
 }
 
 TEST_CASE("recording: the root's disk budget refuses a recording that would pass it (507)") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.max_total_bytes = 3u << 20; }));
@@ -421,7 +421,7 @@ TEST_CASE("recording: the root's disk budget refuses a recording that would pass
 }
 
 TEST_CASE("recording: queue_bytes over recordings.max_queue_bytes is refused (400)") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -433,7 +433,7 @@ TEST_CASE("recording: queue_bytes over recordings.max_queue_bytes is refused (40
 }
 
 TEST_CASE("recording: ended recordings keep only their status, the last keep_ended of them") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.keep_ended = 3; }));
@@ -463,7 +463,7 @@ TEST_CASE("recording: ended recordings keep only their status, the last keep_end
 }
 
 TEST_CASE("recording: the writer's index is bounded: a new file when it passes max_index_bytes") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
