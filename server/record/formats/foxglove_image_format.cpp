@@ -1,10 +1,13 @@
-#include "server/record/foxglove_image.hpp"
+#include "server/record/formats/foxglove_image_format.hpp"
 
 #include <openssl/evp.h>
 
 #include <cstddef>
 #include <span>
 #include <vector>
+
+#include "core/value/pack_value.hpp"
+#include "server/record/formats/formats.hpp"
 
 namespace rr::server::record {
 namespace {
@@ -23,21 +26,12 @@ std::string base64(std::span<const std::byte> bytes) {
     return out;
 }
 
-// The image's bytes: a {"$binary": i} reference (element_json with BinaryArrays) or a JSON number array.
-std::optional<std::span<const std::byte>> image_bytes(const json& data, const BinaryArrays& binary,
-                                                      std::vector<std::byte>& storage) {
-    if (data.is_object() && data.contains("$binary") && data["$binary"].is_number_integer()) {
-        const auto i = data["$binary"].get<std::int64_t>();
-        if (i < 0 || static_cast<std::size_t>(i) >= binary.blobs.size()) return std::nullopt;
-        return binary.blobs[static_cast<std::size_t>(i)].bytes();
-    }
-    if (!data.is_array()) return std::nullopt;
-    storage.reserve(data.size());
-    for (const auto& b : data) {
-        if (!b.is_number_integer() || b.get<std::int64_t>() < 0 || b.get<std::int64_t>() > 255) return std::nullopt;
-        storage.push_back(static_cast<std::byte>(b.get<std::int64_t>()));
-    }
-    return std::span<const std::byte>(storage);
+// The image's bytes: its `data`, a uint8 array (shared with the received element when it has more than
+// one byte).
+std::optional<SharedBytes> image_bytes(const Value* data) {
+    const auto* a = data ? data->get_if<NumericArray>() : nullptr;
+    if (!a || a->type() != DataTypes::uint8_t) return std::nullopt;
+    return a->to_bytes();
 }
 
 std::optional<std::string_view> compressed_format(std::span<const std::byte> b) {
@@ -50,19 +44,25 @@ std::optional<std::string_view> compressed_format(std::span<const std::byte> b) 
     return std::nullopt;
 }
 
-json timestamp(const json& image_info, std::uint64_t log_ns) {
+// An integer field of `v` (a struct, or a scalar pod), or nothing.
+std::optional<std::int64_t> integer_field(const Value* v, std::string_view name) {
+    const Value* f = v ? v->field(name) : nullptr;
+    if (!f) return std::nullopt;
+    auto i = f->as<std::int64_t>();
+    if (!i) return std::nullopt;
+    return *i;
+}
+
+json timestamp(const Value* image_info, std::uint64_t log_ns) {
     std::uint64_t ns = log_ns;
-    const json* ts = nullptr;
-    if (image_info.is_object() && image_info.contains("data_header") && image_info["data_header"].is_object() &&
-        image_info["data_header"].contains("ts"))
-        ts = &image_info["data_header"]["ts"];
-    if (ts && ts->is_object() && (*ts)["seconds"].is_number_integer() && (*ts)["nanoseconds"].is_number_integer()) {
-        const auto sec = (*ts)["seconds"].get<std::int64_t>();
-        const auto nsec = (*ts)["nanoseconds"].get<std::int64_t>();
+    const Value* header = image_info ? image_info->field("data_header") : nullptr;
+    const Value* ts = header ? header->field("ts") : nullptr;
+    const auto sec = integer_field(ts, "seconds"), nsec = integer_field(ts, "nanoseconds");
+    if (sec && nsec) {
         const auto log_sec = static_cast<std::int64_t>(log_ns / kNsPerSec);
-        if (sec > 0 && nsec >= 0 && nsec < static_cast<std::int64_t>(kNsPerSec) && sec > log_sec - kDaySeconds &&
-            sec < log_sec + kDaySeconds)
-            ns = static_cast<std::uint64_t>(sec) * kNsPerSec + static_cast<std::uint64_t>(nsec);
+        if (*sec > 0 && *nsec >= 0 && *nsec < static_cast<std::int64_t>(kNsPerSec) && *sec > log_sec - kDaySeconds &&
+            *sec < log_sec + kDaySeconds)
+            ns = static_cast<std::uint64_t>(*sec) * kNsPerSec + static_cast<std::uint64_t>(*nsec);
     }
     return json{{"sec", ns / kNsPerSec}, {"nsec", ns % kNsPerSec}};
 }
@@ -133,36 +133,109 @@ std::optional<std::string_view> foxglove_raw_encoding(std::int64_t rr_encoding) 
     }
 }
 
-std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const nlohmann::json& value,
-                                                  const BinaryArrays& binary, std::uint64_t log_ns) {
-    if (!value.is_object() || !value.contains("data") || !value.contains("image_info")) return std::nullopt;
-    const json& info = value["image_info"];
-    std::vector<std::byte> storage;
-    auto bytes = image_bytes(value["data"], binary, storage);
-    if (!bytes) return std::nullopt;
+std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const Value& image, std::uint64_t log_ns) {
+    const Value* info = image.field("image_info");
+    auto data = image_bytes(image.field("data"));
+    if (!info || !data) return std::nullopt;
+    const auto bytes = data->bytes();
     json out{{"timestamp", timestamp(info, log_ns)}, {"frame_id", ""}};
     if (kind == FoxgloveImageKind::raw) {
-        if (!info.is_object()) return std::nullopt;
-        for (const char* k : {"width", "height", "step", "encoding"})
-            if (!info.contains(k) || !info[k].is_number_integer()) return std::nullopt;
-        auto encoding = foxglove_raw_encoding(info["encoding"].get<std::int64_t>());
+        const auto width = integer_field(info, "width"), height = integer_field(info, "height");
+        auto step = integer_field(info, "step");
+        const auto rr_encoding = integer_field(info, "encoding");
+        if (!width || !height || !step || !rr_encoding) return std::nullopt;
+        auto encoding = foxglove_raw_encoding(*rr_encoding);
         if (!encoding) return std::nullopt;
-        const auto width = info["width"].get<std::int64_t>(), height = info["height"].get<std::int64_t>();
-        auto step = info["step"].get<std::int64_t>();
-        if (width < 0 || height < 0 || step < 0) return std::nullopt;
-        if (step == 0 && height > 0) step = static_cast<std::int64_t>(bytes->size()) / height;  // step not set by the driver
-        if (static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(height) > bytes->size()) return std::nullopt;
-        out["width"] = width;
-        out["height"] = height;
-        out["step"] = step;
+        if (*width < 0 || *height < 0 || *step < 0) return std::nullopt;
+        if (*step == 0 && *height > 0) *step = static_cast<std::int64_t>(bytes.size()) / *height;  // step not set by the driver
+        if (static_cast<std::uint64_t>(*step) * static_cast<std::uint64_t>(*height) > bytes.size()) return std::nullopt;
+        out["width"] = *width;
+        out["height"] = *height;
+        out["step"] = *step;
         out["encoding"] = std::string(*encoding);
     } else {
-        auto format = compressed_format(*bytes);
+        auto format = compressed_format(bytes);
         if (!format) return std::nullopt;
         out["format"] = std::string(*format);
     }
-    out["data"] = base64(*bytes);
+    out["data"] = base64(bytes);
     return out.dump();
 }
+
+// --- the format ------------------------------------------------------------------------------------
+
+namespace {
+
+class FoxgloveImageEncoder : public FormatEncoder {
+public:
+    explicit FoxgloveImageEncoder(const FormatContext& context) : context_(context) {
+        for (const auto& m : context_.members) {
+            const auto& t = *m.target;
+            kinds_.push_back(m.kind == RecordedKind::event ? std::nullopt
+                                                           : foxglove_image_kind(t.member->type, t.types->set(), t.context()));
+        }
+    }
+
+    Result<void> open_file(FormatFile& file) override {
+        channels_.assign(context_.members.size(), std::nullopt);
+        std::optional<std::uint16_t> schemas[2];  // by kind, added once a file
+        for (std::size_t i = 0; i < context_.members.size(); ++i) {
+            if (!kinds_[i]) continue;
+            const auto kind = *kinds_[i];
+            auto& sid = schemas[kind == FoxgloveImageKind::raw ? 0 : 1];
+            if (!sid) {
+                auto id = file.add_schema(foxglove_schema_name(kind), "jsonschema", foxglove_image_schema(kind).dump());
+                if (!id) return id.take_error();
+                sid = *id;
+            }
+            const auto& m = context_.members[i];
+            auto metadata = m.metadata;
+            metadata[channel_key::foxglove] = kind == FoxgloveImageKind::raw
+                                                  ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
+                                                    "bayer_*8888 depth_u16; other frames are not on this channel"
+                                                  : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
+            auto cid = file.add_channel(*sid, m.topic + "/foxglove", "json", metadata);
+            if (!cid) return cid.take_error();
+            channels_[i] = *cid;
+        }
+        return {};
+    }
+
+    Result<void> write(const RecordedEntry& e, MessageOut& out) override {
+        if (!channels_[e.member]) return {};
+        const auto& m = context_.members[e.member];
+        const auto& t = *m.target;
+        const MessageEntry& entry = e.entry.entry();
+        const MessageElement* el = m.kind == RecordedKind::wire   ? entry.find("packet")
+                                   : m.kind == RecordedKind::pipe ? (entry.elements.empty() ? nullptr : &entry.elements[0])
+                                                                  : entry.find("value");
+        if (!el) return {};
+        // One conversion: the element to a value whose pixel bytes are the element's, read into the message.
+        auto image = unpack_value(*el, t.member->type, t.types->set(), t.context(), context_.api.options().limits);
+        if (!image) return {};
+        auto text = foxglove_image_message(*kinds_[e.member], *image, e.log_ns);
+        if (!text) return {};
+        return out.write(*channels_[e.member], *text);
+    }
+
+private:
+    const FormatContext& context_;
+    std::vector<std::optional<FoxgloveImageKind>> kinds_;      // per member: an image, or not
+    std::vector<std::optional<std::uint16_t>> channels_;       // per member, in the open file
+};
+
+class FoxgloveImageFormat : public RecordingFormat {
+public:
+    std::string_view name() const noexcept override { return "foxglove_image"; }
+    bool is_encoding() const noexcept override { return false; }
+    bool enabled(const RecordingSpec& spec) const override { return spec.encodes("json") && spec.foxglove_images; }
+    std::unique_ptr<FormatEncoder> encoder(const FormatContext& context) const override {
+        return std::make_unique<FoxgloveImageEncoder>(context);
+    }
+};
+
+}  // namespace
+
+std::shared_ptr<const RecordingFormat> foxglove_image_format() { return std::make_shared<FoxgloveImageFormat>(); }
 
 }  // namespace rr::server::record

@@ -1,8 +1,10 @@
-// Extra `json` channels that Foxglove's / Lichtblick's Image panel shows (docs/recording.md "Opening a
-// recording in Foxglove or Lichtblick"): a recorded member whose value is a standard image
+// The `foxglove_image` format: extra `json` channels that Foxglove's / Lichtblick's Image panel shows
+// (docs/recording.md "Opening a recording in Foxglove or Lichtblick"). With `json` and
+// RecordingSpec::foxglove_images, a recorded member whose value is a standard image
 // (com.robotraconteur.image.Image or CompressedImage) also gets a channel `<device>/<member>/foxglove`
 // whose schema is named foxglove.RawImage or foxglove.CompressedImage and whose messages have those
-// schemas' fields, the pixel bytes in base64.
+// schemas' fields, the pixel bytes in base64. The format itself is foxglove_image_format()
+// (formats.hpp); these are its parts.
 #pragma once
 
 #include <cstdint>
@@ -12,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/json/value_json.hpp"
+#include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"
 
@@ -37,12 +39,12 @@ nlohmann::json foxglove_image_schema(FoxgloveImageKind kind);
 /// equivalent of (rgba16_16_16_16, mono32, floating-point, the other depth formats, freeform, ...).
 std::optional<std::string_view> foxglove_raw_encoding(std::int64_t rr_encoding);
 
-/// The Foxglove message for one recorded image: `value` is the image as element_json writes it with
-/// `binary` (its `data` a {"$binary": i} reference into binary.blobs, or a JSON array of numbers).
-/// `timestamp` is the image's data_header.ts when it lies within a day of `log_ns` (a device clock on the
-/// Unix epoch), else `log_ns`; frame_id is "". Nothing when the value is null or malformed, a raw
-/// image's encoding has no Foxglove equivalent, or a compressed image's bytes are not JPEG, PNG or WebP.
-std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const nlohmann::json& value,
-                                                  const BinaryArrays& binary, std::uint64_t log_ns);
+/// The Foxglove message for one recorded image: `image` is the value as unpacked from the received
+/// element (unpack_value: its `data` bytes shared with the element, not copied), read once into the
+/// message. `timestamp` is the image's image_info.data_header.ts when it lies within a day of `log_ns` (a
+/// device clock on the Unix epoch), else `log_ns`; frame_id is "". Nothing when the value is null or
+/// malformed (`data` not a uint8 array), a raw image's encoding has no Foxglove equivalent, or a
+/// compressed image's bytes are not JPEG, PNG or WebP.
+std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const Value& image, std::uint64_t log_ns);
 
 }  // namespace rr::server::record
