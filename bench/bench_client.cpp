@@ -280,7 +280,7 @@ int main(int argc, char** argv) {
             timed(op, calls, double(n) * 16, [&] {
                 auto r = must(root.call("Echo", {arg}), "Echo");
                 const auto* a = r.get_if<NumericArray>();
-                if (!a || a->size() != n) die("Echo", RRError{MessageErrorType::DataTypeError, "", "wrong echo size", ""});
+                if (!a || a->size() != n) die("Echo", RRError{MessageErrorType::DataTypeError, "", "wrong echo size", "", nullptr});
             }, n >= 100000 ? 5 : 50);
         } else if (op == "get") timed("get", count, 0, [&] { must(root.get("Value"), "get Value"); });
         else if (op == "set") timed("set", count, 0, [&] { must(root.set("Value", Value::scalar<double>(1.5)), "set Value"); });

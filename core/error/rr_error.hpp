@@ -77,13 +77,18 @@ std::string_view error_name(MessageErrorType type) noexcept;
 /// "…ObjectNotFoundException" names (wire.md §5.1).
 MessageErrorType error_type_from_name(std::string_view name) noexcept;
 
+struct MessageElement;  // core/message/message.hpp
+
 /// An RR error as carried in an error entry (wire.md §5.2): code, `errorname`, `errorstring`,
-/// optional `errorsubname`. User error names pass through unchanged.
+/// optional `errorsubname` and `errorparam`. User error names pass through unchanged.
 struct RRError {
     MessageErrorType type = MessageErrorType::UnknownError;
     std::string name;     ///< errorname; filled from error_name(type) by make_error when empty
     std::string message;  ///< errorstring: human-readable
     std::string sub_name; ///< errorsubname, usually empty
+    /// errorparam: a varvalue element (any name; sent as `errorparam`), usually null. Immutable and
+    /// shared by copies; equality compares the pointer.
+    std::shared_ptr<const MessageElement> param = nullptr;
 
     friend bool operator==(const RRError&, const RRError&) = default;
 };

@@ -29,6 +29,10 @@ void set_entry_error(MessageEntry& entry, const RRError& error) {
     entry.elements.push_back(make_string_element("errorname", name));
     entry.elements.push_back(make_string_element("errorstring", error.message));
     if (!error.sub_name.empty()) entry.elements.push_back(make_string_element("errorsubname", error.sub_name));
+    if (error.param) {
+        MessageElement& p = entry.elements.emplace_back(*error.param);
+        p.name = "errorparam";
+    }
 }
 
 std::optional<RRError> entry_error(const MessageEntry& entry) {
@@ -39,6 +43,7 @@ std::optional<RRError> entry_error(const MessageEntry& entry) {
     e.name = name ? std::move(*name) : std::string(error_name(entry.error));
     e.message = string_value(entry, "errorstring").value_or(std::string());
     e.sub_name = string_value(entry, "errorsubname").value_or(std::string());
+    if (const MessageElement* p = entry.find("errorparam")) e.param = std::make_shared<const MessageElement>(*p);
     return e;
 }
 

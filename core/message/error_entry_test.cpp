@@ -52,6 +52,39 @@ TEST_CASE("message: error entries carry user error names and sub-names") {
     }
 }
 
+TEST_CASE("message: error entries carry an errorparam element and read it back") {
+    MessageEntry e;
+    e.entry_type = MessageEntryType::FunctionCallRes;
+    RRError err = make_error(MessageErrorType::InvalidOperation, "test error");
+    err.sub_name = "my_error";
+    auto param = std::make_shared<MessageElement>(make_string_element("any name", "20"));
+    err.param = param;
+    set_entry_error(e, err);
+    REQUIRE(e.elements.size() == 4);
+    CHECK(e.elements[3].name == "errorparam");
+    CHECK(e.elements[3].type == DataTypes::string_t);
+    CHECK(param->name == "any name");  // the error's element is copied, not renamed in place
+    for (std::uint16_t version : {2, 4}) {
+        Message m;
+        m.version = version;
+        m.entries.push_back(e);
+        auto bytes = encode_message(m);
+        REQUIRE(bytes);
+        auto back = decode_message(*bytes);
+        REQUIRE(back);
+        auto read = entry_error(back->entries[0]);
+        REQUIRE(read);
+        CHECK(read->sub_name == "my_error");
+        REQUIRE(read->param);
+        CHECK(read->param->name == "errorparam");
+        CHECK(std::string(reinterpret_cast<const char*>(read->param->data.data()), read->param->data.size()) == "20");
+    }
+    MessageEntry plain;
+    set_entry_error(plain, make_error(MessageErrorType::InvalidOperation, "no param"));
+    CHECK(plain.elements.size() == 2);
+    CHECK_FALSE(entry_error(plain)->param);
+}
+
 TEST_CASE("message: entry_error maps by code and tolerates missing elements") {
     MessageEntry ok;
     CHECK_FALSE(entry_error(ok));

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -38,7 +39,10 @@ private:
     Result<void> read_header_v4(ByteReader& r, MessageHeaderInfo& info, MessageHeader& h);
     Result<void> read_entry_v4(ByteReader& r, MessageEntry& entry);
     Result<void> read_element_v4(ByteReader& r, MessageElement& e, std::size_t depth);
-    Result<std::string> resolve_code(std::uint32_t code) const;
+    /// The string `code` names (a view into the header's local table or the standard table).
+    Result<std::string_view> resolve_code(std::uint32_t code) const;
+    /// Whether decoded names keep their codes (DecodeContext::keep_string_table_codes).
+    bool keep_codes() const noexcept { return !context_ || context_->keep_string_table_codes; }
 
     // shared (message_reader.cpp)
     /// Raw array, void or nested payload of `e` after its DataCount; `r` must end with it.
@@ -62,8 +66,15 @@ private:
     std::uint16_t version_ = 0;
     std::size_t elements_seen_ = 0;
     const std::vector<std::pair<std::uint32_t, std::string>>* local_table_ = nullptr;  // v4 header table
-    std::vector<std::pair<std::uint32_t, std::size_t>> local_index_;           // sorted (code, position)
+    // Sorted (code, position), built only for a table longer than kLinearLocalTable (a small table is
+    // searched in place: no allocation per message).
+    std::vector<std::pair<std::uint32_t, std::size_t>> local_index_;
+    static constexpr std::size_t kLinearLocalTable = 16;
 };
+
+/// Drops what a message's string table left in its header once its entries hold plain strings
+/// (DecodeContext::keep_string_table_codes false): the local table and the STRING_TABLE flag.
+void forget_string_table(MessageHeader& header) noexcept;
 
 /// Whether children of an element of type `t` carry element numbers in CORE (wire.md §3.2).
 constexpr bool has_numbered_children(DataTypes t) noexcept {

@@ -32,6 +32,7 @@ Result<MessageHeaderInfo> decode_message_header(std::span<const std::byte> messa
     ByteReader body;
     MessageHeaderInfo info;
     if (auto ok = decoder.read_header(body, info, info.header); !ok) return ok.take_error();
+    if (context && !context->keep_string_table_codes) detail::forget_string_table(info.header);
     return info;
 }
 
@@ -55,10 +56,17 @@ Result<void> decode_message_into(Message& out, const SharedBytes& buffer, const 
     MessageHeaderInfo info;
     if (auto ok = decoder.read_header(body, info, out.header); !ok) return ok;
     out.version = info.version;
-    return decoder.read_entries(info, out.header, body, out.entries);
+    if (auto ok = decoder.read_entries(info, out.header, body, out.entries); !ok) return ok;
+    if (context && !context->keep_string_table_codes) detail::forget_string_table(out.header);
+    return {};
 }
 
 namespace detail {
+
+void forget_string_table(MessageHeader& header) noexcept {
+    header.string_table.clear();
+    if (header.v4_flags) *header.v4_flags &= static_cast<std::uint8_t>(~message_flags::string_table);
+}
 
 Result<void> MessageDecoder::read_header(ByteReader& body, MessageHeaderInfo& info, MessageHeader& header) {
     auto size = read_message_preamble(message_, limits_);
@@ -92,8 +100,8 @@ Result<void> MessageDecoder::read_entries(const MessageHeaderInfo& info, const M
                      std::to_string(info.entry_count) + " entries over limit " + std::to_string(limits_.max_entries));
     const std::size_t min_entry = version_ == 2 ? 22 : 5;
     if (auto c = check_count(body, info.entry_count, min_entry, false, "entries"); !c) return c.take_error();
-    if (version_ == 4 && !header.string_table.empty()) {
-        local_table_ = &header.string_table;
+    if (version_ == 4 && !header.string_table.empty()) local_table_ = &header.string_table;
+    if (local_table_ && local_table_->size() > kLinearLocalTable) {
         local_index_.reserve(local_table_->size());
         for (std::size_t i = 0; i < local_table_->size(); ++i) local_index_.emplace_back((*local_table_)[i].first, i);
         // CORE keeps the first definition of a duplicated code.

@@ -21,7 +21,8 @@
 // What the model records so that re-encoding is byte-identical (for inputs written with CORE's
 // rules, i.e. shortest varints and CORE's entry/element flag choices):
 //  * v4 header flags are kept in MessageHeader::v4_flags, string-table codes in the *_code fields,
-//    the local table in MessageHeader::string_table (wire order), Extended blobs as bytes.
+//    the local table in MessageHeader::string_table (wire order), Extended blobs as bytes. (Not with a
+//    DecodeContext whose keep_string_table_codes is false: then only the resolved strings remain.)
 //  * Element numbers: v4 ELEMENT_NUMBER → MessageElement::number (name empty). In v2 a decimal
 //    name is read back as a number (name cleared) only where CORE writes numbers: children of
 //    vector_t, list_t and pod_array_t, and the top-level elements of PipePacketRet entries
@@ -51,6 +52,13 @@ struct DecodeContext {
     /// STANDARD_TABLE capability was negotiated); otherwise they are a ProtocolError, as in CORE.
     /// Odd codes always use the message's own table. Without a context both are accepted.
     bool standard_string_table = true;
+    /// Whether the *_code fields, MessageHeader::string_table and the STRING_TABLE flag of
+    /// MessageHeader::v4_flags keep what was on the wire (so the message re-encodes byte-identical).
+    /// A connection sets this false, as CORE's receiver does (StringTable::MessageReplaceCodesWithStrings):
+    /// codes name strings only within the message and connection they came in, so its entries then
+    /// hold plain strings and may be forwarded, stored or re-encoded for any other connection
+    /// (wire.md §2.6). Without a context codes are kept.
+    bool keep_string_table_codes = true;
 };
 
 /// "RRAC" + uint32 MessageSize: the first bytes of every message on a stream (wire.md §6).

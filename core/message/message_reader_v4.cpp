@@ -106,20 +106,25 @@ Result<void> MessageDecoder::read_header_v4(ByteReader& r, MessageHeaderInfo& in
     return {};
 }
 
-Result<std::string> MessageDecoder::resolve_code(std::uint32_t code) const {
+Result<std::string_view> MessageDecoder::resolve_code(std::uint32_t code) const {
     if (code & 1u) {
-        auto it = std::lower_bound(local_index_.begin(), local_index_.end(), code,
-                                   [](const auto& e, std::uint32_t c) { return e.first < c; });
-        if (it == local_index_.end() || it->first != code)
-            return fail(MessageErrorType::ProtocolError, "unknown local string table code " + std::to_string(code));
-        return (*local_table_)[it->second].second;
+        if (local_table_ && local_index_.empty()) {
+            // Small table: the first definition in wire order wins, as with the index below.
+            for (const auto& [c, text] : *local_table_)
+                if (c == code) return std::string_view(text);
+        } else {
+            auto it = std::lower_bound(local_index_.begin(), local_index_.end(), code,
+                                       [](const auto& e, std::uint32_t c) { return e.first < c; });
+            if (it != local_index_.end() && it->first == code) return std::string_view((*local_table_)[it->second].second);
+        }
+        return fail(MessageErrorType::ProtocolError, "unknown local string table code " + std::to_string(code));
     }
     if (context_ && !context_->standard_string_table)
         return fail(MessageErrorType::ProtocolError, "string table code " + std::to_string(code) +
                                                          " without a negotiated standard table");
     auto s = standard_string_for_code(code);
     if (!s) return fail(MessageErrorType::ProtocolError, "unknown string table code " + std::to_string(code));
-    return std::string(*s);
+    return *s;
 }
 
 Result<void> MessageDecoder::read_entry_v4(ByteReader& r, MessageEntry& entry) {
@@ -146,8 +151,8 @@ Result<void> MessageDecoder::read_entry_v4(ByteReader& r, MessageEntry& entry) {
         if (!code) return bad("entry truncated");
         auto s = resolve_code(*code);
         if (!s) return error(MessageErrorType::ProtocolError, *er, s.error().message);
-        entry.service_path = std::move(*s);
-        entry.service_path_code = *code;
+        entry.service_path.assign(*s);
+        if (keep_codes()) entry.service_path_code = *code;
     }
     if ((f & entry_flags::member_name_str) && !read_xlen_string(*er, entry.member_name))
         return bad("MemberName past EntrySize");
@@ -156,8 +161,8 @@ Result<void> MessageDecoder::read_entry_v4(ByteReader& r, MessageEntry& entry) {
         if (!code) return bad("entry truncated");
         auto s = resolve_code(*code);
         if (!s) return error(MessageErrorType::ProtocolError, *er, s.error().message);
-        entry.member_name = std::move(*s);
-        entry.member_name_code = *code;
+        entry.member_name.assign(*s);
+        if (keep_codes()) entry.member_name_code = *code;
     }
     if (f & entry_flags::request_id) {
         auto id = read_uint_x(*er);
@@ -205,8 +210,8 @@ Result<void> MessageDecoder::read_element_v4(ByteReader& r, MessageElement& e, s
         if (!code) return bad("element truncated");
         auto s = resolve_code(*code);
         if (!s) return error(MessageErrorType::ProtocolError, *er, s.error().message);
-        e.name = std::move(*s);
-        e.name_code = *code;
+        e.name.assign(*s);
+        if (keep_codes()) e.name_code = *code;
     }
     if (f & element_flags::element_number) {
         auto n = read_int_x(*er);
@@ -223,8 +228,8 @@ Result<void> MessageDecoder::read_element_v4(ByteReader& r, MessageElement& e, s
         if (!code) return bad("element truncated");
         auto s = resolve_code(*code);
         if (!s) return error(MessageErrorType::ProtocolError, *er, s.error().message);
-        e.type_name = std::move(*s);
-        e.type_name_code = *code;
+        e.type_name.assign(*s);
+        if (keep_codes()) e.type_name_code = *code;
     }
     if ((f & element_flags::meta_info) && !read_xlen_string(*er, e.metadata)) return bad("MetaData past ElementSize");
     if ((f & element_flags::extended) && !read_xlen_string(*er, e.extended)) return bad("Extended past ElementSize");

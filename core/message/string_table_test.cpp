@@ -134,3 +134,156 @@ TEST_CASE("message: apply_string_table honours the negotiated tables and CORE's 
     REQUIRE(back);
     CHECK(back->entries == m.entries);
 }
+
+namespace {
+
+// `sample()` as a peer with string tables sends it: standard and message-local codes (wire.md 2.6),
+// the local table bigger than the decoder's small-table bound when `long_table` is set.
+SharedBytes coded_sample(bool long_table) {
+    Message m = sample();
+    if (long_table)
+        for (int i = 0; i < 20; ++i) {
+            MessageElement el;
+            el.name = "field_" + std::to_string(i);
+            el.type = DataTypes::void_t;
+            m.entries[0].elements.push_back(el);
+        }
+    apply_string_table(m, StringTableOptions{});
+    REQUIRE(m.header.string_table.size() == (long_table ? 22u : 2u));
+    auto bytes = encode_message(m);
+    REQUIRE(bytes);
+    return *bytes;
+}
+
+bool has_codes(const MessageElement& e) {
+    if (e.name_code || e.type_name_code) return true;
+    for (const auto& c : e.elements)
+        if (has_codes(c)) return true;
+    return false;
+}
+
+bool has_codes(const MessageEntry& e) {
+    if (e.service_path_code || e.member_name_code) return true;
+    for (const auto& c : e.elements)
+        if (has_codes(c)) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST_CASE("message: a connection's decoder resolves string-table codes and keeps none (wire.md 2.6)") {
+    for (bool long_table : {false, true}) {
+        INFO("local table longer than the decoder's linear bound: " << long_table);
+        const SharedBytes coded = coded_sample(long_table);
+        DecodeContext connection;
+        connection.keep_string_table_codes = false;
+        auto m = decode_message(coded, {}, &connection);
+        REQUIRE(m);
+        REQUIRE(m->entries.size() == 1);
+        const MessageEntry& e = m->entries[0];
+        CHECK_FALSE(has_codes(e));
+        CHECK(m->header.string_table.empty());
+        REQUIRE(m->header.v4_flags);
+        CHECK_FALSE(*m->header.v4_flags & message_flags::string_table);
+        // Every name is the sender's text.
+        CHECK(e.member_name == "CreateConnection");
+        CHECK(e.service_path.empty());
+        CHECK(e.elements[0].name == "capabilities");
+        CHECK(e.elements[1].name == "my_struct_field");
+        CHECK(e.elements[1].type_name == "experimental.demo.Point");
+        CHECK(e.elements[1].elements[1].name == "my_struct_field");
+        if (long_table) CHECK(e.elements.back().name == "field_19");
+        Message plain = sample();
+        CHECK(e.elements[0] == plain.entries[0].elements[0]);
+        CHECK(e.elements[1] == plain.entries[0].elements[1]);
+
+        // The entry travels in another message, alone or fanned out (encode_entry), in either format,
+        // and reads back the same: with its codes kept, its local codes are defined nowhere.
+        for (std::uint16_t version : {std::uint16_t{4}, std::uint16_t{2}}) {
+            Message forward;
+            forward.version = version;
+            forward.entries.push_back(e);
+            auto bytes = encode_message(forward);
+            REQUIRE(bytes);
+            auto back = decode_message(*bytes);
+            REQUIRE(back);
+            if (version == 4) {
+                CHECK(back->entries == forward.entries);
+            } else {  // v2 writes the struct's numbered child as a name "0": compare the names only
+                CHECK(back->entries[0].member_name == "CreateConnection");
+                CHECK(back->entries[0].elements[1].type_name == "experimental.demo.Point");
+                CHECK(back->entries[0].elements[1].elements[1].name == "my_struct_field");
+            }
+            std::vector<std::byte> alone;
+            CHECK(encode_entry(e, version, alone));
+        }
+
+        // Without a context (or with the default one) the codes stay, for byte-identical re-encoding.
+        auto kept = decode_message(coded);
+        REQUIRE(kept);
+        CHECK(has_codes(kept->entries[0]));
+        CHECK(*encode_message(*kept) == coded);
+        Message forward_kept;
+        forward_kept.version = 4;
+        forward_kept.entries.push_back(kept->entries[0]);
+        auto refused = encode_message(forward_kept);
+        REQUIRE_FALSE(refused);
+        CHECK(refused.error().message.find("is not defined") != std::string::npos);
+
+        // The header-only decode drops the table too.
+        auto header = decode_message_header(coded.bytes(), {}, &connection);
+        REQUIRE(header);
+        CHECK(header->header.string_table.empty());
+        CHECK_FALSE(*header->header.v4_flags & message_flags::string_table);
+    }
+}
+
+TEST_CASE("message: resolving codes keeps CORE's rules: first definition wins, unknown codes refused") {
+    for (std::size_t extra : {std::size_t{0}, std::size_t{30}}) {
+        INFO("extra table entries: " << extra);
+        Message m;
+        m.version = 4;
+        MessageEntry e;
+        e.entry_type = MessageEntryType::PropertyGetReq;
+        e.member_name = "first";
+        e.member_name_code = 5;
+        e.service_path = "svc";
+        e.service_path_code = 7;
+        m.entries.push_back(e);
+        for (std::size_t i = 0; i < extra; ++i) m.header.string_table.emplace_back(101 + 2 * i, "x" + std::to_string(i));
+        m.header.string_table.emplace_back(5, "first");
+        m.header.string_table.emplace_back(7, "svc");
+        m.header.string_table.emplace_back(5, "second");  // a duplicate: CORE keeps the first
+        auto bytes = encode_message(m);
+        REQUIRE(bytes);
+        DecodeContext connection;
+        connection.keep_string_table_codes = false;
+        auto back = decode_message(*bytes, {}, &connection);
+        REQUIRE(back);
+        CHECK(back->entries[0].member_name == "first");
+        CHECK(back->entries[0].service_path == "svc");
+        CHECK_FALSE(back->entries[0].member_name_code);
+
+        // A code the message's table lacks is a protocol error (CORE: "Invalid local string table code").
+        Message bad = m;
+        bad.entries[0].member_name_code = 9;
+        bad.header.string_table.emplace_back(9, "nine");
+        auto bad_bytes = encode_message(bad);
+        REQUIRE(bad_bytes);
+        auto raw = bad_bytes->bytes();
+        std::vector<std::byte> patched(raw.begin(), raw.end());
+        // Rename code 9 in the table to 11 so the entry's 9 is undefined (the table is in the header).
+        bool renamed = false;
+        for (std::size_t i = 0; i + 5 < patched.size(); ++i)
+            if (patched[i] == std::byte{9} && patched[i + 1] == std::byte{4} && patched[i + 2] == std::byte{'n'}) {
+                patched[i] = std::byte{11};
+                renamed = true;
+                break;
+            }
+        REQUIRE(renamed);
+        auto refused = decode_message(SharedBytes::copy_of(std::span<const std::byte>(patched)), {}, &connection);
+        REQUIRE_FALSE(refused);
+        CHECK(refused.error().type == MessageErrorType::ProtocolError);
+        CHECK(refused.error().message.find("unknown local string table code 9") != std::string::npos);
+    }
+}

@@ -286,7 +286,7 @@ TEST_CASE("properties: get and set typed by the robdef, direction and member che
             r.elements.push_back(point_element("value", 1, -1));
         } else if (e.entry_type == MessageEntryType::PropertySetReq) {
             sets.push_back(e);
-            if (e.member_name == "where") return error_reply(e, RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "no", ""});
+            if (e.member_name == "where") return error_reply(e, RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "no", "", nullptr});
         } else {
             return std::nullopt;
         }
@@ -350,7 +350,7 @@ TEST_CASE("functions: positional arguments, return, void, argument count, user e
             REQUIRE(read_scalar(*e.find("b"), b));
             r.elements.push_back(make_scalar_element("return", a + b));
         } else if (e.member_name == "fault") {
-            return error_reply(e, RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "broken", ""});
+            return error_reply(e, RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "broken", "", nullptr});
         } else {
             r.elements.push_back(make_scalar_element<std::int32_t>("return", 0));
         }
@@ -600,7 +600,7 @@ TEST_CASE("callbacks: the handler's result or error becomes the CallbackCallRet"
     CHECK(v == 3.0);
 
     REQUIRE(f.c.set_callback("svc", "scale", [](std::vector<Value>&) -> Result<Value> {
-        return fail(RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "client says no", ""});
+        return fail(RRError{MessageErrorType::RemoteError, "example.ctx.Fault", "client says no", "", nullptr});
     }));
     f.s.send(call, f.t0);
     f.run();

@@ -141,6 +141,10 @@ public:
     std::size_t pending_output_size() const noexcept { return stream_.pending_output_size(); }
     std::optional<MonoTime> next_deadline() const;
     void on_timer(MonoTime now);
+    /// See StreamConnection::set_liveness_probe.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout, MonoTime now) {
+        stream_.set_liveness_probe(timeout, now);
+    }
     std::optional<ServiceSessionEvent> poll_event();
     /// Every queued event at once, oldest first, into `batch` (its old events are destroyed first; see
     /// EventQueue::take_all), to handle in place. Events queued while handling them wait for the next call.

@@ -501,8 +501,13 @@ std::optional<MonoTime> StreamConnection::next_deadline() const {
     switch (state_) {
         case State::closed: return std::nullopt;
         case State::negotiating: return started_ + config_.connect_timeout;
-        case State::connected:
-            return std::min(last_send_ + config_.heartbeat_period, last_receive_ + config_.receive_timeout);
+        case State::connected: {
+            MonoTime next = std::min(last_send_ + config_.heartbeat_period, last_receive_ + config_.receive_timeout);
+            if (probe_timeout_)
+                next = std::min({next, last_probe_ + *probe_timeout_ / 5,
+                                 std::max(last_receive_, probe_started_) + *probe_timeout_});
+            return next;
+        }
     }
     return std::nullopt;
 }
@@ -518,6 +523,22 @@ void StreamConnection::on_timer(MonoTime now) {
         close(make_error(MessageErrorType::ConnectionError, "receive timeout: peer silent"));
         return;
     }
+    if (probe_timeout_) {
+        if (now - std::max(last_receive_, probe_started_) >= *probe_timeout_) {
+            close(make_error(MessageErrorType::ConnectionError,
+                             "no answer to the liveness probe within " + std::to_string(probe_timeout_->count()) + " ms"));
+            return;
+        }
+        if (now - last_probe_ >= *probe_timeout_ / 5) {
+            last_probe_ = now;
+            MessageEntry e;
+            e.entry_type = MessageEntryType::ConnectionTest;
+            Message m = single_entry_message(std::move(e));
+            m.header.sender_node_id = config_.local_node_id;
+            (void)queue(m, send_version(), now, false);
+            return;
+        }
+    }
     if (now - last_send_ >= config_.heartbeat_period) {
         MessageEntry e;
         e.entry_type = MessageEntryType::ConnectionTest;
@@ -527,12 +548,25 @@ void StreamConnection::on_timer(MonoTime now) {
     }
 }
 
+void StreamConnection::set_liveness_probe(std::optional<std::chrono::milliseconds> timeout, MonoTime now) {
+    if (timeout && (state_ != State::connected || timeout->count() <= 0)) return;
+    if (timeout && probe_timeout_) {
+        probe_timeout_ = timeout;  // already probing: the new bound from the same start
+        return;
+    }
+    probe_timeout_ = timeout;
+    probe_started_ = now;
+    last_probe_ = now - (timeout ? *timeout : std::chrono::milliseconds(0));  // the first probe at once
+}
+
 DecodeContext StreamConnection::decode_context() const noexcept {
     DecodeContext c;
     c.local_node_id = config_.local_node_id;
     c.remote_node_id = negotiated_.remote_node_id;
     c.local_endpoint = local_endpoint_;
     c.remote_endpoint = remote_endpoint_;
+    // Codes are the sending connection's business: entries handed up hold plain strings (wire.md §2.6).
+    c.keep_string_table_codes = false;
     return c;
 }
 

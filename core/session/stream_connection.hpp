@@ -82,8 +82,9 @@ struct StreamConnected {
     bool connect_combined = false;  ///< the peer supports ConnectClientCombined
 };
 
-/// A message for the layer above (never transport-internal entries). `frame` holds the exact bytes
-/// received, for zero-copy forwarding.
+/// A message for the layer above (never transport-internal entries), its names resolved from string-table
+/// codes. `frame` holds the exact bytes received, for zero-copy forwarding; they may hold string-table
+/// codes (wire.md §2.6), which only a peer that negotiated the same tables may be sent.
 struct StreamMessage {
     Message message;
     SharedBytes frame;
@@ -154,12 +155,21 @@ public:
     std::optional<MonoTime> next_deadline() const;
     void on_timer(MonoTime now);
 
+    /// A short liveness probe of the peer (the gateway while a client holds a motion without a timeout
+    /// of its own: docs/security.md "Motion safety"): from `now` on, a ConnectionTest is sent every
+    /// `timeout` / 5 whatever else is sent (a peer answers each with ConnectionTestRet, wire.md §6.3),
+    /// and the connection closes (ConnectionError "no answer to the liveness probe …") when nothing at
+    /// all arrives for `timeout`, counted from `now` at the earliest. nullopt: off (the heartbeat and
+    /// receive timeout of the config apply again). Ignored unless connected.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout, MonoTime now);
+
     bool is_connected() const noexcept { return state_ == State::connected; }
     bool is_closed() const noexcept { return state_ == State::closed; }
     const StreamConnected& negotiated() const noexcept { return negotiated_; }
     StreamRole role() const noexcept { return role_; }
     const StreamConfig& config() const noexcept { return config_; }
-    /// DecodeContext for v4 messages without routing info.
+    /// DecodeContext for v4 messages without routing info; string-table codes are resolved and not
+    /// kept (DecodeContext::keep_string_table_codes), so received entries can go to any connection.
     DecodeContext decode_context() const noexcept;
     std::uint16_t send_version() const noexcept { return negotiated_.message4 ? 4 : 2; }
 
@@ -210,6 +220,9 @@ private:
     MonoTime started_;
     MonoTime last_send_;
     MonoTime last_receive_;
+    std::optional<std::chrono::milliseconds> probe_timeout_;  // set_liveness_probe
+    MonoTime probe_started_{};
+    MonoTime last_probe_{};
     bool session_established_ = false;
     std::uint32_t local_endpoint_ = 0;
     std::uint32_t remote_endpoint_ = 0;

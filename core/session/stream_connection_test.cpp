@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "core/message/message_writer.hpp"
+#include "core/message/string_table.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/stream_connection.hpp"
 #include "test/support/skip.hpp"
@@ -183,6 +184,74 @@ TEST_CASE("heartbeats keep a connection alive, silence closes it") {
     CHECK(client.is_closed());
 }
 
+TEST_CASE("the liveness probe: a ConnectionTest every bound / 5 whatever else is sent, closed without answers") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    REQUIRE(server.is_connected());
+    const MonoTime t1 = t0 + 1s;
+    server.set_liveness_probe(500ms, t1);
+    // The first probe at once, then every 100 ms; the client answers each.
+    MonoTime now = t1;
+    for (int i = 0; i < 10; ++i) {
+        auto d = server.next_deadline();
+        REQUIRE(d);
+        CHECK(*d <= now + 100ms);
+        now = std::max(now, *d);
+        server.on_timer(now);
+        auto ping = drain(server);
+        REQUIRE_FALSE(ping.empty());
+        REQUIRE(client.feed(ping, now));
+        auto pong = drain(client);
+        REQUIRE_FALSE(pong.empty());
+        REQUIRE(server.feed(pong, now + 5ms));
+        CHECK(server.is_connected());
+    }
+    // Busy sending (a wire value each 10 ms) does not hold the probe back.
+    const MonoTime t2 = now;
+    Message m;
+    m.header.sender_node_id = kServerId;
+    server.set_session_established(1, 2);
+    MessageEntry e;
+    e.entry_type = MessageEntryType::EventReq;
+    e.service_path = "svc";
+    e.member_name = "ev";
+    m.entries.push_back(e);
+    int probes = 0;
+    for (auto t = t2 + 10ms; t <= t2 + 400ms; t += 10ms) {
+        REQUIRE(server.send(m, t));
+        (void)drain(server);
+        if (server.next_deadline() && *server.next_deadline() <= t) {
+            server.on_timer(t);
+            auto out = drain(server);
+            if (!out.empty()) ++probes;
+        }
+        if (server.is_closed()) break;
+    }
+    CHECK(probes >= 3);
+    // No answer for the bound after the last one: closed, naming the probe.
+    server.on_timer(t2 + 5ms + 500ms);
+    auto closed = next_event<StreamClosed>(server);
+    REQUIRE(closed);
+    CHECK(closed->error.type == MessageErrorType::ConnectionError);
+    CHECK(closed->error.message.find("liveness probe") != std::string::npos);
+}
+
+TEST_CASE("the liveness probe off: the usual heartbeat and receive timeout again") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    server.set_liveness_probe(500ms, t0);
+    server.set_liveness_probe(std::nullopt, t0 + 100ms);
+    server.on_timer(t0 + 5s);
+    CHECK(server.is_connected());
+    CHECK(drain(server).empty());  // no probe, no heartbeat before 12 s
+    REQUIRE(server.next_deadline());
+    CHECK(*server.next_deadline() == t0 + 12s);
+}
+
 TEST_CASE("an unanswered CreateConnection times out") {
     MonoTime t0{};
     StreamConnection client(StreamRole::client, client_config(), t0);
@@ -342,4 +411,87 @@ TEST_CASE("a large payload leaves a connection spliced into its output and arriv
         REQUIRE(got->message.entries.size() == 1);
         CHECK(got->message.entries[0] == wire);
     }
+}
+
+TEST_CASE("entries from a peer that uses string-table codes can be sent on another connection (wire.md 2.6)") {
+    MonoTime t0{};
+    // Upstream: a device that leaves the string table on (as the official TcpTransport can): both
+    // sides negotiate it, and the device sends names as standard and message-local codes.
+    StreamConfig device_config = server_config();
+    device_config.enable_string_table = true;
+    StreamConnection upstream(StreamRole::client, client_config(), t0);
+    StreamConnection device(StreamRole::server, device_config, t0);
+    pump(upstream, device, t0);
+    auto negotiated = next_event<StreamConnected>(upstream);
+    REQUIRE(negotiated);
+    CHECK(negotiated->string_table);
+    upstream.set_session_established(5, 9);
+    device.set_session_established(9, 5);
+
+    Message event;
+    event.header.sender_node_id = kServerId;
+    event.header.receiver_node_id = kClientId;
+    event.header.sender_endpoint = 9;
+    event.header.receiver_endpoint = 5;
+    MessageEntry e;
+    e.entry_type = MessageEntryType::EventReq;
+    e.service_path = "svc.child";
+    e.member_name = "thenable";
+    MessageElement value = make_array_element("value", std::span<const double>(std::vector<double>{1.5}));
+    MessageElement s;
+    s.name = "point";
+    s.type = DataTypes::structure_t;
+    s.type_name = "experimental.demo.Point";
+    s.elements.push_back(make_array_element("x", std::span<const double>(std::vector<double>{2.5})));
+    e.elements.push_back(value);
+    e.elements.push_back(s);
+    event.entries.push_back(e);
+    Message coded = event;
+    apply_string_table(coded, StringTableOptions{});
+    REQUIRE(coded.entries[0].member_name_code);
+    REQUIRE_FALSE(coded.header.string_table.empty());
+    REQUIRE(device.send(coded, t0));
+    REQUIRE(upstream.feed(drain(device), t0));
+    auto got = next_event<StreamMessage>(upstream);
+    REQUIRE(got);
+    REQUIRE(got->message.entries.size() == 1);
+    const MessageEntry& received = got->message.entries[0];
+    CHECK(received.member_name == "thenable");
+    CHECK(received.service_path == "svc.child");
+    CHECK_FALSE(received.member_name_code);
+    CHECK_FALSE(received.service_path_code);
+    CHECK_FALSE(received.elements[1].type_name_code);
+    CHECK(got->message.header.string_table.empty());
+    CHECK(received.elements == e.elements);
+
+    // Downstream: a client of ours (a stock server side: no string table) gets the entry re-addressed.
+    StreamConnection downstream(StreamRole::server, server_config(), t0);
+    StreamConnection browser(StreamRole::client, client_config(), t0);
+    pump(browser, downstream, t0);
+    REQUIRE(downstream.is_connected());
+    downstream.set_session_established(9, 5);
+    browser.set_session_established(5, 9);
+    Message forward;
+    forward.header.sender_node_id = kServerId;
+    forward.header.receiver_node_id = kClientId;
+    forward.header.sender_endpoint = 9;
+    forward.header.receiver_endpoint = 5;
+    forward.entries.push_back(received);
+    forward.entries[0].service_path = "gateway.child";
+    REQUIRE(downstream.send(forward, t0));
+    // Fanned out as one encoded entry as well.
+    Message header = forward;
+    header.entries.clear();
+    EncodedEntry shared(received);
+    REQUIRE(downstream.send(std::move(header), shared, t0));
+    REQUIRE(browser.feed(drain(downstream), t0));
+    auto first = next_event<StreamMessage>(browser);
+    auto second = next_event<StreamMessage>(browser);
+    REQUIRE(first);
+    REQUIRE(second);
+    CHECK(first->message.entries.at(0).service_path == "gateway.child");
+    CHECK(first->message.entries.at(0).member_name == "thenable");
+    CHECK(first->message.entries.at(0).elements == e.elements);
+    CHECK(second->message.entries.at(0).service_path == "svc.child");
+    CHECK(second->message.entries.at(0).elements == e.elements);
 }

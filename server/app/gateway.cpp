@@ -1,4 +1,6 @@
 #include "server/app/gateway.hpp"
+
+#include "server/gateway/motion_guard.hpp"
 #include "server/app/gateway_auth_config.hpp"
 #include "server/record/replay_routes.hpp"
 #include "server/gateway/mirror_service.hpp"
@@ -332,7 +334,8 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         for (const auto& r : g->replays_) r->start();
     }
 
-    for (const auto& d : devices) {
+    for (auto d : devices) {
+        d.safety = c.safety.for_device(d.name);  // motion safety (docs/security.md "Motion safety")
         auto m = gateway::DeviceMirror::create(g->node_, d);
         if (!m) return m.take_error();
         // The gateway's roles apply to every device. A passthrough device checks its clients' passwords
@@ -420,6 +423,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
                                                    [self](const std::string& name) { return self->device(name) != nullptr; });
         g->discovered_->set_api(json_api);
         g->discovered_->set_auth(g->auth_);
+        g->discovered_->set_safety(c.safety);
         if (json_api) {
             std::weak_ptr<DiscoveredDevices> weak = g->discovered_;
             gateway::JsonApi::DiscoveryHooks hooks;
@@ -466,6 +470,11 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
                 "device " + s.name + ": " + std::string(gateway::device_state_name(s.state)) +
                     (s.reason.empty() ? "" : " (" + s.reason + ")"), LogContext{.device = s.name});
         });
+        // What the motion guard did (a clamp, a refusal, a stop of its own): docs/security.md "Motion safety".
+        if (const auto& guard = d->motion())
+            guard->set_event_listener([name = d->config().name](const std::string& what) {
+                log(LogLevel::info, "motion safety: " + what, LogContext{.device = name});
+            });
         d->start();
     }
     if (g->recordings_)

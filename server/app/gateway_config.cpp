@@ -323,6 +323,89 @@ void parse_usb(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
     }
 }
 
+// A duration in seconds between 0.05 and 10 (safety.hold_to_run_max_s).
+std::chrono::milliseconds bound_seconds(const YAML::Node& n, const Reader& r, const std::string& key) {
+    double v = 0;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !(v >= 0.05 && v <= 10))
+        r.error(n, key, "expected seconds between 0.05 and 10");
+    return std::chrono::milliseconds(static_cast<std::int64_t>(v * 1000 + 0.5));
+}
+
+// `safety:` (docs/gateway-config.md "Motion safety").
+void parse_safety(const YAML::Node& root, const Reader& r, GatewayConfig& c) {
+    auto sn = root["safety"];
+    if (!sn) return;
+    r.check_keys(sn, "safety", {"hold_to_run_max_s", "standard_robot", "hold_to_run", "motions", "streams", "stops"});
+    auto& s = c.safety;
+    if (auto n = sn["hold_to_run_max_s"]) s.hold_to_run_max = bound_seconds(n, r, "safety.hold_to_run_max_s");
+    if (auto n = sn["standard_robot"]) s.standard_robot = r.boolean(n, "safety.standard_robot");
+    // Each list: entries naming a device and a member of its root object, plus their own keys.
+    auto each = [&](const char* list, const std::set<std::string>& keys, auto&& add) {
+        auto l = sn[list];
+        if (!l) return;
+        const std::string lk = std::string("safety.") + list;
+        if (!l.IsSequence()) r.error(l, lk, "expected a list of {device, member, …}");
+        std::size_t i = 0;
+        for (const auto& e : l) {
+            const std::string key = lk + "[" + std::to_string(i++) + "]";
+            std::set<std::string> allowed = keys;
+            allowed.insert({"device", "member"});
+            r.check_keys(e, key, allowed);
+            if (!e["device"]) r.error(e, key + ".device", "missing");
+            if (!e["member"]) r.error(e, key + ".member", "missing");
+            const std::string device = r.string(e["device"], key + ".device");
+            const std::string member = r.string(e["member"], key + ".member");
+            if (device.empty()) r.error(e["device"], key + ".device", "must not be empty");
+            if (member.empty()) r.error(e["member"], key + ".member", "must not be empty");
+            add(e, key, device, member);
+        }
+    };
+    each("hold_to_run", {"timeout_arg", "timeout_unit"}, [&](const YAML::Node& e, const std::string& key, const std::string& device,
+                                                             const std::string& member) {
+        if (!e["timeout_arg"]) r.error(e, key + ".timeout_arg", "missing (the argument that is the call's timeout)");
+        gateway::HoldToRunMember h{member, r.string(e["timeout_arg"], key + ".timeout_arg"), 1.0};
+        if (auto n = e["timeout_unit"]) {
+            const auto unit = r.string(n, key + ".timeout_unit");
+            if (unit == "ms")
+                h.unit_s = 0.001;
+            else if (unit != "s")
+                r.error(n, key + ".timeout_unit", "expected s or ms");
+        }
+        s.hold_to_run.push_back({device, std::move(h)});
+    });
+    each("motions", {"wait_arg"}, [&](const YAML::Node& e, const std::string& key, const std::string& device, const std::string& member) {
+        gateway::UntimedMotionMember m{member, {}};
+        if (auto n = e["wait_arg"]) m.wait_arg = r.string(n, key + ".wait_arg");
+        s.motions.push_back({device, std::move(m)});
+    });
+    each("streams", {}, [&](const YAML::Node&, const std::string&, const std::string& device, const std::string& member) {
+        s.streams.push_back({device, member});
+    });
+    each("stops", {"value"}, [&](const YAML::Node& e, const std::string& key, const std::string& device, const std::string& member) {
+        gateway::StopMember stop{member, std::nullopt};
+        if (auto n = e["value"]) {
+            double v = 0;
+            bool b = false;
+            if (n.IsScalar() && YAML::convert<double>::decode(n, v))
+                stop.value = v;
+            else if (n.IsScalar() && YAML::convert<bool>::decode(n, b))
+                stop.value = b ? 1 : 0;
+            else
+                r.error(n, key + ".value", "expected a number (an enum's value as its number) or true/false");
+        }
+        s.stops.push_back({device, std::move(stop)});
+    });
+}
+
+// devices[].safety: the device's own bound and standard-robot switch.
+void parse_device_safety(const YAML::Node& n, const Reader& r, const std::string& key, GatewayConfig& c, const std::string& device) {
+    r.check_keys(n, key, {"hold_to_run_max_s", "standard_robot"});
+    SafetyConfig::Override o;
+    if (auto x = n["hold_to_run_max_s"]) o.hold_to_run_max = bound_seconds(x, r, key + ".hold_to_run_max_s");
+    if (auto x = n["standard_robot"]) o.standard_robot = r.boolean(x, key + ".standard_robot");
+    c.safety.overrides[device] = o;
+}
+
 std::vector<std::string> patterns(const YAML::Node& n, const Reader& r, const std::string& key) {
     std::vector<std::string> out = n.IsSequence() ? r.string_list(n, key) : std::vector<std::string>{r.string(n, key)};
     if (out.empty()) r.error(n, key, "empty list (use \"*\" for all)");
@@ -543,7 +626,7 @@ void parse_replay_device(const YAML::Node& d, const Reader& r, GatewayConfig& c,
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings", "safety"});
     if (auto n = root["recordings"]) parse_recordings(n, r, c.recordings);
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
@@ -620,7 +703,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             }
             r.check_keys(d, "devices[]", {"name", "url", "username", "password", "required", "backoff_max_ms", "tls_ca",
                                           "tls_certificate", "tls_private_key", "auth", "max_passthrough_sessions",
-                                          "json_api_requires_device_login", "replay"});
+                                          "json_api_requires_device_login", "replay", "safety"});
             gateway::DeviceConfig dc;
             if (!d["name"]) r.error(d, "devices[].name", "missing");
             if (!d["url"]) r.error(d, "devices[].url", "missing");
@@ -660,16 +743,37 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             if (auto n = d["backoff_max_ms"])
                 dc.backoff_max = std::chrono::milliseconds(r.unsigned_int(n, key + ".backoff_max_ms", 3600000));
             if (!names.insert(dc.name).second) r.error(d["name"], key, "duplicate device name");
+            if (auto n = d["safety"]) parse_device_safety(n, r, key + ".safety", c, dc.name);
             c.devices.push_back(std::move(dc));
         }
     }
     parse_discovery(root, r, c);
     parse_usb(root, r, c);
     parse_record(root, r, c);
+    parse_safety(root, r, c);
     return c;
 }
 
 }  // namespace
+
+gateway::MotionSafety SafetyConfig::for_device(std::string_view name) const {
+    gateway::MotionSafety m;
+    m.hold_to_run_max = hold_to_run_max;
+    m.standard_robot = standard_robot;
+    if (auto it = overrides.find(std::string(name)); it != overrides.end()) {
+        if (it->second.hold_to_run_max) m.hold_to_run_max = *it->second.hold_to_run_max;
+        if (it->second.standard_robot) m.standard_robot = *it->second.standard_robot;
+    }
+    for (const auto& h : hold_to_run)
+        if (h.device == name) m.hold_to_run.push_back(h.rule);
+    for (const auto& x : motions)
+        if (x.device == name) m.motions.push_back(x.rule);
+    for (const auto& x : streams)
+        if (x.device == name) m.streams.push_back(x.rule);
+    for (const auto& x : stops)
+        if (x.device == name) m.stops.push_back(x.rule);
+    return m;
+}
 
 bool usb_wanted(const GatewayConfig& config) {
     switch (config.usb.enabled) {

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -119,6 +120,31 @@ struct ReplayDeviceConfig {
     bool paused = false; ///< start paused (play from the API or the dashboard)
 };
 
+/// `safety:` (docs/gateway-config.md, docs/security.md "Motion safety"): the gateway as the dead-man
+/// of the devices' motion. Gateway-wide settings, members of named devices, and per-device overrides
+/// (`devices[].safety`).
+struct SafetyConfig {
+    std::chrono::milliseconds hold_to_run_max{500};  ///< hold_to_run_max_s (0.05 … 10 s)
+    bool standard_robot = true;  ///< guard the standard robot's members where a device is one
+    template <class T>
+    struct ForDevice {
+        std::string device;
+        T rule;
+    };
+    std::vector<ForDevice<gateway::HoldToRunMember>> hold_to_run;
+    std::vector<ForDevice<gateway::UntimedMotionMember>> motions;
+    std::vector<ForDevice<std::string>> streams;
+    std::vector<ForDevice<gateway::StopMember>> stops;
+    struct Override {
+        std::optional<std::chrono::milliseconds> hold_to_run_max;
+        std::optional<bool> standard_robot;
+    };
+    std::map<std::string, Override> overrides;  ///< by device name (devices[].safety)
+
+    /// The settings of device `name`: the gateway's, its override, and the members named for it.
+    gateway::MotionSafety for_device(std::string_view name) const;
+};
+
 struct GatewayConfig {
     // gateway:
     /// Listen address. The default `::` is one dual-stack socket (IPv4 and IPv6, as an official node);
@@ -165,6 +191,8 @@ struct GatewayConfig {
     std::vector<DiscoverRule> discover;
     // usb:
     UsbSettings usb;
+    // safety:
+    SafetyConfig safety;
 };
 
 /// Whether the configuration needs the rr+usb host transport (UsbSettings::enabled).

@@ -589,3 +589,62 @@ TEST_CASE("gateway command line: --allow-origin is checked like gateway.allowed_
     REQUIRE_FALSE(r);
     CHECK_THAT(r.error().message, Catch::StartsWith("--allow-origin: \"https://lab.example.org/dashboard\" has a path"));
 }
+
+TEST_CASE("safety: the bound, the members of named devices, per-device overrides, and errors naming the key") {
+    auto empty = parse_gateway_config("", "x.yaml");
+    REQUIRE(empty);
+    auto d = empty->safety.for_device("arm");
+    CHECK(d.hold_to_run_max == std::chrono::milliseconds(500));
+    CHECK(d.standard_robot);
+    CHECK(d.hold_to_run.empty());
+
+    auto c = parse_gateway_config(R"(
+safety:
+  hold_to_run_max_s: 0.3
+  hold_to_run:
+    - {device: create, member: Drive_for, timeout_arg: duration_ms, timeout_unit: ms}
+  motions:
+    - {device: create, member: MoveTo, wait_arg: wait}
+    - {device: create, member: Dance}
+  streams:
+    - {device: create, member: velocity}
+  stops:
+    - {device: create, member: StopAll}
+    - {device: create, member: mode, value: 0}
+devices:
+  - name: create
+    url: rr+tcp://localhost:1/?service=create
+  - name: arm
+    url: rr+tcp://localhost:2/?service=robot
+    safety: {hold_to_run_max_s: 0.2, standard_robot: false}
+)", "x.yaml");
+    REQUIRE(c);
+    auto create = c->safety.for_device("create");
+    CHECK(create.hold_to_run_max == std::chrono::milliseconds(300));
+    REQUIRE(create.hold_to_run.size() == 1);
+    CHECK(create.hold_to_run[0].member == "Drive_for");
+    CHECK(create.hold_to_run[0].timeout_arg == "duration_ms");
+    CHECK(create.hold_to_run[0].unit_s == 0.001);
+    REQUIRE(create.motions.size() == 2);
+    CHECK(create.motions[0].wait_arg == "wait");
+    CHECK(create.motions[1].wait_arg.empty());
+    REQUIRE(create.streams.size() == 1);
+    REQUIRE(create.stops.size() == 2);
+    CHECK_FALSE(create.stops[0].value);
+    CHECK(create.stops[1].value == 0.0);
+    auto arm = c->safety.for_device("arm");
+    CHECK(arm.hold_to_run_max == std::chrono::milliseconds(200));
+    CHECK_FALSE(arm.standard_robot);
+    CHECK(arm.hold_to_run.empty());  // the members named are create's
+
+    check_refused("safety: {hold_to_run_max_s: 60}\n", "bad.yaml:1: safety.hold_to_run_max_s: expected seconds between 0.05 and 10");
+    check_refused("safety: {hold_to_run_max_s: 0}\n", "bad.yaml:1: safety.hold_to_run_max_s:");
+    check_refused("safety: {hold_to_run: 3}\n", "bad.yaml:1: safety.hold_to_run: expected a list");
+    check_refused("safety:\n  hold_to_run:\n    - {device: a, member: b}\n", "bad.yaml:3: safety.hold_to_run[0].timeout_arg: missing");
+    check_refused("safety:\n  streams:\n    - {member: b}\n", "bad.yaml:3: safety.streams[0].device: missing");
+    check_refused("safety:\n  stops:\n    - {device: a, member: b, value: halt}\n", "bad.yaml:3: safety.stops[0].value: expected a number");
+    check_refused("safety:\n  hold_to_run:\n    - {device: a, member: b, timeout_arg: t, timeout_unit: h}\n",
+                  "bad.yaml:3: safety.hold_to_run[0].timeout_unit: expected s or ms");
+    check_refused("safety: {bound: 1}\n", "bad.yaml:1: safety.bound: unknown key");
+    check_refused("devices:\n  - name: a\n    url: rr+tcp://h:1/?service=a\n    safety: {max: 1}\n", "bad.yaml:4: devices.a.safety.max: unknown key");
+}

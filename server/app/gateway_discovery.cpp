@@ -241,6 +241,7 @@ Result<std::shared_ptr<gateway::DeviceMirror>> DiscoveredDevices::create_device(
         cfg.password = r.password;
         cfg.backoff_max = r.backoff_max;
     }
+    cfg.safety = safety_.for_device(cfg.name);
     auto mirror = gateway::DeviceMirror::create(gw, cfg);
     if (!mirror) return mirror.take_error();
     if (auth_) (*mirror)->mirror_service()->set_access(gateway::auth::MirrorAccess(auth_, cfg.name));

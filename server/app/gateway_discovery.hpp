@@ -41,6 +41,8 @@ public:
     void set_api(std::shared_ptr<gateway::JsonApi> api);
     /// The gateway's users and permissions: discovered devices check them like configured ones.
     void set_auth(std::shared_ptr<gateway::auth::GatewayAuth> auth);
+    /// Motion safety for discovered devices, by their name (SafetyConfig::for_device).
+    void set_safety(SafetyConfig safety) { safety_ = std::move(safety); }
     /// Subscribes to discovery events, and asks the nodes for their services (ServiceInfo2) when there
     /// are rules; without rules the first list() asks.
     void start();
@@ -88,6 +90,7 @@ private:
     std::function<bool(const std::string&)> taken_;
     std::shared_ptr<gateway::JsonApi> api_;
     std::shared_ptr<gateway::auth::GatewayAuth> auth_;
+    SafetyConfig safety_;
     std::uint64_t listener_ = 0;
     mutable std::recursive_mutex mutex_;
     std::map<std::pair<NodeID, std::string>, Entry> entries_;

@@ -16,6 +16,7 @@
 #include "server/client/raw_client.hpp"
 #include "server/demo/demo_devices.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -33,7 +34,7 @@ public:
         }
         cv_.notify_all();
     }
-    std::optional<MessageEntry> take(MessageEntryType type, std::string_view member, std::chrono::milliseconds timeout = 5s) {
+    std::optional<MessageEntry> take(MessageEntryType type, std::string_view member, std::chrono::milliseconds timeout = 30s) {
         std::unique_lock lock(mutex_);
         std::optional<MessageEntry> out;
         cv_.wait_for(lock, timeout, [&] {
@@ -74,7 +75,7 @@ struct Client {
         std::promise<Result<MessageEntry>> p;
         raw->request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
         auto f = p.get_future();
-        REQUIRE(f.wait_for(10s) == std::future_status::ready);
+        REQUIRE(f.wait_for(30s) == std::future_status::ready);
         return f.get();
     }
     MessageEntry ok(MessageEntry e) const {
@@ -94,7 +95,7 @@ Client connect(boost::asio::any_io_executor ex, std::uint16_t port, const std::s
         ex, *url, {}, [inbox = c.inbox](MessageEntry&& e) { inbox->push(std::move(e)); }, {},
         [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
     auto f = p.get_future();
-    REQUIRE(f.wait_for(10s) == std::future_status::ready);
+    REQUIRE(f.wait_for(30s) == std::future_status::ready);
     auto r = f.get();
     INFO((r ? std::string() : r.error().message));
     REQUIRE(r);
@@ -187,11 +188,10 @@ TEST_CASE("demo starter: registers create and webcam on the demo node and return
     c.ok(drive(100, 32767));
     // The timer runs the simulation in real time: the distance grows.
     std::int32_t d = 0;
-    for (int i = 0; i < 100 && d <= 0; ++i) {
-        std::this_thread::sleep_for(20ms);
+    CHECK(rr::testing::eventually([&] {
         d = scalar<std::int32_t>(c.ok(req(MessageEntryType::PropertyGetReq, "create", "DistanceTraveled")), "value");
-    }
-    CHECK(d > 0);
+        return d > 0;
+    }, rr::testing::kHangBound, 20ms));
     c.ok(drive(0, 32767));
 
     auto w = connect(f.node->io_context().get_executor(), f.port, "webcam");
@@ -239,7 +239,7 @@ TEST_CASE("demo create over the wire: Drive, properties, Bump, packets wire, pla
     const std::vector<std::uint8_t> song = {60, 32, 64, 16};
     ret.elements.push_back(make_array_element<std::uint8_t>("return", song));
     c.raw->send(std::move(ret));
-    for (int i = 0; i < 250 && dev.play_stats().replies == 0; ++i) std::this_thread::sleep_for(20ms);
+    rr::testing::eventually([&] { return dev.play_stats().replies != 0; });
     CHECK(dev.play_stats().replies == 1);
     CHECK(dev.play_stats().last_song == song);
 
@@ -255,14 +255,20 @@ TEST_CASE("demo create over the wire: Drive, properties, Bump, packets wire, pla
     // Packets came at 20 Hz of simulated time (the wire keeps the newest per client, so count the
     // sequence numbers instead); the newest shows the robot at the wall and the song.
     CHECK(dev.packet_sequence() == 121);  // one at StartStreaming, then every 50 ms for 6 s
-    std::this_thread::sleep_for(200ms);
-    auto packets = c.inbox->take_all(MessageEntryType::WirePacket);
-    REQUIRE_FALSE(packets.empty());
-    const auto* pe = packets.back().find("packet");
-    REQUIRE(pe);
-    const Value packet = unpack_member_value(*dev.object(), "packets", *pe);
-    const auto data = bytes_of(*packet.field("Data"));
-    REQUIRE(data.size() == kSensorDataSize);
+    // The newest packet is the one numbered 121 (its bytes 2-3): wait until it has arrived.
+    std::vector<std::uint8_t> data;
+    const bool newest = rr::testing::eventually([&] {
+        for (const auto& e : c.inbox->take_all(MessageEntryType::WirePacket)) {
+            const auto* pe = e.find("packet");
+            REQUIRE(pe);
+            const Value packet = unpack_member_value(*dev.object(), "packets", *pe);
+            auto d = bytes_of(*packet.field("Data"));
+            REQUIRE(d.size() == kSensorDataSize);
+            if ((d[2] | (d[3] << 8)) == 121) data = std::move(d);
+        }
+        return !data.empty();
+    });
+    REQUIRE(newest);
     CHECK(le_i32(data, 4) == 1335);
     CHECK(le_i32(data, 12) == 1335);
     CHECK(data[34] == 4);
@@ -300,7 +306,7 @@ TEST_CASE("demo create: a bump during an outstanding play_callback is played whe
     ret.request_id = periodic->request_id;
     ret.elements.push_back(make_array_element<std::uint8_t>("return", std::vector<std::uint8_t>{60, 8}));
     c.raw->send(std::move(ret));
-    for (int i = 0; i < 250 && dev.play_stats().replies == 0; ++i) std::this_thread::sleep_for(20ms);
+    rr::testing::eventually([&] { return dev.play_stats().replies != 0; });
     REQUIRE(dev.play_stats().replies == 1);
 
     // The next step (4.62 s, before the 5 s period) makes the bump's call, at the wall.

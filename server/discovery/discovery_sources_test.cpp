@@ -26,10 +26,7 @@ using rr::server::discovery::NodeDiscovery;
 
 namespace {
 
-template <class Pred>
-bool eventually(Pred pred, std::chrono::milliseconds limit = 10000ms) {
-    return rr::testing::eventually(pred, limit);
-}
+using rr::testing::eventually;
 
 DiscoveryOptions loopback_options() {
     DiscoveryOptions o;

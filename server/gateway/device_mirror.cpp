@@ -1,7 +1,9 @@
 #include "server/gateway/device_mirror.hpp"
 
 #include "core/session/elements.hpp"
+#include "server/gateway/device_types.hpp"
 #include "server/gateway/mirror_service.hpp"
+#include "server/gateway/motion_guard.hpp"
 #include "server/node/node.hpp"
 
 namespace rr::server::gateway {
@@ -51,6 +53,20 @@ Result<std::shared_ptr<DeviceMirror>> DeviceMirror::create(std::shared_ptr<Node>
     }
     std::shared_ptr<DeviceMirror> m(new DeviceMirror(std::move(node), std::move(config), std::move(*url)));
     m->service_ = std::make_shared<MirrorService>(m, m->counters_, m->config_.name, m->url_.service);
+    // The gateway's own stops and generator aborts (motion safety) go to the device like the JSON API's
+    // requests: on a client's passthrough session, or on the shared one.
+    {
+        auto node = m->node_.lock();
+        std::weak_ptr<DeviceMirror> weak = m;
+        m->motion_ = std::make_shared<MotionGuard>(
+            node->io_context().get_executor(), m->config_.name, m->config_.safety,
+            [weak](MessageEntry e, std::uint32_t session, std::function<void(Result<MessageEntry>)> done) {
+                auto self = weak.lock();
+                if (!self) return done(fail(MessageErrorType::ConnectionError, "gateway device stopped"));
+                self->request_stop(std::move(e), std::move(done), session);
+            });
+        m->service_->set_motion_guard(m->motion_);
+    }
     // Lock holders are part of the device's status (JSON API pushes, the dashboard).
     m->service_->set_locks_listener([weak = std::weak_ptr<DeviceMirror>(m)] {
         if (auto self = weak.lock()) self->notify_state();
@@ -206,6 +222,11 @@ void DeviceMirror::on_connected(std::shared_ptr<RawClient> client) {
         do_register = !registered_;
         registered_ = true;
     }
+    {
+        // Which members move the device (its root type and definitions: motion_rules.hpp).
+        auto types = DeviceTypes::parse(service_definitions());
+        motion_->set_root(root_type(), types ? types->get() : nullptr);
+    }
     if (do_register) {
         auto node = node_.lock();
         auto r = node ? node->register_service(service_) : Result<void>(fail(MessageErrorType::InvalidState, "gateway stopped"));
@@ -337,6 +358,20 @@ void DeviceMirror::request(MessageEntry entry, std::function<void(Result<Message
         return;
     }
     p->request(session, std::move(entry), std::move(done));
+}
+
+void DeviceMirror::request_stop(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session) {
+    const auto& p = service_->passthrough();
+    if (!p) return request(std::move(entry), std::move(done), session);
+    MessageEntry again = entry;
+    std::weak_ptr<PassthroughSessions> weak = p;
+    request(std::move(entry),
+            [weak, session, again = std::move(again), done = std::move(done)](Result<MessageEntry> r) mutable {
+                auto ps = weak.lock();
+                if (!ps || !r || !PassthroughSessions::refused_by_lock(*r)) return done(std::move(r));
+                ps->stop_as_lock_holder(session, std::move(again), std::move(done), std::move(r));
+            },
+            session);
 }
 
 void DeviceMirror::open_api_session(std::string username, std::string password, std::function<void(Result<ApiSession>)> done) {

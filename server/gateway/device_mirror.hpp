@@ -27,6 +27,7 @@
 
 #include "core/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
+#include "server/gateway/motion_rules.hpp"
 #include "server/gateway/passthrough_sessions.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/gateway/shared_entry.hpp"
@@ -69,6 +70,9 @@ struct DeviceConfig {
     /// auth: passthrough: JSON API member requests (REST, and the WebSocket without a `device_login`)
     /// are refused with AuthenticationError instead of using the gateway's own session to the device.
     bool json_api_requires_device_login = false;
+    /// Motion safety (docs/security.md "Motion safety"): the bound of hold-to-run timeouts, streams and
+    /// liveness, and the members guarded besides the standard robot's.
+    MotionSafety safety;
     /// /readyz waits for required devices only.
     bool required = true;
     std::chrono::milliseconds backoff_initial{500};
@@ -104,6 +108,7 @@ struct DeviceStatus {
 };
 
 class MirrorService;
+class MotionGuard;
 
 class DeviceMirror : public std::enable_shared_from_this<DeviceMirror> {
 public:
@@ -133,6 +138,10 @@ public:
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done);
     /// The same on a JSON API client's own session (open_api_session); `session` 0 = the shared one.
     void request(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session);
+
+    /// request() for a stop (docs/security.md "Motion safety"): on a passthrough device a refusal for a
+    /// lock another client took through the gateway sends it again on that client's session.
+    void request_stop(MessageEntry entry, std::function<void(Result<MessageEntry>)> done, std::uint32_t session);
 
     /// A JSON API client's own session to a passthrough device: its id for request() and
     /// close_api_session(), and its event, wire and pipe subscriptions.
@@ -165,6 +174,8 @@ public:
 
     /// The downstream half (for the JSON API's gateway-internal pipe endpoints).
     const std::shared_ptr<MirrorService>& mirror_service() const noexcept { return service_; }
+    /// The device's motion guard (motion_guard.hpp), used by every path a request takes to it.
+    const std::shared_ptr<MotionGuard>& motion() const noexcept { return motion_; }
 
 private:
     DeviceMirror(std::shared_ptr<Node> node, DeviceConfig config, ConnectionUrl url);
@@ -180,6 +191,7 @@ private:
     DeviceConfig config_;
     ConnectionUrl url_;
     std::shared_ptr<MirrorService> service_;
+    std::shared_ptr<MotionGuard> motion_;
     boost::asio::steady_timer timer_;
     const std::shared_ptr<DeviceCounters> counters_ = std::make_shared<DeviceCounters>();  // shared with service_
 

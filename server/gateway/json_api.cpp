@@ -1,7 +1,7 @@
 #include "server/gateway/json_api.hpp"
 
 #include <algorithm>
-
+#include <atomic>
 
 #include "core/json/value_json.hpp"
 #include "core/message/error_entry.hpp"
@@ -412,6 +412,43 @@ std::optional<ApiError> JsonApi::check_access(const MemberAddress& a, auth::Oper
                      "user " + a.principal->name + " may not " + std::string(auth::operation_name(op)) + " " + key + " of " + a.device);
 }
 
+std::variant<JsonApi::MotionAdmission, ApiError> JsonApi::admit_motion(const MemberAddress& address, const MemberTarget& t,
+                                                                      MessageEntry& call) {
+    MotionAdmission m;
+    const auto& guard = t.device->motion();
+    if (!guard || !guard->concerns(call)) return m;
+    m.guard = guard;
+    if (address.motion) {
+        m.client = *address.motion;
+    } else {
+        static std::atomic<std::uint64_t> anonymous{0};
+        m.client.key = "api:" + std::to_string(anonymous.fetch_add(1) + 1);
+        m.client.description = "a JSON API request";
+    }
+    m.client.device_session = t.device_session;
+    if (address.motion_waits_only && call.entry_type == MessageEntryType::FunctionCallReq) {
+        const auto rules = guard->rules();
+        const auto* u = rules ? rules->untimed(call.member_name) : nullptr;
+        if (u && !u->wait_arg.empty() && !bool_argument(call, u->wait_arg).value_or(false))
+            return api_error(409, MessageErrorType::InvalidOperation,
+                             call.member_name + " with " + u->wait_arg + " false over plain HTTP would outlive the request, whose " +
+                                 "connection is all the gateway can watch: call it with " + u->wait_arg +
+                                 " true (the request then lasts until the motion ends, and closing its connection stops the " +
+                                 "robot), or from the JSON WebSocket or an RR client (docs/security.md \"Motion safety\")");
+    }
+    auto ticket = guard->admit(m.client, call);
+    if (!ticket)
+        return api_error(ticket.error().type == MessageErrorType::InvalidArgument ? 400 : 409, ticket.error().type,
+                         ticket.error().message);
+    m.stop = ticket->kind == MotionGuard::Ticket::Kind::stop;
+    if (ticket->kind != MotionGuard::Ticket::Kind::pass && !m.stop) m.ticket = *ticket;
+    return m;
+}
+
+void JsonApi::finish_motion(const MotionAdmission& m, const Result<MessageEntry>& reply) {
+    if (m.guard && m.ticket) m.guard->on_reply(m.client, *m.ticket, reply);
+}
+
 std::optional<ApiError> JsonApi::check_locks(const MemberTarget& t, MessageEntryType type) const {
     if (t.device_session != 0) return std::nullopt;
     auto ok = t.device->mirror_service()->check_api_request(t.path, t.user, passes_object_locks(t.member->modifiers, type));
@@ -443,7 +480,7 @@ void JsonApi::get_property(const MemberAddress& address, Done done) {
 void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& value, Done done) {
     if (auto denied = check_access(address, auth::Operation::write)) return done(ApiResult::failed(std::move(*denied)));
     auto self = shared_from_this();
-    resolve(address, [self, value, done = std::move(done)](Resolved r) {
+    resolve(address, [self, address, value, done = std::move(done)](Resolved r) {
         if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
         const auto& t = std::get<MemberTarget>(r);
         if (auto e = expect_kind(t, robdef::MemberKind::property)) return done(ApiResult::failed(*e));
@@ -453,9 +490,20 @@ void JsonApi::set_property(const MemberAddress& address, const nlohmann::json& v
         ApiError error;
         auto el = self->element_from_json(value, t.member->type, t, "value", error, "value");
         if (!el) return done(ApiResult::failed(error));
-        if (auto locked = self->check_locks(t, MessageEntryType::PropertySetReq)) return done(ApiResult::failed(std::move(*locked)));
         auto e = member_request(MessageEntryType::PropertySetReq, t);
         e.elements.push_back(std::move(*el));
+        // A stop (command_mode = halt) passes every lock (docs/security.md "Motion safety").
+        auto motion = admit_motion(address, t, e);
+        if (auto* refused = std::get_if<ApiError>(&motion)) return done(ApiResult::failed(std::move(*refused)));
+        const bool stop = std::get<MotionAdmission>(motion).stop;
+        if (!stop)
+            if (auto locked = self->check_locks(t, MessageEntryType::PropertySetReq)) return done(ApiResult::failed(std::move(*locked)));
+        if (stop)
+            return t.device->request_stop(std::move(e), [done](Result<MessageEntry> r) {
+                if (!r) return done(ApiResult::failed(device_error(r.error())));
+                if (auto err = entry_error(*r)) return done(ApiResult::failed(device_error(*err)));
+                done(ApiResult::ok(nlohmann::json::object()));
+            }, t.device_session);
         send_to_device(t, std::move(e), done, [](const MessageEntry&) { return ApiResult::ok(nlohmann::json::object()); });
     });
 }

@@ -28,6 +28,7 @@
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
 #include "server/gateway/json_api_error.hpp"
+#include "server/gateway/motion_guard.hpp"
 
 namespace rr::server::gateway {
 
@@ -41,6 +42,12 @@ struct MemberAddress {
     /// auth: passthrough: the client's own session to the device (DeviceMirror::open_api_session), so
     /// the device's users, privileges and locks apply; 0 = the gateway's shared session.
     std::uint32_t device_session = 0;
+    /// Motion safety (motion_guard.hpp): the caller as the device's motion guard sees it (who holds a
+    /// motion, whose going away ends it); null: an anonymous caller that holds nothing beyond its request.
+    std::shared_ptr<const MotionClient> motion;
+    /// The caller's motions end with its request (plain HTTP): a motion without a timeout of its own
+    /// whose call does not wait for its end (wait false) is refused with 409.
+    bool motion_waits_only = false;
 };
 
 /// A member resolved against the device's definitions. The pointers point into `types`.
@@ -135,6 +142,23 @@ public:
     /// `device_login`); else 409 with ObjectLockedError ("Object locked by alice") or InvalidOperation
     /// (a monitor).
     std::optional<ApiError> check_locks(const MemberTarget& target, MessageEntryType type) const;
+
+    /// The motion guard's decision on `call` (a FunctionCallReq, PropertySetReq or WirePacket for
+    /// `target`) made by `address`'s caller (docs/security.md "Motion safety"): nothing to follow
+    /// (nullopt ticket, `stop` false), a stop (passes the locks), or a motion to follow with
+    /// finish_motion(). Errors: 409 (held by another client; wait false over plain HTTP), 400 (a
+    /// hold-to-run call without a numeric timeout).
+    struct MotionAdmission {
+        std::shared_ptr<MotionGuard> guard;
+        MotionClient client;
+        std::optional<MotionGuard::Ticket> ticket;
+        bool stop = false;
+        std::int32_t generator_index = -1;  ///< a generator motion's index, once the device answered
+    };
+    static std::variant<MotionAdmission, ApiError> admit_motion(const MemberAddress& address, const MemberTarget& target,
+                                                                MessageEntry& call);
+    /// The device's answer to an admitted motion.
+    static void finish_motion(const MotionAdmission& m, const Result<MessageEntry>& reply);
 
     /// Finds device, object and member. Errors: 404 (unknown device / object / member), 400 (malformed
     /// object path), 503 (device not connected), 502 (definitions unusable), 504.

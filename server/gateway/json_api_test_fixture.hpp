@@ -29,6 +29,7 @@
 #include "server/gateway/json_rest.hpp"
 #include "server/gateway/binary_push.hpp"
 #include "server/gateway/json_socket.hpp"
+#include "test/support/skip.hpp"
 
 extern char** environ;
 
@@ -159,7 +160,7 @@ public:
         gateway_.reset();
     }
 
-    bool wait_state(DeviceState s, std::chrono::milliseconds timeout = 20000ms) {
+    bool wait_state(DeviceState s, std::chrono::milliseconds timeout = 30000ms) {
         const auto until = std::chrono::steady_clock::now() + timeout;
         while (std::chrono::steady_clock::now() < until) {
             if (gateway_->devices().front()->status().state == s) return true;
@@ -271,7 +272,7 @@ public:
     }
 
     /// The next message (reply or push), or nullopt after `timeout`.
-    std::optional<json> next(std::chrono::milliseconds timeout = 10000ms) {
+    std::optional<json> next(std::chrono::milliseconds timeout = 30000ms) {  // defaults: bounds on a hang
         std::unique_lock lock(mutex_);
         if (!cv_.wait_for(lock, timeout, [&] { return !inbox_.empty() || read_failed_; })) return std::nullopt;
         if (inbox_.empty()) return std::nullopt;
@@ -281,7 +282,7 @@ public:
     }
 
     /// Sends a request with a fresh id and waits for its reply; pushes meanwhile go to pushes().
-    json request(json msg, std::chrono::milliseconds timeout = 20000ms) {
+    json request(json msg, std::chrono::milliseconds timeout = 30000ms) {
         const int id = ++next_id_;
         msg["id"] = id;
         send(msg);
@@ -297,7 +298,7 @@ public:
     }
 
     /// Waits for a push matching `pred` (looking at the pushes already kept first).
-    std::optional<json> wait_push(const std::function<bool(const json&)>& pred, std::chrono::milliseconds timeout = 10000ms) {
+    std::optional<json> wait_push(const std::function<bool(const json&)>& pred, std::chrono::milliseconds timeout = 30000ms) {
         for (auto it = pushes_.begin(); it != pushes_.end(); ++it) {
             if (pred(*it)) {
                 json j = *it;
@@ -362,11 +363,13 @@ private:
     int next_id_ = 0;
 };
 
-/// False (tests skip with a warning) when rr_interop_service is not part of the build.
-inline bool interop_service_built() {
-    if (interop_service_bin()) return true;
-    WARN("SKIP: rr_interop_service is not built (test/interop); JSON API test skipped");
-    return false;
-}
-
 }  // namespace rr::server::gateway::testing
+
+/// Ends the test case as skipped (test/support/skip.hpp: ctest shows Skipped) when rr_interop_service is
+/// not part of the build. When it is (test/interop makes rr_server_tests depend on it), a missing or
+/// broken program fails the test instead. Call first, before any assertion.
+#define RR_SKIP_WITHOUT_INTEROP_SERVICE()                                                                  \
+    do {                                                                                                  \
+        if (!::rr::server::gateway::testing::interop_service_bin())                                       \
+            RR_SKIP("rr_interop_service is not part of this build (test/interop): JSON API test not run"); \
+    } while (false)

@@ -108,7 +108,7 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
         return;
     }
     auto self = shared_from_this();
-    resolve(address, [self, args, max_items, done = std::move(done)](Resolved r) {
+    resolve(address, [self, address, args, max_items, done = std::move(done)](Resolved r) mutable {
         if (auto* e = std::get_if<ApiError>(&r)) return done(ApiResult::failed(*e));
         const auto& t = std::get<MemberTarget>(r);
         const auto& m = *t.member;
@@ -171,10 +171,36 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
             call.elements.push_back(std::move(*el));
         }
 
+        // Motion safety: a hold-to-run timeout clamped, another client's motion refused, a stop through
+        // every lock (docs/security.md "Motion safety").
+        auto admitted = admit_motion(address, t, call);
+        if (auto* refused = std::get_if<ApiError>(&admitted)) return done(ApiResult::failed(std::move(*refused)));
+        auto motion = std::make_shared<MotionAdmission>(std::get<MotionAdmission>(std::move(admitted)));
         // A generator is checked once, at its call: its items are one JSON API request.
-        if (auto locked = self->check_locks(t, MessageEntryType::FunctionCallReq)) return done(ApiResult::failed(std::move(*locked)));
-        t.device->request(std::move(call), [self, t, generator, param_generator, max_items, done,
-                                             gen_items = std::move(gen_items)](Result<MessageEntry> r) mutable {
+        if (!motion->stop)
+            if (auto locked = self->check_locks(t, MessageEntryType::FunctionCallReq)) {
+                finish_motion(*motion, fail(MessageErrorType::ObjectLockedError, locked->message));
+                return done(ApiResult::failed(std::move(*locked)));
+            }
+        if (motion->ticket && motion->ticket->kind == MotionGuard::Ticket::Kind::generator) {
+            // The generator's motion ends with the run (its end, max_items reached, an error).
+            done = [motion, inner = std::move(done)](ApiResult result) {
+                MotionGuard::Ticket end{MotionGuard::Ticket::Kind::generator_next};
+                end.generator = motion->generator_index;
+                end.closes = true;
+                if (motion->guard) motion->guard->on_reply(motion->client, end, MessageEntry{});
+                inner(std::move(result));
+            };
+        }
+        auto send = [&](auto&& on_reply) {
+            if (motion->stop) return t.device->request_stop(std::move(call), std::move(on_reply), t.device_session);
+            t.device->request(std::move(call), std::move(on_reply), t.device_session);
+        };
+        send([self, t, generator, param_generator, max_items, done, motion,
+              gen_items = std::move(gen_items)](Result<MessageEntry> r) mutable {
+            finish_motion(*motion, r);
+            if (r && r->error == MessageErrorType::None)
+                if (const auto* idx = r->find("index")) (void)read_scalar(*idx, motion->generator_index);
             if (!r) return done(ApiResult::failed(device_error(r.error())));
             if (auto err = entry_error(*r)) return done(ApiResult::failed(device_error(*err)));
             if (!generator) {
@@ -194,7 +220,7 @@ void JsonApi::call_function(const MemberAddress& address, const nlohmann::json& 
                                                         "FunctionCallRes of a generator has no \"index\" element")));
             auto run = std::make_shared<GeneratorRun>(self, t, index, std::move(gen_items), param_generator, max_items, done);
             run->step();
-        }, t.device_session);
+        });
     });
 }
 

@@ -3,6 +3,7 @@
 #include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/json_access.hpp"
 
+#include <atomic>
 #include <charconv>
 #include <map>
 
@@ -130,9 +131,9 @@ public:
     explicit RestRouter(std::shared_ptr<JsonApi> api) : api_(std::move(api)) {}
     const std::shared_ptr<JsonApi>& api() const noexcept { return api_; }
 
-    void handle(const http::Request& req, http::Responder respond) {
+    void handle(const http::Request& req, http::Responder respond, const std::shared_ptr<http::RequestConnection>& connection = {}) {
         try {
-            dispatch(req, respond);
+            dispatch(req, respond, connection);
         } catch (const std::exception& e) {
             // nlohmann type errors and the like: a bug, but never a crash of the gateway.
             respond(error_response(req, api_error(500, MessageErrorType::InternalError, e.what())));
@@ -140,7 +141,7 @@ public:
     }
 
 private:
-    void dispatch(const http::Request& req, const http::Responder& respond) {
+    void dispatch(const http::Request& req, const http::Responder& respond, const std::shared_ptr<http::RequestConnection>& connection) {
         const std::string_view target(req.target().data(), req.target().size());
         const std::string_view path = target.substr(0, target.find('?'));
         // HEAD is GET without the body (the HttpServer drops it when writing).
@@ -266,8 +267,28 @@ private:
                 }
             }
         }
+        // Motion safety (docs/security.md "Motion safety"): a user's requests from one address are one
+        // holder; a motion without a timeout of its own must wait for its end, and ends when this
+        // request's connection closes first.
+        auto who = std::make_shared<MotionClient>();
+        const std::string client(req[http::kClientAddressField]);
+        const std::string ip = client.substr(0, client.rfind(':'));
+        const std::string user = principal ? principal->rr_user_name() : std::string();
+        who->key = "http:" + user + "@" + ip;
+        who->owner = "http-request:" + std::to_string(next_request_.fetch_add(1) + 1);
+        who->user = user;
+        who->description = "HTTP requests from " + ip;
+        address.motion = who;
+        address.motion_waits_only = true;
+        if (connection)
+            connection->on_gone([api = api_, device, owner = who->owner] {
+                if (auto d = api->find_device(device))
+                    if (const auto& guard = d->motion()) guard->client_gone(owner);
+            });
         api_->call_function(address, args, max_items, done);
     }
+
+    std::atomic<std::uint64_t> next_request_{0};
 
     std::shared_ptr<JsonApi> api_;
 };
@@ -336,6 +357,13 @@ void install_json_rest(http::HttpServer& http, std::shared_ptr<JsonApi> api) {
                        hooks.add(*body, [head, respond](ApiResult r) { respond(result_response(*head, r)); });
                    });
 
+    // Function calls get their request's connection: a motion they start ends when it closes.
+    http.add_watched_route(
+        bhttp::verb::post, "/api/devices/",
+        [router](const http::Request& req, http::Responder respond, const std::shared_ptr<http::RequestConnection>& connection) {
+            router->handle(req, std::move(respond), connection);
+        },
+        /*prefix=*/true);
     // Every other method and path under /api (the HttpServer tries routes of a method first): the router
     // answers 405 (with Allow) for a method a route does not take and 404 for a path that is no route,
     // both as JSON (docs/json-api.md).

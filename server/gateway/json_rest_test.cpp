@@ -1,6 +1,7 @@
 // The JSON API's REST routes against rr_interop_service behind a Gateway: every value kind both ways,
 // functions and generators, wires, objects below the root, and every error status.
 #include "server/gateway/json_api_test_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -60,7 +61,7 @@ TEST_CASE("json api: pure helpers: object paths, URL decoding, error statuses") 
 }
 
 TEST_CASE("json api: devices, definitions, the member summary") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
 
@@ -161,7 +162,7 @@ TEST_CASE("json api: devices, definitions, the member summary") {
 }
 
 TEST_CASE("json api: every read/write property round-trips through JSON unchanged") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     auto info = http_get(gw.port(), "/api/devices/interop");
@@ -243,7 +244,7 @@ TEST_CASE("json api: every read/write property round-trips through JSON unchange
 }
 
 TEST_CASE("json api: objects below the root are addressed with ?object=") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     CHECK(http_get(gw.port(), kProps + "value?object=child").body == json{{"value", 1}});
@@ -271,7 +272,7 @@ TEST_CASE("json api: objects below the root are addressed with ?object=") {
 }
 
 TEST_CASE("json api: functions, device errors, generators") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     const auto port = gw.port();
@@ -337,7 +338,7 @@ TEST_CASE("json api: functions, device errors, generators") {
 }
 
 TEST_CASE("json api: wires are peeked, the Origin policy holds on API routes") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     const auto port = gw.port();
@@ -364,7 +365,7 @@ TEST_CASE("json api: wires are peeked, the Origin policy holds on API routes") {
 }
 
 TEST_CASE("json api: a device that is not connected gives 503") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     auto device = std::make_unique<InteropProcess>();
     TestGateway gw(device->url());
     CHECK(http_get(gw.port(), kProps + "p_int32").status == 200);
@@ -381,7 +382,7 @@ TEST_CASE("json api: a device that is not connected gives 503") {
 }
 
 TEST_CASE("json api: the installer of rr-gateway serves the same API") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     app::GatewayConfig cfg;
     cfg.local = false;  // tests run side by side: no shared NodeName on this computer
@@ -394,8 +395,7 @@ TEST_CASE("json api: the installer of rr-gateway serves the same API") {
     cfg.devices.push_back(d);
     auto g = app::Gateway::start(cfg, {}, install_json_api);
     REQUIRE(g);
-    for (int i = 0; i < 2000 && !(*g)->ready(); ++i) std::this_thread::sleep_for(10ms);
-    REQUIRE((*g)->ready());
+    REQUIRE(rr::testing::eventually([&] { return (*g)->ready(); }));
     CHECK(http_get((*g)->port(), kProps + "ro_value").body == json{{"value", 17}});
     WsClient ws((*g)->port());
     CHECK(ws.handshake_response()[bhttp::field::sec_websocket_protocol] == kJsonSubprotocol);

@@ -25,6 +25,11 @@ namespace rr::server::gateway {
 /// messages, device strands deliver pushes and replies; mutex_ guards the registry and keeps each
 /// subscription's reply ahead of its pushes.
 class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession> {
+    static std::uint64_t next_socket_id() {
+        static std::atomic<std::uint64_t> n{0};
+        return n.fetch_add(1) + 1;
+    }
+
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
                       boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options)
@@ -69,6 +74,19 @@ public:
         }
         for (auto& [sid, s] : subs)
             if (s.upstream_known && !s.own) unsubscribe_upstream(s);  // those on a device_login end with its session
+        // What this socket started without a timeout of its own ends with it (motion safety); on a
+        // device_login's session the device's stops go there first, before it closes.
+        for (const auto& d : api_->devices()) {
+            const auto& guard = d->motion();
+            auto login = logins.find(d->config().name);
+            if (!guard) continue;
+            if (login == logins.end()) {
+                guard->client_gone(motion_key_);
+                continue;
+            }
+            guard->client_gone(motion_key_, [self = shared_from_this(), l = login->second] { self->end_device_login(l); });
+            logins.erase(login);
+        }
         for (auto& [name, l] : logins) end_device_login(l);
     }
 
@@ -172,6 +190,7 @@ private:
     void act(const nlohmann::json& id, SendRequest r) { send_packet(id, r.subscription, r.value, r.request_ack); }
     void act(const nlohmann::json& id, MemberRequest r) {
         r.address.principal = principal();
+        r.address.motion = motion_client(r.address.principal);
         r.address.device_session = device_session(r.address.device);
         if (!begin_request(id)) return;
         switch (r.op) {
@@ -201,6 +220,21 @@ private:
             }
             self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write, binary);
         });
+    }
+
+    // The socket as a device's motion guard sees it: one holder for all its requests, probed with
+    // pings while it holds a motion without a timeout of its own (docs/security.md "Motion safety").
+    std::shared_ptr<const MotionClient> motion_client(const auth::PrincipalPtr& who) const {
+        auto c = std::make_shared<MotionClient>();
+        c->key = motion_key_;
+        c->user = who ? who->rr_user_name() : std::string();
+        const std::string peer = socket_->peer();
+        c->description = "JSON WebSocket from " + peer.substr(0, peer.rfind(':'));
+        std::weak_ptr<http::JsonSocket> weak = socket_;
+        c->liveness = [weak](std::optional<std::chrono::milliseconds> timeout) {
+            if (auto s = weak.lock()) s->set_liveness_probe(timeout);
+        };
+        return c;
     }
 
     bool needs_login() const {
@@ -576,6 +610,16 @@ private:
         e.metadata = "unreliable\n";
         e.elements.push_back(pack_timespec(wall_clock_timespec(), "packettime"));
         e.elements.push_back(std::move(*packet));
+        // A command stream (position_command, …): refused while another client holds the motion, and
+        // ended by the gateway when it goes silent (motion safety).
+        {
+            e.service_path = t.path;
+            MemberAddress address;
+            address.motion = motion_client(principal());
+            address.device_session = t.device_session;
+            auto motion = JsonApi::admit_motion(address, t, e);
+            if (auto* refused = std::get_if<ApiError>(&motion)) return fail(id, std::move(*refused));
+        }
         if (own) {
             e.service_path = t.path;
             auto sent = own->send_wire_packet(std::move(e));
@@ -788,6 +832,7 @@ private:
     std::vector<WireToSend> wire_batch_;  // flush_wires()' batch: used by the one flusher, outside mutex_
     JsonSubscriptions subs_;
     auth::PrincipalPtr principal_;  // auth: gateway — who logged this socket in
+    const std::string motion_key_ = "ws:" + std::to_string(next_socket_id());  // the motion guards' holder key
     std::map<std::string, DeviceLogin, std::less<>> device_logins_;  // by device name
     std::size_t in_flight_ = 0;
     ConvertStrand convert_strand_;                  // shared by the server's sockets

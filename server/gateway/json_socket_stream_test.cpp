@@ -23,7 +23,8 @@ json webcam(std::string op, std::string m, json more = json::object()) {
 
 }  // namespace
 
-TEST_CASE("json socket: requests to a device are answered while its pipe streams camera frames") {
+// [timing]: it asserts how long each request takes while the frames stream.
+TEST_CASE("json socket: requests to a device are answered while its pipe streams camera frames", "[timing]") {
     app::GatewayConfig cfg;
     cfg.local = false;  // tests run side by side: no shared NodeName on this computer
     cfg.port = 0;

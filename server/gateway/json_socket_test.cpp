@@ -1,6 +1,9 @@
 // The JSON WebSocket (`rr-gateway.json.v1`) against rr_interop_service behind a Gateway: requests,
 // subscriptions to wires, events and pipes, their end, device state pushes, and a client that never reads.
+#include <algorithm>
+
 #include "server/gateway/json_api_test_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -35,7 +38,7 @@ auto push_of(std::uint64_t sid, std::string kind) {
 }  // namespace
 
 TEST_CASE("json socket: \"binary\": true sends values with numeric arrays as binary pushes, the rest as text") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     WsClient ws(gw.port());
@@ -90,7 +93,7 @@ TEST_CASE("json socket: \"binary\": true sends values with numeric arrays as bin
 }
 
 TEST_CASE("json socket: requests are answered by id") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     WsClient ws(gw.port());
@@ -152,7 +155,7 @@ TEST_CASE("json socket: requests are answered by id") {
 }
 
 TEST_CASE("json socket: subscribe to wires, events, pipes, unsubscribe") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     WsClient ws(gw.port());
@@ -228,20 +231,23 @@ TEST_CASE("json socket: subscribe to wires, events, pipes, unsubscribe") {
     const auto sink = subscribe(ws, "w_sink", "wire");
     CHECK(ws.request(op("set_out_value", {{"subscription", sink}, {"value", 77}}))["result"] == json::object());
     json last;
-    for (int i = 0; i < 100; ++i) {
+    rr::testing::eventually([&] {
         last = ws.request(member("call", "w_sink_value"))["result"];
-        if (last == json{{"return", 77}}) break;
-        std::this_thread::sleep_for(20ms);
-    }
+        return last == json{{"return", 77}};
+    });
     CHECK(last == json{{"return", 77}});
 
     // Unsubscribe: no more values for that subscription.
     CHECK(ws.request(op("unsubscribe", {{"subscription", state}}))["result"] == json::object());
-    std::this_thread::sleep_for(100ms);  // a value already on its way may still arrive
-    ws.pushes().clear();
-    while (ws.next(50ms)) {
-    }
-    CHECK_FALSE(ws.wait_push(push_of(state, "wire"), 700ms));  // w_state ticks every 200 ms
+    ws.pushes().clear();  // those before the reply
+    // A value the gateway took for sending just before the unsubscribe may still follow its reply (one
+    // at most: a wire's waiting values are coalesced). A new subscription of the same wire counts the
+    // device's ticks (every 200 ms): after four of its values, no more than that one may have come.
+    const auto probe = subscribe(ws, "w_state", "wire");
+    for (int tick = 0; tick < 4; ++tick) REQUIRE(ws.wait_push(push_of(probe, "wire")));
+    while (auto m = ws.next(0ms)) ws.pushes().push_back(std::move(*m));
+    CHECK(std::count_if(ws.pushes().begin(), ws.pushes().end(), push_of(state, "wire")) <= 1);
+    CHECK(ws.request(op("unsubscribe", {{"subscription", probe}}))["result"] == json::object());
     CHECK(error_name(ws.request(op("unsubscribe", {{"subscription", state}}))) == "RobotRaconteur.InvalidArgument");
     CHECK(gw.sockets().stats().at(0).subscriptions == 5);  // values, empty, echo, both, sink
 }
@@ -249,7 +255,7 @@ TEST_CASE("json socket: subscribe to wires, events, pipes, unsubscribe") {
 TEST_CASE("json socket: subscribers of one wire and one event each get every value under their own id") {
     // The gateway renders a value's JSON once and shares it: every push must still carry its own
     // subscription id and the whole value.
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     WsClient a(gw.port());
@@ -284,7 +290,7 @@ TEST_CASE("json socket: subscribers of one wire and one event each get every val
 }
 
 TEST_CASE("json socket: subscriptions end with the socket, device state is pushed") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     auto device = std::make_unique<InteropProcess>();
     TestGateway gw(device->url());
     {
@@ -295,8 +301,7 @@ TEST_CASE("json socket: subscriptions end with the socket, device state is pushe
         CHECK(gw.sockets().stats().size() == 1);
         ws.close();
     }
-    for (int i = 0; i < 200 && !gw.sockets().stats().empty(); ++i) std::this_thread::sleep_for(10ms);
-    CHECK(gw.sockets().stats().empty());
+    CHECK(rr::testing::eventually([&] { return gw.sockets().stats().empty(); }));
 
     WsClient ws(gw.port());
     const auto echo = subscribe(ws, "p_echo", "pipe");
@@ -316,7 +321,7 @@ TEST_CASE("json socket: subscriptions end with the socket, device state is pushe
 }
 
 TEST_CASE("json socket: a client that never reads stays within the queue limits") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     JsonSocketOptions options;
     TestGateway gw(device.url(), true, options);
@@ -351,25 +356,23 @@ TEST_CASE("json socket: a client that never reads stays within the queue limits"
     }
     // A healthy client is served meanwhile.
     CHECK(driver.request(member("get", "ro_value"))["result"] == json{{"value", 17}});
-    bool limited = false;
-    for (int i = 0; i < 300 && !limited; ++i) {
+    const bool limited = rr::testing::eventually([&] {
         observe();
-        for (const auto& s : gw.sockets().stats())
-            limited |= s.push_drops > 0 || s.wire_coalesced > 0 || s.pending_wires > 0;
-        std::this_thread::sleep_for(20ms);
-    }
+        bool any = false;
+        for (const auto& s : gw.sockets().stats()) any |= s.push_drops > 0 || s.wire_coalesced > 0 || s.pending_wires > 0;
+        return any;
+    });
     CHECK(limited);  // the slow socket's pushes were dropped or coalesced instead of queued
     observe();
     driver.close();
     slow.close();
     never.close();
-    for (int i = 0; i < 300 && !gw.sockets().stats().empty(); ++i) std::this_thread::sleep_for(10ms);
-    CHECK(gw.sockets().stats().empty());
+    CHECK(rr::testing::eventually([&] { return gw.sockets().stats().empty(); }));
     (void)events;
 }
 
 TEST_CASE("json socket: a slow reader of large wire values gets the newest, not a backlog") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     JsonSocketOptions options;
     options.wire_bytes_threshold = 256u << 10;
@@ -411,7 +414,7 @@ TEST_CASE("json socket: a slow reader of large wire values gets the newest, not 
 }
 
 TEST_CASE("json socket: a disallowed Origin cannot open the socket") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     boost::asio::io_context io;

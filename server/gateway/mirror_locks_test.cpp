@@ -130,7 +130,7 @@ struct LockGateway {
                            [inbox = c.inbox](MessageEntry&& e) { inbox->push(std::move(e)); }, {},
                            [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
         auto f = p.get_future();
-        REQUIRE(f.wait_for(10s) == std::future_status::ready);
+        REQUIRE(f.wait_for(30s) == std::future_status::ready);
         auto r = f.get();
         INFO((r ? std::string() : r.error().message));
         REQUIRE(r);
@@ -266,13 +266,11 @@ TEST_CASE("auth shared: a monitor at the gateway refuses other sessions and is h
     b.raw->request(enter_op(-1), [&](Result<MessageEntry> r) { waiting.set_value(std::move(r)); });
     auto fut = waiting.get_future();
     CHECK(fut.wait_for(300ms) == std::future_status::timeout);
-    const auto t0 = std::chrono::steady_clock::now();
     CHECK(op_result(a.ok(shared_lock_op("MonitorExit"))) == "OK");
-    REQUIRE(fut.wait_for(3s) == std::future_status::ready);
-    CHECK(std::chrono::steady_clock::now() - t0 < 2s);
+    REQUIRE(fut.wait_for(rr::testing::kHangBound) == std::future_status::ready);
     auto got = fut.get();
     REQUIRE(got);
-    CHECK(op_result(*got) == "OK");
+    CHECK(op_result(*got) == "OK");  // handed over, not the "Continue" of 5 s later
     CHECK(gw.locks() == HeldLocks{{"dev", "bob", "monitor"}});
     CHECK(a.error(get_req("pos")).type == MessageErrorType::InvalidOperation);
     CHECK(a.error(enter_op(200)).type == MessageErrorType::RequestTimeout);
@@ -282,7 +280,7 @@ TEST_CASE("auth shared: a monitor at the gateway refuses other sessions and is h
     CHECK(scalar_of<double>(a.ok(get_req("pos")), "value") == 1.5);
 }
 
-TEST_CASE("auth shared: locks need the roles' `lock`; a login without it is refused every lock operation") {
+TEST_CASE("auth shared: locks need the roles' `lock`, a login without it is refused every lock operation") {
     LockGateway gw;
     auto a = gw.connect("alice", "a");
     auto m = gw.connect("mallory", "m");

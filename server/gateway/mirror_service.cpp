@@ -133,11 +133,24 @@ void MirrorService::on_session_open(const SessionRef& session) {
     if (passthrough_) passthrough_->attach(session);
 }
 
+MotionClient MirrorService::motion_client(const SessionRef& session, bool passthrough) {
+    MotionClient c;
+    c.key = "rr:" + std::to_string(session.endpoint());
+    c.user = session.username();
+    const std::string peer = session.peer();
+    c.description = "RR session from " + (peer.empty() ? std::string("an unknown address") : peer);
+    if (passthrough) c.device_session = session.endpoint();
+    c.liveness = [session](std::optional<std::chrono::milliseconds> timeout) { session.set_liveness_probe(timeout); };
+    return c;
+}
+
 void MirrorService::on_session_close(const SessionRef& session) {
     if (passthrough_) {
         end_session(session, {});
         return;
     }
+    // What it started without a timeout of its own ends with it (motion safety).
+    if (motion_) motion_->client_gone(motion_client(session, false).key);
     drop_session_state(session.endpoint());
     // Its client locks and monitors go; its user's user locks with the user's last session here.
     const std::string user = session.username();
@@ -156,7 +169,13 @@ void MirrorService::end_session(const SessionRef& session, std::function<void()>
         return;
     }
     drop_session_state(session.endpoint());
-    passthrough_->close(session.endpoint(), std::move(ended));
+    // The motion guard's stops go on the client's own upstream session (its device locks are still
+    // held there) before that session closes.
+    auto close = [p = passthrough_, endpoint = session.endpoint(), ended = std::move(ended)]() mutable {
+        p->close(endpoint, std::move(ended));
+    };
+    if (!motion_) return close();
+    motion_->client_gone(motion_client(session, true).key, std::move(close));
 }
 
 void MirrorService::admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
@@ -241,8 +260,23 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
         if (!responder.done()) responder.fail(std::move(*denied));
         return;
     }
+    // Motion safety: a hold-to-run call's timeout clamped, another client's motion refused while one
+    // holds (a refused packet is dropped), stops through every lock.
+    ReplyObserver observe;
+    bool stop = false;
+    if (motion_ && motion_->concerns(entry)) {
+        const MotionClient who = motion_client(session, passthrough_ != nullptr);
+        auto ticket = motion_->admit(who, entry);
+        if (!ticket) {
+            if (!responder.done()) responder.fail(ticket.error());
+            return;
+        }
+        stop = ticket->kind == MotionGuard::Ticket::Kind::stop;
+        if (ticket->kind != MotionGuard::Ticket::Kind::pass && !stop)
+            observe = [guard = motion_, who, t = *ticket](const Result<MessageEntry>& r) { guard->on_reply(who, t, r); };
+    }
     if (passthrough_) {
-        passthrough_->handle_entry(session, std::move(entry), std::move(responder));
+        passthrough_->handle_entry(session, std::move(entry), std::move(responder), std::move(observe), stop);
         return;
     }
     if (entry.entry_type == MessageEntryType::ClientSessionOpReq) {
@@ -252,23 +286,25 @@ void MirrorService::handle_entry(const SessionRef& session, MessageEntry&& entry
     const auto type = entry.entry_type;
     const bool packet = type == MessageEntryType::PipePacket || type == MessageEntryType::PipePacketRet ||
                         type == MessageEntryType::WirePacket;
-    if (!packet && locks_->any()) {  // while nothing is locked: no username copy per request
+    // A stop passes every lock held at the gateway (docs/security.md "Motion safety").
+    if (!packet && !stop && locks_->any()) {  // while nothing is locked: no username copy per request
         // Locks held at the gateway bind every member request, as ObjectService's do; packets on
         // connections opened before a lock pass (CORE checks requests only).
         auto ok = locks_->check(entry.service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, false);
         if (!ok && ok.error().type == MessageErrorType::ObjectLockedError) {
-            recheck_nolock(session, std::move(entry), std::move(responder));
+            recheck_nolock(session, std::move(entry), std::move(responder), std::move(observe));
             return;
         }
         if (!ok) {
+            if (observe) observe(fail(ok.error()));
             responder.fail(ok.error());
             return;
         }
     }
-    dispatch_shared(session, std::move(entry), std::move(responder));
+    dispatch_shared(session, std::move(entry), std::move(responder), std::move(observe));
 }
 
-void MirrorService::dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+void MirrorService::dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe) {
     switch (entry.entry_type) {
         case MessageEntryType::WireConnectReq: wire_connect(session, std::move(entry), std::move(responder)); return;
         case MessageEntryType::WireDisconnectReq: wire_disconnect(session, std::move(entry), std::move(responder)); return;
@@ -298,10 +334,10 @@ void MirrorService::dispatch_shared(const SessionRef& session, MessageEntry&& en
                 responder.fail(make_error(MessageErrorType::InvalidOperation, "generator index not owned by this client"));
                 return;
             }
-            forward(session, std::move(entry), std::move(responder));
+            forward(session, std::move(entry), std::move(responder), std::move(observe));
             return;
         }
-        default: forward(session, std::move(entry), std::move(responder)); return;
+        default: forward(session, std::move(entry), std::move(responder), std::move(observe)); return;
     }
 }
 
@@ -340,19 +376,20 @@ void MirrorService::lock_op(const SessionRef& session, MessageEntry&& entry, Res
     });
 }
 
-void MirrorService::recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+void MirrorService::recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe) {
     auto shared = std::make_shared<Responder>(std::move(responder));
     auto request = std::make_shared<MessageEntry>(std::move(entry));
     auto self = shared_from_this();
-    auto decide = [self, session, request, shared](Result<ObjectTypeInfo> type) {
+    auto decide = [self, session, request, shared, observe = std::move(observe)](Result<ObjectTypeInfo> type) mutable {
         bool nolock = false;
         if (type) nolock = passes_object_locks(self->member_modifiers(type->object_type, request->member_name), request->entry_type);
         auto ok = self->locks_->check(request->service_path, ServiceLocks::Requester{session.endpoint(), session.username()}, nolock);
         if (!ok) {
+            if (observe) observe(fail(ok.error()));
             shared->fail(ok.error());
             return;
         }
-        self->dispatch_shared(session, std::move(*request), std::move(*shared));
+        self->dispatch_shared(session, std::move(*request), std::move(*shared), std::move(observe));
     };
     if (request->service_path == name_) {
         decide(root_type());
@@ -392,9 +429,10 @@ std::vector<DeviceLockInfo> MirrorService::gateway_locks() const {
     return out;
 }
 
-void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe) {
     auto c = client();
     if (!c) {
+        if (observe) observe(fail(not_connected(name_)));
         if (!responder.done()) responder.fail(not_connected(name_));
         return;
     }
@@ -409,8 +447,9 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
     counters_->requests.fetch_add(1);
     auto self = shared_from_this();
     auto shared = std::make_shared<Responder>(std::move(responder));
-    c->request(std::move(entry), [self, shared, type, endpoint, start](Result<MessageEntry> r) {
+    c->request(std::move(entry), [self, shared, type, endpoint, start, observe = std::move(observe)](Result<MessageEntry> r) {
         self->counters_->observe_latency(std::chrono::steady_clock::now() - start);
+        if (observe) observe(r);
         if (!r) {
             // No answer from the device (its connection dropped, the request timed out): say which device,
             // as not_connected() does for requests made while it is down.

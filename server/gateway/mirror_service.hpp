@@ -12,6 +12,7 @@
 #include "server/gateway/auth/mirror_access.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
+#include "server/gateway/motion_guard.hpp"
 #include "server/gateway/upstream_subscriptions.hpp"
 #include "server/service/service_locks.hpp"
 
@@ -49,6 +50,12 @@ public:
     void admit_session(std::uint32_t endpoint, std::string username, std::optional<MessageElement> credentials,
                        std::function<void(Result<void>)> done) override;
     void abandon_admission(std::uint32_t endpoint) override;
+
+    /// The device's motion guard (set once, by DeviceMirror::create, before registration): motion
+    /// requests are admitted by it, stops pass every lock, a session's going away ends its motions.
+    void set_motion_guard(std::shared_ptr<MotionGuard> guard) { motion_ = std::move(guard); }
+    /// How the motion guard sees a native client's session.
+    static MotionClient motion_client(const SessionRef& session, bool passthrough);
 
     /// auth: passthrough (set once, by DeviceMirror::create, before registration).
     void set_passthrough(std::shared_ptr<PassthroughSessions> p) {
@@ -112,8 +119,11 @@ private:
         std::int32_t upstream_index = 0;
     };
 
+    /// Told the device's answer to a forwarded request (the motion guard follows its motions).
+    using ReplyObserver = std::function<void(const Result<MessageEntry>&)>;
+
     std::shared_ptr<RawClient> client() const;
-    void forward(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void forward(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe = {});
     void wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder);
     void wire_disconnect(const SessionRef& session, MessageEntry&& entry, Responder responder);
     /// Connects the wire upstream unless it is connected or being connected (or fails its waiting
@@ -130,12 +140,12 @@ private:
     void fan_out(MessageEntry&& entry);
     void drop_session_state(std::uint32_t endpoint);
     /// auth: shared: a client's request after the roles (and, for member requests, the locks).
-    void dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void dispatch_shared(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe = {});
     /// auth: shared: RequestObjectLock … MonitorExit, decided by locks_.
     void lock_op(const SessionRef& session, MessageEntry&& entry, Responder responder);
     /// auth: shared: a member request an object lock refused: passes when the device's definition
     /// marks the member [nolock] / [nolockread] (the object's type asked of the device when below the root).
-    void recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    void recheck_nolock(const SessionRef& session, MessageEntry&& entry, Responder responder, ReplyObserver observe);
     /// The robdef modifiers of `member` of object type `type` (empty when unknown).
     std::vector<std::string> member_modifiers(const std::string& type, const std::string& member);
     /// objectlock / objectlockoverride of a gateway user (none without gateway.auth).
@@ -144,6 +154,7 @@ private:
     std::weak_ptr<DeviceMirror> mirror_;
     const std::shared_ptr<DeviceCounters> counters_;
     std::shared_ptr<PassthroughSessions> passthrough_;
+    std::shared_ptr<MotionGuard> motion_;
     // auth: shared: the object and monitor locks of this device's gateway clients, held here (the
     // device sees one session); unused on a passthrough device.
     const std::shared_ptr<ServiceLocks> locks_ = std::make_shared<ServiceLocks>();

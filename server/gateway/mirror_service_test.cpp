@@ -12,13 +12,14 @@
 #include "server/node/test_node.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
 using namespace rr::server::gateway;
 using namespace std::chrono_literals;
-using testing::RawTestService;
-using testing::test_node;
+using rr::server::testing::RawTestService;
+using rr::server::testing::test_node;
 
 namespace {
 
@@ -59,7 +60,7 @@ struct Gateway {
         node->shutdown();
     }
 
-    bool wait_state(DeviceState s, std::chrono::milliseconds timeout = 5000ms) {
+    bool wait_state(DeviceState s, std::chrono::milliseconds timeout = rr::testing::kHangBound) {
         auto until = std::chrono::steady_clock::now() + timeout;
         while (std::chrono::steady_clock::now() < until) {
             if (mirror->status().state == s) return true;
@@ -145,8 +146,7 @@ TEST_CASE("a device counts as connected only once its service is registered on t
         if (self->status().state == DeviceState::connected) connected_before_registered = true;
     });
     (*m)->start();
-    for (int i = 0; i < 500 && (*m)->status().state != DeviceState::connected; ++i) std::this_thread::sleep_for(10ms);
-    CHECK((*m)->status().state == DeviceState::connected);
+    CHECK(rr::testing::eventually([&] { return (*m)->status().state == DeviceState::connected; }));
     CHECK(registrations.load() == 1);
     CHECK_FALSE(connected_before_registered.load());
     (*m)->stop();
@@ -200,7 +200,7 @@ TEST_CASE("events and wire values fan out to every client, callbacks go to the c
         CHECK(device.service->wire_sessions.size() == 1);
     }
     REQUIRE(call(*clients[2], request(MessageEntryType::FunctionCallReq, "fire")));
-    auto until = std::chrono::steady_clock::now() + 5s;
+    auto until = std::chrono::steady_clock::now() + rr::testing::kHangBound;
     auto done = [&] {
         for (int i = 0; i < 3; ++i) {
             std::lock_guard lock(seen[i]->m);
@@ -245,13 +245,13 @@ TEST_CASE("a device that restarts: errors while it is gone, then everything work
     CHECK_FALSE(gw.mirror->status().reason.empty());
 
     device = std::make_unique<Device>(port);
-    REQUIRE(gw.wait_state(DeviceState::connected, 10000ms));
+    REQUIRE(gw.wait_state(DeviceState::connected));
     auto back = call(*c, request(MessageEntryType::PropertyGetReq, "x"));
     REQUIRE(back);
     CHECK(back->error == MessageErrorType::None);
     CHECK(scalar(*back, "value") == 42.5);
     // The downstream wire connection survived and was re-subscribed upstream.
-    auto until = std::chrono::steady_clock::now() + 5s;
+    auto until = std::chrono::steady_clock::now() + rr::testing::kHangBound;
     std::size_t n = 0;
     while (std::chrono::steady_clock::now() < until) {
         {
@@ -304,9 +304,8 @@ TEST_CASE("auth: passthrough: one upstream session per client, bounded, closed w
     std::shared_ptr<RawClient> c;
     a->close();
     a.reset();
-    for (int i = 0; i < 100 && gw.mirror->status().upstream_sessions != 1; ++i) std::this_thread::sleep_for(20ms);
-    CHECK(gw.mirror->status().upstream_sessions == 1);
-    for (int i = 0; i < 100 && device.service->closed.load() < 1; ++i) std::this_thread::sleep_for(20ms);
+    CHECK(rr::testing::eventually([&] { return gw.mirror->status().upstream_sessions == 1; }));
+    CHECK(rr::testing::eventually([&] { return device.service->closed.load() >= 1; }));
     CHECK(device.service->closed.load() == 1);  // a's upstream session went with a
     auto r = gw.try_connect(cb_answer(&c, &a_called, 3.0));
     REQUIRE(r);

@@ -244,9 +244,11 @@ RRError PassthroughSessions::session_gone() const {
                       "the device \"" + settings_.device_name + "\" closed this client's session");
 }
 
-void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder) {
+void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder,
+                                       std::function<void(const Result<MessageEntry>&)> observe, bool stop) {
     auto client = open_client(session.endpoint());
     if (!client) {
+        if (observe) observe(fail(session_gone()));
         if (!responder.done()) responder.fail(session_gone());
         return;
     }
@@ -256,12 +258,54 @@ void PassthroughSessions::handle_entry(const SessionRef& session, MessageEntry&&
         return;
     }
     auto shared = std::make_shared<Responder>(std::move(responder));
-    forward(session.endpoint(), client, std::move(entry), [shared](Result<MessageEntry> r) {
-        if (!r)
-            shared->fail(r.error());
-        else
-            shared->respond(std::move(*r));
-    });
+    std::optional<MessageEntry> again;
+    if (stop) again = entry;  // a stop is small (halt(), one property value)
+    const std::uint32_t endpoint = session.endpoint();
+    std::weak_ptr<PassthroughSessions> weak = weak_from_this();
+    forward(endpoint, client, std::move(entry),
+            [shared, observe = std::move(observe), again = std::move(again), weak, endpoint](Result<MessageEntry> r) mutable {
+                // By value: it may run later, from stop_as_lock_holder's own request.
+                auto answer = [shared, observe](Result<MessageEntry> reply) {
+                    if (observe) observe(reply);
+                    if (!reply)
+                        shared->fail(reply.error());
+                    else
+                        shared->respond(std::move(*reply));
+                };
+                auto self = weak.lock();
+                if (!again || !self || !r || !self->refused_by_lock(*r)) return answer(std::move(r));
+                // A lock another client took through the gateway refused the stop: sent again on that
+                // client's session, which the lock does not bind.
+                self->stop_as_lock_holder(endpoint, std::move(*again), std::move(answer), std::move(r));
+            });
+}
+
+bool PassthroughSessions::refused_by_lock(const MessageEntry& reply) {
+    if (reply.error == MessageErrorType::ObjectLockedError) return true;
+    if (reply.error != MessageErrorType::InvalidOperation) return false;
+    const auto* msg = reply.find("errorstring");
+    return msg && read_string(*msg).find("monitor locked") != std::string_view::npos;
+}
+
+void PassthroughSessions::stop_as_lock_holder(std::uint32_t endpoint, MessageEntry stop,
+                                              std::function<void(Result<MessageEntry>)> answer, Result<MessageEntry> refused) {
+    std::shared_ptr<RawClient> holder;
+    std::uint32_t holder_endpoint = 0;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& l : locks_) {
+            if (l.endpoint == endpoint) continue;
+            // Stops are on the root object, which only a lock on the root binds (gateway naming on both).
+            if (l.path != stop.service_path) continue;
+            auto it = links_.find(l.endpoint);
+            if (it == links_.end() || it->second.lost || !it->second.client || !it->second.client->is_open()) continue;
+            holder = it->second.client;
+            holder_endpoint = l.endpoint;
+            break;
+        }
+    }
+    if (!holder) return answer(std::move(refused));
+    forward(holder_endpoint, holder, std::move(stop), [answer = std::move(answer)](Result<MessageEntry> r) { answer(std::move(r)); });
 }
 
 void PassthroughSessions::request(std::uint32_t endpoint, MessageEntry entry, std::function<void(Result<MessageEntry>)> done) {

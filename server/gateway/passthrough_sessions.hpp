@@ -104,8 +104,13 @@ public:
     void close_all();
     void reopen();
 
-    /// A request or packet from a client (Service::handle_entry).
-    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder);
+    /// A request or packet from a client (Service::handle_entry). `observe` (optional) is told the
+    /// device's answer first. `stop`: the request stops motion (docs/security.md "Motion safety"): when
+    /// the device refuses it for a lock (ObjectLockedError, or a monitor held by another session), it is
+    /// sent again on the session of a client that holds a lock taken through the gateway, so that no
+    /// lock known here blocks a stop; the client gets that answer.
+    void handle_entry(const SessionRef& session, MessageEntry&& entry, Responder responder,
+                      std::function<void(const Result<MessageEntry>&)> observe = {}, bool stop = false);
 
     /// Whether a client's session may receive one of the device's entries (gateway.auth roles, checked
     /// packet by packet: docs/security.md): asked for events, wire and pipe packets (`read`) and
@@ -117,6 +122,14 @@ public:
 
     std::size_t session_count() const;
     std::vector<DeviceLockInfo> locks() const;
+
+    /// The device refused a request for a lock (ObjectLockedError, or InvalidOperation "… monitor locked").
+    static bool refused_by_lock(const MessageEntry& reply);
+    /// A stop (paths in gateway naming) the device refused with `refused` for a lock: sent again on the
+    /// session of a client (not `except`) that holds a lock on the root object taken through the
+    /// gateway; `answer` gets that reply, or `refused` when no such session is open.
+    void stop_as_lock_holder(std::uint32_t except, MessageEntry stop, std::function<void(Result<MessageEntry>)> answer,
+                             Result<MessageEntry> refused);
 
 private:
     struct Link {

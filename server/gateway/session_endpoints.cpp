@@ -1,5 +1,7 @@
 #include "server/gateway/session_endpoints.hpp"
 
+#include <algorithm>
+
 #include "core/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/pipe_entries.hpp"
@@ -31,6 +33,11 @@ std::size_t SessionEndpoints::subscription_count() const {
     for (const auto& [k, subs] : events_) n += subs.size();
     for (const auto& [k, w] : wires_) n += w.subscribers.size();
     return n;
+}
+
+std::size_t SessionEndpoints::open_pipe_count() const {
+    std::lock_guard lock(mutex_);
+    return static_cast<std::size_t>(std::count_if(pipes_.begin(), pipes_.end(), [](const auto& p) { return p.second.connected; }));
 }
 
 // --- events and wires -----------------------------------------------------------------------------

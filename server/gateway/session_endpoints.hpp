@@ -105,6 +105,8 @@ public:
     void forget();
 
     std::size_t subscription_count() const;
+    /// Pipe endpoints connected now (their PipeConnectReq answered; not those still connecting).
+    std::size_t open_pipe_count() const;
 
 private:
     using MemberKey = std::pair<std::string, std::string>;  // service path, member

@@ -72,12 +72,24 @@ HttpHandler http_handler(std::weak_ptr<HttpServer> server) {
     };
 }
 
+namespace {
+WatchedRouteHandler unwatched(RouteHandler handler) {
+    return [handler = std::move(handler)](const Request& req, Responder respond, const std::shared_ptr<RequestConnection>&) {
+        handler(req, std::move(respond));
+    };
+}
+}  // namespace
+
 void HttpServer::add_route(bhttp::verb method, std::string path, RouteHandler handler, bool prefix) {
-    routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
+    routes_.push_back(Route{method, std::move(path), prefix, unwatched(std::move(handler))});
 }
 
 void HttpServer::add_route_any_method(std::string path, RouteHandler handler, bool prefix) {
-    routes_.push_back(Route{std::nullopt, std::move(path), prefix, std::move(handler)});
+    routes_.push_back(Route{std::nullopt, std::move(path), prefix, unwatched(std::move(handler))});
+}
+
+void HttpServer::add_watched_route(bhttp::verb method, std::string path, WatchedRouteHandler handler, bool prefix) {
+    routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
 }
 
 std::string HttpServer::subprotocol_names() const {
@@ -90,7 +102,7 @@ void HttpServer::add_subprotocol(std::string name, JsonSocketHandler handler) {
     subprotocols_.emplace(std::move(name), std::move(handler));
 }
 
-const RouteHandler* HttpServer::find_route(bhttp::verb method, std::string_view path, bool any_method) const {
+const WatchedRouteHandler* HttpServer::find_route(bhttp::verb method, std::string_view path, bool any_method) const {
     auto matches = [&](const Route& r) { return r.prefix ? path.rfind(r.path, 0) == 0 : path == r.path; };
     for (const auto& r : routes_)
         if (r.method && *r.method == method && matches(r)) return &r.handler;

@@ -50,6 +50,20 @@ inline constexpr std::string_view kSecureField = "X-RR-Gateway-Secure";
 using Responder = std::function<void(Response)>;
 using RouteHandler = std::function<void(const Request& request, Responder respond)>;
 
+/// The connection a request came on, for a handler whose work must end with its client (the
+/// gateway's motion safety: a motion a request started ends when the request's connection closes).
+class RequestConnection {
+public:
+    virtual ~RequestConnection() = default;
+    /// Calls `gone` once, from the connection's strand, when the client closes the connection (or it
+    /// fails) before the request is answered; never once it is answered. A later call replaces `gone`.
+    /// Thread-safe. Plain HTTP has no round trip while the client waits: a connection that stops
+    /// forwarding without closing (a black-holed proxy) is not noticed (docs/security.md).
+    virtual void on_gone(std::function<void()> gone) = 0;
+};
+using WatchedRouteHandler =
+    std::function<void(const Request& request, Responder respond, const std::shared_ptr<RequestConnection>& connection)>;
+
 /// A WebSocket session for a non-RR subprotocol: `send` queues a text message (thread-safe), `close`
 /// ends the session. The handler gets messages through on_message and on_close.
 class JsonSocket {
@@ -89,6 +103,10 @@ public:
     virtual std::size_t queued_bytes() const { return 0; }
     /// Messages dropped because the queue was full (HttpOptions::json_socket_queue_limit).
     virtual std::uint64_t dropped() const { return 0; }
+    /// Probes the client (the gateway while it holds a motion without a timeout of its own): a ping every
+    /// `timeout` / 5, and the socket ends (on_close) when no frame at all, pong or message, arrives for
+    /// `timeout`. nullopt: off. Thread-safe.
+    virtual void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) {}
 };
 struct JsonSocketHandler {
     std::function<void(std::shared_ptr<JsonSocket>)> on_open;
@@ -141,6 +159,8 @@ public:
     void add_route(boost::beast::http::verb method, std::string path, RouteHandler handler, bool prefix = false);
     /// A route for every method, also ones Beast does not know (the handler answers 405 itself).
     void add_route_any_method(std::string path, RouteHandler handler, bool prefix = false);
+    /// A route whose handler also gets the request's connection (RequestConnection).
+    void add_watched_route(boost::beast::http::verb method, std::string path, WatchedRouteHandler handler, bool prefix = false);
     /// WebSocket subprotocol served by a JSON handler.
     void add_subprotocol(std::string name, JsonSocketHandler handler);
 
@@ -149,7 +169,7 @@ public:
     // Used by sessions.
     /// The route for `method` and `path`: routes of that method first, then (with `any_method`) routes
     /// for any method, each in the order added.
-    const RouteHandler* find_route(boost::beast::http::verb method, std::string_view path, bool any_method = true) const;
+    const WatchedRouteHandler* find_route(boost::beast::http::verb method, std::string_view path, bool any_method = true) const;
     const JsonSocketHandler* find_subprotocol(std::string_view name) const;
     /// The registered JSON subprotocols, comma-separated (for error messages).
     std::string subprotocol_names() const;
@@ -162,7 +182,7 @@ private:
         std::optional<boost::beast::http::verb> method;  ///< none: any method
         std::string path;
         bool prefix;
-        RouteHandler handler;
+        WatchedRouteHandler handler;  // a RouteHandler's ignores the connection
     };
     std::vector<Route> routes_;
     std::map<std::string, JsonSocketHandler, std::less<>> subprotocols_;

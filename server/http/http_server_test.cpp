@@ -16,6 +16,7 @@
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -311,7 +312,8 @@ TEST_CASE("X-Forwarded-For/-Proto are believed from a trusted proxy only") {
 TEST_CASE("a JSON WebSocket's urgent message goes ahead of the pushes still waiting") {
     Fixture f;
     SubprotocolClient client(f.port, "test.flood.v1", "flood");
-    std::this_thread::sleep_for(300ms);  // the 13 MB backlog builds up while we do not read
+    // The handler queues the 200 pushes (13 MB) and the reply in one run on the socket's strand, so the
+    // reply meets the backlog whenever this client starts reading.
     int reply_at = -1, pushes = 0, last_push = -1;
     bool in_order = true;
     for (int i = 0; i < 201; ++i) {
@@ -351,7 +353,7 @@ TEST_CASE("a JSON WebSocket writes a shared body after each message's own head, 
 TEST_CASE("a JSON WebSocket keeps each sending thread's order and loses nothing below its limit") {
     Fixture f;
     SubprotocolClient client(f.port, "test.push.threads.v1", "go");
-    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
+    beast::get_lowest_layer(client.ws).expires_after(60s);  // a lost message fails the read, not the suite (a bound on a hang)
     std::array<int, 4> next{};
     bool in_order = true;
     for (int i = 0; i < 4 * 200; ++i) {
@@ -372,18 +374,14 @@ TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and 
     Fixture f({}, 16);
     SubprotocolClient client(f.port, "test.push.burst.v1", "go");
     std::shared_ptr<http::JsonSocket> socket;
-    for (int i = 0; i < 100 && !socket; ++i) {
-        std::this_thread::sleep_for(10ms);
-        socket = f.burst_socket->get();
-    }
-    REQUIRE(socket);
-    std::this_thread::sleep_for(200ms);  // the burst is queued while we do not read
+    // Set once the whole burst is sent (queued or dropped) while this client does not read yet.
+    REQUIRE(rr::testing::eventually([&] { return (socket = f.burst_socket->get()) != nullptr; }));
     CHECK(socket->queued() <= 2 * 16);
     CHECK(socket->queued_bytes() <= 2 * 16 * (64 * 1024 + 16));
     const auto dropped = socket->dropped();
     CHECK(dropped >= 100 - 2 * 16);
     // What is left arrives in order and ends with the newest.
-    beast::get_lowest_layer(client.ws).expires_after(20s);  // a lost message fails the read, not the suite
+    beast::get_lowest_layer(client.ws).expires_after(60s);  // a lost message fails the read, not the suite (a bound on a hang)
     int last = -1, received = 0;
     bool in_order = true;
     while (last < 99) {

@@ -14,6 +14,10 @@
 #include <type_traits>
 #include <utility>
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
 #include <boost/asio/bind_allocator.hpp>
 #include <boost/asio/ssl/error.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -137,7 +141,7 @@ public:
     JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
                          std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {})
         : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), peer_(std::move(peer)),
-          cookie_(std::move(cookie)), pacer_(node, ws_.get_executor()) {
+          cookie_(std::move(cookie)), pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()) {
         const auto executor = ws_.get_executor();
         if (const auto* io = executor.template target<IoStrand>()) io_strand_ = *io;
     }
@@ -145,6 +149,8 @@ public:
     void start() {
         ws_.text(true);
         ws_.auto_fragment(false);  // one frame per message, not Beast's 4 KiB fragments (one write each)
+        // Any frame from the client counts for the liveness probe, a pong too.
+        ws_.control_callback([this](websocket::frame_type, beast::string_view) { last_receive_ = std::chrono::steady_clock::now(); });
         if (handler_->on_open) handler_->on_open(shared_from_this());
         read();
     }
@@ -181,6 +187,11 @@ public:
             self->closed_ = true;
             self->ws_.async_close(websocket::close_code::normal, [self](beast::error_code) {});
         });
+    }
+
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self, timeout] { self->probe(timeout); });
     }
 
     std::string peer() const override { return peer_; }
@@ -299,6 +310,7 @@ private:
                 self->finish();
                 return;
             }
+            self->last_receive_ = std::chrono::steady_clock::now();
             std::string text = beast::buffers_to_string(self->buffer_.data());
             self->buffer_.consume(self->buffer_.size());
             // Beast 1.81 checks UTF-8 per frame and misses a text message that ends inside a UTF-8
@@ -311,6 +323,40 @@ private:
             self->pacer_.charge(text.size(), self->peer_);
             if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
             self->read();
+        });
+    }
+
+    // --- liveness probe (on the strand) ---
+
+    void probe(std::optional<std::chrono::milliseconds> timeout) {
+        ++probe_gen_;
+        probe_timeout_ = timeout;
+        probe_timer_.cancel();
+        if (!timeout || finished_ || timeout->count() <= 0) return;
+        probe_started_ = std::chrono::steady_clock::now();
+        probe_tick(probe_gen_);
+    }
+
+    void probe_tick(std::uint64_t gen) {
+        if (gen != probe_gen_ || finished_ || closed_ || !probe_timeout_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - std::max(last_receive_, probe_started_) >= *probe_timeout_) {
+            // Nothing came back for the bound: the client counts as gone now (on_close), and the
+            // connection is dropped without waiting for a close handshake that cannot come.
+            finish();
+            beast::error_code ec;
+            beast::get_lowest_layer(ws_).socket().close(ec);
+            return;
+        }
+        if (!ping_in_flight_) {
+            ping_in_flight_ = true;
+            auto self = shared_from_this();
+            ws_.async_ping({}, [self](beast::error_code) { self->ping_in_flight_ = false; });
+        }
+        probe_timer_.expires_after(*probe_timeout_ / 5);
+        auto self = shared_from_this();
+        probe_timer_.async_wait([self, gen](beast::error_code ec) {
+            if (!ec) self->probe_tick(gen);
         });
     }
 
@@ -359,6 +405,7 @@ private:
             queue_.pop_back();
         }
         pacer_.cancel();
+        probe_timer_.cancel();
         if (handler_->on_close) handler_->on_close(shared_from_this());
     }
 
@@ -384,6 +431,12 @@ private:
     bool writing_ = false;
     bool closed_ = false;
     bool finished_ = false;
+    // set_liveness_probe: the strand's.
+    asio::steady_timer probe_timer_;
+    std::optional<std::chrono::milliseconds> probe_timeout_;
+    std::uint64_t probe_gen_ = 0;
+    std::chrono::steady_clock::time_point probe_started_{}, last_receive_{};
+    bool ping_in_flight_ = false;
 };
 
 /// One HTTP connection over `Stream` (Beast's TCP stream, or TlsStream for HTTPS): requests in order,
@@ -394,7 +447,8 @@ public:
     using std::enable_shared_from_this<HttpSession<Stream>>::shared_from_this;
 
     HttpSession(std::shared_ptr<HttpServer> server, Stream stream)
-        : server_(std::move(server)), stream_(std::move(stream)), pacer_(server_->node(), stream_.get_executor()) {}
+        : server_(std::move(server)), stream_(std::move(stream)), pacer_(server_->node(), stream_.get_executor()),
+          watch_timer_(stream_.get_executor()) {}
 
     void start(std::vector<std::byte> initial, std::shared_ptr<const void> hold = {}) {
         hold_ = std::move(hold);
@@ -481,16 +535,17 @@ private:
         std::string_view target(req.target().data(), req.target().size());
         auto path = target.substr(0, target.find('?'));
         // A route of this method, for HEAD one of GET (its headers, no body), then a route for any method.
-        const RouteHandler* route = server_->find_route(req.method(), path, false);
+        const WatchedRouteHandler* route = server_->find_route(req.method(), path, false);
         if (!route && head_) route = server_->find_route(bhttp::verb::get, path, false);
         if (!route) route = server_->find_route(req.method(), path);
         if (route) {
             auto self = shared_from_this();
             auto keep = std::make_shared<Request>(std::move(req));
             auto ex = stream_.get_executor();
+            auto connection = std::make_shared<Watch>(self, ++request_gen_);
             (*route)(*keep, [self, keep, ex](Response r) {
                 asio::post(ex, [self, r = std::move(r)]() mutable { self->write(std::move(r)); });
-            });
+            }, connection);
             return;
         }
         if ((req.method() == bhttp::verb::get || req.method() == bhttp::verb::head) &&
@@ -631,6 +686,78 @@ private:
         });
     }
 
+    // --- the connection of a request being answered (RequestConnection) ---
+
+    class Watch : public RequestConnection {
+    public:
+        Watch(std::weak_ptr<HttpSession> session, std::uint64_t gen) : session_(std::move(session)), gen_(gen) {}
+        void on_gone(std::function<void()> gone) override {
+            auto s = session_.lock();
+            if (!s) return;
+            asio::post(s->stream_.get_executor(), [s, gen = gen_, gone = std::move(gone)]() mutable {
+                s->arm_watch(gen, std::move(gone));
+            });
+        }
+
+    private:
+        std::weak_ptr<HttpSession> session_;
+        std::uint64_t gen_;
+    };
+
+    // On the strand. Nothing else waits on the socket while a request is handled: a readable socket
+    // with nothing to read is the client's end (FIN or RST).
+    void arm_watch(std::uint64_t gen, std::function<void()> gone) {
+        if (gen != request_gen_) return;  // answered already
+        gone_ = std::move(gone);
+        if (watching_) return;
+        watching_ = true;
+        auto self = shared_from_this();
+        beast::get_lowest_layer(stream_).socket().async_wait(tcp::socket::wait_read, [self, gen](beast::error_code ec) {
+            if (gen != self->request_gen_ || ec == asio::error::operation_aborted) return;
+            beast::error_code aec;
+            const std::size_t n = beast::get_lowest_layer(self->stream_).socket().available(aec);
+            if (ec || aec || n == 0) return self->client_gone(gen);
+            self->poll_gone(gen);  // bytes wait (a pipelined request, a TLS alert): the TCP state tells
+        });
+    }
+
+    void poll_gone(std::uint64_t gen) {
+        watch_timer_.expires_after(std::chrono::milliseconds(100));
+        auto self = shared_from_this();
+        watch_timer_.async_wait([self, gen](beast::error_code ec) {
+            if (ec || gen != self->request_gen_) return;
+            if (self->peer_closed()) return self->client_gone(gen);
+            self->poll_gone(gen);
+        });
+    }
+
+    bool peer_closed() {
+        auto& socket = beast::get_lowest_layer(stream_).socket();
+        tcp_info info{};
+        socklen_t len = sizeof info;
+        if (::getsockopt(socket.native_handle(), IPPROTO_TCP, TCP_INFO, &info, &len) != 0) return true;
+        return info.tcpi_state != TCP_ESTABLISHED;
+    }
+
+    void client_gone(std::uint64_t gen) {
+        if (gen != request_gen_) return;
+        watching_ = false;
+        auto gone = std::move(gone_);
+        gone_ = nullptr;
+        if (gone) gone();
+    }
+
+    // The request is answered: its watch ends (the socket's wait cancelled before the write starts).
+    void end_watch() {
+        ++request_gen_;
+        gone_ = nullptr;
+        if (!watching_) return;
+        watching_ = false;
+        beast::error_code ec;
+        beast::get_lowest_layer(stream_).socket().cancel(ec);
+        watch_timer_.cancel();
+    }
+
     ClientOrigin client() const { return ClientOrigin{remote(), "", false}; }
 
     std::string remote() const {
@@ -640,6 +767,7 @@ private:
     }
 
     void write(Response r) {
+        end_watch();
         if (const auto& hook = server_->options().on_response) {
             // The client as the request named it (behind a trusted proxy: the proxy's client).
             hook(request_line_.empty() || client_.address.empty() ? remote() : client_.address, request_line_, r.result_int());
@@ -677,6 +805,11 @@ private:
     ClientOrigin client_;  // who sent the request being answered (behind a trusted proxy: the proxy's client)
     std::string request_line_;  // "METHOD target" of that request, for HttpOptions::on_response
     ReadPacer pacer_;  // gateway.limits rates: requests and their bytes
+    // RequestConnection of the request being answered: its number, its `gone`, the wait on the socket.
+    std::uint64_t request_gen_ = 0;
+    std::function<void()> gone_;
+    bool watching_ = false;
+    asio::steady_timer watch_timer_;
 };
 
 }  // namespace rr::server::http::detail

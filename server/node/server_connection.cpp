@@ -92,6 +92,15 @@ std::string SessionRef::local_url() const {
     return p ? p->local_url() : std::string();
 }
 
+std::string SessionRef::peer() const {
+    auto p = session_.lock();
+    return p ? p->peer() : std::string();
+}
+
+void SessionRef::set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) const {
+    if (auto p = session_.lock()) p->set_liveness_probe(timeout);
+}
+
 Responder::Responder(std::shared_ptr<ReplySink> sink, const MessageEntry& request)
     : sink_(std::move(sink)),
       request_type_(request.entry_type),
@@ -144,6 +153,19 @@ void ServerSession::set_username(std::string name) {
 std::string ServerSession::local_url() const {
     auto c = connection_.lock();
     return c ? c->local_url() : std::string();
+}
+
+std::string ServerSession::peer() const {
+    auto c = connection_.lock();
+    return c ? c->peer() : std::string();
+}
+
+void ServerSession::set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) {
+    auto pump = pump_.lock();
+    if (!pump || !alive()) return;
+    pump->post([conn = connection_, timeout] {
+        if (auto c = conn.lock()) c->set_liveness_probe(timeout);
+    });
 }
 
 // From another thread (a fan-out, a worker's reply or event): queued in order with the pump's one
@@ -290,6 +312,10 @@ void ServerConnection::take_output(GatherBuffer& out) {
     session_.take_output(out);
     stats_->bytes_out.fetch_add(out.size(), std::memory_order_relaxed);
     update_queue_estimate();
+}
+
+void ServerConnection::set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) {
+    session_.set_liveness_probe(timeout, mono_now());
 }
 
 void ServerConnection::on_timer(MonoTime now) {

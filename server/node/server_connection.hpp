@@ -74,6 +74,10 @@ public:
     void set_queued_bytes(std::size_t n) noexcept { queued_.store(n); }
     /// The connection's local_url() (empty once the connection is gone).
     std::string local_url() const;
+    /// The connection's client address (ServerConnectionConfig::peer; empty once it is gone).
+    std::string peer() const;
+    /// SessionRef::set_liveness_probe: posted to the connection's strand.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout);
 
     /// A wire packet of this session's own, or one shared by many sessions.
     using PendingWire = std::variant<MessageEntry, std::shared_ptr<const EncodedEntry>>;
@@ -127,6 +131,9 @@ public:
     ~ServerConnection() override;
 
     const std::string& local_url() const noexcept { return local_url_; }
+    const std::string& peer() const noexcept { return config_.peer; }
+    /// On the strand: ServiceSession::set_liveness_probe at the time now.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout);
 
     // ConnectionLogic
     void attach(std::weak_ptr<PumpHandle> pump) override { pump_ = std::move(pump); }

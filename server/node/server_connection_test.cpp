@@ -20,6 +20,7 @@
 #include "server/node/server_connection.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -27,8 +28,8 @@ using namespace std::chrono_literals;
 
 namespace {
 
-using testing::RawTestService;
-using testing::kDef;
+using rr::server::testing::RawTestService;
+using rr::server::testing::kDef;
 
 struct Fixture {
     std::shared_ptr<Node> node = Node::create(NodeOptions{NodeID(), "rawtest.node", 2, {}, 0, 5000ms});
@@ -138,7 +139,7 @@ TEST_CASE("events reach the client and callbacks reach back into it") {
     weak = c;
     REQUIRE(Fixture::call(*c, request(MessageEntryType::FunctionCallReq, "fire")));
     auto ev = event.get_future();
-    REQUIRE(ev.wait_for(5s) == std::future_status::ready);
+    REQUIRE(ev.wait_for(30s) == std::future_status::ready);
     auto e = ev.get();
     CHECK(e.member_name == "changed");
     double v = 0;
@@ -173,7 +174,7 @@ TEST_CASE("connecting to an unknown service fails with ServiceNotFound") {
 
 namespace {
 
-// Writes raw bytes on a fresh socket and reads until the server closes (or 5 s pass).
+// Writes raw bytes on a fresh socket and reads until the server closes (or 30 s pass: a bound on a hang).
 std::string raw_exchange(std::uint16_t port, const std::string& bytes) {
     boost::asio::io_context io;
     boost::asio::ip::tcp::socket s(io);
@@ -182,7 +183,7 @@ std::string raw_exchange(std::uint16_t port, const std::string& bytes) {
     std::string got;
     std::array<char, 4096> buf;
     boost::system::error_code ec;
-    auto deadline = std::chrono::steady_clock::now() + 5s;
+    auto deadline = std::chrono::steady_clock::now() + 30s;
     s.non_blocking(true);
     while (std::chrono::steady_clock::now() < deadline) {
         auto n = s.read_some(boost::asio::buffer(buf), ec);
@@ -227,7 +228,7 @@ TEST_CASE("disconnect closes the session on the service") {
         CHECK(f.service->opened == 1);
         c->close();
     }
-    for (int i = 0; i < 100 && f.service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(rr::testing::eventually([&] { return f.service->closed != 0; }));
     CHECK(f.service->closed == 1);
 }
 
@@ -405,14 +406,14 @@ TEST_CASE("replies completed on another thread after the client has gone are dro
     {
         auto c = f.connect();
         for (int i = 0; i < 20; ++i) c->request(add_call(2 * i, 1), [](Result<MessageEntry>) {});
-        for (int i = 0; i < 500 && service->queued_ < 20; ++i) std::this_thread::sleep_for(10ms);
+        REQUIRE(rr::testing::eventually([&] { return service->queued_ >= 20; }));
         REQUIRE(service->queued_ == 20);
         c->close();
     }
-    for (int i = 0; i < 500 && service->closed == 0; ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE(rr::testing::eventually([&] { return service->closed != 0; }));
     REQUIRE(service->closed == 1);
     service->hold(false);  // the 20 Responders now complete with their connection and pump gone
-    for (int i = 0; i < 500 && service->answered_ < 20; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(rr::testing::eventually([&] { return service->answered_ >= 20; }));
     CHECK(service->answered_ == 20);
 
     auto c = f.connect();
@@ -519,13 +520,10 @@ TEST_CASE("a worker thread's event and reply reach the client in the order it se
     }
     REQUIRE(seen->all.get_future().wait_for(30s) == std::future_status::ready);
     // The last call's event may follow its reply: wait for it.
-    for (int i = 0; i < 500; ++i) {
-        {
-            std::lock_guard lock(seen->mutex);
-            if (seen->order.size() == 2u * kCalls) break;
-        }
-        std::this_thread::sleep_for(10ms);
-    }
+    rr::testing::eventually([&] {
+        std::lock_guard lock(seen->mutex);
+        return seen->order.size() >= 2u * kCalls;
+    });
     std::lock_guard lock(seen->mutex);
     REQUIRE(seen->order.size() == 2u * kCalls);
     int wrong = 0;
@@ -548,7 +546,7 @@ TEST_CASE("a request made while the client connection closes is answered once, n
         c->close();  // queued on the connection's strand before the request
         c->request(request(MessageEntryType::PropertyGetReq, "x"),
                    [&answered](Result<MessageEntry> r) { answered.set_value(std::move(r)); });  // twice would throw
-        REQUIRE(answer.wait_for(10s) == std::future_status::ready);
+        REQUIRE(answer.wait_for(30s) == std::future_status::ready);
         auto r = answer.get();
         if (!r) {
             ++local_errors;
@@ -607,7 +605,7 @@ TEST_CASE("requests racing the end of the client's transport are each answered o
     sender.join();
     const int requests = sent.load();
     REQUIRE(requests < kMaxRequests);  // the client saw its transport end
-    for (int i = 0; i < 1000 && tally->answered.load() < requests; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(rr::testing::eventually([&] { return tally->answered.load() >= requests; }));
     CHECK(tally->answered.load() == requests);
     int wrong = 0;
     for (int i = 0; i < requests; ++i) wrong += tally->calls[i].load() != 1;

@@ -7,6 +7,7 @@
 // gateway, a mirror that forwards entries to a device.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -66,6 +67,11 @@ public:
     /// Base URL of the transport this client came in on, as CORE's service index reports it
     /// (`rr+tcp://<local address>:<port>/`, wire.md §11.2); empty when the transport did not say.
     std::string local_url() const;
+    /// The client's address ("ip:port"; behind a trusted proxy, the proxy's client), "" when unknown.
+    std::string peer() const;
+    /// Probes the client's connection (StreamConnection::set_liveness_probe): a ConnectionTest every
+    /// `timeout` / 5, the connection closed when nothing arrives for `timeout`; nullopt: off. Thread-safe.
+    void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) const;
 
     friend bool operator==(const SessionRef& a, const SessionRef& b) noexcept { return a.endpoint_ == b.endpoint_; }
 

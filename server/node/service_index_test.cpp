@@ -11,6 +11,7 @@
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace std::chrono_literals;
@@ -105,11 +106,15 @@ TEST_CASE("node: RobotRaconteurServiceIndex lists the registered services with t
     auto sub = root.subscribe("LocalNodeServicesChanged", [&](const std::string&, std::vector<Value>&) { ++changes; });
     REQUIRE(sub);
     node->unregister_service("svc");
-    for (int i = 0; i < 200 && changes.load() < 1; ++i) std::this_thread::sleep_for(10ms);
+    CHECK(rr::testing::eventually([&] { return changes.load() >= 1; }));
     CHECK(changes.load() == 1);
     node->unregister_service("svc");  // nothing to remove: no event
-    std::this_thread::sleep_for(100ms);
-    CHECK(changes.load() == 1);
+    // A real change after it: its event comes after any the no-op would have sent (one session, in order).
+    REQUIRE(node->register_service(std::make_shared<AttributedService>()));
+    CHECK(rr::testing::eventually([&] { return changes.load() >= 2; }));
+    CHECK(changes.load() == 2);
+    node->unregister_service("svc");
+    CHECK(rr::testing::eventually([&] { return changes.load() >= 3; }));
     r = root.call("GetLocalNodeServices");
     REQUIRE(r);
     REQUIRE(r->get_if<MapInt32>()->entries.size() == 1);

@@ -138,18 +138,15 @@ TEST_CASE("record queue: the writer is woken at half the budget, not per value")
     auto entry = entry_of_bytes(1000);  // 1,192 bytes each
     RecordQueue q(12000);               // half: 6,000 bytes, crossed by the sixth entry
     std::vector<RecordQueue::Item> batch;
-    // One value: the writer sleeps its period out.
-    std::thread one([&] {
-        std::this_thread::sleep_for(20ms);
-        q.offer(0, 0, entry);
-    });
+    // One value waiting: the writer sleeps its period out. (Offered before the take: a thread offering
+    // "during" the wait could, on a loaded machine, offer after the period and leave the batch empty.)
+    q.offer(0, 0, entry);
     auto t0 = std::chrono::steady_clock::now();
     q.take(batch, 400ms);
-    one.join();
     CHECK(std::chrono::steady_clock::now() - t0 >= 390ms);
     CHECK(batch.size() == 1);
     batch.clear();
-    // Six values: woken early.
+    // Six values: woken early (whether they come before the take or during its wait).
     std::thread six([&] {
         std::this_thread::sleep_for(20ms);
         for (int i = 0; i < 6; ++i) q.offer(0, 0, entry);

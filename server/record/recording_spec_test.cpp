@@ -231,8 +231,8 @@ TEST_CASE("access policy: record is a right of its own, not implied by write") {
     using server::gateway::auth::Operation;
     AccessPolicy policy;
     policy.add_role("operator", {AccessRule{{"*"}, {"*"}, true, true, true}});
-    policy.add_role("recorder", {AccessRule{{"create"}, {"*"}, true, false, false, true}});
-    policy.add_role("member_only", {AccessRule{{"*"}, {"packets"}, false, false, false, true}});
+    policy.add_role("recorder", {AccessRule{.devices = {"create"}, .members = {"*"}, .read = true, .record = true}});
+    policy.add_role("member_only", {AccessRule{.devices = {"*"}, .members = {"packets"}, .record = true}});
     CHECK_FALSE(policy.allows({"operator"}, "create", "*", Operation::record));
     CHECK(policy.allows({"operator"}, "create", "*", Operation::write));
     CHECK(policy.allows({"recorder"}, "create", "*", Operation::record));

@@ -16,10 +16,13 @@
 #include "core/mcap/mcap_reader.hpp"
 #include "server/gateway/json_api_test_fixture.hpp"
 #include "core/names/service_path.hpp"
+#include "server/gateway/mirror_service.hpp"
+#include "server/gateway/session_endpoints.hpp"
 #include "server/mcap/mcap_file.hpp"
 #include "server/record/recording.hpp"
 #include "server/record/recordings.hpp"
 #include "server/record/replay_device.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr::server::gateway::testing;
 namespace fs = std::filesystem;
@@ -75,10 +78,32 @@ std::string file_text(const fs::path& p) {
     return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
+// Waits until `n` pipe endpoints of the gateway itself (a recording's) are connected to the device:
+// packets the device sends before that are not recorded.
+bool gateway_pipes_open(TestGateway& gw, std::size_t n) {
+    const auto endpoints = gw.gateway().devices().front()->mirror_service()->shared_endpoints();
+    return rr::testing::eventually([&] { return endpoints->open_pipe_count() == n; });
+}
+
+// Waits until the recording has written at least `n` messages (GET /api/recordings/{id}; each value is
+// one message per encoding: `robotraconteur` and `json`).
+bool written_at_least(TestGateway& gw, std::uint64_t id, std::uint64_t n) {
+    std::uint64_t last = 0;
+    const bool ok = rr::testing::eventually([&] {
+        auto r = http_get(gw.port(), "/api/recordings/" + std::to_string(id));
+        REQUIRE(r.status == 200);
+        last = r.body["messages"].get<std::uint64_t>();
+        return last >= n;
+    });
+    INFO("messages written: " << last << ", waited for " << n);
+    CHECK(ok);
+    return ok;
+}
+
 }  // namespace
 
 TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -88,10 +113,13 @@ TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") 
     CHECK(r.body["state"] == "recording");
     CHECK(r.body["members"] == json({"p_stream", "w_state", "ev_values"}));
     const auto id = r.body["id"].get<std::uint64_t>();
-    std::this_thread::sleep_for(300ms);  // the gateway's pipe endpoint is open
+    REQUIRE(gateway_pipes_open(gw, 1));
+    // The device sends the packets and events before its reply, on the same connection: recorded once
+    // the reply is here.
     REQUIRE(http_post(gw.port(), "/api/devices/interop/functions/send_stream", json{{"args", {5}}}).status == 200);
     REQUIRE(http_post(gw.port(), "/api/devices/interop/functions/fire_events", json{{"args", {3}}}).status == 200);
-    std::this_thread::sleep_for(600ms);  // w_state ticks every 200 ms
+    // w_state ticks every 200 ms: 20 messages are 10 values, of which at most 5 packets and 3 events.
+    REQUIRE(written_at_least(gw, id, 2 * (5 + 3 + 2)));
     auto stopped = http_post(gw.port(), "/api/recordings/" + std::to_string(id) + "/stop", json::object());
     REQUIRE(stopped.status == 200);
     CHECK(stopped.body["state"] == "stopped");
@@ -126,7 +154,7 @@ TEST_CASE("recording: a pipe, a wire and an event of a live device, read back") 
 }
 
 TEST_CASE("recording: members below the root by path, read back, and served again by a replay") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -140,7 +168,9 @@ TEST_CASE("recording: members below the root by path, read back, and served agai
     REQUIRE(r.status == 201);
     const json names = {"child_by_name[" + enc + "].value", "child_by_name[" + enc + "].leaf.x", "child_by_int[%2d1].name"};
     CHECK(r.body["members"] == names);
-    std::this_thread::sleep_for(700ms);
+    // Polled every 100 ms, the three at once; a round starts when the last one's replies are in: 12
+    // messages are at least two rounds, every member in both encodings.
+    REQUIRE(written_at_least(gw, r.body["id"].get<std::uint64_t>(), 12));
     auto stopped = http_post(gw.port(), "/api/recordings/" + r.body["id"].dump() + "/stop", json::object());
     REQUIRE(stopped.status == 200);
     REQUIRE(stopped.body["files"].size() == 1);
@@ -199,7 +229,7 @@ TEST_CASE("recording: members below the root by path, read back, and served agai
 }
 
 TEST_CASE("recording: rotation by size keeps the disk budget") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -207,10 +237,11 @@ TEST_CASE("recording: rotation by size keeps the disk budget") {
                        json{{"device", "interop"}, {"members", {"p_stream"}},
                             {"max_file_bytes", 20000}, {"max_total_bytes", 60000}, {"chunk_bytes", 4096}, {"compression", "none"}});
     REQUIRE(r.status == 201);
-    std::this_thread::sleep_for(300ms);
-    for (int i = 0; i < 6; ++i) {
+    REQUIRE(gateway_pipes_open(gw, 1));
+    for (std::uint64_t i = 0; i < 6; ++i) {
         REQUIRE(http_post(gw.port(), "/api/devices/interop/functions/send_stream", json{{"args", {200}}}).status == 200);
-        std::this_thread::sleep_for(1100ms);  // a chunk at least every second: the size grows
+        // Written before the next burst (200 packets, each in both encodings): the files grow step by step.
+        REQUIRE(written_at_least(gw, r.body["id"].get<std::uint64_t>(), 400 * (i + 1)));
     }
     auto stopped = http_post(gw.port(), "/api/recordings/" + r.body["id"].dump() + "/stop", json::object());
     REQUIRE(stopped.status == 200);
@@ -226,7 +257,7 @@ TEST_CASE("recording: rotation by size keeps the disk budget") {
 }
 
 TEST_CASE("recording: bad requests are clear errors") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());
     auto unknown = http_post(gw.port(), "/api/recordings", json{{"device", "nope"}});

@@ -6,9 +6,12 @@
 //     void return); an error ends the generator (StopIteration 109 is the normal end);
 //   * Close: a GeneratorNextReq carrying Error 109 → close(), answered with `return` int32 0;
 //   * Abort: a GeneratorNextReq carrying Error 107 → abort(), answered the same way.
-// After close, abort or any error the index is released: a later Next gets InvalidOperation
-// ("Invalid generator"), as CORE answers an unknown index. Generators of a client are dropped when
-// its session ends, and after 10 minutes without a request (CORE's generator idle timeout).
+// After an error from next() the index is released: a later Next gets InvalidOperation ("Invalid
+// generator"), as CORE answers an unknown index. After close or abort the index stays known for 30 s
+// (CORE keeps the generator as long): the next Next is answered StopIteration (after a close) or
+// OperationAborted (after an abort), as official clients expect, without calling next(); then the
+// index goes. Generators of a client are dropped when its session ends, and after 10 minutes without
+// a request (CORE's generator idle timeout).
 //
 // Threads: next/close/abort run on the requesting client's strand (one client at a time: a
 // generator belongs to the session that created it). They must not block; async_next may complete

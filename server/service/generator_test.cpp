@@ -1,6 +1,7 @@
 // Generator functions at the entry level: index, Next with and without parameter, StopIteration,
 // close (request with Error 109), abort (Error 107), and requests after the end.
 #include "server/service/object_service_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 #include <thread>
 
@@ -77,17 +78,19 @@ TEST_CASE("generators: return generator to the end, close, abort, and requests a
     CHECK(after.type == MessageErrorType::InvalidOperation);
     CHECK(after.message == "Invalid generator");
 
-    SECTION("close: request with Error 109, answered with return int32 0; then the index is gone") {
+    SECTION("close: request with Error 109, answered with return int32 0; the next Next StopIteration, then the index is gone") {
         const auto h = start(10);
         CHECK(scalar_of<std::int32_t>(c.ok(next("count", h)), "return") == 0);
         CHECK(scalar_of<std::int32_t>(c.ok(next("count", h, MessageErrorType::StopIteration)), "return") == 0);
         CHECK(log->get() == std::vector<std::string>{"close"});
+        CHECK(c.error(next("count", h)).type == MessageErrorType::StopIteration);  // as official clients expect
         CHECK(c.error(next("count", h)).type == MessageErrorType::InvalidOperation);
     }
-    SECTION("abort: request with Error 107") {
+    SECTION("abort: request with Error 107; the next Next OperationAborted, then the index is gone") {
         const auto h = start(10);
         CHECK(scalar_of<std::int32_t>(c.ok(next("count", h, MessageErrorType::AbortOperation)), "return") == 0);
         CHECK(log->get() == std::vector<std::string>{"abort"});
+        CHECK(c.error(next("count", h)).type == MessageErrorType::OperationAborted);
         CHECK(c.error(next("count", h)).type == MessageErrorType::InvalidOperation);
     }
     SECTION("wrong index, wrong member, missing index, another client's generator") {
@@ -169,6 +172,5 @@ TEST_CASE("generators: dropped when their session ends") {
         CHECK(c.error(next("count", g)).type == MessageErrorType::StopIteration);
         c.raw->close();
     }
-    for (int i = 0; i < 200 && alive != 0; ++i) std::this_thread::sleep_for(10ms);
-    CHECK(alive == 0);
+    CHECK(rr::testing::eventually([&] { return alive == 0; }));
 }

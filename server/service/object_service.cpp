@@ -311,8 +311,23 @@ void ObjectService::handle_generator_next(const SessionRef& session, MessageEntr
             return;
         }
         generator = it->second.generator;
-        it->second.last_access = std::chrono::steady_clock::now();
-        if (ending) generators_.erase(it);
+        if (it->second.ended != MessageErrorType::None) {
+            // Closed or aborted: official clients expect StopIteration / OperationAborted from a Next
+            // that follows (CORE keeps the generator, whose own next() says so); then the index goes.
+            const auto ended = it->second.ended;
+            if (!ending) {
+                generators_.erase(it);
+                responder.fail(make_error(ended, ended == MessageErrorType::StopIteration ? "Generator closed"
+                                                                                        : "Generator aborted"));
+                return;
+            }
+        } else if (ending) {
+            it->second.ended = entry.error == MessageErrorType::StopIteration ? MessageErrorType::StopIteration
+                                                                               : MessageErrorType::OperationAborted;
+            it->second.last_access = std::chrono::steady_clock::now() - (kGeneratorIdleTimeout - kEndedGeneratorGrace);
+        } else {
+            it->second.last_access = std::chrono::steady_clock::now();
+        }
     }
     if (ending) {
         auto r = entry.error == MessageErrorType::StopIteration ? generator->close() : generator->abort();
@@ -431,6 +446,29 @@ void ObjectService::handle_entry(const SessionRef& session, MessageEntry&& entry
 // --- locks -----------------------------------------------------------------------------------
 
 void ObjectService::attach(boost::asio::io_context& io) { locks_->attach(io); }
+
+namespace {
+
+/// `path` is the service's root path or an object below it.
+bool in_service(const std::string& service_name, const std::string& path) {
+    return path == service_name ||
+           (path.size() > service_name.size() && path.compare(0, service_name.size(), service_name) == 0 &&
+            (path[service_name.size()] == '.' || path[service_name.size()] == '['));
+}
+
+}  // namespace
+
+Result<void> ObjectService::request_object_lock(const std::string& path, const std::string& username) {
+    if (!in_service(name_, path))
+        return fail(MessageErrorType::InvalidArgument, "\"" + path + "\" is not a path of service " + name_);
+    return locks_->lock_for_user(path, username);
+}
+
+Result<void> ObjectService::release_object_lock(const std::string& path) {
+    if (!in_service(name_, path))
+        return fail(MessageErrorType::InvalidArgument, "\"" + path + "\" is not a path of service " + name_);
+    return locks_->release_user_lock(path);
+}
 
 std::optional<ObjectLocks::Holder> ObjectService::lock_holder(const std::string& path) const { return locks_->holder(path); }
 

@@ -13,7 +13,7 @@
 //   authentication  optional user table (password_table.hpp): when set, every session must log in
 //                   (ConnectClientCombined `username` + `credentials{password}` or AuthenticateUser)
 //                   before member requests are accepted, and events skip sessions not logged in.
-//   object locks    RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock and MonitorEnter /
+//   object locks    request_object_lock() from the service side, and RequestObjectLock, RequestClientObjectLock, ReleaseObjectLock and MonitorEnter /
 //                   MonitorContinueEnter / MonitorExit with CORE's semantics (service_locks.hpp): object
 //                   locks need a logged-in user with the `objectlock` or `objectlockoverride` privilege
 //                   (PermissionDenied / ObjectLockedError otherwise); every member request (not pipe or
@@ -65,6 +65,20 @@ public:
     /// path; ObjectNotFound when nothing is served at `path`.
     Result<void> release_path(const std::string& path);
 
+    /// Locks the object at `path` and every object below it for user `username`, from the service
+    /// side (CORE: ServerContext::RequestObjectLock; the official test service locks
+    /// `RobotRaconteurTestService2.nolock_test` for "server"): requests from sessions of other users
+    /// and anonymous sessions get ObjectLockedError, except to `[nolock]` members (and reads of
+    /// `[nolockread]` ones). The path need not be resolved yet. Held until release_object_lock(), a
+    /// client's ReleaseObjectLock with `objectlockoverride`, or the close of the last session of a
+    /// client logged in as `username`. Errors: InvalidArgument (`path` not in this service),
+    /// ObjectLockedError (a lock already covers `path` or an object below it).
+    Result<void> request_object_lock(const std::string& path, const std::string& username);
+    /// Releases the lock taken on exactly `path` (by the service or a client). Nothing held: OK.
+    /// Errors: InvalidArgument (`path` not in this service), ObjectLockedError (the lock covering
+    /// `path` was taken on an ancestor).
+    Result<void> release_object_lock(const std::string& path);
+
     /// The object lock covering `path` (its user, the path it was taken on, its session for a client
     /// lock), if any.
     std::optional<ObjectLocks::Holder> lock_holder(const std::string& path) const;
@@ -81,6 +95,9 @@ public:
     /// untouched generator is dropped.
     static constexpr std::size_t kMaxGeneratorsPerSession = 1024;
     static constexpr std::chrono::minutes kGeneratorIdleTimeout{10};
+    /// How long a closed or aborted generator's index stays known (CORE: 30 s): its next Next is
+    /// answered StopIteration (closed) or OperationAborted (aborted), then the index goes.
+    static constexpr std::chrono::seconds kEndedGeneratorGrace{30};
     /// A waiting MonitorEnter / MonitorContinueEnter is answered "Continue" after this (CORE: 5 s).
     static constexpr std::chrono::seconds kMonitorWait = ServiceLocks::kMonitorWait;
 
@@ -123,6 +140,9 @@ private:
         std::string path, member;
         std::shared_ptr<Generator> generator;
         std::chrono::steady_clock::time_point last_access;
+        /// StopIteration after a close, OperationAborted after an abort: the answer to the next Next,
+        /// within kEndedGeneratorGrace (requests do not refresh last_access then).
+        MessageErrorType ended = MessageErrorType::None;
     };
 
     const std::string name_;

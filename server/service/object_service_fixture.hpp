@@ -104,7 +104,7 @@ public:
     }
     /// The first entry matching `pred` (removed from the inbox), waiting up to `timeout`.
     std::optional<MessageEntry> take(const std::function<bool(const MessageEntry&)>& pred,
-                                     std::chrono::milliseconds timeout = 5000ms) {
+                                     std::chrono::milliseconds timeout = 30000ms) {  // a bound on a hang
         std::unique_lock lock(mutex_);
         std::optional<MessageEntry> out;
         cv_.wait_for(lock, timeout, [&] {
@@ -119,7 +119,7 @@ public:
         });
         return out;
     }
-    std::optional<MessageEntry> take(MessageEntryType type, std::chrono::milliseconds timeout = 5000ms) {
+    std::optional<MessageEntry> take(MessageEntryType type, std::chrono::milliseconds timeout = 30000ms) {  // a bound on a hang
         return take([type](const MessageEntry& e) { return e.entry_type == type; }, timeout);
     }
     std::size_t count(MessageEntryType type) {
@@ -145,7 +145,7 @@ struct TestClient {
         std::promise<Result<MessageEntry>> p;
         raw->request(std::move(e), [&](Result<MessageEntry> r) { p.set_value(std::move(r)); });
         auto f = p.get_future();
-        REQUIRE(f.wait_for(10s) == std::future_status::ready);
+        REQUIRE(f.wait_for(30s) == std::future_status::ready);
         return f.get();
     }
     /// A reply that must be a success.
@@ -223,7 +223,7 @@ struct ServiceFixture {
             },
             {}, [&](Result<std::shared_ptr<RawClient>> r) { p.set_value(std::move(r)); });
         auto f = p.get_future();
-        REQUIRE(f.wait_for(10s) == std::future_status::ready);
+        REQUIRE(f.wait_for(30s) == std::future_status::ready);
         auto r = f.get();
         if (!r) return r.take_error();
         c.raw = *r;

@@ -162,6 +162,77 @@ TEST_CASE("properties: stored value, handlers, direction and type errors") {
     }
 }
 
+TEST_CASE("properties: asynchronous getter and setter answer later, from another thread") {
+    ServiceFixture f;
+    std::atomic<std::int32_t> written{0};
+    REQUIRE(f.root->set_async_property_handlers(
+        "label",
+        [](const SessionRef&, Completion done) {
+            std::thread([done = std::move(done)] {
+                done(Value("later"));
+                done(Value("twice"));  // a second completion is ignored
+            }).detach();
+        },
+        [&written](const SessionRef&, Value v, SetCompletion done) {
+            const std::string s = *v.as<std::string>();
+            std::thread([&written, s, done = std::move(done)] {
+                if (s == "bad") {
+                    done(fail(MessageErrorType::InvalidArgument, "no bad labels"));
+                    return;
+                }
+                written = static_cast<std::int32_t>(s.size());
+                done({});
+            }).detach();
+        }));
+    auto c = f.connect();
+    auto get = c.ok(req(MessageEntryType::PropertyGetReq, "label"));
+    CHECK(read_string(*get.find("value")) == "later");
+    auto set = req(MessageEntryType::PropertySetReq, "label");
+    set.elements.push_back(make_string_element("value", "four"));
+    c.ok(set);
+    CHECK(written == 4);
+    auto bad = req(MessageEntryType::PropertySetReq, "label");
+    bad.elements.push_back(make_string_element("value", "bad"));
+    auto e = c.error(bad);
+    CHECK(e.type == MessageErrorType::InvalidArgument);
+    CHECK(e.message == "no bad labels");
+
+    SECTION("a value of the wrong type from the async getter is answered with the packing error") {
+        REQUIRE(f.root->set_async_property_handlers("value", [](const SessionRef&, Completion done) { done(Value("x")); }));
+        CHECK(c.error(req(MessageEntryType::PropertyGetReq, "value")).type == MessageErrorType::DataTypeMismatch);
+    }
+    SECTION("synchronous handlers replace the asynchronous ones") {
+        REQUIRE(f.root->set_property_handlers("label", [](const SessionRef&) -> Result<Value> { return Value("now"); }));
+        CHECK(read_string(*c.ok(req(MessageEntryType::PropertyGetReq, "label")).find("value")) == "now");
+    }
+}
+
+TEST_CASE("functions: an error with a sub-name and a parameter reaches the client with both") {
+    ServiceFixture f([](ServiceFixture& f) {
+        auto* fixture = &f;
+        REQUIRE(f.root->set_function("unimplemented", [fixture](const SessionRef&, std::vector<Value>) -> Result<Value> {
+            RRError e = make_error(MessageErrorType::InvalidOperation, "test error");
+            e.sub_name = "my_error";
+            MapString params;
+            params.entries.emplace_back("param1", Value::scalar<std::int32_t>(10));
+            params.entries.emplace_back("param2", Value("20"));
+            e.param = std::make_shared<const MessageElement>(fixture->pack(Value(std::move(params)), "varvalue", "p"));
+            return fail(std::move(e));
+        }));
+    });
+    auto c = f.connect();
+    auto e = c.error(req(MessageEntryType::FunctionCallReq, "unimplemented"));
+    CHECK(e.type == MessageErrorType::InvalidOperation);
+    CHECK(e.sub_name == "my_error");
+    REQUIRE(e.param);
+    auto param = f.unpack(*e.param, "varvalue");
+    const auto* m = param.get_if<MapString>();
+    REQUIRE(m);
+    REQUIRE(m->find("param1"));
+    CHECK(*m->find("param1")->as<std::int32_t>() == 10);
+    CHECK(*m->find("param2")->as<std::string>() == "20");
+}
+
 TEST_CASE("functions: sync, async from another thread, structs, user and standard errors") {
     ServiceFixture f([](ServiceFixture& f) {
         REQUIRE(f.root->set_function("add", [](const SessionRef&, std::vector<Value> a) -> Result<Value> {

@@ -19,6 +19,7 @@
 #include "server/service/test_raw_service.hpp"
 #include "server/transport/tcp_listener.hpp"
 #include "server/transport/test_raw_stream.hpp"
+#include "test/support/eventually.hpp"
 
 using namespace rr;
 using namespace rr::server;
@@ -39,13 +40,13 @@ std::shared_ptr<Node> make_node(NodeOptions options, std::shared_ptr<Service> se
 }
 
 // A raw client-role stream to the node's TCP port.
-struct RawStream : testing::RawStream<asio::ip::tcp> {
+struct RawStream : rr::server::testing::RawStream<asio::ip::tcp> {
     RawStream(std::uint16_t port, StreamConfig config)
-        : testing::RawStream<asio::ip::tcp>({asio::ip::make_address("127.0.0.1"), port}, std::move(config)) {}
+        : rr::server::testing::RawStream<asio::ip::tcp>({asio::ip::make_address("127.0.0.1"), port}, std::move(config)) {}
 };
-using testing::framed;
-using testing::is_closed_event;
-using testing::reply_entry;
+using rr::server::testing::framed;
+using rr::server::testing::is_closed_event;
+using rr::server::testing::reply_entry;
 
 Result<MessageEntry> call(RawClient& c, MessageEntry e) {
     std::promise<Result<MessageEntry>> p;
@@ -60,19 +61,19 @@ Result<std::shared_ptr<RawClient>> raw_connect(asio::any_io_executor ex, std::ui
     return p.get_future().get();
 }
 
-using testing::padded_get;
+using rr::server::testing::padded_get;
 
 }  // namespace
 
 TEST_CASE("limits: a message over 512 KiB before the client session exists closes the connection") {
     std::uint16_t port = 0;
-    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node({}, std::make_shared<rr::server::testing::RawTestService>(), port);
     StreamConfig big;
     big.limits.max_pre_session_message_size = 4u << 20;  // our side may send it; the node must refuse
 
     RawStream under(port, big);
     under.send_special(MessageEntryType::GetServiceDesc, "svc", 400u * 1024u);
-    auto r = under.next_event(5s);
+    auto r = under.next_event(30s);
     const MessageEntry* reply = reply_entry(r);
     REQUIRE(reply);
     CHECK(reply->entry_type == MessageEntryType::GetServiceDescRet);
@@ -80,7 +81,7 @@ TEST_CASE("limits: a message over 512 KiB before the client session exists close
 
     RawStream over(port, big);
     over.send_special(MessageEntryType::GetServiceDesc, "svc", 600u * 1024u);
-    CHECK(is_closed_event(over.next_event(5s)));
+    CHECK(is_closed_event(over.next_event(30s)));
     node->shutdown();
 }
 
@@ -88,7 +89,7 @@ TEST_CASE("limits: max_message_size is configurable and applies once the session
     std::uint16_t port = 0;
     NodeOptions options;
     options.server.stream.limits.max_message_size = 1u << 20;
-    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node(options, std::make_shared<rr::server::testing::RawTestService>(), port);
     client::IoThreads io{1};
 
     auto c = raw_connect(io.executor(), port);
@@ -101,8 +102,7 @@ TEST_CASE("limits: max_message_size is configurable and applies once the session
     auto over = call(**c, padded_get(2u << 20));
     REQUIRE_FALSE(over);
     CHECK(over.error().type == MessageErrorType::ConnectionError);
-    for (int i = 0; i < 100 && (*c)->is_open(); ++i) std::this_thread::sleep_for(10ms);
-    CHECK_FALSE((*c)->is_open());
+    CHECK(rr::testing::eventually([&] { return !(*c)->is_open(); }));
 
     // Others are unaffected.
     auto d = raw_connect(io.executor(), port);
@@ -115,11 +115,11 @@ TEST_CASE("limits: max_connections refuses further connections until one closes"
     std::uint16_t port = 0;
     NodeOptions options;
     options.max_connections = 2;
-    auto node = make_node(options, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node(options, std::make_shared<rr::server::testing::RawTestService>(), port);
     client::IoThreads io{1};
-    RawClientOptions quick;
-    quick.connect_timeout = 2000ms;
-    quick.request_timeout = 2000ms;
+    RawClientOptions quick;  // the refused connection is closed at once: these are bounds on a hang
+    quick.connect_timeout = rr::testing::kHangBound;
+    quick.request_timeout = rr::testing::kHangBound;
 
     auto a = raw_connect(io.executor(), port, quick);
     auto b = raw_connect(io.executor(), port, quick);
@@ -131,7 +131,7 @@ TEST_CASE("limits: max_connections refuses further connections until one closes"
     CHECK(third.error().type == MessageErrorType::ConnectionError);
 
     (*a)->close();
-    for (int i = 0; i < 200 && node->connection_count() >= 2; ++i) std::this_thread::sleep_for(10ms);
+    REQUIRE(rr::testing::eventually([&] { return node->connection_count() < 2; }));
     auto again = raw_connect(io.executor(), port, quick);
     REQUIRE(again);
     CHECK(call(**again, padded_get(0)));
@@ -140,13 +140,13 @@ TEST_CASE("limits: max_connections refuses further connections until one closes"
 
 TEST_CASE("limits: wrong magic or a truncated message inside an established stream closes it") {
     std::uint16_t port = 0;
-    auto node = make_node({}, std::make_shared<testing::RawTestService>(), port);
+    auto node = make_node({}, std::make_shared<rr::server::testing::RawTestService>(), port);
 
     SECTION("wrong magic") {
         RawStream s(port, {});
         std::vector<std::byte> bad = framed("RRAX", 64);
         s.write_raw(bad);
-        CHECK(is_closed_event(s.next_event(5s)));
+        CHECK(is_closed_event(s.next_event(30s)));
     }
     SECTION("truncated: MessageSize covers the bytes, the entries inside do not fit") {
         RawStream s(port, {});
@@ -156,17 +156,17 @@ TEST_CASE("limits: wrong magic or a truncated message inside an established stre
         bad[10] = std::byte{52};
         bad[56] = std::byte{3};
         s.write_raw(bad);
-        CHECK(is_closed_event(s.next_event(5s)));
+        CHECK(is_closed_event(s.next_event(30s)));
     }
     SECTION("unknown special request: answered with ProtocolError, the stream stays up") {
         RawStream s(port, {});
         s.send_special(static_cast<MessageEntryType>(151), "svc", 0);
-        auto r = s.next_event(5s);
+        auto r = s.next_event(30s);
         const MessageEntry* reply = reply_entry(r);
         REQUIRE(reply);
         CHECK(reply->error == MessageErrorType::ProtocolError);
         s.send_special(MessageEntryType::GetServiceDesc, "svc", 0);
-        auto next = s.next_event(5s);
+        auto next = s.next_event(30s);
         const MessageEntry* desc = reply_entry(next);
         REQUIRE(desc);
         CHECK(desc->entry_type == MessageEntryType::GetServiceDescRet);
@@ -177,7 +177,7 @@ TEST_CASE("limits: wrong magic or a truncated message inside an established stre
 namespace {
 
 // A service that never answers function calls (the responder is kept), for client timeouts.
-class SilentService : public testing::RawTestService {
+class SilentService : public rr::server::testing::RawTestService {
 public:
     void handle_entry(const SessionRef& session, MessageEntry&& e, Responder responder) override {
         if (e.entry_type == MessageEntryType::FunctionCallReq) {
@@ -209,7 +209,7 @@ TEST_CASE("client: an unanswered request times out, and a dropped connection fai
     REQUIRE_FALSE(r);
     CHECK(r.error().type == MessageErrorType::RequestTimeout);
     CHECK(took >= 700ms);
-    CHECK(took < 5s);
+    CHECK(took < 10s);  // not the 15 s default (a bound this wide holds on a loaded machine)
     CHECK((*c)->is_open());  // a timeout does not end the session
 
     // Default timeout (15 s): the node goes away while a call waits; the call fails long before 15 s.
@@ -218,20 +218,17 @@ TEST_CASE("client: an unanswered request times out, and a dropped connection fai
     auto pending = std::async(std::launch::async, [&] {
         return (*d)->root().call("add", {Value::scalar(std::int32_t{1}), Value::scalar(std::int32_t{2})});
     });
-    for (int i = 0; i < 200; ++i) {
-        {
-            std::lock_guard lock(service->mutex);
-            if (service->held.size() >= 2) break;
-        }
-        std::this_thread::sleep_for(10ms);
-    }
+    REQUIRE(rr::testing::eventually([&] {
+        std::lock_guard lock(service->mutex);
+        return service->held.size() >= 2;  // the pending call reached the service
+    }));
     t0 = std::chrono::steady_clock::now();
     node->shutdown();
-    REQUIRE(pending.wait_for(5s) == std::future_status::ready);
+    REQUIRE(pending.wait_for(rr::testing::kHangBound) == std::future_status::ready);
     auto lost = pending.get();
     REQUIRE_FALSE(lost);
     CHECK(lost.error().type == MessageErrorType::ConnectionError);
-    CHECK(std::chrono::steady_clock::now() - t0 < 5s);
+    CHECK(std::chrono::steady_clock::now() - t0 < 10s);  // not the 15 s default timeout
     {
         std::lock_guard lock(service->mutex);
         service->held.clear();

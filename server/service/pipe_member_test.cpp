@@ -1,6 +1,7 @@
 // Pipe members at the entry level: connect (index rules, unreliable), packets both ways with
 // packet numbers and acks, service-side close, disconnect, direction, backlog limit.
 #include "server/service/object_service_fixture.hpp"
+#include "test/support/eventually.hpp"
 
 #include <thread>
 
@@ -129,13 +130,10 @@ TEST_CASE("pipes: connect, echo with packet numbers and acks, service close, dis
     a.number = 5;
     ret.elements.push_back(a);
     c.send(ret);
-    for (int i = 0; i < 200; ++i) {
-        {
-            std::lock_guard lock(seen->m);
-            if (!seen->acks.empty()) break;
-        }
-        std::this_thread::sleep_for(10ms);
-    }
+    rr::testing::eventually([&] {
+        std::lock_guard lock(seen->m);
+        return !seen->acks.empty();
+    });
     {
         std::lock_guard lock(seen->m);
         CHECK(seen->acks == std::vector<std::uint32_t>{1});
@@ -169,8 +167,7 @@ TEST_CASE("pipes: connect, echo with packet numbers and acks, service close, dis
 
     // the session ends: its endpoints close (on_close runs for each)
     c.raw->close();
-    for (int i = 0; i < 200 && !pipe->endpoints().empty(); ++i) std::this_thread::sleep_for(10ms);
-    CHECK(pipe->endpoints().empty());
+    CHECK(rr::testing::eventually([&] { return pipe->endpoints().empty(); }));
     std::lock_guard lock(seen->m);
     CHECK(seen->closed.size() == 5);
 }

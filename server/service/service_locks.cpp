@@ -175,6 +175,31 @@ Result<void> ServiceLocks::check(const std::string& path, const Requester& who, 
     return r;
 }
 
+Result<void> ServiceLocks::lock_for_user(const std::string& path, const std::string& username) {
+    Result<void> r;
+    {
+        std::lock_guard lock(mutex_);
+        r = locks_.lock(path, username, 0);
+        update_any();
+    }
+    if (r) changed();
+    return r;
+}
+
+Result<void> ServiceLocks::release_user_lock(const std::string& path) {
+    Result<void> r;
+    bool had = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto h = locks_.holder(path);
+        had = h.has_value();
+        if (h) r = locks_.release(path, h->username, h->endpoint, true);
+        update_any();
+    }
+    if (r && had) changed();
+    return r;
+}
+
 void ServiceLocks::session_closed(std::uint32_t endpoint, std::string_view username, bool last_session_of_user) {
     std::vector<ObjectLocks::MonitorEvent> events;
     std::vector<std::shared_ptr<Parked>> parked;  // destroyed outside the mutex

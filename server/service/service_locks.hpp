@@ -76,6 +76,14 @@ public:
     /// MonitorContinueEnter, MonitorExit) on `entry.service_path`, an object that exists, for a
     /// requester that passed check_privileges(). Others get InvalidOperation "Invalid command" (as CORE).
     void handle_op(const Requester& who, Privileges privileges, const MessageEntry& entry, Responder responder);
+    /// A user lock taken by the service itself (no session: CORE's ServerContext::RequestObjectLock):
+    /// held for `username` until release_user_lock() or until a session of that user that logged in
+    /// closes as the user's last. Errors: ObjectLockedError "Object already locked".
+    Result<void> lock_for_user(const std::string& path, const std::string& username);
+    /// Releases a lock taken on exactly `path`, whoever holds it. Nothing held there: OK.
+    /// Errors: ObjectLockedError "Cannot release inherited lock" (the lock covering `path` was taken on
+    /// an ancestor).
+    Result<void> release_user_lock(const std::string& path);
     /// A member request to the object at `path`: passes unless another session holds its monitor
     /// (InvalidOperation "Object is currently monitor locked. Use MonitorEnter to obtain monitor lock")
     /// or, unless `nolock`, a lock of another user or session covers it (ObjectLockedError "Object

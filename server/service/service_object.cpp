@@ -38,6 +38,8 @@ struct ServiceObject::Slot {
     };
     std::shared_ptr<const PropertyGetter> getter;
     std::shared_ptr<const PropertySetter> setter;
+    std::shared_ptr<const AsyncPropertyGetter> async_getter;
+    std::shared_ptr<const AsyncPropertySetter> async_setter;
     std::shared_ptr<const Stored> stored;
     std::shared_ptr<const FunctionHandler> function;
     std::shared_ptr<const AsyncFunctionHandler> async_function;
@@ -214,6 +216,22 @@ Result<void> ServiceObject::set_property_handlers(std::string_view property, Pro
     std::lock_guard lock(mutex_);
     (*s)->getter = std::move(g);
     (*s)->setter = std::move(st);
+    (*s)->async_getter.reset();
+    (*s)->async_setter.reset();
+    return {};
+}
+
+Result<void> ServiceObject::set_async_property_handlers(std::string_view property, AsyncPropertyGetter get,
+                                                        AsyncPropertySetter set) {
+    auto s = slot_of(property, MemberKind::property);
+    if (!s) return s.take_error();
+    auto g = share(std::move(get));
+    auto st = share(std::move(set));
+    std::lock_guard lock(mutex_);
+    (*s)->async_getter = std::move(g);
+    (*s)->async_setter = std::move(st);
+    (*s)->getter.reset();
+    (*s)->setter.reset();
     return {};
 }
 
@@ -294,6 +312,8 @@ void ServiceObject::clear_handlers() {
         for (auto& s : slots_) {
             dropped.push_back(std::move(s->getter));
             dropped.push_back(std::move(s->setter));
+            dropped.push_back(std::move(s->async_getter));
+            dropped.push_back(std::move(s->async_setter));
             dropped.push_back(std::move(s->function));
             dropped.push_back(std::move(s->async_function));
             dropped.push_back(std::move(s->generator));
@@ -490,6 +510,17 @@ void ServiceObject::handle_entry(ObjectService& service, const SessionRef& sessi
     }
 }
 
+namespace {
+
+/// An asynchronous property reply: answered once, whichever thread completes first.
+struct PendingReply {
+    Responder responder;
+    std::shared_ptr<const MemberInfo> info;
+    std::atomic<bool> done{false};
+};
+
+}  // namespace
+
 void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, MessageEntry&& entry, Responder&& responder) {
     const MemberInfo& info = *slot.info;
     if (info.def->direction() == robdef::MemberDirection::writeonly) {
@@ -497,11 +528,34 @@ void ServiceObject::handle_property_get(Slot& slot, const SessionRef& session, M
         return;
     }
     std::shared_ptr<const PropertyGetter> getter;
+    std::shared_ptr<const AsyncPropertyGetter> async_getter;
     std::shared_ptr<const Slot::Stored> stored;
     {
         std::lock_guard lock(mutex_);
         getter = slot.getter;
+        async_getter = slot.async_getter;
         stored = slot.stored;
+    }
+    if (async_getter) {
+        auto pending = std::make_shared<PendingReply>();
+        pending->responder = std::move(responder);
+        pending->info = slot.info;
+        (*async_getter)(session, [pending](Result<Value> r) {
+            if (pending->done.exchange(true)) return;
+            if (!r) {
+                pending->responder.fail(r.error());
+                return;
+            }
+            auto e = detail::pack_member(*pending->info, *r, pending->info->def->type, "value");
+            if (!e) {
+                pending->responder.fail(e.error());
+                return;
+            }
+            MessageEntry reply;
+            reply.elements.push_back(std::move(*e));
+            pending->responder.respond(std::move(reply));
+        });
+        return;
     }
     MessageEntry reply = reply_in(entry);
     if (getter) {
@@ -542,9 +596,23 @@ void ServiceObject::handle_property_set(Slot& slot, const SessionRef& session, M
         return;
     }
     std::shared_ptr<const PropertySetter> setter;
+    std::shared_ptr<const AsyncPropertySetter> async_setter;
     {
         std::lock_guard lock(mutex_);
         setter = slot.setter;
+        async_setter = slot.async_setter;
+    }
+    if (async_setter) {
+        auto pending = std::make_shared<PendingReply>();
+        pending->responder = std::move(responder);
+        (*async_setter)(session, std::move(*v), [pending](Result<void> r) {
+            if (pending->done.exchange(true)) return;
+            if (!r)
+                pending->responder.fail(r.error());
+            else
+                pending->responder.respond(MessageEntry{});
+        });
+        return;
     }
     if (setter) {
         if (auto r = (*setter)(session, std::move(*v)); !r) {

@@ -3,7 +3,8 @@
 // application attaches handlers by member name (checked against the robdef: a wrong name or a wrong
 // member kind gives MemberNotFound) or uses the defaults:
 //
-//   property  stored value (set_property_value) and/or getter/setter handlers   1111–1114
+//   property  stored value (set_property_value) and/or getter/setter handlers,  1111–1114
+//             synchronous or asynchronous (answered later from any thread)
 //   function  sync handler returning Result<Value>, or async handler + Completion 1121/1122
 //   generator handler returning a Generator (generator.hpp)                     1121/1122, 1123/1124
 //   event     fire_event(): packed once, sent to every client session           1131
@@ -66,6 +67,11 @@ using ObjRefIndex = std::variant<std::monostate, std::int32_t, std::string>;
 
 using PropertyGetter = std::function<Result<Value>(const SessionRef& session)>;
 using PropertySetter = std::function<Result<void>(const SessionRef& session, Value value)>;
+/// Completes a property set: call once, from any thread.
+using SetCompletion = std::function<void(Result<void>)>;
+/// Asynchronous forms: answer later (from any thread) through `done`, e.g. after device I/O.
+using AsyncPropertyGetter = std::function<void(const SessionRef& session, Completion done)>;
+using AsyncPropertySetter = std::function<void(const SessionRef& session, Value value, SetCompletion done)>;
 /// Arguments in robdef parameter order, each unpacked and checked against its parameter type.
 using FunctionHandler = std::function<Result<Value>(const SessionRef& session, std::vector<Value> args)>;
 using AsyncFunctionHandler = std::function<void(const SessionRef& session, std::vector<Value> args, Completion done)>;
@@ -112,7 +118,13 @@ public:
     Result<Value> property_value(std::string_view property) const;
     /// Handlers replace the stored value for gets / sets; an empty function removes one.
     /// A property with neither a getter nor a stored value answers gets with ValueNotSet.
+    /// Replaces the property's asynchronous handlers (both).
     Result<void> set_property_handlers(std::string_view property, PropertyGetter get, PropertySetter set = {});
+    /// Asynchronous handlers: the reply waits for `done` (the client's own timeout still applies);
+    /// an empty function removes one. Replaces the property's synchronous handlers (both). A value
+    /// given to the getter's `done` is packed with the property type (a packing error is the reply).
+    Result<void> set_async_property_handlers(std::string_view property, AsyncPropertyGetter get,
+                                             AsyncPropertySetter set = {});
 
     // --- function ---------------------------------------------------------------------------------
     /// The return value is packed with the robdef return type (void: send Null; the reply carries

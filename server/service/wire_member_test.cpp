@@ -20,10 +20,7 @@ MessageEntry wire_packet(const ServiceFixture& f, const char* member, const Valu
     return e;
 }
 
-template <class F>
-bool eventually(F&& pred) {
-    return rr::testing::eventually(std::forward<F>(pred), std::chrono::seconds(3));
-}
+using rr::testing::eventually;
 
 }  // namespace
 

@@ -43,13 +43,13 @@ struct RawStream {
     StreamConnection conn;
     NodeID remote;
 
-    /// Connects to `endpoint`; with `handshake`, waits (5 s) for CreateConnection to complete.
+    /// Connects to `endpoint`; with `handshake`, waits for CreateConnection to complete (30 s at most: a bound on a hang).
     RawStream(const typename Protocol::endpoint& endpoint, StreamConfig config, bool handshake = true)
         : conn(StreamRole::client, with_id(std::move(config)), std::chrono::steady_clock::now()) {
         socket.connect(endpoint);
         socket.non_blocking(true);
         if (!handshake) return;
-        auto e = next_event(std::chrono::seconds(5));
+        auto e = next_event(std::chrono::seconds(30));
         REQUIRE(e);
         auto* c = std::get_if<StreamConnected>(&*e);
         REQUIRE(c);

@@ -11,7 +11,8 @@
 // puts the joints where the form says; the sim has no jog_cartesian (NotImplementedError), so its
 // Cartesian buttons go after the first press without motion; closing the tab, killing the page's TCP
 // connection (a relay between browser and gateway) and stopping the gateway while a button is held
-// each stop the robot within 0.5 s; a viewer sees no moving control (no jog, Enable, Disable, Reset
+// each stop the robot within 0.5 s; a second page's jog while the first page jogs is refused by the
+// gateway with the holder's name, shown on that page (docs/security.md "Motion safety"); a viewer sees no moving control (no jog, Enable, Disable, Reset
 // errors, Halt, mode switch, lock offer or move form), and a jog_joint call from its page is refused
 // by the gateway (PermissionDenied) and the robot does not move. The page decides which controls to show
 // from the gateway's answer to GET api/devices/<device>/access, as a user's page does.
@@ -322,6 +323,39 @@ test("keyboard: S held while the panel has focus jogs the elbow −, keyup stops
   const after = latest().q;
   assert.ok(before[1] - after[1] > 0.05, `the elbow moved ${after[1] - before[1]} rad`);
   assert.ok(Math.abs(after[0] - before[0]) < EPS, "the shoulder stayed");
+});
+
+test("two pages jogging one robot: the second page's jog is refused by the gateway, naming the page that holds the motion", async () => {
+  // docs/security.md "Motion safety": one client holds a robot's motion at a time; the other is told who.
+  const second = await loggedInPage("alice", "alice-pw");
+  let released = null;
+  try {
+    await holdDown(operator, "shoulder", "1");
+    await moving(0);
+    const elbowBefore = latest().q[1];
+    const b = jogButton(second, "elbow", "1");
+    await waitFor(async () => !(await b.isDisabled()), "the second page's elbow + enabled", 15000);
+    await b.hover({ timeout: 10000 });
+    await second.mouse.down();
+    const error = panel(second).locator(".robot-error");
+    await waitFor(async () => ((await error.textContent()) ?? "").includes("held by"), "the second page shows the refusal", 10000);
+    const text = await error.textContent();
+    console.log(`# the second page shows: ${text}`);
+    assert.match(text, /^jog_joint: RobotRaconteur\.ObjectLockedError: motion of robot is held by alice \(RR session from 127\.0\.0\.1:\d+\) since \d{4}-\d\d-\d\dT[\d:.]+Z/);
+    assert.ok(await error.isVisible(), "the refusal is visible on the second page");
+    assert.equal(await panel(second).getAttribute("data-jog"), "off", "the second page's hold ended with the refusal");
+    await second.mouse.up();
+    await screenshot(panel(second), "dashboard-robot-jog-held.png");
+    assert.ok(Math.abs(latest().q[1] - elbowBefore) < EPS, "the elbow did not move");
+    // the first page still jogs
+    await moving(0);
+    await operator.mouse.up();
+    released = Date.now() / 1000;
+  } finally {
+    if (released === null) await operator.mouse.up().catch(() => {});
+    await second.context().close();
+  }
+  await assertStopsAfter(0, released, STOP_BOUND_S, "release after the two-page check");
 });
 
 test("lock offer: a hold takes the device's lock (holder shown on the panel and by the gateway) and lets it go after", async () => {

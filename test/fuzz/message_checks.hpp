@@ -88,6 +88,27 @@ inline void check_message_input(const std::uint8_t* data, std::size_t size) {
     ctx.remote_endpoint = 9;
     ctx.standard_string_table = false;
     if (decode_message(buffer, limits, &ctx)) check(m.ok());
+    // A connection's decode resolves string-table codes and keeps none (wire.md §2.6): each entry then
+    // travels alone in a message of its own, with the same strings as the decode that keeps codes.
+    DecodeContext connection;
+    connection.keep_string_table_codes = false;
+    if (auto plain = decode_message(buffer, limits, &connection)) {
+        check(m.ok() && plain->entries.size() == m->entries.size() && plain->header.string_table.empty());
+        for (std::size_t i = 0; i < plain->entries.size(); ++i) {
+            const MessageEntry& e = plain->entries[i];
+            check(!e.service_path_code && !e.member_name_code && e.member_name == m->entries[i].member_name &&
+                  e.service_path == m->entries[i].service_path);
+            Message alone;
+            alone.version = 4;
+            alone.entries.push_back(e);
+            auto bytes = encode_message(alone);
+            check(bytes.ok());
+            auto back = decode_message(*bytes, roomy_limits());
+            check(back.ok() && back->entries.size() == 1 && back->entries[0] == e);
+        }
+    } else {
+        check(!m.ok());
+    }
 
     // 2. The input as a stream, fed in three parts.
     const std::size_t a = size ? (data[0] * size) / 256 : 0;

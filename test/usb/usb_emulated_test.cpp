@@ -116,7 +116,7 @@ TEST_CASE("usb emulated: detection by BOS capability (sysfs and over the wire) a
     for (auto* o : {&a, &b, &c, &d}) plug(*w, *o);
     start(*w);
 
-    auto devices = w->host->enumerate_wait(10s);
+    auto devices = w->host->enumerate_wait(30s);
     REQUIRE(devices);
     REQUIRE(devices->size() == 3);
     const auto* da = find(*devices, "bos_sysfs");
@@ -143,7 +143,7 @@ TEST_CASE("usb emulated: detection by BOS capability (sysfs and over the wire) a
 
     // The hidden one appears once allowed.
     w->host->allow_device({0x1209, 0x0004, 0});
-    auto again = w->host->enumerate_wait(10s);
+    auto again = w->host->enumerate_wait(30s);
     REQUIRE(again);
     CHECK(again->size() == 4);
     CHECK(find(*again, "hidden"));
@@ -174,7 +174,7 @@ TEST_CASE("usb emulated: the RR descriptor set is read and parsed, a malformed o
     plug(*w, old);
     start(*w);
 
-    auto devices = w->host->enumerate_wait(10s);
+    auto devices = w->host->enumerate_wait(30s);
     REQUIRE(devices);
     REQUIRE(devices->size() == 3);
     std::size_t good = 0, bad_count = 0;
@@ -223,7 +223,7 @@ TEST_CASE("usb emulated: every member kind of the demo services over rr+usb", "[
     REQUIRE(create.call("StartStreaming"));
     for (int i = 0; i < 250; ++i) w->demo.create->advance(20ms);  // 5 s simulated: the wall is hit
     CHECK(eventually([&] { return bumps.load() >= 1 && plays.load() >= 1; }));
-    auto packet = wire->wait_value([](const rr::WireValue&) { return true; }, 5s, 0);
+    auto packet = wire->wait_value([](const rr::WireValue&) { return true; }, 30s, 0);
     REQUIRE(packet);
     CHECK(create.get("Bumpers").value() == Value::scalar(std::uint8_t{3}));
     CHECK(eventually([&] { return w->demo.create->play_stats().replies >= 1; }));
@@ -241,7 +241,7 @@ TEST_CASE("usb emulated: every member kind of the demo services over rr+usb", "[
     REQUIRE(pipe);
     REQUIRE(cam->call("StartStreaming"));
     w->demo.webcam->tick();
-    auto frame = pipe->receive(5s);
+    auto frame = pipe->receive(30s);
     REQUIRE(frame);
     CHECK(frame->field("width"));
     REQUIRE(cam->call("StopStreaming"));
@@ -364,12 +364,12 @@ TEST_CASE("usb emulated: unplug during a request fails it with a clear error, re
     REQUIRE(c->root().call("nop"));
     std::promise<Result<Value>> p;
     c->root().async_call("slow", {Value::scalar(1.0)}, [&](Result<Value> r) { p.set_value(std::move(r)); });
-    REQUIRE(w->slow->wait_for_call(5s));  // the request reached the device's service
+    REQUIRE(w->slow->wait_for_call(30s));  // the request reached the device's service
     const auto t0 = std::chrono::steady_clock::now();
     w->emulator->unplug(dev);
     auto f = p.get_future();
-    REQUIRE(f.wait_for(5s) == std::future_status::ready);
-    CHECK(std::chrono::steady_clock::now() - t0 < 2s);
+    REQUIRE(f.wait_for(30s) == std::future_status::ready);
+    CHECK(std::chrono::steady_clock::now() - t0 < 10s);  // failed by the unplug, not by the 15 s request timeout
     auto r = f.get();
     REQUIRE_FALSE(r);
     INFO(r.error().message);
@@ -419,7 +419,7 @@ TEST_CASE("usb emulated: malformed and stray sub-packets from the device", "[mal
     c->set_closed_handler([&](const RRError& e) { closed.set_value(e); });
     dev->inject_in_transfer(bad);
     auto f = closed.get_future();
-    REQUIRE(f.wait_for(5s) == std::future_status::ready);
+    REQUIRE(f.wait_for(30s) == std::future_status::ready);
     auto e = f.get();
     INFO(e.message);
     CHECK(e.message.find("USB device broke the rr+usb protocol") != std::string::npos);
@@ -436,7 +436,7 @@ TEST_CASE("usb emulated: malformed and stray sub-packets from the device", "[mal
     again->set_closed_handler([&](const RRError& e) { closed_again.set_value(e); });
     dev->inject_in_transfer(odd);
     auto g = closed_again.get_future();
-    REQUIRE(g.wait_for(5s) == std::future_status::ready);
+    REQUIRE(g.wait_for(30s) == std::future_status::ready);
     auto e2 = g.get();
     INFO(e2.message);
     CHECK(e2.message.find("USB device broke the rr+usb protocol") != std::string::npos);
@@ -464,7 +464,7 @@ std::string check_permission_report(const std::string& path) {
         if (!host) {
             problem = "host: " + host.error().message;
         } else {
-            auto devices = (*host)->enumerate_wait(10s);
+            auto devices = (*host)->enumerate_wait(30s);
             const UsbDeviceInfo* found = nullptr;
             if (devices)
                 for (const auto& d : *devices)
@@ -507,7 +507,7 @@ std::string check_gateway_and_cli_report() {
         auto s = (*gw)->device("board")->status();
         return s.state != server::gateway::DeviceState::connected && s.reason.find("70-robotraconteur-usb.rules") != std::string::npos;
     };
-    if (!eventually(reason_ok, 10s)) problem = "device reason: " + (*gw)->device("board")->status().reason;
+    if (!eventually(reason_ok)) problem = "device reason: " + (*gw)->device("board")->status().reason;
     (*gw)->stop();
     if (!problem.empty()) return problem;
 
@@ -595,17 +595,17 @@ TEST_CASE("usb emulated: the device table follows plug and unplug by hotplug, an
         CHECK(w->host->uses_hotplug() == hotplug);
         CHECK(w->host->devices().empty());
         auto* dev = plug(*w);  // no enumerate or connect: the table updates by itself
-        // 10 s: a liveness bound, not a latency one (polling is every 100 ms; CI runs 8 tests per 2 CPUs).
-        const bool seen = eventually([&] { return w->host->devices().size() == 1; }, 10s);
+        // A liveness bound (30 s), not a latency one (polling is every 100 ms; CI runs 8 tests per 2 CPUs).
+        const bool seen = eventually([&] { return w->host->devices().size() == 1; });
         CHECK(seen);
         if (!seen) {  // failed twice in full CI runs, never alone or under CPU load: which half is stuck?
             const auto& st = w->host->stats();
-            WARN("host after 10 s: " << st.scans.load() << " scans, " << st.probes.load() << " probes started, "
+            WARN("host after 30 s: " << st.scans.load() << " scans, " << st.probes.load() << " probes started, "
                  << st.hotplug_events.load() << " hotplug events (scans but no probe: libusb never listed the device; "
                  << "a probe and no table entry: the probe never finished)");
         }
         w->emulator->unplug(dev);
-        CHECK(eventually([&] { return w->host->devices().empty(); }, 10s));
+        CHECK(eventually([&] { return w->host->devices().empty(); }));
         if (!hotplug) CHECK(w->host->stats().hotplug_events == 0);
     }
 }
@@ -629,7 +629,7 @@ TEST_CASE("usb emulated: USB devices feed the discovery table, their services ar
     CHECK_FALSE(d->node(device_node_id()));
 
     auto* dev = plug(*w);  // hotplug: the host's table changes, the source adds the node
-    REQUIRE(eventually([&] { return d->node(device_node_id()).has_value(); }, 5s));
+    REQUIRE(eventually([&] { return d->node(device_node_id()).has_value(); }));
     auto n = d->node(device_node_id());
     CHECK(n->node_name == kDeviceNodeName);
     CHECK(n->source == rr::discovery::NodeSource::usb);
@@ -638,7 +638,7 @@ TEST_CASE("usb emulated: USB devices feed the discovery table, their services ar
     REQUIRE(eventually([&] {
         auto x = d->node(device_node_id());
         return x && x->services.has_value();
-    }, 10s));
+    }));
     n = d->node(device_node_id());
     auto s = std::find_if(n->services->begin(), n->services->end(), [](const auto& x) { return x.name == "usbtest"; });
     REQUIRE(s != n->services->end());
@@ -646,10 +646,10 @@ TEST_CASE("usb emulated: USB devices feed the discovery table, their services ar
     CHECK(s->connection_urls == std::vector<std::string>{"rr+usb:///?nodeid=" + device_node_id().to_string() + "&service=usbtest"});
 
     w->emulator->unplug(dev);  // unplugged: lost at once, not after the 60 s expiry
-    CHECK(eventually([&] { return lost->load() == 1; }, 5s));
+    CHECK(eventually([&] { return lost->load() == 1; }));
     CHECK_FALSE(d->node(device_node_id()));
     plug(*w, UsbWorld::device_options(5));  // re-plugged at another address: back
-    CHECK(eventually([&] { return d->node(device_node_id()).has_value(); }, 5s));
+    CHECK(eventually([&] { return d->node(device_node_id()).has_value(); }));
 
     source->stop();
     CHECK_FALSE(d->node(device_node_id()));  // stop() takes its URLs back

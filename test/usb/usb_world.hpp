@@ -18,6 +18,8 @@
 #include "server/service/object_service.hpp"
 #include "server/service/service_types.hpp"
 #include "server/transport/usb/usb_host.hpp"
+#include "server/transport/usb/usb_libusb.hpp"
+#include "test/support/eventually.hpp"
 #include "test/usb/usb_emulator.hpp"
 
 namespace rr::test::usb {
@@ -113,6 +115,10 @@ public:
 
     /// Starts the host transport (after plugging, so the first scan finds the devices).
     Result<void> start_host() {
+        // An earlier world's libusb context still open would keep libusb's hotplug monitor on that
+        // world's (removed) umockdev testbed: this world's devices would never be listed.
+        if (!rr::testing::eventually([] { return server::usb::LibusbContext::open_contexts() == 0; }))
+            return fail(MessageErrorType::InvalidOperation, "a libusb context of an earlier USB world is still open");
         if (std::getenv("RR_USB_DEBUG"))
             options_.host.log = [](std::string_view line) { std::fprintf(stderr, "usb host: %.*s\n", int(line.size()), line.data()); };
         auto h = server::usb::UsbHost::create(io.executor(), options_.host);
@@ -132,11 +138,18 @@ public:
     ~UsbWorld() {
         if (host) {
             host->shutdown();
-            for (int i = 0; i < 500 && !host->idle(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            rr::testing::eventually([&] { return host->idle(); });
+            // Probes and links in flight hold the host, and with it the libusb context, until their
+            // transfers end: the emulator must answer until then (a transfer left to a gone emulator
+            // never ends, or aborts umockdev's preload), and the context must be exited before the
+            // next world's is made (start_host()).
+            std::weak_ptr<server::usb::UsbHost> gone = host;
             host.reset();
+            if (!rr::testing::eventually([&] { return gone.expired(); }))
+                std::fprintf(stderr, "usb world: the USB host still in use after shutdown\n");
         }
-        // Device handles are closed now; give libusb's event thread a moment to let go of them.
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (!rr::testing::eventually([] { return server::usb::LibusbContext::open_contexts() == 0; }))
+            std::fprintf(stderr, "usb world: a libusb context is still open\n");
         node->shutdown();
         if (demo.create_service) demo.create_service->shutdown();
         if (demo.webcam_service) demo.webcam_service->shutdown();

@@ -57,13 +57,17 @@ public:
         return {};
     }
 
-    // One entry, decoded inside a format-4 message of its own, as a session would receive it.
+    // One entry, decoded inside a format-4 message of its own, as a session would receive it: standard
+    // string-table codes (in files recorded before entries were kept free of them) are resolved, not
+    // replayed.
     Result<MessageEntry> read_entry(std::span<const std::byte> bytes) const override {
         Message m;
         m.version = 4;
         std::vector<std::byte> out;
         if (auto r = encode_message(m, bytes, out); !r) return r.take_error();
-        auto decoded = decode_message(SharedBytes::adopt(std::move(out)));
+        DecodeContext plain;
+        plain.keep_string_table_codes = false;
+        auto decoded = decode_message(SharedBytes::adopt(std::move(out)), {}, &plain);
         if (!decoded) return decoded.take_error();
         if (decoded->entries.size() != 1) return fail(MessageErrorType::DataSerializationError, "not one message entry");
         return std::move(decoded->entries[0]);

@@ -154,8 +154,8 @@ public:
         : strand_(asio::make_strand(ex)), dirs_(std::move(dirs)), options_(std::move(options)), listener_(std::move(listener)),
           poll_timer_(strand_), debounce_timer_(strand_), notify_(strand_) {}
 
-    void start() {
-        asio::dispatch(strand_, [self = shared_from_this()] {
+    void start(std::function<void()> on_started) {
+        asio::dispatch(strand_, [self = shared_from_this(), on_started = std::move(on_started)] {
             if (self->started_ || self->stopped_) return;
             self->started_ = true;
             if (self->options_.use_inotify) {
@@ -169,6 +169,7 @@ public:
             self->scan();
             self->wait_events();
             self->arm_poll();
+            if (on_started) on_started();
         });
     }
 
@@ -225,9 +226,9 @@ private:
         if (listener) listener(found, lost);
     }
 
-    // Watches the entry directories that exist now (new ones appear between scans).
-    void update_watches() {
-        if (!notify_.is_open()) return;
+    // The directories to watch: each entry directory, or while it does not exist its nearest existing
+    // ancestor (whose IN_CREATE starts a rescan that watches the directory once it is there).
+    std::set<std::string> wanted_watches() const {
         std::vector<std::string> want;
         for (const auto& [user, dir] : scan_dirs(dirs_, options_.scan.max_public_users)) {
             want.push_back(dir);
@@ -235,8 +236,6 @@ private:
             want.push_back(dir + "/by-nodename");
         }
         want.push_back(public_search_dir(dirs_));
-        // A directory that does not exist yet is watched through its nearest existing ancestor, whose
-        // IN_CREATE starts a rescan that watches it once it is there.
         std::set<std::string> wanted;
         for (const auto& dir : want) {
             std::error_code ec;
@@ -244,21 +243,41 @@ private:
             while (!p.empty() && !fs::is_directory(p, ec) && p.has_relative_path()) p = p.parent_path();
             if (!p.empty() && fs::is_directory(p, ec)) wanted.insert(p.string());
         }
-        for (auto it = watches_.begin(); it != watches_.end();) {
-            if (!wanted.count(it->first)) {
-                ::inotify_rm_watch(notify_.native_handle(), it->second);
-                it = watches_.erase(it);
-            } else {
-                ++it;
-            }
-        }
+        return wanted;
+    }
+
+    // Watches the entry directories that exist now. A directory created after wanted_watches() looked
+    // and before its parent's watch was added sends no event: so after adding watches, look again, until
+    // a look adds none (then every directory made since is announced by a watch already in place).
+    void update_watches() {
+        if (!notify_.is_open()) return;
         constexpr std::uint32_t kMask = IN_CREATE | IN_DELETE | IN_MODIFY | IN_ATTRIB | IN_CLOSE_WRITE | IN_MOVED_FROM |
                                         IN_MOVED_TO | IN_DELETE_SELF | IN_ONLYDIR;
-        for (const auto& dir : wanted) {
-            if (dir.empty() || watches_.count(dir)) continue;
-            const int wd = ::inotify_add_watch(notify_.native_handle(), dir.c_str(), kMask);
-            if (wd >= 0) watches_[dir] = wd;
+        // Each round that adds a watch found a directory one level deeper; the paths are a few levels deep.
+        constexpr int kMaxRounds = 16;
+        bool settled = false;
+        for (int round = 0; round < kMaxRounds && !settled; ++round) {
+            const auto wanted = wanted_watches();
+            for (auto it = watches_.begin(); it != watches_.end();) {
+                if (!wanted.count(it->first)) {
+                    ::inotify_rm_watch(notify_.native_handle(), it->second);
+                    it = watches_.erase(it);
+                } else {
+                    ++it;
+                }
+            }
+            settled = true;
+            for (const auto& dir : wanted) {
+                if (dir.empty() || watches_.count(dir)) continue;
+                const int wd = ::inotify_add_watch(notify_.native_handle(), dir.c_str(), kMask);
+                if (wd >= 0) {
+                    watches_[dir] = wd;
+                    settled = false;
+                }
+            }
         }
+        // Directories kept changing under every look: look again after the debounce.
+        if (!settled) schedule_scan();
         std::lock_guard lock(mutex_);
         inotify_ = true;
     }
@@ -292,7 +311,12 @@ private:
                 off += static_cast<ssize_t>(sizeof(inotify_event) + ev.len);
             }
         }
-        if (!any || debounce_pending_) return;
+        if (any) schedule_scan();
+    }
+
+    // A scan after the debounce (a starting server writes several files), unless one is pending.
+    void schedule_scan() {
+        if (debounce_pending_ || stopped_) return;
         debounce_pending_ = true;
         debounce_timer_.expires_after(options_.debounce);
         debounce_timer_.async_wait(asio::bind_executor(strand_, [self = shared_from_this()](boost::system::error_code ec) {
@@ -335,7 +359,7 @@ std::shared_ptr<LocalNodeWatcher> LocalNodeWatcher::create(asio::any_io_executor
 
 LocalNodeWatcher::~LocalNodeWatcher() { stop(); }
 
-void LocalNodeWatcher::start() { impl_->start(); }
+void LocalNodeWatcher::start(std::function<void()> on_started) { impl_->start(std::move(on_started)); }
 void LocalNodeWatcher::stop() {
     if (impl_) impl_->stop();
 }

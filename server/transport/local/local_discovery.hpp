@@ -20,8 +20,9 @@
 //
 // LocalNodeWatcher keeps the list current: inotify on the entry directories (CORE's events plus
 // IN_CLOSE_WRITE, which the kernel sends when a server's entry file is closed, also when the process is
-// killed) with a short debounce, and a periodic rescan for directories that do not exist yet and as a
-// fallback where inotify is unavailable.
+// killed) with a short debounce, and a periodic rescan as a fallback where inotify is unavailable. A
+// directory that does not exist yet is watched through its nearest existing ancestor; after adding
+// watches the watcher looks again, so a directory created between a look and its watch is not missed.
 #pragma once
 
 #include <chrono>
@@ -86,8 +87,11 @@ public:
                                                     LocalWatchOptions options, Listener listener);
     ~LocalNodeWatcher();
 
-    /// Scans at once, then on changes. Idempotent.
-    void start();
+    /// Scans at once, then on changes. `on_started` (may be empty) is called on the watcher's strand
+    /// once the first scan has run and its inotify watches are in place (uses_inotify() is final then):
+    /// a directory or entry made after that is seen. Not called when stop() came first. Idempotent (a
+    /// second call's `on_started` is never called).
+    void start(std::function<void()> on_started = {});
     /// Stops watching; no callback runs after stop() returns on another thread than the strand's
     /// (a callback already running finishes). Idempotent.
     void stop();

@@ -7,7 +7,9 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <sys/wait.h>
@@ -228,19 +230,21 @@ TEST_CASE("local discovery: the watcher follows servers starting and stopping") 
         LocalWatchOptions o;
         o.scan.include_own_process = true;
         o.use_inotify = inotify;
-        o.poll_interval = inotify ? 60s : 100ms;  // with inotify, events alone must do it
+        o.poll_interval = inotify ? 0ms : 100ms;  // with inotify, events alone must do it (no polling)
         auto w = LocalNodeWatcher::create(io.executor(), tmp.dirs, o,
                                           [&](const std::vector<LocalNodeInfo>& f, const std::vector<LocalNodeInfo>& l) {
                                               std::lock_guard lock(m);
                                               for (const auto& n : f) seen.push_back(n.node_id);
                                               for (const auto& n : l) lost.push_back(n.node_id);
                                           });
-        w->start();
+        std::promise<void> started;
+        w->start([&] { started.set_value(); });
+        REQUIRE(started.get_future().wait_for(30s) == std::future_status::ready);
+        CHECK(w->uses_inotify() == inotify);
         // The directories do not exist yet: the first server creates them.
-        std::this_thread::sleep_for(50ms);
+        CHECK_FALSE(std::filesystem::exists(tmp.dirs.user_run_dir + "/transport"));
         auto s = serve(tmp.dirs, unique_node_name("disc.watch"));
         const auto id = s.node->node_id();
-        CHECK(w->uses_inotify() == inotify);
         CHECK(eventually([&] {
             std::lock_guard lock(m);
             return std::find(seen.begin(), seen.end(), id) != seen.end();
@@ -256,4 +260,59 @@ TEST_CASE("local discovery: the watcher follows servers starting and stopping") 
         w->stop();
         s.node->shutdown();
     }
+}
+
+// The race a watcher must not lose: entry directories created while it looks for them and adds its
+// watches. Each round starts a watcher (events only, no polling) while another thread creates the
+// directory tree level by level, then publishes an entry a process holds; the node must be found, and
+// lost once its entry goes, every round.
+TEST_CASE("local discovery: directories created while the watcher starts are watched") {
+    constexpr int kRounds = 30;
+    int missed_found = 0, missed_lost = 0;
+    for (int round = 0; round < kRounds; ++round) {
+        TempNodeDirs tmp;
+        client::IoThreads io(1);
+        std::mutex m;
+        std::set<NodeID> seen, lost;
+        LocalWatchOptions o;
+        o.poll_interval = 0ms;
+        o.debounce = 5ms;
+        auto w = LocalNodeWatcher::create(io.executor(), tmp.dirs, o,
+                                          [&](const std::vector<LocalNodeInfo>& f, const std::vector<LocalNodeInfo>& l) {
+                                              std::lock_guard lock(m);
+                                              for (const auto& n : f) seen.insert(n.node_id);
+                                              for (const auto& n : l) lost.insert(n.node_id);
+                                          });
+        const auto id = NodeID::parse("{51111111-2222-4333-8444-555555555555}").value();
+        const std::string dir = tmp.dirs.user_run_dir + "/transport/local";
+        const std::string info = by_nodeid_file(dir, id, "info");
+        std::thread maker([&] {
+            // One level at a time, so that each level may appear between a look and a watch.
+            for (const std::string& d : {tmp.dirs.user_run_dir, tmp.dirs.user_run_dir + "/transport", dir, dir + "/by-nodeid"})
+                std::filesystem::create_directory(d);
+        });
+        w->start();
+        maker.join();
+        // Published as a server would be seen by a watcher that missed nothing: the entry, already
+        // held, moved into by-nodeid (a lock itself sends no inotify event).
+        const std::string staged = tmp.root + "/staged.info";
+        write_entry_file(staged, info_text(id, "race.node", *current_user_name(), "N"));
+        LockHolder holder({staged});
+        std::filesystem::rename(staged, info);
+        if (!eventually([&] {
+                std::lock_guard lock(m);
+                return seen.count(id) == 1;
+            }))
+            ++missed_found;
+        holder.release();
+        std::filesystem::remove(info);  // what a stopping server does
+        if (!eventually([&] {
+                std::lock_guard lock(m);
+                return lost.count(id) == 1;
+            }))
+            ++missed_lost;
+        w->stop();
+    }
+    CHECK(missed_found == 0);
+    CHECK(missed_lost == 0);
 }

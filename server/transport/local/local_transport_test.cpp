@@ -27,6 +27,8 @@
 #include "server/transport/local/local_layout.hpp"
 #include "server/transport/local/local_listener.hpp"
 #include "server/transport/local/local_test_support.hpp"
+#include "test/support/eventually.hpp"
+#include "test/support/skip.hpp"
 #include "server/transport/local/node_identity.hpp"
 
 extern char** environ;
@@ -38,6 +40,7 @@ using namespace std::chrono_literals;
 using rr::client::Client;
 using rr::server::local::testing::TempNodeDirs;
 using rr::server::local::testing::unique_node_name;
+using rr::testing::eventually;
 
 namespace {
 
@@ -94,7 +97,7 @@ unsigned mode_of(const std::string& p) {
 
 Result<std::shared_ptr<Client>> connect(client::IoThreads& io, const std::string& url) {
     client::ClientOptions o;
-    o.request_timeout = 5000ms;
+    o.request_timeout = 30000ms;  // a bound on a hang
     return Client::connect(io.executor(), url, o);
 }
 
@@ -262,19 +265,18 @@ TEST_CASE("local: the NodeID cache gives a NodeName the same NodeID on every sta
         CHECK(o.error().type == MessageErrorType::IOError);
         CHECK_THAT(o.error().message, Catch::Contains(path));
     }
-    SECTION("root reads a NodeID an administrator put in the config dir") {
-        if (::getuid() != 0) {
-            WARN("skipped: needs root (the config-dir NodeID file is read only by root)");
-            return;
-        }
-        const std::string other = unique_node_name("local.cache");
-        std::filesystem::create_directories(tmp.dirs.user_config_dir + "/nodeids");
-        write_file(tmp.dirs.user_config_dir + "/nodeids/" + other, "{11111111-2222-3333-4444-555555555555}");
-        auto o = reserve_node_name(tmp.dirs, other);
-        REQUIRE(o);
-        CHECK(o->node_id.to_string() == "11111111-2222-3333-4444-555555555555");
-        CHECK(o->nodeid_file == tmp.dirs.user_config_dir + "/nodeids/" + other);
-    }
+}
+
+TEST_CASE("local: root reads a NodeID an administrator put in the config dir") {
+    if (::getuid() != 0) RR_SKIP("needs root (the config-dir NodeID file is read only by root)");
+    TempNodeDirs tmp;
+    const std::string other = unique_node_name("local.cache");
+    std::filesystem::create_directories(tmp.dirs.user_config_dir + "/nodeids");
+    write_file(tmp.dirs.user_config_dir + "/nodeids/" + other, "{11111111-2222-3333-4444-555555555555}");
+    auto o = reserve_node_name(tmp.dirs, other);
+    REQUIRE(o);
+    CHECK(o->node_id.to_string() == "11111111-2222-3333-4444-555555555555");
+    CHECK(o->nodeid_file == tmp.dirs.user_config_dir + "/nodeids/" + other);
 }
 
 TEST_CASE("local: bad NodeNames, and a node whose NodeID is not the cached one") {
@@ -463,23 +465,28 @@ TEST_CASE("local: unknown names, stale entries and mismatched entries are clear 
     }
 }
 
-TEST_CASE("local: an entry or a socket this user may not open is a permission error") {
-    if (::getuid() != 0 && ::geteuid() != 0) {
-        // As an ordinary user a mode-000 directory is enough for the first half.
-        TempNodeDirs tmp;
-        const std::string by_name = tmp.dirs.user_run_dir + "/transport/local/by-nodename";
-        std::filesystem::create_directories(by_name);
-        write_file(by_name + "/locked.node.info", "socket: /nowhere.sock\n");
-        ::chmod(by_name.c_str(), 0);
-        client::IoThreads io{1};
-        auto ex = io.executor();
-        auto s = connect_local_socket(ex, *parse_connection_url("rr+local:///?nodename=locked.node&service=svc"), tmp.dirs);
-        ::chmod(by_name.c_str(), 0755);
-        REQUIRE_FALSE(s);
-        CHECK_THAT(s.error().message, Catch::Contains("permission denied reading " + by_name + "/locked.node.info"));
-        WARN("partly skipped: the socket half needs root (to act as another user)");
-        return;
-    }
+TEST_CASE("local: an entry this user may not read is a permission error naming it") {
+    // A mode-000 directory: root reads it anyway, so root acts as nobody.
+    TempNodeDirs tmp;
+    const std::string by_name = tmp.dirs.user_run_dir + "/transport/local/by-nodename";
+    std::filesystem::create_directories(by_name);
+    write_file(by_name + "/locked.node.info", "socket: /nowhere.sock\n");
+    for (const auto& d : {tmp.dirs.user_run_dir, tmp.dirs.user_run_dir + "/transport", tmp.dirs.user_run_dir + "/transport/local"})
+        ::chmod(d.c_str(), 0755);
+    ::chmod(by_name.c_str(), 0);
+    client::IoThreads io{1};
+    const auto url = *parse_connection_url("rr+local:///?nodename=locked.node&service=svc");
+    Result<boost::asio::local::stream_protocol::socket> s = fail(MessageErrorType::None, "");
+    if (::geteuid() == 0) as_nobody([&] { s = connect_local_socket(io.executor(), url, tmp.dirs); });
+    else s = connect_local_socket(io.executor(), url, tmp.dirs);
+    ::chmod(by_name.c_str(), 0755);
+    REQUIRE_FALSE(s);
+    CHECK(s.error().type == MessageErrorType::ConnectionError);
+    CHECK_THAT(s.error().message, Catch::Contains("permission denied reading " + by_name + "/locked.node.info"));
+}
+
+TEST_CASE("local: the socket of another user's node is a permission error, its own user connects") {
+    if (::getuid() != 0 && ::geteuid() != 0) RR_SKIP("needs root (to act as another user)");
     TempNodeDirs tmp;
     const std::string name = unique_node_name("local.perm");
     auto [node, listener] = start_named(tmp.dirs, name);
@@ -491,15 +498,6 @@ TEST_CASE("local: an entry or a socket this user may not open is a permission er
     client::IoThreads io{1};
     auto url = *parse_connection_url("rr+local:///?nodename=" + name + "&service=svc");
 
-    SECTION("the entry's directory is closed (mode 000)") {
-        ::chmod((entry_dir + "/by-nodename").c_str(), 0);
-        Result<boost::asio::local::stream_protocol::socket> s = fail(MessageErrorType::None, "");
-        as_nobody([&] { s = connect_local_socket(io.executor(), url, tmp.dirs); });
-        ::chmod((entry_dir + "/by-nodename").c_str(), 0755);
-        REQUIRE_FALSE(s);
-        CHECK(s.error().type == MessageErrorType::ConnectionError);
-        CHECK_THAT(s.error().message, Catch::Contains("permission denied reading " + info));
-    }
     SECTION("the entry is readable, the socket (0770, another user's) is not") {
         ::chmod(info.c_str(), 0644);
         Result<boost::asio::local::stream_protocol::socket> s = fail(MessageErrorType::None, "");
@@ -517,10 +515,7 @@ TEST_CASE("local: an entry or a socket this user may not open is a permission er
 }
 
 TEST_CASE("local: a run directory this user may not write is a permission error naming it") {
-    if (::getuid() != 0 && ::geteuid() != 0) {
-        WARN("skipped: needs root (to act as another user on a directory root owns)");
-        return;
-    }
+    if (::getuid() != 0 && ::geteuid() != 0) RR_SKIP("needs root (to act as another user on a directory root owns)");
     TempNodeDirs tmp;  // root-owned, mode 0755: another user may read but not write
     const std::string name = unique_node_name("local.nowrite");
     auto r = reserve_node_name(tmp.dirs, name);
@@ -542,20 +537,26 @@ TEST_CASE("local: a run directory this user may not write is a permission error 
 
 TEST_CASE("local: a NodeName held by another process is refused, and free again when it exits") {
     // The other process: Python's fcntl.lockf takes the same kind of lock CORE takes (fcntl F_SETLK).
-    if (::access("/usr/bin/python3", X_OK) != 0) {
-        WARN("skipped: /usr/bin/python3 is needed to hold a lock from another process");
-        return;
-    }
+    if (::access("/usr/bin/python3", X_OK) != 0) RR_SKIP("/usr/bin/python3 is needed to hold a lock from another process");
     TempNodeDirs tmp;
     const std::string name = unique_node_name("local.taken");
     const std::string lock_path = tmp.dirs.user_run_dir + "/nodeids/" + name + ".pid";
     std::filesystem::create_directories(tmp.dirs.user_run_dir + "/nodeids");
     const std::string script = "import fcntl,os,sys,time\nf=open(sys.argv[1],'a+')\nfcntl.lockf(f,fcntl.LOCK_EX|fcntl.LOCK_NB)\n"
-                               "f.write(str(os.getpid()));f.flush()\ntime.sleep(30)\n";
+                               "f.write(str(os.getpid()));f.flush()\ntime.sleep(300)\n";  // killed below
     const char* argv[] = {"/usr/bin/python3", "-c", script.c_str(), lock_path.c_str(), nullptr};
     pid_t child = 0;
     REQUIRE(::posix_spawn(&child, argv[0], nullptr, nullptr, const_cast<char* const*>(argv), environ) == 0);
-    for (int i = 0; i < 300 && !lock_holder(lock_path); ++i) std::this_thread::sleep_for(10ms);
+    struct Reaper {  // a failed REQUIRE must not leave the child holding ctest's output pipe
+        pid_t& pid;
+        ~Reaper() {
+            if (pid <= 0) return;
+            ::kill(pid, SIGKILL);
+            int st = 0;
+            ::waitpid(pid, &st, 0);
+        }
+    } reaper{child};
+    REQUIRE(eventually([&] { return lock_holder(lock_path).has_value(); }));  // Python started (slow under load)
     REQUIRE(lock_holder(lock_path) == child);
 
     auto r = reserve_node_name(tmp.dirs, name);
@@ -564,9 +565,11 @@ TEST_CASE("local: a NodeName held by another process is refused, and free again 
     CHECK(r.error().message == "NodeName \"" + name + "\" is already in use by process " + std::to_string(child) + " (lock " +
                                    lock_path + ")");
 
-    ::kill(child, SIGKILL);
+    const pid_t holder = child;
+    child = 0;
+    ::kill(holder, SIGKILL);
     int status = 0;
-    ::waitpid(child, &status, 0);
+    ::waitpid(holder, &status, 0);
     auto again = reserve_node_name(tmp.dirs, name);
     REQUIRE(again);
 }

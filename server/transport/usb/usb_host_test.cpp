@@ -3,12 +3,14 @@
 // test/usb.
 #include <catch2/catch.hpp>
 
+#include <exception>
 #include <future>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/strand.hpp>
 
 #include "server/transport/usb/usb_host.hpp"
+#include "test/support/skip.hpp"
 
 using namespace rr;
 using namespace rr::server::usb;
@@ -143,29 +145,34 @@ TEST_CASE("usb host: permission errors name the udev rule") {
 
 TEST_CASE("usb host: on a bus without RR devices enumerate is empty and connect says no device") {
     boost::asio::io_context io;
-    auto work = boost::asio::make_work_guard(io);
-    std::thread t([&] { io.run(); });
     UsbHostOptions o;
     o.sysfs_root = "/nonexistent";
     auto host = UsbHost::create(io.get_executor(), o);
-    if (!host) {
-        WARN("SKIP: libusb cannot start here: " << host.error().message);
-    } else {
-        auto devices = (*host)->enumerate_wait(5s);
-        REQUIRE(devices);
-        CHECK(devices->empty());
-        std::promise<Result<UsbByteStream>> p;
-        (*host)->open_stream(url("rr+usb:///?nodename=nobody&service=s"), io.get_executor(),
-                             [&](Result<UsbByteStream> r) { p.set_value(std::move(r)); });
-        auto f = p.get_future();
-        REQUIRE(f.wait_for(5s) == std::future_status::ready);
-        auto r = f.get();
-        REQUIRE_FALSE(r);
-        CHECK(r.error().type == MessageErrorType::ConnectionError);
-        CHECK(r.error().message.find("no rr+usb device with NodeName \"nobody\" is attached") != std::string::npos);
-        (*host)->shutdown();
-        host->reset();
-    }
-    work.reset();
-    t.join();
+    if (!host) RR_SKIP("libusb cannot start here: " << host.error().message);
+    auto work = boost::asio::make_work_guard(io);
+    std::thread t([&] { io.run(); });
+    struct Joiner {  // a failed REQUIRE (an exception) must not leave the thread joinable, nor wait on the host
+        boost::asio::io_context& io;
+        boost::asio::executor_work_guard<boost::asio::io_context::executor_type>& work;
+        std::thread& t;
+        ~Joiner() {
+            work.reset();
+            if (std::uncaught_exceptions() > 0) io.stop();
+            t.join();
+        }
+    } joiner{io, work, t};
+    auto devices = (*host)->enumerate_wait(30s);
+    REQUIRE(devices);
+    CHECK(devices->empty());
+    std::promise<Result<UsbByteStream>> p;
+    (*host)->open_stream(url("rr+usb:///?nodename=nobody&service=s"), io.get_executor(),
+                         [&](Result<UsbByteStream> r) { p.set_value(std::move(r)); });
+    auto f = p.get_future();
+    REQUIRE(f.wait_for(30s) == std::future_status::ready);
+    auto r = f.get();
+    REQUIRE_FALSE(r);
+    CHECK(r.error().type == MessageErrorType::ConnectionError);
+    CHECK(r.error().message.find("no rr+usb device with NodeName \"nobody\" is attached") != std::string::npos);
+    (*host)->shutdown();
+    host->reset();
 }

@@ -8,6 +8,12 @@ namespace rr::server::usb {
 
 // --- LibusbContext -------------------------------------------------------------------------------------
 
+namespace {
+std::atomic<std::size_t> g_open_contexts{0};  // libusb_init'ed, libusb_exit not yet returned
+}
+
+std::size_t LibusbContext::open_contexts() noexcept { return g_open_contexts.load(); }
+
 Result<std::shared_ptr<LibusbContext>> LibusbContext::create() {
     std::shared_ptr<LibusbContext> c(new LibusbContext());
     const int r = libusb_init(&c->ctx_);
@@ -15,6 +21,7 @@ Result<std::shared_ptr<LibusbContext>> LibusbContext::create() {
         c->ctx_ = nullptr;
         return fail(MessageErrorType::IOError, "libusb_init: " + libusb_error_text(r));
     }
+    g_open_contexts.fetch_add(1);
     c->thread_ = std::thread([ctx = c->ctx_, stop = c->stop_] {
         while (!stop->load()) {
             timeval tv{1, 0};
@@ -35,11 +42,15 @@ LibusbContext::~LibusbContext() {
             libusb_interrupt_event_handler(ctx);
             t.join();
             libusb_exit(ctx);
+            g_open_contexts.fetch_sub(1);
         }).detach();
         return;
     }
     stop();
-    if (ctx_) libusb_exit(ctx_);
+    if (ctx_) {
+        libusb_exit(ctx_);
+        g_open_contexts.fetch_sub(1);
+    }
 }
 
 bool LibusbContext::has_hotplug() const noexcept { return libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) != 0; }

@@ -55,6 +55,11 @@ public:
     /// Deregisters hotplug and joins the event thread; transfers must be finished first. Idempotent.
     void stop();
     bool on_event_thread() const noexcept { return std::this_thread::get_id() == thread_id_; }
+    /// Contexts of this process initialised and not yet exited (the last owner may finish the exit on
+    /// a thread of its own). libusb's Linux hotplug monitor is shared by all the contexts of a process
+    /// and started by the first one, on the udev view of that moment: tests that change the view
+    /// (umockdev testbeds) wait for 0 before they make the next context.
+    static std::size_t open_contexts() noexcept;
 
 private:
     LibusbContext() = default;

@@ -273,7 +273,9 @@ export function createRobotPanel(parent, ctx) {
       if (q.some((x) => !Number.isFinite(x)) || !(f > 0 && f <= 1)) { showError("move to: every joint needs a number, max velocity 1..100 %"); return; }
       go.disabled = true;
       try {
-        await obj.jog_freespace(Float64Array.from(q), Float64Array.from(model, (j) => f * j.reducedVelocity), false);
+        // wait true: the call lasts as long as the move, so the gateway's hold on the robot's motion (one
+        // client at a time, docs/security.md "Motion safety") ends with it, not with this page.
+        await obj.jog_freespace(Float64Array.from(q), Float64Array.from(model, (j) => f * j.reducedVelocity), true);
         if (!disposed) showError(null);
       } catch (e) {
         if (!disposed) showError(`jog_freespace: ${errorText(e)}`);

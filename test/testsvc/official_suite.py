@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""The official Python client suite (test/python of robotraconteur/robotraconteur) against rr-test-service,
+run by hand (docs/native-service.md "The official client suite against rr-test-service").
+
+For each transport (rr+tcp, rr+ws, rr+wss with a throw-away certificate, rr+local) it starts
+rr-test-service with the official values file, sets ROBOTRACONTEUR_TEST_SERVER_URL and runs the suite's
+service tests with pytest; with --gateway also through rr-gateway (the four services as devices of the
+same names, `auth: passthrough`, over rr+tcp and rr+ws); with --reference also without the variable,
+where the suite starts the official test server in its own process (the reference). Prints one line per
+test and configuration and a summary; the JUnit files stay in --out.
+
+    .venv/bin/python test/testsvc/official_suite.py --repo /tmp/rr-official --values /tmp/official-values.json \\
+        --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/rr-gateway] [--reference] \\
+        [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws] [--pytest-path DIR] [--out DIR]
+Exit 0 when every test passed in every configuration run, 1 otherwise.
+"""
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.request
+import uuid
+import xml.etree.ElementTree as ET
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "interop"))
+
+SUITE = ["RobotRaconteurTest/test_attributes.py", "RobotRaconteurTest/test_service.py",
+         "RobotRaconteurTest/test_service2.py", "RobotRaconteurTest/test_service3.py"]
+SERVICES = ["RobotRaconteurTestService", "RobotRaconteurTestService_auth", "RobotRaconteurTestService2",
+            "RobotRaconteurTestService3"]
+
+
+class Proc:
+    """A child process whose first stdout line matching `accept` is its ready line."""
+
+    def __init__(self, argv, logdir, name, accept, timeout=90):
+        self.log = open(os.path.join(logdir, name + ".log"), "w")
+        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, text=True)
+        line = []
+
+        def read():
+            for ln in self.p.stdout:
+                if accept(ln):
+                    line.append(ln)
+                    return
+        t = threading.Thread(target=read, daemon=True)
+        t.start()
+        t.join(timeout)
+        if not line:
+            self.stop()
+            raise RuntimeError("%s printed no ready line; see %s" % (argv[0], self.log.name))
+        self.ready = line[0]
+        threading.Thread(target=lambda: [None for _ in self.p.stdout], daemon=True).start()
+
+    def stop(self):
+        if self.p.poll() is None:
+            self.p.send_signal(signal.SIGTERM)
+            try:
+                self.p.wait(60)
+            except subprocess.TimeoutExpired:
+                self.p.kill()
+                self.p.wait()
+        return self.p.returncode
+
+
+def start_service(args, logdir, name, extra):
+    p = Proc([args.service, "--port", "0", "--robdef-dir", os.path.join(args.repo, "test", "robdef"),
+              "--official-values", args.values] + extra, logdir, name, lambda ln: ln.startswith("ready "))
+    return p, json.loads(p.ready[len("ready "):])
+
+
+def start_gateway(args, logdir, urls, name):
+    cfg = os.path.join(logdir, name + ".yaml")
+    with open(cfg, "w") as f:
+        f.write("devices:\n")
+        for s in SERVICES:
+            f.write("  - name: %s\n    url: %s?service=%s\n    auth: passthrough\n" % (s, urls["url"], s))
+            if s.endswith("_auth"):  # the gateway's own session needs a login there too
+                f.write("    username: testuser1\n    password: testpass1\n")
+    p = Proc([args.gateway, "--config", cfg, "--listen", "127.0.0.1", "--port", "0", "--no-demo", "--no-local",
+              "--no-discovery", "--log-level", "warning"], logdir, name,
+             lambda ln: ln.strip().startswith("{") and '"port"' in ln)
+    port = json.loads(p.ready)["port"]
+    deadline = time.time() + 60
+    while True:  # /readyz answers 200 once every device is connected
+        try:
+            if urllib.request.urlopen("http://127.0.0.1:%d/readyz" % port, timeout=2).status == 200:
+                break
+        except Exception:
+            pass
+        if time.time() > deadline:
+            p.stop()
+            raise RuntimeError("gateway not ready; see " + p.log.name)
+        time.sleep(0.2)
+    return p, port
+
+
+def run_suite(args, logdir, name, url, env_extra=None, plugins=()):
+    junit = os.path.join(logdir, name + ".xml")
+    env = dict(os.environ)
+    env.pop("ROBOTRACONTEUR_TEST_SERVER_URL", None)
+    if url is not None:
+        env["ROBOTRACONTEUR_TEST_SERVER_URL"] = url
+    env["PYTHONPATH"] = os.pathsep.join(x for x in (args.pytest_path, os.path.join(args.repo, "test", "python"), HERE,
+                                                    env.get("PYTHONPATH")) if x)
+    env.update(env_extra or {})
+    with open(os.path.join(logdir, name + ".pytest.log"), "w") as out:
+        subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-rA", "--junitxml", junit]
+                       + [a for p in plugins for a in ("-p", p)] + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
+                       stderr=subprocess.STDOUT, timeout=1800)
+    results = {}
+    for case in ET.parse(junit).getroot().iter("testcase"):
+        test = "%s::%s" % (case.get("classname", "").split(".")[-1], case.get("name"))
+        outcome = "passed"
+        for kind in ("failure", "error", "skipped"):
+            el = case.find(kind)
+            if el is not None:
+                outcome = "%s: %s" % ("failed" if kind != "skipped" else "skipped",
+                                      (el.get("message") or "").splitlines()[0][:160] if el.get("message") else "")
+        results[test] = outcome
+    return results
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repo", required=True)
+    ap.add_argument("--values", required=True, help="made by official_values.py")
+    ap.add_argument("--service", required=True)
+    ap.add_argument("--gateway")
+    ap.add_argument("--reference", action="store_true", help="also run the suite against the official server")
+    ap.add_argument("--configs", default="tcp,ws,wss,local,gateway-tcp,gateway-ws")
+    ap.add_argument("--pytest-path", default=None, help="a folder to add to PYTHONPATH for pytest")
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    logdir = args.out or tempfile.mkdtemp(prefix="official-suite-")
+    os.makedirs(logdir, exist_ok=True)
+    configs = [c for c in args.configs.split(",") if c and (args.gateway or not c.startswith("gateway"))]
+    table = {}
+
+    if args.reference:
+        table["official server"] = run_suite(args, logdir, "reference", None)
+    for config in configs:
+        procs = []
+        try:
+            extra, env = [], {}
+            if config == "wss":
+                import tls_pki
+                pki = tls_pki.Pki(os.path.join(logdir, "pki"))
+                ca = pki.ca("ca")
+                leaf = pki.issue(ca, "server", "localhost", sans=["DNS:localhost", "IP:127.0.0.1"])
+                extra = ["--tls-cert", leaf.cert, "--tls-key", leaf.key]
+                env = {"SSL_CERT_FILE": ca.cert}
+            if config == "local":
+                extra = ["--nodename", "testsvc_" + uuid.uuid4().hex[:10]]
+            svc, urls = start_service(args, logdir, "service-" + config, extra)
+            procs.append(svc)
+            if config == "tcp":
+                url = urls["url"]
+            elif config == "ws":
+                url = urls["ws_url"]
+            elif config == "wss":
+                url = urls["wss_url"].replace("localhost", "127.0.0.1")
+            elif config == "local":
+                url = urls["local_url"]
+            else:
+                gw, port = start_gateway(args, logdir, urls, "gateway-" + config)
+                procs.append(gw)
+                url = ("rr+tcp://127.0.0.1:%d/" if config == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
+            print("%s: %s" % (config, url), flush=True)
+            table[config] = run_suite(args, logdir, config, url, env)
+            if config == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
+                table["local (URL joined with &)"] = run_suite(args, logdir, "local-joined", url, env,
+                                                               plugins=["official_suite_local_url"])
+        except Exception as e:
+            table[config] = {"(setup)": "failed: %s" % e}
+        finally:
+            for p in reversed(procs):
+                code = p.stop()
+                if code not in (0, None):
+                    table.setdefault(config, {})["(%s exit)" % os.path.basename(p.p.args[0])] = "failed: exit status %s" % code
+
+    tests = sorted({t for r in table.values() for t in r})
+    ok = True
+    for config, results in table.items():
+        for t in tests:
+            outcome = results.get(t, "not run")
+            ok = ok and outcome == "passed"
+            print("%-16s %-45s %s" % (config, t, outcome))
+    for config, results in table.items():
+        print("%s: %d of %d passed" % (config, sum(1 for v in results.values() if v == "passed"), len(results)))
+    print("logs and JUnit files: " + logdir)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
