@@ -5,7 +5,6 @@
 // once, not N times.
 #pragma once
 
-#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -26,17 +25,8 @@ public:
     /// subscriber must pass an equivalent `render` (the same conversion for the same member).
     template <class Render>
     const std::string& rendered(Render&& render) const {
-        std::call_once(once_, [&] {
-            rendered_ = std::forward<Render>(render)(entry());
-            rendered_made_.store(true, std::memory_order_release);
-        });
+        std::call_once(once_, [&] { rendered_ = std::forward<Render>(render)(entry()); });
         return rendered_;
-    }
-    /// The text rendered() made, when a subscriber has made it already (the JSON sockets' push body,
-    /// json_push.hpp), else nullptr: never renders, never waits. For a reader that wants that text only
-    /// if it is there for free (the recorder's json channels).
-    const std::string* rendered_if_made() const noexcept {
-        return rendered_made_.load(std::memory_order_acquire) ? &rendered_ : nullptr;
     }
 
     /// Like rendered(), for the subscribers of binary pushes (binary_push.hpp): the body's text with
@@ -56,7 +46,6 @@ public:
 private:
     mutable std::once_flag once_, binary_once_;
     mutable std::string rendered_;
-    mutable std::atomic<bool> rendered_made_{false};
     mutable BinaryRendering binary_;
 };
 

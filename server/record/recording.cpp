@@ -15,12 +15,10 @@
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/mcap/mcap_file.hpp"
-#include "server/record/object_path.hpp"
 
 namespace rr::server::record {
 
 namespace fs = std::filesystem;
-using gateway::MemberTarget;
 using gateway::SharedEntry;
 using gateway::SharedEntryPtr;
 
@@ -78,12 +76,6 @@ std::vector<std::string> declared_service_names(const std::vector<std::string>& 
     return names;
 }
 
-// The object's path below the root from a target's service path in gateway naming (`<device>` or
-// `<device>.<relative path>`): "" for the root.
-std::string object_path_of(const std::string& service_path, const std::string& device) {
-    return service_path.size() > device.size() ? service_path.substr(device.size() + 1) : std::string();
-}
-
 std::span<const std::byte> as_bytes(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
 
 }  // namespace
@@ -120,89 +112,13 @@ Result<std::shared_ptr<Recording>> Recording::create(std::uint64_t id, Recording
         return fail(MessageErrorType::InvalidArgument, "record: encoding: no format to write");
     if (!device->upstream())
         return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\" is not connected (its definitions are needed)");
-    gateway::ApiError type_error;
-    auto types = api->types_for(*device, &type_error);
-    if (!types) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": " + type_error.message);
-    const std::string object_type = device->object_type();
-    auto object = types->find_object(object_type);
-    if (!object) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": unknown root type " + object_type);
-
-    std::vector<RecordedMember> members;
-    // `m` of the object at `below` (nullptr: the root).
-    auto add = [&](const robdef::MemberDefinition& m, const ObjectBelow* below = nullptr) -> Result<void> {
-        RecordedMember r;
-        switch (m.kind) {
-            case robdef::MemberKind::wire: r.kind = RecordedMember::Kind::wire; break;
-            case robdef::MemberKind::pipe: r.kind = RecordedMember::Kind::pipe; break;
-            case robdef::MemberKind::event: r.kind = RecordedMember::Kind::event; break;
-            case robdef::MemberKind::property:
-                if (m.direction() == robdef::MemberDirection::writeonly)
-                    return fail(MessageErrorType::InvalidArgument, "record: members: property \"" + m.name + "\" is write-only");
-                r.kind = RecordedMember::Kind::property;
-                break;
-            default:
-                return fail(MessageErrorType::InvalidArgument,
-                            "record: members: \"" + m.name + "\" is " + robdef::with_article(robdef::member_kind_keyword(m.kind)) +
-                                " (wires, pipes, events and properties can be recorded)");
-        }
-        auto t = std::make_shared<MemberTarget>();
-        t->device = device;
-        t->types = types;
-        t->path = below ? device->config().name + "." + below->path : device->config().name;
-        t->object_type = below ? below->object_type : object_type;
-        t->service = below ? below->object.service : object->service;
-        t->object = below ? below->object.entry : object->entry;
-        t->member = &m;
-        // What every channel of the member carries (channel_metadata.hpp).
-        const std::string path = object_path_of(t->path, spec.device);
-        r.topic = channel_topic(spec.device, path, m.name);
-        r.metadata = {{channel_key::device, spec.device},
-                      {channel_key::member, m.name},
-                      {channel_key::kind, std::string(member_kind_name(r.kind))},
-                      {channel_key::object_type, t->object_type},
-                      {channel_key::path, path},
-                      {channel_key::root_type, device->object_type()}};
-        if (r.kind != RecordedMember::Kind::event) r.metadata[channel_key::type] = m.type.to_string();
-        if (r.kind == RecordedMember::Kind::property)
-            r.metadata[channel_key::period_ms] = std::to_string(spec.property_period.count() > 0 ? spec.property_period.count() : 1000);
-        r.target = std::move(t);
-        members.push_back(std::move(r));
-        return {};
-    };
-    if (spec.members.empty()) {
-        for (const auto& m : object->entry->members) {
-            const bool stream = m.kind == robdef::MemberKind::wire || m.kind == robdef::MemberKind::pipe ||
-                                m.kind == robdef::MemberKind::event;
-            const bool prop = m.kind == robdef::MemberKind::property && spec.property_period.count() > 0 &&
-                              m.direction() != robdef::MemberDirection::writeonly;
-            if (stream || prop)
-                if (auto r = add(m); !r) return r.take_error();
-        }
-    } else {
-        for (const auto& name : spec.members) {
-            const auto split = split_member_path(name);
-            if (split.object.empty()) {
-                const auto* m = object->entry->find_member(name);
-                if (!m) return fail(MessageErrorType::InvalidArgument, "record: members: " + object_type + " has no member \"" + name + "\"");
-                if (auto r = add(*m); !r) return r.take_error();
-                continue;
-            }
-            auto below = object_below(*types, object_type, split.object);
-            if (!below) return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below.error().message);
-            const auto* m = below->object.entry->find_member(split.member);
-            if (!m)
-                return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below->object_type +
-                                                                   " has no member \"" + split.member + "\"");
-            if (auto r = add(*m, &*below); !r) return r.take_error();
-        }
-    }
-    if (members.empty()) return fail(MessageErrorType::InvalidArgument, "record: " + object_type + ": nothing to record");
-    if (members.size() > 30000) return fail(MessageErrorType::InvalidArgument, "record: too many members");
+    auto members = recorded_members(device, *api, spec.members, spec.property_period);
+    if (!members) return members.take_error();
 
     if (spec.prefix.empty()) spec.prefix = prefix_of_device(spec.device);
 
-    auto definition_names = declared_service_names(types->texts());
-    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(members),
+    auto definition_names = declared_service_names(members->front().target->types->texts());
+    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(*members),
                                                std::move(definition_names), formats));
     r->listeners_ = std::move(listeners);
     // The thread keeps the recording alive until it has ended; the disk work is all done there.
@@ -644,7 +560,7 @@ RecordingStatus Recording::status() const {
     s.id = id_;
     s.spec = spec_;
     for (const auto& m : members_) {
-        const auto object = object_path_of(m.target->path, device_->config().name);
+        const auto object = metadata_value(m.metadata, channel_key::path);
         s.members.push_back(object.empty() ? m.target->member->name : object + "." + m.target->member->name);
     }
     s.drops = queue_.drops();

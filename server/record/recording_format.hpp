@@ -21,7 +21,7 @@
 #include "core/message/message.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/gateway/shared_entry.hpp"
-#include "server/record/channel_metadata.hpp"
+#include "server/record/channel_mapping.hpp"
 #include "server/record/recording_spec.hpp"
 
 namespace rr::mcap {
@@ -29,15 +29,6 @@ class McapWriter;
 }
 
 namespace rr::server::record {
-
-/// One recorded member: what it is, and what every channel of it carries.
-struct RecordedMember {
-    using Kind = RecordedKind;
-    Kind kind = Kind::wire;
-    std::shared_ptr<const gateway::MemberTarget> target;
-    std::string topic;         ///< its channels' topic (object_path.hpp channel_topic)
-    ChannelMetadata metadata;  ///< the keys each of its channels has (channel_metadata.hpp); a format may add its own
-};
 
 /// What a format's encoder is made with: the recording's spec, its members (indexed as
 /// RecordedEntry::member) and the JSON API (for the JSON mapping). All outlive the encoder.

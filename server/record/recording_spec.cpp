@@ -30,10 +30,10 @@ Result<std::vector<std::string>> encodings_of(const json& j) {
     for (const auto& x : given) {
         if (!x.is_string() || std::find(names.begin(), names.end(), x.get<std::string>()) == names.end()) {
             std::string expected;
-            for (std::size_t i = 0; i < names.size(); ++i)
-                expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + json(names[i]).dump();
-            return fail(MessageErrorType::InvalidArgument,
-                        "record: encoding: expected " + expected + ", or a list of them, not " + x.dump());
+            for (const auto& n : names) expected += json(n).dump() + ", ";
+            expected.resize(expected.size() - 2);
+            return fail(MessageErrorType::InvalidArgument, "record: encoding: expected " + expected + " or a list of " +
+                                                               (names.size() == 2 ? "both" : "them") + ", not " + x.dump());
         }
     }
     for (const auto& n : names)

@@ -162,6 +162,35 @@ std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const 
     return out.dump();
 }
 
+std::optional<FoxgloveImageKind> foxglove_image_kind_of(const RecordedMember& m) {
+    if (m.kind == RecordedKind::event) return std::nullopt;
+    const auto& t = *m.target;
+    return foxglove_image_kind(t.member->type, t.types->set(), t.context());
+}
+
+MappedChannel foxglove_image_channel(const RecordedMember& m, FoxgloveImageKind kind) {
+    auto metadata = m.metadata;
+    metadata[channel_key::foxglove] = kind == FoxgloveImageKind::raw
+                                          ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
+                                            "bayer_*8888 depth_u16; other frames are not on this channel"
+                                          : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
+    return MappedChannel{m.topic + "/foxglove", "json", std::string(foxglove_schema_name(kind)), "jsonschema",
+                         foxglove_image_schema(kind).dump(), std::move(metadata)};
+}
+
+std::optional<std::string> foxglove_image_message(const gateway::JsonApi& api, const RecordedMember& m, FoxgloveImageKind kind,
+                                                  const MessageEntry& entry, std::uint64_t log_ns) {
+    const auto& t = *m.target;
+    const MessageElement* el = m.kind == RecordedKind::wire   ? entry.find("packet")
+                               : m.kind == RecordedKind::pipe ? (entry.elements.empty() ? nullptr : &entry.elements[0])
+                                                              : entry.find("value");
+    if (!el) return std::nullopt;
+    // One conversion: the element to a value whose pixel bytes are the element's, read into the message.
+    auto image = unpack_value(*el, t.member->type, t.types->set(), t.context(), api.options().limits);
+    if (!image) return std::nullopt;
+    return foxglove_image_message(kind, *image, log_ns);
+}
+
 // --- the format ------------------------------------------------------------------------------------
 
 namespace {
@@ -169,11 +198,7 @@ namespace {
 class FoxgloveImageEncoder : public FormatEncoder {
 public:
     explicit FoxgloveImageEncoder(const FormatContext& context) : context_(context) {
-        for (const auto& m : context_.members) {
-            const auto& t = *m.target;
-            kinds_.push_back(m.kind == RecordedKind::event ? std::nullopt
-                                                           : foxglove_image_kind(t.member->type, t.types->set(), t.context()));
-        }
+        for (const auto& m : context_.members) kinds_.push_back(foxglove_image_kind_of(m));
     }
 
     Result<void> open_file(FormatFile& file) override {
@@ -181,20 +206,14 @@ public:
         std::optional<std::uint16_t> schemas[2];  // by kind, added once a file
         for (std::size_t i = 0; i < context_.members.size(); ++i) {
             if (!kinds_[i]) continue;
-            const auto kind = *kinds_[i];
-            auto& sid = schemas[kind == FoxgloveImageKind::raw ? 0 : 1];
+            const auto c = foxglove_image_channel(context_.members[i], *kinds_[i]);
+            auto& sid = schemas[*kinds_[i] == FoxgloveImageKind::raw ? 0 : 1];
             if (!sid) {
-                auto id = file.add_schema(foxglove_schema_name(kind), "jsonschema", foxglove_image_schema(kind).dump());
+                auto id = file.add_schema(c.schema_name, c.schema_encoding, c.schema);
                 if (!id) return id.take_error();
                 sid = *id;
             }
-            const auto& m = context_.members[i];
-            auto metadata = m.metadata;
-            metadata[channel_key::foxglove] = kind == FoxgloveImageKind::raw
-                                                  ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
-                                                    "bayer_*8888 depth_u16; other frames are not on this channel"
-                                                  : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
-            auto cid = file.add_channel(*sid, m.topic + "/foxglove", "json", metadata);
+            auto cid = file.add_channel(*sid, c.topic, c.message_encoding, c.metadata);
             if (!cid) return cid.take_error();
             channels_[i] = *cid;
         }
@@ -203,25 +222,15 @@ public:
 
     Result<void> write(const RecordedEntry& e, MessageOut& out) override {
         if (!channels_[e.member]) return {};
-        const auto& m = context_.members[e.member];
-        const auto& t = *m.target;
-        const MessageEntry& entry = e.entry.entry();
-        const MessageElement* el = m.kind == RecordedKind::wire   ? entry.find("packet")
-                                   : m.kind == RecordedKind::pipe ? (entry.elements.empty() ? nullptr : &entry.elements[0])
-                                                                  : entry.find("value");
-        if (!el) return {};
-        // One conversion: the element to a value whose pixel bytes are the element's, read into the message.
-        auto image = unpack_value(*el, t.member->type, t.types->set(), t.context(), context_.api.options().limits);
-        if (!image) return {};
-        auto text = foxglove_image_message(*kinds_[e.member], *image, e.log_ns);
+        auto text = foxglove_image_message(context_.api, context_.members[e.member], *kinds_[e.member], e.entry.entry(), e.log_ns);
         if (!text) return {};
         return out.write(*channels_[e.member], *text);
     }
 
 private:
     const FormatContext& context_;
-    std::vector<std::optional<FoxgloveImageKind>> kinds_;      // per member: an image, or not
-    std::vector<std::optional<std::uint16_t>> channels_;       // per member, in the open file
+    std::vector<std::optional<FoxgloveImageKind>> kinds_;  // per member: an image, or not
+    std::vector<std::optional<std::uint16_t>> channels_;   // per member, in the open file
 };
 
 class FoxgloveImageFormat : public RecordingFormat {

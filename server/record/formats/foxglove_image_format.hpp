@@ -4,7 +4,8 @@
 // (com.robotraconteur.image.Image or CompressedImage) also gets a channel `<device>/<member>/foxglove`
 // whose schema is named foxglove.RawImage or foxglove.CompressedImage and whose messages have those
 // schemas' fields, the pixel bytes in base64. The format itself is foxglove_image_format()
-// (formats.hpp); these are its parts.
+// (formats.hpp); these are its parts, the member-level ones usable without a Recording
+// (channel_mapping.hpp).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"
+#include "server/record/channel_mapping.hpp"
 
 namespace rr::server::record {
 
@@ -46,5 +48,20 @@ std::optional<std::string_view> foxglove_raw_encoding(std::int64_t rr_encoding);
 /// malformed (`data` not a uint8 array), a raw image's encoding has no Foxglove equivalent, or a
 /// compressed image's bytes are not JPEG, PNG or WebP.
 std::optional<std::string> foxglove_image_message(FoxgloveImageKind kind, const Value& image, std::uint64_t log_ns);
+
+/// The Foxglove image `member`'s values become (foxglove_image_kind of its type); nothing for an event
+/// or a member of another type.
+std::optional<FoxgloveImageKind> foxglove_image_kind_of(const RecordedMember& member);
+
+/// The member's Foxglove image channel: topic `<member topic>/foxglove`, "json", foxglove_schema_name,
+/// "jsonschema", foxglove_image_schema's text; the member's metadata and `foxglove` (what the channel
+/// shows, in words).
+MappedChannel foxglove_image_channel(const RecordedMember& member, FoxgloveImageKind kind);
+
+/// The message of one entry of `member` on that channel (a WirePacket, a PipePacket or a property's
+/// PropertyGetRes), its element unpacked once (its pixel bytes shared with the entry, not copied) and
+/// read into the message; nothing when the entry holds no image the channel shows (see above).
+std::optional<std::string> foxglove_image_message(const gateway::JsonApi& api, const RecordedMember& member, FoxgloveImageKind kind,
+                                                  const MessageEntry& entry, std::uint64_t log_ns);
 
 }  // namespace rr::server::record

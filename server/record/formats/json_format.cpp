@@ -1,10 +1,7 @@
-// The `json` format (docs/recording.md): each recorded value in the JSON API's mapping
-// (docs/json-mapping.md), on a channel whose `jsonschema` schema (json_schema.hpp) lets Foxglove and
-// Lichtblick open the file as it is.
-//
-// A json channel leaves a null member out of its object (an absent struct, list, map or varvalue): its
-// schema gives every property one type, as Foxglove's parser requires, so a null there would not
-// validate; an absent member does. Nulls inside arrays stay (removing them would shift the indices).
+// The `json` format (json_format.hpp): its channel mapping, and its encoder writing one message per
+// entry on each member's channel.
+#include "server/record/formats/json_format.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include "server/gateway/json_push.hpp"
@@ -14,6 +11,8 @@
 namespace rr::server::record {
 namespace {
 
+// Null members left out of every object (see json_format.hpp); nulls inside arrays stay (removing them
+// would shift the indices).
 void drop_null_members(nlohmann::json& j) {
     if (j.is_object()) {
         for (auto it = j.begin(); it != j.end();) {
@@ -68,17 +67,10 @@ public:
     Result<void> open_file(FormatFile& file) override {
         channels_.clear();
         for (const auto& m : context_.members) {
-            const auto& t = *m.target;
-            const std::string title = t.object_type + "." + t.member->name;
-            nlohmann::json schema;
-            switch (m.kind) {
-                case RecordedKind::wire: schema = wire_message_schema(t.member->type, t.types->set(), t.context(), title); break;
-                case RecordedKind::event: schema = event_message_schema(*t.member, t.types->set(), t.context(), title); break;
-                default: schema = value_message_schema(t.member->type, t.types->set(), t.context(), title);
-            }
-            auto sid = file.add_schema(title, "jsonschema", schema.dump());
+            const auto c = json_channel(m);
+            auto sid = file.add_schema(c.schema_name, c.schema_encoding, c.schema);
             if (!sid) return sid.take_error();
-            auto cid = file.add_channel(*sid, m.topic, "json", m.metadata);
+            auto cid = file.add_channel(*sid, c.topic, c.message_encoding, c.metadata);
             if (!cid) return cid.take_error();
             channels_.push_back(*cid);
         }
@@ -86,27 +78,7 @@ public:
     }
 
     Result<void> write(const RecordedEntry& e, MessageOut& out) override {
-        const auto& m = context_.members[e.member];
-        const auto& t = *m.target;
-        const MessageEntry& entry = e.entry.entry();
-        switch (m.kind) {
-            case RecordedKind::wire:
-            case RecordedKind::event: {
-                // A wire value or event a JSON socket has pushed: its body, rendered once for all of them,
-                // is this message when it holds no null member to leave out.
-                if (const std::string* shared = e.entry.rendered_if_made(); shared && shared->find("null") == std::string::npos)
-                    return out.write(channels_[e.member], *shared);
-                std::string text = m.kind == RecordedKind::wire
-                                       ? gateway::wire_push_text(context_.api, entry, t, /*omit_null_members=*/true)
-                                       : gateway::event_push_text(context_.api, entry, t, /*omit_null_members=*/true);
-                return out.write(channels_[e.member], without_null_members(std::move(text)));
-            }
-            case RecordedKind::pipe:
-                return out.write(channels_[e.member],
-                                 value_message_text(context_.api, entry.elements.empty() ? nullptr : &entry.elements[0], t));
-            case RecordedKind::property: return out.write(channels_[e.member], value_message_text(context_.api, entry.find("value"), t));
-        }
-        return {};
+        return out.write(channels_[e.member], json_message(context_.api, context_.members[e.member], e.entry));
     }
 
 private:
@@ -121,6 +93,41 @@ public:
 };
 
 }  // namespace
+
+MappedChannel json_channel(const RecordedMember& m) {
+    const auto& t = *m.target;
+    const std::string title = t.object_type + "." + t.member->name;
+    nlohmann::json schema;
+    switch (m.kind) {
+        case RecordedKind::wire: schema = wire_message_schema(t.member->type, t.types->set(), t.context(), title); break;
+        case RecordedKind::event: schema = event_message_schema(*t.member, t.types->set(), t.context(), title); break;
+        case RecordedKind::pipe:
+        case RecordedKind::property: schema = value_message_schema(t.member->type, t.types->set(), t.context(), title); break;
+    }
+    return MappedChannel{m.topic, "json", title, "jsonschema", schema.dump(), m.metadata};
+}
+
+std::string json_message(const gateway::JsonApi& api, const RecordedMember& m, const gateway::SharedEntry& shared) {
+    const auto& t = *m.target;
+    const MessageEntry& entry = shared.entry();
+    switch (m.kind) {
+        case RecordedKind::wire:
+        case RecordedKind::event: {
+            // The JSON sockets' body of this entry (json_socket.cpp renders it the same way), made once for
+            // all of them and this channel; when it holds a null member, the text without them.
+            const std::string& body = shared.rendered([&](const MessageEntry& e) {
+                return m.kind == RecordedKind::wire ? gateway::wire_push_text(api, e, t) : gateway::event_push_text(api, e, t);
+            });
+            if (body.find("null") == std::string::npos) return body;
+            std::string text = m.kind == RecordedKind::wire ? gateway::wire_push_text(api, entry, t, /*omit_null_members=*/true)
+                                                            : gateway::event_push_text(api, entry, t, /*omit_null_members=*/true);
+            return without_null_members(std::move(text));
+        }
+        case RecordedKind::pipe: return value_message_text(api, entry.elements.empty() ? nullptr : &entry.elements[0], t);
+        case RecordedKind::property: return value_message_text(api, entry.find("value"), t);
+    }
+    return {};
+}
 
 std::shared_ptr<const RecordingFormat> json_format() { return std::make_shared<JsonFormat>(); }
 
