@@ -23,24 +23,15 @@
 #include "server/record/recordings.hpp"
 #include "server/record/replay_device.hpp"
 #include "test/support/eventually.hpp"
+#include "test/support/temp_dir.hpp"
 
 using namespace rr::server::gateway::testing;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct RecordingDir {
-    fs::path path;
-    RecordingDir() {
-        // a folder of its own under TMPDIR (or /tmp), made atomically so parallel test runs never share one
-        std::string tmpl = (fs::temp_directory_path() / "rr-recording-test-XXXXXX").string();
-        REQUIRE(::mkdtemp(tmpl.data()));
-        path = tmpl;
-    }
-    ~RecordingDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct RecordingDir : rr::testing::TempDir {
+    RecordingDir() : rr::testing::TempDir("rr-recording-test") {}
 };
 
 std::map<std::string, std::vector<rr::mcap::Message>> read_recording(const std::string& file, rr::mcap::Summary* summary = nullptr) {

@@ -13,6 +13,7 @@
 #include "server/mcap/mcap_file.hpp"
 #include "server/record/channel_metadata.hpp"
 #include "server/record/replay_device.hpp"
+#include "test/support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace rr::server::record;
@@ -42,23 +43,10 @@ fs::path write_file(const fs::path& dir, std::optional<std::string> entry_format
     return path;
 }
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string tmpl = (fs::temp_directory_path() / "rr-replay-format-XXXXXX").string();
-        REQUIRE(::mkdtemp(tmpl.data()));
-        path = tmpl;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-};
-
 }  // namespace
 
 TEST_CASE("replay: a robotraconteur channel's entry_format is checked before anything is played") {
-    TempDir dir;
+    rr::testing::TempDir dir("rr-replay-format");
     ReplayOptions known;
     known.file = write_file(dir.path, std::string(kEntryFormat)).string();
     auto opened = ReplayDevice::open(known);
