@@ -4,6 +4,7 @@
 
 #include "core/mcap/mcap_reader.hpp"
 #include "core/value/pack_value.hpp"
+#include "core/names/object_path_walk.hpp"
 #include "core/names/service_path.hpp"
 #include "server/mcap/mcap_file.hpp"
 #include "server/record/recording_format.hpp"
@@ -192,37 +193,30 @@ void ReplayDevice::serve_members(ServiceObject& object, const std::string& path)
 
 Result<ServiceObject*> ReplayDevice::object_at(const std::string& path, const std::string& type) {
     if (auto it = objects_.find(path); it != objects_.end()) return it->second.get();
-    // Recorded paths are normalized (recording.cpp): segments `name` or `name[encoded index]`, no '.'
-    // inside an index.
-    const auto dot = path.rfind('.');
-    const std::string parent_path = dot == std::string::npos ? std::string() : path.substr(0, dot);
-    const std::string segment = dot == std::string::npos ? path : path.substr(dot + 1);
-    const std::string member = segment.substr(0, segment.find('['));
-    // The parent: already served, else of the type its own objref declares (walked from the root).
+    // Recorded paths are normalized (recording.cpp): indexes in service-path encoding. The whole path
+    // must follow the objrefs' declared types (core/names/object_path_walk.hpp), as when it was recorded.
+    auto parsed = parse_object_path(path, ObjectPathIndexes::encoded);
+    if (!parsed) return fail(parsed.error());
+    ObjectPath last;
+    last.segments.push_back(std::move(parsed->segments.back()));
+    parsed->segments.pop_back();
+    const std::string member = last.segments[0].name, parent_path = parsed->text();
+    std::string parent_type = object_type_;
+    if (!parsed->segments.empty()) {
+        auto at = walk_object_path(types_->set(), object_type_, *parsed, path);
+        if (!at) return fail(at.error());
+        parent_type = at->object_type;
+    }
+    if (auto at = walk_object_path(types_->set(), parent_type, last, path); !at) return fail(at.error());
+    // The parent: already served, else served now.
     ServiceObject* parent = nullptr;
     if (auto it = objects_.find(parent_path); it != objects_.end()) {
         parent = it->second.get();
     } else {
-        std::string parent_type = object_type_;
-        std::size_t pos = 0;
-        while (pos < parent_path.size()) {
-            auto end = parent_path.find('.', pos);
-            if (end == std::string::npos) end = parent_path.size();
-            const std::string seg = parent_path.substr(pos, end - pos);
-            const auto* def = types_->find_object(parent_type);
-            const auto* ref = def ? def->find_member(seg.substr(0, seg.find('['))) : nullptr;
-            if (!ref || ref->kind != robdef::MemberKind::objref || ref->type.qualified_name.empty())
-                return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + seg + "\" on " + parent_type);
-            parent_type = ref->type.qualified_name;
-            pos = end + 1;
-        }
         auto p = object_at(parent_path, parent_type);
         if (!p) return p.take_error();
         parent = *p;
     }
-    const auto* ref = parent->definition().find_member(member);
-    if (!ref || ref->kind != robdef::MemberKind::objref)
-        return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + member + "\" on " + parent->type());
     auto object = ServiceObject::create(types_, type);
     if (!object) return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": " + object.error().message);
     objects_[path] = *object;
