@@ -20,18 +20,18 @@ using namespace rr::server::record;
 
 namespace {
 
-constexpr std::string_view kDefinition = "service experimental.fmt\n\nobject Thing\n    wire double value [readonly]\nend\n";
+constexpr std::string_view kThingDefinition = "service experimental.fmt\n\nobject Thing\n    wire double value [readonly]\nend\n";
 
-std::span<const std::byte> bytes_of(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
+std::span<const std::byte> text_bytes(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
 
 // A one-channel recording of Thing.value whose channel has `entry_format` (none when nullopt).
-fs::path write_file(const fs::path& dir, std::optional<std::string> entry_format) {
+fs::path recording_with_entry_format(const fs::path& dir, std::optional<std::string> entry_format) {
     const auto path = dir / ("thing-" + entry_format.value_or("none") + ".mcap");
     auto sink = rr::mcap::FileSink::create(path.string());
     REQUIRE(sink);
     rr::mcap::McapWriter writer(**sink);
     REQUIRE(writer.open());
-    auto schema = writer.add_schema("experimental.fmt", kServiceDefinitionSchemaEncoding, bytes_of(kDefinition));
+    auto schema = writer.add_schema("experimental.fmt", kServiceDefinitionSchemaEncoding, text_bytes(kThingDefinition));
     REQUIRE(schema);
     ChannelMetadata metadata{{channel_key::device, "thing"},     {channel_key::member, "value"},
                              {channel_key::kind, "wire"},        {channel_key::object_type, "experimental.fmt.Thing"},
@@ -48,13 +48,13 @@ fs::path write_file(const fs::path& dir, std::optional<std::string> entry_format
 TEST_CASE("replay: a robotraconteur channel's entry_format is checked before anything is played") {
     rr::testing::TempDir dir("rr-replay-format");
     ReplayOptions known;
-    known.file = write_file(dir.path, std::string(kEntryFormat)).string();
+    known.file = recording_with_entry_format(dir.path, std::string(kEntryFormat)).string();
     auto opened = ReplayDevice::open(known);
     INFO((opened ? std::string() : opened.error().message));
     CHECK(opened);
 
     ReplayOptions other;
-    other.file = write_file(dir.path, std::string("5")).string();
+    other.file = recording_with_entry_format(dir.path, std::string("5")).string();
     auto refused = ReplayDevice::open(other);
     REQUIRE_FALSE(refused);
     CHECK(refused.error().type == rr::MessageErrorType::InvalidArgument);
@@ -62,7 +62,7 @@ TEST_CASE("replay: a robotraconteur channel's entry_format is checked before any
           std::string::npos);
 
     ReplayOptions missing;
-    missing.file = write_file(dir.path, std::nullopt).string();
+    missing.file = recording_with_entry_format(dir.path, std::nullopt).string();
     auto without = ReplayDevice::open(missing);
     REQUIRE_FALSE(without);
     CHECK(without.error().type == rr::MessageErrorType::InvalidArgument);
