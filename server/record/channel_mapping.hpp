@@ -9,15 +9,20 @@
 // server) uses it the same way:
 //
 //     auto members = recorded_members(device, *api, names, {});  // names {}: every wire, pipe and event of the root
+//     if (!members) ...;                                                    // InvalidArgument / InvalidState, see below
 //     for (const auto& m : *members) {
 //         advertise(json_channel(m));                                        // topic, "json", schema name and text
 //         if (auto kind = foxglove_image_kind_of(m)) advertise(foxglove_image_channel(m, *kind));
 //     }
-//     // then, for each entry of member i (DeviceMirror::subscribe for wires/events, a pipe endpoint's packet,
-//     // a property's reply, as Recording::subscribe_members does):
-//     send(json_message(*api, members[i], shared_entry));                    // the JSON text of that channel
-//     if (kind) if (auto image = foxglove_image_message(*api, members[i], *kind, entry, log_ns)) send(*image);
+//     // Then each entry of member i, as a gateway::SharedEntry: a wire value or event from
+//     // DeviceMirror::subscribe(m.target->path, m.target->member->name, ...), a pipe packet wrapped in a
+//     // PipePacket entry (element 0 = the packet), a property's PropertyGetRes (Recording::subscribe_members
+//     // and its poller do exactly this):
+//     send(json_message(*api, members[i], shared));                          // that channel's JSON text
+//     if (kind) if (auto image = foxglove_image_message(*api, members[i], *kind, shared.entry(), log_ns)) send(*image);
 //
+// json_message renders a wire value or event through shared.rendered(): the JSON WebSocket's body of the
+// same entry, made once for every subscriber and for these channels.
 // Thread-safe: the functions keep no state; a member holds shared, immutable types.
 #pragma once
 
