@@ -203,6 +203,13 @@ void Session::services_unadvertised(const std::vector<std::uint32_t>& service_id
     for (auto id : service_ids) services_.erase(id);
 }
 
+void Session::end_subscription(std::uint32_t subscription_id) {
+    auto it = subscriptions_.find(subscription_id);
+    if (it == subscriptions_.end()) return;
+    channel_subscription_.erase(it->second);
+    subscriptions_.erase(it);
+}
+
 void Session::call_finished(std::uint32_t service_id, std::uint32_t call_id) { calls_.erase({service_id, call_id}); }
 
 std::optional<std::uint32_t> Session::subscription_channel(std::uint32_t subscription_id) const {

@@ -97,6 +97,9 @@ public:
     std::vector<event::Unsubscribed> channels_unadvertised(const std::vector<std::uint32_t>& channel_ids);
     void services_advertised(const std::vector<Service>& services);
     void services_unadvertised(const std::vector<std::uint32_t>& service_ids);
+    /// The server ended subscription `subscription_id` itself (refused for rights, or its upstream
+    /// failed): the id and its channel are free again.
+    void end_subscription(std::uint32_t subscription_id);
     /// A call's response or failure was sent: it no longer counts against max_calls_in_flight.
     void call_finished(std::uint32_t service_id, std::uint32_t call_id);
 
