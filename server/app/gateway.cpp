@@ -405,7 +405,9 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         record::install_recording_routes(*g->http_, json_api, g->recordings_);
         record::install_replay_routes(*g->http_, json_api, g->replays_);
         // The Foxglove WebSocket protocol at /foxglove (docs/foxglove.md).
-        g->foxglove_ = foxglove::install_foxglove(*g->http_, json_api);
+        foxglove::FoxgloveOptions fo;
+        fo.objects = c.foxglove_objects;
+        g->foxglove_ = foxglove::install_foxglove(*g->http_, json_api, std::move(fo));
     }
 
     // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the

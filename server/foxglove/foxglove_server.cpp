@@ -862,6 +862,9 @@ void FoxgloveServer::device_up(const std::shared_ptr<gateway::DeviceMirror>& dev
     std::vector<std::string> objects;
     if (auto it = options_.objects.find(name); it != options_.objects.end()) objects = it->second;
     auto members = device_members(*api_, device, objects);
+    // An object path of the configuration that does not resolve on this device: the root alone.
+    if (!members && !objects.empty() && members.error().type == MessageErrorType::InvalidArgument)
+        members = device_members(*api_, device, {});
     if (!members) return;  // not usable yet (definitions); the next state change tries again
     Catalog added;
     {
