@@ -125,7 +125,8 @@ TEST_CASE("foxglove session: service calls are bounded and unknown services fail
     Session s(limits);
     s.services_advertised({Service{4, "create/Drive", "T", {}, {}}});
     const auto call = [](int service, int id) { return bin({2, service, 0, 0, 0, id, 0, 0, 0, 4, 0, 0, 0}) + "json" + "{}"; };
-    auto out = s.feed_binary(call(4, 1));
+    const std::string first = call(4, 1);  // the event's payload views it
+    auto out = s.feed_binary(first);
     REQUIRE(out.events.size() == 1);
     CHECK(std::get<event::ServiceCall>(out.events[0]).payload == "{}");
 
