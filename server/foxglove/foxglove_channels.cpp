@@ -69,6 +69,19 @@ Result<std::vector<LiveMember>> device_members(const gateway::JsonApi& api, cons
                 }
             }
             live.target = std::move(t);
+            std::optional<record::FoxgloveImageKind> image;
+            if (live.kind == LiveKind::wire || live.kind == LiveKind::pipe) image = record::foxglove_image_kind(m.type, lookup, context);
+            if (image) {
+                LiveMember pictures = live;
+                pictures.image = image;
+                pictures.topic += "/foxglove";
+                pictures.schema_name = std::string(record::foxglove_schema_name(*image));
+                pictures.schema = record::foxglove_image_schema(*image).dump();
+                pictures.writable = false;
+                out.push_back(std::move(live));
+                out.push_back(std::move(pictures));
+                continue;
+            }
             out.push_back(std::move(live));
         }
     };
@@ -94,6 +107,15 @@ std::string packet_message(const gateway::JsonApi& api, const MessageElement& pa
     else
         body["error"] = gateway::error_object(*j.error);
     return gateway::json_text(body);
+}
+
+std::optional<std::string> image_message(const gateway::JsonApi& api, const MessageElement& element, const LiveMember& member,
+                                         std::uint64_t receive_ns) {
+    if (!member.image) return std::nullopt;
+    BinaryArrays binary;
+    auto j = api.element_json(element, member.target->member->type, *member.target, &binary);
+    if (!j) return std::nullopt;
+    return record::foxglove_image_message(*member.image, j.value, binary, receive_ns);
 }
 
 }  // namespace rr::server::foxglove

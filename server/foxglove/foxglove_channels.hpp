@@ -15,6 +15,7 @@
 
 #include "core/error/rr_error.hpp"
 #include "server/gateway/json_api.hpp"
+#include "server/record/foxglove_image.hpp"
 
 namespace rr::server::foxglove {
 
@@ -30,6 +31,9 @@ struct LiveMember {
     std::string schema;       ///< JSON Schema text: the message's (channels), the request's (services)
     std::string response_schema;  ///< services: {"return": T}
     bool writable = false;    ///< wires and pipes a client may publish to (not readonly); writable properties
+    /// A standard image wire's or pipe's second channel `<topic>/foxglove` (foxglove.RawImage /
+    /// CompressedImage, as recordings have: record/foxglove_image.hpp); nothing for the member's own.
+    std::optional<record::FoxgloveImageKind> image;
 };
 
 /// The members of `device` (connected: its definitions known) at the root and at each of `objects`
@@ -43,5 +47,9 @@ Result<std::vector<LiveMember>> device_members(const gateway::JsonApi& api, cons
 std::string entry_message(const gateway::JsonApi& api, const MessageEntry& entry, const LiveMember& member);
 /// A pipe packet's message: {"value": …} (or {"error": …} for a packet that does not fit its type).
 std::string packet_message(const gateway::JsonApi& api, const MessageElement& packet, const LiveMember& member);
+/// An image channel's message for the value `element` (a wire's "packet", a pipe packet), received at
+/// `receive_ns`: the recorder's foxglove_image_message; nothing for a frame Foxglove has no form of.
+std::optional<std::string> image_message(const gateway::JsonApi& api, const MessageElement& element, const LiveMember& member,
+                                         std::uint64_t receive_ns);
 
 }  // namespace rr::server::foxglove

@@ -426,6 +426,10 @@ private:
 
     void on_wire(std::uint32_t sid, const SharedEntryPtr& e) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) return upstream_closed(sid, "wire closed");
+        if (image_subscription(sid)) {
+            if (const MessageElement* packet = e->entry().find("packet")) on_pipe_packet(sid, *packet);
+            return;
+        }
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
         if (closed_ || it == subs_.end()) return;
@@ -447,6 +451,12 @@ private:
             return;
         }
         send_entry(it->second, e);
+    }
+
+    bool image_subscription(std::uint32_t sid) const {
+        std::lock_guard lock(mutex_);
+        auto it = subs_.find(sid);
+        return it != subs_.end() && it->second.member->image.has_value();
     }
 
     // Under mutex_.
@@ -501,7 +511,17 @@ private:
         }
         const std::uint64_t received = now_ns();
         boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, member, bytes, received] {
-            std::string frame = fg::message_data_head(sid, received) + packet_message(*self->api_, packet, *member);
+            std::string frame = fg::message_data_head(sid, received);
+            if (member->image) {
+                auto image = image_message(*self->api_, packet, *member, received);
+                if (!image) {  // a frame Foxglove has no form of: nothing on the image channel
+                    self->pipe_budget_.release(bytes);
+                    return;
+                }
+                frame += *image;
+            } else {
+                frame += packet_message(*self->api_, packet, *member);
+            }
             self->pipe_budget_.release(bytes);
             std::lock_guard lock(self->mutex_);
             if (self->closed_ || !self->subs_.count(sid)) return;
