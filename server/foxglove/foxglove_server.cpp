@@ -11,6 +11,7 @@
 #include "server/common/random_ids.hpp"
 #include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/conversion_budget.hpp"
+#include "server/gateway/json_push.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/node/node.hpp"
@@ -416,20 +417,30 @@ private:
         return socket_->queued() >= options_.push_queue_limit || socket_->queued_bytes() >= options_.push_bytes_limit;
     }
 
-    // Under mutex_: one messageData frame whose payload is the value's one rendering (shared with every
-    // subscriber of both WebSocket front ends, not copied per socket).
+    // Under mutex_: one messageData frame of a wire value or event. Its payload is the value's one
+    // rendering, shared with every subscriber of both WebSocket front ends and the recorder and written
+    // without a copy, when it holds no null member; else the recorder's json message without them
+    // (record::json_message, which makes the same choice).
     void send_entry(const Sub& s, const SharedEntryPtr& e) {
-        const std::string& body = e->rendered([&](const MessageEntry& entry) { return entry_message(*api_, entry, *s.member); });
-        socket_->send_binary(fg::message_data_head(s.id, now_ns()), std::shared_ptr<const std::string>(e, &body));
+        const auto& t = *s.member->target;
+        const bool wire = s.member->kind == LiveKind::wire;
+        const std::string& body = e->rendered([&](const MessageEntry& entry) {
+            return wire ? gateway::wire_push_text(*api_, entry, t) : gateway::event_push_text(*api_, entry, t);
+        });
+        std::string head = fg::message_data_head(s.id, now_ns());
+        if (body.find("null") == std::string::npos) {
+            socket_->send_binary(std::move(head), std::shared_ptr<const std::string>(e, &body));
+        } else {
+            auto text = channel_message(*api_, *s.member, *e, 0);
+            if (!text) return;
+            socket_->send_binary(std::move(head) + *text);
+        }
         ++stats_.messages_sent;
     }
 
     void on_wire(std::uint32_t sid, const SharedEntryPtr& e) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) return upstream_closed(sid, "wire closed");
-        if (image_subscription(sid)) {
-            if (const MessageElement* packet = e->entry().find("packet")) on_pipe_packet(sid, *packet);
-            return;
-        }
+        if (image_subscription(sid)) return convert(sid, e);
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
         if (closed_ || it == subs_.end()) return;
@@ -489,9 +500,18 @@ private:
         if (waiting) arm_retry();
     }
 
-    // On the device's strand: the packet's JSON is made on the shared conversion strand (a camera frame
-    // is large), within this connection's budget; newer packets are dropped while it is full.
+    // On the device's strand: a pipe packet as the recorder's pipe entry (its first element).
     void on_pipe_packet(std::uint32_t sid, const MessageElement& packet) {
+        MessageEntry entry;
+        entry.entry_type = MessageEntryType::PipePacket;
+        entry.elements.push_back(packet);
+        convert(sid, std::make_shared<const gateway::SharedEntry>(std::move(entry)));
+    }
+
+    // A pipe packet's or an image's message is made on the shared conversion strand, never on the
+    // device's (a camera frame is large), within this connection's budget; newer ones are dropped
+    // while it is full.
+    void convert(std::uint32_t sid, SharedEntryPtr entry) {
         std::shared_ptr<const LiveMember> member;
         {
             std::lock_guard lock(mutex_);
@@ -503,26 +523,19 @@ private:
             }
             member = it->second.member;
         }
-        const std::size_t bytes = gateway::payload_bytes(packet);
+        std::size_t bytes = 0;
+        for (const auto& el : entry->entry().elements) bytes += gateway::payload_bytes(el);
         if (!pipe_budget_.try_acquire(bytes)) {
             std::lock_guard lock(mutex_);
             ++stats_.dropped;
             return;
         }
         const std::uint64_t received = now_ns();
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, member, bytes, received] {
-            std::string frame = fg::message_data_head(sid, received);
-            if (member->image) {
-                auto image = image_message(*self->api_, packet, *member, received);
-                if (!image) {  // a frame Foxglove has no form of: nothing on the image channel
-                    self->pipe_budget_.release(bytes);
-                    return;
-                }
-                frame += *image;
-            } else {
-                frame += packet_message(*self->api_, packet, *member);
-            }
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, entry = std::move(entry), member, bytes, received] {
+            auto message = channel_message(*self->api_, *member, *entry, received);
             self->pipe_budget_.release(bytes);
+            if (!message) return;  // a frame Foxglove has no form of: nothing on the image channel
+            std::string frame = fg::message_data_head(sid, received) + *message;
             std::lock_guard lock(self->mutex_);
             if (self->closed_ || !self->subs_.count(sid)) return;
             self->socket_->send_binary(std::move(frame));
