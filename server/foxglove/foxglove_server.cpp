@@ -196,6 +196,7 @@ public:
 private:
     struct Sub {
         std::uint32_t id = 0;
+        std::uint64_t serial = 0;  // this connection's count: a reused subscription id is another Sub
         std::shared_ptr<const LiveMember> member;
         std::uint64_t upstream = 0;
         bool upstream_known = false;
@@ -279,54 +280,56 @@ private:
         }
         Sub s;
         s.id = e.subscription_id;
+        s.serial = ++next_serial_;
         s.member = member;
         subs_[e.subscription_id] = s;
-        start_upstream(e.subscription_id, member);
+        start_upstream(e.subscription_id, s.serial, member);
     }
 
     // Under mutex_: the upstream subscription is opened off this lock (the device's `done` may run
     // inside subscribe(), and it takes the lock).
-    void start_upstream(std::uint32_t sid, const std::shared_ptr<const LiveMember>& member) {
-        boost::asio::post(timer_.get_executor(), [self = shared_from_this(), sid, member] { self->open_upstream(sid, member); });
+    void start_upstream(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member) {
+        boost::asio::post(timer_.get_executor(),
+                          [self = shared_from_this(), sid, serial, member] { self->open_upstream(sid, serial, member); });
     }
 
-    void open_upstream(std::uint32_t sid, const std::shared_ptr<const LiveMember>& member) {
+    void open_upstream(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member) {
         std::weak_ptr<FoxgloveConnection> weak = weak_from_this();
         const auto& t = *member->target;
         if (member->kind == LiveKind::pipe) {
             gateway::GatewayPipeHandlers h;
-            h.on_packet = [weak, sid](const MessageElement& packet, std::uint32_t) {
-                if (auto s = weak.lock()) s->on_pipe_packet(sid, packet);
+            h.on_packet = [weak, sid, serial](const MessageElement& packet, std::uint32_t) {
+                if (auto s = weak.lock()) s->on_pipe_packet(sid, serial, packet);
             };
-            h.on_closed = [weak, sid](const RRError& reason) {
-                if (auto s = weak.lock()) s->upstream_closed(sid, reason.message);
+            h.on_closed = [weak, sid, serial](const RRError& reason) {
+                if (auto s = weak.lock()) s->upstream_closed(sid, serial, reason.message);
             };
             t.device->mirror_service()->shared_endpoints()->open_pipe(
                 t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
-                [weak, sid, device = t.device](Result<std::uint64_t> r) {
+                [weak, sid, serial, member](Result<std::uint64_t> r) {
                     auto s = weak.lock();
                     if (!s) {
-                        if (r) device->mirror_service()->shared_endpoints()->close_pipe(*r);
+                        if (r) member->target->device->mirror_service()->shared_endpoints()->close_pipe(*r);
                         return;
                     }
-                    s->upstream_opened(sid, r ? std::optional<std::uint64_t>(*r) : std::nullopt, r ? "" : r.error().message);
+                    s->upstream_opened(sid, serial, member, r ? std::optional<std::uint64_t>(*r) : std::nullopt, r ? "" : r.error().message);
                 });
             return;
         }
         const bool is_wire = member->kind == LiveKind::wire;
         std::uint64_t upstream = t.device->subscribe(
             t.path, t.member->name, is_wire,
-            [weak, sid, is_wire](const SharedEntryPtr& e) {
-                if (auto s = weak.lock()) is_wire ? s->on_wire(sid, e) : s->on_event(sid, e);
+            [weak, sid, serial, is_wire](const SharedEntryPtr& e) {
+                if (auto s = weak.lock()) is_wire ? s->on_wire(sid, serial, e) : s->on_event(sid, serial, e);
             },
-            [weak, sid](Result<void> r) {
-                if (auto s = weak.lock(); s && !r) s->upstream_opened(sid, std::nullopt, r.error().message);
+            [weak, sid, serial, member](Result<void> r) {
+                if (auto s = weak.lock(); s && !r) s->upstream_opened(sid, serial, member, std::nullopt, r.error().message);
             });
         bool drop = false;
         {
             std::lock_guard lock(mutex_);
             auto it = subs_.find(sid);
-            if (it == subs_.end() || it->second.cancelled) {
+            if (it == subs_.end() || it->second.serial != serial || it->second.cancelled) {
                 drop = true;
             } else {
                 it->second.upstream = upstream;
@@ -337,14 +340,17 @@ private:
         if (drop) t.device->unsubscribe(upstream);
     }
 
-    void upstream_opened(std::uint32_t sid, std::optional<std::uint64_t> id, const std::string& error) {
+    void upstream_opened(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member,
+                         std::optional<std::uint64_t> id,
+                         const std::string& error) {
         std::optional<Sub> orphan;
         {
             std::lock_guard lock(mutex_);
             auto it = subs_.find(sid);
-            if (it == subs_.end()) {
-                if (id) {
+            if (it == subs_.end() || it->second.serial != serial) {
+                if (id) {  // unsubscribed (or the connection closed) while the device answered
                     orphan.emplace();
+                    orphan->member = member;
                     orphan->upstream = *id;
                     orphan->upstream_known = true;
                 }
@@ -370,10 +376,10 @@ private:
         if (orphan && orphan->upstream_known && orphan->member) end_upstream(*orphan);
     }
 
-    void upstream_closed(std::uint32_t sid, const std::string& why) {
+    void upstream_closed(std::uint32_t sid, std::uint64_t serial, const std::string& why) {
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
-        if (it == subs_.end()) return;
+        if (it == subs_.end() || it->second.serial != serial) return;
         const std::string topic = it->second.member->topic;
         subs_.erase(it);
         session_.end_subscription(sid);
@@ -438,12 +444,12 @@ private:
         ++stats_.messages_sent;
     }
 
-    void on_wire(std::uint32_t sid, const SharedEntryPtr& e) {
-        if (e->entry().entry_type == MessageEntryType::WireClosed) return upstream_closed(sid, "wire closed");
-        if (image_subscription(sid)) return convert(sid, e);
+    void on_wire(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e) {
+        if (e->entry().entry_type == MessageEntryType::WireClosed) return upstream_closed(sid, serial, "wire closed");
+        if (image_subscription(sid)) return convert(sid, serial, e);
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
-        if (closed_ || it == subs_.end()) return;
+        if (closed_ || it == subs_.end() || it->second.serial != serial) return;
         if (it->second.pending || wire_congested()) {
             if (it->second.pending) ++stats_.wire_coalesced;
             it->second.pending = e;  // newest wins
@@ -453,10 +459,10 @@ private:
         send_entry(it->second, e);
     }
 
-    void on_event(std::uint32_t sid, const SharedEntryPtr& e) {
+    void on_event(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e) {
         std::lock_guard lock(mutex_);
         auto it = subs_.find(sid);
-        if (closed_ || it == subs_.end()) return;
+        if (closed_ || it == subs_.end() || it->second.serial != serial) return;
         if (push_congested()) {
             ++stats_.dropped;
             return;
@@ -501,22 +507,22 @@ private:
     }
 
     // On the device's strand: a pipe packet as the recorder's pipe entry (its first element).
-    void on_pipe_packet(std::uint32_t sid, const MessageElement& packet) {
+    void on_pipe_packet(std::uint32_t sid, std::uint64_t serial, const MessageElement& packet) {
         MessageEntry entry;
         entry.entry_type = MessageEntryType::PipePacket;
         entry.elements.push_back(packet);
-        convert(sid, std::make_shared<const gateway::SharedEntry>(std::move(entry)));
+        convert(sid, serial, std::make_shared<const gateway::SharedEntry>(std::move(entry)));
     }
 
     // A pipe packet's or an image's message is made on the shared conversion strand, never on the
     // device's (a camera frame is large), within this connection's budget; newer ones are dropped
     // while it is full.
-    void convert(std::uint32_t sid, SharedEntryPtr entry) {
+    void convert(std::uint32_t sid, std::uint64_t serial, SharedEntryPtr entry) {
         std::shared_ptr<const LiveMember> member;
         {
             std::lock_guard lock(mutex_);
             auto it = subs_.find(sid);
-            if (closed_ || it == subs_.end()) return;
+            if (closed_ || it == subs_.end() || it->second.serial != serial) return;
             if (push_congested()) {
                 ++stats_.dropped;
                 return;
@@ -531,13 +537,14 @@ private:
             return;
         }
         const std::uint64_t received = now_ns();
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, entry = std::move(entry), member, bytes, received] {
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, serial, entry = std::move(entry), member, bytes, received] {
             auto message = channel_message(*self->api_, *member, *entry, received);
             self->pipe_budget_.release(bytes);
             if (!message) return;  // a frame Foxglove has no form of: nothing on the image channel
             std::string frame = fg::message_data_head(sid, received) + *message;
             std::lock_guard lock(self->mutex_);
-            if (self->closed_ || !self->subs_.count(sid)) return;
+            auto it = self->subs_.find(sid);
+            if (self->closed_ || it == self->subs_.end() || it->second.serial != serial) return;
             self->socket_->send_binary(std::move(frame));
             ++self->stats_.messages_sent;
         });
@@ -810,6 +817,7 @@ private:
     std::map<std::uint32_t, Sub> subs_;
     std::map<std::uint32_t, std::shared_ptr<const LiveMember>> publish_targets_;  // by client channel id
     std::size_t parameter_requests_ = 0;
+    std::uint64_t next_serial_ = 0;
     auth::PrincipalPtr principal_;
     FoxgloveStats stats_;
     const std::string motion_key_ = "foxglove:" + std::to_string(next_id());
