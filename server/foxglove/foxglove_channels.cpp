@@ -108,13 +108,18 @@ Result<std::vector<LiveMember>> device_members(const gateway::JsonApi& api, cons
             if (!property) {
                 const auto& lookup = types->set();
                 const std::string_view context = o.object.service->name;
-                // The request: the arguments by name, as the JSON API's call takes them.
-                nlohmann::json props = nlohmann::json::object();
+                // The request: the arguments by name, as the JSON API's call takes them, in the
+                // definition's order (a client's form lists them so).
+                nlohmann::ordered_json props = nlohmann::ordered_json::object();
                 for (const auto& p : m.parameters) {
                     auto s = record::value_schema(p, lookup, context);
-                    if (!s.is_null()) props[p.name] = std::move(s);
+                    if (!s.is_null()) props[p.name] = nlohmann::ordered_json::parse(s.dump());
                 }
-                live.schema = nlohmann::json{{"title", live.schema_name + " request"}, {"type", "object"}, {"properties", props}}.dump();
+                nlohmann::ordered_json request = nlohmann::ordered_json::object();
+                request["title"] = live.schema_name + " request";
+                request["type"] = "object";
+                request["properties"] = std::move(props);
+                live.schema = request.dump();
                 nlohmann::json response{{"title", live.schema_name + " response"}, {"type", "object"}};
                 auto r = record::value_schema(m.type, lookup, context);
                 response["properties"] = r.is_null() ? nlohmann::json::object() : nlohmann::json{{"return", r}};

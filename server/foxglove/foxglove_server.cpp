@@ -143,14 +143,17 @@ public:
 
     void close() {
         std::map<std::uint32_t, Sub> subs;
+        std::map<std::uint32_t, PublishTarget> publishing;
         {
             std::lock_guard lock(mutex_);
             if (closed_) return;
             closed_ = true;
             subs.swap(subs_);
+            publishing.swap(publish_targets_);
             timer_.cancel();
         }
         for (auto& [id, s] : subs) end_upstream(s);
+        for (auto& [id, p] : publishing) end_publish(p);
         for (const auto& d : api_->devices())
             if (const auto& guard = d->motion()) guard->client_gone(motion_key_);
     }
@@ -203,6 +206,15 @@ private:
         bool active = false;      // the upstream subscription is open
         bool cancelled = false;   // ended before its upstream answered
         SharedEntryPtr pending;   // the newest wire value waiting while the socket is behind
+    };
+
+    struct PublishTarget {
+        std::shared_ptr<const LiveMember> member;
+        std::uint64_t serial = 0;
+        std::uint64_t upstream = 0;  // the DeviceMirror wire subscription that keeps the wire connected
+        bool upstream_known = false;
+        bool ready = false;                   // that wire connection is open
+        std::optional<MessageEntry> pending;  // the newest value published before it was
     };
 
     // A refused connection: one status naming why, then the close.
@@ -745,24 +757,99 @@ private:
 
     // --- client publish ---------------------------------------------------------------------------
 
+    // A client channel on a writable wire: the gateway's wire connection to the device is opened for it
+    // (DeviceMirror::subscribe, shared with every subscriber of that wire), as the JSON WebSocket's
+    // set_out_value needs its subscription; values published before it is open wait (the newest).
     void on(fg::event::ClientAdvertised e) {
         auto server = server_.lock();
         auto member = server ? server->member_named(e.channel.topic, LiveKind::wire) : nullptr;
-        std::lock_guard lock(mutex_);
-        if (!member || !member->writable) {
-            status("advertise: \"" + e.channel.topic + "\" is not a writable wire of a connected device; messages on it are refused");
-            return;
+        std::uint64_t serial = 0;
+        {
+            std::lock_guard lock(mutex_);
+            if (!member || !member->writable) {
+                status("advertise: \"" + e.channel.topic + "\" is not a writable wire of a connected device; messages on it are refused");
+                return;
+            }
+            if (auto denied = api_->check_access(address_of(*member), auth::Operation::write)) {
+                status("advertise: " + e.channel.topic + ": " + error_text(*denied) + "; messages on it are refused");
+                return;
+            }
+            PublishTarget target;
+            target.member = member;
+            target.serial = serial = ++next_serial_;
+            publish_targets_[e.channel.id] = std::move(target);
         }
-        if (auto denied = api_->check_access(address_of(*member), auth::Operation::write)) {
-            status("advertise: " + e.channel.topic + ": " + error_text(*denied) + "; messages on it are refused");
-            return;
+        std::weak_ptr<FoxgloveConnection> weak = weak_from_this();
+        const auto& t = *member->target;
+        const std::uint32_t cid = e.channel.id;
+        const std::uint64_t upstream = t.device->subscribe(
+            t.path, t.member->name, /*is_wire=*/true, [](const SharedEntryPtr&) {},
+            [weak, cid, serial](Result<void> r) {
+                if (auto s = weak.lock()) s->publish_ready(cid, serial, r ? std::string() : r.error().message);
+            });
+        bool drop = false;
+        {
+            std::lock_guard lock(mutex_);
+            auto it = publish_targets_.find(cid);
+            if (it == publish_targets_.end() || it->second.serial != serial) {
+                drop = true;
+            } else {
+                it->second.upstream = upstream;
+                it->second.upstream_known = true;
+            }
         }
-        publish_targets_[e.channel.id] = member;
+        if (drop) t.device->unsubscribe(upstream);
+    }
+
+    void publish_ready(std::uint32_t cid, std::uint64_t serial, const std::string& error) {
+        std::optional<MessageEntry> pending;
+        std::shared_ptr<const LiveMember> member;
+        std::optional<std::uint64_t> unsubscribe;
+        {
+            std::lock_guard lock(mutex_);
+            auto it = publish_targets_.find(cid);
+            if (it == publish_targets_.end() || it->second.serial != serial) return;
+            member = it->second.member;
+            if (!error.empty()) {
+                if (it->second.upstream_known) unsubscribe = it->second.upstream;
+                status("advertise: " + member->topic + ": the device refused the wire connection: " + error);
+                publish_targets_.erase(it);
+            } else {
+                it->second.ready = true;
+                pending = std::move(it->second.pending);
+                it->second.pending.reset();
+            }
+        }
+        if (unsubscribe) member->target->device->unsubscribe(*unsubscribe);
+        if (pending) send_upstream(*member, std::move(*pending));
+    }
+
+    void end_publish(PublishTarget& p) {
+        if (p.upstream_known) p.member->target->device->unsubscribe(p.upstream);
     }
 
     void on(fg::event::ClientUnadvertised e) {
-        std::lock_guard lock(mutex_);
-        publish_targets_.erase(e.channel.id);
+        std::optional<PublishTarget> p;
+        {
+            std::lock_guard lock(mutex_);
+            auto it = publish_targets_.find(e.channel.id);
+            if (it == publish_targets_.end()) return;
+            p = std::move(it->second);
+            publish_targets_.erase(it);
+        }
+        end_publish(*p);
+    }
+
+    // The wire packet to the device over the gateway's own session (its wire connection is open).
+    void send_upstream(const LiveMember& member, MessageEntry entry) {
+        const auto& t = *member.target;
+        auto client = t.device->upstream();
+        if (!client) {
+            std::lock_guard lock(mutex_);
+            return status("message on \"" + member.topic + "\" refused: device \"" + t.device->config().name + "\" is not connected");
+        }
+        entry.service_path = t.device->mirror_service()->to_upstream(t.path);
+        client->send(std::move(entry));
     }
 
     void on(fg::event::ClientPublish e) {
@@ -774,7 +861,7 @@ private:
             topic = e.channel->topic;
             auto it = publish_targets_.find(e.channel->id);
             if (it == publish_targets_.end()) return status("message on \"" + topic + "\" refused: not a writable wire this login may write");
-            member = it->second;
+            member = it->second.member;
         }
         auto report = [&](const std::string& why) {
             std::lock_guard lock(mutex_);
@@ -800,10 +887,16 @@ private:
         // A command stream: refused while another client holds the motion, ended when it goes silent.
         auto motion = gateway::JsonApi::admit_motion(address, t, entry);
         if (auto* refused = std::get_if<gateway::ApiError>(&motion)) return report(error_text(*refused));
-        auto client = t.device->upstream();
-        if (!client) return report("device \"" + t.device->config().name + "\" is not connected");
-        entry.service_path = t.device->mirror_service()->to_upstream(t.path);
-        client->send(std::move(entry));
+        {
+            std::lock_guard lock(mutex_);
+            auto it = publish_targets_.find(e.channel->id);
+            if (it == publish_targets_.end()) return;
+            if (!it->second.ready) {
+                it->second.pending = std::move(entry);  // newest wins until the wire connection is open
+                return;
+            }
+        }
+        send_upstream(*member, std::move(entry));
     }
 
     std::weak_ptr<FoxgloveServer> server_;
@@ -815,7 +908,7 @@ private:
     boost::asio::steady_timer timer_;
     bool started_ = false, closed_ = false, timer_armed_ = false;
     std::map<std::uint32_t, Sub> subs_;
-    std::map<std::uint32_t, std::shared_ptr<const LiveMember>> publish_targets_;  // by client channel id
+    std::map<std::uint32_t, PublishTarget> publish_targets_;  // by client channel id
     std::size_t parameter_requests_ = 0;
     std::uint64_t next_serial_ = 0;
     auth::PrincipalPtr principal_;

@@ -4,7 +4,8 @@ WebSocket test of a client publish reaching a wire (docs/foxglove.md "How it is 
 
 Service "sink", object experimental.foxglove_sink.Sink: `wire double[] command [writeonly]` (what a
 Foxglove Publish panel sends goes to the device's InValue), `property double[] last_command [readonly]`
-(the newest InValue received, empty before any) and `property int32 commands [readonly]` (how many).
+(the newest InValue received, empty before any), `property int32 commands [readonly]` (how many), and
+`property string label` (read and written: a parameter to set).
 
 Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=sink", "port": P}.
 Usage: command_sink.py [--port P] [--max-lifetime 300]
@@ -28,6 +29,7 @@ object Sink
     wire double[] command [writeonly]
     property double[] last_command [readonly]
     property int32 commands [readonly]
+    property string label
 end
 """
 
@@ -39,6 +41,7 @@ class Sink:
         self._count = 0
         self._wire = None
         self._receiver = None
+        self.label = "sink"
 
     @property
     def command(self):

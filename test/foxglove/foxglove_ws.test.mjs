@@ -28,7 +28,7 @@ let missing = "";
 try {
   ({ FoxgloveClient } = require("@foxglove/ws-protocol"));
   WebSocket = require("ws");
-  Ajv = require("ajv");
+  Ajv = require("ajv/dist/2020");  // the schemas are JSON Schema draft 2020-12
   if (Ajv.default) Ajv = Ajv.default;
 } catch (e) {
   missing = `test/foxglove/node_modules incomplete (run ./scripts/setup.sh): ${e.message}`;
@@ -170,24 +170,31 @@ test("values of every demo device arrive and are valid against their channel's s
 test("parameters read and set, the update to a subscribed client", { skip: missing || false }, async () => {
   const c = await connect({ token: OPERATOR });
   const watcher = await connect({ token: OPERATOR });
-  watcher.client.subscribeParameterUpdates(["webcam/Webcams[0]/Name"]);
-  await waitFor(() => watcher.got.params.some((p) => p.parameters.some((x) => x.name === "webcam/Webcams[0]/Name")),
+  watcher.client.subscribeParameterUpdates(["sink/label"]);
+  await waitFor(() => watcher.got.params.some((p) => p.parameters.some((x) => x.name === "sink/label")),
     "the subscribed parameter's current value", 30000);
-  c.client.getParameters(["create/DistanceTraveled", "webcam/Webcams[0]/Name"], "get-1");
+  c.client.getParameters(["create/DistanceTraveled", "webcam/Webcams[0]/Name", "sink/label"], "get-1");
   const got = await waitFor(() => c.got.params.find((p) => p.id === "get-1"), "parameterValues get-1", 30000);
   const byName = Object.fromEntries(got.parameters.map((p) => [p.name, p.value]));
   assert.equal(typeof byName["create/DistanceTraveled"], "number");
   assert.equal(typeof byName["webcam/Webcams[0]/Name"], "string");
+  assert.equal(byName["sink/label"], "sink");
 
-  c.client.setParameters([{ name: "webcam/Webcams[0]/Name", value: "foxglove-cam" }], "set-1");
+  c.client.setParameters([{ name: "sink/label", value: "foxglove" }], "set-1");
   const set = await waitFor(() => c.got.params.find((p) => p.id === "set-1"), "parameterValues set-1", 30000);
-  assert.deepEqual(set.parameters, [{ name: "webcam/Webcams[0]/Name", value: "foxglove-cam" }]);
-  await waitFor(() => watcher.got.params.some((p) => p.parameters.some((x) => x.value === "foxglove-cam")),
+  assert.deepEqual(set.parameters, [{ name: "sink/label", value: "foxglove" }], JSON.stringify(c.got.statuses));
+  await waitFor(() => watcher.got.params.some((p) => p.parameters.some((x) => x.name === "sink/label" && x.value === "foxglove")),
     "the update at the subscribed client", 30000);
+  // A property the device refuses to set: a status naming the device's error, the value unchanged.
+  c.client.setParameters([{ name: "webcam/Webcams[0]/Name", value: "renamed" }], "set-2");
+  const refused = await waitFor(() => c.got.params.find((p) => p.id === "set-2"), "parameterValues set-2", 30000);
+  assert.deepEqual(refused.parameters, []);
+  assert.ok(c.got.statuses.some((x) => x.level === 2 && /webcam\/Webcams\[0\]\/Name: RobotRaconteur\.ReadOnlyMember/.test(x.message)),
+    JSON.stringify(c.got.statuses));
   // All parameters: every readable property of every device.
   c.client.getParameters([], "all");
   const all = await waitFor(() => c.got.params.find((p) => p.id === "all"), "parameterValues all", 30000);
-  for (const n of ["create/Bumpers", "webcam/WebcamNames", "sink/commands"]) assert.ok(all.parameters.some((p) => p.name === n), n);
+  for (const n of ["create/Bumpers", "webcam/WebcamNames", "sink/commands", "sink/label"]) assert.ok(all.parameters.some((p) => p.name === n), n);
 });
 
 test("a service called, and a failure as serviceCallFailure", { skip: missing || false }, async () => {
@@ -214,7 +221,7 @@ test("a client publish reaches the device's wire", { skip: missing || false }, a
     const p = await waitFor(() => c.got.params.length > n && c.got.params[c.got.params.length - 1], "sink/last_command", 30000);
     return p.parameters[0]?.value;
   };
-  await waitFor(async () => JSON.stringify(await read()) === "[1.5,-2,3]", "the published value at the device", 30000, 200);
+  await waitFor(async () => JSON.stringify(await read()) === "[1.5,-2,3]", `the published value at the device (${JSON.stringify(c.got.statuses)})`, 30000, 200);
   send([4, 5]);  // the bare value works too
   await waitFor(async () => JSON.stringify(await read()) === "[4,5]", "the bare published value at the device", 30000, 200);
   send({ value: "not numbers" });
@@ -230,11 +237,12 @@ test("a viewer reads but may not set, call or publish; no login is refused", { s
   const refused = await callService(v, "create/StartStreaming", {}, 3);
   assert.equal(refused.op, "serviceCallFailure");
   assert.match(refused.message, /PermissionDenied|may not|not allowed/i);
-  v.client.setParameters([{ name: "webcam/Webcams[0]/Name", value: "viewer-was-here" }], "v-set");
-  await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /not set/.test(x.message)), "setParameters refused", 30000);
+  v.client.setParameters([{ name: "sink/label", value: "viewer-was-here" }], "v-set");
+  await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /not set: sink\/label: .*PermissionDenied/.test(x.message)),
+    `setParameters refused (${JSON.stringify(v.got.statuses)})`, 30000);
   v.client.advertise({ topic: "sink/command", encoding: "json", schemaName: "x" });
   await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /advertise: sink\/command/.test(x.message)), "publish refused", 30000);
-  v.client.getParameters(["webcam/Webcams[0]/Name"], "v-get");
+  v.client.getParameters(["sink/label"], "v-get");
   const p = await waitFor(() => v.got.params.find((x) => x.id === "v-get"), "the viewer's read", 30000);
   assert.notEqual(p.parameters[0].value, "viewer-was-here");
 
