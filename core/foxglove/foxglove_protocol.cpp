@@ -317,14 +317,13 @@ std::string parameter_values_json(const std::vector<Parameter>& parameters, cons
 std::string advertise_services_json(const std::vector<Service>& services) {
     json a = json::array();
     for (const auto& s : services) {
-        // Both forms: `request`/`response` (current clients) and the older requestSchema/responseSchema.
+        // The current form (`request`/`response` with their encodings); Lichtblick warns about the older
+        // requestSchema/responseSchema, so they are left out.
         a.push_back(json{{"id", s.id},
                          {"name", s.name},
                          {"type", s.type},
                          {"request", schema_json(s.request)},
-                         {"response", schema_json(s.response)},
-                         {"requestSchema", s.request.schema},
-                         {"responseSchema", s.response.schema}});
+                         {"response", schema_json(s.response)}});
     }
     return dump(json{{"op", "advertiseServices"}, {"services", std::move(a)}});
 }

@@ -45,7 +45,8 @@ TEST_CASE("foxglove protocol: server messages carry the spec's field names") {
     CHECK(j["id"] == 3);
     CHECK(j["request"]["schemaName"] == "Drive request");
     CHECK(j["response"]["encoding"] == "json");
-    CHECK(j["requestSchema"] == "{\"a\":1}");
+    CHECK(j["request"]["schema"] == "{\"a\":1}");
+    CHECK_FALSE(j.contains("requestSchema"));  // the deprecated form, which Lichtblick warns about
     CHECK(json::parse(service_call_failure_json(3, 9, "no")) ==
           json({{"op", "serviceCallFailure"}, {"serviceId", 3}, {"callId", 9}, {"message", "no"}}));
 }

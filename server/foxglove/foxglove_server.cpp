@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <set>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -766,10 +767,9 @@ private:
         std::uint64_t serial = 0;
         {
             std::lock_guard lock(mutex_);
-            if (!member || !member->writable) {
-                status("advertise: \"" + e.channel.topic + "\" is not a writable wire of a connected device; messages on it are refused");
-                return;
-            }
+            // Not a writable wire: nothing now (Lichtblick advertises ROS topics of its own, e.g.
+            // /clicked_point, whether anything is published there or not); its first message gets a status.
+            if (!member || !member->writable) return;
             if (auto denied = api_->check_access(address_of(*member), auth::Operation::write)) {
                 status("advertise: " + e.channel.topic + ": " + error_text(*denied) + "; messages on it are refused");
                 return;
@@ -832,6 +832,7 @@ private:
         std::optional<PublishTarget> p;
         {
             std::lock_guard lock(mutex_);
+            publish_refused_.erase(e.channel.id);
             auto it = publish_targets_.find(e.channel.id);
             if (it == publish_targets_.end()) return;
             p = std::move(it->second);
@@ -860,7 +861,12 @@ private:
             if (!e.channel) return;
             topic = e.channel->topic;
             auto it = publish_targets_.find(e.channel->id);
-            if (it == publish_targets_.end()) return status("message on \"" + topic + "\" refused: not a writable wire this login may write");
+            if (it == publish_targets_.end()) {
+                // Once per client channel, not per message (a Publish panel sends at its rate).
+                if (publish_refused_.insert(e.channel->id).second)
+                    status("message on \"" + topic + "\" refused: not a writable wire of a connected device that this login may write");
+                return;
+            }
             member = it->second.member;
         }
         auto report = [&](const std::string& why) {
@@ -909,6 +915,7 @@ private:
     bool started_ = false, closed_ = false, timer_armed_ = false;
     std::map<std::uint32_t, Sub> subs_;
     std::map<std::uint32_t, PublishTarget> publish_targets_;  // by client channel id
+    std::set<std::uint32_t> publish_refused_;                 // client channels whose refusal was reported
     std::size_t parameter_requests_ = 0;
     std::uint64_t next_serial_ = 0;
     auth::PrincipalPtr principal_;

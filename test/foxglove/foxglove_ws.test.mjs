@@ -226,6 +226,16 @@ test("a client publish reaches the device's wire", { skip: missing || false }, a
   await waitFor(async () => JSON.stringify(await read()) === "[4,5]", "the bare published value at the device", 30000, 200);
   send({ value: "not numbers" });
   await waitFor(() => c.got.statuses.some((x) => x.level === 2 && /sink\/command/.test(x.message)), "a status for a bad value", 30000);
+  // A topic that is no writable wire (Lichtblick advertises ROS topics of its own): accepted silently,
+  // its messages refused with one status, not one per message.
+  const other = c.client.advertise({ topic: "/clicked_point", encoding: "json", schemaName: "geometry_msgs/PointStamped" });
+  const before = c.got.statuses.length;
+  for (let i = 0; i < 3; ++i) c.client.sendMessage(other, new TextEncoder().encode("{}"));
+  send([7, 8]);  // in order after those: once it arrives, their statuses are in
+  await waitFor(async () => JSON.stringify(await read()) === "[7,8]", "a value after the refused ones", 30000, 200);
+  const refused = c.got.statuses.slice(before).filter((x) => /clicked_point/.test(x.message));
+  assert.equal(refused.length, 1, JSON.stringify(c.got.statuses.slice(before)));
+  assert.match(refused[0].message, /not a writable wire/);
 });
 
 test("a viewer reads but may not set, call or publish; no login is refused", { skip: missing || false }, async () => {

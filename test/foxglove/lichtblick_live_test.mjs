@@ -4,7 +4,8 @@
 // camera driver's synthetic camera (a standard Image pipe, so also a foxglove.RawImage channel).
 // Checked: the camera's picture in an Image panel (many saturated colours, from the live
 // `camera/frame_stream/foxglove` channel), a Plot of a wire field drawing a line, Raw Messages showing
-// a live packet with its schema name, and the topics list naming the channels and schemas.
+// a live packet with its schema name, the topics list naming the channels and schemas, and the
+// Problems list holding nothing about the connection, channels, schemas or services.
 //
 //   LICHTBLICK_WEB=~/.cache/rr-gateway/lichtblick-web RR_GATEWAY=… node test/foxglove/lichtblick_live_test.mjs
 //
@@ -172,5 +173,13 @@ test("Lichtblick live over the Foxglove WebSocket: the camera's picture, a plot 
     "experimental.create.Create.packets", "foxglove.RawImage"])
     assert.ok(topics.includes(t), `the topics list shows ${t}:\n${topics}`);
   await screenshot(page, "lichtblick-live.png");  // docs/img with RR_DOCS_SCREENSHOTS=1
+  await page.locator('[data-testid="problems-left"]').click();
+  await new Promise((r) => setTimeout(r, 500));
+  // Problems: none about the connection, channels, schemas or services; a device's own error reading a
+  // property (the camera driver's trigger_mode) is reported as such.
+  const problems = (await sidebar.innerText()).split("\n").map((l) => l.trim()).filter(Boolean);
+  const listed = problems.slice(problems.indexOf("Layouts") + 1);
+  const known = [/^parameters not read: /, /^No details provided$/];
+  for (const line of listed) assert.ok(known.some((re) => re.test(line)), `an unexpected problem in Lichtblick: ${line}\n${listed.join("\n")}`);
   assert.deepEqual(pageErrors, []);
 });
