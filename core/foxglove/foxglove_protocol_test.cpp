@@ -14,7 +14,7 @@ std::string bytes(std::initializer_list<int> b) {
 }
 }  // namespace
 
-TEST_CASE("foxglove protocol: server messages carry the spec's field names") {
+TEST_CASE("protocol: server messages carry the spec's field names") {
     ServerInfo info{"rr-gateway", {capability::parameters, capability::services}, {"json"}, {{"k", "v"}}, "s1"};
     auto j = json::parse(server_info_json(info));
     CHECK(j["op"] == "serverInfo");
@@ -51,14 +51,14 @@ TEST_CASE("foxglove protocol: server messages carry the spec's field names") {
           json({{"op", "serviceCallFailure"}, {"serviceId", 3}, {"callId", 9}, {"message", "no"}}));
 }
 
-TEST_CASE("foxglove protocol: binary frames are little-endian with the spec's opcodes") {
+TEST_CASE("protocol: binary frames are little-endian with the spec's opcodes") {
     CHECK(message_data_head(0x01020304, 0x1122334455667788ull) ==
           bytes({1, 4, 3, 2, 1, 0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11}));
     CHECK(time_frame(1) == bytes({2, 1, 0, 0, 0, 0, 0, 0, 0}));
     CHECK(service_call_response_head(5, 6, "json") == bytes({3, 5, 0, 0, 0, 6, 0, 0, 0, 4, 0, 0, 0}) + "json");
 }
 
-TEST_CASE("foxglove protocol: client text messages decode") {
+TEST_CASE("protocol: client text messages decode") {
     auto m = decode_text(R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":3},{"id":1,"channelId":5}]})");
     REQUIRE(m);
     auto& sub = std::get<Subscribe>(*m);
@@ -89,7 +89,7 @@ TEST_CASE("foxglove protocol: client text messages decode") {
     CHECK(std::get<SubscribeParameterUpdates>(*m).names.empty());
 }
 
-TEST_CASE("foxglove protocol: malformed client messages are refused with the reason") {
+TEST_CASE("protocol: malformed client messages are refused with the reason") {
     auto why = [](std::string_view text) {
         auto m = decode_text(text, DecodeLimits{});
         return m ? std::string("accepted") : m.error().message;
@@ -126,7 +126,7 @@ TEST_CASE("foxglove protocol: malformed client messages are refused with the rea
     CHECK(m.error().type == MessageErrorType::BufferLimitViolation);
 }
 
-TEST_CASE("foxglove protocol: client binary messages decode and truncated ones are refused") {
+TEST_CASE("protocol: client binary messages decode and truncated ones are refused") {
     const std::string data = bytes({1, 9, 0, 0, 0}) + "{\"x\":1}";
     auto m = decode_binary(data);
     REQUIRE(m);

@@ -28,7 +28,7 @@ std::string bin(std::initializer_list<int> b) {
 
 }  // namespace
 
-TEST_CASE("foxglove session: subscribe and unsubscribe advertised channels") {
+TEST_CASE("session: subscribe and unsubscribe advertised channels") {
     Session s;
     s.channels_advertised({channel(1), channel(2)});
     auto out = s.feed_text(R"({"op":"subscribe","subscriptions":[{"id":10,"channelId":1},{"id":11,"channelId":2}]})");
@@ -50,7 +50,7 @@ TEST_CASE("foxglove session: subscribe and unsubscribe advertised channels") {
     CHECK_FALSE(s.channel_advertised(2));
 }
 
-TEST_CASE("foxglove session: bad subscriptions get one status and change nothing") {
+TEST_CASE("session: bad subscriptions get one status and change nothing") {
     Session s;
     s.channels_advertised({channel(1), channel(2)});
     auto out = s.feed_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1},{"id":2,"channelId":99}]})");
@@ -70,7 +70,7 @@ TEST_CASE("foxglove session: bad subscriptions get one status and change nothing
     CHECK(s.subscription_count() == 1);
 }
 
-TEST_CASE("foxglove session: a flood of subscriptions stops at the bound") {
+TEST_CASE("session: a flood of subscriptions stops at the bound") {
     SessionLimits limits;
     limits.max_subscriptions = 3;
     Session s(limits);
@@ -88,7 +88,7 @@ TEST_CASE("foxglove session: a flood of subscriptions stops at the bound") {
     CHECK(s.subscription_count() == 3);
 }
 
-TEST_CASE("foxglove session: client channels, publish and unknown channel ids") {
+TEST_CASE("session: client channels, publish and unknown channel ids") {
     SessionLimits limits;
     limits.max_client_channels = 2;
     Session s(limits);
@@ -119,7 +119,7 @@ TEST_CASE("foxglove session: client channels, publish and unknown channel ids") 
     CHECK(errors(s.feed_binary(msg)) == std::vector<std::string>{"message refused: client channel 1 is not advertised"});
 }
 
-TEST_CASE("foxglove session: service calls are bounded and unknown services fail the call") {
+TEST_CASE("session: service calls are bounded and unknown services fail the call") {
     SessionLimits limits;
     limits.max_calls_in_flight = 1;
     Session s(limits);
@@ -143,7 +143,7 @@ TEST_CASE("foxglove session: service calls are bounded and unknown services fail
     CHECK(json::parse(out.texts[0])["message"] == "service 5 is not advertised");
 }
 
-TEST_CASE("foxglove session: parameter subscriptions") {
+TEST_CASE("session: parameter subscriptions") {
     SessionLimits limits;
     limits.max_parameter_subscriptions = 2;
     Session s(limits);
