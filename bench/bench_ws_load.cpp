@@ -17,6 +17,9 @@
 //       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
 //   --slow K --read-delay-ms D: the first K clients wait D ms before each read (slow consumers); the
 //       row's figures are the other clients', and "slow" holds theirs.
+//   --foxglove: the clients are Foxglove WebSocket clients (docs/foxglove.md: /foxglove, subprotocol
+//       foxglove.websocket.v1) subscribed to the channel `D/M`; the values are the messageData payloads
+//       ({"value": [stamp_us, sequence, ...], "time": …}).
 // Connections are opened at most 64 at a time (the gateway's listen backlog is finite).
 #include <cstring>
 #include <deque>
@@ -49,6 +52,7 @@ using clock_type = std::chrono::steady_clock;
 namespace {
 
 constexpr const char* kJsonSubprotocol = "rr-gateway.json.v1";
+constexpr const char* kFoxgloveSubprotocol = "foxglove.websocket.v1";
 constexpr std::size_t kMaxConnecting = 64;
 
 struct Stats {
@@ -69,15 +73,21 @@ public:
                std::chrono::milliseconds read_delay = {})
         : ws_(io), stats_(stats), on_open_done_(std::move(on_open_done)), read_delay_(read_delay), delay_(io) {}
 
+    /// Foxglove WebSocket instead of the JSON API: subscribes to the channel of this topic once advertised.
+    void foxglove(std::string topic) { foxglove_topic_ = std::move(topic); }
+
     void open(tcp::endpoint endpoint, std::string host, std::optional<nlohmann::json> subscribe) {
         subscribe_ = std::move(subscribe);
+        if (!foxglove_topic_.empty()) subscribe_.reset();
         auto self = shared_from_this();
         beast::get_lowest_layer(ws_).async_connect(endpoint, [self, host](beast::error_code ec) {
             if (ec) return self->failed("connect: " + ec.message());
             beast::get_lowest_layer(self->ws_).socket().set_option(tcp::no_delay(true));
-            self->ws_.set_option(websocket::stream_base::decorator(
-                [](websocket::request_type& req) { req.set(beast::http::field::sec_websocket_protocol, kJsonSubprotocol); }));
-            self->ws_.async_handshake(host, "/", [self](beast::error_code ec) {
+            const bool fox = !self->foxglove_topic_.empty();
+            self->ws_.set_option(websocket::stream_base::decorator([fox](websocket::request_type& req) {
+                req.set(beast::http::field::sec_websocket_protocol, fox ? kFoxgloveSubprotocol : kJsonSubprotocol);
+            }));
+            self->ws_.async_handshake(host, fox ? "/foxglove" : "/", [self](beast::error_code ec) {
                 if (ec) return self->failed("handshake: " + ec.message());
                 ++self->stats_.opened;
                 self->opened_ = true;
@@ -137,6 +147,7 @@ private:
     void on_message(std::string_view text) {
         const double now = rr::bench::wall_clock_us();
         auto msg = nlohmann::json::parse(text, nullptr, false);
+        if (!foxglove_topic_.empty()) return on_foxglove_text(msg);
         if (msg.is_discarded() || msg.value("kind", "") != "wire") return;
         const auto& v = msg["value"];
         if (!v.is_array() || v.size() < 2 || v[1].get<double>() < 0) return;
@@ -144,8 +155,33 @@ private:
     }
     // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array
     // (a double[] such as Ticks, or a uint8[] frame whose first 16 bytes are those two doubles).
+    // Foxglove: subscribe once the topic's channel is advertised.
+    void on_foxglove_text(const nlohmann::json& msg) {
+        if (subscribed_ || msg.is_discarded() || msg.value("op", "") != "advertise" || !msg["channels"].is_array()) return;
+        for (const auto& c : msg["channels"]) {
+            if (c.value("topic", "") != foxglove_topic_) continue;
+            subscribed_ = true;
+            out_ = nlohmann::json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", c["id"]}}}}}.dump();
+            ws_.text(true);
+            auto self = shared_from_this();
+            ws_.async_write(asio::buffer(out_), [self](beast::error_code ec, std::size_t) {
+                if (ec) self->failed("subscribe: " + ec.message());
+            });
+            return;
+        }
+    }
+    // Foxglove messageData: 0x01, subscription id, receive time, then the channel's JSON message.
+    void on_foxglove_binary(double now, std::string_view m) {
+        if (m.size() <= 13 || m[0] != 0x01) return;
+        auto msg = nlohmann::json::parse(m.substr(13), nullptr, false);
+        if (msg.is_discarded() || !msg.is_object() || !msg["value"].is_array()) return;
+        const auto& v = msg["value"];
+        if (v.size() < 2 || !v[0].is_number() || !v[1].is_number()) return;
+        on_value(now, v[0].get<double>(), v[1].get<double>());
+    }
     void on_binary(std::string_view m) {
         const double now = rr::bench::wall_clock_us();
+        if (!foxglove_topic_.empty()) return on_foxglove_binary(now, m);
         auto parts = rr::server::gateway::split_binary_push(m);
         if (!parts) return;
         auto msg = nlohmann::json::parse(parts->json_text, nullptr, false);
@@ -180,6 +216,8 @@ private:
     std::chrono::milliseconds read_delay_;
     asio::steady_timer delay_;
     std::optional<nlohmann::json> subscribe_;
+    std::string foxglove_topic_;  // "" = the JSON API
+    bool subscribed_ = false;
     beast::flat_buffer buffer_;
     std::string out_;
     bool got_value_ = false, opened_ = false;
@@ -194,7 +232,7 @@ int main(int argc, char** argv) {
     std::size_t clients = 10;
     double seconds = 5, hz = 100;
     std::string mode, device = "bench", member = "Ticks";
-    bool binary = false;
+    bool binary = false, foxglove = false;
     std::size_t slow = 0;
     long read_delay_ms = 0;
     for (int i = 1; i < argc; ++i) {
@@ -207,12 +245,13 @@ int main(int argc, char** argv) {
         else if (a == "--device") device = value();
         else if (a == "--member") member = value();
         else if (a == "--binary") binary = true;
+        else if (a == "--foxglove") foxglove = true;
         else if (a == "--slow") slow = std::stoul(value());
         else if (a == "--read-delay-ms") read_delay_ms = std::stol(value());
         else if (a == "fanout" || a == "idle") mode = a;
         else {
             std::cerr << "usage: " << argv[0]
-                      << " --port P --clients N (fanout [--seconds S] [--hz H] [--binary] [--slow K --read-delay-ms D] | idle)\n";
+                      << " --port P --clients N (fanout [--seconds S] [--hz H] [--binary | --foxglove] [--slow K --read-delay-ms D] | idle)\n";
             return 2;
         }
     }
@@ -243,6 +282,7 @@ int main(int argc, char** argv) {
                 pump();
             }, std::chrono::milliseconds(is_slow ? read_delay_ms : 0));
             conns.push_back(c);
+            if (foxglove && mode == "fanout") c->foxglove(device + "/" + member);
             c->open(endpoint, host, subscribe);
         }
     };
@@ -317,6 +357,7 @@ int main(int argc, char** argv) {
                                 {"loadgen_vcsw_per_value", stats.delivered ? double(cpu1.vcsw - cpu0.vcsw) / double(stats.delivered) : 0.0},
                                 {"member", member},
                                 {"binary", binary},
+                                {"foxglove", foxglove},
                                 {"slow", slow_row},
                                 {"bytes_per_value", stats.delivered ? double(stats.bytes) / double(stats.delivered) : 0.0},
                                 {"error", stats.first_error}}

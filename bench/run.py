@@ -751,6 +751,24 @@ def main(argv=None):
                                           "--hz", "100", "--bytes", str(max(16, int(round(row.get("bytes_per_value") or 128))))])
                         if floor:
                             row["floor"] = floor[0]
+                        row["protocol"] = "JSON"
+                        fanout.append(row)
+                    # The same values to N Foxglove WebSocket clients (docs/foxglove.md), beside the JSON row.
+                    log("fan-out: %d Foxglove WebSocket clients" % n)
+                    sampler = Sampler(gpid)
+                    sampler.start()
+                    t0 = time.time()
+                    rows = run_rows([exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n),
+                                     "fanout", "--foxglove", "--seconds", "3" if args.quick else "5", "--hz", "100"])
+                    t1 = time.time()
+                    sampler.stop_flag.set()
+                    sampler.join()
+                    for row in rows:
+                        w = sampler.window(t1 - row["seconds"], t1)
+                        if w:
+                            row["gateway_cpu_pct"], row["gateway_rss_kib"] = w["cpu_pct"], w["rss_kib_max"]
+                        row["wall_s"] = t1 - t0
+                        row["protocol"] = "Foxglove"
                         fanout.append(row)
         for p in reversed(procs):
             p.stop()
@@ -924,18 +942,19 @@ def markdown(res):
         for g in res["cost_growth"]:
             out.append("| %s | %.3f | %s |" % (g["path"], g["ns_per_byte"], fmt(g["intercept_us"])))
     if res["fanout"]:
-        out += ["", "Fan-out: one device wire at 100 Hz → gateway → N JSON WebSocket clients (rr-gateway.json.v1); "
+        out += ["", "Fan-out: one device wire at 100 Hz → gateway → N JSON WebSocket clients (rr-gateway.json.v1), and "
+                "N Foxglove WebSocket clients (foxglove.websocket.v1, docs/foxglove.md; no floor row of their own); "
                 "latency from the device's stamp to the client's arrival. Floor: right after each row, one thread writes "
                 "the same N × 100 messages/s of the same size to N plain loopback TCP sockets and another reads them "
                 "(`rr_bench_floor --fanout`, no protocol): its writer's CPU is what the kernel alone charges a sender "
                 "for this traffic:", "",
-                "| clients | delivered/s | expected/s | delivered of sent | p50 µs | p99 µs | max µs | gateway CPU % | gateway CPU µs / value | gateway RSS MiB | load generator CPU % | floor: writer CPU % | floor: writer CPU µs / value | floor: p99 µs |",
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                "| clients | protocol | delivered/s | expected/s | delivered of sent | p50 µs | p99 µs | max µs | gateway CPU % | gateway CPU µs / value | gateway RSS MiB | load generator CPU % | floor: writer CPU % | floor: writer CPU µs / value | floor: p99 µs |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for f in res["fanout"]:
             fl = f.get("floor") or {}
             per_value = (10000 * f["gateway_cpu_pct"] / f["delivered_per_s"]) if f.get("gateway_cpu_pct") and f.get("delivered_per_s") else None
-            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                fmt(f["clients"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
+            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                fmt(f["clients"]), f.get("protocol", "JSON"), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
                 "%.1f %%" % (100 * f.get("delivered_of_sent", 0)), fmt(f["p50_us"]), fmt(f["p99_us"]),
                 fmt(f["max_us"]), fmt(f.get("gateway_cpu_pct")), fmt(per_value), fmt(f.get("gateway_rss_kib", 0) / 1024),
                 fmt(f["loadgen_cpu_pct"]), fmt(fl.get("writer_cpu_pct")), fmt(fl.get("writer_cpu_us_per_value")),

@@ -122,4 +122,15 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "$want" > "$stamp"
 fi
 fi
+# npm: the official Foxglove WebSocket client for the gateway's Foxglove tests (test/foxglove/package-lock.json).
+if wants test; then
+lock=test/foxglove/package-lock.json
+stamp=test/foxglove/node_modules/.lock.sha
+want=$(sha256sum "$lock" | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "setup: installing npm packages from $lock"
+  (cd test/foxglove && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$want" > "$stamp"
+fi
+fi
 echo "setup: ok (${parts[*]})"

@@ -3,6 +3,7 @@
 #include "server/gateway/motion_guard.hpp"
 #include "server/app/gateway_auth_config.hpp"
 #include "server/record/replay_routes.hpp"
+#include "server/foxglove/foxglove_server.hpp"
 #include "server/gateway/mirror_service.hpp"
 
 #include <cstdio>
@@ -403,6 +404,10 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         log(LogLevel::debug, "recordings go below " + g->recordings_->root()->path());
         record::install_recording_routes(*g->http_, json_api, g->recordings_);
         record::install_replay_routes(*g->http_, json_api, g->replays_);
+        // The Foxglove WebSocket protocol at /foxglove (docs/foxglove.md).
+        foxglove::FoxgloveOptions fo;
+        fo.objects = c.foxglove_objects;
+        g->foxglove_ = foxglove::install_foxglove(*g->http_, json_api, std::move(fo));
     }
 
     // Node discovery (docs/discovery.md): announce the gateway, keep a table of nodes, and turn the

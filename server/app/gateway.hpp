@@ -51,6 +51,9 @@ class DiscoveredDevices;
 namespace rr::server::discovery {
 class LocalDiscoverySource;
 }
+namespace rr::server::foxglove {
+class FoxgloveServer;
+}
 namespace rr::server::usb {
 class UsbHost;
 class UsbDiscoverySource;
@@ -100,6 +103,8 @@ public:
     std::string metrics_text() const;
     /// The recordings (docs/recording.md), nullptr without the JSON API.
     const std::shared_ptr<record::Recordings>& recordings() const noexcept { return recordings_; }
+    /// The Foxglove WebSocket server (docs/foxglove.md); null without the JSON API.
+    const std::shared_ptr<foxglove::FoxgloveServer>& foxglove() const noexcept { return foxglove_; }
     /// The replayed devices (`replay:` entries, --replay), served from replay_node().
     const std::vector<std::shared_ptr<record::ReplayDevice>>& replays() const noexcept { return replays_; }
     const std::shared_ptr<Node>& replay_node() const noexcept { return replay_node_; }
@@ -130,6 +135,7 @@ private:
     std::shared_ptr<discovery::LocalDiscoverySource> local_source_;
     std::shared_ptr<usb::UsbDiscoverySource> usb_source_;
     std::shared_ptr<record::Recordings> recordings_;
+    std::shared_ptr<foxglove::FoxgloveServer> foxglove_;  // docs/foxglove.md
     /// Replayed devices live on a node of their own on loopback, mirrored like any device.
     std::shared_ptr<Node> replay_node_;
     std::vector<std::shared_ptr<record::ReplayDevice>> replays_;

@@ -626,8 +626,20 @@ void parse_replay_device(const YAML::Node& d, const Reader& r, GatewayConfig& c,
 GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     GatewayConfig c;
     if (!root.IsDefined() || root.IsNull()) return c;
-    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings", "safety"});
+    r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings", "safety", "foxglove"});
     if (auto n = root["recordings"]) parse_recordings(n, r, c.recordings);
+    // foxglove: (docs/foxglove.md): objects below a device's root advertised beside it.
+    if (auto f = root["foxglove"]) {
+        r.check_keys(f, "foxglove", {"objects"});
+        if (auto o = f["objects"]) {
+            if (!o.IsMap()) r.error(o, "foxglove.objects", "expected a map of device name to a list of object paths");
+            else
+                for (const auto& kv : o) {
+                    const std::string device = kv.first.as<std::string>();
+                    c.foxglove_objects[device] = r.string_list(kv.second, "foxglove.objects." + device);
+                }
+        }
+    }
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",

@@ -186,6 +186,8 @@ struct GatewayConfig {
     std::vector<record::RecordingSpec> record;
     // recordings: where recordings go and the bounds on them (docs/recording.md "Where recordings go")
     record::RecordingsSettings recordings;
+    // foxglove: (docs/foxglove.md) objects below the root advertised to Foxglove clients, by device name
+    std::map<std::string, std::vector<std::string>> foxglove_objects;
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;

@@ -118,6 +118,15 @@ TEST_CASE("gateway.local: false and --no-local turn the gateway's rr+local off")
     CHECK_FALSE(c.local);
 }
 
+TEST_CASE("foxglove.objects: objects below a device's root for the Foxglove WebSocket") {
+    auto c = parse_gateway_config("foxglove:\n  objects:\n    webcam: [\"Webcams[0]\", \"Webcams[1]\"]\n", "t.yaml");
+    REQUIRE(c);
+    REQUIRE(c->foxglove_objects.count("webcam") == 1);
+    CHECK(c->foxglove_objects.at("webcam") == std::vector<std::string>{"Webcams[0]", "Webcams[1]"});
+    check_refused("foxglove:\n  objects: [1]\n", "bad.yaml:2: foxglove.objects: expected a map");
+    check_refused("foxglove:\n  object: {}\n", "bad.yaml:2: foxglove.object: unknown key");
+}
+
 TEST_CASE("configuration errors name the key and the line") {
     struct Case {
         const char* yaml;

@@ -97,6 +97,11 @@ public:
     /// The Cookie header of the upgrade request ("" without one), for handlers that authenticate the
     /// socket by a session cookie.
     virtual std::string cookie_header() const { return {}; }
+    /// The upgrade request's target (path and query, e.g. `/foxglove?token=…`), for handlers that
+    /// serve one path or read a login from the query (browsers cannot set headers on a WebSocket).
+    virtual std::string request_target() const { return {}; }
+    /// The subprotocol the upgrade chose (one of the handler's names).
+    virtual std::string subprotocol() const { return {}; }
     /// Messages accepted by send() (and send_binary()) and not yet written (the one being written included), and
     /// their bytes: for backpressure decisions by the handler. Thread-safe.
     virtual std::size_t queued() const { return 0; }
@@ -112,6 +117,8 @@ struct JsonSocketHandler {
     std::function<void(std::shared_ptr<JsonSocket>)> on_open;
     std::function<void(const std::shared_ptr<JsonSocket>&, std::string text)> on_message;
     std::function<void(const std::shared_ptr<JsonSocket>&)> on_close;
+    /// Binary messages from the client; unset: they go to on_message like text (the JSON API).
+    std::function<void(const std::shared_ptr<JsonSocket>&, std::string bytes)> on_binary;
 };
 
 struct HttpOptions {

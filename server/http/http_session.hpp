@@ -139,9 +139,11 @@ public:
     using std::enable_shared_from_this<JsonWebSocketSession<Stream>>::shared_from_this;
 
     JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
-                         std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {})
+                         std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {},
+                         std::string target = {}, std::string subprotocol = {})
         : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), peer_(std::move(peer)),
-          cookie_(std::move(cookie)), pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()) {
+          cookie_(std::move(cookie)), target_(std::move(target)), subprotocol_(std::move(subprotocol)),
+          pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()) {
         const auto executor = ws_.get_executor();
         if (const auto* io = executor.template target<IoStrand>()) io_strand_ = *io;
     }
@@ -198,6 +200,8 @@ public:
     /// Keeps `hold` alive as long as the session (the connection's per-address slot).
     void keep(std::shared_ptr<const void> hold) { hold_ = std::move(hold); }
     std::string cookie_header() const override { return cookie_; }
+    std::string request_target() const override { return target_; }
+    std::string subprotocol() const override { return subprotocol_; }
 
 private:
     using IoStrand = asio::strand<asio::io_context::executor_type>;
@@ -321,7 +325,10 @@ private:
                 return;
             }
             self->pacer_.charge(text.size(), self->peer_);
-            if (self->handler_->on_message) self->handler_->on_message(self, std::move(text));
+            if (!self->ws_.got_text() && self->handler_->on_binary)
+                self->handler_->on_binary(self, std::move(text));
+            else if (self->handler_->on_message)
+                self->handler_->on_message(self, std::move(text));
             self->read();
         });
     }
@@ -419,6 +426,7 @@ private:
     std::string peer_;
     std::shared_ptr<const void> hold_;
     std::string cookie_;
+    std::string target_, subprotocol_;
     beast::flat_buffer buffer_;
     std::mutex incoming_mutex_;
     std::vector<Outgoing> incoming_;  // sent, not yet taken by the strand; under incoming_mutex_
@@ -630,12 +638,14 @@ private:
         auto holder = std::make_shared<websocket::stream<Stream>>(std::move(ws));
         const bool unnamed = protocols.empty();
         std::string cookie(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
-        holder->async_accept(req, [holder, server, json, peer, info, unnamed, cookie = std::move(cookie)](beast::error_code ec) {
+        std::string target(req.target().data(), req.target().size());
+        holder->async_accept(req, [holder, server, json, peer, info, unnamed, cookie = std::move(cookie),
+                                   target = std::move(target), chosen](beast::error_code ec) {
             if (ec) return;
             if (json) {
                 auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
                                                                 server->options().json_socket_queue_limit, peer, cookie,
-                                                                server->node());
+                                                                server->node(), target, chosen);
                 s->keep(info.hold);
                 s->start();
                 return;

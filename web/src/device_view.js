@@ -20,6 +20,7 @@ import { RecordControl } from "./record/record_control.js";
 import { ReplayTimeline } from "./record/replay_timeline.js";
 import { listReplays } from "./record/recording_api.js";
 import { fetchAccess } from "./robot/access.js";
+import { foxgloveLinks } from "./foxglove_link.js";
 
 // The panels chosen by object type (panels/standard.js) and the renderers of value types
 // (std/standard.js) unless the page gave its own (dashboard.js startDashboard).
@@ -63,7 +64,7 @@ export class DeviceView {
       h("header", { class: "device-header" },
         h("h2", { text: name }), this.typeEl,
         h("span", { class: "state-label", text: "gateway → device" }), this.gatewayBadge,
-        h("span", { class: "state-label", text: "this page → gateway" }), this.sessionBadge, this.userBox),
+        h("span", { class: "state-label", text: "this page → gateway" }), this.sessionBadge, this.userBox, foxgloveLinks(name)),
       this.banner,
       h("div", { class: "device-body" }, h("div", { class: "device-main" }, this.loginForm.el, this.tools, this.members), h("aside", { class: "device-side" }, logBox, this.defBox)));
     root.append(this.el);
