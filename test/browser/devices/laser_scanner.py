@@ -35,6 +35,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
+from param_store import ParamStore  # noqa: E402
 
 import numpy as np  # noqa: E402
 import RobotRaconteur as RR  # noqa: E402
@@ -88,8 +89,9 @@ def room_scan(person_y):
     return ranges, intensities
 
 
-class ScannerBase:
+class ScannerBase(ParamStore):
     def __init__(self, name):
+        ParamStore.__init__(self, {"motor_speed": 10.0}, emit)
         ident = IdentifierUtil(RRN)
         self.device_info = RRN.NewStructure("com.robotraconteur.device.DeviceInfo")
         self.device_info.device = ident.CreateIdentifierFromName(name)
@@ -107,8 +109,6 @@ class ScannerBase:
         info.param_info = [param]
         self.scanner_info = info
         self._data = SensorDataUtil(RRN)
-        self._params = {"motor_speed": 10.0}
-        self._lock = threading.Lock()
         self.seqno = 0
 
     def scan_info(self, header):
@@ -130,19 +130,6 @@ class ScannerBase:
     def next_info(self):
         self.seqno += 1
         return self.scan_info(self._data.FillSensorDataHeader(self.device_info, self.seqno))
-
-    def getf_param(self, name):
-        with self._lock:
-            if name not in self._params:
-                raise RR.InvalidArgumentException(f"unknown parameter {name}")
-            return RR.VarValue(np.array([self._params[name]]), "double[]")
-
-    def setf_param(self, name, value):
-        with self._lock:
-            if name not in self._params:
-                raise RR.InvalidArgumentException(f"unknown parameter {name}")
-            self._params[name] = float(np.asarray(value.data).reshape(-1)[0])
-        emit({"param_set": name, "value": self._params[name]})
 
 
 class Scanner(ScannerBase):

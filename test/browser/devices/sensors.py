@@ -40,6 +40,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
+from param_store import ParamStore  # noqa: E402
 
 import numpy as np  # noqa: E402
 import RobotRaconteur as RR  # noqa: E402
@@ -128,8 +129,30 @@ class Periodic:
         self._thread.join(2)
 
 
-class WrenchSensorImpl:
+class HeldPattern:
+    """The wrench of the pattern, or one held on the test's command."""
+
     def __init__(self):
+        self._lock = threading.Lock()
+        self._held = None
+
+    def hold(self, torque, force):
+        with self._lock:
+            self._held = (tuple(map(float, torque)), tuple(map(float, force)))
+
+    def resume(self):
+        with self._lock:
+            self._held = None
+
+    def wrench_at(self, t):
+        with self._lock:
+            return self._held or wrench_pattern(t)
+
+
+class WrenchSensorImpl(HeldPattern, ParamStore):
+    def __init__(self):
+        HeldPattern.__init__(self)
+        ParamStore.__init__(self, {"filter_cutoff": 100.0}, emit)
         self.device_info = device_info("wrist_ft", "ft-6")
         info = RRN.NewStructure("com.robotraconteur.sensor.SensorInfo")
         info.device_info = self.device_info
@@ -145,24 +168,12 @@ class WrenchSensorImpl:
         param.default_value = RR.VarValue(np.array([100.0]), "double[]")
         info.parameter_info = [param]
         self.sensor_info = info
-        self._params = {"filter_cutoff": 100.0}
         self._wrench_dtype = RRN.GetNamedArrayDType("com.robotraconteur.geometry.Wrench")
         self._data = SensorDataUtil(RRN)
-        self._lock = threading.Lock()
-        self._held = None
         self._seqno = 0
 
-    def hold(self, torque, force):
-        with self._lock:
-            self._held = (tuple(map(float, torque)), tuple(map(float, force)))
-
-    def resume(self):
-        with self._lock:
-            self._held = None
-
     def step(self, t):
-        with self._lock:
-            torque, force = self._held or wrench_pattern(t)
+        torque, force = self.wrench_at(t)
         w = np.zeros((1,), dtype=self._wrench_dtype)
         w[0]["torque"] = torque
         w[0]["force"] = force
@@ -177,45 +188,20 @@ class WrenchSensorImpl:
         d.data_units = si_units(WRENCH_UNITS)
         self.sensor_data.SendPacket(d)
 
-    def getf_param(self, name):
-        with self._lock:
-            if name not in self._params:
-                raise RR.InvalidArgumentException(f"unknown parameter {name}")
-            return RR.VarValue(np.array([self._params[name]]), "double[]")
 
-    def setf_param(self, name, value):
-        with self._lock:
-            if name not in self._params:
-                raise RR.InvalidArgumentException(f"unknown parameter {name}")
-            self._params[name] = float(np.asarray(value.data).reshape(-1)[0])
-        emit({"param_set": name, "value": self._params[name]})
-
-
-class OldWrenchSensorImpl:
+class OldWrenchSensorImpl(HeldPattern):
     device_name = "wrist_ft (older definition)"
 
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._held = None
-
-    def hold(self, torque, force):
-        with self._lock:
-            self._held = (tuple(map(float, torque)), tuple(map(float, force)))
-
-    def resume(self):
-        with self._lock:
-            self._held = None
-
     def step(self, t):
-        with self._lock:
-            torque, force = self._held or wrench_pattern(t)
+        torque, force = self.wrench_at(t)
         self.sensor_value.OutValue = np.array(list(torque) + list(force), dtype=np.float64)
 
 
-class ClimateSensorImpl:
+class ClimateSensorImpl(ParamStore):
     UNITS = ["°C", "%"]
 
     def __init__(self):
+        ParamStore.__init__(self, {}, emit)
         self.device_info = device_info("bench_climate", "climate-2")
         info = RRN.NewStructure("com.robotraconteur.sensor.SensorInfo")
         info.device_info = self.device_info
@@ -238,12 +224,6 @@ class ClimateSensorImpl:
         d.data = values
         d.data_units = si_units(self.UNITS)
         self.sensor_data.SendPacket(d)
-
-    def getf_param(self, name):
-        raise RR.InvalidArgumentException(f"unknown parameter {name}")
-
-    def setf_param(self, name, value):
-        raise RR.InvalidArgumentException(f"unknown parameter {name}")
 
 
 def main():

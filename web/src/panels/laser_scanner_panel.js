@@ -8,7 +8,7 @@
 
 import { h, errorText } from "../dom.js";
 import { describeMember } from "../views/context.js";
-import { fetchAccess } from "../robot/access.js";
+import { errorLine, whenAccess } from "./panel_parts.js";
 import { drawScan, scanText, scanGeometry, ScanAssembler } from "../std/laserscan.js";
 import { buildParamControl, parameterNames } from "./param_control.js";
 import { RateMeter } from "./sensor_panel.js";
@@ -27,8 +27,8 @@ export function createLaserScannerPanel(parent, ctx) {
   let disposed = false;
   const cleanups = [];
 
-  const error = h("div", { class: "member-error scan-error", role: "alert", hidden: true });
-  const showError = (text) => { if (!disposed) { error.textContent = text || ""; error.hidden = !text; } };
+  const errors = errorLine("scan-error", () => !disposed);
+  const error = errors.el, showError = errors.show;
   const info = h("dl", { class: "camera-info-rows scan-info" });
   const status = h("output", { class: "scan-status" });
   const canvas = h("canvas", { class: "scan-canvas", width: SIZE, height: SIZE, "aria-label": "laser scan, top view", style: "max-width: 100%; border: 1px solid #ddd" });
@@ -99,20 +99,13 @@ export function createLaserScannerPanel(parent, ctx) {
         if (assembler) { const s = assembler.push(p); if (s) take(s); } else take(p);
       },
       onOpen: (open) => { el.dataset.pipeOpen = open ? "true" : "false"; },
-      onError: (e) => {
-        if (e) showError(`${pipe.name}: ${errorText(e)}`);
-        else if (error.textContent.startsWith(`${pipe.name}:`)) showError(null);
-      },
+      onError: errors.onMemberError(pipe.name),
     });
     cleanups.push(() => { follow.close(); if (frame) cancelAnimationFrame(frame); });
   }
 
-  const accessRead = ctx.device ? fetchAccess(ctx.device, ctx.session?.username ?? null) : Promise.resolve({ members: null });
-  Promise.all([accessRead, infoRead]).then(([access]) => {
-    if (disposed) return;
-    el.dataset.access = access.members === null ? "all" : "checked";
-    buildParamControl(params, { obj, view, access, names: paramNames, onError: showError });
-  }, (e) => { el.dataset.access = "none"; showError(`${e.message}: no controls`); });
+  whenAccess(ctx, el, infoRead, () => !disposed,
+    (access) => buildParamControl(params, { obj, view, access, names: paramNames, onError: showError }), showError);
 
   return {
     el,

@@ -7,7 +7,7 @@
 
 import { h, errorText } from "../dom.js";
 import { describeMember } from "../views/context.js";
-import { fetchAccess } from "../robot/access.js";
+import { errorLine, whenAccess } from "./panel_parts.js";
 import { objectTypes } from "./registry.js";
 import { SENSOR_TYPES, sensorSource, sensorAxes, infoUnits, axisText, sensorTitle } from "../sensor/sensor_source.js";
 import { buildParamControl, parameterNames } from "./param_control.js";
@@ -34,8 +34,8 @@ export function createSensorPanel(parent, ctx) {
   let disposed = false;
   const cleanups = [];
 
-  const error = h("div", { class: "member-error sensor-error", role: "alert", hidden: true });
-  const showError = (text) => { if (!disposed) { error.textContent = text || ""; error.hidden = !text; } };
+  const errors = errorLine("sensor-error", () => !disposed);
+  const error = errors.el, showError = errors.show;
   const info = h("dl", { class: "camera-info-rows sensor-info" });
   const rate = h("output", { class: "sensor-rate" });
   const table = h("table", { class: "sensor-values" });
@@ -107,21 +107,14 @@ export function createSensorPanel(parent, ctx) {
         el.dataset.samples = String(++samples);
         if (!frame) frame = requestAnimationFrame(draw);
       },
-      onError: (e) => {
-        if (e) showError(`${source.member}: ${errorText(e)}`);
-        else if (error.textContent.startsWith(`${source.member}:`)) showError(null);
-      },
+      onError: errors.onMemberError(source.member),
     });
     cleanups.push(() => { follow.dispose(); if (frame) cancelAnimationFrame(frame); });
   }
 
   // the parameter control, for users allowed to call getf_param / setf_param
-  const accessRead = ctx.device ? fetchAccess(ctx.device, ctx.session?.username ?? null) : Promise.resolve({ members: null });
-  Promise.all([accessRead, infoRead]).then(([access]) => {
-    if (disposed) return;
-    el.dataset.access = access.members === null ? "all" : "checked";
-    buildParamControl(params, { obj, view, access, names: paramNames, onError: showError });
-  }, (e) => { el.dataset.access = "none"; showError(`${e.message}: no controls`); });
+  whenAccess(ctx, el, infoRead, () => !disposed,
+    (access) => buildParamControl(params, { obj, view, access, names: paramNames, onError: showError }), showError);
 
   return {
     el,
