@@ -1,9 +1,11 @@
 // Standard sensors behind rr-gateway, in headless Chromium (issue 54): test/browser/devices/sensors.py on
 // the official library serves a WrenchSensor (a wrench following a pattern, held at known values on
-// command) and a two-value Sensor (temperature and humidity); the same script with --old-layout serves a
+// command), a two-value Sensor (temperature and humidity), an ImuSensor (spinning, held at a yaw on
+// command) and a GpsSensor (walking a circle); the same script with --old-layout serves a
 // WrenchSensor from an older, trimmed definition. The gateway has logins: alice (operator) and bob
 // (viewer). Checked: the sensor panel shows each axis with its unit equal to what the device sent, the
-// sensor_info rows, a live plot that grows, the value following the device; the parameter control
+// sensor_info rows, a live plot that grows, the value following the device; the IMU's orientation as
+// roll, pitch, yaw and a gizmo whose pixels turn with it; the GPS fix, accuracy and a track that grows; the parameter control
 // works for the operator and is absent for the viewer (whose calls the gateway refuses); the older
 // layout falls back to the generic view; no page error anywhere. Screenshots to $RR_ARTIFACTS (docs/img
 // with RR_DOCS_SCREENSHOTS=1).
@@ -26,7 +28,9 @@ before(async () => {
   assert.ok(s.gateway, "RR_GATEWAY must be set");
   sensors = await startDevice("sensors.py", ["--max-lifetime", "240"], { stdin: "pipe" });
   old = await startDevice("sensors.py", ["--old-layout", "--max-lifetime", "240"], { stdin: "pipe" });
-  ({ gateway, tmp, cookie } = await gatewayWithLogins({ wrench: sensors.info.url, climate: sensors.info.climate_url, wrench_old: old.info.url }));
+  ({ gateway, tmp, cookie } = await gatewayWithLogins({
+    wrench: sensors.info.url, climate: sensors.info.climate_url, imu: sensors.info.imu_url, gps: sensors.info.gps_url, wrench_old: old.info.url,
+  }));
   browser = await launchChromium();
   operator = await loggedInPage(browser, gateway.base, "alice", "wrench", pageErrors);
   await panel(operator).waitFor({ timeout: 30000 });
@@ -141,5 +145,63 @@ test("an older WrenchSensor definition (no wrench_sensor_value, no sensor_info):
   const card = operator.locator('.device-view[data-device="wrench_old"] .member[data-member="sensor_value"]').first();
   await waitFor(async () => /1, 2, 3, 4, 5, 6/.test(await card.locator(".stream output.value").textContent().catch(() => "")), "sensor_value in its card", 20000);
   assert.ok(await operator.locator('.device-view[data-device="wrench_old"] .member[data-member="device_name"]').count() > 0, "the older definition's own member shown");
+  assert.deepEqual(pageErrors, []);
+});
+
+/** Keeps a copy of a canvas's pixels in the page; resolves how many pixels differ from it later. */
+const keepPixels = (canvas) => canvas.evaluate((c) => { c.keptPixels = c.getContext("2d", { willReadFrequently: true }).getImageData(0, 0, c.width, c.height).data; });
+const changedPixels = (canvas) => canvas.evaluate((c) => {
+  const now = c.getContext("2d", { willReadFrequently: true }).getImageData(0, 0, c.width, c.height).data;
+  let k = 0;
+  for (let i = 0; i < now.length; i += 4) if (now[i] !== c.keptPixels[i] || now[i + 1] !== c.keptPixels[i + 1] || now[i + 2] !== c.keptPixels[i + 2]) k++;
+  return k;
+});
+
+test("IMU: orientation as roll, pitch, yaw and a gizmo that turns with it; rates and accelerations with units", async () => {
+  await operator.goto(`${gateway.base}/#/imu`);
+  const p = panelOf(operator, "imu", "imu");
+  await p.waitFor({ timeout: 30000 });
+  const row = (k) => p.locator(`dd[data-row="${k}"]`).textContent();
+  await command(sensors, { imu_hold: 90 }, "imu_held");
+  await waitFor(async () => (await row("orientation")) === "rpy (0, 0, 90)°", "yaw 90° shown", 15000);
+  assert.equal(await row("angular velocity"), "(0, 0, 0) rad/s");
+  assert.equal(await row("linear acceleration"), "(0, 0, 9.81) m/s²");
+  const canvas = p.locator("canvas.imu-gizmo");
+  // held: the gizmo stays as it is drawn
+  await keepPixels(canvas);
+  const n = Number(await p.getAttribute("data-samples"));
+  await waitFor(async () => Number(await p.getAttribute("data-samples")) >= n + 5, "five more states drawn");
+  assert.equal(await changedPixels(canvas), 0, "a still IMU, a still gizmo");
+  await screenshot(p, "dashboard-imu.png");
+  // another yaw: the text and the pixels follow
+  await command(sensors, { imu_hold: -45 }, "imu_held");
+  await waitFor(async () => (await row("orientation")) === "rpy (0, 0, -45)°", "yaw -45° shown", 15000);
+  assert.ok(await changedPixels(canvas) > 50, "the gizmo turned");
+  // the sensor panel beside it (ImuSensor implements Sensor): its sensor_info
+  const sensor = panelOf(operator, "imu", "sensor");
+  await waitFor(async () => (await sensor.locator('dd[data-row="type"]').textContent().catch(() => "")) === "inertial", "the sensor panel's type");
+  assert.deepEqual(pageErrors, []);
+});
+
+test("GPS: position, fix, satellites and accuracy as sent; the track grows", async () => {
+  await operator.goto(`${gateway.base}/#/gps`);
+  const p = panelOf(operator, "gps", "gps");
+  await p.waitFor({ timeout: 30000 });
+  const row = (k) => p.locator(`dd[data-row="${k}"]`).textContent();
+  await waitFor(async () => (await row("fix")) === "dgps_fix", "the fix by name", 15000);
+  assert.equal(await row("altitude"), "120.5 m");
+  assert.equal(await row("satellites"), "9 used of 14 visible");
+  assert.equal(await row("horizontal error"), "0.8 m");
+  assert.equal(await row("error"), "1.5 m");
+  assert.equal(await row("speed"), "1 m/s");
+  const [lat0, lon0] = sensors.info.gps_centre;
+  const lat = Number((await row("latitude")).replace("°", "")), lon = Number((await row("longitude")).replace("°", ""));
+  // on the circle of 20 m around the centre (1e-7° is about 1 cm)
+  const north = (lat - lat0) * Math.PI / 180 * 6371008.8, east = (lon - lon0) * Math.PI / 180 * 6371008.8 * Math.cos(lat0 * Math.PI / 180);
+  assert.ok(Math.abs(Math.hypot(north, east) - 20) < 0.05, `${Math.hypot(north, east)} m from the centre`);
+  const canvas = p.locator("canvas.gps-track");
+  await keepPixels(canvas);
+  await waitFor(async () => (await changedPixels(canvas)) > 5, "the track grew", 20000);
+  await screenshot(p, "dashboard-gps.png");
   assert.deepEqual(pageErrors, []);
 });

@@ -115,3 +115,21 @@ test("parameter names from a ParameterInfo list", () => {
   assert.deepEqual(parameterNames([{ parameter_identifier: { name: "filter_cutoff" } }, {}, null]), ["filter_cutoff"]);
   assert.deepEqual(parameterNames(null), []);
 });
+
+test("IMU gizmo: the axes of a quaternion from the fixed viewpoint; GPS track in metres", async () => {
+  const { rotationMatrix, gizmoAxes, localMetres, GpsTrack } = await import("../src/sensor/imu_gps.js");
+  const s = Math.SQRT1_2;
+  const R = rotationMatrix({ w: s, x: 0, y: 0, z: s });  // 90° about z: x → y
+  assert.ok(Math.abs(R[1][0] - 1) < 1e-12 && Math.abs(R[0][0]) < 1e-12);
+  assert.equal(rotationMatrix({ w: 0, x: 0, y: 0, z: 0 }), null);
+  const still = Object.fromEntries(gizmoAxes({ w: 1, x: 0, y: 0, z: 0 }).map((a) => [a.axis, a]));
+  assert.ok(still.z.dy < -0.5 && Math.abs(still.z.dx) < 1e-12, "z up on the screen");
+  const turned = Object.fromEntries(gizmoAxes({ w: s, x: 0, y: 0, z: s }).map((a) => [a.axis, a]));
+  assert.ok(Math.abs(turned.x.dx - still.y.dx) < 1e-12 && Math.abs(turned.x.dy - still.y.dy) < 1e-12, "x where y was");
+  const m = localMetres(42.7285 + 20 / 6371008.8 * 180 / Math.PI, -73.6789, 42.7285, -73.6789);
+  assert.ok(Math.abs(m.north - 20) < 1e-9 && Math.abs(m.east) < 1e-9);
+  const t = new GpsTrack(3);
+  assert.equal(t.push(91, 0), false);
+  for (let i = 0; i < 5; i++) t.push(1 + i * 1e-5, 2);
+  assert.equal(t.points().length, 3);
+});

@@ -15,6 +15,12 @@ Services of one node:
   "climate"  com.robotraconteur.sensor.Sensor: two named values, temperature (degC) and relative
              humidity (%), 5 Hz, drifting slowly.
 
+  "imu"      com.robotraconteur.imu.ImuSensor: imu_state at 20 Hz, spinning about z at 0.5 rad/s (yaw
+             0.5 t), level (gravity 9.81 m/s^2 on z); held still at a given yaw on command.
+  "gps"      com.robotraconteur.gps.GpsSensor: gps_state at 5 Hz, walking a circle of 20 m radius at
+             1 m/s around 42.7285 N, 73.6789 W, altitude 120.5 m; fix dgps_fix, 9 of 14 satellites,
+             horizontal error 0.8 m, error 1.5 m.
+
 With --old-layout the node instead serves "wrench" from a definition of com.robotraconteur.sensor
 as an older or trimmed release might have it: WrenchSensor without wrench_sensor_value and
 sensor_info, sensor_value only. The dashboard must fall back to its generic member view.
@@ -23,8 +29,9 @@ The test drives it by JSON lines on stdin, each answered by one JSON line on std
   {"hold": {"torque": [x, y, z], "force": [x, y, z]}}  the wrench (and sensor_value) stay at these
                                                        -> {"held": {...}}
   {"resume": true}                                     the pattern again -> {"resumed": true}
+  {"imu_hold": yaw_deg}                                the IMU still at that yaw -> {"imu_held": yaw_deg}
 
-Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=wrench", "climate_url": ..., "port": P,
+Ready line: {"url": "rr+tcp://127.0.0.1:P/?service=wrench", "climate_url": ..., "imu_url", "gps_url", "port": P,
 "units": [...]}.
 
 Usage: sensors.py [--old-layout] [--max-lifetime 300]
@@ -226,6 +233,77 @@ class ClimateSensorImpl(ParamStore):
         self.sensor_data.SendPacket(d)
 
 
+class ImuSensorImpl(ParamStore):
+    def __init__(self):
+        ParamStore.__init__(self, {}, emit)
+        self.device_info = device_info("base_imu", "imu-9")
+        info = RRN.NewStructure("com.robotraconteur.sensor.SensorInfo")
+        info.device_info = self.device_info
+        info.sensor_type = RRN.GetConstants("com.robotraconteur.sensor")["SensorTypeCode"]["inertial"]
+        info.update_frequency = 20.0
+        self.sensor_info = info
+        self._quat = RRN.GetNamedArrayDType("com.robotraconteur.geometry.Quaternion")
+        self._vec = RRN.GetNamedArrayDType("com.robotraconteur.geometry.Vector3")
+        self._lock = threading.Lock()
+        self._held_yaw = None
+
+    def hold(self, yaw_deg):
+        with self._lock:
+            self._held_yaw = math.radians(float(yaw_deg))
+
+    def step(self, t):
+        with self._lock:
+            held = self._held_yaw
+        yaw, rate = (held, 0.0) if held is not None else (0.5 * t, 0.5)
+        st = RRN.NewStructure("com.robotraconteur.imu.ImuState")
+        q = np.zeros((1,), dtype=self._quat)
+        q[0]["w"], q[0]["z"] = math.cos(yaw / 2), math.sin(yaw / 2)
+        st.orientation = q
+        w = np.zeros((1,), dtype=self._vec)
+        w[0]["z"] = rate
+        st.angular_velocity = w
+        a = np.zeros((1,), dtype=self._vec)
+        a[0]["z"] = 9.81
+        st.linear_acceleration = a
+        st.orientation_covariance = np.zeros((3, 3))
+        st.angular_velocity_covariance = np.zeros((3, 3))
+        st.linear_acceleration_covariance = np.zeros((3, 3))
+        self.imu_state.OutValue = st
+        self.sensor_value.OutValue = np.array([q[0]["w"], 0, 0, q[0]["z"], 0, 0, rate, 0, 0, 9.81])
+
+
+GPS_CENTRE = (42.7285, -73.6789)
+
+
+class GpsSensorImpl(ParamStore):
+    def __init__(self):
+        ParamStore.__init__(self, {}, emit)
+        self.device_info = device_info("cart_gps", "gps-1")
+        info = RRN.NewStructure("com.robotraconteur.sensor.SensorInfo")
+        info.device_info = self.device_info
+        info.sensor_type = RRN.GetConstants("com.robotraconteur.sensor")["SensorTypeCode"]["navigation"]
+        info.update_frequency = 5.0
+        self.sensor_info = info
+
+    def step(self, t):
+        r, w = 20.0, 1.0 / 20.0   # 1 m/s on a circle of 20 m
+        east, north = r * math.sin(w * t), r * math.cos(w * t)
+        lat = GPS_CENTRE[0] + math.degrees(north / 6371008.8)
+        lon = GPS_CENTRE[1] + math.degrees(east / (6371008.8 * math.cos(math.radians(GPS_CENTRE[0]))))
+        st = RRN.NewStructure("com.robotraconteur.gps.GpsState")
+        status = RRN.NewStructure("com.robotraconteur.gps.GpsStatus")
+        status.satellites_used = 9
+        status.satellites_visible = 14
+        status.status_code = RRN.GetConstants("com.robotraconteur.gps")["GpsMeasurementStatusCode"]["dgps_fix"]
+        st.status = status
+        st.latitude_deg, st.longitude_deg, st.altitude = lat, lon, 120.5
+        st.track_deg = (math.degrees(w * t) + 90.0) % 360.0
+        st.speed, st.err_horz, st.err = 1.0, 0.8, 1.5
+        st.position_covariance = np.zeros((3, 3))
+        self.gps_state.OutValue = st
+        self.sensor_value.OutValue = np.array([lat, lon, 120.5])
+
+
 def main():
     die_with_parent()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -247,6 +325,10 @@ def main():
             climate = ClimateSensorImpl()
             RRN.RegisterService("climate", "com.robotraconteur.sensor.Sensor", climate)
             loops.append(Periodic(0.2, climate.step))
+            imu, gps = ImuSensorImpl(), GpsSensorImpl()
+            RRN.RegisterService("imu", "com.robotraconteur.imu.ImuSensor", imu)
+            RRN.RegisterService("gps", "com.robotraconteur.gps.GpsSensor", gps)
+            loops += [Periodic(0.05, imu.step), Periodic(0.2, gps.step)]
         loops.append(Periodic(0.02, wrench.step))
         for loop in loops:
             loop.start()
@@ -258,6 +340,9 @@ def main():
                     if "hold" in cmd:
                         wrench.hold(cmd["hold"]["torque"], cmd["hold"]["force"])
                         reply = {"held": cmd["hold"]}
+                    elif "imu_hold" in cmd:
+                        imu.hold(cmd["imu_hold"])
+                        reply = {"imu_held": cmd["imu_hold"]}
                     elif cmd.get("resume"):
                         wrench.resume()
                         reply = {"resumed": True}
@@ -270,6 +355,8 @@ def main():
         threading.Thread(target=commands, daemon=True).start()
         ready(url=f"rr+tcp://127.0.0.1:{port}/?service=wrench",
               climate_url=None if args.old_layout else f"rr+tcp://127.0.0.1:{port}/?service=climate",
+              imu_url=None if args.old_layout else f"rr+tcp://127.0.0.1:{port}/?service=imu",
+              gps_url=None if args.old_layout else f"rr+tcp://127.0.0.1:{port}/?service=gps", gps_centre=GPS_CENTRE,
               port=port, units=WRENCH_UNITS, climate_units=ClimateSensorImpl.UNITS, pid=os.getpid())
         wait_for_stop(args.max_lifetime)
         for loop in loops:
