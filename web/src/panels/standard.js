@@ -6,8 +6,15 @@ import { PanelRegistry } from "./registry.js";
 import { deviceCardPanel } from "./device_card.js";
 import { cameraPanel } from "./camera_panel.js";
 import { robotPanel } from "./robot_panel.js";
+// stdpanels-a: sensors, laser scanners, point clouds
+import { sensorPanel } from "./sensor_panel.js";
+import { laserScannerPanel } from "./laser_scanner_panel.js";
+import { imuPanel } from "./imu_panel.js";
+import { gpsPanel } from "./gps_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
-  return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel);
+  return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel)
+    // stdpanels-a: sensors, laser scanners, point clouds
+    .register(sensorPanel, laserScannerPanel, imuPanel, gpsPanel);
 }

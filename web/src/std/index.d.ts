@@ -206,3 +206,27 @@ export function sensorTimestamp(value: unknown, d: TypeDescriptor | null | undef
 export function deviceInfoRows(info: unknown, extraTypes?: string[]): Array<{ key: string; label: string; text: string }>;
 /** The robdef type text a com.robotraconteur.datatype.DataType value stands for ("double[3]", "string{list}"); `descriptor` gives the device's enum values. */
 export function formatDataType(value: unknown, descriptor?: TypeDescriptor | null): string | null;
+
+// stdpanels-a (issue 54): wrenches, laser scans
+/** "force (x, y, z) N, torque (x, y, z) N·m" of a com.robotraconteur.geometry.Wrench value, or null. */
+export function formatWrench(value: unknown, digits?: number): string | null;
+/** { torque: {x, y, z}, force: {x, y, z} } of a Wrench value (object or six numbers), or null. */
+export function wrenchParts(value: unknown): { torque: { x: number; y: number; z: number }; force: { x: number; y: number; z: number } } | null;
+/** A LaserScan's angles (radians) and ranges (metres). */
+export function scanGeometry(scan: unknown): { angleMin: number; angleMax: number; angleIncrement: number; rangeMin: number; rangeMax: number; scanTime: number; count: number };
+/** The returns of a LaserScan as points in metres (x forward, y left) and the index of each range. */
+export function scanPoints(scan: unknown): { x: Float32Array; y: Float32Array; index: Uint32Array; n: number; maxRange: number };
+/** [lo, hi] of a scan's finite intensities, or null. */
+export function intensityRange(scan: unknown): [number, number] | null;
+/** Draws a scan top-down into a 2D context; keep the returned reach and pass it back for a steady zoom. */
+export function drawScan(g: CanvasRenderingContext2D | OffscreenCanvasRenderingContext2D, scan: unknown, width: number, height: number,
+  options?: { reach?: number; background?: string }): { scale: number; reach: number; points: number; radius: number };
+/** "541 ranges, -135° to 135° by 0.5°, 0.05 to 10 m". */
+export function scanText(scan: unknown): string;
+/** LaserScanPart packets back into whole scans. */
+export class ScanAssembler {
+  constructor(maxRanges?: number);
+  dropped: number;
+  stray: number;
+  push(part: unknown): { scan_info: unknown; ranges: Float64Array; intensities: Float64Array | never[] } | null;
+}

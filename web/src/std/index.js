@@ -25,3 +25,6 @@ export { deviceInfoRows } from "./device_info.js";
 export { formatDataType } from "./datatype.js";
 export { FrameDecoder } from "./frame_decoder.js";
 export { RobdefOutline } from "./robdef_outline.js";
+// stdpanels-a (issue 54): wrenches, laser scans
+export { formatWrench, wrenchParts } from "./wrench.js";
+export { scanGeometry, scanPoints, intensityRange, drawScan, scanText, ScanAssembler } from "./laserscan.js";

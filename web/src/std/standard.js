@@ -13,10 +13,15 @@ import { renderers as units } from "./units.js";
 import { renderers as image } from "./image_renderers.js";
 import { renderers as deviceInfo } from "./device_info.js";
 import { renderers as datatype } from "./datatype.js";
+// stdpanels-a: sensors, laser scans, point clouds
+import { renderers as wrench } from "./wrench.js";
+import { renderers as laserscan } from "./laserscan.js";
 
 /** A new registry holding the standard renderers (add your own with register()). */
 export function standardRegistry() {
-  return new RendererRegistry().register(uuid, identifier, datetime, geometry, units, image, deviceInfo, datatype);
+  return new RendererRegistry().register(uuid, identifier, datetime, geometry, units, image, deviceInfo, datatype)
+    // stdpanels-a: sensors, laser scans, point clouds
+    .register(wrench, laserscan);
 }
 
 /** The field annotators of the standard types: flag enums, enum codes in integer fields, units. */
