@@ -9,5 +9,12 @@ import { robotPanel } from "./robot_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
-  return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel);
+  return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel)
+    .register(stdpanelsB());
+}
+
+// Tools, lights, signals, joysticks and the other standard device types (stdpanels-b, issue 54).
+import { toolPanel } from "./tool_panel.js";
+function stdpanelsB() {
+  return [toolPanel];
 }
