@@ -15,6 +15,7 @@ export function standardPanels() {
 
 // Tools, lights, signals, joysticks and the other standard device types (stdpanels-b, issue 54).
 import { toolPanel } from "./tool_panel.js";
+import { lightPanel } from "./light_panel.js";
 function stdpanelsB() {
-  return [toolPanel];
+  return [toolPanel, lightPanel];
 }
