@@ -180,6 +180,35 @@ TEST_CASE("motion guard: jog_freespace without wait is ended by halt and command
     CHECK_FALSE(probe.calls[1].has_value());
 }
 
+TEST_CASE("motion guard: a tool's close() holds until halt(), and is halted when its client goes", "[motion]") {
+    Fixture f;
+    f.guard->set_root(ObjectTypeInfo{std::string(kStandardToolType), {}}, nullptr);
+    auto alice = client("ws:1", "alice");
+    auto bob = client("rr:2", "bob");
+    auto close = call("close");
+    auto t = f.guard->admit(alice, close);
+    REQUIRE(t);
+    MessageEntry ok;
+    ok.entry_type = MessageEntryType::FunctionCallRes;
+    f.guard->on_reply(alice, *t, ok);
+    REQUIRE(f.guard->holder());  // the fingers keep moving after the call returns
+    auto open = call("open");
+    CHECK_FALSE(f.guard->admit(bob, open));  // another client may not move the tool meanwhile
+    auto halt = call("halt");
+    CHECK(f.guard->admit(bob, halt)->kind == MotionGuard::Ticket::Kind::stop);
+    CHECK_FALSE(f.guard->holder());
+
+    auto set = call("setf_command", {make_scalar_element<double>("command", 0.06)});
+    auto t2 = f.guard->admit(alice, set);
+    REQUIRE(t2);
+    f.guard->on_reply(alice, *t2, ok);
+    bool done = false;
+    f.guard->client_gone("ws:1", [&] { done = true; });
+    CHECK(done);
+    CHECK(f.sent_members() == std::vector<std::string>{"halt@0"});
+    CHECK_FALSE(f.guard->holder());
+}
+
 TEST_CASE("motion guard: a call that waits holds until its answer; a failed call holds nothing", "[motion]") {
     Fixture f;
     Probe probe;

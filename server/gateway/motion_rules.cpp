@@ -122,15 +122,22 @@ std::optional<double> scalar_number(const MessageElement& e) {
 MotionRules MotionRules::compile(const MotionSafety& settings, const ObjectTypeInfo& root, const DeviceTypes* types) {
     MotionRules r;
     r.bound_ = settings.hold_to_run_max;
-    const bool robot = root.object_type == kStandardRobotType ||
-                       std::find(root.implements.begin(), root.implements.end(), kStandardRobotType) != root.implements.end();
-    r.standard_robot_ = robot && settings.standard_robot;
+    auto is = [&](std::string_view type) {
+        return root.object_type == type || std::find(root.implements.begin(), root.implements.end(), type) != root.implements.end();
+    };
+    r.standard_robot_ = is(kStandardRobotType) && settings.standard_robot;
+    r.standard_tool_ = !r.standard_robot_ && is(kStandardToolType) && settings.standard_robot;
     if (r.standard_robot_) {
         r.hold_to_run_ = {{"jog_joint", "timeout", 1.0}, {"jog_cartesian", "timeout", 1.0}};
         r.untimed_ = {{"jog_freespace", "wait"}, {"execute_trajectory", ""}, {"home", ""}};
         r.streams_ = {"position_command", "velocity_command"};
         r.stop_functions_ = {"halt"};
         r.stop_properties_.push_back(StopProperty{"command_mode", standard_halt_mode(types), DataTypes::int32_t});
+    }
+    if (r.standard_tool_) {
+        // each call starts a motion and returns: it lasts until halt() or its client's end
+        r.untimed_ = {{"open", ""}, {"close", ""}, {"setf_command", ""}, {"home", ""}};
+        r.stop_functions_ = {"halt"};
     }
     for (const auto& h : settings.hold_to_run) r.hold_to_run_.push_back(h);
     for (const auto& m : settings.motions) r.untimed_.push_back(m);

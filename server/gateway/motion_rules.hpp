@@ -12,8 +12,8 @@
 //     ended by the gateway when their sender goes silent for the bound;
 //   * stops: a function (halt) or a property value (command_mode = halt) that ends motion; they reach the
 //     device whatever lock another client holds, and they are what the gateway calls to end a motion.
-// The standard robot's set (com.robotraconteur.robotics.robot.Robot, as root type or implemented) is
-// built in; a configuration adds members of any device (safety.hold_to_run, .motions, .streams, .stops).
+// The standard robot's set (com.robotraconteur.robotics.robot.Robot, as root type or implemented) and the
+// standard tool's (com.robotraconteur.robotics.tool.Tool) are built in; a configuration adds members of any device (safety.hold_to_run, .motions, .streams, .stops).
 #pragma once
 
 #include <chrono>
@@ -31,6 +31,9 @@ namespace rr::server::gateway {
 class DeviceTypes;
 
 inline constexpr std::string_view kStandardRobotType = "com.robotraconteur.robotics.robot.Robot";
+/// The standard tool (grippers): open(), close(), setf_command() and home() start a motion that lasts
+/// until halt() (its stop) or its client's end.
+inline constexpr std::string_view kStandardToolType = "com.robotraconteur.robotics.tool.Tool";
 
 /// A function one of whose arguments is the motion's own timeout.
 struct HoldToRunMember {
@@ -57,7 +60,8 @@ struct MotionSafety {
     /// Longest timeout a hold-to-run call may ask for; also how long a command stream may stay silent,
     /// and how soon a client that stops answering is noticed while it holds a motion without a timeout.
     std::chrono::milliseconds hold_to_run_max{500};
-    /// The standard robot's members are guarded when the device is one (false: only the lists below).
+    /// The standard robot's (or standard tool's) members are guarded when the device is one (false: only
+    /// the lists below).
     bool standard_robot = true;
     std::vector<HoldToRunMember> hold_to_run;
     std::vector<UntimedMotionMember> motions;
@@ -78,6 +82,7 @@ public:
         return hold_to_run_.empty() && untimed_.empty() && streams_.empty() && stop_functions_.empty() && stop_properties_.empty();
     }
     bool standard_robot() const noexcept { return standard_robot_; }
+    bool standard_tool() const noexcept { return standard_tool_; }
     std::chrono::milliseconds bound() const noexcept { return bound_; }
 
     const HoldToRunMember* hold_to_run(std::string_view member) const;
@@ -100,6 +105,7 @@ private:
         DataTypes type = DataTypes::int32_t;  ///< how the value travels (enums as int32)
     };
     bool standard_robot_ = false;
+    bool standard_tool_ = false;
     std::chrono::milliseconds bound_{500};
     std::vector<HoldToRunMember> hold_to_run_;
     std::vector<UntimedMotionMember> untimed_;

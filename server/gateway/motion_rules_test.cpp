@@ -55,6 +55,31 @@ TEST_CASE("motion rules: the standard robot's members, by root type or an implem
     CHECK(MotionRules::compile(s, kRobot, nullptr).empty());
 }
 
+TEST_CASE("motion rules: the standard tool's open, close, setf_command and home run until halt", "[motion]") {
+    MotionSafety s;
+    auto r = MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardToolType), {}}, nullptr);
+    CHECK(r.standard_tool());
+    CHECK_FALSE(r.standard_robot());
+    for (const char* m : {"open", "close", "setf_command", "home"}) {
+        INFO(m);
+        REQUIRE(r.untimed(m));
+        CHECK(r.untimed(m)->wait_arg.empty());
+    }
+    CHECK(r.stop_function("halt"));
+    CHECK_FALSE(r.hold_to_run("jog_joint"));
+    CHECK_FALSE(r.guards("enable"));
+    CHECK_FALSE(r.guards("tool_state"));
+    // halt() is all the gateway sends to stop a tool (a tool has no command_mode)
+    auto stops = r.stop_requests("gripper");
+    REQUIRE(stops.size() == 1);
+    CHECK(stops[0].member_name == "halt");
+    CHECK(stops[0].entry_type == MessageEntryType::FunctionCallReq);
+
+    CHECK(MotionRules::compile(s, ObjectTypeInfo{"vendor.grip.Gripper", {std::string(kStandardToolType)}}, nullptr).standard_tool());
+    s.standard_robot = false;  // the one switch turns both standard sets off
+    CHECK(MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardToolType), {}}, nullptr).empty());
+}
+
 TEST_CASE("motion rules: configured members of any device", "[motion]") {
     MotionSafety s;
     s.hold_to_run.push_back({"Drive", "duration_ms", 0.001});

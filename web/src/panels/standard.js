@@ -11,10 +11,14 @@ import { sensorPanel } from "./sensor_panel.js";
 import { laserScannerPanel } from "./laser_scanner_panel.js";
 import { imuPanel } from "./imu_panel.js";
 import { gpsPanel } from "./gps_panel.js";
+import { toolPanel } from "./tool_panel.js";
+import { lightPanel } from "./light_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
   return new PanelRegistry().register(deviceCardPanel, cameraPanel, robotPanel)
     // stdpanels-a: sensors, laser scanners, point clouds
-    .register(sensorPanel, laserScannerPanel, imuPanel, gpsPanel);
+    .register(sensorPanel, laserScannerPanel, imuPanel, gpsPanel)
+    // tools and lights
+    .register(toolPanel, lightPanel);
 }
