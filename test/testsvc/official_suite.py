@@ -2,16 +2,21 @@
 """The official Python client suite (test/python of robotraconteur/robotraconteur) against rr-test-service,
 run by hand (docs/native-service.md "The official client suite against rr-test-service").
 
-For each transport (rr+tcp, rr+ws, rr+wss with a throw-away certificate, rr+local) it starts
-rr-test-service with the official values file, sets ROBOTRACONTEUR_TEST_SERVER_URL and runs the suite's
-service tests with pytest; with --gateway also through rr-gateway (the four services as devices of the
-same names, `auth: passthrough`, over rr+tcp and rr+ws); with --reference also without the variable,
-where the suite starts the official test server in its own process (the reference). Prints one line per
-test and configuration and a summary; the JUnit files stay in --out.
+For each configuration it starts a service, sets ROBOTRACONTEUR_TEST_SERVER_URL and runs the suite's
+service tests with pytest. Configurations (--configs, comma-separated):
+  tcp, ws, wss, local        rr-test-service with the official values on rr+tcp, rr+ws, rr+wss (a
+                             throw-away certificate), rr+local (also with the URL joined by &)
+  gateway-tcp, gateway-ws    rr-gateway (--gateway) in front of it: the four services as devices of the
+                             same names, `auth: passthrough`, the client on rr+tcp / rr+ws
+  official-CONFIG            the same with the official test server (official_server.py) instead of
+                             rr-test-service (not wss): the reference
+--reference also runs the suite without the variable, where it starts the official test server in its
+own process. Prints one line per test and configuration and a summary; the JUnit files stay in --out.
 
     .venv/bin/python test/testsvc/official_suite.py --repo /tmp/rr-official --values /tmp/official-values.json \\
-        --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/rr-gateway] [--reference] \\
-        [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws] [--pytest-path DIR] [--out DIR]
+        --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/server/app/rr-gateway] \\
+        [--reference] [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws,official-tcp,...] \\
+        [--pytest-path DIR] [--select PYTEST_K_EXPR] [--out DIR]
 Exit 0 when every test passed in every configuration run, 1 otherwise.
 """
 
@@ -40,9 +45,9 @@ SERVICES = ["RobotRaconteurTestService", "RobotRaconteurTestService_auth", "Robo
 class Proc:
     """A child process whose first stdout line matching `accept` is its ready line."""
 
-    def __init__(self, argv, logdir, name, accept, timeout=90):
+    def __init__(self, argv, logdir, name, accept, timeout=90, env=None):
         self.log = open(os.path.join(logdir, name + ".log"), "w")
-        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, text=True)
+        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, text=True, env=env)
         line = []
 
         def read():
@@ -76,14 +81,27 @@ def start_service(args, logdir, name, extra):
     return p, json.loads(p.ready[len("ready "):])
 
 
+def start_official(args, logdir, name):
+    """The official test server (official_server.py) as the service: the reference."""
+    nodename = "official_" + uuid.uuid4().hex[:10]
+    env = dict(os.environ)  # the official modules import pytest
+    env["PYTHONPATH"] = os.pathsep.join(x for x in (args.pytest_path, env.get("PYTHONPATH")) if x)
+    p = Proc([sys.executable, os.path.join(HERE, "official_server.py"), "--repo", args.repo, "--nodename", nodename],
+             logdir, name, lambda ln: ln.startswith("ready "), env=env)
+    return p, json.loads(p.ready[len("ready "):])
+
+
 def start_gateway(args, logdir, urls, name):
     cfg = os.path.join(logdir, name + ".yaml")
     with open(cfg, "w") as f:
         f.write("devices:\n")
         for s in SERVICES:
             f.write("  - name: %s\n    url: %s?service=%s\n    auth: passthrough\n" % (s, urls["url"], s))
-            if s.endswith("_auth"):  # the gateway's own session needs a login there too
-                f.write("    username: testuser1\n    password: testpass1\n")
+            if s.endswith("_auth"):
+                # The gateway's own session needs a login there too. Not as a user the suite locks
+                # with: a user lock goes with its user's last session, and the gateway's own session
+                # lasts (through the gateway, testuser1's lock outlived the suite's testuser1 sessions).
+                f.write("    username: testsuperuser\n    password: superpass1\n")
     p = Proc([args.gateway, "--config", cfg, "--listen", "127.0.0.1", "--port", "0", "--no-demo", "--no-local",
               "--no-discovery", "--log-level", "warning"], logdir, name,
              lambda ln: ln.strip().startswith("{") and '"port"' in ln)
@@ -113,7 +131,7 @@ def run_suite(args, logdir, name, url, env_extra=None, plugins=()):
     env.update(env_extra or {})
     with open(os.path.join(logdir, name + ".pytest.log"), "w") as out:
         subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-rA", "--junitxml", junit]
-                       + [a for p in plugins for a in ("-p", p)] + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
+                       + [a for p in plugins for a in ("-p", p)] + (["-k", args.select] if args.select else []) + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
                        stderr=subprocess.STDOUT, timeout=1800)
     results = {}
     for case in ET.parse(junit).getroot().iter("testcase"):
@@ -138,6 +156,7 @@ def main():
     ap.add_argument("--configs", default="tcp,ws,wss,local,gateway-tcp,gateway-ws")
     ap.add_argument("--pytest-path", default=None, help="a folder to add to PYTHONPATH for pytest")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--select", default=None, help="only the tests pytest -k EXPR selects")
     args = ap.parse_args()
     logdir = args.out or tempfile.mkdtemp(prefix="official-suite-")
     os.makedirs(logdir, exist_ok=True)
@@ -148,48 +167,58 @@ def main():
         table["official server"] = run_suite(args, logdir, "reference", None)
     for config in configs:
         procs = []
+        official = config.startswith("official-")  # the reference: the official server in a process of its own
+        kind = config[len("official-"):] if official else config
         try:
             extra, env = [], {}
-            if config == "wss":
+            if kind == "wss":
+                if official:
+                    raise RuntimeError("the official server is not run with TLS here (it needs RR node certificates)")
                 import tls_pki
                 pki = tls_pki.Pki(os.path.join(logdir, "pki"))
                 ca = pki.ca("ca")
                 leaf = pki.issue(ca, "server", "localhost", sans=["DNS:localhost", "IP:127.0.0.1"])
                 extra = ["--tls-cert", leaf.cert, "--tls-key", leaf.key]
                 env = {"SSL_CERT_FILE": ca.cert}
-            if config == "local":
+            if kind == "local":
                 extra = ["--nodename", "testsvc_" + uuid.uuid4().hex[:10]]
-            svc, urls = start_service(args, logdir, "service-" + config, extra)
+            if official:
+                svc, urls = start_official(args, logdir, "service-" + config)
+            else:
+                svc, urls = start_service(args, logdir, "service-" + config, extra)
             procs.append(svc)
-            if config == "tcp":
+            if kind == "tcp":
                 url = urls["url"]
-            elif config == "ws":
+            elif kind == "ws":
                 url = urls["ws_url"]
-            elif config == "wss":
+            elif kind == "wss":
                 url = urls["wss_url"].replace("localhost", "127.0.0.1")
-            elif config == "local":
+            elif kind == "local":
                 url = urls["local_url"]
             else:
                 gw, port = start_gateway(args, logdir, urls, "gateway-" + config)
                 procs.append(gw)
-                url = ("rr+tcp://127.0.0.1:%d/" if config == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
+                url = ("rr+tcp://127.0.0.1:%d/" if kind == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
             print("%s: %s" % (config, url), flush=True)
             table[config] = run_suite(args, logdir, config, url, env)
-            if config == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
-                table["local (URL joined with &)"] = run_suite(args, logdir, "local-joined", url, env,
-                                                               plugins=["official_suite_local_url"])
+            if kind == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
+                table[config + " (URL joined with &)"] = run_suite(args, logdir, config + "-joined", url, env,
+                                                                   plugins=["official_suite_local_url"])
         except Exception as e:
             table[config] = {"(setup)": "failed: %s" % e}
         finally:
             for p in reversed(procs):
                 code = p.stop()
                 if code not in (0, None):
-                    table.setdefault(config, {})["(%s exit)" % os.path.basename(p.p.args[0])] = "failed: exit status %s" % code
+                    name = os.path.splitext(os.path.basename(p.log.name))[0]
+                    table.setdefault(config, {})["(%s exit)" % name] = "failed: exit status %s" % code
 
     tests = sorted({t for r in table.values() for t in r})
     ok = True
     for config, results in table.items():
         for t in tests:
+            if t.startswith("(") and t not in results:
+                continue  # a configuration's setup failure or exit status
             outcome = results.get(t, "not run")
             ok = ok and outcome == "passed"
             print("%-16s %-45s %s" % (config, t, outcome))
