@@ -10,13 +10,13 @@ service tests with pytest. Configurations (--configs, comma-separated):
                              same names, `auth: passthrough`, the client on rr+tcp / rr+ws
   official-CONFIG            the same with the official test server (official_server.py) instead of
                              rr-test-service (not wss): the reference
---reference also runs the suite without the variable, where it starts the official test server in its
-own process. Prints one line per test and configuration and a summary; the JUnit files stay in --out.
+--reference also runs the suite without the variable, where it serves the official test services in
+pytest's own process (service_test_util.py). Prints one line per test and configuration and a summary; the JUnit files stay in --out.
 
     .venv/bin/python test/testsvc/official_suite.py --repo /tmp/rr-official --values /tmp/official-values.json \\
         --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/server/app/rr-gateway] \\
         [--reference] [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws,official-tcp,...] \\
-        [--pytest-path DIR] [--select PYTEST_K_EXPR] [--out DIR]
+        [--pytest-path DIR] [--select PYTEST_K_EXPR] [--repeat N] [--out DIR]
 Exit 0 when every test passed in every configuration run, 1 otherwise.
 """
 
@@ -157,6 +157,7 @@ def main():
     ap.add_argument("--pytest-path", default=None, help="a folder to add to PYTHONPATH for pytest")
     ap.add_argument("--out", default=None)
     ap.add_argument("--select", default=None, help="only the tests pytest -k EXPR selects")
+    ap.add_argument("--repeat", type=int, default=1, help="run the suite N times against each service process")
     args = ap.parse_args()
     logdir = args.out or tempfile.mkdtemp(prefix="official-suite-")
     os.makedirs(logdir, exist_ok=True)
@@ -201,6 +202,8 @@ def main():
                 url = ("rr+tcp://127.0.0.1:%d/" if kind == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
             print("%s: %s" % (config, url), flush=True)
             table[config] = run_suite(args, logdir, config, url, env)
+            for n in range(2, args.repeat + 1):  # again against the same service process
+                table["%s #%d" % (config, n)] = run_suite(args, logdir, "%s-%d" % (config, n), url, env)
             if kind == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
                 table[config + " (URL joined with &)"] = run_suite(args, logdir, config + "-joined", url, env,
                                                                    plugins=["official_suite_local_url"])
