@@ -7,7 +7,9 @@ service tests with pytest. Configurations (--configs, comma-separated):
   tcp, ws, wss, local        rr-test-service with the official values on rr+tcp, rr+ws, rr+wss (a
                              throw-away certificate), rr+local (also with the URL joined by &)
   gateway-tcp, gateway-ws    rr-gateway (--gateway) in front of it: the four services as devices of the
-                             same names, `auth: passthrough`, the client on rr+tcp / rr+ws
+                             same names, `auth: passthrough`, the client on rr+tcp / rr+ws, the gateway
+                             reaching the service on rr+tcp; gateway-CLIENT-via-DEVICE (DEVICE: ws,
+                             wss, local) reaches it on another transport
   official-CONFIG            the same with the official test server (official_server.py) instead of
                              rr-test-service (not wss): the reference
 --reference also runs the suite without the variable, where it serves the official test services in
@@ -91,12 +93,18 @@ def start_official(args, logdir, name):
     return p, json.loads(p.ready[len("ready "):])
 
 
-def start_gateway(args, logdir, urls, name):
+URL_KEYS = {"tcp": "url", "ws": "ws_url", "wss": "wss_url", "local": "local_url"}
+
+
+def start_gateway(args, logdir, device_url, name, tls_ca=None):
     cfg = os.path.join(logdir, name + ".yaml")
     with open(cfg, "w") as f:
         f.write("devices:\n")
         for s in SERVICES:
-            f.write("  - name: %s\n    url: %s?service=%s\n    auth: passthrough\n" % (s, urls["url"], s))
+            f.write("  - name: %s\n    url: %s%sservice=%s\n    auth: passthrough\n"
+                    % (s, device_url, "&" if "?" in device_url else "?", s))
+            if tls_ca:
+                f.write("    tls_ca: %s\n" % tls_ca)
             if s.endswith("_auth"):
                 # The gateway's own session needs a login there too. Not as a user the suite locks
                 # with: a user lock goes with its user's last session, and the gateway's own session
@@ -170,36 +178,38 @@ def main():
         procs = []
         official = config.startswith("official-")  # the reference: the official server in a process of its own
         kind = config[len("official-"):] if official else config
+        # gateway-CLIENT[-via-DEVICE]: the suite reaches the gateway on CLIENT, the gateway the service on DEVICE
+        client, _, via = kind[len("gateway-"):].partition("-via-") if kind.startswith("gateway-") else (kind, "", "")
+        served = via or ("tcp" if kind.startswith("gateway-") else kind)  # the service's transport in use
         try:
-            extra, env = [], {}
-            if kind == "wss":
+            if client not in ("tcp", "ws", "wss", "local") or served not in URL_KEYS or \
+                    (kind.startswith("gateway-") and client not in ("tcp", "ws")):
+                raise RuntimeError("unknown configuration " + config)
+            extra, env, ca_cert = [], {}, None
+            if served == "wss":
                 if official:
                     raise RuntimeError("the official server is not run with TLS here (it needs RR node certificates)")
                 import tls_pki
-                pki = tls_pki.Pki(os.path.join(logdir, "pki"))
+                pki = tls_pki.Pki(os.path.join(logdir, "pki-" + config))
                 ca = pki.ca("ca")
                 leaf = pki.issue(ca, "server", "localhost", sans=["DNS:localhost", "IP:127.0.0.1"])
                 extra = ["--tls-cert", leaf.cert, "--tls-key", leaf.key]
-                env = {"SSL_CERT_FILE": ca.cert}
-            if kind == "local":
+                ca_cert = ca.cert
+            if served == "local":
                 extra = ["--nodename", "testsvc_" + uuid.uuid4().hex[:10]]
             if official:
                 svc, urls = start_official(args, logdir, "service-" + config)
             else:
                 svc, urls = start_service(args, logdir, "service-" + config, extra)
             procs.append(svc)
-            if kind == "tcp":
-                url = urls["url"]
-            elif kind == "ws":
-                url = urls["ws_url"]
-            elif kind == "wss":
-                url = urls["wss_url"].replace("localhost", "127.0.0.1")
-            elif kind == "local":
-                url = urls["local_url"]
-            else:
-                gw, port = start_gateway(args, logdir, urls, "gateway-" + config)
+            url = urls[URL_KEYS[served]]
+            if served == "wss" and not kind.startswith("gateway-"):
+                url = url.replace("localhost", "127.0.0.1")
+                env = {"SSL_CERT_FILE": ca_cert}
+            if kind.startswith("gateway-"):
+                gw, port = start_gateway(args, logdir, url, "gateway-" + config, tls_ca=ca_cert)
                 procs.append(gw)
-                url = ("rr+tcp://127.0.0.1:%d/" if kind == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
+                url = "rr+%s://127.0.0.1:%d/" % (client, port)
             print("%s: %s" % (config, url), flush=True)
             table[config] = run_suite(args, logdir, config, url, env)
             for n in range(2, args.repeat + 1):  # again against the same service process
