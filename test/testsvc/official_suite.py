@@ -30,18 +30,16 @@ import subprocess
 import sys
 import tempfile
 import threading
-import time
-import urllib.request
 import uuid
 import xml.etree.ElementTree as ET
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
+sys.path.insert(0, HERE)
+import gateway_front  # noqa: E402
 
 SUITE = ["RobotRaconteurTest/test_attributes.py", "RobotRaconteurTest/test_service.py",
          "RobotRaconteurTest/test_service2.py", "RobotRaconteurTest/test_service3.py"]
-SERVICES = ["RobotRaconteurTestService", "RobotRaconteurTestService_auth", "RobotRaconteurTestService2",
-            "RobotRaconteurTestService3"]
 
 
 class Proc:
@@ -99,32 +97,12 @@ URL_KEYS = {"tcp": "url", "ws": "ws_url", "wss": "wss_url", "local": "local_url"
 def start_gateway(args, logdir, device_url, name, tls_ca=None):
     cfg = os.path.join(logdir, name + ".yaml")
     with open(cfg, "w") as f:
-        f.write("devices:\n")
-        for s in SERVICES:
-            f.write("  - name: %s\n    url: %s%sservice=%s\n    auth: passthrough\n"
-                    % (s, device_url, "&" if "?" in device_url else "?", s))
-            if tls_ca:
-                f.write("    tls_ca: %s\n" % tls_ca)
-            if s.endswith("_auth"):
-                # The gateway's own session needs a login there too. Not as a user the suite locks
-                # with: a user lock goes with its user's last session, and the gateway's own session
-                # lasts (through the gateway, testuser1's lock outlived the suite's testuser1 sessions).
-                f.write("    username: testsuperuser\n    password: superpass1\n")
-    p = Proc([args.gateway, "--config", cfg, "--listen", "127.0.0.1", "--port", "0", "--no-demo", "--no-local",
-              "--no-discovery", "--log-level", "warning"], logdir, name,
-             lambda ln: ln.strip().startswith("{") and '"port"' in ln)
-    port = json.loads(p.ready)["port"]
-    deadline = time.time() + 60
-    while True:  # /readyz answers 200 once every device is connected
-        try:
-            if urllib.request.urlopen("http://127.0.0.1:%d/readyz" % port, timeout=2).status == 200:
-                break
-        except Exception:
-            pass
-        if time.time() > deadline:
-            p.stop()
-            raise RuntimeError("gateway not ready; see " + p.log.name)
-        time.sleep(0.2)
+        f.write(gateway_front.config_text(device_url, tls_ca))
+    p = Proc(gateway_front.argv(args.gateway, cfg), logdir, name, gateway_front.is_ready_line)
+    port = gateway_front.port_of(p.ready)
+    if not gateway_front.wait_until_ready(port, 60, lambda: p.p.poll() is None):
+        p.stop()
+        raise RuntimeError("gateway not ready; see " + p.log.name)
     return p, port
 
 
