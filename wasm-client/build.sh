@@ -31,21 +31,22 @@ mkdir -p "$dist"
 copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || { cp "$1" "$2.tmp$$" && mv -f "$2.tmp$$" "$2"; }; }
 copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
 copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
-for f in robotraconteur.mjs errors.mjs proxy.mjs subscription.mjs backoff.mjs json_client.mjs json_client.d.ts index.d.ts; do copy_if_changed "$here/src/$f" "$dist/$f"; done
+for f in "$here"/src/*.mjs "$here"/src/*.d.ts; do copy_if_changed "$f" "$dist/$(basename "$f")"; done
 copy_if_changed "$here/README.md" "$dist/README.md"
-# The dashboard's standard-type modules (web/src/std: renderers, image decoding, readable text) for
-# the package's users, with the three page modules they import, in the same layout:
-# import { ... } from "robotraconteur-wasm/std" (dist/dashboard/std/index.js).
+# The dashboard's folders that are packages of their own, each copied whole with its declarations and
+# nothing else (they import nothing from outside their folder but each other: web/test/std_package.test.mjs):
+#   web/src/std   -> dashboard/std   (standard-type renderers, image decoding, readable text):
+#                    import { ... } from "robotraconteur-wasm/std" (dashboard/std/index.js)
+#   web/src/robot -> dashboard/robot (forward kinematics, the three.js view, ...):
+#                    import { ... } from "robotraconteur-wasm/robot/kinematics.js"
 web="$root/web/src"
-mkdir -p "$dist/dashboard/std"
-for f in rr_types.js value_codec.js robdef_outline.js; do copy_if_changed "$web/$f" "$dist/dashboard/$f"; done
-for f in "$web"/std/*.js "$web"/std/index.d.ts; do copy_if_changed "$f" "$dist/dashboard/std/$(basename "$f")"; done
-for f in "$dist"/dashboard/std/*.js; do [ -f "$web/std/$(basename "$f")" ] || rm -f "$f"; done
-# The robot modules (web/src/robot: forward kinematics, the three.js view, ...), the whole folder with
-# its declarations: import { ... } from "robotraconteur-wasm/robot/kinematics.js" (dashboard/robot/).
-mkdir -p "$dist/dashboard/robot"
-for f in "$web"/robot/*.js "$web"/robot/*.d.ts; do [ -f "$f" ] && copy_if_changed "$f" "$dist/dashboard/robot/$(basename "$f")"; done
-for f in "$dist"/dashboard/robot/*; do [ -f "$web/robot/$(basename "$f")" ] || rm -f "$f"; done
+for folder in std robot; do
+  mkdir -p "$dist/dashboard/$folder"
+  for f in "$web/$folder"/*.js "$web/$folder"/*.d.ts; do [ -f "$f" ] && copy_if_changed "$f" "$dist/dashboard/$folder/$(basename "$f")"; done
+  for f in "$dist/dashboard/$folder"/*; do [ -f "$web/$folder/$(basename "$f")" ] || rm -f "$f"; done
+done
+# what older builds put beside std/ (the page modules std once imported)
+rm -f "$dist"/dashboard/*.js
 # The standard service definitions as TypeScript (`rr-robdef ts`, robdef/typescript.hpp; the node build of
 # rr-robdef from this build folder): dist/types/std/<service>.d.ts + .js, imported as
 # "robotraconteur-wasm/std/<service>" (package.json exports "./std/*"; "./std" alone stays the dashboard's

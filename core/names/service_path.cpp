@@ -1,5 +1,7 @@
 #include "core/names/service_path.hpp"
 
+#include "core/names/object_path.hpp"
+
 namespace rr {
 namespace {
 
@@ -54,37 +56,12 @@ Result<std::string> decode_service_path_index(std::string_view encoded) {
 }
 
 Result<std::vector<ServicePathSegment>> split_service_path(std::string_view path) {
+    // A service path is an object path whose first segment is the service (object_path.hpp): one parser.
+    auto parsed = parse_object_path(path, ObjectPathIndexes::encoded);
+    if (!parsed) return parsed.take_error();
     std::vector<ServicePathSegment> segments;
-    if (path.empty()) return fail(MessageErrorType::InvalidArgument, "empty service path");
-    std::size_t pos = 0;
-    while (pos <= path.size()) {
-        // A segment ends at the next '.' outside brackets (brackets never hold '.': it would be escaped).
-        auto dot = path.find('.', pos);
-        auto seg = path.substr(pos, dot == std::string_view::npos ? std::string_view::npos : dot - pos);
-        ServicePathSegment s;
-        auto open = seg.find('[');
-        auto name = seg.substr(0, open);
-        if (name.empty()) return fail(MessageErrorType::InvalidArgument, "empty segment in service path \"" + std::string(path) + "\"");
-        for (char c : name)
-            if (!is_alnum(c) && c != '_')
-                return fail(MessageErrorType::InvalidArgument, "invalid character in service path \"" + std::string(path) + "\"");
-        s.name = std::string(name);
-        if (open != std::string_view::npos) {
-            if (seg.back() != ']' || seg.size() - open < 3)
-                return fail(MessageErrorType::InvalidArgument, "bad index in service path \"" + std::string(path) + "\"");
-            auto enc = seg.substr(open + 1, seg.size() - open - 2);
-            for (char c : enc)
-                if (!is_alnum(c) && c != '_' && c != '%')
-                    return fail(MessageErrorType::InvalidArgument, "bad index in service path \"" + std::string(path) + "\"");
-            auto idx = decode_service_path_index(enc);
-            if (!idx) return idx.take_error();
-            s.index = std::move(*idx);
-            s.has_index = true;
-        }
-        segments.push_back(std::move(s));
-        if (dot == std::string_view::npos) break;
-        pos = dot + 1;
-    }
+    segments.reserve(parsed->segments.size());
+    for (auto& s : parsed->segments) segments.push_back(ServicePathSegment{std::move(s.name), std::move(s.index), s.has_index});
     return segments;
 }
 

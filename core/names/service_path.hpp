@@ -26,8 +26,8 @@ struct ServicePathSegment {
     bool has_index = false;
 };
 
-/// Splits and validates a service path (segments match `^[A-Za-z0-9_]+(\[[A-Za-z0-9_%]+\])?$`).
-/// Errors: InvalidArgument.
+/// Splits and validates a service path (segments match `^[A-Za-z0-9_]+(\[[A-Za-z0-9_%]+\])?$`, every
+/// `%` followed by two hex digits). Errors: InvalidArgument, object_path.hpp's messages.
 Result<std::vector<ServicePathSegment>> split_service_path(std::string_view path);
 
 /// `parent.member` or `parent.member[encoded index]`.

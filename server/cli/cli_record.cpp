@@ -82,8 +82,7 @@ ExitCode run_record(const CommandLine& cl, std::ostream& out, std::ostream& err,
     server::record::RecordingSpec spec;
     spec.device = dc.name;
     spec.members = cl.record_members;
-    spec.json = cl.encoding != "robotraconteur";
-    spec.robotraconteur = cl.encoding != "json";
+    if (!cl.encoding.empty()) spec.encodings = {cl.encoding};  // empty: both (the default)
     spec.prefix = cl.prefix;
     // The CLI writes on its user's own computer, where its user chose: --dir is its root (no budget),
     // the files go into it (made new, O_EXCL, as the gateway makes them).

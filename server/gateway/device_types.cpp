@@ -1,5 +1,7 @@
 #include "server/gateway/device_types.hpp"
 
+#include "core/names/object_path_walk.hpp"
+
 namespace rr::server::gateway {
 
 Result<std::shared_ptr<const DeviceTypes>> DeviceTypes::parse(std::vector<std::string> texts) {
@@ -13,13 +15,9 @@ Result<std::shared_ptr<const DeviceTypes>> DeviceTypes::parse(std::vector<std::s
 }
 
 std::optional<DeviceTypes::Object> DeviceTypes::find_object(std::string_view qualified_name) const {
-    const auto dot = qualified_name.rfind('.');
-    if (dot == std::string_view::npos) return std::nullopt;
-    const auto* svc = set_.find_service(qualified_name.substr(0, dot));
-    if (!svc) return std::nullopt;
-    const auto* entry = svc->find_entry(qualified_name.substr(dot + 1));
-    if (!entry || entry->kind != robdef::EntryKind::object) return std::nullopt;
-    return Object{svc, entry};
+    auto at = find_object_type(set_, qualified_name);
+    if (!at) return std::nullopt;
+    return Object{at->service, at->object};
 }
 
 const element_json_text::Plan* DeviceTypes::json_text_plan(const robdef::TypeDefinition& type,

@@ -5,7 +5,6 @@
 
 #include "core/json/value_json.hpp"
 #include "core/message/error_entry.hpp"
-#include "core/names/service_path.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/timespec.hpp"
@@ -16,62 +15,9 @@ namespace rr::server::gateway {
 
 namespace {
 
-bool is_name_char(char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-}
-
-bool is_hex(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F'); }
-
-// An index already in RR's service-path encoding: letters, digits, `_`, and `%hh` escapes.
-bool is_encoded_index(std::string_view s) {
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        if (is_name_char(s[i])) continue;
-        if (s[i] == '%' && i + 2 < s.size() && is_hex(s[i + 1]) && is_hex(s[i + 2])) {
-            i += 2;
-            continue;
-        }
-        return false;
-    }
-    return true;
-}
-
 std::string_view kind_word(robdef::MemberKind k) { return robdef::member_kind_keyword(k); }
 
 }  // namespace
-
-Result<std::string> normalize_object_path(std::string_view rel) {
-    const std::string quoted = "object path \"" + std::string(rel) + "\"";
-    if (rel.empty()) return fail(MessageErrorType::InvalidArgument, quoted + " is empty");
-    std::string out;
-    std::size_t i = 0;
-    while (i < rel.size()) {
-        const std::size_t start = i;
-        while (i < rel.size() && is_name_char(rel[i])) ++i;
-        if (i == start)
-            return fail(MessageErrorType::InvalidArgument,
-                        quoted + ": expected a member name at offset " + std::to_string(start));
-        std::string segment(rel.substr(start, i - start));
-        if (i < rel.size() && rel[i] == '[') {
-            const auto close = rel.find(']', i + 1);
-            if (close == std::string_view::npos) return fail(MessageErrorType::InvalidArgument, quoted + ": '[' without ']'");
-            const auto index = rel.substr(i + 1, close - i - 1);
-            if (index.empty()) return fail(MessageErrorType::InvalidArgument, quoted + ": empty index");
-            segment += '[';
-            segment += is_encoded_index(index) ? std::string(index) : encode_service_path_index(index);
-            segment += ']';
-            i = close + 1;
-        }
-        if (!out.empty()) out += '.';
-        out += segment;
-        if (i < rel.size()) {
-            if (rel[i] != '.')
-                return fail(MessageErrorType::InvalidArgument,
-                            quoted + ": unexpected '" + std::string(1, rel[i]) + "' at offset " + std::to_string(i));
-            if (++i == rel.size()) return fail(MessageErrorType::InvalidArgument, quoted + " ends with '.'");
-        }
-    }
-    return out;
-}
 
 Result<nlohmann::json> parse_request_json(std::string_view text) {
     std::size_t depth = 0;

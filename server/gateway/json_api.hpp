@@ -24,6 +24,7 @@
 
 #include "core/codec/limits.hpp"
 #include "core/json/value_json.hpp"
+#include "core/names/object_path.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
@@ -79,10 +80,8 @@ struct JsonApiOptions {
     Limits limits;
 };
 
-/// Turns a relative object path into RR service-path form: segments `name` or `name[index]` joined
-/// by '.'; an index already in RR's encoding (letters, digits, `_`, `%hh`) is kept, any other index
-/// text (`-1`, `with space`) is encoded (wire.md §6.5). Errors: InvalidArgument.
-Result<std::string> normalize_object_path(std::string_view relative);
+/// A relative object path (`object=`) in RR service-path form: core/names/object_path.hpp.
+using ::rr::normalize_object_path;
 
 class JsonApi : public std::enable_shared_from_this<JsonApi> {
 public:

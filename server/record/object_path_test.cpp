@@ -31,19 +31,7 @@ end
 
 }  // namespace
 
-TEST_CASE("record: a member path splits at its last dot outside brackets") {
-    CHECK(split_member_path("packets").object.empty());
-    CHECK(split_member_path("packets").member == "packets");
-    auto p = split_member_path("Webcams[0].FrameStream");
-    CHECK(p.object == "Webcams[0]");
-    CHECK(p.member == "FrameStream");
-    p = split_member_path("arms[left.arm].tool.state");
-    CHECK(p.object == "arms[left.arm].tool");
-    CHECK(p.member == "state");
-    p = split_member_path("cams[a.b]");
-    CHECK(p.object.empty());
-    CHECK(p.member == "cams[a.b]");
-}
+// How a member path splits: core/names/object_path_test.cpp (split_member_path).
 
 TEST_CASE("record: an object below the root is found through the objrefs' declared types") {
     auto types = gateway::DeviceTypes::parse({kArmDef, kToolDef});

@@ -11,18 +11,14 @@
 
 #include "core/mcap/mcap_writer.hpp"
 #include "core/value/timespec.hpp"
-#include "server/gateway/json_push.hpp"
+#include "robdef/parser.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/mcap/mcap_file.hpp"
-#include "server/record/foxglove_image.hpp"
-#include "server/record/json_schema.hpp"
-#include "server/record/object_path.hpp"
 
 namespace rr::server::record {
 
 namespace fs = std::filesystem;
-using gateway::MemberTarget;
 using gateway::SharedEntry;
 using gateway::SharedEntryPtr;
 
@@ -32,16 +28,6 @@ std::string_view recording_state_name(RecordingState s) noexcept {
         case RecordingState::stopping: return "stopping";
         case RecordingState::stopped: return "stopped";
         case RecordingState::failed: return "failed";
-    }
-    return "?";
-}
-
-std::string_view member_kind_name(RecordedMember::Kind k) noexcept {
-    switch (k) {
-        case RecordedMember::Kind::wire: return "wire";
-        case RecordedMember::Kind::pipe: return "pipe";
-        case RecordedMember::Kind::event: return "event";
-        case RecordedMember::Kind::property: return "property";
     }
     return "?";
 }
@@ -57,56 +43,6 @@ nlohmann::json status_json(const RecordingStatus& s) {
 }
 
 namespace {
-
-// A json channel leaves a null member out of its object (an absent struct, list, map or varvalue):
-// its schema gives every property one type, as Foxglove's parser requires, so a null there would not
-// validate; an absent member does. Nulls inside arrays stay (removing them would shift the indices).
-void drop_null_members(nlohmann::json& j) {
-    if (j.is_object()) {
-        for (auto it = j.begin(); it != j.end();) {
-            if (it->is_null()) it = j.erase(it);
-            else drop_null_members(*it++);
-        }
-    } else if (j.is_array()) {
-        for (auto& x : j) drop_null_members(x);
-    }
-}
-
-std::string without_null_members(std::string text) {
-    // The common case (a text plan's, null members already left out): nothing to parse again.
-    if (text.find("null") == std::string::npos) return text;
-    auto j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded()) return text;
-    drop_null_members(j);
-    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-// The json message of a pipe packet or a polled property: {"value": …}, or {"error": …} for no value or
-// one that does not fit. Written straight from the element, null members left out, when the member's
-// type has a text plan (core/json/element_json_plan.hpp): a 320x240 camera frame is one pass over its
-// bytes, not a tree of 230,400 numbers built, walked for nulls and dumped; through element_json
-// otherwise and for errors.
-std::string value_message_text(const gateway::JsonApi& api, const MessageElement* el, const gateway::MemberTarget& t) {
-    if (el && t.types && t.service) {
-        if (const auto* plan = t.types->json_text_plan(t.member->type, t.context(), api.options().limits)) {
-            std::string out = "{\"value\":";
-            if (plan->append(out, *el, /*omit_null_members=*/true)) {
-                out += '}';
-                return without_null_members(std::move(out));
-            }
-        }
-    }
-    nlohmann::json body = nlohmann::json::object();
-    if (!el) {
-        body["error"] = {{"message", "no value"}};
-    } else {
-        auto j = api.element_json(*el, t.member->type, t);
-        if (j) body["value"] = std::move(j.value);
-        else body["error"] = {{"name", j.error->name}, {"message", j.error->message}};
-    }
-    drop_null_members(body);
-    return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
 
 std::uint64_t now_ns() {
     return static_cast<std::uint64_t>(
@@ -129,44 +65,26 @@ std::string utc_stamp() {
     return buf;
 }
 
-// The service name a definition text declares (`service a.b.c`), for the schema's name.
-std::string service_name_of(const std::string& text) {
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-        std::size_t end = text.find('\n', pos);
-        if (end == std::string::npos) end = text.size();
-        std::string_view line(text.data() + pos, end - pos);
-        while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
-        if (line.substr(0, 8) == "service ") {
-            line.remove_prefix(8);
-            while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
-            return std::string(line);
-        }
-        pos = end + 1;
+// The service name each definition text declares (`service a.b.c`), read by the robdef parser (the
+// texts parsed already as the device's types): the schemas' names.
+std::vector<std::string> declared_service_names(const std::vector<std::string>& texts) {
+    std::vector<std::string> names;
+    for (const auto& text : texts) {
+        auto parsed = robdef::parse_service_definition(text, "device definition");
+        names.push_back(parsed ? parsed->definition.name : "unknown");
     }
-    return "unknown";
-}
-
-// The object's path below the root from a target's service path in gateway naming (`<device>` or
-// `<device>.<relative path>`): "" for the root.
-std::string object_path_of(const std::string& service_path, const std::string& device) {
-    return service_path.size() > device.size() ? service_path.substr(device.size() + 1) : std::string();
+    return names;
 }
 
 std::span<const std::byte> as_bytes(std::string_view s) { return {reinterpret_cast<const std::byte*>(s.data()), s.size()}; }
 
 }  // namespace
 
-// The open MCAP file and its channel ids.
+// The open MCAP file (its channels are the formats' encoders').
 struct Recording::File {
     std::string path;
     std::unique_ptr<mcap::FileSink> sink;
     std::unique_ptr<mcap::McapWriter> writer;
-    std::vector<int> json_channel, rr_channel;  // per member; -1 = none
-    // Per member: the Foxglove image channel (-1 = none), its kind and its sequence counter.
-    std::vector<int> foxglove_channel;
-    std::vector<FoxgloveImageKind> foxglove_kind;
-    std::vector<std::uint32_t> foxglove_sequence;
     std::chrono::steady_clock::time_point opened = std::chrono::steady_clock::now();
     std::size_t summary_base = 0;  // the writer's summary memory once schemas and channels were added
 };
@@ -182,92 +100,35 @@ static std::string prefix_of_device(const std::string& device) {
 
 Result<std::shared_ptr<Recording>> Recording::create(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
                                                      std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
-                                                     RecordingListeners listeners) {
+                                                     RecordingListeners listeners, const RecordingFormats& formats) {
     if (!device || !api) return fail(MessageErrorType::InvalidArgument, "record: no such device \"" + spec.device + "\"");
     if (!root) return fail(MessageErrorType::InvalidState, "record: no recordings root");
     if (auto r = check_subfolder(spec.directory); !r) return r.take_error();
     if (auto r = check_prefix(spec.prefix); !r) return r.take_error();
+    for (const auto& e : spec.encodings)
+        if (std::none_of(formats.begin(), formats.end(), [&](const auto& f) { return f->is_encoding() && f->name() == e; }))
+            return fail(MessageErrorType::InvalidArgument, "record: encoding: no format \"" + e + "\"");
+    if (std::none_of(formats.begin(), formats.end(), [&](const auto& f) { return f->enabled(spec); }))
+        return fail(MessageErrorType::InvalidArgument, "record: encoding: no format to write");
     if (!device->upstream())
         return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\" is not connected (its definitions are needed)");
-    gateway::ApiError type_error;
-    auto types = api->types_for(*device, &type_error);
-    if (!types) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": " + type_error.message);
-    const std::string object_type = device->object_type();
-    auto object = types->find_object(object_type);
-    if (!object) return fail(MessageErrorType::InvalidState, "record: device \"" + spec.device + "\": unknown root type " + object_type);
-
-    std::vector<RecordedMember> members;
-    // `m` of the object at `below` (nullptr: the root).
-    auto add = [&](const robdef::MemberDefinition& m, const ObjectBelow* below = nullptr) -> Result<void> {
-        RecordedMember r;
-        switch (m.kind) {
-            case robdef::MemberKind::wire: r.kind = RecordedMember::Kind::wire; break;
-            case robdef::MemberKind::pipe: r.kind = RecordedMember::Kind::pipe; break;
-            case robdef::MemberKind::event: r.kind = RecordedMember::Kind::event; break;
-            case robdef::MemberKind::property:
-                if (m.direction() == robdef::MemberDirection::writeonly)
-                    return fail(MessageErrorType::InvalidArgument, "record: members: property \"" + m.name + "\" is write-only");
-                r.kind = RecordedMember::Kind::property;
-                break;
-            default:
-                return fail(MessageErrorType::InvalidArgument,
-                            "record: members: \"" + m.name + "\" is " + robdef::with_article(robdef::member_kind_keyword(m.kind)) +
-                                " (wires, pipes, events and properties can be recorded)");
-        }
-        auto t = std::make_shared<MemberTarget>();
-        t->device = device;
-        t->types = types;
-        t->path = below ? device->config().name + "." + below->path : device->config().name;
-        t->object_type = below ? below->object_type : object_type;
-        t->service = below ? below->object.service : object->service;
-        t->object = below ? below->object.entry : object->entry;
-        t->member = &m;
-        r.target = std::move(t);
-        members.push_back(std::move(r));
-        return {};
-    };
-    if (spec.members.empty()) {
-        for (const auto& m : object->entry->members) {
-            const bool stream = m.kind == robdef::MemberKind::wire || m.kind == robdef::MemberKind::pipe ||
-                                m.kind == robdef::MemberKind::event;
-            const bool prop = m.kind == robdef::MemberKind::property && spec.property_period.count() > 0 &&
-                              m.direction() != robdef::MemberDirection::writeonly;
-            if (stream || prop)
-                if (auto r = add(m); !r) return r.take_error();
-        }
-    } else {
-        for (const auto& name : spec.members) {
-            const auto split = split_member_path(name);
-            if (split.object.empty()) {
-                const auto* m = object->entry->find_member(name);
-                if (!m) return fail(MessageErrorType::InvalidArgument, "record: members: " + object_type + " has no member \"" + name + "\"");
-                if (auto r = add(*m); !r) return r.take_error();
-                continue;
-            }
-            auto below = object_below(*types, object_type, split.object);
-            if (!below) return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below.error().message);
-            const auto* m = below->object.entry->find_member(split.member);
-            if (!m)
-                return fail(MessageErrorType::InvalidArgument, "record: members: \"" + name + "\": " + below->object_type +
-                                                                   " has no member \"" + split.member + "\"");
-            if (auto r = add(*m, &*below); !r) return r.take_error();
-        }
-    }
-    if (members.empty()) return fail(MessageErrorType::InvalidArgument, "record: " + object_type + ": nothing to record");
-    if (members.size() > 30000) return fail(MessageErrorType::InvalidArgument, "record: too many members");
+    auto members = recorded_members(device, *api, spec.members, spec.property_period);
+    if (!members) return members.take_error();
 
     if (spec.prefix.empty()) spec.prefix = prefix_of_device(spec.device);
 
-    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(members)));
+    auto definition_names = declared_service_names(members->front().target->types->texts());
+    std::shared_ptr<Recording> r(new Recording(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(*members),
+                                               std::move(definition_names), formats));
     r->listeners_ = std::move(listeners);
-    r->sequence_.assign(r->members_.size() * 2, 0);
     // The thread keeps the recording alive until it has ended; the disk work is all done there.
     r->writer_ = std::thread([self = r] { self->writer_loop(); });
     return r;
 }
 
 Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root) {
+                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
+                                                    const RecordingFormats& formats) {
     struct Outcome {
         std::mutex mutex;
         std::condition_variable cv;
@@ -280,7 +141,7 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
         outcome->result = started;
         outcome->cv.notify_all();
     };
-    auto r = create(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(l));
+    auto r = create(id, std::move(spec), std::move(device), std::move(api), std::move(root), std::move(l), formats);
     if (!r) return r;
     std::unique_lock<std::mutex> lock(outcome->mutex);
     outcome->cv.wait(lock, [&] { return outcome->result.has_value(); });
@@ -293,14 +154,20 @@ Result<std::shared_ptr<Recording>> Recording::start(std::uint64_t id, RecordingS
 }
 
 Recording::Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-                     std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members)
+                     std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members,
+                     std::vector<std::string> definition_names, const RecordingFormats& formats)
     : id_(id),
       spec_(std::move(spec)),
       device_(std::move(device)),
       api_(std::move(api)),
       root_(std::move(root)),
       members_(std::move(members)),
-      queue_(spec_.queue_bytes) {}
+      definition_names_(std::move(definition_names)),
+      queue_(spec_.queue_bytes) {
+    for (const auto& f : formats)
+        if (f->enabled(spec_)) encoders_.push_back(f->encoder(format_context_));
+    sequence_.assign(encoders_.size() * members_.size(), 0);
+}
 
 Recording::~Recording() {
     stop();
@@ -478,90 +345,20 @@ Result<void> Recording::open_file() {
     };
     if (auto r = check(f->writer->open()); !r) return r;
 
-    // The device's service definitions (root first): the `robotraconteur` channels' schema, the
-    // definition holding the root object; the others are there for replay and RR tools.
+    // The device's service definitions (root first), for replay and RR tools: a format's channels may
+    // refer to them (FormatFile::definition_schema). Then each format's schemas and channels.
     const auto& texts = members_.front().target->types->texts();
     std::uint16_t root_schema = 0;
     std::map<std::string, std::uint16_t> definition_schemas;  // service name -> schema id
     for (std::size_t i = 0; i < texts.size(); ++i) {
-        const auto name = service_name_of(texts[i]);
-        auto id = f->writer->add_schema(name, "robotraconteur_servicedef", as_bytes(texts[i]));
+        auto id = f->writer->add_schema(definition_names_[i], kServiceDefinitionSchemaEncoding, as_bytes(texts[i]));
         if (!id) return check(id.take_error());
         if (i == 0) root_schema = *id;
-        definition_schemas.emplace(name, *id);
+        definition_schemas.emplace(definition_names_[i], *id);
     }
-    const std::string device = spec_.device;
-    std::map<std::string, std::uint16_t> image_schemas;  // Foxglove schema name -> id, added once
-    for (const auto& m : members_) {
-        const auto& t = *m.target;
-        std::map<std::string, std::string> meta{{"device", device},
-                                                {"member", t.member->name},
-                                                {"kind", std::string(member_kind_name(m.kind))},
-                                                {"object_type", t.object_type},
-                                                {"path", object_path_of(t.path, device)},
-                                                {"root_type", device_->object_type()}};
-        if (m.kind != RecordedMember::Kind::event) meta["type"] = t.member->type.to_string();
-        if (m.kind == RecordedMember::Kind::property)
-            meta["period_ms"] = std::to_string(spec_.property_period.count() > 0 ? spec_.property_period.count() : 1000);
-        const std::string topic = channel_topic(device, meta["path"], t.member->name);
-        int json_id = -1, rr_id = -1;
-        if (spec_.json) {
-            const std::string title = t.object_type + "." + t.member->name;
-            nlohmann::json schema;
-            switch (m.kind) {
-                case RecordedMember::Kind::wire:
-                    schema = wire_message_schema(t.member->type, t.types->set(), t.context(), title);
-                    break;
-                case RecordedMember::Kind::event:
-                    schema = event_message_schema(*t.member, t.types->set(), t.context(), title);
-                    break;
-                default: schema = value_message_schema(t.member->type, t.types->set(), t.context(), title);
-            }
-            const std::string text = schema.dump();
-            auto sid = f->writer->add_schema(title, "jsonschema", as_bytes(text));
-            if (!sid) return check(sid.take_error());
-            auto cid = f->writer->add_channel(*sid, topic, "json", meta);
-            if (!cid) return check(cid.take_error());
-            json_id = *cid;
-        }
-        if (spec_.robotraconteur) {
-            auto rr_meta = meta;
-            rr_meta["entry_format"] = "4";
-            // the schema: the definition holding the member's object (the root's for root members)
-            const auto d = definition_schemas.find(t.service->name);
-            auto cid = f->writer->add_channel(d != definition_schemas.end() ? d->second : root_schema, topic, "robotraconteur", rr_meta);
-            if (!cid) return check(cid.take_error());
-            rr_id = *cid;
-        }
-        // A standard image also as Foxglove's RawImage / CompressedImage (foxglove_image.hpp).
-        int foxglove_id = -1;
-        FoxgloveImageKind foxglove_kind = FoxgloveImageKind::raw;
-        if (spec_.json && spec_.foxglove_images && m.kind != RecordedMember::Kind::event) {
-            if (auto kind = foxglove_image_kind(t.member->type, t.types->set(), t.context())) {
-                foxglove_kind = *kind;
-                const std::string name(foxglove_schema_name(*kind));
-                auto& sid = image_schemas[name];
-                if (!sid) {
-                    auto id = f->writer->add_schema(name, "jsonschema", as_bytes(foxglove_image_schema(*kind).dump()));
-                    if (!id) return check(id.take_error());
-                    sid = *id;
-                }
-                auto fox_meta = meta;
-                fox_meta["foxglove"] = *kind == FoxgloveImageKind::raw
-                                           ? "RawImage of the encodings rgb888 rgba8888 bgr888 bgra8888 mono8 mono16 "
-                                             "bayer_*8888 depth_u16; other frames are not on this channel"
-                                           : "CompressedImage of JPEG, PNG or WebP bytes; other frames are not on this channel";
-                auto cid = f->writer->add_channel(sid, topic + "/foxglove", "json", fox_meta);
-                if (!cid) return check(cid.take_error());
-                foxglove_id = *cid;
-            }
-        }
-        f->json_channel.push_back(json_id);
-        f->rr_channel.push_back(rr_id);
-        f->foxglove_channel.push_back(foxglove_id);
-        f->foxglove_kind.push_back(foxglove_kind);
-        f->foxglove_sequence.push_back(0);
-    }
+    FormatFile file(*f->writer, f->path, definition_schemas, root_schema);
+    for (auto& encoder : encoders_)
+        if (auto r = encoder->open_file(file); !r) return r;
     f->summary_base = f->writer->summary_memory_bytes();
     // Schemas and channels on disk at once: a file killed before its first full chunk still names them.
     if (auto r = check(f->writer->flush()); !r) return r;
@@ -614,7 +411,6 @@ void Recording::enforce_budget() {
 
 Result<void> Recording::write_item(const Item& item) {
     const auto& m = members_[item.member];
-    const auto& t = *m.target;
     const MessageEntry& e = item.entry->entry();
     std::uint64_t publish = item.log_ns;
     if (m.kind == RecordedMember::Kind::wire) {
@@ -622,54 +418,10 @@ Result<void> Recording::write_item(const Item& item) {
             if (auto time = unpack_timespec(*ts); time && time->seconds >= 0)
                 publish = static_cast<std::uint64_t>(time->seconds) * 1000000000ull + static_cast<std::uint64_t>(time->nanoseconds);
     }
-    auto write = [&](int channel, std::uint32_t& seq, std::span<const std::byte> data) -> Result<void> {
-        mcap::MessageView v;
-        v.channel_id = static_cast<std::uint16_t>(channel);
-        v.sequence = seq++;
-        v.log_time = item.log_ns;
-        v.publish_time = publish;
-        v.data = data;
-        auto r = file_->writer->write(v);
-        if (!r) return fail(r.error().type, "record: " + file_->path + ": " + r.error().message);
-        messages_.fetch_add(1, std::memory_order_relaxed);
-        return {};
-    };
-    if (file_->rr_channel[item.member] >= 0) {
-        // The bytes native clients are sent (cached in the SharedEntry, made once).
-        auto bytes = item.entry->bytes(4);
-        if (bytes)
-            if (auto r = write(file_->rr_channel[item.member], sequence_[item.member * 2 + 1], *bytes); !r) return r;
-    }
-    if (file_->json_channel[item.member] >= 0) {
-        std::string text;
-        switch (m.kind) {
-            case RecordedMember::Kind::wire: text = gateway::wire_push_text(*api_, e, t, /*omit_null_members=*/true); break;
-            case RecordedMember::Kind::event: text = gateway::event_push_text(*api_, e, t, /*omit_null_members=*/true); break;
-            default: {
-                const MessageElement* el = m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
-                                                                                : e.find("value");
-                text = value_message_text(*api_, el, t);
-            }
-        }
-        if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event)
-            text = without_null_members(std::move(text));
-        if (auto r = write(file_->json_channel[item.member], sequence_[item.member * 2], as_bytes(text)); !r) return r;
-    }
-    if (file_->foxglove_channel[item.member] >= 0) {
-        // The image with its pixel bytes as binary blobs (no JSON numbers), then base64 for Foxglove.
-        const MessageElement* el = m.kind == RecordedMember::Kind::wire   ? e.find("packet")
-                                   : m.kind == RecordedMember::Kind::pipe ? (e.elements.empty() ? nullptr : &e.elements[0])
-                                                                          : e.find("value");
-        if (el) {
-            BinaryArrays binary;
-            auto j = api_->element_json(*el, t.member->type, t, &binary);
-            if (j)
-                if (auto text = foxglove_image_message(file_->foxglove_kind[item.member], j.value, binary, item.log_ns))
-                    if (auto r = write(file_->foxglove_channel[item.member], file_->foxglove_sequence[item.member],
-                                       as_bytes(*text));
-                        !r)
-                        return r;
-        }
+    const RecordedEntry entry{item.member, *item.entry, item.log_ns};
+    for (std::size_t k = 0; k < encoders_.size(); ++k) {
+        MessageOut out(*file_->writer, file_->path, item.log_ns, publish, sequence_[k * members_.size() + item.member], messages_);
+        if (auto r = encoders_[k]->write(entry, out); !r) return r;
     }
     return {};
 }
@@ -808,7 +560,7 @@ RecordingStatus Recording::status() const {
     s.id = id_;
     s.spec = spec_;
     for (const auto& m : members_) {
-        const auto object = object_path_of(m.target->path, device_->config().name);
+        const auto object = metadata_value(m.metadata, channel_key::path);
         s.members.push_back(object.empty() ? m.target->member->name : object + "." + m.target->member->name);
     }
     s.drops = queue_.drops();

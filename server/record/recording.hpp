@@ -6,10 +6,12 @@
 // device's reply. They wait in a RecordQueue (record_queue.hpp: bounded by RecordingSpec::queue_bytes;
 // when it is full the entry is dropped and counted, the live path never waits, allocates nothing per
 // value once warm and does not wake the writer per value) and one writer thread per recording (named
-// "rr-record"; the property poller "rr-record-poll") encodes them (`robotraconteur`: the entry's bytes in RR
-// message format 4, cached and shared with the native clients' sends; `json`: the JSON API's mapping)
-// and writes them with McapWriter (core/mcap), rotating files by size, time and the size of the index the
-// writer keeps for the file's summary, deleting the oldest files over the disk budget.
+// "rr-record"; the property poller "rr-record-poll") hands them to each format the spec enables
+// (recording_format.hpp; built in: `robotraconteur`, the entry's bytes in RR message format 4, cached and
+// shared with the native clients' sends; `json`, the JSON API's mapping; `foxglove_image`) and writes
+// what they make with McapWriter (core/mcap), rotating files by size, time and the size of the index the
+// writer keeps for the file's summary, deleting the oldest files over the disk budget. Every file holds
+// the device's service definitions, then each format's schemas and channels.
 //
 // Where: below a RecordingsRoot (recordings_root.hpp), in the spec's sub-folder, each file made new with
 // O_EXCL|O_NOFOLLOW (a name taken, e.g. by a recording of the same prefix started in the same second,
@@ -47,6 +49,7 @@
 #include "server/gateway/json_api.hpp"
 #include "server/gateway/shared_entry.hpp"
 #include "server/record/record_queue.hpp"
+#include "server/record/recording_format.hpp"
 #include "server/record/recording_spec.hpp"
 #include "server/record/recordings_root.hpp"
 
@@ -54,14 +57,6 @@ namespace rr::server::record {
 
 enum class RecordingState : std::uint8_t { recording, stopping, stopped, failed };
 std::string_view recording_state_name(RecordingState s) noexcept;
-
-/// One recorded member: what it is and how it is written.
-struct RecordedMember {
-    enum class Kind : std::uint8_t { wire, pipe, event, property };
-    Kind kind = Kind::wire;
-    std::shared_ptr<const gateway::MemberTarget> target;
-};
-std::string_view member_kind_name(RecordedMember::Kind k) noexcept;
 
 struct RecordingStatus {
     std::uint64_t id = 0;
@@ -104,15 +99,18 @@ public:
     /// empty: every wire, pipe and event of the root. Errors here: InvalidArgument (a member the root
     /// object, or the object at the path, does not have; a path that does not follow objrefs,
     /// object_path.hpp; a member of a kind that cannot be recorded: functions, callbacks, objrefs,
-    /// memories; a bad directory or prefix), InvalidState (device not connected). Errors told to
-    /// `started`: OutOfSystemResource (the root's budget, RecordingsRoot::admit), IOError (a folder or
-    /// file that cannot be made; the message names the path and the reason).
+    /// memories; a bad directory or prefix; an encoding none of `formats` is), InvalidState (device not
+    /// connected). Errors told to `started`: OutOfSystemResource (the root's budget,
+    /// RecordingsRoot::admit), IOError (a folder or file that cannot be made; the message names the path
+    /// and the reason). `formats`: those the spec may enable, in the order their channels are added.
     static Result<std::shared_ptr<Recording>> create(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
                                                      std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
-                                                     RecordingListeners listeners = {});
+                                                     RecordingListeners listeners = {},
+                                                     const RecordingFormats& formats = builtin_recording_formats());
     /// create(), then waits for the start's outcome: every error above is returned (`rr record`, tests).
     static Result<std::shared_ptr<Recording>> start(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root);
+                                                    std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root,
+                                                    const RecordingFormats& formats = builtin_recording_formats());
     ~Recording();
 
     /// Stops taking entries, writes what is queued, closes the file (summary and index); `done` (may be
@@ -128,7 +126,8 @@ private:
     struct File;
 
     Recording(std::uint64_t id, RecordingSpec spec, std::shared_ptr<gateway::DeviceMirror> device,
-              std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members);
+              std::shared_ptr<gateway::JsonApi> api, std::shared_ptr<RecordingsRoot> root, std::vector<RecordedMember> members,
+              std::vector<std::string> definition_names, const RecordingFormats& formats);
     /// From the live path: queue (the reference) or drop.
     void offer(std::uint16_t member, gateway::SharedEntryPtr entry);
     /// The open file's size into files_ and the root's budget (once per batch: the writer does not take
@@ -156,6 +155,11 @@ private:
     const std::shared_ptr<gateway::JsonApi> api_;
     const std::shared_ptr<RecordingsRoot> root_;
     const std::vector<RecordedMember> members_;
+    /// The service name each of the device's definition texts declares (DeviceTypes::texts order).
+    const std::vector<std::string> definition_names_;
+    const FormatContext format_context_{spec_, members_, *api_};
+    /// The enabled formats' encoders, in the formats' order (writer thread only).
+    std::vector<std::unique_ptr<FormatEncoder>> encoders_;
     const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
     RecordingListeners listeners_;
 
@@ -185,7 +189,7 @@ private:
     std::unique_ptr<RecordingsFolder> folder_;
     std::shared_ptr<RecordingsRoot::Admission> admission_;
     std::uint64_t noted_bytes_ = 0;  // what the admission was told the files hold
-    std::vector<std::uint32_t> sequence_;
+    std::vector<std::uint32_t> sequence_;  // per encoder and member: encoders_ index * members + member
     std::uint64_t file_counter_ = 0;
     std::thread poller_;  // started and joined by the writer thread
 

@@ -1,6 +1,9 @@
 #include "server/record/recording_spec.hpp"
 
+#include <algorithm>
 #include <set>
+
+#include "server/record/recording_format.hpp"
 
 namespace rr::server::record {
 namespace {
@@ -16,6 +19,27 @@ Result<std::uint64_t> unsigned_of(const json& j, const std::string& key) {
 Result<std::string> string_of(const json& j, const std::string& key) {
     if (!j.is_string()) return fail(MessageErrorType::InvalidArgument, "record: " + key + ": expected a string");
     return j.get<std::string>();
+}
+
+// `encoding`: a format's name or a list of them, kept in the formats' order, each once.
+Result<std::vector<std::string>> encodings_of(const json& j) {
+    const json given = j.is_array() ? j : json::array({j});
+    std::vector<std::string> names, out;
+    for (const auto& f : builtin_recording_formats())
+        if (f->is_encoding()) names.emplace_back(f->name());
+    for (const auto& x : given) {
+        if (!x.is_string() || std::find(names.begin(), names.end(), x.get<std::string>()) == names.end()) {
+            std::string expected;
+            for (const auto& n : names) expected += json(n).dump() + ", ";
+            expected.resize(expected.size() - 2);
+            return fail(MessageErrorType::InvalidArgument, "record: encoding: expected " + expected + " or a list of " +
+                                                               (names.size() == 2 ? "both" : "them") + ", not " + x.dump());
+        }
+    }
+    for (const auto& n : names)
+        if (std::find(given.begin(), given.end(), n) != given.end()) out.push_back(n);
+    if (out.empty()) return fail(MessageErrorType::InvalidArgument, "record: encoding: empty list");
+    return out;
 }
 
 }  // namespace
@@ -47,14 +71,9 @@ Result<RecordingSpec> spec_from_json(const json& j) {
         }
     }
     if (j.contains("encoding")) {
-        json e = j["encoding"].is_array() ? j["encoding"] : json::array({j["encoding"]});
-        s.json = s.robotraconteur = false;
-        for (const auto& x : e) {
-            if (x == "json") s.json = true;
-            else if (x == "robotraconteur") s.robotraconteur = true;
-            else return fail(MessageErrorType::InvalidArgument, "record: encoding: expected \"json\", \"robotraconteur\" or a list of both, not " + x.dump());
-        }
-        if (!s.json && !s.robotraconteur) return fail(MessageErrorType::InvalidArgument, "record: encoding: empty list");
+        auto encodings = encodings_of(j["encoding"]);
+        if (!encodings) return encodings.take_error();
+        s.encodings = std::move(*encodings);
     }
     if (j.contains("directory")) {
         auto d = string_of(j["directory"], "directory");
@@ -166,12 +185,9 @@ Result<void> check_spec_bounds(const RecordingSpec& spec, const RecordingsSettin
 }
 
 json spec_json(const RecordingSpec& s) {
-    json enc = json::array();
-    if (s.json) enc.push_back("json");
-    if (s.robotraconteur) enc.push_back("robotraconteur");
     return json{{"device", s.device},
                 {"members", s.members},
-                {"encoding", enc},
+                {"encoding", s.encodings},
                 {"directory", s.directory},
                 {"prefix", s.prefix},
                 {"property_period_ms", s.property_period.count()},

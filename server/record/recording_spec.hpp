@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -18,10 +19,13 @@ struct RecordingSpec {
     /// Root-object members to record: wires, pipes, events and properties. Empty: every wire, pipe and
     /// event (and every readable property when `property_period` is set).
     std::vector<std::string> members;
-    bool json = true;                  ///< `json` channels (JSON mapping + JSON Schema)
-    bool robotraconteur = true;        ///< `robotraconteur` channels (RR entry bytes, for replay)
+    /// The formats written, by name (`encoding`; recording_format.hpp, the built-in ones registered in
+    /// formats/formats.cpp): `json` channels (JSON mapping + JSON Schema) and `robotraconteur` channels
+    /// (RR entry bytes, for replay) by default. In the order of the formats' registration, each once.
+    std::vector<std::string> encodings{"json", "robotraconteur"};
     /// With `json`: a standard image member (com.robotraconteur.image.Image / CompressedImage) also on a
-    /// channel `<device>/<member>/foxglove` as foxglove.RawImage / CompressedImage (foxglove_image.hpp).
+    /// channel `<device>/<member>/foxglove` as foxglove.RawImage / CompressedImage
+    /// (formats/foxglove_image_format.hpp).
     bool foxglove_images = true;
     /// The sub-folder of the recordings root the files go to ("" = the root itself): relative, parts of
     /// letters, digits and `-_.` without a leading dot, joined by `/` (check_subfolder). For `rr record`,
@@ -54,6 +58,13 @@ struct RecordingSpec {
     /// channels (its chunk indexes grow by one per chunk: mcap::McapWriter::summary_memory_bytes). Not a
     /// JSON key: tests lower it.
     std::size_t max_index_bytes = 8u << 20;
+
+    /// Whether `encoding` names the format `name`.
+    bool encodes(std::string_view name) const noexcept {
+        for (const auto& e : encodings)
+            if (e == name) return true;
+        return false;
+    }
 };
 
 /// `recordings:` of the gateway configuration (docs/gateway-config.md, docs/recording.md "Where
@@ -93,7 +104,8 @@ Result<void> check_prefix(std::string_view prefix);
 Result<void> check_spec_bounds(const RecordingSpec& spec, const RecordingsSettings& settings);
 
 /// The spec from JSON (POST /api/recordings, docs/recording.md), the same keys as a `record:` entry:
-/// {"device", "members"?, "encoding"?: "json"|"robotraconteur"|["json","robotraconteur"], "directory"?,
+/// {"device", "members"?, "encoding"?: a format's name or a list of them ("json", "robotraconteur";
+/// builtin_recording_formats), "directory"?,
 /// "prefix"?, "property_period_ms"?, "max_file_bytes"?, "max_file_seconds"?, "max_total_bytes"?,
 /// "duration_s"?, "queue_bytes"?, "chunk_bytes"?, "compression"?: "zstd"|"none", "foxglove_images"?: bool}.
 /// `directory` and `prefix` are checked by check_subfolder and check_prefix.

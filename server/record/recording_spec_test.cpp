@@ -13,8 +13,8 @@ using nlohmann::json;
 TEST_CASE("record spec: defaults and every key") {
     auto d = record::spec_from_json(json{{"device", "cam"}});
     REQUIRE(d);
-    CHECK(d->json);
-    CHECK(d->robotraconteur);
+    CHECK(d->encodes("json"));
+    CHECK(d->encodes("robotraconteur"));
     CHECK(d->directory.empty());  // the recordings root itself
     CHECK(d->max_file_bytes == 256ull << 20);
     auto s = record::spec_from_json(json{{"device", "cam"},
@@ -32,8 +32,8 @@ TEST_CASE("record spec: defaults and every key") {
     REQUIRE(s);
     CHECK(s->members == std::vector<std::string>{"frames", "pos"});
     CHECK(s->directory == "lab/run-1.a");
-    CHECK_FALSE(s->json);
-    CHECK(s->robotraconteur);
+    CHECK_FALSE(s->encodes("json"));
+    CHECK(s->encodes("robotraconteur"));
     CHECK(s->property_period == std::chrono::milliseconds(250));
     CHECK(s->max_file_duration == std::chrono::seconds(60));
     CHECK_FALSE(s->compress);

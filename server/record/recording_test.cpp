@@ -23,24 +23,15 @@
 #include "server/record/recordings.hpp"
 #include "server/record/replay_device.hpp"
 #include "test/support/eventually.hpp"
+#include "test/support/temp_dir.hpp"
 
 using namespace rr::server::gateway::testing;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct RecordingDir {
-    fs::path path;
-    RecordingDir() {
-        // a folder of its own under TMPDIR (or /tmp), made atomically so parallel test runs never share one
-        std::string tmpl = (fs::temp_directory_path() / "rr-recording-test-XXXXXX").string();
-        REQUIRE(::mkdtemp(tmpl.data()));
-        path = tmpl;
-    }
-    ~RecordingDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct RecordingDir : rr::testing::TempDir {
+    RecordingDir() : rr::testing::TempDir("rr-recording-test") {}
 };
 
 std::map<std::string, std::vector<rr::mcap::Message>> read_recording(const std::string& file, rr::mcap::Summary* summary = nullptr) {
@@ -76,6 +67,8 @@ std::function<void(rr::server::app::GatewayConfig&)> root_in(const RecordingDir&
 std::string file_text(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
 // Waits until `n` pipe endpoints of the gateway itself (a recording's) are connected to the device:
 // packets the device sends before that are not recorded.
 bool gateway_pipes_open(TestGateway& gw, std::size_t n) {
@@ -275,7 +268,7 @@ TEST_CASE("recording: bad requests are clear errors") {
 // --- issue 52: recordings stay in their place, and their memory is bounded ----------------------------
 
 TEST_CASE("recording: a request's directory and prefix stay inside the recordings root") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir, outside;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -307,7 +300,7 @@ TEST_CASE("recording: a request's directory and prefix stay inside the recording
 }
 
 TEST_CASE("recording: a symbolic link planted in the root is not followed, folder or file") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir, outside;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -348,7 +341,7 @@ TEST_CASE("recording: a symbolic link planted in the root is not followed, folde
 }
 
 TEST_CASE("recording: one prefix started in the same second never shares a file, and past max_active it is 429") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.max_active = 6; }));
@@ -394,7 +387,7 @@ TEST_CASE("recording: one prefix started in the same second never shares a file,
 }
 
 TEST_CASE("recording: the root's disk budget refuses a recording that would pass it (507)") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.max_total_bytes = 3u << 20; }));
@@ -419,7 +412,7 @@ TEST_CASE("recording: the root's disk budget refuses a recording that would pass
 }
 
 TEST_CASE("recording: queue_bytes over recordings.max_queue_bytes is refused (400)") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -431,7 +424,7 @@ TEST_CASE("recording: queue_bytes over recordings.max_queue_bytes is refused (40
 }
 
 TEST_CASE("recording: ended recordings keep only their status, the last keep_ended of them") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir, [](auto& s) { s.keep_ended = 3; }));
@@ -461,7 +454,7 @@ TEST_CASE("recording: ended recordings keep only their status, the last keep_end
 }
 
 TEST_CASE("recording: the writer's index is bounded: a new file when it passes max_index_bytes") {
-    if (!interop_service_built()) return;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     RecordingDir dir;
     TestGateway gw(device.url(), true, {}, root_in(dir));
@@ -496,4 +489,99 @@ TEST_CASE("recording: the writer's index is bounded: a new file when it passes m
         packets += msgs["interop/p_stream json"].size();
     }
     CHECK(packets == 300);
+}
+
+namespace {
+
+// A format a test registers: per member one channel `<topic>/fake` (its own schema, added once a file,
+// and the member's metadata), each entry as "<member> <entry type> <n>" with n counted per member.
+class FakeEncoder : public rr::server::record::FormatEncoder {
+public:
+    explicit FakeEncoder(const rr::server::record::FormatContext& context) : context_(context), counts_(context.members.size(), 0) {}
+    rr::Result<void> open_file(rr::server::record::FormatFile& file) override {
+        auto schema = file.add_schema("fake.Count", "text", "a member's entries, counted");
+        if (!schema) return schema.take_error();
+        channels_.clear();
+        for (const auto& m : context_.members) {
+            auto id = file.add_channel(*schema, m.topic + "/fake", "fake", m.metadata);
+            if (!id) return id.take_error();
+            channels_.push_back(*id);
+        }
+        return {};
+    }
+    rr::Result<void> write(const rr::server::record::RecordedEntry& e, rr::server::record::MessageOut& out) override {
+        const auto& entry = e.entry.entry();
+        return out.write(channels_[e.member], entry.member_name + " " + std::to_string(static_cast<int>(entry.entry_type)) + " " +
+                                                  std::to_string(counts_[e.member]++));
+    }
+
+private:
+    const rr::server::record::FormatContext& context_;
+    std::vector<std::uint16_t> channels_;
+    std::vector<int> counts_;
+};
+
+class FakeFormat : public rr::server::record::RecordingFormat {
+public:
+    std::string_view name() const noexcept override { return "fake"; }
+    std::unique_ptr<rr::server::record::FormatEncoder> encoder(const rr::server::record::FormatContext& context) const override {
+        return std::make_unique<FakeEncoder>(context);
+    }
+};
+
+}  // namespace
+
+TEST_CASE("recording: a format registered by a test gets its channels and every entry, Recording unchanged") {
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
+    using namespace rr::server::record;
+    InteropProcess device;
+    RecordingDir dir;
+    TestGateway gw(device.url(), true, {}, root_in(dir));
+    RecordingFormats formats = builtin_recording_formats();
+    formats.push_back(std::make_shared<FakeFormat>());
+    RecordingSpec spec;
+    spec.device = "interop";
+    spec.members = {"p_stream", "ev_values"};
+    spec.encodings = {"fake"};
+    auto root = std::make_shared<RecordingsRoot>(dir.path.string(), 0);
+    // Not a built-in format: refused where only those are known.
+    auto unknown = Recording::start(1, spec, gw.gateway().devices().front(), gw.api(), root);
+    REQUIRE_FALSE(unknown);
+    CHECK(unknown.error().message == "record: encoding: no format \"fake\"");
+
+    auto rec = Recording::start(2, spec, gw.gateway().devices().front(), gw.api(), root, formats);
+    INFO((rec ? std::string() : rec.error().message));
+    REQUIRE(rec);
+    REQUIRE(gateway_pipes_open(gw, 1));
+    REQUIRE(http_post(gw.port(), "/api/devices/interop/functions/send_stream", json{{"args", {5}}}).status == 200);
+    REQUIRE(http_post(gw.port(), "/api/devices/interop/functions/fire_events", json{{"args", {3}}}).status == 200);
+    REQUIRE(rr::testing::eventually([&] { return (*rec)->status().messages >= 8; }));
+    (*rec)->stop();
+    (*rec)->wait();
+    const auto s = (*rec)->status();
+    CHECK(s.state == RecordingState::stopped);
+    CHECK(s.messages == 8);
+    REQUIRE(s.files.size() == 1);
+
+    rr::mcap::Summary summary;
+    auto msgs = read_recording(s.files[0], &summary);
+    CHECK(msgs.size() == 2);  // the fake channels only: no json, robotraconteur or Foxglove channel
+    REQUIRE(msgs["interop/p_stream/fake fake"].size() == 5);
+    REQUIRE(msgs["interop/ev_values/fake fake"].size() == 3);
+    const auto pipe_packet = std::to_string(static_cast<int>(rr::MessageEntryType::PipePacket));
+    const auto event = std::to_string(static_cast<int>(rr::MessageEntryType::EventReq));
+    for (int i = 0; i < 5; ++i) CHECK(text_of(msgs["interop/p_stream/fake fake"][i]) == "p_stream " + pipe_packet + " " + std::to_string(i));
+    for (int i = 0; i < 3; ++i) CHECK(text_of(msgs["interop/ev_values/fake fake"][i]) == "ev_values " + event + " " + std::to_string(i));
+    // The channels carry the member's metadata (channel_metadata.hpp), the file the device's definitions.
+    std::set<std::string> kinds;
+    for (const auto& [cid, c] : summary.channels) {
+        CHECK(c.metadata.at(channel_key::device) == "interop");
+        CHECK(summary.schemas.at(c.schema_id).name == "fake.Count");
+        kinds.insert(c.metadata.at(channel_key::kind));
+    }
+    CHECK(kinds == std::set<std::string>{"pipe", "event"});
+    bool servicedef = false;
+    for (const auto& [sid, sc] : summary.schemas)
+        if (sc.encoding == kServiceDefinitionSchemaEncoding && sc.name == "experimental.interop_test") servicedef = true;
+    CHECK(servicedef);
 }

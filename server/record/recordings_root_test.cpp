@@ -10,6 +10,7 @@
 #include <string>
 
 #include "server/record/recordings_root.hpp"
+#include "test/support/temp_dir.hpp"
 
 using rr::MessageErrorType;
 using rr::server::record::RecordingsRoot;
@@ -17,17 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string tmpl = (fs::temp_directory_path() / "rr-root-test-XXXXXX").string();
-        REQUIRE(::mkdtemp(tmpl.data()));
-        path = tmpl;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct TempDir : rr::testing::TempDir {
+    TempDir() : rr::testing::TempDir("rr-root-test") {}
 };
 
 void write_file(const fs::path& p, const std::string& text) {

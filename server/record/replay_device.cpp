@@ -3,11 +3,11 @@
 #include <cmath>
 
 #include "core/mcap/mcap_reader.hpp"
-#include "core/message/message_reader.hpp"
-#include "core/message/message_writer.hpp"
 #include "core/value/pack_value.hpp"
+#include "core/names/object_path_walk.hpp"
 #include "core/names/service_path.hpp"
 #include "server/mcap/mcap_file.hpp"
+#include "server/record/recording_format.hpp"
 #include "server/service/pipe_member.hpp"
 #include "server/service/wire_member.hpp"
 
@@ -23,22 +23,6 @@ nlohmann::json replay_status_json(const ReplayStatus& s) {
 }
 
 namespace {
-
-// A recorded `robotraconteur` message: one RR message entry in message format 4 (recording.cpp). The
-// entry is decoded inside a message of its own, as a session would receive it: standard string-table
-// codes (in files recorded before entries were kept free of them) are resolved, not replayed.
-Result<MessageEntry> decode_entry(std::span<const std::byte> bytes) {
-    Message m;
-    m.version = 4;
-    std::vector<std::byte> out;
-    if (auto r = encode_message(m, bytes, out); !r) return r.take_error();
-    DecodeContext plain;
-    plain.keep_string_table_codes = false;
-    auto decoded = decode_message(SharedBytes::adopt(std::move(out)), {}, &plain);
-    if (!decoded) return decoded.take_error();
-    if (decoded->entries.size() != 1) return fail(MessageErrorType::DataSerializationError, "not one message entry");
-    return std::move(decoded->entries[0]);
-}
 
 RRError refused(const std::string& name, const std::string& file) {
     return make_error(MessageErrorType::InvalidOperation,
@@ -70,25 +54,25 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     d->playback_->reader.emplace(std::move(*reader));
     const auto& summary = d->playback_->reader->summary();
 
-    auto meta_of = [](const mcap::Channel& ch, const char* k) {
-        auto it = ch.metadata.find(k);
-        return it == ch.metadata.end() ? std::string() : it->second;
-    };
+    // The channels replay plays: those of the format that replays (robotraconteur_format.cpp).
+    const auto& formats = builtin_recording_formats();
+    auto played = [&](const mcap::Channel& ch) { return replay_format(formats, ch.message_encoding); };
+    auto meta_of = [](const mcap::Channel& ch, const char* k) { return metadata_value(ch.metadata, k); };
     // The root object's type: a root channel's `object_type` (its schema is the root's definition),
     // else `root_type` of a channel below the root (a file of objects below the root only).
     std::string root_type;
     std::uint16_t root_schema = 0;
     for (const auto& [id, ch] : summary.channels) {
-        if (ch.message_encoding != "robotraconteur") continue;
-        if (meta_of(ch, "path").empty()) {
-            root_type = meta_of(ch, "object_type");
+        if (!played(ch)) continue;
+        if (meta_of(ch, channel_key::path).empty()) {
+            root_type = meta_of(ch, channel_key::object_type);
             root_schema = ch.schema_id;
-            d->recorded_device_ = meta_of(ch, "device");
+            d->recorded_device_ = meta_of(ch, channel_key::device);
             break;
         }
         if (root_type.empty()) {
-            root_type = meta_of(ch, "root_type");
-            d->recorded_device_ = meta_of(ch, "device");
+            root_type = meta_of(ch, channel_key::root_type);
+            d->recorded_device_ = meta_of(ch, channel_key::device);
         }
     }
     if (root_type.empty())
@@ -97,7 +81,7 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     // The definitions: every robotraconteur_servicedef schema, the root's first.
     std::vector<std::string> texts;
     for (const auto& [id, s] : summary.schemas) {
-        if (s.encoding != "robotraconteur_servicedef") continue;
+        if (s.encoding != kServiceDefinitionSchemaEncoding) continue;
         std::string text(reinterpret_cast<const char*>(s.data.data()), s.data.size());
         if (id == root_schema || (!root_schema && s.name == root_service)) texts.insert(texts.begin(), std::move(text));
         else texts.push_back(std::move(text));
@@ -111,29 +95,35 @@ Result<std::shared_ptr<ReplayDevice>> ReplayDevice::open(ReplayOptions options) 
     std::map<std::uint16_t, std::string> channel_types;  // object type of each replayed channel
     for (const auto& [id, channel] : summary.channels) {
         const auto& ch = channel;
-        if (ch.message_encoding != "robotraconteur") continue;
+        const auto* format = played(ch);
+        if (!format) continue;
         auto meta = [&](const char* k) { return meta_of(ch, k); };
-        const std::string path = meta("path"), type = meta("object_type");
+        const std::string path = meta(channel_key::path), type = meta(channel_key::object_type);
         if (path.empty() && type != d->object_type_) continue;  // not this device's root
+        if (auto r = format->check_replay_channel(ch); !r) return err(r.error().type, r.error().message);
         const auto* obj = d->types_->find_object(type);
         if (!obj) return err(MessageErrorType::InvalidArgument, "the recorded definitions have no object type \"" + type + "\" (channel " + ch.topic + ")");
-        const auto* m = obj->find_member(meta("member"));
-        if (!m) return err(MessageErrorType::InvalidArgument, type + " has no member \"" + meta("member") + "\" (channel " + ch.topic + ")");
+        const std::string member = meta(channel_key::member);
+        const auto* m = obj->find_member(member);
+        if (!m) return err(MessageErrorType::InvalidArgument, type + " has no member \"" + member + "\" (channel " + ch.topic + ")");
         Channel c;
+        c.format = format;
         c.member = m;
         c.path = path;
         c.context = type.substr(0, type.rfind('.'));
         c.property_key = path + '\n' + m->name;
-        const std::string kind = meta("kind");
-        if (kind == "wire" && m->kind == robdef::MemberKind::wire) c.kind = Channel::Kind::wire;
-        else if (kind == "pipe" && m->kind == robdef::MemberKind::pipe) c.kind = Channel::Kind::pipe;
-        else if (kind == "event" && m->kind == robdef::MemberKind::event) c.kind = Channel::Kind::event;
-        else if (kind == "property" && m->kind == robdef::MemberKind::property) c.kind = Channel::Kind::property;
-        else return err(MessageErrorType::InvalidArgument, "channel " + ch.topic + ": kind \"" + kind + "\" does not match member " + m->name);
+        const std::string kind = meta(channel_key::kind);
+        const auto recorded = member_kind_from_name(kind);
+        const bool matches = recorded && ((*recorded == RecordedKind::wire && m->kind == robdef::MemberKind::wire) ||
+                                          (*recorded == RecordedKind::pipe && m->kind == robdef::MemberKind::pipe) ||
+                                          (*recorded == RecordedKind::event && m->kind == robdef::MemberKind::event) ||
+                                          (*recorded == RecordedKind::property && m->kind == robdef::MemberKind::property));
+        if (!matches) return err(MessageErrorType::InvalidArgument, "channel " + ch.topic + ": kind \"" + kind + "\" does not match member " + m->name);
+        c.kind = *recorded;
         d->channels_[id] = c;
         channel_types[id] = type;
         d->playback_->all_ids.insert(id);
-        if (c.kind == Channel::Kind::wire || c.kind == Channel::Kind::property) d->playback_->state_ids.insert(id);
+        if (c.kind == RecordedKind::wire || c.kind == RecordedKind::property) d->playback_->state_ids.insert(id);
     }
     if (d->channels_.empty()) return err(MessageErrorType::InvalidArgument, "no replayable channel");
     d->context_service_ = d->object_type_.substr(0, d->object_type_.rfind('.'));
@@ -203,37 +193,30 @@ void ReplayDevice::serve_members(ServiceObject& object, const std::string& path)
 
 Result<ServiceObject*> ReplayDevice::object_at(const std::string& path, const std::string& type) {
     if (auto it = objects_.find(path); it != objects_.end()) return it->second.get();
-    // Recorded paths are normalized (recording.cpp): segments `name` or `name[encoded index]`, no '.'
-    // inside an index.
-    const auto dot = path.rfind('.');
-    const std::string parent_path = dot == std::string::npos ? std::string() : path.substr(0, dot);
-    const std::string segment = dot == std::string::npos ? path : path.substr(dot + 1);
-    const std::string member = segment.substr(0, segment.find('['));
-    // The parent: already served, else of the type its own objref declares (walked from the root).
+    // Recorded paths are normalized (recording.cpp): indexes in service-path encoding. The whole path
+    // must follow the objrefs' declared types (core/names/object_path_walk.hpp), as when it was recorded.
+    auto parsed = parse_object_path(path, ObjectPathIndexes::encoded);
+    if (!parsed) return fail(parsed.error());
+    ObjectPath last;
+    last.segments.push_back(std::move(parsed->segments.back()));
+    parsed->segments.pop_back();
+    const std::string member = last.segments[0].name, parent_path = parsed->text();
+    std::string parent_type = object_type_;
+    if (!parsed->segments.empty()) {
+        auto at = walk_object_path(types_->set(), object_type_, *parsed, path);
+        if (!at) return fail(at.error());
+        parent_type = at->object_type;
+    }
+    if (auto at = walk_object_path(types_->set(), parent_type, last, path); !at) return fail(at.error());
+    // The parent: already served, else served now.
     ServiceObject* parent = nullptr;
     if (auto it = objects_.find(parent_path); it != objects_.end()) {
         parent = it->second.get();
     } else {
-        std::string parent_type = object_type_;
-        std::size_t pos = 0;
-        while (pos < parent_path.size()) {
-            auto end = parent_path.find('.', pos);
-            if (end == std::string::npos) end = parent_path.size();
-            const std::string seg = parent_path.substr(pos, end - pos);
-            const auto* def = types_->find_object(parent_type);
-            const auto* ref = def ? def->find_member(seg.substr(0, seg.find('['))) : nullptr;
-            if (!ref || ref->kind != robdef::MemberKind::objref || ref->type.qualified_name.empty())
-                return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + seg + "\" on " + parent_type);
-            parent_type = ref->type.qualified_name;
-            pos = end + 1;
-        }
         auto p = object_at(parent_path, parent_type);
         if (!p) return p.take_error();
         parent = *p;
     }
-    const auto* ref = parent->definition().find_member(member);
-    if (!ref || ref->kind != robdef::MemberKind::objref)
-        return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": no objref \"" + member + "\" on " + parent->type());
     auto object = ServiceObject::create(types_, type);
     if (!object) return fail(MessageErrorType::InvalidArgument, "object path \"" + path + "\": " + object.error().message);
     objects_[path] = *object;
@@ -358,7 +341,7 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
     auto it = channels_.find(channel);
     if (it == channels_.end()) return;
     const auto& c = it->second;
-    auto entry = decode_entry(data);
+    auto entry = c.format->read_entry(data);
     if (!entry) return;  // a malformed recorded entry is skipped
     const auto& set = types_->set();
     auto unpack = [&](const MessageElement* el, const robdef::TypeDefinition& type) -> std::optional<Value> {
@@ -368,20 +351,20 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
         return std::move(*v);
     };
     switch (c.kind) {
-        case Channel::Kind::wire: {
+        case RecordedKind::wire: {
             auto v = unpack(entry->find("packet"), c.member->type);
             if (!v) return;
             if (auto w = c.object->wire(c.member->name)) (void)(*w)->set_out_value(std::move(*v));
             break;
         }
-        case Channel::Kind::pipe: {
+        case RecordedKind::pipe: {
             if (!live || entry->elements.empty()) return;
             auto v = unpack(&entry->elements[0], c.member->type);
             if (!v) return;
             if (auto p = c.object->pipe(c.member->name)) (*p)->broadcast(*v);
             break;
         }
-        case Channel::Kind::event: {
+        case RecordedKind::event: {
             if (!live) return;
             std::vector<Value> args;
             for (const auto& p : c.member->parameters) {
@@ -392,7 +375,7 @@ void ReplayDevice::apply(std::uint16_t channel, std::span<const std::byte> data,
             (void)c.object->fire_event(c.member->name, std::move(args));
             break;
         }
-        case Channel::Kind::property: {
+        case RecordedKind::property: {
             auto v = unpack(entry->find("value"), c.member->type);
             if (!v) return;
             std::lock_guard<std::mutex> lock(mutex_);
@@ -417,7 +400,7 @@ void ReplayDevice::restore_state(std::uint64_t t_ns) {
         auto m = it.next();
         if (!m || !*m) break;
         auto& msg = **m;
-        if (channels_[msg.channel_id].kind == Channel::Kind::wire) last_wire[msg.channel_id] = std::move(msg);
+        if (channels_[msg.channel_id].kind == RecordedKind::wire) last_wire[msg.channel_id] = std::move(msg);
         else apply(msg.channel_id, msg.data, false);
     }
     // Each wire's value at that point, once (the clients see where the seek landed).

@@ -1,6 +1,6 @@
 // A device whose source is a recording (docs/recording.md "Replay"): the recorded service definition
 // served by an ObjectService, its wires, pipes and events played from the file's `robotraconteur`
-// channels with the recorded spacing (divided by the speed factor; looping if asked), its recorded
+// channels (those of the format that replays: recording_format.hpp) with the recorded spacing (divided by the speed factor; looping if asked), its recorded
 // properties answering their last value at the replay position, its functions refused with a clear
 // error (InvalidOperation "… is a recording …"), writes refused (ReadOnlyMember).
 //
@@ -32,9 +32,12 @@
 
 #include "core/error/rr_error.hpp"
 #include "core/value/value.hpp"
+#include "server/record/channel_metadata.hpp"
 #include "server/service/object_service.hpp"
 
 namespace rr::server::record {
+
+class RecordingFormat;
 
 struct ReplayOptions {
     std::string file;
@@ -71,7 +74,8 @@ public:
     /// Opens and checks the file and builds the service (not playing yet: start()). Errors, each naming
     /// the file: IOError (unreadable), DataSerializationError / BufferLimitViolation (not an MCAP file, or
     /// corrupt: the reader's message with the record and offset), InvalidArgument (no `robotraconteur`
-    /// channel, no service definition, definitions that do not parse, a member the definition lacks).
+    /// channel, one whose entry_format is missing or unknown, no service definition, definitions that do
+    /// not parse, a member the definition lacks).
     static Result<std::shared_ptr<ReplayDevice>> open(ReplayOptions options);
     ~ReplayDevice();
 
@@ -96,7 +100,8 @@ public:
 
 private:
     struct Channel {
-        enum class Kind : std::uint8_t { wire, pipe, event, property } kind = Kind::wire;
+        RecordedKind kind = RecordedKind::wire;
+        const RecordingFormat* format = nullptr;  ///< reads its messages back (RecordingFormat::read_entry)
         const robdef::MemberDefinition* member = nullptr;
         std::string path;         ///< the object's path below the root ("" = the root)
         ServiceObject* object = nullptr;  ///< the served object at `path` (owned by objects_)

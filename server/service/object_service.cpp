@@ -4,7 +4,7 @@
 #include <atomic>
 #include <limits>
 
-#include "core/names/service_path.hpp"
+#include "core/names/object_path.hpp"
 #include "core/value/named_type.hpp"
 #include "server/service/member_support.hpp"
 
@@ -19,27 +19,8 @@ bool valid_service_name(std::string_view name) {
     return true;
 }
 
-bool is_path_char(char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-}
-
 RRError object_not_found(std::string_view path) {
     return make_error(MessageErrorType::ObjectNotFound, "Object not found: " + std::string(path));
-}
-
-/// Splits one path segment `name` or `name[encoded]`. Errors: ObjectNotFound.
-Result<std::pair<std::string_view, std::string_view>> split_segment(std::string_view seg, bool& has_index) {
-    has_index = false;
-    std::size_t open = seg.find('[');
-    std::string_view name = seg.substr(0, open);
-    if (name.empty() || !std::all_of(name.begin(), name.end(), is_path_char)) return fail(object_not_found(seg));
-    if (open == std::string_view::npos) return std::make_pair(name, std::string_view());
-    if (seg.back() != ']' || seg.size() < open + 3) return fail(object_not_found(seg));
-    std::string_view index = seg.substr(open + 1, seg.size() - open - 2);
-    for (char c : index)
-        if (!is_path_char(c) && c != '%') return fail(object_not_found(seg));
-    has_index = true;
-    return std::make_pair(name, index);
 }
 
 bool param_is_generator(const robdef::MemberDefinition& def) {
@@ -163,30 +144,23 @@ Result<std::shared_ptr<ServiceObject>> ObjectService::resolve(const SessionRef& 
     }
     if (path.size() <= name_.size() || path.compare(0, name_.size(), name_) != 0 || path[name_.size()] != '.')
         return fail(object_not_found(path));
+    // The objects below the root, segment by segment (core/names/object_path.hpp: indexes in
+    // service-path encoding); each prefix is resolved once and kept.
+    auto below = parse_object_path(std::string_view(path).substr(name_.size() + 1), ObjectPathIndexes::encoded);
+    if (!below) return fail(object_not_found(path));
     std::shared_ptr<ServiceObject> current = root_;
-    std::size_t pos = name_.size();
-    while (pos < path.size()) {
-        std::size_t next = path.find('.', pos + 1);
-        if (next == std::string::npos) next = path.size();
-        std::string prefix = path.substr(0, next);
+    std::string prefix = name_;
+    for (const auto& segment : below->segments) {
+        prefix += '.';
+        prefix += segment.text();  // the path's own text: indexes kept as given
         {
             std::lock_guard lock(mutex_);
             if (auto it = objects_.find(prefix); it != objects_.end()) {
                 current = it->second;
-                pos = next;
                 continue;
             }
         }
-        bool has_index = false;
-        auto seg = split_segment(std::string_view(path).substr(pos + 1, next - pos - 1), has_index);
-        if (!seg) return seg.take_error();
-        std::string index;
-        if (has_index) {
-            auto decoded = decode_service_path_index(seg->second);
-            if (!decoded) return fail(object_not_found(path));
-            index = std::move(*decoded);
-        }
-        auto obj = current->resolve_objref(session, seg->first, index, has_index);
+        auto obj = current->resolve_objref(session, segment.name, segment.index, segment.has_index);
         if (!obj) return obj.take_error();
         std::shared_ptr<ServiceObject> resolved = std::move(*obj);
         bool inserted = false;
@@ -205,7 +179,6 @@ Result<std::shared_ptr<ServiceObject>> ObjectService::resolve(const SessionRef& 
             }
         }
         current = std::move(resolved);
-        pos = next;
     }
     return current;
 }

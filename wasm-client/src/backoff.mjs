@@ -65,3 +65,25 @@ export class Listeners {
     this.fns.clear();
   }
 }
+
+/**
+ * The three connection events of a reconnecting thing (a subscription, a member connection of it, the
+ * JSON client): what `fn` gets is each class's own (its docs say). `onConnect`, `onDisconnect` and
+ * `onError` return the remover.
+ */
+export class ConnectionEvents {
+  constructor() {
+    this.connectListeners = new Listeners();
+    this.disconnectListeners = new Listeners();
+    this.errorListeners = new Listeners();
+  }
+  onConnect(fn) {
+    return this.connectListeners.add(fn);
+  }
+  onDisconnect(fn) {
+    return this.disconnectListeners.add(fn);
+  }
+  onError(fn) {
+    return this.errorListeners.add(fn);
+  }
+}

@@ -12,6 +12,8 @@ export class RRError extends Error {
 
 export function toRRError(e) {
   if (e instanceof RRError) return e;
+  // an RR error from elsewhere (another copy of this module, a stand-in): its name is kept
+  if (e && typeof e === "object" && typeof e.errorName === "string") return new RRError(e.errorName, e.message ?? "", e.code ?? 0);
   if (e && typeof e === "object" && typeof e.name === "string" && "code" in e)
     return new RRError(e.name, e.message ?? "", e.code);
   return new RRError("RobotRaconteur.UnknownError", String(e?.message ?? e));

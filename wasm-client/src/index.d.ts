@@ -398,7 +398,17 @@ export interface SubscriptionClient<T = ObjectProxy> {
   readonly connectCount: number;
 }
 
-export interface WireSubscription<V = RRValue> {
+/** What wire and pipe subscriptions tell about their member connections (one per connected service). */
+export interface MemberConnectionEvents {
+  /** `fn(client)` each time the member connection to a service opens (first time, and again after each reconnect). */
+  onConnect(fn: (client: SubscriptionClient) => void): () => void;
+  /** `fn(client, error)` each time an open member connection closes (by the service, or with its client connection); error null when closed cleanly. */
+  onDisconnect(fn: (client: SubscriptionClient, error: RRError | null) => void): () => void;
+  /** `fn(error, client)` each time opening the member connection fails; it is tried again with the backoff. */
+  onError(fn: (error: RRError, client: SubscriptionClient) => void): () => void;
+}
+
+export interface WireSubscription<V = RRValue> extends MemberConnectionEvents {
   /** The newest InValue from any service; throws RRError "RobotRaconteur.ValueNotSet" when none is valid. */
   readonly inValue: V;
   readonly inValueTime: TimeSpec;
@@ -416,7 +426,7 @@ export interface WireSubscription<V = RRValue> {
   close(): Promise<void>;
 }
 
-export interface PipeSubscription<P = RRValue> extends AsyncIterable<P> {
+export interface PipeSubscription<P = RRValue> extends AsyncIterable<P>, MemberConnectionEvents {
   /** Packets queued for receivePacket (at most maxBacklog; the oldest are dropped). */
   readonly available: number;
   tryReceivePacket(): P | undefined;
@@ -439,6 +449,8 @@ export interface ServiceSubscription<T = ObjectProxy> {
   tryGetDefaultClient(): T | null;
   /** Waits for a connected service (timeoutMs −1, the default: no limit); rejects with ConnectionError. */
   getDefaultClientWait(timeoutMs?: number): Promise<T>;
+  /** `fn(client)` as each attempt to connect to a service starts (the first, and each after a drop or a failure). */
+  onConnecting(fn: (client: SubscriptionClient<T>) => void): () => void;
   onConnect(fn: (client: SubscriptionClient<T>, proxy: T) => void): () => void;
   onDisconnect(fn: (client: SubscriptionClient<T>, error: RRError | null) => void): () => void;
   onError(fn: (error: RRError, client: SubscriptionClient<T> | null) => void): () => void;

@@ -3,7 +3,7 @@
 // the socket opened again with a jittered backoff after any drop, logging in and subscribing again.
 // Types: json_client.d.ts; guide: README.md "Subscriptions" → "The JSON client".
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
 
 export { RRError };
 
@@ -69,8 +69,9 @@ export function connectJson(url, options = {}) {
   return new JsonClient(url, options);
 }
 
-export class JsonClient {
+export class JsonClient extends ConnectionEvents {
   constructor(url, options = {}) {
+    super();
     for (const k of ["timeoutMs", "heartbeatPeriodMs", "receiveTimeoutMs"]) {
       const v = options[k];
       if (v !== undefined && !(Number.isInteger(v) && v > 0)) throw invalid(`${k} must be a positive integer (ms), not ${v}`);
@@ -89,9 +90,6 @@ export class JsonClient {
     this.waitingForOpen = new Set();
     this.subscriptions = new Set();
     this.bySocketId = new Map();  // the gateway's subscription number → JsonSubscription
-    this.connectListeners = new Listeners();
-    this.disconnectListeners = new Listeners();
-    this.errorListeners = new Listeners();
     this.deviceStateListeners = new Listeners();
     this.attempt = 0;
     this.connectCount = 0;
@@ -298,18 +296,9 @@ export class JsonClient {
     }
   }
 
-  /** `fn()` after every (re)connection (logged in and subscribed again). Returns the remover. */
-  onConnect(fn) {
-    return this.connectListeners.add(fn);
-  }
-  /** `fn(error)` after every lost connection. Returns the remover. */
-  onDisconnect(fn) {
-    return this.disconnectListeners.add(fn);
-  }
-  /** `fn(error)`: a failed connection attempt, login or resubscription. Returns the remover. */
-  onError(fn) {
-    return this.errorListeners.add(fn);
-  }
+  // onConnect(fn()) after every (re)connection (logged in and subscribed again); onDisconnect(fn(error))
+  // after every lost connection; onError(fn(error)): a failed connection attempt, login or
+  // resubscription (ConnectionEvents).
   /** `fn(push)` for every device_state push ({device, state, reason, ...}). Returns the remover. */
   onDeviceState(fn) {
     return this.deviceStateListeners.add(fn);

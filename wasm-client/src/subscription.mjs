@@ -3,7 +3,7 @@
 // connect again with a jittered backoff after any drop, and restore on the new connection the wires,
 // pipe endpoints, event handlers and callbacks the app asked for.
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
@@ -100,8 +100,9 @@ class SubscriptionClient {
  * ServiceSubscription: see subscribe() in robotraconteur.mjs for the target and options.
  * `connectFn(url, options)` is robotraconteur.mjs connect (injected: no import cycle).
  */
-export class ServiceSubscription {
+export class ServiceSubscription extends ConnectionEvents {
   constructor(target, options, connectFn) {
+    super();
     this.options = options;
     this.connectFn = connectFn;
     this.backoff = backoffOptions(options.backoff);
@@ -113,9 +114,7 @@ export class ServiceSubscription {
     this.pipes = new Set();
     this.events = new Set();
     this.callbacks = new Map();
-    this.connectListeners = new Listeners();
-    this.disconnectListeners = new Listeners();
-    this.errorListeners = new Listeners();
+    this.connectingListeners = new Listeners();
     this.defaultWaiters = [];
     if (typeof target === "string" || Array.isArray(target)) {
       const urls = typeof target === "string" ? [target] : target;
@@ -190,11 +189,13 @@ export class ServiceSubscription {
 
   addClient(c) {
     this.clientsById.set(c.id, c);
-    this.run(c).catch((e) => this.errorListeners.emit(toRRError(e), c));
+    // started after the caller's current task, so listeners added right after subscribe() hear the first attempt
+    queueMicrotask(() => this.run(c).catch((e) => this.errorListeners.emit(toRRError(e), c)));
   }
 
-  /** Waits `ms`, or less when close() or a removal wakes the client. */
+  /** Waits `ms`, or less when close() or a removal wakes the client (at once when that came first). */
   sleep(c, ms) {
+    if (this.closed || c.removed) return Promise.resolve();
     return new Promise((resolve) => {
       const t = setTimeout(() => {
         c.wake = null;
@@ -211,6 +212,7 @@ export class ServiceSubscription {
   async run(c) {
     while (!this.closed && !c.removed) {
       c.state = "connecting";
+      this.connectingListeners.emit(c);
       let proxy;
       try {
         proxy = await this.connectFn(c.url, this.connectOptions);
@@ -239,7 +241,7 @@ export class ServiceSubscription {
       const error = await lost;
       c.proxy = null;
       c.generation++;
-      for (const s of [...this.wires, ...this.pipes]) s.detach(c);
+      for (const s of [...this.wires, ...this.pipes]) s.detach(c, error ?? null);
       if (this.closed || c.removed) break;
       c.state = "waiting";
       c.lastError = keepable(error);
@@ -338,20 +340,14 @@ export class ServiceSubscription {
     });
   }
 
-  /** `fn(client, proxy)` after every (re)connection. Returns the remover. */
-  onConnect(fn) {
-    return this.connectListeners.add(fn);
+  /** `fn(client)` as every attempt to connect to a service starts (the first, and each after a drop or a failure). Returns the remover. */
+  onConnecting(fn) {
+    return this.connectingListeners.add(fn);
   }
 
-  /** `fn(client, error)` after every lost connection (error null after a clean close). Returns the remover. */
-  onDisconnect(fn) {
-    return this.disconnectListeners.add(fn);
-  }
-
-  /** `fn(error, client | null)`: a failed connect or restore, or a failed discovery request. Returns the remover. */
-  onError(fn) {
-    return this.errorListeners.add(fn);
-  }
+  // onConnect(fn(client, proxy)) after every (re)connection; onDisconnect(fn(client, error)) after every
+  // lost connection (error null after a clean close); onError(fn(error, client | null)): a failed connect
+  // or restore, or a failed discovery request (ConnectionEvents).
 
   /** A WireSubscription on wire `name` of the object at `servicePath` (relative objref path, "" = root). */
   subscribeWire(name, servicePath = "") {
@@ -420,10 +416,13 @@ export class ServiceSubscription {
 
 /**
  * Keeps one member connection (a wire connection, a pipe endpoint) per connected client, connecting it
- * again when the service closes it while the client stays connected.
+ * again when the service closes it while the client stays connected. Tells its own listeners when a
+ * member connection opens, closes or fails to open (onConnect, onDisconnect, onError), so a view can
+ * show the state of the one member it shows.
  */
-class MemberSubscription {
+class MemberSubscription extends ConnectionEvents {
   constructor(sub, member, servicePath) {
+    super();
     this.sub = sub;
     this.member = member;
     this.servicePath = servicePath;
@@ -443,9 +442,11 @@ class MemberSubscription {
         if (!alive()) return link.close().catch(() => {});
         this.links.set(c, link);
         this.listen(link, c);
+        this.connectListeners.emit(c);
         link.onClose((err) => {
           if (this.links.get(c) !== link) return;
           this.links.delete(c);
+          if (!this.closed) this.disconnectListeners.emit(c, err ? keepable(toRRError(err)) : null);
           // Closed by the service while the connection stays (a device behind the gateway went away):
           // connect it again on this connection. A lost connection is the client loop's business.
           if (!alive() || proxy.$client.state !== "connected") return;
@@ -455,20 +456,27 @@ class MemberSubscription {
       })
       .catch((err) => {
         if (!alive() || proxy.$client.state !== "connected") return;
-        this.sub.errorListeners.emit(toRRError(err), c);
+        const e = toRRError(err);
+        this.sub.errorListeners.emit(e, c);
+        this.errorListeners.emit(keepable(e), c);
         setTimeout(() => alive() && this.attach(c, proxy, gen, attempt + 1), backoffDelay(attempt, this.sub.backoff));
       });
   }
 
-  /** The client's connection is gone: its link died with it. */
-  detach(c) {
-    this.links.delete(c);
+  /** The client's connection is gone (`error`: why): its link died with it. */
+  detach(c, error = null) {
+    if (this.links.delete(c) && !this.closed) this.disconnectListeners.emit(c, error ? keepable(toRRError(error)) : null);
   }
+
+  // onConnect(fn(client)) each time the member connection to a service opens (first time and after each
+  // reconnect); onDisconnect(fn(client, error)) each time an open one closes (error null when closed
+  // cleanly); onError(fn(error, client)) each time opening it fails (tried again with backoff): ConnectionEvents.
 
   closeLocal() {
     this.closed = true;
     const links = [...this.links.values()];
     this.links.clear();
+    for (const l of [this.connectListeners, this.disconnectListeners, this.errorListeners]) l.clear();
     return links;
   }
 

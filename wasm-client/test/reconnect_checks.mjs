@@ -28,7 +28,7 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 async function until(cond, what, timeoutMs = 30000) {
   const end = Date.now() + timeoutMs;
   while (!cond()) {
-    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    if (Date.now() > end) throw new Error(`timed out waiting for ${typeof what === "function" ? what() : what}`);
     await sleep(10);
   }
 }
@@ -52,7 +52,9 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
   };
 
   const sub = rr.subscribe(url, FAST);
-  const seen = { connects: 0, disconnects: 0, errors: [], wire: 0, wireKeys: new Set(), wireDup: 0, events: [], packets: [], notifies: 0 };
+  const seen = { connects: 0, disconnects: 0, errors: [], wire: 0, wireKeys: new Set(), wireDup: 0, events: [], packets: [], notifies: 0,
+    wireOpens: 0, wireCloses: 0, pipeOpens: 0, pipeCloses: 0, attempts: 0 };
+  sub.onConnecting(() => seen.attempts++);
   sub.onConnect(() => seen.connects++);
   sub.onDisconnect(() => seen.disconnects++);
   sub.onError((e) => seen.errors.push(e?.message));
@@ -65,6 +67,11 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
   });
   const pipe = sub.subscribePipe("p_stream", "", 10);
   pipe.onPacketReceived((p) => seen.packets.push(p[0]));
+  // the member connections' own events: one open per (re)connection of each, one close per loss
+  wire.onConnect(() => seen.wireOpens++);
+  wire.onDisconnect(() => seen.wireCloses++);
+  pipe.onConnect(() => seen.pipeOpens++);
+  pipe.onDisconnect(() => seen.pipeCloses++);
   sub.subscribeEvent("ev_values", (seq) => seen.events.push(seq));
   sub.setCallback("cb_compute", (x, label) => x * 2 + label.length);
   sub.setCallback("cb_notify", () => {
@@ -102,17 +109,38 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
   };
   const client = () => sub.clients[0];
 
+  /**
+   * The wire's and pipe's own onConnect fired once more than their onDisconnect (each open now), and
+   * each closed and opened again at least `opens.wire` / `opens.pipe` times since `before`.
+   */
+  const memberEvents = async (what, before, opens) => {
+    const moved = () => seen.wireOpens >= before.wireOpens + opens.wire && seen.pipeOpens >= before.pipeOpens + opens.pipe;
+    await until(() => seen.wireOpens === seen.wireCloses + 1 && seen.pipeOpens === seen.pipeCloses + 1 && moved(),
+      () => `${what}: member onConnect/onDisconnect (wire opens/closes ${seen.wireOpens}/${seen.wireCloses}, pipe ${seen.pipeOpens}/${seen.pipeCloses}, before ${JSON.stringify(before)})`);
+    const counts = `wire ${seen.wireOpens}/${seen.wireCloses}, pipe ${seen.pipeOpens}/${seen.pipeCloses}`;
+    assert(seen.wireCloses >= before.wireCloses + opens.wire && seen.pipeCloses >= before.pipeCloses + opens.pipe, `${what}: closes ${counts}`);
+    return counts;
+  };
+  const memberCounts = () => ({ wireOpens: seen.wireOpens, wireCloses: seen.wireCloses, pipeOpens: seen.pipeOpens, pipeCloses: seen.pipeCloses });
+
   await check("first connection: wire, pipe, event, callbacks", async () => {
     await works("first");
     assert(client().connectCount === 1 && seen.connects === 1, `connectCount ${client().connectCount}, onConnect ${seen.connects}`);
+    assert(seen.attempts === 1, `onConnecting fired ${seen.attempts} times for one connection`);
+    await until(() => seen.wireOpens === 1 && seen.pipeOpens === 1, "the wire's and pipe's onConnect");
+    assert(seen.wireCloses === 0 && seen.pipeCloses === 0, `closes before any drop: wire ${seen.wireCloses}, pipe ${seen.pipeCloses}`);
   });
 
   if (control.restartDevice) {
     await check("device restarted: everything resumes", async () => {
       const c0 = client().connectCount;
+      const m0 = memberCounts();
       await control.restartDevice();
       await works("after device restart");
-      return `connections ${c0} -> ${client().connectCount}, onDisconnect ${seen.disconnects}`;
+      // the pipe endpoint goes with the device; a wire connection through the gateway may stay open
+      // (the gateway connects the device's wire again behind it): then it only has to be open now
+      const members = await memberEvents("after device restart", m0, { wire: 0, pipe: 1 });
+      return `connections ${c0} -> ${client().connectCount}, onDisconnect ${seen.disconnects}; member opens/closes ${members}`;
     });
   }
 
@@ -120,10 +148,13 @@ export async function runReconnectChecks(rr, { url, control, log = console.log, 
     await check("gateway restarted: reconnects and everything resumes", async () => {
       const c0 = client().connectCount;
       const d0 = seen.disconnects;
+      const m0 = memberCounts();
       await control.restartGateway();
       await works("after gateway restart");
+      await memberEvents("after gateway restart", m0, { wire: 1, pipe: 1 });
       assert(client().connectCount === c0 + 1 && seen.disconnects === d0 + 1,
         `connectCount ${c0} -> ${client().connectCount}, onDisconnect +${seen.disconnects - d0} (want +1 each)`);
+      assert(seen.attempts >= seen.connects, `onConnecting ${seen.attempts} times, onConnect ${seen.connects}: every connection had its attempt`);
     });
   }
 

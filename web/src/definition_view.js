@@ -8,7 +8,7 @@ const KEYWORDS = new Set(["service", "stdver", "import", "using", "struct", "pod
   "constant", "exception", "implements", "option"]);
 
 export class DefinitionView {
-  /** @param {HTMLElement} parent @param {import("./robdef_outline.js").RobdefOutline} outline */
+  /** @param {HTMLElement} parent @param {import("./std/robdef_outline.js").RobdefOutline} outline */
   constructor(parent, outline, idPrefix) {
     this.outline = outline;
     this.idPrefix = idPrefix;

@@ -1,19 +1,26 @@
-// One browser RR session to a device through the gateway (rr+ws://<gateway>/<page's folder>?service=<device>), made
-// with the client package (vendor/rr/robotraconteur.mjs) and kept up: after a failed connect or a
-// close it connects again with backoff (0.5 s doubling to 5 s).
+// The one place that knows the state of this page's RR session to a device through the gateway
+// (rr+ws://<gateway>/<page's folder>?service=<device>): a subscription of the client package
+// (vendor/rr/robotraconteur.mjs `subscribe`, wasm-client/src/subscription.mjs) keeps it up with the
+// package's reconnect policy (its jittered backoff, 0.5 s doubling to 5 s here), and every view of the
+// device subscribes its wires, pipes and events through that same subscription (`subscription`, and
+// views/live_object.js), so a fix to reconnecting is made in the package alone.
 //
 // A device with logins of its own behind an `auth: passthrough` gateway device (docs/security.md "Logins
 // and locks through the gateway") refuses a connect without the right credentials with
-// RobotRaconteur.AuthenticationError. Retrying cannot help then, so the loop waits in state "login"
-// until login(username, password) (or stop()); the credentials live in this object only.
+// RobotRaconteur.AuthenticationError. Retrying cannot help then, so the session closes its subscription
+// and waits in state "login" until login(username, password) (or stop()); the credentials live in this
+// object only.
 //
 // Events (EventTarget): "state" with detail { state: "connecting" | "connected" | "closed" | "login" |
-// "stopped", client (when connected), error (why the last attempt failed or the session ended; for
-// "login" the device's refusal, or null after logout()) }.
+// "stopped", client (the root proxy, when connected), attempt (when connecting: attempts so far), error
+// (why the last attempt failed or the session ended; for "login" the device's refusal, or null after
+// logout()) }.
 
-const BACKOFF_MIN_MS = 500;
-const BACKOFF_MAX_MS = 5000;
+/** The package's backoff, capped lower than its default: a person watches this page. */
+const BACKOFF = { maxMs: 5000 };
 const CONNECT_TIMEOUT_MS = 15000;
+/** A client package that failed to load (not deployed yet) is asked for again after this long. */
+const PACKAGE_RETRY_MS = 5000;
 
 let rrModule = null;
 /** The client package, loaded once (a missing package is reported as the connect error). */
@@ -46,19 +53,21 @@ export class DeviceSession extends EventTarget {
   /**
    * @param {string} url  the device's RR URL on the gateway
    * @param {object} [options]  credentials: { username, password } to connect with (null: none);
-   *   connect: the client package's connect (tests pass their own)
+   *   subscribe: the client package's subscribe(url, options) (tests pass their own)
    */
   constructor(url, options = {}) {
     super();
     this.url = url;
     this.credentials = options.credentials ?? null;
-    this.connectImpl = options.connect ?? null;
+    this.subscribeImpl = options.subscribe ?? null;
     this.stopped = false;
+    /** The root object proxy while connected, else null. */
     this.client = null;
-    this.wake = null;
-    this.loginWait = null;
+    /** The subscription now in use (a new one after each login and logout), null while none is. */
+    this.subscription = null;
     this.needLogin = false;
     this.attempts = 0;
+    this.retryTimer = 0;
   }
 
   /** The user this session logs in as, or null without credentials. */
@@ -69,96 +78,97 @@ export class DeviceSession extends EventTarget {
     this.dispatchEvent(new CustomEvent("state", { detail: { state, ...extra } }));
   }
 
-  /** Starts the connect loop (once). */
+  /** Starts the session (once); `loop` resolves once it has stopped. */
   start() {
-    if (!this.loop) this.loop = this.run();
+    if (!this.loop) {
+      this.loop = new Promise((resolve) => { this.finished = resolve; });
+      this.open();
+    }
     return this;
   }
 
-  /** Ends a waiting backoff now (e.g. the gateway reports the device back); not a wait for a login. */
-  retryNow() { this.wake?.(); }
+  /** Replaces the subscription by a new one with the current credentials (none while a login is awaited). */
+  async open() {
+    this.drop();
+    if (this.stopped) return;
+    if (this.needLogin) { this.emit("login", { error: null }); return; }
+    let subscribe = this.subscribeImpl;
+    if (!subscribe) {
+      try {
+        subscribe = (await loadClientPackage()).subscribe;
+      } catch (e) {
+        if (this.stopped || this.subscription) return;
+        this.emit("closed", { error: e });
+        this.retryTimer = setTimeout(() => this.open(), PACKAGE_RETRY_MS);
+        return;
+      }
+      if (this.stopped || this.subscription) return;
+    }
+    const sub = subscribe(this.url, { timeoutMs: CONNECT_TIMEOUT_MS, backoff: BACKOFF, ...(this.credentials ?? {}) });
+    this.subscription = sub;
+    const mine = (fn) => (...args) => { if (this.subscription === sub && !this.stopped) fn(...args); };
+    // The subscription's events come in the order they happened: an error between an attempt's start
+    // and its connection is that attempt's failure; any other (a wire's, an event's) is its view's.
+    let attempting = false;
+    sub.onConnecting(mine(() => {
+      attempting = true;
+      this.emit("connecting", { attempt: ++this.attempts });
+    }));
+    sub.onConnect(mine((c, proxy) => {
+      attempting = false;
+      this.client = proxy;
+      this.emit("connected", { client: proxy });
+    }));
+    sub.onDisconnect(mine((c, error) => {
+      this.client = null;
+      this.emit("closed", { error: error ?? "session closed" });
+    }));
+    sub.onError(mine((error) => {
+      if (!attempting) return;
+      attempting = false;
+      if (isAuthenticationError(error)) {
+        this.drop();
+        this.emit("login", { error });
+        return;
+      }
+      this.emit("closed", { error });
+    }));
+  }
+
+  /** Closes the subscription now in use (its events no longer count). */
+  drop() {
+    clearTimeout(this.retryTimer);
+    const sub = this.subscription;
+    this.subscription = null;
+    this.client = null;
+    sub?.close().catch(() => {});
+  }
+
+  /** Connects again at once when the session is waiting to (e.g. the gateway reports the device back); not a wait for a login. */
+  retryNow() {
+    if (this.state === "closed" && !this.stopped) this.open();
+  }
 
   /** Connects (again) as `username` with `password`: ends a wait for a login, or replaces the session. */
   login(username, password) {
     this.credentials = { username, password };
     this.needLogin = false;
-    if (this.loginWait) this.loginWait();
-    else this.reopen();
+    this.open();
   }
 
-  /** Forgets the credentials and closes the session; the loop then waits for login() without connecting. */
+  /** Forgets the credentials and closes the session; it then waits for login() without connecting. */
   logout() {
     this.credentials = null;
     this.needLogin = true;
-    this.reopen();
-  }
-
-  reopen() {
-    this.wake?.();
-    try { this.client?.$client.close(); } catch { /* already closed */ }
-  }
-
-  /** Waits in state "login" (no retries) until login() or stop(). */
-  async waitForLogin(error) {
-    this.emit("login", { error });
-    await new Promise((resolve) => { this.loginWait = resolve; });
-    this.loginWait = null;
-  }
-
-  async run() {
-    let backoff = BACKOFF_MIN_MS;
-    while (!this.stopped) {
-      if (this.needLogin) {
-        await this.waitForLogin(null);
-        continue;
-      }
-      this.attempts++;
-      this.emit("connecting", { attempt: this.attempts });
-      let error = null;
-      const used = this.credentials;
-      // login() or logout() while this attempt was under way: its result no longer counts.
-      const superseded = () => this.needLogin || this.credentials !== used;
-      try {
-        const connect = this.connectImpl ?? (await loadClientPackage()).connect;
-        const c = await connect(this.url, { timeoutMs: CONNECT_TIMEOUT_MS, ...(used ?? {}) });
-        if (this.stopped) { c.$client.close(); break; }
-        if (superseded()) { c.$client.close(); continue; }
-        backoff = BACKOFF_MIN_MS;
-        this.client = c;
-        const closed = new Promise((resolve) => c.$client.onClose((why) => resolve(why)));
-        this.emit("connected", { client: c });
-        error = await closed;
-        this.client = null;
-        if (this.stopped) break;
-        // login() and logout() close the session on purpose: connect again at once (or wait for a login).
-        if (superseded()) continue;
-        this.emit("closed", { error: error ?? "session closed" });
-      } catch (e) {
-        if (this.stopped) break;
-        if (superseded()) continue;
-        if (isAuthenticationError(e)) {
-          backoff = BACKOFF_MIN_MS;
-          await this.waitForLogin(e);
-          continue;
-        }
-        error = e;
-        this.emit("closed", { error: e });
-      }
-      await new Promise((resolve) => {
-        this.wake = resolve;
-        setTimeout(resolve, backoff);
-      });
-      this.wake = null;
-      backoff = Math.min(backoff * 2, BACKOFF_MAX_MS);
-    }
-    this.emit("stopped");
+    this.open();
   }
 
   /** Closes the session and stops reconnecting. */
   stop() {
+    if (this.stopped) return;
     this.stopped = true;
-    this.wake?.();
-    this.loginWait?.();
-    try { this.client?.$client.close(); } catch { /* already closed */ }
+    this.drop();
+    this.emit("stopped");
+    this.finished?.();
   }
 }

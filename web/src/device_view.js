@@ -9,28 +9,39 @@
 
 import { h, errorText } from "./dom.js";
 import { DeviceSession, deviceUrl } from "./device_session.js";
-import { RobdefOutline } from "./robdef_outline.js";
+import { RobdefOutline } from "./std/robdef_outline.js";
 import { DefinitionView } from "./definition_view.js";
 import { ObjectPanel } from "./object_panel.js";
 import { EventLog } from "./event_log.js";
 import { viewContext } from "./views/context.js";
+import { LiveObject } from "./views/live_object.js";
 import { standardPanels } from "./panels/standard.js";
 import { RecordControl } from "./record/record_control.js";
 import { ReplayTimeline } from "./record/replay_timeline.js";
 import { listReplays } from "./record/recording_api.js";
 import { fetchAccess } from "./robot/access.js";
 
-// The panels chosen by object type (panels/standard.js), the same for every device.
-const PANELS = standardPanels();
+// The panels chosen by object type (panels/standard.js) and the renderers of value types
+// (std/standard.js) unless the page gave its own (dashboard.js startDashboard).
+const STANDARD_PANELS = standardPanels();
 
 // Device logins of this page, by device name: kept in memory only (never in localStorage,
 // sessionStorage or cookies), so that switching between devices does not ask again; a reload forgets them.
 const deviceLogins = new Map();
 
 export class DeviceView {
-  constructor(root, name, list) {
+  /**
+   * @param {HTMLElement} root
+   * @param {string} name  the device's name at the gateway
+   * @param {import("./device_list.js").DeviceList} list
+   * @param {object} [options]  panels: a PanelRegistry (panels/registry.js), renderers: a
+   *   RendererRegistry (std/registry.js); the standard ones by default
+   */
+  constructor(root, name, list, { panels = STANDARD_PANELS, renderers = undefined } = {}) {
     this.name = name;
     this.list = list;
+    this.panels = panels;
+    this.renderers = renderers;
     this.memory = new Map();
     this.panel = null;
     this.client = null;
@@ -222,9 +233,10 @@ export class DeviceView {
     if (this.replayFile) recorder.markReplay(this.replayFile);
     this.mayRecordDevice().then((may) => { if (!may) recorder.refuse("Your login may not record this device (it needs the record right on the device)."); });
     // the device's types described once, from the definitions it sent (views/context.js)
-    const view = viewContext(outline);
+    const view = viewContext(outline, { registry: this.renderers });
     this.panel = new ObjectPanel(this.members, {
-      obj: client, outline, view, panels: PANELS, definitions: this.definitions, log: this.log, memory: this.memory, path: "",
+      // every wire, pipe, event and callback of the page through the session's one subscription
+      obj: client, live: new LiveObject(this.session.subscription), outline, view, panels: this.panels, definitions: this.definitions, log: this.log, memory: this.memory, path: "",
       // for panels that ask the gateway about this device (the robot panel: access, locks)
       device: this.name, session: this.session, devices: this.list,
     });

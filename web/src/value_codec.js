@@ -1,30 +1,35 @@
-// Values between the page and the client package: text in editors -> typed values (typed arrays for
-// numeric arrays, BigInt for int64, plain objects for structs, {dims, array} for multidim arrays,
-// {real, imag} for complex numbers, {type, value} for varvalues), and values -> short display text.
-// Structured inputs are JSON (JSON.parse); numbers JSON cannot hold are written as strings there
-// ("NaN", "Infinity", "-Infinity", "-0"), as are 64-bit integers.
+// Editor text -> values for the client package, typed by a type descriptor (std/describe.js, made
+// once per member when the device's definitions arrive): typed arrays for numeric arrays, BigInt for
+// int64, plain objects for structs, {dims, array} for multidim arrays, {real, imag} for complex
+// numbers, {type, value} for varvalues; and values -> editor text. Structured inputs are JSON
+// (JSON.parse); numbers JSON cannot hold are written as strings there ("NaN", "Infinity",
+// "-Infinity", "-0"), as are 64-bit integers. Nothing here reads type text: the descriptor carries
+// the shape, and a varvalue's own type is described by the describer that made its descriptor.
 
-import { NUMERIC_ARRAYS, parseType, parseNumber, isNumericBase } from "./rr_types.js";
+import { NUMERIC_ARRAYS, parseNumber, isNumericBase } from "./std/rr_types.js";
+import { numberText, toPlain } from "./std/value_text.js";
+
+const scalar = (d) => !d.container && !d.array;
 
 /**
- * Converts editor text to a value of `typeText`. Numbers and numeric vectors are plain text
- * ("1.5", "0.2, 0.4, 0.6"); strings are taken as written; everything else is JSON, converted field by
- * field with the struct definitions of `outline` (robdef_outline.js). Throws Error with the reason.
+ * Converts editor text to a value of the type described by `d`. Numbers and numeric vectors are
+ * plain text ("1.5", "0.2, 0.4, 0.6"); strings are taken as written; enums by name or number;
+ * everything else is JSON, converted field by field with the descriptor's fields. Throws Error with
+ * the reason.
  */
-export function parseInput(typeText, text, outline, scope) {
-  const t = parseType(typeText);
-  if (!t.container && !t.array) {
-    if (isNumericBase(t.base)) return parseNumber(t.base, text);
-    if (t.base === "string") return String(text);
-    if (outline?.enumOf(t.base, scope)) return parseEnum(outline.enumOf(t.base, scope), text);
+export function parseInput(d, text) {
+  if (scalar(d)) {
+    if (isNumericBase(d.base)) return parseNumber(d.base, text);
+    if (d.base === "string") return String(text);
+    if (d.kind === "enum") return parseEnum(d.enumValues, text);
   }
-  if (!t.container && t.array === "vector" && isNumericBase(t.base) && !String(text).trim().startsWith("[")) {
+  if (!d.container && d.array === "vector" && isNumericBase(d.base) && !String(text).trim().startsWith("[")) {
     const parts = String(text).split(/[\s,;]+/).filter((p) => p !== "");
-    return toArray(t.base, parts.map((p) => parseNumber(t.base, p)));
+    return toArray(d.base, parts.map((p) => parseNumber(d.base, p)));
   }
   let json;
-  try { json = JSON.parse(text); } catch (e) { throw new Error(`JSON expected for ${typeText}: ${e.message}`); }
-  return fromJson(typeText, json, outline, scope);
+  try { json = JSON.parse(text); } catch (e) { throw new Error(`JSON expected for ${d.text}: ${e.message}`); }
+  return fromJson(d, json);
 }
 
 function parseEnum(values, text) {
@@ -43,52 +48,51 @@ function toArray(base, items) {
   return Ctor.from(items);
 }
 
-/** Converts parsed JSON to a value typed by `typeText` (see parseInput). */
-export function fromJson(typeText, json, outline, scope) {
-  const t = parseType(typeText);
-  if (json === null && (t.container || t.array || !isNumericBase(t.base))) return null;
-  if (t.container) {
-    const inner = typeText.replace(/\{(int32|string|list)\}\s*$/, "");
-    if (t.container === "list") return asList(json).map((x) => fromJson(inner, x, outline, scope));
-    const out = t.container === "int32" ? new Map() : {};
+/** The items of an array of descriptor `d` (vector or multidim): a typed array for numbers, else each item converted. */
+function arrayFrom(d, items) {
+  if (isNumericBase(d.base)) return toArray(d.base, items.map((x) => parseNumber(d.base, String(x))));
+  return items.map((x) => fromJson(d.element, x));
+}
+
+/** Converts parsed JSON to a value of the type described by `d` (see parseInput). */
+export function fromJson(d, json) {
+  if (json === null && (d.container || d.array || !isNumericBase(d.base))) return null;
+  if (d.container) {
+    if (d.container === "list") return asList(json).map((x) => fromJson(d.element, x));
+    const out = d.container === "int32" ? new Map() : {};
     for (const [k, v] of Object.entries(json)) {
-      const item = fromJson(inner, v, outline, scope);
+      const item = fromJson(d.element, v);
       if (out instanceof Map) out.set(parseNumber("int32", k), item); else out[k] = item;
     }
     return out;
   }
-  if (t.array === "multidim") {
+  if (d.array === "multidim") {
     if (!json || !Array.isArray(json.dims) || !Array.isArray(json.array)) {
-      throw new Error(`${typeText}: {"dims": [...], "array": [...]} expected (column-major)`);
+      throw new Error(`${d.text}: {"dims": [...], "array": [...]} expected (column-major)`);
     }
-    return { dims: json.dims.map(Number), array: fromJson(`${t.base}[]`, json.array, outline, scope) };
+    return { dims: json.dims.map(Number), array: arrayFrom(d, json.array) };
   }
-  if (t.array === "vector") {
-    const items = asList(json);
-    if (isNumericBase(t.base)) return toArray(t.base, items.map((x) => parseNumber(t.base, String(x))));
-    return items.map((x) => fromJson(t.base, x, outline, scope));
-  }
-  if (isNumericBase(t.base)) return parseNumber(t.base, String(json));
-  if (t.base === "string") return String(json);
-  if (t.base === "cdouble" || t.base === "csingle") {
-    if (!json || typeof json !== "object") throw new Error(`${typeText}: {"real": …, "imag": …} expected`);
+  if (d.array === "vector") return arrayFrom(d, asList(json));
+  if (isNumericBase(d.base)) return parseNumber(d.base, String(json));
+  if (d.base === "string") return String(json);
+  if (d.base === "cdouble" || d.base === "csingle") {
+    if (!json || typeof json !== "object") throw new Error(`${d.text}: {"real": …, "imag": …} expected`);
     return { real: parseNumber("double", String(json.real)), imag: parseNumber("double", String(json.imag)) };
   }
-  if (t.base === "varvalue") {
-    // {type, value}: the value is typed by its own type text
-    if (json && typeof json === "object" && typeof json.type === "string" && "value" in json) {
-      return { type: json.type, value: fromJson(json.type, json.value, outline, scope) };
+  if (d.base === "varvalue") {
+    // {type, value}: the value is typed by its own type, described as the device's definitions say
+    if (json && typeof json === "object" && typeof json.type === "string" && "value" in json && d.describeValueType) {
+      return { type: json.type, value: fromJson(d.describeValueType(json.type), json.value) };
     }
     return json;
   }
-  const def = outline?.typeOf(t.base, scope);
-  if (def?.kind === "enum") return parseEnum(def.values, String(json));
-  if (def && def.fields) {
-    if (!json || typeof json !== "object" || Array.isArray(json)) throw new Error(`${typeText}: an object expected`);
+  if (d.kind === "enum") return parseEnum(d.enumValues, String(json));
+  if (d.fields) {
+    if (!json || typeof json !== "object" || Array.isArray(json)) throw new Error(`${d.text}: an object expected`);
     const out = {};
-    for (const f of def.fields) {
-      if (!(f.name in json)) throw new Error(`${typeText}: field ${f.name} missing`);
-      out[f.name] = fromJson(f.type, json[f.name], outline, def.service);
+    for (const f of d.fields) {
+      if (!(f.name in json)) throw new Error(`${d.text}: field ${f.name} missing`);
+      out[f.name] = fromJson(f.type, json[f.name]);
     }
     return out;
   }
@@ -100,65 +104,18 @@ function asList(json) {
   return json;
 }
 
-/** A number as editor text: shortest round-trip form, keeping the sign of -0. */
-export function numberText(x) {
-  return Object.is(x, -0) ? "-0" : String(x);
+/** True when editors show values of `d` as plain text (numbers, numeric vectors, strings), not JSON. */
+export function isPlainText(d) {
+  return !d.container && (!d.array || (d.array === "vector" && isNumericBase(d.base)))
+    && (isNumericBase(d.base) || d.base === "string");
 }
 
-function plainNumber(x) {
-  return Number.isFinite(x) && !Object.is(x, -0) ? x : numberText(x);
-}
-
-/** Plain JSON-able form of a value (typed arrays as arrays, BigInt and non-finite numbers as text,
- * Maps as objects). */
-export function toPlain(v) {
-  if (typeof v === "bigint") return v.toString();
-  if (typeof v === "number") return plainNumber(v);
-  if (ArrayBuffer.isView(v)) return Array.from(v, (x) => (typeof x === "bigint" ? x.toString() : plainNumber(x)));
-  if (v instanceof Map) return Object.fromEntries([...v].map(([k, x]) => [String(k), toPlain(x)]));
-  if (Array.isArray(v)) return v.map(toPlain);
-  if (v && typeof v === "object") return Object.fromEntries(Object.entries(v).map(([k, x]) => [k, toPlain(x)]));
-  return v;
-}
-
-/** Short display text; long arrays are cut to `maxItems` with a count of the rest. */
-export function formatValue(v, maxItems = 32) {
-  if (v === undefined) return "(no value)";
-  if (v === null) return "null";
-  if (typeof v === "string") return JSON.stringify(v);
-  if (typeof v === "number") return formatNumber(v);
-  if (typeof v === "bigint" || typeof v === "boolean") return String(v);
-  if (ArrayBuffer.isView(v) || Array.isArray(v)) {
-    const items = Array.from(v.slice(0, maxItems), (x) => formatValue(x, maxItems));
-    const more = v.length > maxItems ? `, … ${v.length - maxItems} more` : "";
-    return `[${items.join(", ")}${more}]`;
-  }
-  if (v instanceof Map) {
-    // maps have no order in RR: shown by key
-    const entries = [...v].sort(([a], [b]) => (a < b ? -1 : a > b ? 1 : 0));
-    return `{${entries.slice(0, maxItems).map(([k, x]) => `${k}: ${formatValue(x, maxItems)}`).join(", ")}}`;
-  }
-  if (typeof v === "object") {
-    if (v.dims && v.array) return `${Array.from(v.dims).join("×")} ${formatValue(v.array, maxItems)}`;
-    return `{${Object.entries(v).map(([k, x]) => `${k}: ${formatValue(x, maxItems)}`).join(", ")}}`;
-  }
-  return String(v);
-}
-
-function formatNumber(x) {
-  if (Number.isInteger(x) || !Number.isFinite(x)) return numberText(x);
-  return String(Number(x.toPrecision(6)));
-}
-
-/** Editor text for a value (inverse of parseInput for the shapes parseInput reads as plain text). */
-export function editorText(typeText, v) {
-  const t = parseType(typeText);
-  const plainText = !t.container && (!t.array || (t.array === "vector" && isNumericBase(t.base)))
-    && (isNumericBase(t.base) || t.base === "string");
-  if (v === undefined || v === null) return plainText ? "" : "null";
-  if (!t.container && !t.array && t.base === "string") return v;
-  if (!t.container && !t.array && isNumericBase(t.base)) return typeof v === "number" ? numberText(v) : String(v);
-  if (!t.container && t.array === "vector" && isNumericBase(t.base)) {
+/** Editor text for a value of descriptor `d` (inverse of parseInput for the shapes parseInput reads as plain text). */
+export function editorText(d, v) {
+  if (v === undefined || v === null) return isPlainText(d) ? "" : "null";
+  if (scalar(d) && d.base === "string") return v;
+  if (scalar(d) && isNumericBase(d.base)) return typeof v === "number" ? numberText(v) : String(v);
+  if (!d.container && d.array === "vector" && isNumericBase(d.base)) {
     return Array.from(v, (x) => (typeof x === "number" ? numberText(x) : String(x))).join(", ");
   }
   return JSON.stringify(toPlain(v));

@@ -1,9 +1,11 @@
-// The device session's connect loop (src/device_session.js) with a stand-in for the client package's
-// connect: a device that refuses the login (AuthenticationError) makes the loop wait for login()
-// instead of retrying; other failures are retried; logout() closes the session and waits again.
+// The device session (src/device_session.js) on the client package's subscription (the real
+// ServiceSubscription of wasm-client/src/subscription.mjs) with a stand-in for the package's connect: a
+// device that refuses the login (AuthenticationError) makes the session wait for login() instead of
+// retrying; other failures are retried; logout() closes the session and waits again.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { DeviceSession, isAuthenticationError } from "../src/device_session.js";
+import { ServiceSubscription } from "../../wasm-client/src/subscription.mjs";
 
 class FakeError extends Error {
   constructor(errorName, message) {
@@ -27,8 +29,10 @@ function fakeDevice({ users = { alice: "alice-pw" }, failFirst = 0 } = {}) {
     }
     const listeners = [];
     const client = {
-      close() {
+      state: "connected",
+      async close() {
         if (!dev.open.delete(client)) return;
+        client.state = "closed";
         for (const fn of listeners) fn(null);
       },
       onClose(fn) { listeners.push(fn); },
@@ -36,6 +40,8 @@ function fakeDevice({ users = { alice: "alice-pw" }, failFirst = 0 } = {}) {
     dev.open.add(client);
     return { $client: client, $type: "t.T" };
   };
+  // the client package's subscribe(url, options), connecting with the stand-in
+  dev.subscribe = (url, options) => new ServiceSubscription(url, options, dev.connect);
   return dev;
 }
 
@@ -60,7 +66,7 @@ test("isAuthenticationError: only the device's refusal of a login", () => {
 
 test("a device without logins connects as before, with no credentials", async () => {
   const dev = fakeDevice({ users: null });
-  const s = new DeviceSession("rr+ws://gw/?service=d", { connect: dev.connect });
+  const s = new DeviceSession("rr+ws://gw/?service=d", { subscribe: dev.subscribe });
   const connected = next(s, "connected");
   s.start();
   await connected;
@@ -71,7 +77,7 @@ test("a device without logins connects as before, with no credentials", async ()
 
 test("refused login: waits for login() without retrying; a wrong password refuses again; the right one connects", async () => {
   const dev = fakeDevice();
-  const s = new DeviceSession("rr+ws://gw/?service=d", { connect: dev.connect });
+  const s = new DeviceSession("rr+ws://gw/?service=d", { subscribe: dev.subscribe });
   let login = next(s, "login");
   s.start();
   assert.match((await login).error.message, /Username not provided/);
@@ -105,7 +111,7 @@ test("refused login: waits for login() without retrying; a wrong password refuse
 
 test("other connect errors are retried with the credentials given", async () => {
   const dev = fakeDevice({ failFirst: 1 });
-  const s = new DeviceSession("rr+ws://gw/?service=d", { connect: dev.connect, credentials: { username: "alice", password: "alice-pw" } });
+  const s = new DeviceSession("rr+ws://gw/?service=d", { subscribe: dev.subscribe, credentials: { username: "alice", password: "alice-pw" } });
   const closed = next(s, "closed");
   const connected = next(s, "connected");
   s.start();
@@ -119,7 +125,7 @@ test("other connect errors are retried with the credentials given", async () => 
 
 test("stop() ends a wait for a login", async () => {
   const dev = fakeDevice();
-  const s = new DeviceSession("rr+ws://gw/?service=d", { connect: dev.connect });
+  const s = new DeviceSession("rr+ws://gw/?service=d", { subscribe: dev.subscribe });
   const login = next(s, "login");
   s.start();
   await login;

@@ -6,7 +6,7 @@ import { test } from "node:test";
 import assert from "node:assert/strict";
 import { FrameDecoder } from "../src/std/frame_decoder.js";
 import { STANDARD_IMAGE_ENCODINGS as E } from "../src/std/image_encodings.js";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 import { standardDescriber } from "../src/std/standard.js";
 import { imageKind, hasImages, picturesOf } from "../src/views/image_set.js";
 import { frameTime, ageWords } from "../src/views/frame_view.js";

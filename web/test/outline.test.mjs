@@ -1,12 +1,12 @@
-// The robdef outline (src/robdef_outline.js) over the seed paper's definitions and the standard ones
+// The robdef outline (src/std/robdef_outline.js) over the seed paper's definitions and the standard ones
 // in ../shared (skipped when absent): every field type is a primitive or resolves to a declared type.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
-import { RobdefOutline, outlineDefinition } from "../src/robdef_outline.js";
-import { parseType, NUMERIC_ARRAYS } from "../src/rr_types.js";
+import { RobdefOutline, outlineDefinition } from "../src/std/robdef_outline.js";
+import { parseType, NUMERIC_ARRAYS } from "../src/std/rr_types.js";
 
 const shared = process.env.RR_SHARED_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../../../shared");
 const PRIMITIVES = new Set([...Object.keys(NUMERIC_ARRAYS), "bool", "string", "varvalue", "varobject", "cdouble", "csingle"]);

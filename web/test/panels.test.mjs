@@ -9,7 +9,7 @@ import { standardPanels } from "../src/panels/standard.js";
 import { deviceInfoMember } from "../src/panels/device_card.js";
 import { structRows } from "../src/panels/camera_panel.js";
 import { deviceInfoRows } from "../src/std/device_info.js";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 import { viewContext, describeMember } from "../src/views/context.js";
 import { plotSample } from "../src/views/plot_sample.js";
 import { standardDefinitions, SKIP_REASON } from "./std_fixtures.mjs";

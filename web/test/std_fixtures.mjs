@@ -3,7 +3,7 @@
 import fs from "node:fs";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
-import { outlineDefinition } from "../src/robdef_outline.js";
+import { outlineDefinition } from "../src/std/robdef_outline.js";
 
 export const shared = process.env.RR_SHARED_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../../../shared");
 export const standardDir = path.join(shared, "robdef-standard");

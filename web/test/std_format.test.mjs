@@ -2,7 +2,7 @@
 // enums.js, units.js): expected outputs written by hand or computed here another way.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 import { formatUuid, isNilUuid } from "../src/std/uuid.js";
 import { formatIdentifier } from "../src/std/identifier.js";
 import { formatTime, formatDuration, timeParts, isoTime, ageText, timeSeconds } from "../src/std/datetime.js";

@@ -3,7 +3,7 @@
 // out from how it packed them, the bad frames one by one, compressed formats by magic bytes.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 import { decodeImage, checkImage } from "../src/std/image_decode.js";
 import { STANDARD_IMAGE_ENCODINGS, PIXEL_FORMATS } from "../src/std/image_encodings.js";
 import { halfToNumber } from "../src/std/float16.js";

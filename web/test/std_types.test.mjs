@@ -3,14 +3,14 @@
 // view, flag and unit fields found by their names, and what plots take (plot_fields.js).
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 import { standardDescriber, standardRegistry } from "../src/std/standard.js";
 import { TypeDescriber, fieldAt, qualifyType } from "../src/std/describe.js";
 import { RendererRegistry } from "../src/std/registry.js";
 import { typedText, memberText } from "../src/std/typed_text.js";
 import { typedNumericFields, leaveOutOfPlot, plotRole, sensorTimestamp } from "../src/std/plot_fields.js";
-import { formatValue } from "../src/value_codec.js";
-import { parseType } from "../src/rr_types.js";
+import { formatValue } from "../src/std/value_text.js";
+import { parseType } from "../src/std/rr_types.js";
 import { standardDefinitions, SKIP_REASON } from "./std_fixtures.mjs";
 
 const defs = standardDefinitions();

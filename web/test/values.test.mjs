@@ -1,9 +1,11 @@
-// Editor text <-> values typed by robdef (src/value_codec.js, src/rr_types.js).
+// Editor text <-> values typed by robdef (src/value_codec.js, src/std/rr_types.js).
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { parseType, parseNumber, isPlottable } from "../src/rr_types.js";
-import { parseInput, formatValue, editorText, toPlain } from "../src/value_codec.js";
-import { RobdefOutline } from "../src/robdef_outline.js";
+import { parseType, parseNumber, isPlottable } from "../src/std/rr_types.js";
+import { parseInput, editorText } from "../src/value_codec.js";
+import { formatValue, toPlain } from "../src/std/value_text.js";
+import { TypeDescriber } from "../src/std/describe.js";
+import { RobdefOutline } from "../src/std/robdef_outline.js";
 
 const outline = new RobdefOutline({
   "experimental.t": `service experimental.t
@@ -22,6 +24,10 @@ object T
 end
 `,
 });
+
+// the descriptors the page makes once per member (std/describe.js), as the editors get them
+const types = new TypeDescriber(outline);
+const typed = (text) => types.describe(text, "experimental.t");
 
 test("type texts split into base, array and container", () => {
   assert.deepEqual(parseType("double[]"), { text: "double[]", base: "double", array: "vector", dims: null, container: null });
@@ -44,27 +50,27 @@ test("numbers are checked against their type", () => {
 });
 
 test("plain text gives scalars and typed arrays", () => {
-  const v = parseInput("double[]", "0.2, 0.4 0.6", outline, "experimental.t");
+  const v = parseInput(typed("double[]"), "0.2, 0.4 0.6");
   assert.ok(v instanceof Float64Array);
   assert.deepEqual(Array.from(v), [0.2, 0.4, 0.6]);
-  assert.ok(parseInput("int64[]", "1,2", outline) instanceof BigInt64Array);
-  assert.equal(parseInput("string", "  spaced  ", outline), "  spaced  ");
-  assert.equal(parseInput("Mode", "fast", outline, "experimental.t"), 3);
-  assert.equal(parseInput("Mode", "2", outline, "experimental.t"), 2);
-  assert.throws(() => parseInput("uint8[]", "1, 300", outline), /out of range/);
+  assert.ok(parseInput(typed("int64[]"), "1,2") instanceof BigInt64Array);
+  assert.equal(parseInput(typed("string"), "  spaced  "), "  spaced  ");
+  assert.equal(parseInput(typed("Mode"), "fast"), 3);
+  assert.equal(parseInput(typed("Mode"), "2"), 2);
+  assert.throws(() => parseInput(typed("uint8[]"), "1, 300"), /out of range/);
 });
 
 test("JSON gives structs typed field by field", () => {
-  const p = parseInput("Point", '{"x": 1.5, "id": "12345678901234567", "raw": [1, 2]}', outline, "experimental.t");
+  const p = parseInput(typed("Point"), '{"x": 1.5, "id": "12345678901234567", "raw": [1, 2]}');
   assert.equal(p.x, 1.5);
   assert.equal(p.id, 12345678901234567n);
   assert.ok(p.raw instanceof Uint8Array);
-  assert.throws(() => parseInput("Point", '{"x": 1}', outline, "experimental.t"), /field id missing/);
-  const list = parseInput("Point{list}", '[{"x": 0, "id": 1, "raw": []}]', outline, "experimental.t");
+  assert.throws(() => parseInput(typed("Point"), '{"x": 1}'), /field id missing/);
+  const list = parseInput(typed("Point{list}"), '[{"x": 0, "id": 1, "raw": []}]');
   assert.equal(list.length, 1);
-  const map = parseInput("double{int32}", '{"3": 1.5}', outline);
+  const map = parseInput(typed("double{int32}"), '{"3": 1.5}');
   assert.ok(map instanceof Map && map.get(3) === 1.5);
-  const md = parseInput("uint8[*]", '{"dims": [2, 1], "array": [7, 8]}', outline);
+  const md = parseInput(typed("uint8[*]"), '{"dims": [2, 1], "array": [7, 8]}');
   assert.deepEqual([Array.from(md.dims), Array.from(md.array)], [[2, 1], [7, 8]]);
 });
 
@@ -74,27 +80,27 @@ test("values format for display and back for editors", () => {
   assert.equal(formatValue({ a: 1n, b: "x" }), '{a: 1, b: "x"}');
   assert.equal(formatValue(new Map([[0, "Left"]])), '{0: "Left"}');
   assert.equal(formatValue({ dims: Uint32Array.of(2, 2), array: Uint8Array.of(1, 2, 3, 4) }), "2×2 [1, 2, 3, 4]");
-  assert.equal(editorText("double[]", Float64Array.of(1, 2.5)), "1, 2.5");
-  assert.equal(editorText("Point", { x: 1, id: 2n, raw: Uint8Array.of(3) }), '{"x":1,"id":"2","raw":[3]}');
+  assert.equal(editorText(typed("double[]"), Float64Array.of(1, 2.5)), "1, 2.5");
+  assert.equal(editorText(typed("Point"), { x: 1, id: 2n, raw: Uint8Array.of(3) }), '{"x":1,"id":"2","raw":[3]}');
   assert.deepEqual(toPlain(new Map([[1, BigInt64Array.of(5n)]])), { 1: ["5"] });
 });
 
 test("numbers JSON cannot hold, nulls, complex numbers and varvalues survive an editor round trip", () => {
   const a = Float64Array.of(0, -0, Infinity, -Infinity, NaN, 5e-324);
-  const text = editorText("double[]", a);
+  const text = editorText(typed("double[]"), a);
   assert.equal(text, "0, -0, Infinity, -Infinity, NaN, 5e-324");
-  const back = parseInput("double[]", text, outline);
+  const back = parseInput(typed("double[]"), text);
   assert.ok(Object.is(back[1], -0) && Number.isNaN(back[4]) && back[5] === 5e-324);
   const map = new Map([[-1, -0], [0, NaN]]);
-  const m = parseInput("double{int32}", editorText("double{int32}", map), outline);
+  const m = parseInput(typed("double{int32}"), editorText(typed("double{int32}"), map));
   assert.ok(Object.is(m.get(-1), -0) && Number.isNaN(m.get(0)));
-  assert.equal(editorText("Point", null), "null");
-  assert.equal(parseInput("Point", "null", outline, "experimental.t"), null);
-  assert.equal(editorText("string", "two\nlines"), "two\nlines");
-  const c = parseInput("cdouble[]", editorText("cdouble[]", [{ real: -0, imag: Infinity }]), outline);
+  assert.equal(editorText(typed("Point"), null), "null");
+  assert.equal(parseInput(typed("Point"), "null"), null);
+  assert.equal(editorText(typed("string"), "two\nlines"), "two\nlines");
+  const c = parseInput(typed("cdouble[]"), editorText(typed("cdouble[]"), [{ real: -0, imag: Infinity }]));
   assert.ok(Object.is(c[0].real, -0) && c[0].imag === Infinity);
   const v = { type: "experimental.t.Point[]", value: [{ x: NaN, id: 9007199254740993n, raw: Uint8Array.of(1) }] };
-  const vb = parseInput("varvalue", editorText("varvalue", v), outline, "experimental.t");
+  const vb = parseInput(typed("varvalue"), editorText(typed("varvalue"), v));
   assert.equal(vb.type, "experimental.t.Point[]");
   assert.ok(Number.isNaN(vb.value[0].x) && vb.value[0].id === 9007199254740993n && vb.value[0].raw instanceof Uint8Array);
   assert.equal(formatValue(new Map([[5, "b"], [-1, "a"]])), '{-1: "a", 5: "b"}');

@@ -3,12 +3,13 @@
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
-import { formatValue, parseInput } from "../value_codec.js";
+import { parseInput } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
 
-export function callbackView(ctx, member) {
-  const card = memberCard(ctx, member);
+export function callbackView(ctx, member, _ObjectPanel, described) {
+  const card = memberCard(ctx, member, described);
   const box = h("input", { type: "checkbox" });
-  const reply = member.type !== "void" ? valueInput(member.type, `${member.name} reply`, ctx.outline, ctx.scope) : null;
+  const reply = member.type !== "void" ? valueInput(described.type, `${member.name} reply`) : null;
   const count = h("output", { class: "count", text: "0" });
   let n = 0;
   card.body.append(h("label", { class: "toggle" }, box, "answer calls"),
@@ -21,14 +22,16 @@ export function callbackView(ctx, member) {
       ctx.log.add("callback", ctx.path + member.name, `(${argText}) refused: answering is off`);
       throw new Error("The dashboard is not answering this callback");
     }
-    const value = reply ? parseInput(member.type, reply.read(), ctx.outline, ctx.scope) : undefined;
+    const value = reply ? parseInput(described.type, reply.read()) : undefined;
     ctx.log.add("callback", ctx.path + member.name, `(${argText}) -> ${formatValue(value)}`);
     return value;
   };
+  // answered through the device session's subscription (views/live_object.js), set again after a reconnect
+  let clear = null;
   try {
-    ctx.obj[member.name].set(handler);
+    clear = ctx.live.setCallback(member.name, handler);
   } catch (e) {
     card.showError(e);
   }
-  return { el: card.el, dispose() {} };
+  return { el: card.el, dispose() { clear?.(); } };
 }

@@ -2,7 +2,7 @@
 // and an error line that shows device errors in place.
 
 import { h, errorText } from "../dom.js";
-import { parseType, isNumericBase } from "../rr_types.js";
+import { isNumericBase } from "../std/rr_types.js";
 
 /** The member's signature as robdef writes it (for functions and callbacks, with parameters). */
 export function signature(member) {
@@ -30,8 +30,8 @@ export function memberCard(ctx, member, described = null) {
   const typeEl = h("code", { class: "member-type" });
   const words = signature(member).split(/([\s,()<>{}\[\]]+)/);
   for (const w of words) {
-    const base = parseType(w).base;
-    const link = w && /^[A-Za-z_][\w.]*$/.test(base) ? ctx.linkType?.(base) : null;
+    // the separators cut the signature into names: each word is a type name, a member name or a keyword
+    const link = /^[A-Za-z_][\w.]*$/.test(w) ? ctx.linkType?.(w) : null;
     typeEl.append(link || w);
   }
   const error = h("div", { class: "member-error", role: "alert", hidden: true });
@@ -56,16 +56,16 @@ export function memberCard(ctx, member, described = null) {
   };
 }
 
-/** An input for a value of `type`: a checkbox for bool, a list of names for enums, a text field for
- * numbers and numeric vectors, a text area for strings (they may hold line breaks), a JSON text area for everything
- * else. `.read()` gives the text ("true"/"false" for the checkbox). */
-export function valueInput(type, label, outline, scope) {
-  const t = parseType(type);
+/** An input for a value of type descriptor `d` (std/describe.js): a checkbox for bool, a list of names
+ * for enums, a text field for numbers and numeric vectors, a text area for strings (they may hold line
+ * breaks), a JSON text area for everything else. `.read()` gives the text ("true"/"false" for the checkbox). */
+export function valueInput(d, label) {
+  const t = d;
   if (t.base === "bool" && !t.array && !t.container) {
     const box = h("input", { type: "checkbox", "aria-label": label });
     return { el: box, read: () => String(box.checked), write: (text) => { box.checked = text === "true"; } };
   }
-  const values = !t.container && !t.array ? outline?.enumOf(t.base, scope) : null;
+  const values = !t.container && !t.array && t.kind === "enum" ? t.enumValues : null;
   if (values) {
     const select = h("select", { "aria-label": label },
       ...values.map((v) => h("option", { value: v.name, text: `${v.name} (${v.value})` })));
@@ -75,7 +75,7 @@ export function valueInput(type, label, outline, scope) {
     };
     return { el: select, read: () => select.value, write };
   }
-  const simple = !t.container && (t.array === null || (t.array === "vector" && t.base !== "string"))
+  const simple = !t.container && (!t.array || (t.array === "vector" && t.base !== "string"))
     && isNumericBase(t.base);
   let el;
   if (simple) el = h("input", { type: "text", "aria-label": label, placeholder: t.array ? "1, 2, 3" : t.base, spellcheck: "false" });

@@ -3,21 +3,19 @@
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
-import { formatValue } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
 import { typedText } from "../std/typed_text.js";
 
-export function eventView(ctx, member, _ObjectPanel, described = null) {
+export function eventView(ctx, member, _ObjectPanel, described) {
   const card = memberCard(ctx, member, described);
-  const scope = ctx.outline?.serviceOfObject?.(ctx.obj.$type);
-  const params = (member.params || []).map((p) => {
-    try { return ctx.view?.types?.describe(p.type, scope) ?? null; } catch { return null; }
-  });
+  const params = described.params.map((p) => p.type);
   const text = (a, i) => (params[i] ? typedText(a, params[i], ctx.view?.text) : formatValue(a));
   const count = h("output", { class: "count", text: "0" });
   card.body.append(h("div", {}, "received: ", count));
   let n = 0, off = null;
   try {
-    off = ctx.obj[member.name].on((...args) => {
+    // through the device session's subscription (views/live_object.js): subscribed again after a reconnect
+    off = ctx.live.onEvent(member.name, (...args) => {
       count.textContent = String(++n);
       ctx.log.add("event", ctx.path + member.name, args.length ? args.map(text).join(", ") : "(no arguments)");
     });

@@ -4,19 +4,20 @@
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
-import { formatValue, parseInput } from "../value_codec.js";
+import { parseInput } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
 import { asImage, drawImage } from "../image_view.js";
 import { typedText } from "../std/typed_text.js";
 import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
 
 const MAX_GENERATOR_ITEMS = 100;
 
-export function functionView(ctx, member, _ObjectPanel, described = null) {
+export function functionView(ctx, member, _ObjectPanel, described) {
   const card = memberCard(ctx, member, described);
-  const type = described?.type ?? null;
-  const text = (v) => (type ? typedText(v, type, ctx.view?.text, 32) : formatValue(v));
+  const type = described.type;
+  const text = (v) => typedText(v, type, ctx.view?.text, 32);
   let images = null;
-  const inputs = (member.params || []).map((p) => ({ param: p, input: valueInput(p.type, p.name, ctx.outline, ctx.scope) }));
+  const inputs = (member.params || []).map((p, i) => ({ param: p, type: described.params[i].type, input: valueInput(described.params[i].type, p.name) }));
   const result = h("output", { class: "result" });
   const canvas = h("canvas", { class: "image", hidden: true });
   let calls = 0;
@@ -25,8 +26,8 @@ export function functionView(ctx, member, _ObjectPanel, described = null) {
     ev.preventDefault();
     let args;
     try {
-      args = inputs.map(({ param, input }) => {
-        try { return parseInput(param.type, input.read(), ctx.outline, ctx.scope); } catch (e) { throw new Error(`${param.name}: ${e.message}`); }
+      args = inputs.map(({ param, type: t, input }) => {
+        try { return parseInput(t, input.read()); } catch (e) { throw new Error(`${param.name}: ${e.message}`); }
       });
     } catch (e) {
       card.showError(e);
@@ -50,8 +51,8 @@ export function functionView(ctx, member, _ObjectPanel, described = null) {
 
   function show(r) {
     result.textContent = member.type === "void" ? "done" : text(r);
-    if (type && hasImages(type)) {
-      images ??= new ImageSet(card.body, { encodings: ctx.view?.encodings, clockEnum: ctx.view?.clockEnum, label: member.name });
+    if (hasImages(type)) {
+      images ??= new ImageSet(card.body, { context: ctx.view?.text, label: member.name });
       images.push(picturesOf(r, type));
       return;
     }

@@ -4,8 +4,9 @@
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
-import { parseInput, formatValue } from "../value_codec.js";
-import { parseType, parseNumber } from "../rr_types.js";
+import { parseInput } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
+import { parseNumber } from "../std/rr_types.js";
 import { asImage, drawImage } from "../image_view.js";
 import { typedText } from "../std/typed_text.js";
 
@@ -16,11 +17,11 @@ function numbers(text) {
   return String(text).split(/[\s,;]+/).filter(Boolean).map((s) => parseNumber("uint64", s)).map(Number);
 }
 
-export function memoryView(ctx, member, _ObjectPanel, described = null) {
+export function memoryView(ctx, member, _ObjectPanel, described) {
   const card = memberCard(ctx, member, described);
-  const item = described?.type?.element ?? null;  // pods and namedarrays read as their own text (UUIDs, times)
+  const item = described.type.element ?? null;  // pods and namedarrays read as their own text (UUIDs, times)
   const mem = ctx.obj[member.name];
-  const t = parseType(member.type);
+  const t = described.type;
   const multidim = t.array === "multidim";
   const lengthOut = h("output", { class: "length" });
   const start = h("input", { type: "text", "aria-label": "start", value: multidim ? "0, 0, 0" : "0", spellcheck: "false" });
@@ -82,10 +83,10 @@ export function memoryView(ctx, member, _ObjectPanel, described = null) {
     try {
       const s = numbers(writeStart.value);
       if (multidim) {
-        const v = parseInput(`${t.base}[*]`, writeValues.value, ctx.outline, ctx.scope);
+        const v = parseInput(t, writeValues.value);
         await mem.write(s, v);
       } else {
-        await mem.write(s[0], parseInput(`${t.base}[]`, writeValues.value, ctx.outline, ctx.scope));
+        await mem.write(s[0], parseInput(t, writeValues.value));
       }
       card.clearError();
     } catch (e) {

@@ -4,12 +4,13 @@
 
 import { h } from "../dom.js";
 import { memberCard } from "./card.js";
-import { parseType, parseNumber } from "../rr_types.js";
+import { parseNumber } from "../std/rr_types.js";
+import { describeMember } from "../views/context.js";
 
-export function objrefView(ctx, member, ObjectPanel) {
-  const card = memberCard(ctx, member);
+export function objrefView(ctx, member, ObjectPanel, described) {
+  const card = memberCard(ctx, member, described);
   const ref = ctx.obj[member.name];
-  const t = parseType(member.type);
+  const t = described.type;
   const keyed = t.container === "int32" || t.container === "string";
   const memoryKey = `${ctx.path}${member.name}:open`;
   const opened = new Map(); // index text -> { panel, box }
@@ -29,7 +30,9 @@ export function objrefView(ctx, member, ObjectPanel) {
       const box = h("div", { class: "child-object", dataset: { path: `${ctx.path}${label}` } },
         h("div", { class: "child-title" }, h("strong", { text: label }), h("code", { text: ` ${child.$type ?? ""} ` }), closeButton));
       card.body.append(box);
-      const panel = new ObjectPanel(box, { ...ctx, obj: child, path: `${ctx.path}${label}.` });
+      // the child's live members go through the session's subscription at its objref path (Webcams[0])
+      const live = ctx.live.child(member.name, keyed ? key : undefined);
+      const panel = new ObjectPanel(box, { ...ctx, obj: child, live, path: `${ctx.path}${label}.` });
       opened.set(key, { panel, box });
       remember();
     } catch (e) {
@@ -53,7 +56,7 @@ export function objrefView(ctx, member, ObjectPanel) {
 
   // Offer the keys of a sibling map property with the same key type.
   if (keyed) {
-    const sibling = (ctx.obj.$members || []).find((m) => m.kind === "property" && !m.writeonly && parseType(m.type).container === t.container);
+    const sibling = (ctx.obj.$members || []).find((m) => m.kind === "property" && !m.writeonly && describeMember(ctx.view, ctx.obj, m)?.type.container === t.container);
     if (sibling) {
       ctx.obj[sibling.name].get().then((map) => {
         const entries = map instanceof Map ? [...map] : Object.entries(map || {});

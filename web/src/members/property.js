@@ -4,9 +4,9 @@
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
-import { formatValue, parseInput, editorText } from "../value_codec.js";
-import { isPlottable } from "../rr_types.js";
-import { numericFields } from "../numeric_fields.js";
+import { parseInput, editorText } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
+import { isPlottable } from "../std/rr_types.js";
 import { LivePlot } from "../live_plot.js";
 import { memberText } from "../std/typed_text.js";
 import { typedNumericFields } from "../std/plot_fields.js";
@@ -14,27 +14,26 @@ import { hasImages, picturesOf, ImageSet } from "../views/image_set.js";
 
 const POLL_MS = 250;
 
-export function propertyView(ctx, member, _ObjectPanel, described = null) {
+export function propertyView(ctx, member, _ObjectPanel, described) {
   const card = memberCard(ctx, member, described);
   const prop = ctx.obj[member.name];
   const out = h("output", { class: "value" });
   let plot = null, timer = 0, inFlight = false, disposed = false, reads = 0, images = null;
 
   // pictures: their bytes are not written out as editor text (megabytes), unless the property is writable
-  const pictures = !!described && hasImages(described.type);
+  const pictures = hasImages(described.type);
   const wantsText = !pictures || !member.readonly;
 
   function show(v, text) {
     if (wantsText) out.dataset.value = text;
-    out.textContent = described ? memberText(v, described, ctx.view?.text, 32) : formatValue(v);
+    out.textContent = memberText(v, described, ctx.view?.text, 32);
     if (pictures) {
-      images ??= new ImageSet(card.body, { encodings: ctx.view?.encodings, clockEnum: ctx.view?.clockEnum, label: member.name });
+      images ??= new ImageSet(card.body, { context: ctx.view?.text, label: member.name });
       images.push(picturesOf(v, described.type));
     }
   }
 
   function plotPairs(v) {
-    if (!described) return numericFields(v, null, member.name);
     return typedNumericFields(v, described.type, member.name).map(([n, x, hide, label]) => [n, x, hide || !!described.flags, label]);
   }
 
@@ -43,7 +42,7 @@ export function propertyView(ctx, member, _ObjectPanel, described = null) {
     try {
       const v = await prop.get();
       if (disposed) return undefined;
-      const text = wantsText ? editorText(member.type, v) : "";  // before the pictures' bytes go to their decoder
+      const text = wantsText ? editorText(described.type, v) : "";  // before the pictures' bytes go to their decoder
       const pairs = plot ? plotPairs(v) : null;
       show(v, text);
       if (pairs) plot?.push(pairs);
@@ -64,10 +63,10 @@ export function propertyView(ctx, member, _ObjectPanel, described = null) {
   }
   let input = null;
   if (!member.readonly) {
-    input = valueInput(member.type, `${member.name} value`, ctx.outline, ctx.scope);
+    input = valueInput(described.type, `${member.name} value`);
     const set = async () => {
       try {
-        const v = parseInput(member.type, input.read(), ctx.outline, ctx.scope);
+        const v = parseInput(described.type, input.read());
         await prop.set(v);
         card.clearError();
         if (!member.writeonly) await read();
@@ -90,7 +89,7 @@ export function propertyView(ctx, member, _ObjectPanel, described = null) {
       plot = null;
     }
   }
-  if (isPlottable(member.type) && !member.writeonly) {
+  if (isPlottable(described.type) && !member.writeonly) {
     const on = ctx.memory.get(memoryKey) ?? Boolean(member.readonly);
     const box = h("input", { type: "checkbox", checked: on, onchange: () => setPlotting(box.checked) });
     card.tools.prepend(h("label", { class: "toggle" }, box, "plot"));

@@ -1,12 +1,12 @@
-// What wires and pipes show for each value: standard pictures (Image, CompressedImage, or arrays and
-// maps of them) in FrameViews, other image-like values (a struct with width, height, data, as the
+// What wires and pipes show for each value: pictures (values whose renderer draws them: the standard
+// Image, CompressedImage, a page's own picture types, or arrays and maps of them) in FrameViews, other image-like values (a struct with width, height, data, as the
 // demo webcam's WebcamImage) on a canvas, and otherwise the value's readable text (std/typed_text.js)
 // and a live plot of its numbers (std/plot_fields.js: no UUID bytes, identifiers or clock fields; the
 // value's own timestamp on the time axis when it carries one). Text and the plain canvas are drawn at
 // most once per animation frame; the newest value wins.
 
 import { h } from "../dom.js";
-import { formatValue } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
 import { asImage, drawImage } from "../image_view.js";
 import { LivePlot } from "../live_plot.js";
 import { typedText } from "../std/typed_text.js";
@@ -17,14 +17,14 @@ export class StreamDisplay {
   /**
    * @param {HTMLElement} parent
    * @param {object} [opts]
-   * @param {string|null} [opts.qualifiedType]  the value's named type, for known byte layouts (packet_layouts.js)
-   * @param {object|null} [opts.type]  the value's type descriptor (std/describe.js)
+   * @param {object|null} [opts.type]  the value's type descriptor (std/describe.js); its named type picks
+   *   a known byte layout (packet_layouts.js)
    * @param {object} [opts.view]  the device's view context (views/context.js)
    * @param {string} [opts.label]  what the pictures are called
    */
   constructor(parent, opts = {}) {
-    this.qualifiedType = opts.qualifiedType ?? null;
     this.type = opts.type ?? null;
+    this.qualifiedType = this.type?.qualified ?? null;
     this.view = opts.view ?? null;
     this.label = opts.label || "stream";
     this.pictures = hasImages(this.type);
@@ -53,7 +53,7 @@ export class StreamDisplay {
       if (this.pictures) {
         // text first: the pictures' bytes may be handed to the decoder's Worker
         this.latestText = this.describe(value);
-        this.images ??= new ImageSet(this.el, { encodings: this.view?.encodings, clockEnum: this.view?.clockEnum, label: this.label });
+        this.images ??= new ImageSet(this.el, { context: this.view?.text, label: this.label });
         this.images.push(picturesOf(value, this.type));
       } else if (!asImage(value)) {
         const { pairs, t } = plotSample(value, this.type, this.qualifiedType);

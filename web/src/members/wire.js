@@ -1,49 +1,20 @@
-// A wire: connected while the device page is open (readonly and read-write wires), newest in-value
+// A wire: followed while the device page is open (readonly and read-write wires), newest in-value
 // shown and plotted; writable wires get an out-value editor. Peek reads the value without connecting.
-// A wire connection that closes while the page is open is connected again after REOPEN_MS. The
-// connection is shared with the panels that show the same wire (views/shared_wire.js).
+// The connection is the device session's subscription's, shared with the panels that show the same
+// wire (views/shared_wire.js): it is connected again by the subscription when the device or gateway
+// closes it, and the card shows why it is down meanwhile.
 
 import { h } from "../dom.js";
 import { memberCard, valueInput } from "./card.js";
-import { formatValue, parseInput } from "../value_codec.js";
-import { parseType } from "../rr_types.js";
+import { parseInput } from "../value_codec.js";
+import { formatValue } from "../std/value_text.js";
 import { memberText } from "../std/typed_text.js";
 import { StreamDisplay } from "./stream_display.js";
-import { connectShared } from "../views/shared_wire.js";
 
-const REOPEN_MS = 2000;
-
-export function wireView(ctx, member, _ObjectPanel, described = null) {
+export function wireView(ctx, member, _ObjectPanel, described) {
   const card = memberCard(ctx, member, described);
   const wire = ctx.obj[member.name];
-  const qualified = ctx.outline.typeOf(parseType(member.type).base, ctx.scope)?.qualified ?? null;
-  let conn = null, display = null, disposed = false, reopen = 0;
-
-  async function open() {
-    try {
-      conn = await connectShared(ctx.obj, member.name);
-      if (disposed) { await conn.close(); return; }
-      card.clearError();
-      display ??= new StreamDisplay(card.body, { qualifiedType: qualified, type: described?.type, view: ctx.view, label: member.name });
-      conn.onChange((v) => display.push(v));
-      conn.onClose((err) => {
-        conn = null;
-        if (disposed) return;
-        card.showError(err ?? new Error("wire connection closed"));
-        reopen = setTimeout(open, REOPEN_MS);
-      });
-      try {
-        const v = conn.inValue;
-        if (v !== undefined) display.push(v);
-      } catch {
-        // no value received yet: the first onChange brings it
-      }
-    } catch (e) {
-      if (disposed) return;
-      card.showError(e);
-      reopen = setTimeout(open, REOPEN_MS);
-    }
-  }
+  let display = null, follow = null;
 
   if (!member.writeonly) {
     card.tools.append(h("button", {
@@ -59,11 +30,11 @@ export function wireView(ctx, member, _ObjectPanel, described = null) {
   const peekOut = h("output", { class: "peek" });
   card.body.append(peekOut);
   if (!member.readonly) {
-    const input = valueInput(member.type, `${member.name} out value`, ctx.outline, ctx.scope);
+    const input = valueInput(described.type, `${member.name} out value`);
     const send = async () => {
       try {
-        const v = parseInput(member.type, input.read(), ctx.outline, ctx.scope);
-        if (conn) conn.outValue = v; else await wire.pokeOutValue(v);
+        const v = parseInput(described.type, input.read());
+        if (follow?.connected) follow.setOutValue(v); else await wire.pokeOutValue(v);
         card.clearError();
       } catch (e) {
         card.showError(e);
@@ -71,14 +42,23 @@ export function wireView(ctx, member, _ObjectPanel, described = null) {
     };
     card.body.append(h("div", { class: "editor" }, input.el, h("button", { type: "button", text: "Send", onclick: send })));
   }
-  if (!member.writeonly) open();
+  // what the wire shows appears once it is connected (or brings a value)
+  const shown = () => (display ??= new StreamDisplay(card.body, { type: described.type, view: ctx.view, label: member.name }));
+  if (!member.writeonly) {
+    follow = ctx.live.followWire(member.name, {
+      onValue: (v) => shown().push(v),
+      onError: (e) => {
+        if (e) { card.showError(e); return; }
+        card.clearError();
+        shown();
+      },
+    });
+  }
   return {
     el: card.el,
     dispose() {
-      disposed = true;
-      clearTimeout(reopen);
+      follow?.dispose();
       display?.dispose();
-      if (conn) conn.close().catch(() => {});
     },
   };
 }

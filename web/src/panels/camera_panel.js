@@ -10,7 +10,6 @@ import { describeMember } from "../views/context.js";
 import { FrameView } from "../views/frame_view.js";
 import { imageKind } from "../views/image_set.js";
 import { PictureStream } from "../views/picture_stream.js";
-import { followWire } from "../views/shared_wire.js";
 import { typedText, fieldText, memberText } from "../std/typed_text.js";
 
 export const CAMERA = "com.robotraconteur.imaging.Camera";
@@ -36,11 +35,11 @@ export function createCameraPanel(parent, ctx) {
 
   const state = h("output", { class: "camera-state" });
   const controls = h("div", { class: "camera-controls" });
-  const live = h("div", { class: "camera-live" });
+  const liveBox = h("div", { class: "camera-live" });
   const captured = h("div", { class: "camera-capture", hidden: true }, h("div", { class: "hint", text: "captured" }));
   const info = h("div", { class: "camera-info" });
   const el = h("section", { class: "panel camera-panel", dataset: { panel: "camera" } },
-    h("h3", { text: "Camera" }), state, controls, error, h("div", { class: "camera-views" }, live, captured), info);
+    h("h3", { text: "Camera" }), state, controls, error, h("div", { class: "camera-views" }, liveBox, captured), info);
   parent.append(el);
 
   // live picture: one stream at a time
@@ -54,8 +53,8 @@ export function createCameraPanel(parent, ctx) {
     current = null;
     const [m, d] = streams.find(([x]) => x.name === name) || [];
     if (!m) return;
-    current = new PictureStream(live, {
-      pipe: obj[m.name], type: d.type, view, label: m.name,
+    current = new PictureStream(liveBox, {
+      live: ctx.live, member: m.name, type: d.type, view, label: m.name,
       onError: (t) => { if (!disposed) showError(t); },
       onOpen: (open) => { el.dataset.streamOpen = open ? m.name : ""; },
     });
@@ -89,13 +88,12 @@ export function createCameraPanel(parent, ctx) {
   call("stop_streaming", "Stop streaming");
   let captureView = null;
   const showCapture = (r, m) => {
-    const kind = imageKind(described(m)?.type);
-    if (!kind) return;
+    const type = described(m)?.type;
+    if (!imageKind(type)) return;
     captured.hidden = false;
-    captureView ??= new FrameView(captured, { encodings: view?.encodings, clockEnum: view?.clockEnum, label: "captured frame" });
-    captureView.kind = kind;
+    captureView ??= new FrameView(captured, { context: view?.text, label: "captured frame" });
     captureView.el.dataset.capture = m.name;
-    captureView.push(r);
+    captureView.push(r, type.renderer);
   };
   call("capture_frame", "Capture frame", showCapture);
   call("capture_frame_compressed", "Capture compressed", showCapture);
@@ -107,7 +105,7 @@ export function createCameraPanel(parent, ctx) {
   const flagsField = stateDesc?.fields?.find((f) => f.name === "state_flags");
   if (stateMember && !stateMember.writeonly) {
     // shared with the camera_state card below (one connection per wire), reconnected after a close
-    const follow = followWire(obj, stateMember.name, {
+    const follow = ctx.live.followWire(stateMember.name, {
       onValue: (v) => {
         const text = flagsField ? fieldText(v, flagsField, stateDesc, view?.text) : typedText(v, stateDesc, view?.text);
         state.textContent = `state: ${text}`;

@@ -6,7 +6,7 @@
 // (an older release of the standard definitions, or a type of the same name that is something else)
 // gets no renderer and a `mismatch` reason: the generic member view shows it.
 
-import { parseType, NUMERIC_ARRAYS } from "../rr_types.js";
+import { parseType, NUMERIC_ARRAYS } from "./rr_types.js";
 
 const PRIMITIVES = new Set([...Object.keys(NUMERIC_ARRAYS), "bool", "string", "varvalue", "varobject",
   "cdouble", "csingle", "void"]);
@@ -63,11 +63,13 @@ export function qualifyType(outline, text, scope) {
  */
 export class TypeDescriber {
   /**
-   * @param {import("../robdef_outline.js").RobdefOutline} outline  the device's definitions
+   * @param {import("./robdef_outline.js").RobdefOutline} outline  the device's definitions
    * @param {import("./registry.js").RendererRegistry} [registry]
-   * @param {Array<(owner: object, field: {name: string, type: string}, outline: object) => object|null>} [annotators]
+   * @param {Array<(owner: object, field: {name: string, type: string, descriptor: object}, outline: object,
+   *   fieldTypes: Map<string, object>) => object|null>} [annotators]
    *   field annotators: each may return properties to add to a field (flags: enum values of a bit-flag
-   *   field, unitsField: the sibling field holding its units, ...)
+   *   field, unitsField: the sibling field holding its units, ...). `field.descriptor` is the field's
+   *   type descriptor, `fieldTypes` the descriptors of the owner's fields by name (empty for objects).
    */
   constructor(outline, registry = null, annotators = []) {
     this.outline = outline;
@@ -80,20 +82,28 @@ export class TypeDescriber {
   /**
    * The descriptor of type text `text` written in service `scope`:
    * { text, qualifiedText, base, array, dims, container, kind, qualified, def, enumValues, renderer,
-   *   mismatch, element, fields }.
+   *   mismatch, element, fields, generator, describeValueType }.
    * kind: "primitive", "struct", "pod", "namedarray", "enum", "object" or "unknown" (a name that does
    * not resolve). For arrays and containers (`array` or `container` set) `element` describes one item;
    * `fields` ([{ name, type, ...annotations }]) is there for structures, pods and namedarrays.
+   * A generator's type ("double{generator}") is described by what it yields, with `generator: true`;
+   * a varvalue's descriptor has describeValueType(text), which describes the type a value names.
+   * Never throws: text it cannot read is a descriptor of kind "unknown".
    */
   describe(text, scope) {
-    const t = parseType(text);
-    const qualifiedText = qualifyType(this.outline, text, scope);
+    const raw = String(text ?? "");
+    const yielded = raw.replace(/\{generator\}\s*$/, "");
+    if (yielded !== raw) return { ...this.describe(yielded, scope), generator: true };
+    const t = parseType(raw);
+    const qualifiedText = qualifyType(this.outline, raw, scope);
     if (t.array || t.container) {
       // the outer level only: "double[]{list}" holds "double[]"
-      const elementText = t.container
-        ? String(text).replace(/\{(int32|string|list)\}\s*$/, "") : String(text).replace(/\[[^\]]*\]\s*$/, "");
+      const elementText = t.container ? raw.replace(/\{(int32|string|list)\}\s*$/, "") : raw.replace(/\[[^\]]*\]\s*$/, "");
       const element = this.describe(elementText, scope);
       return { ...t, qualifiedText, kind: element.kind, qualified: null, element };
+    }
+    if (t.base === "varvalue") {
+      return { ...t, qualifiedText, kind: "primitive", qualified: null, describeValueType: (valueType) => this.describe(valueType, scope) };
     }
     if (isPrimitive(t.base)) return { ...t, qualifiedText, kind: "primitive", qualified: null };
     const def = resolveName(this.outline, t.base, scope);
@@ -101,15 +111,18 @@ export class TypeDescriber {
     return this.describeNamed(def);
   }
 
-  /** The field-like descriptor { name, type, ...annotations } of member `member` ({name, type} as
-   * the client package's $members give it) of object type `objectQualified`: its type annotated as a
-   * field of the object would be, e.g. Camera's uint32 `capabilities` property with its flags. */
+  /** The field-like descriptor { name, type, params, ...annotations } of member `member` ({name, type,
+   * params?} as the client package's $members give it) of object type `objectQualified`: its type
+   * annotated as a field of the object would be, e.g. Camera's uint32 `capabilities` property with
+   * its flags; `params` ([{name, type}]) the descriptors of a function's, event's or callback's
+   * parameters. A generator function is described by the type it yields (`type.generator` true). */
   describeMember(objectQualified, member) {
     const owner = this.outline?.types.get(objectQualified);
     const scope = owner?.service ?? String(objectQualified).split(".").slice(0, -1).join(".");
     const type = this.describe(member.type, scope);
-    const annotations = owner ? this.annotate(owner, { name: member.name, type: member.type }) : {};
-    return { name: member.name, type, ...annotations };
+    const annotations = owner ? this.annotate(owner, { name: member.name, type: member.type, descriptor: type }, new Map()) : {};
+    const params = (member.params || []).map((p) => ({ name: p.name, type: this.describe(p.type, scope) }));
+    return { name: member.name, type, params, ...annotations };
   }
 
   describeNamed(def) {
@@ -122,8 +135,9 @@ export class TypeDescriber {
     this.named.set(def.qualified, d);
     if (def.kind === "enum") d.enumValues = def.values;
     if (["struct", "pod", "namedarray"].includes(def.kind)) {
+      const types = new Map(def.fields.map((f) => [f.name, this.describe(f.type, def.service)]));
       d.fields = def.fields.map((f) => ({
-        name: f.name, type: this.describe(f.type, def.service), ...this.annotate(def, f),
+        name: f.name, type: types.get(f.name), ...this.annotate(def, { ...f, descriptor: types.get(f.name) }, types),
       }));
     }
     const renderer = this.registry?.get(def.qualified);
@@ -134,9 +148,9 @@ export class TypeDescriber {
     return d;
   }
 
-  annotate(owner, field) {
+  annotate(owner, field, fieldTypes) {
     const out = {};
-    for (const a of this.annotators) Object.assign(out, a(owner, field, this.outline) || {});
+    for (const a of this.annotators) Object.assign(out, a(owner, field, this.outline, fieldTypes) || {});
     return out;
   }
 

@@ -10,6 +10,7 @@
 // nonzero value is a power of two. GpsStatus names its enum otherwise (FLAG_ENUMS).
 
 import { findNamed } from "./describe.js";
+import { parseType } from "./rr_types.js";
 
 /** Flag fields whose enum the naming rule does not find: "<owner qualified>.<field>" → enum name. */
 export const FLAG_ENUMS = Object.freeze({
@@ -59,14 +60,19 @@ export function formatFlags(values, n) {
 
 const camel = (s) => s.split("_").filter(Boolean).map((w) => w[0].toUpperCase() + w.slice(1)).join("");
 
+const INTEGER = /^u?int(8|16|32|64)$/;
+/** The parts ({base, array, dims, container}) of a field's type: its descriptor (from TypeDescriber), else its text split. */
+const partsOf = (field) => field?.descriptor ?? parseType(field?.type);
+
 /**
- * The enum values of flag field `field` ({name, type}) of `owner` (an outline entry: structure or
- * object), or null when it is not a flag field or its enum is not found.
+ * The enum values of flag field `field` ({name, type, descriptor?}) of `owner` (an outline entry:
+ * structure or object), or null when it is not a flag field or its enum is not found.
  */
 export function flagEnumFor(outline, owner, field) {
   const name = field?.name || "";
   const suffix = /flags$/.test(name) ? "Flags" : /capabilities$/.test(name) ? "Capabilities" : null;
-  if (!suffix || !/^u?int(8|16|32|64)$/.test(String(field.type).trim())) return null;
+  const t = partsOf(field);
+  if (!suffix || t.array || t.container || !INTEGER.test(t.base)) return null;
   const ownerName = owner?.name || "";
   const candidates = [
     FLAG_ENUMS[`${owner?.qualified}.${name}`], camel(name), `${ownerName}${suffix}`,
@@ -94,7 +100,9 @@ export function flagAnnotator(owner, field, outline) {
  */
 export function codeEnumFor(outline, owner, field) {
   const name = field?.name || "";
-  if (!/_units$/.test(name) || !/^u?int(8|16|32|64)(\[\])?$/.test(String(field.type).replace(/\s+/g, ""))) return null;
+  const p = partsOf(field);
+  const scalarOrVector = !p.container && (!p.array || (p.array === "vector" && !p.dims));
+  if (!/_units$/.test(name) || !scalarOrVector || !INTEGER.test(p.base)) return null;
   const t = findNamed(outline, camel(name), owner?.service);
   return t?.kind === "enum" && !isFlagEnum(t.values) ? t.values : null;
 }

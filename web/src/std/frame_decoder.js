@@ -1,22 +1,25 @@
 // Frames of a stream decoded off the page's thread, the newest winning: at most one frame is being
 // decoded (in image_worker.js, a module Worker) and at most one waits; a frame that arrives while one
 // waits takes its place (the older one is dropped, counted in `stats.dropped`). A frame whose header
-// is wrong (checkImage / checkCompressedImage: short data, unknown encoding, step below a row, no
-// magic) is refused on the spot, before any pixel is read or sent anywhere: a flood of bad frames
-// costs less than good ones.
+// is wrong (its renderer's `check`: for the standard images checkImage / checkCompressedImage, short
+// data, unknown encoding, step below a row, no magic) is refused on the spot, before any pixel is read
+// or sent anywhere: a flood of bad frames costs less than good ones.
 //
 //   import { FrameDecoder } from "./std/frame_decoder.js";
 //   const dec = new FrameDecoder({ onResult: (r, meta) => r.ok ? draw(r.bitmap) : show(r.error) });
 //   endpoint.onPacket((frame) => dec.submit(frame, { compressed: true }));
+//   // or any picture type, through its renderer's hooks (registry.js "Renderer"):
+//   dec.submit(value, { renderer: descriptor.renderer, context: { encodings } });
 //
-// The frame's data is transferred to the Worker (the value's Uint8Array is left empty) when it is a
-// whole buffer of its own, as the client package gives it; otherwise (or with `transfer: false`)
-// copied. Without Workers (or when the Worker cannot start) frames are decoded on the page with
-// imageToBitmap, one at a time as above.
+// Frames are decoded by their renderer (the standard Image or CompressedImage one unless `renderer` is
+// given): off the page when the renderer hands frames to the image Worker (`toWorker`), else on the page
+// (pictureToBitmap). The frame's data is transferred to the Worker (the value's Uint8Array is left
+// empty) when it is a whole buffer of its own, as the client package gives it; otherwise (or with
+// `transfer: false`) copied. Without Workers (or when the Worker cannot start) frames are decoded on
+// the page, one at a time as above.
 
-import { imageToBitmap, isCompressedEncoding } from "./image_bitmap.js";
-import { checkImage } from "./image_decode.js";
-import { checkCompressedImage } from "./compressed_image.js";
+import { pictureToBitmap, isCompressedEncoding } from "./image_bitmap.js";
+import { standardPictureRenderer } from "./image_renderers.js";
 
 const WORKER_URL = new URL("./image_worker.js", import.meta.url);
 
@@ -28,12 +31,13 @@ export class FrameDecoder {
    * @param {Function|null} [opts.Worker]  the Worker class (default the global one; null: decode here)
    * @param {string|URL} [opts.workerUrl]  default image_worker.js beside this module
    * @param {(value: object, options: object) => Promise<object>} [opts.decode]  decoding on this
-   *   thread (default imageToBitmap)
+   *   thread (default: the frame's renderer's hooks, pictureToBitmap); `options` is the renderer
+   *   context with `compressed` (whether the renderer's bytes are compressed) and `renderer`
    * @param {boolean} [opts.transfer]  false: never detach the caller's data (copy instead)
    */
   constructor(opts) {
     this.onResult = opts.onResult;
-    this.decodeHere = opts.decode || imageToBitmap;
+    this.decodeHere = opts.decode || ((value, options) => pictureToBitmap(value, options.renderer, options));
     this.transfer = opts.transfer !== false;
     this.stats = { submitted: 0, decoded: 0, failed: 0, dropped: 0, refused: 0 };
     this.seq = 0;
@@ -60,18 +64,22 @@ export class FrameDecoder {
   /**
    * Queues a frame. Returns the refusal result ({ok: false, error}) when its header is wrong (also
    * given to onResult), else null.
-   * @param {{image_info: object, data: Uint8Array}} value  an Image or CompressedImage value
-   * @param {object} [options]  compressed (default: image_info.encoding tells), encodings, depthRange, floatRange
+   * @param {object} value  a picture value: an Image or CompressedImage ({image_info, data}), or any
+   *   value of `options.renderer`'s type
+   * @param {object} [options]  renderer (the value's renderer; default: the standard Image or
+   *   CompressedImage one, `compressed` or image_info.encoding tells which), context (what the
+   *   renderer's hooks get; default these options: encodings, depthRange, floatRange)
    * @param {object} [meta]  anything; handed back with the result
    */
   submit(value, options = {}, meta = {}) {
     if (this.disposed) return null;
     const seq = ++this.seq;
     this.stats.submitted++;
-    const compressed = options.compressed ?? isCompressedEncoding(value, options.encodings);
+    const renderer = options.renderer ?? standardPictureRenderer(options.compressed ?? isCompressedEncoding(value, options.encodings));
+    const context = options.context ?? options;
     let head;
     try {
-      head = compressed ? checkCompressedImage(value) : checkImage(value, options.encodings);
+      head = renderer.check ? renderer.check(value, context) : { ok: true };
     } catch (e) {
       head = { ok: false, error: { code: "not_an_image", message: String(e?.message || e) } };
     }
@@ -85,13 +93,13 @@ export class FrameDecoder {
       }
       return refusal;
     }
-    const info = value.image_info;
-    const job = {
-      seq, meta: { ...meta, seq }, compressed,
-      image_info: { width: Number(info.width), height: Number(info.height), step: Number(info.step), encoding: info.encoding },
-      data: value.data,
-      options: { encodings: options.encodings, depthRange: options.depthRange, floatRange: options.floatRange },
-    };
+    let work = null;
+    try {
+      work = this.worker && renderer.toWorker ? renderer.toWorker(value, context) : null;
+    } catch {
+      work = null;  // decoded on the page instead
+    }
+    const job = { seq, meta: { ...meta, seq }, value, work, options: { ...context, compressed: !!renderer.compressed, renderer } };
     if (this.busy) {
       if (this.waiting) this.stats.dropped++;
       this.waiting = job;
@@ -103,17 +111,16 @@ export class FrameDecoder {
 
   start(job) {
     this.busy = job;
-    if (this.worker) {
-      const d = job.data;
+    if (this.worker && job.work) {
+      const { data: d, ...rest } = job.work;
       const own = this.transfer && d.byteOffset === 0 && d.byteLength === d.buffer.byteLength;
       const data = own ? d : d.slice();
       job.sent = true;
-      this.worker.postMessage({ id: job.seq, image_info: job.image_info, data, compressed: job.compressed, options: job.options },
-        [data.buffer]);
+      this.worker.postMessage({ id: job.seq, ...rest, data }, [data.buffer]);
       return;
     }
     Promise.resolve()
-      .then(() => this.decodeHere({ image_info: job.image_info, data: job.data }, { ...job.options, compressed: job.compressed }))
+      .then(() => this.decodeHere(job.value, job.options))
       .catch((e) => ({ ok: false, error: { code: "decode_failed", message: String(e?.message || e) } }))
       .then((result) => this.finished(job.seq, result));
   }

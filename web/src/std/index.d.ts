@@ -47,6 +47,11 @@ export function imageToBitmap(value: unknown, options?: ImageOptions & {
   ImageData?: typeof ImageData;
 }): Promise<BitmapResult>;
 export function isCompressedEncoding(value: unknown, encodings?: EnumValue[]): boolean;
+/** Any value to an ImageBitmap through its renderer's picture hooks (`compressed`, else `image`); never rejects. */
+export function pictureToBitmap(value: unknown, renderer: Renderer, ctx?: RendererContext, env?: {
+  createImageBitmap?: (source: ImageBitmapSource) => Promise<ImageBitmap>;
+  ImageData?: typeof ImageData;
+}): Promise<BitmapResult>;
 export const STANDARD_IMAGE_ENCODINGS: Readonly<Record<string, number>>;
 export const PIXEL_FORMATS: Readonly<Record<string, Readonly<{ kind: string; bytes: number; sample: string }>>>;
 export const COMPRESSED_FORMATS: ReadonlyArray<Readonly<{ name: string; mime: string; drawable: boolean }>>;
@@ -63,8 +68,9 @@ export class FrameDecoder {
   });
   readonly inWorker: boolean;
   readonly stats: { submitted: number; decoded: number; failed: number; dropped: number; refused: number };
-  /** Queues a frame; returns the refusal ({ok: false}) when its header is wrong, else null. */
-  submit(value: unknown, options?: ImageOptions & { compressed?: boolean }, meta?: Record<string, unknown>):
+  /** Queues a frame (decoded by `renderer`'s hooks, the standard Image / CompressedImage one by default);
+   * returns the refusal ({ok: false}) when its header is wrong, else null. */
+  submit(value: unknown, options?: ImageOptions & { compressed?: boolean; renderer?: Renderer; context?: RendererContext }, meta?: Record<string, unknown>):
     { ok: false; error: ImageError; format?: CompressedFormat } | null;
   dispose(): void;
 }
@@ -89,12 +95,26 @@ export interface OutlineEntry {
   members: Array<{ kind: string; text: string; line: number }>;
 }
 
+/** What a renderer's hooks get: the device's definitions and enums (and image options). */
+export interface RendererContext extends ImageOptions {
+  outline?: RobdefOutline;
+  clockEnum?: EnumValue[];
+  [key: string]: unknown;
+}
+
+/** A renderer of one type (registry.js): its hooks are what the dashboard shows and draws with. */
 export interface Renderer {
   type: string;
   layout?: Record<string, string | string[]>;
-  text?: (value: any, ctx: object) => string;
-  image?: (value: any, ctx: object) => DecodeResult;
-  compressed?: (value: any) => ReturnType<typeof checkCompressedImage>;
+  text?: (value: any, ctx: RendererContext) => string;
+  /** The header alone (no pixel read): a bad frame refused before decoding. */
+  check?: (value: any, ctx: RendererContext) => { ok: true } | { ok: false; error: ImageError };
+  /** RGBA pixels ({ok, width, height, data}) or {ok: false, error}. */
+  image?: (value: any, ctx: RendererContext) => DecodeResult | Promise<DecodeResult>;
+  /** Bytes the browser decodes: their format, and `bytes` when they are not the value's `data`. */
+  compressed?: (value: any, ctx?: RendererContext) => ReturnType<typeof checkCompressedImage> & { bytes?: Uint8Array };
+  /** The frame as the image Worker takes it (std/image_worker.js); leave out to decode on the page. */
+  toWorker?: (value: any, ctx: RendererContext) => object;
 }
 
 export interface TypeDescriptor {

@@ -12,7 +12,7 @@ export { standardRegistry, standardDescriber, STANDARD_ANNOTATORS } from "./stan
 export { typedText, fieldText, memberText } from "./typed_text.js";
 export { decodeImage, checkImage } from "./image_decode.js";
 export { compressedFormat, checkCompressedImage, COMPRESSED_FORMATS } from "./compressed_image.js";
-export { imageToBitmap, isCompressedEncoding } from "./image_bitmap.js";
+export { imageToBitmap, pictureToBitmap, isCompressedEncoding } from "./image_bitmap.js";
 export { STANDARD_IMAGE_ENCODINGS, PIXEL_FORMATS, encodingNames } from "./image_encodings.js";
 export { formatUuid, isNilUuid, uuidBytes } from "./uuid.js";
 export { formatIdentifier } from "./identifier.js";
@@ -24,4 +24,4 @@ export { plotRole, leaveOutOfPlot, typedNumericFields, sensorTimestamp } from ".
 export { deviceInfoRows } from "./device_info.js";
 export { formatDataType } from "./datatype.js";
 export { FrameDecoder } from "./frame_decoder.js";
-export { RobdefOutline } from "../robdef_outline.js";
+export { RobdefOutline } from "./robdef_outline.js";

@@ -4,7 +4,7 @@
 // view writes it (value_codec.js formatValue). Never throws: a renderer that fails gives the
 // generic text.
 
-import { formatValue } from "../value_codec.js";
+import { formatValue } from "./value_text.js";
 import { formatEnum, formatFlags, formatCodes } from "./enums.js";
 import { unitsOf } from "./units.js";
 

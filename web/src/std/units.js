@@ -5,7 +5,7 @@
 // P_resolution, P_units.
 
 import { findNamed } from "./describe.js";
-import { parseType, isNumericBase } from "../rr_types.js";
+import { isNumericBase } from "./rr_types.js";
 
 /** The text of an SIUnit value ({display_units, encoded_units}): display_units, else encoded_units. */
 export function siUnitText(u) {
@@ -29,16 +29,17 @@ export function unitsFieldFor(owner, name) {
 /**
  * Field annotator for TypeDescriber: { units: { field, enumValues } } on numeric fields whose units a
  * sibling names; enumValues for siblings of enum codes in an integer array, found by the sibling's
- * name in CamelCase (joint_position_units → JointPositionUnits).
+ * name in CamelCase (joint_position_units → JointPositionUnits). Reads the fields' descriptors
+ * (`field.descriptor`, `fieldTypes`), not their type text.
  */
-export function unitsAnnotator(owner, field, outline) {
-  const t = parseType(field.type);
-  if (t.container || !isNumericBase(t.base) || t.base === "bool") return null;
+export function unitsAnnotator(owner, field, outline, fieldTypes) {
+  const t = field.descriptor;
+  if (!t || t.container || !isNumericBase(t.base) || t.base === "bool") return null;
   const sibling = unitsFieldFor(owner, field.name);
   if (!sibling) return null;
-  const siblingType = parseType(owner.fields.find((f) => f.name === sibling).type);
+  const siblingType = fieldTypes?.get(sibling);
   let enumValues = null;
-  if (isNumericBase(siblingType.base)) {
+  if (siblingType && isNumericBase(siblingType.base)) {
     const e = findNamed(outline, camel(sibling), owner.service);
     if (e?.kind === "enum") enumValues = e.values;
   }

@@ -1,6 +1,8 @@
-// One picture fed with standard Image or CompressedImage frames (a camera stream, a captured frame,
-// a property or function result): frames are decoded off the page's thread (std/frame_decoder.js,
-// the newest winning) and drawn at most once per animation frame. Beside the picture: its size and
+// One picture fed with frames of a type whose renderer has a picture hook (std/registry.js: the
+// standard Image or CompressedImage, or a page's own type; a camera stream, a captured frame, a
+// property or function result): frames are decoded by that renderer, off the page's thread when it
+// hands them to the image Worker (std/frame_decoder.js, the newest winning), and drawn at most once
+// per animation frame. Beside the picture: its size and
 // encoding (the depth range for depth images), the frame rate drawn, the frame's age from its own
 // timestamp (image_info.data_header.ts, when its clock can be compared with the page's) and how many
 // frames were dropped for newer ones. A bad frame (short data, unknown encoding, corrupt JPEG, step
@@ -32,16 +34,16 @@ export class FrameView {
   /**
    * @param {HTMLElement} parent
    * @param {object} [opts]
-   * @param {"image"|"compressed"} [opts.kind]  what the frames are (default: image_info.encoding tells)
-   * @param {Array<{name, value}>} [opts.encodings]  the device's ImageEncoding values
-   * @param {Array<{name, value}>} [opts.clockEnum]  the device's ClockTypeCode values
+   * @param {object} [opts.renderer]  the frames' renderer (its picture hooks draw them; push() may name another)
+   * @param {object} [opts.context]  what the renderer's hooks get: { encodings, clockEnum, outline } of
+   *   the device (views/context.js `text`)
    * @param {string} [opts.label]  the canvas's accessible name
    * @param {Function|null} [opts.Worker]  for FrameDecoder (null: decode on the page)
    */
   constructor(parent, opts = {}) {
-    this.kind = opts.kind ?? null;
-    this.encodings = opts.encodings;
-    this.clockEnum = opts.clockEnum;
+    this.renderer = opts.renderer ?? null;
+    this.context = opts.context ?? {};
+    this.clockEnum = this.context.clockEnum;
     this.canvas = h("canvas", { class: "image frame-canvas", "aria-label": opts.label || "image", hidden: true });
     this.status = h("figcaption", { class: "frame-status" });
     this.errorEl = h("div", { class: "frame-error", role: "status", hidden: true });
@@ -61,14 +63,12 @@ export class FrameView {
     this.updateStatus();
   }
 
-  /** Shows `value` (an Image or CompressedImage value); its data may be handed to the decoder. */
-  push(value) {
+  /** Shows `value`, drawn by `renderer` (default the view's); its data may be handed to the decoder. */
+  push(value, renderer = this.renderer) {
     this.received++;
     this.el.dataset.received = String(this.received);
     const ts = frameTime(value, this.clockEnum);
-    const options = { encodings: this.encodings };
-    if (this.kind) options.compressed = this.kind === "compressed";
-    this.decoder.submit(value, options, { ts });
+    this.decoder.submit(value, { renderer, context: this.context }, { ts });
   }
 
   result(r, meta) {

@@ -1,5 +1,6 @@
 // RR type text (robdef §Types) as the member list gives it: "double", "double[]", "uint8[*]",
-// "int32[3]", "string{int32}", "SensorPacket", "varvalue". Read only to pick editors and displays.
+// "int32[3]", "string{int32}", "SensorPacket", "varvalue". Split here once, by the TypeDescriber
+// (describe.js), into the descriptors every view uses; and the numeric types' ranges.
 
 /** Numeric scalar types and the typed array the client package uses for their arrays. */
 export const NUMERIC_ARRAYS = {
@@ -39,10 +40,11 @@ export function parseType(text) {
 
 export function isNumericBase(base) { return base in NUMERIC_ARRAYS || base === "bool"; }
 
-/** A scalar or a vector of numbers (what a plot can show without knowing the struct). */
+/** A scalar or a vector of numbers (what a plot can show without knowing the struct): type text, or
+ * anything with its parts ({base, array, container}: a type descriptor). */
 export function isPlottable(type) {
-  const t = parseType(type);
-  return !t.container && t.array !== "multidim" && isNumericBase(t.base);
+  const t = typeof type === "string" ? parseType(type) : type;
+  return !!t && !t.container && t.array !== "multidim" && isNumericBase(t.base);
 }
 
 /** Parses one number of a base type; int64/uint64 give BigInt. Throws a readable Error. */

@@ -1,13 +1,20 @@
-// Foxglove image channels (foxglove_image.hpp): which types become images, the RR → Foxglove encoding
-// names, and the messages (base64 bytes, {sec, nsec} timestamps, what is left out).
+// Foxglove image channels (foxglove_image_format.hpp): which types become images, the RR → Foxglove
+// encoding names, and the messages (base64 bytes, {sec, nsec} timestamps, what is left out).
 #include <catch2/catch.hpp>
 
 #include "robdef/service_definition_set.hpp"
-#include "server/record/foxglove_image.hpp"
+#include "server/record/formats/foxglove_image_format.hpp"
 
 using namespace rr;
 namespace record = rr::server::record;
 using nlohmann::json;
+using rr::DataTypes;
+using rr::Enum;
+using rr::NumericArray;
+using rr::PodArray;
+using rr::SharedBytes;
+using rr::Structure;
+using rr::Value;
 
 namespace {
 
@@ -29,9 +36,27 @@ end
 
 constexpr std::uint64_t kLog = 1764180000ull * 1000000000ull + 5;  // 2025-11-26, 5 ns
 
-json rgb_image(json data, std::int64_t step = 6) {
-    return json{{"image_info", {{"width", 2}, {"height", 1}, {"step", step}, {"encoding", 0x1000}}}, {"data", std::move(data)}};
+// An image value as unpack_value gives it: `data` a uint8 array (or anything else, for the bad cases).
+Value image(Value info, Value data) {
+    Structure s;
+    s.type_name = "com.robotraconteur.image.Image";
+    s.set("image_info", std::move(info)).set("data", std::move(data));
+    return Value(std::move(s));
 }
+
+Structure rgb_info(std::int64_t step = 6) {
+    Structure info;
+    info.type_name = "com.robotraconteur.image.ImageInfo";
+    info.set("width", Value::scalar(std::uint32_t{2}))
+        .set("height", Value::scalar(std::uint32_t{1}))
+        .set("step", Value::scalar(static_cast<std::uint32_t>(step)))
+        .set("encoding", Value(Enum{"com.robotraconteur.image.ImageEncoding", 0x1000}));
+    return info;
+}
+
+Value bytes(std::initializer_list<std::uint8_t> b) { return Value::array<std::uint8_t>(b); }
+
+Value rgb_image(Value data, std::int64_t step = 6) { return image(Value(rgb_info(step)), std::move(data)); }
 
 }  // namespace
 
@@ -68,12 +93,11 @@ TEST_CASE("foxglove image: encodings that have a Foxglove name, and those that d
     CHECK_FALSE(record::foxglove_raw_encoding(0));
 }
 
-TEST_CASE("foxglove image: a raw image's message, bytes from a binary blob or JSON numbers") {
-    BinaryArrays binary;
+TEST_CASE("foxglove image: a raw image's message, bytes shared with the received element or copied") {
     const std::byte px[6] = {std::byte{1}, std::byte{2}, std::byte{3}, std::byte{250}, std::byte{251}, std::byte{252}};
-    binary.blobs.push_back(SharedBytes::copy_of(std::span<const std::byte>(px)));
-    auto text = record::foxglove_image_message(record::FoxgloveImageKind::raw,
-                                               rgb_image(json{{"$binary", 0u}, {"type", "uint8"}, {"length", 6}}), binary, kLog);
+    auto received = NumericArray::wrap(DataTypes::uint8_t, SharedBytes::copy_of(std::span<const std::byte>(px)));
+    REQUIRE(received);
+    auto text = record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(Value(std::move(*received))), kLog);
     REQUIRE(text);
     auto m = json::parse(*text);
     CHECK(m["encoding"] == "rgb8");
@@ -83,17 +107,22 @@ TEST_CASE("foxglove image: a raw image's message, bytes from a binary blob or JS
     CHECK(m["frame_id"] == "");
     CHECK(m["data"] == "AQID+vv8");
     CHECK(m["timestamp"] == json({{"sec", 1764180000}, {"nsec", 5}}));
-    auto from_numbers = record::foxglove_image_message(record::FoxgloveImageKind::raw,
-                                                       rgb_image(json{1, 2, 3, 250, 251, 252}), {}, kLog);
+    auto from_numbers = record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(bytes({1, 2, 3, 250, 251, 252})), kLog);
     REQUIRE(from_numbers);
     CHECK(json::parse(*from_numbers)["data"] == "AQID+vv8");
 }
 
 TEST_CASE("foxglove image: the device's time stamp when it is on the Unix epoch, else the log time") {
     auto with_ts = [](std::int64_t sec, std::int64_t nsec) {
-        json v = rgb_image(json{1, 2, 3, 4, 5, 6});
-        v["image_info"]["data_header"] = {{"ts", {{"seconds", sec}, {"nanoseconds", nsec}}}};
-        auto text = record::foxglove_image_message(record::FoxgloveImageKind::raw, v, {}, kLog);
+        // data_header.ts as a com.robotraconteur.datetime.TimeSpec2 pod
+        PodArray ts("com.robotraconteur.datetime.TimeSpec2", {"seconds", "nanoseconds"});
+        REQUIRE(ts.push_back({Value::scalar(sec), Value::scalar(static_cast<std::int32_t>(nsec))}));
+        Structure header;
+        header.type_name = "com.robotraconteur.sensordata.SensorDataHeader";
+        header.set("ts", Value(std::move(ts)));
+        auto info = rgb_info();
+        info.set("data_header", Value(std::move(header)));
+        auto text = record::foxglove_image_message(record::FoxgloveImageKind::raw, image(Value(std::move(info)), bytes({1, 2, 3, 4, 5, 6})), kLog);
         REQUIRE(text);
         return json::parse(*text)["timestamp"];
     };
@@ -102,16 +131,16 @@ TEST_CASE("foxglove image: the device's time stamp when it is on the Unix epoch,
 }
 
 TEST_CASE("foxglove image: what cannot be shown is left out") {
-    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, json(nullptr), {}, kLog));
-    json f32 = rgb_image(json{1, 2, 3, 4, 5, 6});
-    f32["image_info"]["encoding"] = 0x2004;
-    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, f32, {}, kLog));
-    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(json{1, 2, 3}), {}, kLog));  // short
-    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(json{{"$binary", 3u}}), {}, kLog));
-    json not_an_image{{"image_info", json::object()}, {"data", json{1, 2, 3, 4}}};
-    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::compressed, not_an_image, {}, kLog));
-    json jpeg{{"image_info", json::object()}, {"data", json{0xFF, 0xD8, 0xFF, 0xE0}}};
-    auto text = record::foxglove_image_message(record::FoxgloveImageKind::compressed, jpeg, {}, kLog);
+    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, Value(), kLog));
+    auto f32 = rgb_info();
+    f32.set("encoding", Value(Enum{"com.robotraconteur.image.ImageEncoding", 0x2004}));
+    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, image(Value(std::move(f32)), bytes({1, 2, 3, 4, 5, 6})), kLog));
+    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(bytes({1, 2, 3})), kLog));  // short
+    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::raw, rgb_image(Value::array<double>({1, 2, 3, 4, 5, 6})), kLog));
+    Structure empty_info;
+    empty_info.type_name = "com.robotraconteur.image.ImageInfo";
+    CHECK_FALSE(record::foxglove_image_message(record::FoxgloveImageKind::compressed, image(Value(empty_info), bytes({1, 2, 3, 4})), kLog));
+    auto text = record::foxglove_image_message(record::FoxgloveImageKind::compressed, image(Value(empty_info), bytes({0xFF, 0xD8, 0xFF, 0xE0})), kLog);
     REQUIRE(text);
     CHECK(json::parse(*text)["format"] == "jpeg");
     CHECK(json::parse(*text)["data"] == "/9j/4A==");
