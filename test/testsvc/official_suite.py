@@ -2,16 +2,23 @@
 """The official Python client suite (test/python of robotraconteur/robotraconteur) against rr-test-service,
 run by hand (docs/native-service.md "The official client suite against rr-test-service").
 
-For each transport (rr+tcp, rr+ws, rr+wss with a throw-away certificate, rr+local) it starts
-rr-test-service with the official values file, sets ROBOTRACONTEUR_TEST_SERVER_URL and runs the suite's
-service tests with pytest; with --gateway also through rr-gateway (the four services as devices of the
-same names, `auth: passthrough`, over rr+tcp and rr+ws); with --reference also without the variable,
-where the suite starts the official test server in its own process (the reference). Prints one line per
-test and configuration and a summary; the JUnit files stay in --out.
+For each configuration it starts a service, sets ROBOTRACONTEUR_TEST_SERVER_URL and runs the suite's
+service tests with pytest. Configurations (--configs, comma-separated):
+  tcp, ws, wss, local        rr-test-service with the official values on rr+tcp, rr+ws, rr+wss (a
+                             throw-away certificate), rr+local (also with the URL joined by &)
+  gateway-tcp, gateway-ws    rr-gateway (--gateway) in front of it: the four services as devices of the
+                             same names, `auth: passthrough`, the client on rr+tcp / rr+ws, the gateway
+                             reaching the service on rr+tcp; gateway-CLIENT-via-DEVICE (DEVICE: ws,
+                             wss, local) reaches it on another transport
+  official-CONFIG            the same with the official test server (official_server.py) instead of
+                             rr-test-service (not wss): the reference
+--reference also runs the suite without the variable, where it serves the official test services in
+pytest's own process (service_test_util.py). Prints one line per test and configuration and a summary; the JUnit files stay in --out.
 
     .venv/bin/python test/testsvc/official_suite.py --repo /tmp/rr-official --values /tmp/official-values.json \\
-        --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/rr-gateway] [--reference] \\
-        [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws] [--pytest-path DIR] [--out DIR]
+        --service build/debug/test/testsvc/rr-test-service [--gateway build/debug/server/app/rr-gateway] \\
+        [--reference] [--configs tcp,ws,wss,local,gateway-tcp,gateway-ws,official-tcp,...] \\
+        [--pytest-path DIR] [--select PYTEST_K_EXPR] [--repeat N] [--out DIR]
 Exit 0 when every test passed in every configuration run, 1 otherwise.
 """
 
@@ -23,26 +30,24 @@ import subprocess
 import sys
 import tempfile
 import threading
-import time
-import urllib.request
 import uuid
 import xml.etree.ElementTree as ET
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
+sys.path.insert(0, HERE)
+import gateway_front  # noqa: E402
 
 SUITE = ["RobotRaconteurTest/test_attributes.py", "RobotRaconteurTest/test_service.py",
          "RobotRaconteurTest/test_service2.py", "RobotRaconteurTest/test_service3.py"]
-SERVICES = ["RobotRaconteurTestService", "RobotRaconteurTestService_auth", "RobotRaconteurTestService2",
-            "RobotRaconteurTestService3"]
 
 
 class Proc:
     """A child process whose first stdout line matching `accept` is its ready line."""
 
-    def __init__(self, argv, logdir, name, accept, timeout=90):
+    def __init__(self, argv, logdir, name, accept, timeout=90, env=None):
         self.log = open(os.path.join(logdir, name + ".log"), "w")
-        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, text=True)
+        self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=self.log, text=True, env=env)
         line = []
 
         def read():
@@ -76,29 +81,28 @@ def start_service(args, logdir, name, extra):
     return p, json.loads(p.ready[len("ready "):])
 
 
-def start_gateway(args, logdir, urls, name):
+def start_official(args, logdir, name):
+    """The official test server (official_server.py) as the service: the reference."""
+    nodename = "official_" + uuid.uuid4().hex[:10]
+    env = dict(os.environ)  # the official modules import pytest
+    env["PYTHONPATH"] = os.pathsep.join(x for x in (args.pytest_path, env.get("PYTHONPATH")) if x)
+    p = Proc([sys.executable, os.path.join(HERE, "official_server.py"), "--repo", args.repo, "--nodename", nodename],
+             logdir, name, lambda ln: ln.startswith("ready "), env=env)
+    return p, json.loads(p.ready[len("ready "):])
+
+
+URL_KEYS = {"tcp": "url", "ws": "ws_url", "wss": "wss_url", "local": "local_url"}
+
+
+def start_gateway(args, logdir, device_url, name, tls_ca=None):
     cfg = os.path.join(logdir, name + ".yaml")
     with open(cfg, "w") as f:
-        f.write("devices:\n")
-        for s in SERVICES:
-            f.write("  - name: %s\n    url: %s?service=%s\n    auth: passthrough\n" % (s, urls["url"], s))
-            if s.endswith("_auth"):  # the gateway's own session needs a login there too
-                f.write("    username: testuser1\n    password: testpass1\n")
-    p = Proc([args.gateway, "--config", cfg, "--listen", "127.0.0.1", "--port", "0", "--no-demo", "--no-local",
-              "--no-discovery", "--log-level", "warning"], logdir, name,
-             lambda ln: ln.strip().startswith("{") and '"port"' in ln)
-    port = json.loads(p.ready)["port"]
-    deadline = time.time() + 60
-    while True:  # /readyz answers 200 once every device is connected
-        try:
-            if urllib.request.urlopen("http://127.0.0.1:%d/readyz" % port, timeout=2).status == 200:
-                break
-        except Exception:
-            pass
-        if time.time() > deadline:
-            p.stop()
-            raise RuntimeError("gateway not ready; see " + p.log.name)
-        time.sleep(0.2)
+        f.write(gateway_front.config_text(device_url, tls_ca))
+    p = Proc(gateway_front.argv(args.gateway, cfg), logdir, name, gateway_front.is_ready_line)
+    port = gateway_front.port_of(p.ready)
+    if not gateway_front.wait_until_ready(port, 60, lambda: p.p.poll() is None):
+        p.stop()
+        raise RuntimeError("gateway not ready; see " + p.log.name)
     return p, port
 
 
@@ -113,7 +117,7 @@ def run_suite(args, logdir, name, url, env_extra=None, plugins=()):
     env.update(env_extra or {})
     with open(os.path.join(logdir, name + ".pytest.log"), "w") as out:
         subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "-rA", "--junitxml", junit]
-                       + [a for p in plugins for a in ("-p", p)] + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
+                       + [a for p in plugins for a in ("-p", p)] + (["-k", args.select] if args.select else []) + SUITE, cwd=os.path.join(args.repo, "test", "python"), env=env, stdout=out,
                        stderr=subprocess.STDOUT, timeout=1800)
     results = {}
     for case in ET.parse(junit).getroot().iter("testcase"):
@@ -138,6 +142,8 @@ def main():
     ap.add_argument("--configs", default="tcp,ws,wss,local,gateway-tcp,gateway-ws")
     ap.add_argument("--pytest-path", default=None, help="a folder to add to PYTHONPATH for pytest")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--select", default=None, help="only the tests pytest -k EXPR selects")
+    ap.add_argument("--repeat", type=int, default=1, help="run the suite N times against each service process")
     args = ap.parse_args()
     logdir = args.out or tempfile.mkdtemp(prefix="official-suite-")
     os.makedirs(logdir, exist_ok=True)
@@ -148,48 +154,62 @@ def main():
         table["official server"] = run_suite(args, logdir, "reference", None)
     for config in configs:
         procs = []
+        official = config.startswith("official-")  # the reference: the official server in a process of its own
+        kind = config[len("official-"):] if official else config
+        # gateway-CLIENT[-via-DEVICE]: the suite reaches the gateway on CLIENT, the gateway the service on DEVICE
+        client, _, via = kind[len("gateway-"):].partition("-via-") if kind.startswith("gateway-") else (kind, "", "")
+        served = via or ("tcp" if kind.startswith("gateway-") else kind)  # the service's transport in use
         try:
-            extra, env = [], {}
-            if config == "wss":
+            if client not in ("tcp", "ws", "wss", "local") or served not in URL_KEYS or \
+                    (kind.startswith("gateway-") and client not in ("tcp", "ws")):
+                raise RuntimeError("unknown configuration " + config)
+            extra, env, ca_cert = [], {}, None
+            if served == "wss":
+                if official:
+                    raise RuntimeError("the official server is not run with TLS here (it needs RR node certificates)")
                 import tls_pki
-                pki = tls_pki.Pki(os.path.join(logdir, "pki"))
+                pki = tls_pki.Pki(os.path.join(logdir, "pki-" + config))
                 ca = pki.ca("ca")
                 leaf = pki.issue(ca, "server", "localhost", sans=["DNS:localhost", "IP:127.0.0.1"])
                 extra = ["--tls-cert", leaf.cert, "--tls-key", leaf.key]
-                env = {"SSL_CERT_FILE": ca.cert}
-            if config == "local":
+                ca_cert = ca.cert
+            if served == "local":
                 extra = ["--nodename", "testsvc_" + uuid.uuid4().hex[:10]]
-            svc, urls = start_service(args, logdir, "service-" + config, extra)
-            procs.append(svc)
-            if config == "tcp":
-                url = urls["url"]
-            elif config == "ws":
-                url = urls["ws_url"]
-            elif config == "wss":
-                url = urls["wss_url"].replace("localhost", "127.0.0.1")
-            elif config == "local":
-                url = urls["local_url"]
+            if official:
+                svc, urls = start_official(args, logdir, "service-" + config)
             else:
-                gw, port = start_gateway(args, logdir, urls, "gateway-" + config)
+                svc, urls = start_service(args, logdir, "service-" + config, extra)
+            procs.append(svc)
+            url = urls[URL_KEYS[served]]
+            if served == "wss" and not kind.startswith("gateway-"):
+                url = url.replace("localhost", "127.0.0.1")
+                env = {"SSL_CERT_FILE": ca_cert}
+            if kind.startswith("gateway-"):
+                gw, port = start_gateway(args, logdir, url, "gateway-" + config, tls_ca=ca_cert)
                 procs.append(gw)
-                url = ("rr+tcp://127.0.0.1:%d/" if config == "gateway-tcp" else "rr+ws://127.0.0.1:%d/") % port
+                url = "rr+%s://127.0.0.1:%d/" % (client, port)
             print("%s: %s" % (config, url), flush=True)
             table[config] = run_suite(args, logdir, config, url, env)
-            if config == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
-                table["local (URL joined with &)"] = run_suite(args, logdir, "local-joined", url, env,
-                                                               plugins=["official_suite_local_url"])
+            for n in range(2, args.repeat + 1):  # again against the same service process
+                table["%s #%d" % (config, n)] = run_suite(args, logdir, "%s-%d" % (config, n), url, env)
+            if kind == "local":  # the suite cannot name an rr+local service unaided (official_suite_local_url.py)
+                table[config + " (URL joined with &)"] = run_suite(args, logdir, config + "-joined", url, env,
+                                                                   plugins=["official_suite_local_url"])
         except Exception as e:
             table[config] = {"(setup)": "failed: %s" % e}
         finally:
             for p in reversed(procs):
                 code = p.stop()
                 if code not in (0, None):
-                    table.setdefault(config, {})["(%s exit)" % os.path.basename(p.p.args[0])] = "failed: exit status %s" % code
+                    name = os.path.splitext(os.path.basename(p.log.name))[0]
+                    table.setdefault(config, {})["(%s exit)" % name] = "failed: exit status %s" % code
 
     tests = sorted({t for r in table.values() for t in r})
     ok = True
     for config, results in table.items():
         for t in tests:
+            if t.startswith("(") and t not in results:
+                continue  # a configuration's setup failure or exit status
             outcome = results.get(t, "not run")
             ok = ok and outcome == "passed"
             print("%-16s %-45s %s" % (config, t, outcome))

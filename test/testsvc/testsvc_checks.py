@@ -4,10 +4,12 @@ test service, with the values computed here (testsvc_values.py: the LFSR and the
 not taken from the service. Checks of our own, written from the definitions; docs/native-service.md.
 
     .venv/bin/python test/testsvc/testsvc_checks.py --service build/debug/test/testsvc/rr-test-service \\
-        [--robdef-dir DIR] [--only testroot,auth,testroot3,async,transports] [--verbose]
+        [--robdef-dir DIR] [--only testroot,auth,testroot3,async,transports] [--gateway RR_GATEWAY] [--verbose]
 
 Starts rr-test-service (port 0, rr+local with a NodeName of its own), waits for its `ready` line, runs the
-checks, stops it with SIGTERM and expects a clean exit. Exit 0: all passed; 1: a check failed (each
+checks, stops it with SIGTERM and expects a clean exit. With --gateway the checks go through rr-gateway
+in front of it (gateway_front.py: the four services as `auth: passthrough` devices of the same names;
+the transports check then uses the gateway's rr+ws), and the gateway must stop cleanly too. Exit 0: all passed; 1: a check failed (each
 failure and the service's log tail are printed); 77: skipped (no definitions, no venv packages).
 Deadlines are bounds on a hang (tens of seconds), never expected durations.
 """
@@ -43,6 +45,7 @@ try:
 except ImportError as e:  # not the project's venv
     skip("the official Python package and numpy are needed (%s)" % e)
 
+import gateway_front  # noqa: E402
 import testsvc_values as tv  # noqa: E402
 from testsvc_values import Lfsr, SEED, lfsr_json, to_json, from_json  # noqa: E402
 
@@ -209,9 +212,14 @@ def check_testroot(types, urls, log):
         e1.PacketReceivedEvent += collect("e1", 3)
         e2.PacketReceivedEvent += collect("e2", 2)
         e3.PacketReceivedEvent += collect("e3", 1)
-        acked = threading.Event()
+        acks, ack_seen = set(), threading.Condition()
+
+        def on_ack(ep, n):
+            with ack_seen:
+                acks.add(n)
+                ack_seen.notify_all()
+        e1.PacketAckReceivedEvent += on_ack  # before the send: its ack may come before SendPacket returns
         sent = e1.SendPacket([1, 2, 3, 4])
-        e1.PacketAckReceivedEvent += lambda ep, n: acked.set() if n == sent else None
         e1.SendPacket([5, 6, 7, 8])
         e1.SendPacket([-1, -2, -3, -5.32])
         e2.SendPacket([3.21])
@@ -224,7 +232,8 @@ def check_testroot(types, urls, log):
         equal([list(x) for x in received["e1"]], [[1, 2, 3, 4], [5, 6, 7, 8], [-1, -2, -3, -5.32]], "p1 echo")
         equal([list(x) for x in received["e2"]], [[3.21], [4.72]], "p1 echo (second endpoint)")
         equal(list(received["e3"][0].mydat), [738.29], "p2 echo")
-        wait(acked, "ack of the first packet sent on p1")
+        with ack_seen:
+            check(ack_seen.wait_for(lambda: sent in acks, BOUND), "ack of the first packet sent on p1: nothing within %.0f s" % BOUND)
         # the service's ack request: the client acks the first echo, pipe_check_error sees it
         deadline = time.time() + BOUND
         while True:
@@ -629,7 +638,9 @@ def check_async(types, urls, log):
 
 def check_transports(types, urls, log):
     for key in ("ws_url", "local_url"):
-        base = urls[key]
+        base = urls.get(key)
+        if base is None:  # through the gateway: no rr+local
+            continue
         sep = "&" if "?" in base else "?"
         c = RRN.ConnectService(base + sep + "service=RobotRaconteurTestService")
         try:
@@ -646,6 +657,31 @@ def check_transports(types, urls, log):
         log("transports: " + key)
 
 
+def start_gateway(program, logdir, device_url, log):
+    """rr-gateway in front of the service (gateway_front.py); (process, its URLs) once every device is
+    connected, (None, None) when it does not get there within the bound."""
+    cfg = os.path.join(logdir, "gateway.yaml")
+    with open(cfg, "w") as f:
+        f.write(gateway_front.config_text(device_url))
+    gw = subprocess.Popen(gateway_front.argv(program, cfg), stdout=subprocess.PIPE, stderr=log, text=True)
+    first = []
+
+    def read():
+        for line in gw.stdout:
+            if not first and gateway_front.is_ready_line(line):
+                first.append(line)  # then keep draining, so the gateway never blocks on stdout
+    threading.Thread(target=read, daemon=True).start()
+    deadline = time.time() + 60  # bound: an ASan start at load 15 takes seconds
+    while not first and gw.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    if not first or not gateway_front.wait_until_ready(gateway_front.port_of(first[0]), 60, lambda: gw.poll() is None):
+        gw.kill()
+        gw.wait()
+        return None, None
+    port = gateway_front.port_of(first[0])
+    return gw, {"url": "rr+tcp://127.0.0.1:%d/" % port, "ws_url": "rr+ws://127.0.0.1:%d/" % port}
+
+
 CHECKS = {"testroot": check_testroot, "auth": check_auth, "testroot3": check_testroot3, "async": check_async,
           "transports": check_transports}
 
@@ -657,6 +693,7 @@ def main():
     ap.add_argument("--shared-default", default=os.path.join(HERE, "..", "..", "..", "shared"), metavar="SHARED",
                     help="the shared test data folder when RR_SHARED_DIR is not set (CMake passes its RR_SHARED_DIR)")
     ap.add_argument("--only", default=",".join(CHECKS))
+    ap.add_argument("--gateway", default=None, help="the rr-gateway program: the checks go through it")
     ap.add_argument("--verbose", action="store_true")
     args = ap.parse_args()
 
@@ -677,11 +714,13 @@ def main():
     proc = subprocess.Popen([args.service, "--port", "0", "--robdef-dir", robdef_dir, "--nodename", nodename,
                              "--max-lifetime", "900"], stdout=subprocess.PIPE, stderr=errlog, text=True)
     failures = []
+    gateway = None
+    gwlog = open(os.path.join(logdir, "gateway.stderr"), "w+")
 
-    def tail():
-        errlog.flush()
-        errlog.seek(0)
-        lines = errlog.read().splitlines()
+    def tail(log=errlog):
+        log.flush()
+        log.seek(0)
+        lines = log.read().splitlines()
         return "\n".join(lines[-40:])
 
     try:
@@ -693,6 +732,11 @@ def main():
             print("rr-test-service did not print its ready line (%r); its log:\n%s" % (ready[:1], tail()))
             return 1
         urls = json.loads(ready[0][len("ready "):])
+        if args.gateway:
+            gateway, urls = start_gateway(args.gateway, logdir, urls["url"], gwlog)
+            if gateway is None:
+                print("rr-gateway did not get ready; its log:\n%s" % tail(gwlog))
+                return 1
         for name in only:
             t0 = time.time()
             try:
@@ -703,6 +747,15 @@ def main():
                 print("FAIL %s: %s" % (name, e))
                 traceback.print_exc()
     finally:
+        if gateway is not None:
+            gateway.send_signal(signal.SIGTERM)
+            try:
+                if gateway.wait(60) != 0:
+                    failures.append("gateway exit status %d" % gateway.returncode)
+            except subprocess.TimeoutExpired:
+                gateway.kill()
+                gateway.wait()
+                failures.append("gateway exit (did not stop within 60 s of SIGTERM)")
         proc.send_signal(signal.SIGTERM)
         try:
             code = proc.wait(60)
@@ -710,10 +763,12 @@ def main():
             proc.kill()
             code = proc.wait()
             failures.append("exit (did not stop within 60 s of SIGTERM)")
-        if code != 0 and "exit" not in " ".join(failures):
+        if code != 0 and "exit (" not in " ".join(failures):
             failures.append("exit status %d" % code)
     if failures:
         print("FAILED: %s\nrr-test-service log (tail):\n%s" % (", ".join(failures), tail()))
+        if args.gateway:
+            print("rr-gateway log (tail):\n%s" % tail(gwlog))
         return 1
     print("all %d checks passed" % len(only))
     return 0
