@@ -209,7 +209,7 @@ TEST_CASE("motion guard: a tool's close() holds until halt(), and is halted when
     CHECK_FALSE(f.guard->holder());
 }
 
-TEST_CASE("motion guard: a call that waits holds until its answer; a failed call holds nothing", "[motion]") {
+TEST_CASE("motion guard: a call that waits holds until its answer, a failed call holds nothing", "[motion]") {
     Fixture f;
     Probe probe;
     auto alice = client("rr:5", "alice", &probe);
@@ -276,7 +276,7 @@ TEST_CASE("motion guard: a generator that finished needs nothing when its client
     CHECK(f.device.sent.empty());
 }
 
-TEST_CASE("motion guard: a command stream silent for the bound stops the robot; another sender is refused meanwhile", "[motion]") {
+TEST_CASE("motion guard: a command stream silent for the bound stops the robot, another sender is refused meanwhile", "[motion]") {
     Fixture f(200ms);
     Probe probe;
     auto carol = client("rr:3", "carol", &probe);

@@ -44,6 +44,25 @@ RRN = ll.RRN
 GATEWAY_USER = ("gateway", "gateway-pw")
 
 
+# When the last round (or step) finished: the watchdog ends a hang, not a slow run (each round needs
+# CPU; under CI's load 250 rounds take minutes).
+last_progress = [time.monotonic()]
+
+
+def progressed():
+    last_progress[0] = time.monotonic()
+
+
+def watchdog(hang_s):
+    def watch():
+        while True:
+            time.sleep(1)
+            if time.monotonic() - last_progress[0] > hang_s:
+                print(json.dumps({"error": "no progress for %.0f s: a hang" % hang_s}), flush=True)
+                os._exit(3)
+    threading.Thread(target=watch, daemon=True).start()
+
+
 def run_rounds(url, rounds):
     """`rounds` rounds against `url`; returns (rounds whose read right after the disconnect was refused,
     the first refusal's text)."""
@@ -51,6 +70,7 @@ def run_rounds(url, rounds):
     bob = ll.connect(url, "bob")
     try:
         for i in range(rounds):
+            progressed()
             a1 = ll.connect(url, "alice")
             ll.expect(RRN.RequestObjectLock(a1, RR.RobotRaconteurObjectLockFlags_USER_LOCK) == "OK", "alice locks")
             if i % 10 == 0:  # as test_object_lock, now and then: her other session closes first, the lock stays
@@ -75,16 +95,14 @@ def main():
     ap.add_argument("--gateway", required=True)
     ap.add_argument("--service", help="our rr_interop_service as the device (default: the official service)")
     ap.add_argument("--rounds", type=int, default=250, help="rounds per transport (rr+tcp, rr+ws)")
-    ap.add_argument("--timeout", type=float, default=120)
+    ap.add_argument("--timeout", type=float, default=60, help="seconds without progress that count as a hang")
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-pt-disconnect-")
     svc_err = os.path.join(tmp, "service.err")
     gw_err = os.path.join(tmp, "gateway.err")
     svc = gw = None
-    timer = threading.Timer(args.timeout, lambda: os._exit(3))
-    timer.daemon = True
-    timer.start()
+    watchdog(args.timeout)
     results = {}
     try:
         svc, ready = ll.start_device(args.service, os.path.join(tmp, "users.txt"), {GATEWAY_USER[0]: (GATEWAY_USER[1], "_")},
@@ -95,6 +113,7 @@ def main():
                      "  - name: interop\n    url: %s\n    username: %s\n    password: %s\n    auth: passthrough\n"
                      % (json.dumps(ready["url"]), GATEWAY_USER[0], GATEWAY_USER[1]))
         gw = start([args.gateway, "--config", config, "--no-local", "--log-level", "warning"], gw_err)
+        progressed()
         port = read_json_line(gw, 30, "rr-gateway")["port"]
         deadline = time.monotonic() + 30
         while True:

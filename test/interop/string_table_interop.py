@@ -238,11 +238,10 @@ def entry_has_codes(entry):
 
 def recording_check(ck, port, workdir):
     def record():
-        directory = os.path.join(workdir, "rec")
-        os.makedirs(directory, exist_ok=True)
+        # The gateway's recordings root is workdir (--recordings-root); a request names a sub-folder.
         status, st = http(port, "POST", "/api/recordings",
                           {"device": "interop", "members": ["w_state", "ev_values"], "encoding": ["robotraconteur"],
-                           "directory": directory, "compression": "none"})
+                           "directory": "rec", "compression": "none"})
         expect(status == 201, "start recording: %s %r" % (status, st))
         rid = st["id"]
         s = JsonSocket(port)
@@ -299,7 +298,8 @@ def part_gateway(args, ck, workdir, procs):
     procs.append(proxy)
     gw_err = os.path.join(workdir, "gateway.stderr")
     gateway = start([args.gateway, "--no-demo", "--no-local", "--no-discovery", "--listen", "127.0.0.1", "--port", "0",
-                     "--log-level", "warning", "--device", "interop=rr+tcp://127.0.0.1:%d/?service=interop" % pport],
+                     "--log-level", "warning", "--recordings-root", workdir,
+                     "--device", "interop=rr+tcp://127.0.0.1:%d/?service=interop" % pport],
                     gw_err)
     procs.append(gateway)
     port = read_json_line(gateway, START_S, "rr-gateway")["port"]
