@@ -1,4 +1,5 @@
 #include "core/foxglove/foxglove_protocol.hpp"
+#include "core/json/json_nesting.hpp"
 
 #include <cstring>
 #include <limits>
@@ -146,27 +147,6 @@ std::size_t depth_of(const json& j, std::size_t limit) {
     std::size_t d = 0;
     for (const auto& x : j) d = std::max(d, depth_of(x, limit - 1));
     return d + 1;
-}
-
-// Nesting of `text` before parsing: nlohmann recurses per level.
-bool nests_deeper_than(std::string_view text, std::size_t limit) {
-    std::size_t depth = 0;
-    bool in_string = false, escaped = false;
-    for (char c : text) {
-        if (in_string) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') in_string = false;
-            continue;
-        }
-        if (c == '"') in_string = true;
-        else if (c == '[' || c == '{') {
-            if (++depth > limit) return true;
-        } else if ((c == ']' || c == '}') && depth) {
-            --depth;
-        }
-    }
-    return false;
 }
 
 template <class T>
@@ -369,7 +349,7 @@ Result<ClientMessage> decode_text(std::string_view text, const DecodeLimits& lim
         return fail(MessageErrorType::BufferLimitViolation,
                     "text message of " + std::to_string(text.size()) + " bytes is over the limit of " +
                         std::to_string(limits.max_text_bytes));
-    if (nests_deeper_than(text, limits.max_json_depth + 4))
+    if (rr::json_limits::nests_deeper_than(text, limits.max_json_depth + 4))
         return fail(MessageErrorType::BufferLimitViolation, "JSON nests deeper than " + std::to_string(limits.max_json_depth + 4));
     json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) return fail(MessageErrorType::ProtocolError, "the text message is not JSON");

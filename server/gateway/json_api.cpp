@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "core/json/json_nesting.hpp"
 #include "core/json/value_json.hpp"
 #include "core/message/error_entry.hpp"
 #include "core/session/elements.hpp"
@@ -20,24 +21,8 @@ std::string_view kind_word(robdef::MemberKind k) { return robdef::member_kind_ke
 }  // namespace
 
 Result<nlohmann::json> parse_request_json(std::string_view text) {
-    std::size_t depth = 0;
-    bool in_string = false, escaped = false;
-    for (char c : text) {
-        if (in_string) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') in_string = false;
-            continue;
-        }
-        if (c == '"') in_string = true;
-        else if (c == '[' || c == '{') {
-            if (++depth > kMaxRequestJsonDepth)
-                return fail(MessageErrorType::InvalidArgument,
-                            "JSON nested deeper than " + std::to_string(kMaxRequestJsonDepth) + " levels");
-        } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
-        }
-    }
+    if (rr::json_limits::nests_deeper_than(text, kMaxRequestJsonDepth))
+        return fail(MessageErrorType::InvalidArgument, "JSON nested deeper than " + std::to_string(kMaxRequestJsonDepth) + " levels");
     auto j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) return fail(MessageErrorType::InvalidArgument, "the request is not valid JSON");
     return j;

@@ -615,7 +615,7 @@ def case_locks(exe, work):
         for u in ("alice", "bob"):
             f.write("%s %s operator%s\n" % (u, hashlib.md5((u + "-pw").encode()).hexdigest(), ",objectlock" if u == "alice" else ""))
     robot = Robot(work)
-    auth = ("gateway:\n  auth:\n    users: %s\n    roles:\n      operator:\n        - allow: [read, write, call]\n" % users)
+    auth = ("gateway:\n  auth:\n    users: %s\n    roles:\n      operator:\n        - allow: [read, write, call, lock]\n" % users)
     gw = Gateway(exe, work, auth + robot_config(robot))
     try:
         url = "rr+tcp://127.0.0.1:%d/?service=robot" % gw.port
