@@ -46,7 +46,7 @@ MotionClient client(std::string key, std::string user, Probe* probe = nullptr, s
     return c;
 }
 
-MessageEntry call(std::string member, std::vector<MessageElement> args = {}) {
+MessageEntry function_call(std::string member, std::vector<MessageElement> args = {}) {
     MessageEntry e;
     e.entry_type = MessageEntryType::FunctionCallReq;
     e.service_path = "arm";
@@ -56,7 +56,7 @@ MessageEntry call(std::string member, std::vector<MessageElement> args = {}) {
 }
 
 MessageEntry jog(double timeout) {
-    return call("jog_joint", {make_array_element<double>("joint_velocity", std::vector<double>{0.1, 0, 0}),
+    return function_call("jog_joint", {make_array_element<double>("joint_velocity", std::vector<double>{0.1, 0, 0}),
                               make_scalar_element<double>("timeout", timeout), make_scalar_element<bool>("wait", false)});
 }
 
@@ -115,7 +115,7 @@ TEST_CASE("motion guard: a 60 s jog is clamped to the bound and holds the robot 
     REQUIRE(f.guard->holder());
     CHECK(f.guard->holder()->user == "alice");
     // Other members, other objects and read requests pass untouched.
-    auto enable = call("enable");
+    auto enable = function_call("enable");
     CHECK(f.guard->admit(bob, enable)->kind == MotionGuard::Ticket::Kind::pass);
     auto below = jog(60);
     below.service_path = "arm.tool";
@@ -131,7 +131,7 @@ TEST_CASE("motion guard: a stop passes, ends every hold, and is recognised for t
     auto bob = client("rr:2", "bob");
     auto e = jog(0.4);
     REQUIRE(f.guard->admit(alice, e));
-    auto halt = call("halt");
+    auto halt = function_call("halt");
     CHECK(f.guard->is_stop(halt));
     auto t = f.guard->admit(bob, halt);
     REQUIRE(t);
@@ -156,7 +156,7 @@ TEST_CASE("motion guard: jog_freespace without wait is ended by halt and command
     Fixture f;
     Probe probe;
     auto alice = client("rr:5", "alice", &probe);
-    auto e = call("jog_freespace", {make_array_element<double>("joint_position", std::vector<double>{0.1, 0, 0}),
+    auto e = function_call("jog_freespace", {make_array_element<double>("joint_position", std::vector<double>{0.1, 0, 0}),
                                     make_array_element<double>("max_velocity", std::vector<double>{0.01, 0.01, 0.01}),
                                     make_scalar_element<bool>("wait", false)});
     auto t = f.guard->admit(alice, e);
@@ -185,20 +185,20 @@ TEST_CASE("motion guard: a tool's close() holds until halt(), and is halted when
     f.guard->set_root(ObjectTypeInfo{std::string(kStandardToolType), {}}, nullptr);
     auto alice = client("ws:1", "alice");
     auto bob = client("rr:2", "bob");
-    auto close = call("close");
+    auto close = function_call("close");
     auto t = f.guard->admit(alice, close);
     REQUIRE(t);
     MessageEntry ok;
     ok.entry_type = MessageEntryType::FunctionCallRes;
     f.guard->on_reply(alice, *t, ok);
     REQUIRE(f.guard->holder());  // the fingers keep moving after the call returns
-    auto open = call("open");
+    auto open = function_call("open");
     CHECK_FALSE(f.guard->admit(bob, open));  // another client may not move the tool meanwhile
-    auto halt = call("halt");
+    auto halt = function_call("halt");
     CHECK(f.guard->admit(bob, halt)->kind == MotionGuard::Ticket::Kind::stop);
     CHECK_FALSE(f.guard->holder());
 
-    auto set = call("setf_command", {make_scalar_element<double>("command", 0.06)});
+    auto set = function_call("setf_command", {make_scalar_element<double>("command", 0.06)});
     auto t2 = f.guard->admit(alice, set);
     REQUIRE(t2);
     f.guard->on_reply(alice, *t2, ok);
@@ -213,7 +213,7 @@ TEST_CASE("motion guard: a call that waits holds until its answer, a failed call
     Fixture f;
     Probe probe;
     auto alice = client("rr:5", "alice", &probe);
-    auto e = call("jog_freespace", {make_scalar_element<bool>("wait", true)});
+    auto e = function_call("jog_freespace", {make_scalar_element<bool>("wait", true)});
     auto t = f.guard->admit(alice, e);
     REQUIRE(t);
     CHECK(t->waits);
@@ -222,7 +222,7 @@ TEST_CASE("motion guard: a call that waits holds until its answer, a failed call
     CHECK_FALSE(f.guard->holder());
     REQUIRE(probe.calls.size() == 2);  // on, then off
 
-    auto e2 = call("jog_freespace", {make_scalar_element<bool>("wait", false)});
+    auto e2 = function_call("jog_freespace", {make_scalar_element<bool>("wait", false)});
     auto t2 = f.guard->admit(alice, e2);
     REQUIRE(t2);
     f.guard->on_reply(alice, *t2, fail(MessageErrorType::InvalidOperation, "Robot not in jog mode"));
@@ -234,7 +234,7 @@ TEST_CASE("motion guard: a call that waits holds until its answer, a failed call
 TEST_CASE("motion guard: a trajectory generator is aborted, then the robot halted, when its client goes", "[motion]") {
     Fixture f;
     auto alice = client("rr:8", "alice", nullptr, /*passthrough session*/ 8);
-    auto e = call("execute_trajectory");
+    auto e = function_call("execute_trajectory");
     auto t = f.guard->admit(alice, e);
     REQUIRE(t);
     CHECK(t->kind == MotionGuard::Ticket::Kind::generator);
@@ -257,7 +257,7 @@ TEST_CASE("motion guard: a trajectory generator is aborted, then the robot halte
 TEST_CASE("motion guard: a generator that finished needs nothing when its client goes", "[motion]") {
     Fixture f;
     auto alice = client("rr:8", "alice");
-    auto e = call("execute_trajectory");
+    auto e = function_call("execute_trajectory");
     auto t = f.guard->admit(alice, e);
     f.guard->on_reply(alice, *t, reply_with_index(4));
     MessageEntry next;
@@ -307,7 +307,7 @@ TEST_CASE("motion guard: a device that is no robot and has nothing configured is
     FakeDevice device;
     auto guard = std::make_shared<MotionGuard>(io.get_executor(), "create", MotionSafety{}, device.request());
     guard->set_root(ObjectTypeInfo{"experimental.create.Create", {}}, nullptr);
-    auto e = call("Drive");
+    auto e = function_call("Drive");
     e.service_path = "create";
     CHECK_FALSE(guard->concerns(e));
     CHECK(guard->admit(client("a", ""), e)->kind == MotionGuard::Ticket::Kind::pass);

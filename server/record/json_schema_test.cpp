@@ -11,7 +11,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr const char* kDef = R"(service test.rec
+constexpr const char* kSchemaDef = R"(service test.rec
 
 enum Mode
     idle = 0,
@@ -45,7 +45,7 @@ struct SchemaFixture {
     robdef::ServiceDefinitionSet set;
     const robdef::ServiceEntryDefinition* dev = nullptr;
     SchemaFixture() {
-        auto r = set.add_text(kDef, "test.rec.robdef");
+        auto r = set.add_text(kSchemaDef, "test.rec.robdef");
         INFO((r ? std::string() : r.error().message));
         REQUIRE(r);
         auto ref = set.find("Dev", "test.rec");
