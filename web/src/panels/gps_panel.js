@@ -4,11 +4,10 @@
 // the first fix (no map: the numbers and the track). The sensor panel beside it shows sensor_info.
 
 import { h } from "../dom.js";
-import { describeMember } from "../views/context.js";
 import { fieldText } from "../std/typed_text.js";
 import { GpsTrack } from "../sensor/imu_gps.js";
 import { axisText } from "../sensor/sensor_source.js";
-import { errorLine } from "./panel_parts.js";
+import { stateWirePanel } from "./panel_parts.js";
 
 const SIZE = 240;
 
@@ -38,58 +37,34 @@ const num = (v, unit) => (typeof v === "number" && Number.isFinite(v) ? `${axisT
 const deg = (v) => (typeof v === "number" && Number.isFinite(v) ? `${Number(v.toFixed(7))}°` : "—");
 
 export function createGpsPanel(parent, ctx) {
-  const { obj, view } = ctx;
-  const m = (obj.$members || []).find((x) => x.name === "gps_state" && x.kind === "wire" && !x.writeonly);
-  const t = m ? describeMember(view, obj, m)?.type : null;
-  const ok = t?.qualified === "com.robotraconteur.gps.GpsState" && ["latitude_deg", "longitude_deg", "altitude"].every((n) => t.fields?.some((f) => f.name === n));
-  let disposed = false, frame = 0, newest = null, count = 0;
-  const errors = errorLine("gps-error", () => !disposed);
-  const rows = h("dl", { class: "camera-info-rows gps-rows" });
-  const canvas = h("canvas", { class: "gps-track", width: SIZE, height: SIZE, "aria-label": "track", style: "border: 1px solid #ddd" });
-  const el = h("section", { class: "panel gps-panel", dataset: { panel: "gps", samples: "0" } }, h("h3", { text: "GPS" }), errors.el, h("div", { style: "display: flex; gap: 12px; align-items: flex-start" }, canvas, rows));
-  parent.append(el);
-  const row = (label) => { const dd = h("dd", { dataset: { row: label } }); rows.append(h("dt", { text: label }), dd); return dd; };
-  let follow = null;
-  if (!ok) {
-    el.dataset.fallback = "true";
-    canvas.hidden = true;
-    el.append(h("div", { class: "hint", text: "no gps_state wire of the standard GpsState type on this device: its members are shown below" }));
-  } else {
-    const out = Object.fromEntries(["latitude", "longitude", "altitude", "fix", "satellites", "horizontal error", "error", "speed", "track"].map((k) => [k, row(k)]));
-    const statusType = t.fields.find((f) => f.name === "status")?.type;
-    const codeField = statusType?.fields?.find((f) => f.name === "status_code");
-    const track = new GpsTrack();
-    const g = canvas.getContext("2d");
-    const draw = () => {
-      frame = 0;
-      if (disposed || !newest) return;
-      const s = newest;
-      out.latitude.textContent = deg(s.latitude_deg);
-      out.longitude.textContent = deg(s.longitude_deg);
-      out.altitude.textContent = num(s.altitude, " m");
-      out.fix.textContent = s.status && codeField ? fieldText(s.status, codeField, statusType, view?.text) : "—";
-      out.satellites.textContent = s.status ? `${s.status.satellites_used ?? "?"} used of ${s.status.satellites_visible ?? "?"} visible` : "—";
-      out["horizontal error"].textContent = num(s.err_horz, " m");
-      out.error.textContent = num(s.err, " m");
-      out.speed.textContent = num(s.speed, " m/s");
-      out.track.textContent = num(s.track_deg, "°");
-      el.dataset.metresPerPixel = String(drawTrack(g, track.points()));
-      el.dataset.samples = String(count);
-    };
-    follow = ctx.live.followWire(m.name, {
-      onValue: (v) => {
-        newest = v;
-        count++;
-        track.push(Number(v?.latitude_deg), Number(v?.longitude_deg));
-        if (!frame) frame = requestAnimationFrame(draw);
-      },
-      onError: errors.onMemberError(m.name),
-    });
-  }
-  return {
-    el,
-    dispose() { disposed = true; follow?.dispose(); if (frame) cancelAnimationFrame(frame); el.remove(); },
-  };
+  const { view } = ctx;
+  return stateWirePanel(parent, ctx, {
+    panel: "gps", title: "GPS", wire: "gps_state", typeName: "com.robotraconteur.gps.GpsState",
+    fields: ["latitude_deg", "longitude_deg", "altitude"],
+    canvasClass: "gps-track", canvasLabel: "track", size: SIZE,
+    setup({ type: t, row, canvas, el }) {
+      const out = Object.fromEntries(["latitude", "longitude", "altitude", "fix", "satellites", "horizontal error", "error", "speed", "track"].map((k) => [k, row(k)]));
+      const statusType = t.fields.find((f) => f.name === "status")?.type;
+      const codeField = statusType?.fields?.find((f) => f.name === "status_code");
+      const track = new GpsTrack();
+      const g = canvas.getContext("2d");
+      return {
+        received(v) { track.push(Number(v?.latitude_deg), Number(v?.longitude_deg)); return v; },
+        draw(s) {
+          out.latitude.textContent = deg(s.latitude_deg);
+          out.longitude.textContent = deg(s.longitude_deg);
+          out.altitude.textContent = num(s.altitude, " m");
+          out.fix.textContent = s.status && codeField ? fieldText(s.status, codeField, statusType, view?.text) : "—";
+          out.satellites.textContent = s.status ? `${s.status.satellites_used ?? "?"} used of ${s.status.satellites_visible ?? "?"} visible` : "—";
+          out["horizontal error"].textContent = num(s.err_horz, " m");
+          out.error.textContent = num(s.err, " m");
+          out.speed.textContent = num(s.speed, " m/s");
+          out.track.textContent = num(s.track_deg, "°");
+          el.dataset.metresPerPixel = String(drawTrack(g, track.points()));
+        },
+      };
+    },
+  });
 }
 
 export const gpsPanel = { name: "gps", order: 15, types: ["com.robotraconteur.gps.GpsSensor"], create: createGpsPanel };

@@ -4,10 +4,9 @@
 // geometry definitions' SI units). The sensor panel beside it shows sensor_info and the parameters.
 
 import { h } from "../dom.js";
-import { describeMember } from "../views/context.js";
 import { formatRotation, namedFields, shortNumber } from "../std/geometry.js";
 import { gizmoAxes } from "../sensor/imu_gps.js";
-import { errorLine } from "./panel_parts.js";
+import { stateWirePanel } from "./panel_parts.js";
 
 const SIZE = 200;
 const COLORS = { x: "#d62728", y: "#2ca02c", z: "#1f77b4" };
@@ -38,44 +37,24 @@ export function drawGizmo(g, q, size = SIZE) {
 }
 
 export function createImuPanel(parent, ctx) {
-  const { obj, view } = ctx;
-  const m = (obj.$members || []).find((x) => x.name === "imu_state" && x.kind === "wire" && !x.writeonly);
-  const t = m ? describeMember(view, obj, m)?.type : null;
-  const ok = t?.qualified === "com.robotraconteur.imu.ImuState" && ["orientation", "angular_velocity", "linear_acceleration"].every((n) => t.fields?.some((f) => f.name === n));
-  let disposed = false, frame = 0, newest = null, count = 0;
-  const errors = errorLine("imu-error", () => !disposed);
-  const rows = h("dl", { class: "camera-info-rows imu-rows" });
-  const canvas = h("canvas", { class: "imu-gizmo", width: SIZE, height: SIZE, "aria-label": "orientation", style: "border: 1px solid #ddd" });
-  const el = h("section", { class: "panel imu-panel", dataset: { panel: "imu", samples: "0" } }, h("h3", { text: "IMU" }), errors.el, h("div", { style: "display: flex; gap: 12px; align-items: flex-start" }, canvas, rows));
-  parent.append(el);
-  const row = (label) => { const dd = h("dd", { dataset: { row: label } }); rows.append(h("dt", { text: label }), dd); return dd; };
-  let follow = null;
-  if (!ok) {
-    el.dataset.fallback = "true";
-    canvas.hidden = true;
-    el.append(h("div", { class: "hint", text: "no imu_state wire of the standard ImuState type on this device: its members are shown below" }));
-  } else {
-    const out = { orientation: row("orientation"), angular_velocity: row("angular velocity"), linear_acceleration: row("linear acceleration") };
-    const g = canvas.getContext("2d");
-    const draw = () => {
-      frame = 0;
-      if (disposed || !newest) return;
-      const s = newest;
-      out.orientation.textContent = formatRotation(s.orientation) ?? "(invalid quaternion)";
-      out.angular_velocity.textContent = `${vec(s.angular_velocity)} rad/s`;
-      out.linear_acceleration.textContent = `${vec(s.linear_acceleration)} m/s²`;
-      drawGizmo(g, s.orientation);
-      el.dataset.samples = String(count);
-    };
-    follow = ctx.live.followWire(m.name, {
-      onValue: (v) => { newest = Array.isArray(v) && v.length === 1 ? v[0] : v; count++; if (!frame) frame = requestAnimationFrame(draw); },
-      onError: errors.onMemberError(m.name),
-    });
-  }
-  return {
-    el,
-    dispose() { disposed = true; follow?.dispose(); if (frame) cancelAnimationFrame(frame); el.remove(); },
-  };
+  return stateWirePanel(parent, ctx, {
+    panel: "imu", title: "IMU", wire: "imu_state", typeName: "com.robotraconteur.imu.ImuState",
+    fields: ["orientation", "angular_velocity", "linear_acceleration"],
+    canvasClass: "imu-gizmo", canvasLabel: "orientation", size: SIZE,
+    setup({ row, canvas }) {
+      const out = { orientation: row("orientation"), angular_velocity: row("angular velocity"), linear_acceleration: row("linear acceleration") };
+      const g = canvas.getContext("2d");
+      return {
+        received: (v) => (Array.isArray(v) && v.length === 1 ? v[0] : v),
+        draw(s) {
+          out.orientation.textContent = formatRotation(s.orientation) ?? "(invalid quaternion)";
+          out.angular_velocity.textContent = `${vec(s.angular_velocity)} rad/s`;
+          out.linear_acceleration.textContent = `${vec(s.linear_acceleration)} m/s²`;
+          drawGizmo(g, s.orientation);
+        },
+      };
+    },
+  });
 }
 
 export const imuPanel = { name: "imu", order: 15, types: ["com.robotraconteur.imu.ImuSensor"], create: createImuPanel };

@@ -1,8 +1,9 @@
-// Small parts the sensor, laser scanner and point cloud panels share: the error line of a panel and
-// the gateway's access answer that decides their controls.
+// Small parts the sensor, laser scanner, IMU and GPS panels share: the error line of a panel, the
+// gateway's access answer that decides their controls, the frame of a panel showing one state wire.
 
 import { h, errorText } from "../dom.js";
 import { fetchAccess } from "../robot/access.js";
+import { describeMember } from "../views/context.js";
 
 /**
  * The error line of a panel: { el, show(text|null), onMemberError(member) } where onMemberError gives
@@ -35,4 +36,49 @@ export function whenAccess(ctx, panelEl, ready, alive, then, showError) {
     panelEl.dataset.access = "none";
     showError(`${e.message}: no controls`);
   });
+}
+
+/**
+ * A panel that shows one standard state wire (the IMU's and the GPS's): its heading, error line, a
+ * canvas beside rows of label and value, and the newest value drawn at most once per animation frame
+ * (newest wins). Without a readable wire `spec.wire` of type `spec.typeName` holding `spec.fields`,
+ * a one-line note and the generic view below. When the wire is there, `spec.setup({ type, row,
+ * canvas, el })` (row(label) adds a row and gives its value element) returns `{ draw(value),
+ * received?(value) }`: received sees every value and gives what to keep for the next draw.
+ * Returns the panel's { el, dispose() }.
+ */
+export function stateWirePanel(parent, ctx, spec) {
+  const { obj, view } = ctx;
+  const m = (obj.$members || []).find((x) => x.name === spec.wire && x.kind === "wire" && !x.writeonly);
+  const t = m ? describeMember(view, obj, m)?.type : null;
+  const ok = t?.qualified === spec.typeName && spec.fields.every((n) => t.fields?.some((f) => f.name === n));
+  let disposed = false, frame = 0, newest = null, count = 0, follow = null;
+  const errors = errorLine(`${spec.panel}-error`, () => !disposed);
+  const rows = h("dl", { class: `camera-info-rows ${spec.panel}-rows` });
+  const canvas = h("canvas", { class: spec.canvasClass, width: spec.size, height: spec.size, "aria-label": spec.canvasLabel, style: "border: 1px solid #ddd" });
+  const el = h("section", { class: `panel ${spec.panel}-panel`, dataset: { panel: spec.panel, samples: "0" } }, h("h3", { text: spec.title }), errors.el, h("div", { style: "display: flex; gap: 12px; align-items: flex-start" }, canvas, rows));
+  parent.append(el);
+  const row = (label) => { const dd = h("dd", { dataset: { row: label } }); rows.append(h("dt", { text: label }), dd); return dd; };
+  if (!ok) {
+    el.dataset.fallback = "true";
+    canvas.hidden = true;
+    const typeShort = spec.typeName.slice(spec.typeName.lastIndexOf(".") + 1);
+    el.append(h("div", { class: "hint", text: `no ${spec.wire} wire of the standard ${typeShort} type on this device: its members are shown below` }));
+  } else {
+    const shown = spec.setup({ type: t, row, canvas, el });
+    const draw = () => {
+      frame = 0;
+      if (disposed || !newest) return;
+      shown.draw(newest);
+      el.dataset.samples = String(count);
+    };
+    follow = ctx.live.followWire(m.name, {
+      onValue: (v) => { newest = shown.received ? shown.received(v) : v; count++; if (!frame) frame = requestAnimationFrame(draw); },
+      onError: errors.onMemberError(m.name),
+    });
+  }
+  return {
+    el,
+    dispose() { disposed = true; follow?.dispose(); if (frame) cancelAnimationFrame(frame); el.remove(); },
+  };
 }
