@@ -195,7 +195,9 @@ test("GPS: position, fix, satellites and accuracy as sent; the track grows", asy
   assert.equal(await row("error"), "1.5 m");
   assert.equal(await row("speed"), "1 m/s");
   const [lat0, lon0] = sensors.info.gps_centre;
-  const lat = Number((await row("latitude")).replace("°", "")), lon = Number((await row("longitude")).replace("°", ""));
+  // both rows from one snapshot: the cart moves, and two reads may straddle a redraw
+  const [latText, lonText] = await p.evaluate((el) => ["latitude", "longitude"].map((k) => el.querySelector(`dd[data-row="${k}"]`).textContent));
+  const lat = Number(latText.replace("°", "")), lon = Number(lonText.replace("°", ""));
   // on the circle of 20 m around the centre (1e-7° is about 1 cm)
   const north = (lat - lat0) * Math.PI / 180 * 6371008.8, east = (lon - lon0) * Math.PI / 180 * 6371008.8 * Math.cos(lat0 * Math.PI / 180);
   assert.ok(Math.abs(Math.hypot(north, east) - 20) < 0.05, `${Math.hypot(north, east)} m from the centre`);
