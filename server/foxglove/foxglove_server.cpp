@@ -664,7 +664,7 @@ private:
         };
         auto g = std::make_shared<Gather>();
         auto server = server_.lock();
-        std::vector<std::pair<std::shared_ptr<const LiveMember>, nlohmann::json>> todo;
+        std::vector<std::pair<std::shared_ptr<const LiveMember>, nlohmann::json>> writes;
         for (auto& p : e.parameters) {
             auto m = server ? server->member_named(p.name, LiveKind::property) : nullptr;
             if (!m) {
@@ -674,10 +674,10 @@ private:
             } else if (p.value.is_null()) {
                 g->failures.push_back(p.name + ": a property cannot be unset");
             } else {
-                todo.emplace_back(std::move(m), std::move(p.value));
+                writes.emplace_back(std::move(m), std::move(p.value));
             }
         }
-        g->left = todo.size();
+        g->left = writes.size();
         auto self = shared_from_this();
         auto finish = [self, g, id = e.id] {
             if (!g->failures.empty()) {
@@ -697,8 +697,8 @@ private:
                     for (const auto& v : values) server->parameter_changed(v);
             });
         };
-        if (todo.empty()) return finish();
-        for (auto& [m, value] : todo) {
+        if (writes.empty()) return finish();
+        for (auto& [m, value] : writes) {
             std::shared_ptr<const LiveMember> member = m;
             api_->set_property(address_of(*member), value, [g, member, finish](ApiResult r) {
                 bool last = false;
