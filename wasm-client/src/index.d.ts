@@ -579,3 +579,6 @@ export function subscribe<T extends ObjectBase = ObjectProxy>(target: string | s
 export function matchesFilter(info: ServiceInfo, filter: Omit<SubscriptionFilter, "gateway">): boolean;
 /** connect() takes the liveness options too (merged into ConnectOptions above). */
 export interface ConnectOptions extends LivenessOptions {}
+
+// Only the declarations marked `export` above are the package's (memberMark, Mark, IsUntyped, ... stay private).
+export {};
