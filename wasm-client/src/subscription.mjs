@@ -3,7 +3,7 @@
 // connect again with a jittered backoff after any drop, and restore on the new connection the wires,
 // pipe endpoints, event handlers and callbacks the app asked for.
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents, GOING_AWAY_WINDOW_MS } from "./backoff.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
@@ -11,9 +11,7 @@ const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 
  * connection and, through it, its proxies) for as long as the error lives. */
 const keepable = (e) => (e ? new RRError(e.errorName, e.message, e.code) : null);
 const invalid = (m) => new RRError("RobotRaconteur.InvalidArgument", m, 18);
-/** After a server closed with 1001 Going Away (it is stopping, likely to restart), attempts this long
- * after the close keep the first backoff delay instead of growing it. */
-const GOING_AWAY_WINDOW_MS = 15000;
+
 
 /**
  * Walks `path` (an objref path relative to the root: "child", "child_by_int[7]", "a.b[x]"; "" = root)
