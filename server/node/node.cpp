@@ -37,17 +37,6 @@ void Node::start_threads() {
     for (unsigned i = 0; i < options_.threads; ++i) threads_.emplace_back([this] { io_.run(); });
 }
 
-void Node::go_away() {
-    if (going_away_.exchange(true) || stopped_.load()) return;
-    std::vector<std::weak_ptr<PumpHandle>> pumps;
-    {
-        std::lock_guard lock(mutex_);
-        pumps = pumps_;
-    }
-    for (auto& w : pumps)
-        if (auto p = w.lock()) p->close_going_away();
-}
-
 void Node::shutdown() {
     if (stopped_.exchange(true)) return;
     std::vector<std::shared_ptr<Listener>> listeners;
@@ -110,7 +99,7 @@ std::string Node::listen_base_url() const {
 }
 
 std::shared_ptr<ConnectionLogic> Node::open_connection(const AcceptedStream& stream) {
-    if (stopped_.load() || going_away_.load() || !can_accept()) return nullptr;
+    if (stopped_.load() || !can_accept()) return nullptr;
     ServerConnectionConfig config = options_.server;
     config.peer = stream.peer;
     config.web_login = stream.web_login;

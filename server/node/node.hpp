@@ -95,10 +95,6 @@ public:
 
     /// Stops listening, closes every connection and joins the worker threads. Idempotent.
     void shutdown();
-    /// The first step of a graceful stop, before the rest of the process winds down: no new connection
-    /// is accepted, and every open one is closed after flushing, a WebSocket with 1001 Going Away.
-    /// Threads keep running (shutdown() follows). Idempotent.
-    void go_away();
 
     std::shared_ptr<NodeStats> stats() const { return stats_; }
     /// Connections currently open (accepted, any transport).
@@ -132,7 +128,6 @@ private:
     std::vector<std::function<void()>> services_changed_callbacks_;
     std::string service_state_nonce_;  // guarded by mutex_
     std::atomic<bool> stopped_{false};
-    std::atomic<bool> going_away_{false};
     std::atomic<std::uint64_t> reads_throttled_{0};
 };
 
