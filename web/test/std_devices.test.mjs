@@ -1,0 +1,36 @@
+// The pure parts of the joystick, signal and other standard device panels (issue 54, stdpanels-c):
+// values as a person reads them, from hand-made values with the enums of the standard definitions.
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { axisFraction, axisText, pressedButtons, hatText, gamepadRows, joystickInfoRows } from "../src/hid/joystick.js";
+
+const HAT = [["hat_centered", 0], ["hat_up", 1], ["hat_right", 2], ["hat_down", 4], ["hat_left", 8], ["hat_rightup", 3]].map(([name, value]) => ({ name, value }));
+const GP = [["button_A", 1], ["button_B", 2], ["button_X", 4], ["button_Y", 8], ["button_dpad_right", 0x4000]].map(([name, value]) => ({ name, value }));
+const CAPS = [["none", 0], ["rumble", 1], ["force_feedback", 2], ["standard_gamepad", 4]].map(([name, value]) => ({ name, value }));
+
+test("joystick: int16 axes as a share of their travel both ways", () => {
+  assert.equal(axisFraction(32767), 1);
+  assert.equal(axisFraction(-32768), -1);
+  assert.equal(axisFraction(0), 0);
+  assert.equal(axisFraction("x"), 0);
+  assert.equal(axisText(16384), "16384 (50%)");
+  assert.equal(axisText(-32768), "-32768 (-100%)");
+  assert.equal(axisText(-100), "-100 (0%)");
+  assert.deepEqual(pressedButtons(Uint8Array.from([1, 0, 0, 255, 0])), [0, 3]);
+  assert.deepEqual(pressedButtons(undefined), []);
+  assert.equal(hatText(HAT, 2), "hat_right");
+  assert.equal(hatText(HAT, 3), "hat_rightup");
+  assert.equal(hatText(HAT, 99), "99");
+});
+
+test("joystick: gamepad state rows and joystick_info rows", () => {
+  const rows = gamepadRows({ left_x: 16384, left_y: -32768, right_x: 0, right_y: 32767, trigger_left: 0, trigger_right: 32767, buttons: 1 | 8 | 0x4000 }, GP);
+  assert.deepEqual(rows.map((r) => r.text), ["(50%, -100%)", "(0%, 100%)", "left 0%, right 100%", "A | Y | dpad_right"]);
+  assert.equal(gamepadRows({ left_x: -1, left_y: 0, right_x: 0, right_y: 0, buttons: 0 }, GP)[0].text, "(0%, 0%)");
+  assert.equal(gamepadRows({ buttons: 0 }, GP)[3].text, "none");
+  const info = joystickInfoRows({ id: 0, axes_count: 4, button_count: 12, hat_count: 1, joystick_capabilities: 5,
+    joystick_device_vendor: 0x045e, joystick_device_product: 0x028e, joystick_device_version: 0x110 }, CAPS);
+  assert.deepEqual(Object.fromEntries(info.map((r) => [r.key, r.text])),
+    { id: "0", counts: "4 axes, 12 buttons, 1 hats", capabilities: "rumble | standard_gamepad", usb: "045e:028e v0110" });
+  assert.deepEqual(joystickInfoRows(null, CAPS), []);
+});
