@@ -34,3 +34,42 @@ test("joystick: gamepad state rows and joystick_info rows", () => {
     { id: "0", counts: "4 axes, 12 buttons, 1 hats", capabilities: "rumble | standard_gamepad", usb: "045e:028e v0110" });
   assert.deepEqual(joystickInfoRows(null, CAPS), []);
 });
+
+import { signalNumbers, signalKind, signalText, signalCommand } from "../src/signal/signal_state.js";
+
+const SIGTYPE = ["unknown", "digital", "analog", "digital_port"].map((name, value) => ({ name, value }));
+const ACCESS = ["undefined", "internal", "restricted", "readonly", "all"].map((name, value) => ({ name, value }));
+const ENUMS = { type: SIGTYPE, access: ACCESS };
+const info = (over) => ({ signal_identifier: { name: "s" }, signal_type: 2, access_level: 4, units: [{ display_units: "bar" }], min_value: null, max_value: null, ...over });
+
+test("signals: varvalues and vectors as numbers; on/off for digital, units otherwise", () => {
+  assert.deepEqual(signalNumbers({ type: "bool[]", value: [true] }), [1]);
+  assert.deepEqual(signalNumbers({ type: "double[]", value: Float64Array.of(4.25) }), [4.25]);
+  assert.deepEqual(signalNumbers(Int32Array.of(1, 2)), [1, 2]);
+  assert.deepEqual(signalNumbers({ type: "int64[]", value: BigInt64Array.of(7n) }), [7]);
+  assert.equal(signalNumbers({ type: "string", value: "x" }), null);
+  assert.equal(signalNumbers(null), null);
+  const analog = signalKind(info(), ENUMS);
+  assert.deepEqual([analog.type, analog.access, analog.writable, analog.units], ["analog", "all", true, ["bar"]]);
+  assert.equal(signalText({ type: "double[]", value: Float64Array.of(6.12345) }, analog), "6.1235 bar");
+  const digital = signalKind(info({ signal_type: 1, access_level: 3, units: [] }), ENUMS);
+  assert.equal(digital.writable, false, "readonly");
+  assert.equal(signalText({ type: "bool[]", value: [false] }, digital), "off");
+  assert.equal(signalText(Float64Array.of(1), digital), "on");
+  assert.equal(signalKind(info({ access_level: 2 }), ENUMS).writable, false, "restricted");
+  const two = signalKind(info({ units: [{ display_units: "m" }, { display_units: "s" }] }), ENUMS);
+  assert.equal(signalText(Float64Array.of(1, 2), two), "1 m, 2 s");
+  assert.equal(signalText({ type: "string", value: "ok" }, analog), '"ok"');
+});
+
+test("signals: commands as double[], checked against min and max before sending", () => {
+  const k = signalKind(info({ min_value: { type: "double[]", value: Float64Array.of(0) }, max_value: { type: "double[]", value: Float64Array.of(0.5) } }), ENUMS);
+  assert.deepEqual([k.min, k.max], [0, 0.5]);
+  assert.deepEqual(Array.from(signalCommand(k, "0.25")), [0.25]);
+  assert.deepEqual(Array.from(signalCommand(k, true)), [1]);
+  assert.deepEqual(Array.from(signalCommand(k, false)), [0]);
+  assert.throws(() => signalCommand(k, "0.8"), /0\.8 is above its maximum 0\.5/);
+  assert.throws(() => signalCommand(k, "-1"), /below its minimum 0/);
+  assert.throws(() => signalCommand(k, ""), /enter a number/);
+  assert.throws(() => signalCommand(k, "abc"), /enter a number/);
+});

@@ -15,6 +15,7 @@ import { toolPanel } from "./tool_panel.js";
 import { lightPanel } from "./light_panel.js";
 // joysticks, signals and the other standard device types (stdpanels-c)
 import { joystickPanel } from "./joystick_panel.js";
+import { signalPanel } from "./signal_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -24,5 +25,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // joysticks, signals and the other standard device types (stdpanels-c)
-    .register(joystickPanel);
+    .register(joystickPanel, signalPanel);
 }
