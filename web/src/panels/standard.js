@@ -16,6 +16,8 @@ import { lightPanel } from "./light_panel.js";
 // joysticks, signals and the other standard device types (stdpanels-c)
 import { joystickPanel } from "./joystick_panel.js";
 import { signalPanel } from "./signal_panel.js";
+import { servoPanel } from "./servo_panel.js";
+import { actuatorPanel } from "./actuator_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -25,5 +27,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // joysticks, signals and the other standard device types (stdpanels-c)
-    .register(joystickPanel, signalPanel);
+    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel);
 }
