@@ -73,3 +73,48 @@ test("signals: commands as double[], checked against min and max before sending"
   assert.throws(() => signalCommand(k, ""), /enter a number/);
   assert.throws(() => signalCommand(k, "abc"), /enter a number/);
 });
+
+import { clockOffset, offsetText, clockText, zoneText } from "../src/clock/clock.js";
+import { messageRow, passes, mergeRows, newestWindow } from "../src/eventlog/event_log.js";
+import { assembleParts, sizeText } from "../src/resource/resource.js";
+
+test("clock: offset from the browser's clock, times and zones as text", () => {
+  const t = [{ clock_info: { clock_type: 2 }, seconds: 1790000030n, nanoseconds: 500000000 }];
+  assert.equal(clockOffset(t, 1790000000000), 30.5);
+  assert.equal(clockOffset({ nothing: 1 }, 0), null);
+  assert.equal(offsetText(30.5), "+30.500 s");
+  assert.equal(offsetText(-0.012), "-12 ms");
+  assert.equal(offsetText(null), "");
+  assert.equal(clockText(t), "2026-09-21T14:13:50.5Z");
+  assert.equal(clockText({ seconds: 1790000030n, nanoseconds: 0, utc_offset_seconds: 7200, timezone_name: "Europe/Berlin" }), "2026-09-21T16:13:50+02:00 Europe/Berlin");
+  assert.equal(zoneText({ timezone_utc_offset_seconds: -16200, timezone_name: "" }), "-04:30");
+});
+
+test("event log: rows, filters by words and level, merge newest first and bounded, the newest window", () => {
+  const LEVELS = [["undefined", 0], ["trace", 1], ["debug", 2], ["info", 3], ["warning", 4], ["error", 5]].map(([name, value]) => ({ name, value }));
+  const msg = (n, level, title) => ({ header: { level, message_number: BigInt(n), source_device: { name: "plc" }, source_component: "line", source_object: "",
+    timestamp: [{ seconds: 1790000000n, nanoseconds: 0 }] }, title, message: "m" });
+  const r = messageRow(msg(7, 5, "conveyor jam"), LEVELS);
+  assert.deepEqual([r.number, r.level, r.source, r.time], [7n, "error", "plc / line", "2026-09-21T14:13:20Z"]);
+  assert.equal(passes(r, "Conveyor JAM", 0), true);
+  assert.equal(passes(r, "jam heartbeat", 0), false);
+  assert.equal(passes(r, "", 5), true);
+  assert.equal(passes(messageRow(msg(8, 4, "x"), LEVELS), "", 5), false);
+  const rows = mergeRows([messageRow(msg(1, 3, "a"), LEVELS)], [2, 3, 1].map((n) => messageRow(msg(n, 3, `b${n}`), LEVELS)), 2);
+  assert.deepEqual(rows.map((x) => [x.number, x.title]), [[3n, "b3"], [2n, "b2"]]);
+  assert.deepEqual(newestWindow({ min_message_number: 1n, max_message_number: 50n }, 20), { start: 31n, count: 20n });
+  assert.deepEqual(newestWindow({ min_message_number: 5n, max_message_number: 9n }, 20), { start: 5n, count: 5n });
+  assert.equal(newestWindow({ min_message_number: 5n, max_message_number: 4n }), null);
+});
+
+test("resources: parts put together, bounded; sizes as text", () => {
+  const info = { total_size: 5n };
+  const part = (off, bytes) => ({ info, data_offset: BigInt(off), data: Uint8Array.from(bytes) });
+  assert.deepEqual(Array.from(assembleParts([part(3, [4, 5]), part(0, [1, 2, 3])])), [1, 2, 3, 4, 5]);
+  assert.throws(() => assembleParts([part(4, [1, 2])]), /outside the resource's 5/);
+  assert.throws(() => assembleParts([part(0, [1, 2])]), /3 of the resource's 5 bytes did not come/);
+  assert.throws(() => assembleParts([{ info: { total_size: 100 }, data_offset: 0, data: new Uint8Array(1) }], 10), /more than the 10/);
+  assert.equal(assembleParts([]).length, 0);
+  assert.equal(sizeText(3000), "2.9 KiB");
+  assert.equal(sizeText(12), "12 B");
+});

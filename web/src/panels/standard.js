@@ -18,6 +18,10 @@ import { joystickPanel } from "./joystick_panel.js";
 import { signalPanel } from "./signal_panel.js";
 import { servoPanel } from "./servo_panel.js";
 import { actuatorPanel } from "./actuator_panel.js";
+import { clockPanel } from "./clock_panel.js";
+import { eventLogPanel } from "./event_log_panel.js";
+import { billboardPanel } from "./billboard_panel.js";
+import { resourcePanel } from "./resource_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -27,5 +31,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // joysticks, signals and the other standard device types (stdpanels-c)
-    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel);
+    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel, clockPanel, eventLogPanel, billboardPanel, resourcePanel);
 }
