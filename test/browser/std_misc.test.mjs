@@ -4,7 +4,8 @@
 // local time and zone; the event log's messages as the device holds them, new ones arriving on its pipe,
 // filtered by words and by level; the billboard's text; the stored resources listed per bucket, Info
 // and Download giving exactly the device's bytes; a viewer's log (live messages; the stored ones need the
-// call right, refused in place); a clock without time_utc
+// call right, refused in place); the JointTrajectory and PIDParam renderers on a device's property and
+// function result (pixels drawn, other pixels for another trajectory); a clock without time_utc
 // and a log without getf_eventlog_messages fall back to the generic view. No page error. Screenshots to
 // $RR_ARTIFACTS (docs/img with RR_DOCS_SCREENSHOTS=1).
 
@@ -13,7 +14,7 @@ import assert from "node:assert/strict";
 import crypto from "node:crypto";
 import fs from "node:fs";
 import { launchChromium, waitFor } from "./harness.mjs";
-import { startDevice, screenshot } from "./std_support.mjs";
+import { startDevice, screenshot, canvasPixels, pixelDiff } from "./std_support.mjs";
 import { gatewayWithLogins, loggedInPage, panelOf } from "./std_sensor_support.mjs";
 
 const OFFSET_S = 30;
@@ -25,7 +26,7 @@ before(async () => {
   oldClock = await startDevice("misc_devices.py", ["--without-member", "time_utc", "--max-lifetime", "250"]);
   oldLog = await startDevice("misc_devices.py", ["--without-member", "getf_eventlog_messages", "--max-lifetime", "250"]);
   const u = misc.info.urls;
-  gw = await gatewayWithLogins({ clock: u.clock, log: u.log, sign: u.billboard, store: u.storage, oldclock: oldClock.info.urls.clock, oldlog: oldLog.info.urls.log });
+  gw = await gatewayWithLogins({ clock: u.clock, log: u.log, sign: u.billboard, store: u.storage, planner: u.planner, oldclock: oldClock.info.urls.clock, oldlog: oldLog.info.urls.log });
   browser = await launchChromium();
   operator = await loggedInPage(browser, gw.gateway.base, "alice", "clock", pageErrors);
 });
@@ -124,5 +125,30 @@ test("a viewer gets the live messages (the stored ones need the call right); a c
     await page.locator(`.device-view[data-device="${device}"] .member[data-member="${member}"]`).first().waitFor({ timeout: 20000 });
   }
   await page.context().close();
+  assert.deepEqual(pageErrors, []);
+});
+
+test("renderers: a JointTrajectory drawn per joint over time (a property and a function result), a PIDParam as one line", async () => {
+  const page = operator;
+  await page.goto(`${gw.gateway.base}/#/planner`);
+  const card = (m) => page.locator(`.device-view[data-device="planner"] .member[data-member="${m}"]`).first();
+  await card("last_plan").waitFor({ timeout: 60000 });
+  await waitFor(async () => (await card("last_plan").locator("output.value").textContent()) === "3 joints, 11 waypoints over 2 s (shoulder, elbow, wrist)", "the trajectory's text", 30000);
+  const figure = card("last_plan").locator("figure.frame-view canvas");
+  await waitFor(async () => (await figure.count()) === 1 && (await figure.isVisible()), "the trajectory drawn");
+  const drawn = await canvasPixels(figure);
+  const colored = (px) => { let n = 0; for (let i = 0; i < px.data.length; i += 4) if (px.data[i] !== px.data[i + 1] || px.data[i + 1] !== px.data[i + 2]) n++; return n; };
+  assert.ok(colored(drawn) > 300, `the joints' coloured lines: ${colored(drawn)} pixels`);
+  assert.equal(await card("gains").locator("output.value").textContent(), "P 2.5, I 0.1, D 0.02; integral -5 … 5; command -10 … 10");
+  // another trajectory (twice the swing over 4 s) drawn from a function's result: other pixels
+  await card("plan").locator('input[aria-label="duration"]').fill("4");
+  await card("plan").getByRole("button", { name: "Call" }).click();
+  await waitFor(async () => /^3 joints, 11 waypoints over 4 s/.test(await card("plan").locator("output.result").textContent()), "plan()'s result", 20000);
+  const result = card("plan").locator("figure.frame-view canvas");
+  await waitFor(async () => (await result.count()) === 1 && (await result.isVisible()), "the result drawn");
+  const other = await canvasPixels(result);
+  assert.equal(other.width, drawn.width);
+  assert.ok(pixelDiff(other.data, drawn.data).over > 300, "the other trajectory draws other pixels");
+  await screenshot(card("last_plan"), "dashboard-trajectory.png");
   assert.deepEqual(pageErrors, []);
 });

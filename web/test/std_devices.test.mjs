@@ -118,3 +118,44 @@ test("resources: parts put together, bounded; sizes as text", () => {
   assert.equal(sizeText(3000), "2.9 KiB");
   assert.equal(sizeText(12), "12 B");
 });
+
+import { trajectorySeries, trajectoryText, drawTrajectory } from "../src/std/trajectory.js";
+import { formatPid, formatParameterInfo, varText } from "../src/std/param.js";
+
+test("JointTrajectory: series per joint over time (radians in degrees), text, drawn lines", () => {
+  const UNITS = [["implicit", 0], ["meter", 1], ["radian", 2], ["degree", 3]].map(([name, value]) => ({ name, value }));
+  const traj = { joint_names: ["shoulder", "rail"], joint_units: [2, 1], waypoints: [0, 1, 2].map((k) => ({ joint_position: Float64Array.of(k * Math.PI / 4, 0.1 * k), time_from_start: 0.5 * k })) };
+  const s = trajectorySeries(traj, UNITS);
+  assert.deepEqual(s.names, ["shoulder", "rail"]);
+  assert.deepEqual(Array.from(s.times), [0, 0.5, 1]);
+  assert.deepEqual(Array.from(s.series[0], (v) => Math.round(v * 1e9) / 1e9), [0, 45, 90]);
+  assert.deepEqual(Array.from(s.series[1]), [0, 0.1, 0.2]);
+  assert.deepEqual(s.unitText, ["°", "m"]);
+  assert.equal(trajectoryText(traj), "2 joints, 3 waypoints over 1 s (shoulder, rail)");
+  assert.equal(trajectorySeries({ waypoints: [] }), null);
+  assert.equal(trajectoryText({ joint_names: [] }), "joint trajectory without waypoints");
+  // drawing: a stand-in 2D context records the lines
+  const lines = [];
+  let current = null;
+  const g = { fillRect() {}, strokeRect() {}, fillText() {}, measureText: (t) => ({ width: t.length * 6 }), beginPath() { current = []; },
+    moveTo(x, y) { current.push([x, y]); }, lineTo(x, y) { current.push([x, y]); }, stroke() { if (current) lines.push(current); current = null; } };
+  const r = drawTrajectory(g, s, 480, 260);
+  assert.deepEqual([r.min, r.max, r.t0, r.t1], [0, 90, 0, 1]);
+  assert.equal(lines.length, 2);
+  assert.equal(lines[0].length, 3);
+  assert.ok(lines[0][2][1] < lines[0][0][1], "the shoulder's line rises");
+});
+
+test("PIDParam and ParameterInfo as one line", () => {
+  assert.equal(formatPid({ p: 1.2, i: 0.05, d: 0.01, imax: 5, imin: -5, cmd_max: 10, cmd_min: -10 }), "P 1.2, I 0.05, D 0.01; integral -5 … 5; command -10 … 10");
+  assert.equal(formatPid(null), null);
+  assert.equal(varText({ type: "double[]", value: Float64Array.of(0.1, 2) }), "0.1, 2");
+  assert.equal(varText({ type: "string", value: "auto" }), '"auto"');
+  assert.equal(varText(null), "");
+  const info = { parameter_identifier: { name: "exposure" }, data_type: { name: "", type_code: 1, type_string: "", array_type_code: 0, array_len: [], container_type_code: 0 },
+    data_units: [{ display_units: "ms" }], description: "exposure time", default_value: { type: "double[]", value: Float64Array.of(10) },
+    min_value: { type: "double[]", value: Float64Array.of(0.1) }, max_value: { type: "double[]", value: Float64Array.of(100) }, enum_values: {} };
+  const d = { fields: [{ name: "data_type", type: { fields: [{ name: "type_code", type: { enumValues: [{ name: "double_c", value: 1 }] } }] } }] };
+  assert.equal(formatParameterInfo(info, { descriptor: d }), "exposure (double, ms): exposure time, default 10, 0.1 … 100");
+  assert.equal(formatParameterInfo({ parameter_identifier: { name: "mode" }, enum_values: { fast: {}, slow: {} } }), "mode: one of fast, slow");
+});

@@ -12,6 +12,10 @@ RobotRaconteurCompanion's standard definitions:
   "storage"    a com.robotraconteur.resource.device.ResourceStorageDevice with the bucket "programs"
                (pick_place.txt: 3,000 bytes of text, sent by resource_get in parts of 1,024 bytes;
                calibration.yml) and the bucket "empty".
+  "planner"    an experimental.planner.Planner (PLANNER_DEF below: not a standard object, a device whose
+               members carry standard structures): last_plan, a JointTrajectory of 3 joints (radians) and
+               11 waypoints over 2 s; plan(duration) the same motion over `duration` s with twice the
+               swing; gains, a PIDParam.
 
 Ready line: {"url": ".../?service=clock", "urls": {service: url}, "port": P, "clock_offset": s,
 "billboard": text, "resources": {key: sha256 hex}}.
@@ -44,6 +48,23 @@ BILLBOARD_TEXT = "Cell 3: robot maintenance until 14:00. Do not enter the cell."
 PICK_PLACE = ("; pick and place, station 3\n" + "".join(f"MOVE P{i} SPEED 50\nGRIP {'CLOSE' if i % 2 else 'OPEN'}\n" for i in range(200)))[:3000].encode()
 CALIBRATION = b"camera:\n  fx: 612.3\n  fy: 611.9\n  cx: 320.5\n  cy: 240.1\n"
 SERVICES = ["com.robotraconteur.datetime.clock", "com.robotraconteur.eventlog", "com.robotraconteur.device", "com.robotraconteur.resource.device"]
+
+PLANNER_DEF = """service experimental.planner
+
+stdver 0.10
+
+import com.robotraconteur.robotics.trajectory
+import com.robotraconteur.pid
+
+using com.robotraconteur.robotics.trajectory.JointTrajectory
+using com.robotraconteur.pid.PIDParam
+
+object Planner
+    property JointTrajectory last_plan [readonly]
+    property PIDParam gains [readonly]
+    function JointTrajectory plan(double duration)
+end
+"""
 
 DEVICE_INFO = """
 device:
@@ -175,6 +196,37 @@ class Billboard:
         self.device_info = dinfo
 
 
+class Planner:
+    def __init__(self):
+        self.last_plan = self._plan(2.0, 1.0)
+        g = RRN.NewStructure("com.robotraconteur.pid.PIDParam")
+        g.p, g.i, g.d, g.imax, g.imin, g.cmd_max, g.cmd_min = 2.5, 0.1, 0.02, 5.0, -5.0, 10.0, -10.0
+        self.gains = g
+
+    def _plan(self, duration, swing):
+        T = "com.robotraconteur.robotics.trajectory"
+        units = RRN.GetConstants("com.robotraconteur.robotics.joints")["JointPositionUnits"]
+        t = RRN.NewStructure(f"{T}.JointTrajectory")
+        t.joint_names, t.joint_units, t.extended = ["shoulder", "elbow", "wrist"], [units["radian"]] * 3, {}
+        wps = []
+        for k in range(11):
+            w = RRN.NewStructure(f"{T}.JointTrajectoryWaypoint")
+            s = k / 10
+            w.joint_position = np.array([swing * 0.8 * s, swing * 0.5 * np.sin(np.pi * s), -swing * 0.3 * s])
+            w.joint_velocity = np.zeros(3)
+            w.position_tolerance, w.velocity_tolerance = np.zeros(3), np.zeros(3)
+            w.interpolation_mode, w.waypoint_type = 0, 0
+            w.time_from_start = duration * s
+            wps.append(w)
+        t.waypoints = wps
+        return t
+
+    def plan(self, duration):
+        if not (0 < duration <= 60):
+            raise RR.InvalidArgumentException("duration must be in (0, 60] s")
+        return self._plan(duration, 2.0)
+
+
 class PartGenerator:
     def __init__(self, parts):
         self._parts = list(parts)
@@ -259,6 +311,7 @@ def main():
             RRN.RegisterServiceTypes(definitions_without(args.without_member))
         else:
             RRC.RegisterStdRobDefServiceTypes(RRN)
+        RRN.RegisterServiceType(PLANNER_DEF)  # imports only the standard services it names
         loader = InfoFileLoader(RRN)
 
         def dinfo(name, uuid_tail, description, type_name):
@@ -274,6 +327,7 @@ def main():
         RRN.RegisterService("log", "com.robotraconteur.eventlog.EventLogDevice", eventlog)
         RRN.RegisterService("billboard", "com.robotraconteur.device.BillboardDevice", billboard)
         RRN.RegisterService("storage", "com.robotraconteur.resource.device.ResourceStorageDevice", storage)
+        RRN.RegisterService("planner", "experimental.planner.Planner", Planner())
         stop = threading.Event()
 
         def loop():
@@ -288,7 +342,7 @@ def main():
                     log("misc", f"step: {e}")
 
         threading.Thread(target=loop, daemon=True).start()
-        urls = {n: f"rr+tcp://127.0.0.1:{port}/?service={n}" for n in ("clock", "log", "billboard", "storage")}
+        urls = {n: f"rr+tcp://127.0.0.1:{port}/?service={n}" for n in ("clock", "log", "billboard", "storage", "planner")}
         ready(url=urls["clock"], urls=urls, port=port, clock_offset=args.clock_offset, billboard=BILLBOARD_TEXT,
               resources={"pick_place.txt": hashlib.sha256(PICK_PLACE).hexdigest(), "calibration.yml": hashlib.sha256(CALIBRATION).hexdigest()},
               pid=os.getpid())
