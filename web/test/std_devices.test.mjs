@@ -159,3 +159,22 @@ test("PIDParam and ParameterInfo as one line", () => {
   assert.equal(formatParameterInfo(info, { descriptor: d }), "exposure (double, ms): exposure time, default 10, 0.1 … 100");
   assert.equal(formatParameterInfo({ parameter_identifier: { name: "mode" }, enum_values: { fast: {}, slow: {} } }), "mode: one of fast, slow");
 });
+
+import { sceneTree, treeLines, MAX_LINKS } from "../src/planning/scene_tree.js";
+
+test("planning scene: the tree of links from the root, joints between, models marked; loops and size bounded", () => {
+  const j = (name, parent, child, type = 1) => ({ joint_info: { joint_identifier: { name }, joint_type: type }, parent_link_name: parent, child_link_name: child });
+  const l = (name) => ({ link_identifier: { name } });
+  const scene = { links: [l("world"), l("table")], joints: [j("mount", "world", "table", 6)],
+    models: [{ model_identifier: { name: "robot" }, links: [l("base"), l("link_1")], joints: [j("base_mount", "table", "base", 6), j("joint_1", "base", "link_1")] }] };
+  const t = sceneTree(scene, "world");
+  assert.deepEqual([t.placed, t.total], [4, 4]);
+  assert.deepEqual(treeLines(t.tree, (v) => ({ 1: "revolute", 6: "other" })[v]),
+    ["world", "  mount (other) → table", "    base_mount (other) → base [robot]", "      joint_1 (revolute) → link_1 [robot]"]);
+  // a loop (link_1 → world) leaves no root: nothing is placed twice, and the tree is empty rather than endless
+  const loop = sceneTree({ links: [], joints: [j("a", "x", "y"), j("b", "y", "x")] });
+  assert.equal(loop.placed, 0);
+  // a chain longer than the bound is cut
+  const long = { links: [], joints: Array.from({ length: MAX_LINKS + 10 }, (_, i) => j(`j${i}`, `l${i}`, `l${i + 1}`)) };
+  assert.equal(sceneTree(long).placed, MAX_LINKS);
+});

@@ -22,6 +22,7 @@ import { clockPanel } from "./clock_panel.js";
 import { eventLogPanel } from "./event_log_panel.js";
 import { billboardPanel } from "./billboard_panel.js";
 import { resourcePanel } from "./resource_panel.js";
+import { planningPanel } from "./planning_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -31,5 +32,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // joysticks, signals and the other standard device types (stdpanels-c)
-    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel, clockPanel, eventLogPanel, billboardPanel, resourcePanel);
+    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel, clockPanel, eventLogPanel, billboardPanel, resourcePanel, planningPanel);
 }
