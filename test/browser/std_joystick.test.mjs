@@ -181,7 +181,7 @@ test("gamepad: A held closes the gripper through hold-to-run; let go, or the gam
   await haltedAfter(lost, "gamepad lost");
   assert.equal(await p.getAttribute("data-hold-stop"), "gamepad lost");
   await waitFor(async () => (await pad.getAttribute("data-gamepad")) === "none", "no gamepad shown");
-  await screenshot(p, "dashboard-tool-gamepad.png");
+  await screenshot(p, "std-tool-gamepad.png", { docs: false });
   await page.context().close();
   assert.deepEqual(pageErrors, []);
 });

@@ -320,3 +320,37 @@ test("gamepad: a hold ended elsewhere (blur, a refused call) is not restarted by
   assert.equal(r.follower.state, "unarmed");
   r.follower.stop();
 });
+
+import { streamHold } from "../src/hold/stream_hold.js";
+
+test("stream hold: commands streamed every period while held; the device's stop once at every end; none when not prepared", async () => {
+  const timers = fakeTimers();
+  const p = page();
+  const sent = [], stops = [], ends = [];
+  let prepared = true;
+  const hold = streamHold({ send: (v) => { sent.push(v); }, stopDevice: async () => { stops.push("stop"); }, prepare: async () => prepared,
+    onStop: (r) => ends.push(r), client: p.client, win: p.win, doc: p.doc, timers });
+  await hold.press(() => "v+");
+  for (let i = 0; i < 4; i++) { timers.advance(50); await settle(); }
+  assert.equal(sent.length, 5);
+  hold.release("release");
+  await settle();
+  assert.deepEqual(stops, ["stop"]);
+  assert.deepEqual(ends, ["release"]);
+  timers.advance(500);
+  assert.equal(sent.length, 5, "a command after the hold ended");
+  // a send that throws (the wire not connected) ends the hold, and the device is stopped anyway
+  const errors = [];
+  const failing = streamHold({ send: () => { throw new Error("wire velocity_command is not connected"); }, stopDevice: async () => { stops.push("stop2"); },
+    onError: (e, what) => errors.push(`${what}: ${e.message}`), win: p.win, doc: p.doc, timers });
+  await failing.press(() => "v+");
+  await settle();
+  assert.equal(failing.active, false);
+  assert.deepEqual(errors, ["send: wire velocity_command is not connected"]);
+  assert.deepEqual(stops, ["stop", "stop2"]);
+  // not prepared (the mode could not be set): nothing sent, nothing stopped
+  prepared = false;
+  assert.equal(await hold.press(() => "v+"), false);
+  assert.equal(sent.length, 5);
+  assert.deepEqual(stops, ["stop", "stop2"]);
+});
