@@ -230,3 +230,19 @@ export class ScanAssembler {
   stray: number;
   push(part: unknown): { scan_info: unknown; ranges: Float64Array; intensities: Float64Array | never[] } | null;
 }
+
+// stdpanels-c (issue 54): joint trajectories, PID gains, parameter infos
+/** A JointTrajectory as plot series: joint names, times (s), positions per joint (radians as degrees), units. */
+export function trajectorySeries(trajectory: unknown, unitEnum?: Array<{ name: string; value: number }> | null):
+  { names: string[]; times: Float64Array; series: Float64Array[]; units: string[]; unitText: string[]; cut: boolean } | null;
+/** "3 joints, 5 waypoints over 4.2 s (shoulder, elbow, wrist)". */
+export function trajectoryText(trajectory: unknown, ctx?: object): string;
+/** Draws trajectorySeries() as a plot (one line per joint, a legend) into a 2D context. */
+export function drawTrajectory(g: CanvasRenderingContext2D | OffscreenCanvasRenderingContext2D,
+  series: ReturnType<typeof trajectorySeries>, width: number, height: number): { min: number; max: number; t0: number; t1: number } | null;
+/** "P 1.2, I 0.05, D 0.01; integral -5 … 5; command -10 … 10" of a com.robotraconteur.pid.PIDParam, or null. */
+export function formatPid(value: unknown): string | null;
+/** One line of a com.robotraconteur.param.ParameterInfo: name, type, units, description, default, range. */
+export function formatParameterInfo(value: unknown, ctx?: { descriptor?: TypeDescriptor | null }): string | null;
+/** A varvalue as short text ("1, 2", "\"text\""); "" for null. */
+export function varText(value: unknown): string;
