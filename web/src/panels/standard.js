@@ -13,6 +13,8 @@ import { imuPanel } from "./imu_panel.js";
 import { gpsPanel } from "./gps_panel.js";
 import { toolPanel } from "./tool_panel.js";
 import { lightPanel } from "./light_panel.js";
+// stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
+import { pointCloudPanel } from "./point_cloud_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -20,5 +22,7 @@ export function standardPanels() {
     // sensors, laser scanners
     .register(sensorPanel, laserScannerPanel, imuPanel, gpsPanel)
     // tools and lights
-    .register(toolPanel, lightPanel);
+    .register(toolPanel, lightPanel)
+    // stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
+    .register(pointCloudPanel);
 }
