@@ -250,23 +250,28 @@ class CloudSensor(ParamStore):
             self.latest = frame
         header = self.header()
         n = len(frame[0])
+        # the pipes the definitions served have (--without-member takes one away)
+        pipe1 = getattr(self, "point_cloud_sensor_data", None)
+        pipe2 = getattr(self, "point_cloud2_sensor_data", None) if self.kind in ("cloud2", "parts2") else None
         if self.kind in ("cloud", "cloud2"):
-            d = RRN.NewStructure(f"{SENSOR}.PointCloudSensorData")
-            d.sensor_data, d.point_cloud = header, self.cloud(frame[0])
-            self.point_cloud_sensor_data.SendPacket(d)
-            if self.kind == "cloud2":
+            if pipe1 is not None:
+                d = RRN.NewStructure(f"{SENSOR}.PointCloudSensorData")
+                d.sensor_data, d.point_cloud = header, self.cloud(frame[0])
+                pipe1.SendPacket(d)
+            if pipe2 is not None:
                 d2 = RRN.NewStructure(f"{SENSOR}.PointCloud2SensorData")
                 d2.sensor_data, d2.point_cloud = header, self.cloud2(frame)
-                self.point_cloud2_sensor_data.SendPacket(d2)
+                pipe2.SendPacket(d2)
             return
         for s in self.slices(n):
-            d = RRN.NewStructure(f"{SENSOR}.PointCloudPartSensorData")
-            d.sensor_data, d.point_cloud = header, self.cloud(frame[0][s], (s.start, n))
-            self.point_cloud_sensor_data.SendPacket(d)
-            if self.kind == "parts2":
+            if pipe1 is not None:
+                d = RRN.NewStructure(f"{SENSOR}.PointCloudPartSensorData")
+                d.sensor_data, d.point_cloud = header, self.cloud(frame[0][s], (s.start, n))
+                pipe1.SendPacket(d)
+            if pipe2 is not None:
                 d2 = RRN.NewStructure(f"{SENSOR}.PointCloud2PartSensorData")
                 d2.sensor_data, d2.point_cloud = header, self.cloud2(frame, (s.start, n), s)
-                self.point_cloud2_sensor_data.SendPacket(d2)
+                pipe2.SendPacket(d2)
 
 
 class PartGenerator:

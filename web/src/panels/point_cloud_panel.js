@@ -4,8 +4,9 @@
 // height. Clouds are made drawable off the page's thread (std/pointcloud_decoder.js: newest wins, one
 // being coloured, one waiting, never queued); parts are put back into whole clouds first. Beside it the
 // sensor's info (bounds, resolution), the clouds received and drawn per second, the time each took, and
-// for users allowed to call them: Capture (capture_point_cloud / capture_point_cloud2, drawn in the
-// view) and the parameter control. A device whose pipe is not of a standard cloud type gets one line.
+// for users allowed to call them: Capture (capture_point_cloud / capture_point_cloud2, drawn in the view
+// in place of the live clouds until Live is pressed) and the parameter control. A device whose pipe is
+// not of a standard cloud type gets one line.
 
 import { h, errorText } from "../dom.js";
 import { describeMember } from "../views/context.js";
@@ -76,7 +77,7 @@ export function createPointCloudPanel(parent, ctx) {
     el.dataset.pipe = source.pipe.name;
     const received = new RateMeter(), drawnRate = new RateMeter();
     const assembler = source.part ? new CloudAssembler() : null;
-    let mode = "auto", nReceived = 0, nDrawn = 0, last = null, view3d = null, pendingShow = null;
+    let paused = false, mode = "auto", nReceived = 0, nDrawn = 0, nCaptures = 0, last = null, view3d = null, pendingShow = null;
     const modeSelect = h("select", { class: "cloud-color", "aria-label": "colour points by" },
       ...Object.entries(MODE_LABELS).map(([v, t]) => h("option", { value: v, text: t })));
     const reset = h("button", { type: "button", class: "small", text: "Reset view", onclick: () => view3d?.reset() });
@@ -97,6 +98,7 @@ export function createPointCloudPanel(parent, ctx) {
         el.dataset.skipped = String(decoder.stats.dropped);
         if (meta.seqno !== undefined) el.dataset.seqno = String(meta.seqno);
         el.dataset.shown = meta.what;
+        if (meta.capture) el.dataset.captures = String(++nCaptures);
         if (view3d) view3d.show(r); else pendingShow = r;
         writeStatus();
       },
@@ -117,18 +119,13 @@ export function createPointCloudPanel(parent, ctx) {
         if (disposed) return;
         const seqno = d?.sensor_data?.data_header?.seqno;
         const meta = { what: source.pipe.name, seqno: seqno === undefined || seqno === null ? undefined : String(seqno) };
-        if (assembler) {
-          const whole = assembler.push(d?.point_cloud);
-          if (!whole) return;
-          nReceived++;
-          received.tick();
-          decoder.submit({ packed: whole }, { mode }, meta);
-        } else {
-          nReceived++;
-          received.tick();
-          decoder.submit({ cloud: d?.point_cloud }, { mode }, meta);
-        }
+        const whole = assembler ? assembler.push(d?.point_cloud) : null;
+        if (assembler && !whole) return;
+        nReceived++;
+        received.tick();
         el.dataset.received = String(nReceived);
+        if (paused) return;   // a captured cloud is shown until Live
+        decoder.submit(whole ? { packed: whole } : { cloud: d?.point_cloud }, { mode }, meta);
       },
       onOpen: (open) => { el.dataset.pipeOpen = open ? "true" : "false"; },
       onError: errors.onMemberError(source.pipe.name),
@@ -164,14 +161,22 @@ export function createPointCloudPanel(parent, ctx) {
           }
           if (disposed) return;
           errors.show(null);
-          decoder.submit({ packed }, { mode }, { what: captureName });
+          paused = true;
+          live.hidden = false;
+          el.dataset.paused = "true";
+          decoder.submit({ packed }, { mode }, { what: captureName, capture: true });
         } catch (e) {
           if (!disposed) errors.show(`${captureName}: ${errorText(e)}`);
         } finally {
           b.disabled = false;
         }
       } });
-      controls.append(b);
+      const live = h("button", { type: "button", class: "small", text: "Live", hidden: true, dataset: { action: "live" }, onclick: () => {
+        paused = false;
+        live.hidden = true;
+        el.dataset.paused = "false";
+      } });
+      controls.append(b, live);
     };
     whenAccess(ctx, el, infoRead, () => !disposed, (access) => {
       addCapture(access);
