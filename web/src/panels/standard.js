@@ -15,6 +15,8 @@ import { toolPanel } from "./tool_panel.js";
 import { lightPanel } from "./light_panel.js";
 // stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
 import { pointCloudPanel } from "./point_cloud_panel.js";
+import { multiCameraPanel } from "./multicamera_panel.js";
+import { imagePartCameraPanel } from "./image_part_camera_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -24,5 +26,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
-    .register(pointCloudPanel);
+    .register(pointCloudPanel, multiCameraPanel, imagePartCameraPanel);
 }
