@@ -26,7 +26,7 @@ async function centreIs(item, rgb, what) {
   const canvas = item.locator("canvas.frame-canvas");
   let got = null;
   await waitFor(async () => Number(await canvas.getAttribute("data-frames")) > 0
-    && JSON.stringify(got = await pixel(canvas, 32, 30)) === JSON.stringify(rgb), what, 30000).catch(() => {});
+    && JSON.stringify(got = await pixel(canvas, 32, 30)) === JSON.stringify(rgb), what, 60000).catch(() => {});
   assert.deepEqual(got, rgb, what);
 }
 
@@ -52,7 +52,7 @@ after(async () => {
 test("a MultiCamera: each camera's preview named and in its colour; the raw map stream too", async () => {
   const p = panelOf(operator, "rig", "multicamera");
   await waitFor(async () => (await p.getAttribute("data-cameras")) === "3", "camera_names read");
-  await waitFor(async () => (await p.getAttribute("data-pictures")) === "3", "three pictures", 30000);
+  await waitFor(async () => (await p.getAttribute("data-pictures")) === "3", "three pictures", 60000);
   const names = ["left", "centre", "right"];
   for (let k = 0; k < 3; k++) {
     const item = p.locator(`.multicamera-grid .image-item[data-key="${k}"]`);
@@ -112,6 +112,6 @@ test("a MultiCamera without its picture pipes: one line and the generic view", a
   await p.waitFor({ timeout: 30000 });
   assert.equal(await p.getAttribute("data-fallback"), "true");
   assert.match(await p.locator(".multicamera-fallback").textContent(), /no camera picture pipe/);
-  await operator.locator('.device-view[data-device="trimmed"]').getByText("capture_frame_all", { exact: false }).first().waitFor({ timeout: 20000 });
+  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_frame_all"]').waitFor({ timeout: 20000 });
   assert.deepEqual(pageErrors, []);
 });

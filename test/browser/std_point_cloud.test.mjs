@@ -208,7 +208,7 @@ test("a sensor without its pipe: the generic view; without the PointCloud2 pipe:
   assert.match(await p.locator(".cloud-fallback").textContent(), /no point cloud pipe of a standard cloud type/);
   assert.equal(await p.locator("canvas.cloud-canvas").count(), 0);
   // the generic member view below still lists the sensor's members
-  await operator.locator('.device-view[data-device="trimmed"]').getByText("capture_point_cloud", { exact: false }).first().waitFor({ timeout: 20000 });
+  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_point_cloud"]').waitFor({ timeout: 20000 });
 
   await operator.goto(`${gateway.base}/#/trimmed2`);
   const q = panel(operator, "trimmed2");
