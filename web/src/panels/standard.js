@@ -17,6 +17,7 @@ import { lightPanel } from "./light_panel.js";
 import { pointCloudPanel } from "./point_cloud_panel.js";
 import { multiCameraPanel } from "./multicamera_panel.js";
 import { imagePartCameraPanel } from "./image_part_camera_panel.js";
+import { detectionsPanel } from "./detections_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -26,5 +27,5 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
-    .register(pointCloudPanel, multiCameraPanel, imagePartCameraPanel);
+    .register(pointCloudPanel, multiCameraPanel, imagePartCameraPanel, detectionsPanel);
 }
