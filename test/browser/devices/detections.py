@@ -28,13 +28,13 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
 from param_store import ParamStore  # noqa: E402
+from device_parts import definitions_without  # noqa: E402
 
 import numpy as np  # noqa: E402
 import RobotRaconteur as RR  # noqa: E402
 import RobotRaconteurCompanion as RRC  # noqa: E402
 from RobotRaconteurCompanion.Util.IdentifierUtil import IdentifierUtil  # noqa: E402
 from RobotRaconteurCompanion.Util.SensorDataUtil import SensorDataUtil  # noqa: E402
-from RobotRaconteurCompanion.StdRobDef import STANDARD_ROBDEF_TEXT  # noqa: E402
 
 RRN = RR.RobotRaconteurNode.s
 _stdout_lock = threading.Lock()
@@ -189,21 +189,6 @@ class Objects(Detector):
             p.SendPacket(d)
 
 
-def definitions_without(member):
-    """The standard definitions with `member`'s line removed from the fiducial and object recognition services."""
-    texts = dict(STANDARD_ROBDEF_TEXT)
-    removed = 0
-    for key in (FID, OBJ):
-        lines = texts[key].splitlines()
-        kept = [ln for ln in lines if not (len(ln.split()) > 2 and ln.split()[0] in ("pipe", "function", "property", "wire")
-                                           and ln.split()[2].split("(")[0] == member)]
-        removed += len(lines) - len(kept)
-        texts[key] = "\n".join(kept) + "\n"
-    if not removed:
-        raise SystemExit(f"--without-member: no member {member}")
-    return list(texts.values())
-
-
 def main():
     die_with_parent()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -215,7 +200,7 @@ def main():
     stop = threading.Event()
     with RR.ServerNodeSetup("experimental.std_detections", port, argv=["detections"] + node_flags(port)):
         if args.without_member:
-            RRN.RegisterServiceTypes(definitions_without(args.without_member))
+            RRN.RegisterServiceTypes(definitions_without([FID, OBJ], args.without_member))
         else:
             RRC.RegisterStdRobDefServiceTypes(RRN)
         ident = IdentifierUtil(RRN)

@@ -32,13 +32,13 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
+from device_parts import PartGenerator, definitions_without  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 import RobotRaconteur as RR  # noqa: E402
 import RobotRaconteurCompanion as RRC  # noqa: E402
 from RobotRaconteurCompanion.Util.IdentifierUtil import IdentifierUtil  # noqa: E402
-from RobotRaconteurCompanion.StdRobDef import STANDARD_ROBDEF_TEXT  # noqa: E402
 
 RRN = RR.RobotRaconteurNode.s
 _stdout_lock = threading.Lock()
@@ -235,35 +235,6 @@ class PartCamera:
                 self.preview_stream.SendPacket(self.frames.png(self.n))
 
 
-class PartGenerator:
-    def __init__(self, parts):
-        self._parts = list(parts)
-
-    def Next(self):
-        if not self._parts:
-            raise RR.StopIterationException("")
-        return self._parts.pop(0)
-
-    def Close(self):
-        self._parts = []
-
-    def Abort(self):
-        self._parts = []
-
-
-def definitions_without(members):
-    """The standard definitions with the lines of `members` (comma separated) removed from the imaging service."""
-    texts = dict(STANDARD_ROBDEF_TEXT)
-    lines = texts[IMAGING].splitlines()
-    names = set(members.split(","))
-    kept = [ln for ln in lines if not (len(ln.split()) > 2 and ln.split()[0] in ("pipe", "function", "property", "wire", "objref")
-                                       and ln.split()[2].split("(")[0] in names)]
-    if len(kept) == len(lines):
-        raise SystemExit(f"--without-member: the imaging service has no member {members}")
-    texts[IMAGING] = "\n".join(kept) + "\n"
-    return list(texts.values())
-
-
 def main():
     die_with_parent()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -275,7 +246,7 @@ def main():
     stop = threading.Event()
     with RR.ServerNodeSetup("experimental.std_multi_camera", port, argv=["multi_camera"] + node_flags(port)):
         if args.without_member:
-            RRN.RegisterServiceTypes(definitions_without(args.without_member))
+            RRN.RegisterServiceTypes(definitions_without([IMAGING], args.without_member))
         else:
             RRC.RegisterStdRobDefServiceTypes(RRN)
         ident = IdentifierUtil(RRN)

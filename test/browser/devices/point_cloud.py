@@ -39,13 +39,13 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import die_with_parent, free_port, node_flags, ready, wait_for_stop, log  # noqa: E402
 from param_store import ParamStore  # noqa: E402
+from device_parts import PartGenerator, definitions_without  # noqa: E402
 
 import numpy as np  # noqa: E402
 import RobotRaconteur as RR  # noqa: E402
 import RobotRaconteurCompanion as RRC  # noqa: E402
 from RobotRaconteurCompanion.Util.IdentifierUtil import IdentifierUtil  # noqa: E402
 from RobotRaconteurCompanion.Util.SensorDataUtil import SensorDataUtil  # noqa: E402
-from RobotRaconteurCompanion.StdRobDef import STANDARD_ROBDEF_TEXT  # noqa: E402
 
 RRN = RR.RobotRaconteurNode.s
 _stdout_lock = threading.Lock()
@@ -274,37 +274,6 @@ class CloudSensor(ParamStore):
                 pipe2.SendPacket(d2)
 
 
-class PartGenerator:
-    """A {generator} function's result for the official library: Next() gives each part, then StopIteration."""
-
-    def __init__(self, parts):
-        self._parts = list(parts)
-
-    def Next(self):
-        if not self._parts:
-            raise RR.StopIterationException("")
-        return self._parts.pop(0)
-
-    def Close(self):
-        self._parts = []
-
-    def Abort(self):
-        self._parts = []
-
-
-def definitions_without(member):
-    """The standard definitions with `member`'s line removed from the point cloud sensor service."""
-    texts = dict(STANDARD_ROBDEF_TEXT)
-    key = SENSOR
-    lines = texts[key].splitlines()
-    kept = [ln for ln in lines if not (len(ln.split()) > 2 and ln.split()[0] in ("pipe", "function", "property", "wire")
-                                       and ln.split()[2].split("(")[0] == member)]
-    if len(kept) == len(lines):
-        raise SystemExit(f"--without-member: the point cloud sensors have no member {member}")
-    texts[key] = "\n".join(kept) + "\n"
-    return list(texts.values())
-
-
 def main():
     die_with_parent()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -325,7 +294,7 @@ def main():
     types = {"cloud": "PointCloudSensor", "cloud2": "PointCloud2Sensor", "parts": "PointCloudPartSensor", "parts2": "PointCloud2PartSensor"}
     with RR.ServerNodeSetup("experimental.std_point_cloud", port, argv=["point_cloud"] + node_flags(port)):
         if args.without_member:
-            RRN.RegisterServiceTypes(definitions_without(args.without_member))
+            RRN.RegisterServiceTypes(definitions_without([SENSOR], args.without_member))
         else:
             RRC.RegisterStdRobDefServiceTypes(RRN)
         sensors, urls = {}, {}
