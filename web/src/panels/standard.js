@@ -23,6 +23,11 @@ import { eventLogPanel } from "./event_log_panel.js";
 import { billboardPanel } from "./billboard_panel.js";
 import { resourcePanel } from "./resource_panel.js";
 import { planningPanel } from "./planning_panel.js";
+// stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
+import { pointCloudPanel } from "./point_cloud_panel.js";
+import { multiCameraPanel } from "./multicamera_panel.js";
+import { imagePartCameraPanel } from "./image_part_camera_panel.js";
+import { detectionsPanel } from "./detections_panel.js";
 
 /** A new registry holding the standard panels (add your own with register()). */
 export function standardPanels() {
@@ -32,5 +37,7 @@ export function standardPanels() {
     // tools and lights
     .register(toolPanel, lightPanel)
     // joysticks, signals and the other standard device types (stdpanels-c)
-    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel, clockPanel, eventLogPanel, billboardPanel, resourcePanel, planningPanel);
+    .register(joystickPanel, signalPanel, servoPanel, actuatorPanel, clockPanel, eventLogPanel, billboardPanel, resourcePanel, planningPanel)
+    // stdpanels-d: point clouds, cameras beyond one, fiducials, object recognition
+    .register(pointCloudPanel, multiCameraPanel, imagePartCameraPanel, detectionsPanel);
 }
