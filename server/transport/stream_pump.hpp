@@ -190,7 +190,10 @@ public:
         if (goodbye_pending_) {
             goodbye_pending_ = false;
             boost::system::error_code ignored;
-            stream_.lowest_layer().close(ignored);
+            if constexpr (requires(Stream& s) { s.lowest_layer(); })
+                stream_.lowest_layer().close(ignored);
+            else
+                stream_.close(ignored);
         }
     }
 
