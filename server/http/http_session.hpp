@@ -191,15 +191,6 @@ public:
         });
     }
 
-    void close_going_away() override {
-        auto self = shared_from_this();
-        asio::post(ws_.get_executor(), [self] {
-            if (self->closed_ || self->finished_) return;
-            // What is queued is not sent: the server is stopping. The handshake is bounded.
-            self->fail(websocket::close_code::going_away, "server stopping", std::chrono::seconds(1));
-        });
-    }
-
     void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) override {
         auto self = shared_from_this();
         asio::post(ws_.get_executor(), [self, timeout] { self->probe(timeout); });
@@ -377,10 +368,10 @@ private:
     }
 
     // Ends the WebSocket with a close frame carrying `code` (the read side already stopped).
-    void fail(websocket::close_code code, const char* reason, std::chrono::milliseconds bound = std::chrono::seconds(5)) {
+    void fail(websocket::close_code code, const char* reason) {
         auto self = shared_from_this();
         closed_ = true;
-        beast::get_lowest_layer(ws_).expires_after(bound);
+        beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(5));
         ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) { self->finish(); });
     }
 
@@ -657,7 +648,6 @@ private:
                                                                 server->node(), target, chosen);
                 s->keep(info.hold);
                 s->start();
-                server->track_socket(s);
                 return;
             }
             if (unnamed) return sniff_unnamed(holder, server, info);
