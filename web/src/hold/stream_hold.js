@@ -28,3 +28,19 @@ export function streamHold({ send, stopDevice, prepare = null, onStart, onStop =
   hold = new HoldToRun({ motion: repeater, prepare, onStart, onStop, onError: (e) => onError(e, "command"), client, win, doc });
   return hold;
 }
+
+/**
+ * onStart / onStop of a panel's hold that mark the panel element: data-hold "on" / "off", data-holds
+ * counting the holds started (what tests wait for), data-hold-stop the reason the last one ended;
+ * `clearError()` on each start.
+ */
+export function holdMarks(el, clearError = () => {}) {
+  return {
+    onStart: () => {
+      clearError();
+      el.dataset.hold = "on";
+      el.dataset.holds = String(Number(el.dataset.holds ?? 0) + 1);
+    },
+    onStop: (reason) => { el.dataset.hold = "off"; el.dataset.holdStop = reason; },
+  };
+}

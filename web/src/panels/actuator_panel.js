@@ -12,7 +12,7 @@ import { describeMember } from "../views/context.js";
 import { allows } from "../robot/access.js";
 import { formatFlags, enumName } from "../std/enums.js";
 import { siUnitText } from "../std/units.js";
-import { streamHold } from "../hold/stream_hold.js";
+import { streamHold, holdMarks } from "../hold/stream_hold.js";
 import { errorLine, whenAccess } from "./panel_parts.js";
 import { actuatorRows, actuatorCommand } from "../servo/servo_state.js";
 
@@ -109,12 +109,7 @@ export function createActuatorPanel(parent, ctx) {
             return false;
           }
         },
-        onStart: () => {
-          errors.show(null);
-          el.dataset.hold = "on";
-          el.dataset.holds = String(Number(el.dataset.holds ?? 0) + 1);  // for tests: a hold started
-        },
-        onStop: (reason) => { el.dataset.hold = "off"; el.dataset.holdStop = reason; },
+        ...holdMarks(el, () => errors.show(null)),
         onError: (e, what) => { if (!disposed) errors.show(`${what === "stop" ? "actuator_mode" : what === "send" ? "actuator_command" : "run"}: ${errorText(e)}`); },
       });
       const run = hold.button(h("button", { type: "button", class: "small jog", text: "Run (hold)", dataset: { action: "run" } }),

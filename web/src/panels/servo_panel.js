@@ -13,7 +13,7 @@ import { describeMember } from "../views/context.js";
 import { allows } from "../robot/access.js";
 import { formatFlags, flagNames, enumName } from "../std/enums.js";
 import { isStale, STALE_MS } from "../robot/status.js";
-import { streamHold } from "../hold/stream_hold.js";
+import { streamHold, holdMarks } from "../hold/stream_hold.js";
 import { errorLine, whenAccess } from "./panel_parts.js";
 import { servoAxisRows, axisCount, jogVelocities, servoCommand } from "../servo/servo_state.js";
 
@@ -129,12 +129,7 @@ export function createServoPanel(parent, ctx) {
           return false;
         }
       },
-      onStart: () => {
-        errors.show(null);
-        el.dataset.hold = "on";
-        el.dataset.holds = String(Number(el.dataset.holds ?? 0) + 1);  // for tests: a hold started
-      },
-      onStop: (reason) => { el.dataset.hold = "off"; el.dataset.holdStop = reason; },
+      ...holdMarks(el, () => errors.show(null)),
       onError: (e, what) => { if (!disposed) errors.show(`${what === "stop" ? "halt" : what === "send" ? "velocity_command" : "jog"}: ${errorText(e)}`); },
     });
   }
