@@ -1,5 +1,9 @@
 #include "server/node/node.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
 #include <boost/asio/steady_timer.hpp>
 
 #include "robdef/builtin/service_index.hpp"
@@ -44,12 +48,23 @@ void Node::shutdown() {
     }
     for (auto& l : listeners) l->stop();
     for (auto& w : pumps)
-        if (auto p = w.lock()) p->close();
+        if (auto p = w.lock()) p->close_going_away();
     work_.reset();
-    // Give connections a moment to flush and close, then stop whatever is left (user timers etc.).
+    // Give connections a moment to flush and close, at most 200 ms: less once every one has ended (a stop
+    // with no client busy is quick). Then stop whatever is left (user timers etc.).
+    const bool on_own_thread = std::any_of(threads_.begin(), threads_.end(),
+                                           [](const std::thread& t) { return t.get_id() == std::this_thread::get_id(); });
     asio::steady_timer stop_timer(io_);
-    stop_timer.expires_after(std::chrono::milliseconds(200));
-    stop_timer.async_wait([this](boost::system::error_code) { io_.stop(); });
+    if (on_own_thread) {
+        // Cannot wait here (this thread runs the pumps): the moment is a timer, as before.
+        stop_timer.expires_after(std::chrono::milliseconds(200));
+        stop_timer.async_wait([this](boost::system::error_code) { io_.stop(); });
+    } else {
+        const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+        auto ended = [&] { return std::all_of(pumps.begin(), pumps.end(), [](const auto& w) { return w.expired(); }); };
+        while (!ended() && std::chrono::steady_clock::now() < give_up) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        io_.stop();
+    }
     for (auto& t : threads_)
         if (t.joinable() && t.get_id() != std::this_thread::get_id()) t.join();
     threads_.clear();
