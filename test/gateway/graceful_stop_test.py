@@ -47,7 +47,20 @@ def close_code_of(ws, timeout):
     raise AssertionError("no close frame within %.0f s" % timeout)
 
 
-def one_run(exe, exit_bound, checks, run):
+def official_node():
+    """The official library's node with its TCP transport (which also speaks rr+ws; a bare node has no
+    transport). It cannot start again after Shutdown: one for all runs. None when not installed."""
+    try:
+        import RobotRaconteur as RR
+    except ImportError:
+        return None
+    node = RR.RobotRaconteurNode.s
+    node.RegisterTransport(RR.TcpTransport())
+    node.RequestTimeout = 10
+    return node
+
+
+def one_run(exe, exit_bound, checks, run, official):
     gw = gwproc.start_gateway(exe, [])
     port = gw.port
     sockets = {}
@@ -68,14 +81,9 @@ def one_run(exe, exit_bound, checks, run):
             if "subscription" in msg and "value" in msg:  # a push (the answer has "id" and "result")
                 pushes += 1
         sockets["rr"] = websocket.create_connection(base, subprotocols=[RR_PROTOCOL], timeout=10)
-        try:
-            import RobotRaconteur as RR
-            node = RR.RobotRaconteurNode.s
-            node.RequestTimeout = 10
-            rr_client = node.ConnectService("rr+ws://127.0.0.1:%d/?service=create" % port)
+        if official is not None:
+            rr_client = official.ConnectService("rr+ws://127.0.0.1:%d/?service=create" % port)
             expect(isinstance(rr_client.DistanceTraveled, int), "the official client reads DistanceTraveled")
-        except ImportError:
-            rr_client = None
 
         started = time.monotonic()
         gw.p.send_signal(signal.SIGTERM)
@@ -116,8 +124,13 @@ def main():
     ap.add_argument("--runs", type=int, default=1)
     a = ap.parse_args()
     checks = gwproc.Checks()
-    for run in range(1, a.runs + 1):
-        checks.run("run %d" % run, lambda: one_run(a.gateway, a.exit_bound, checks, run))
+    official = official_node()
+    try:
+        for run in range(1, a.runs + 1):
+            checks.run("run %d" % run, lambda: one_run(a.gateway, a.exit_bound, checks, run, official))
+    finally:
+        if official is not None:
+            official.Shutdown()
     return checks.exit_code()
 
 
