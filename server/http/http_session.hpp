@@ -191,6 +191,15 @@ public:
         });
     }
 
+    void close_going_away() override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self] {
+            if (self->closed_ || self->finished_) return;
+            // What is queued is not sent: the server is stopping. The handshake is bounded.
+            self->fail(websocket::close_code::going_away, "server stopping", std::chrono::seconds(1));
+        });
+    }
+
     void set_liveness_probe(std::optional<std::chrono::milliseconds> timeout) override {
         auto self = shared_from_this();
         asio::post(ws_.get_executor(), [self, timeout] { self->probe(timeout); });
@@ -368,10 +377,10 @@ private:
     }
 
     // Ends the WebSocket with a close frame carrying `code` (the read side already stopped).
-    void fail(websocket::close_code code, const char* reason) {
+    void fail(websocket::close_code code, const char* reason, std::chrono::milliseconds bound = std::chrono::seconds(5)) {
         auto self = shared_from_this();
         closed_ = true;
-        beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(5));
+        beast::get_lowest_layer(ws_).expires_after(bound);
         ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) { self->finish(); });
     }
 
@@ -648,6 +657,7 @@ private:
                                                                 server->node(), target, chosen);
                 s->keep(info.hold);
                 s->start();
+                server->track_socket(s);
                 return;
             }
             if (unnamed) return sniff_unnamed(holder, server, info);

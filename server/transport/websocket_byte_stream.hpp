@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 #include <boost/asio/associated_executor.hpp>
@@ -47,6 +48,19 @@ public:
     void async_write_some(const ConstBuffers& buffers, Handler&& handler) {
         ws_.async_write(boost::beast::buffers_prefix(kMaxFramePayload, buffers), std::forward<Handler>(handler));
     }
+
+    /// Ends the WebSocket with a close frame: 1001 Going Away when `going_away` (the server is stopping),
+    /// else 1000 Normal Closure. Beast then waits for the peer's close frame, at most kGoodbyeBound, and closes
+    /// the socket; `handler(ec)` runs when that is over.
+    template <class Handler>
+    void async_goodbye(bool going_away, Handler&& handler) {
+        namespace websocket = boost::beast::websocket;
+        boost::beast::get_lowest_layer(ws_).expires_after(kGoodbyeBound);
+        ws_.async_close(going_away ? websocket::close_reason(websocket::close_code::going_away, "server stopping")
+                                   : websocket::close_reason(websocket::close_code::normal),
+                        std::forward<Handler>(handler));
+    }
+    static constexpr std::chrono::milliseconds kGoodbyeBound{1000};
 
     auto& lowest_layer() noexcept { return boost::beast::get_lowest_layer(ws_).socket(); }
     websocket_type& websocket() noexcept { return ws_; }
