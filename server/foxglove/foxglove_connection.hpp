@@ -5,7 +5,7 @@
 //   foxglove_values.cpp          messageData from the shared entries, backpressure, pipe/image conversion
 //   foxglove_parameters.cpp      getParameters / setParameters / subscribeParameterUpdates on properties
 //   foxglove_services.cpp        service calls on functions
-//   foxglove_client_publish.cpp  clientAdvertise + client messageData to writable wires
+//   foxglove_client_publish.cpp  clientAdvertise + client messageData to writable wires and pipes
 //   foxglove_clock.cpp           (the server's) `time` from a device's clock; receive times
 //
 // Thread-safe: the socket's strand delivers messages, device strands deliver values and replies;
@@ -78,10 +78,11 @@ private:
     struct PublishTarget {
         std::shared_ptr<const LiveMember> member;
         std::uint64_t serial = 0;
-        std::uint64_t upstream = 0;  // the DeviceMirror wire subscription that keeps the wire connected
+        std::uint64_t upstream = 0;  // a wire: the DeviceMirror subscription that keeps it connected; a pipe: the endpoint
         bool upstream_known = false;
-        bool ready = false;                   // that wire connection is open
-        std::optional<MessageEntry> pending;  // the newest value published before it was
+        bool ready = false;                   // that wire connection / pipe endpoint is open
+        std::optional<MessageEntry> pending;  // a wire: the newest value published before it was
+        std::vector<MessageElement> pending_packets;  // a pipe: the packets published before it was
     };
 
     // --- connection (foxglove_connection.cpp) ---
@@ -135,9 +136,12 @@ private:
     void on(rr::foxglove::event::ClientAdvertised e);
     void on(rr::foxglove::event::ClientUnadvertised e);
     void on(rr::foxglove::event::ClientPublish e);
-    void publish_ready(std::uint32_t cid, std::uint64_t serial, const std::string& error);
+    void publish_opened(std::uint32_t cid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member,
+                        std::optional<std::uint64_t> pipe, const std::string& error);
+    void publish_closed(std::uint32_t cid, std::uint64_t serial, const std::string& why);
     void end_publish(PublishTarget& p);
     void send_upstream(const LiveMember& member, MessageEntry entry);
+    void send_pipe_packet(std::uint32_t cid, std::uint64_t serial, MessageElement packet);
 
     static std::uint64_t next_id();
 
