@@ -1,4 +1,7 @@
+// A device's clock as Foxglove's time (foxglove_clock.hpp).
 #include "server/foxglove/foxglove_clock.hpp"
+
+#include <algorithm>
 
 #include "server/foxglove/foxglove_connection.hpp"
 
