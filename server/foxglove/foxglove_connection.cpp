@@ -49,6 +49,7 @@ std::string query_value(std::string_view target, std::string_view key) {
     return {};
 }
 
+std::string_view target_path(std::string_view target) { return target.substr(0, target.find('?')); }
 
 }  // namespace
 
