@@ -95,7 +95,7 @@ void FoxgloveConnection::publish_opened(std::uint32_t cid, std::uint64_t serial,
                                         std::optional<std::uint64_t> pipe, const std::string& error) {
     std::optional<PublishTarget> ended;
     std::optional<MessageEntry> pending;
-    std::vector<MessageElement> pending_packets;
+    bool send_packets = false;
     {
         std::lock_guard lock(mutex_);
         auto it = publish_targets_.find(cid);
@@ -118,12 +118,13 @@ void FoxgloveConnection::publish_opened(std::uint32_t cid, std::uint64_t serial,
             it->second.ready = true;
             pending = std::move(it->second.pending);
             it->second.pending.reset();
-            pending_packets.swap(it->second.pending_packets);
+            send_packets = !it->second.pending_packets.empty() && !it->second.sending;
+            if (send_packets) it->second.sending = true;
         }
     }
     if (ended) return end_publish(*ended);
     if (pending) send_upstream(*member, std::move(*pending));
-    for (auto& packet : pending_packets) send_pipe_packet(cid, serial, std::move(packet));
+    if (send_packets) send_pipe_packets(cid, serial);
 }
 
 // The device closed the pipe endpoint (or the session ended): the client channel's messages are refused
@@ -172,22 +173,34 @@ void FoxgloveConnection::send_upstream(const LiveMember& member, MessageEntry en
     client->send(std::move(entry));
 }
 
-// One packet on the client channel's pipe endpoint (open); a device that does not read gets the client
-// a status per refused packet (BufferLimitViolation past 8 MiB waiting).
-void FoxgloveConnection::send_pipe_packet(std::uint32_t cid, std::uint64_t serial, MessageElement packet) {
-    std::shared_ptr<const LiveMember> member;
-    std::uint64_t endpoint = 0;
-    {
-        std::lock_guard lock(mutex_);
-        auto it = publish_targets_.find(cid);
-        if (it == publish_targets_.end() || it->second.serial != serial || !it->second.upstream_known) return;
-        member = it->second.member;
-        endpoint = it->second.upstream;
-    }
-    auto sent = member->target->device->mirror_service()->shared_endpoints()->send_pipe_packet(endpoint, std::move(packet), false);
-    if (!sent) {
-        std::lock_guard lock(mutex_);
-        status("message on \"" + member->topic + "\" refused: " + sent.error().message);
+// The client channel's waiting packets on its pipe endpoint (open), in order, by the one caller that
+// set `sending` (the socket's messages and the endpoint's opening run on different strands; the
+// device is called without mutex_). A device that does not read gets the client a status per refused
+// packet (BufferLimitViolation past 8 MiB waiting).
+void FoxgloveConnection::send_pipe_packets(std::uint32_t cid, std::uint64_t serial) {
+    for (;;) {
+        std::shared_ptr<const LiveMember> member;
+        std::uint64_t endpoint = 0;
+        MessageElement packet;
+        {
+            std::lock_guard lock(mutex_);
+            auto it = publish_targets_.find(cid);
+            if (it == publish_targets_.end() || it->second.serial != serial) return;
+            auto& target = it->second;
+            if (target.pending_packets.empty() || !target.upstream_known) {
+                target.sending = false;
+                return;
+            }
+            member = target.member;
+            endpoint = target.upstream;
+            packet = std::move(target.pending_packets.front());
+            target.pending_packets.pop_front();
+        }
+        auto sent = member->target->device->mirror_service()->shared_endpoints()->send_pipe_packet(endpoint, std::move(packet), false);
+        if (!sent) {
+            std::lock_guard lock(mutex_);
+            status("message on \"" + member->topic + "\" refused: " + sent.error().message);
+        }
     }
 }
 
@@ -226,15 +239,15 @@ void FoxgloveConnection::on(fg::event::ClientPublish e) {
             std::lock_guard lock(mutex_);
             auto it = publish_targets_.find(e.channel->id);
             if (it == publish_targets_.end() || it->second.serial != serial) return;
-            if (!it->second.ready) {
-                if (it->second.pending_packets.size() >= kMaxPendingPipePackets)
-                    return status("message on \"" + topic + "\" refused: " + std::to_string(kMaxPendingPipePackets) +
-                                  " packets wait for the device to accept the pipe endpoint");
-                it->second.pending_packets.push_back(std::move(*packet));
-                return;
-            }
+            auto& target = it->second;
+            if (target.pending_packets.size() >= kMaxPendingPipePackets)
+                return status("message on \"" + topic + "\" refused: " + std::to_string(kMaxPendingPipePackets) +
+                              " packets wait for the device to accept the pipe endpoint");
+            target.pending_packets.push_back(std::move(*packet));
+            if (!target.ready || target.sending) return;  // sent when the endpoint opens / by the caller sending now
+            target.sending = true;
         }
-        return send_pipe_packet(e.channel->id, serial, std::move(*packet));
+        return send_pipe_packets(e.channel->id, serial);
     }
     // A client's OutValue is the device's InValue (wire.md §6.7: WirePacket, newest wins).
     MessageEntry entry;

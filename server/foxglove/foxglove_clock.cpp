@@ -69,7 +69,7 @@ std::optional<std::uint64_t> clock_time_ns(const gateway::JsonApi& api, const Li
 }
 
 FoxgloveClock::FoxgloveClock(std::shared_ptr<gateway::JsonApi> api, std::chrono::milliseconds interval,
-                             std::function<void(std::uint64_t)> on_time)
+                             std::function<void()> on_time)
     : api_(std::move(api)), interval_(interval), on_time_(std::move(on_time)) {}
 
 FoxgloveClock::~FoxgloveClock() {
@@ -172,8 +172,13 @@ void FoxgloveClock::on_packet(std::uint64_t serial, const gateway::SharedEntryPt
         std::lock_guard lock(mutex_);
         if (serial != serial_) return;
         const auto now = std::chrono::steady_clock::now();
-        // A clock that went back (a simulation restarted): receive times follow it.
-        if (*t < last_returned_) last_returned_ = *t;
+        // A clock that went back itself (a simulation restarted): the times sent follow it. A clock that
+        // went on: never before a time handed out already (receive times run on between its ticks, and
+        // a tick's delay on its way here would otherwise look like a step back).
+        if (last_time_ && *t < *last_time_)
+            last_returned_ = *t;
+        else
+            last_returned_ = std::max(last_returned_, *t);
         last_time_ = *t;
         last_arrival_ = now;
         if (now - last_forwarded_ >= interval_) {
@@ -181,7 +186,7 @@ void FoxgloveClock::on_packet(std::uint64_t serial, const gateway::SharedEntryPt
             forward = true;
         }
     }
-    if (forward && on_time_) on_time_(*t);
+    if (forward && on_time_) on_time_();
 }
 
 }  // namespace rr::server::foxglove

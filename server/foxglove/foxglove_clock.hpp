@@ -41,10 +41,10 @@ std::optional<std::uint64_t> clock_time_ns(const gateway::JsonApi& api, const Li
 /// and hands its times on. Thread-safe.
 class FoxgloveClock : public std::enable_shared_from_this<FoxgloveClock> {
 public:
-    /// `on_time` gets each new time (ns since the epoch), at most one per `interval`; called without
-    /// locks held, on the device's strand.
+    /// `on_time` is called when a new clock time arrived (now_ns() reads it), at most once per `interval`;
+    /// called without locks held, on the device's strand.
     FoxgloveClock(std::shared_ptr<gateway::JsonApi> api, std::chrono::milliseconds interval,
-                  std::function<void(std::uint64_t)> on_time);
+                  std::function<void()> on_time);
     ~FoxgloveClock();
 
     /// Follows `member` (a clock wire of a connected device), replacing the clock followed before.
@@ -65,7 +65,7 @@ private:
 
     std::shared_ptr<gateway::JsonApi> api_;
     const std::chrono::milliseconds interval_;
-    std::function<void(std::uint64_t)> on_time_;
+    std::function<void()> on_time_;
     mutable std::mutex mutex_;
     std::shared_ptr<const LiveMember> member_;
     ClockWireKind kind_ = ClockWireKind::device_time;

@@ -125,14 +125,14 @@ void FoxgloveConnection::start() {
     advertise_locked(catalog);
 }
 
-void FoxgloveConnection::time(std::uint64_t ns) {
+void FoxgloveConnection::time() {
     std::lock_guard lock(mutex_);
     if (!started_ || closed_ || !sends_time_) return;
     if (push_congested()) {
         ++stats_.dropped;
         return;
     }
-    socket_->send_binary(fg::time_frame(ns));
+    socket_->send_binary(fg::time_frame(clock_->now_ns()));
     ++stats_.times_sent;
 }
 

@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -57,9 +58,10 @@ public:
     void advertise(const FoxgloveServer::Catalog& added);
     void unadvertise(const std::vector<std::uint32_t>& channel_ids, const std::vector<std::uint32_t>& service_ids);
     void parameter_changed(const rr::foxglove::Parameter& p);
-    /// The followed clock's new time: a `time` message when this connection has the capability (dropped
-    /// while the socket is congested; the next one follows).
-    void time(std::uint64_t ns);
+    /// The followed clock has a new time: a `time` message of the clock's now_ns() when this connection
+    /// has the capability (dropped while the socket is congested; the next one follows). Read under this
+    /// connection's lock, so time messages and receive times reach the client in order.
+    void time();
     FoxgloveStats stats() const;
 
 private:
@@ -83,7 +85,8 @@ private:
         bool upstream_known = false;
         bool ready = false;                   // that wire connection / pipe endpoint is open
         std::optional<MessageEntry> pending;  // a wire: the newest value published before it was
-        std::vector<MessageElement> pending_packets;  // a pipe: the packets published before it was
+        std::deque<MessageElement> pending_packets;  // a pipe: packets not yet sent, in order
+        bool sending = false;                        // a pipe: one caller sends pending_packets (in order)
     };
 
     // --- connection (foxglove_connection.cpp) ---
@@ -142,7 +145,7 @@ private:
     void publish_closed(std::uint32_t cid, std::uint64_t serial, const std::string& why);
     void end_publish(PublishTarget& p);
     void send_upstream(const LiveMember& member, MessageEntry entry);
-    void send_pipe_packet(std::uint32_t cid, std::uint64_t serial, MessageElement packet);
+    void send_pipe_packets(std::uint32_t cid, std::uint64_t serial);
 
     static std::uint64_t next_id();
 

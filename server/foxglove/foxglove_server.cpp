@@ -22,9 +22,9 @@ std::shared_ptr<FoxgloveServer> FoxgloveServer::create(std::shared_ptr<gateway::
                                                        FoxgloveOptions options) {
     std::shared_ptr<FoxgloveServer> s(new FoxgloveServer(std::move(api), executor, std::move(options)));
     std::weak_ptr<FoxgloveServer> weak_server = s;
-    s->clock_ = std::make_shared<FoxgloveClock>(s->api_, s->options_.time_interval, [weak_server](std::uint64_t ns) {
+    s->clock_ = std::make_shared<FoxgloveClock>(s->api_, s->options_.time_interval, [weak_server] {
         if (auto self = weak_server.lock())
-            for (const auto& c : self->connections()) c->time(ns);
+            for (const auto& c : self->connections()) c->time();
     });
     for (const auto& d : s->api_->devices()) s->watch(d);
     std::weak_ptr<FoxgloveServer> weak = s;
