@@ -11,11 +11,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 namespace {
 
 // Packets a client may send on a pipe before the device accepted the endpoint; more are refused.
@@ -40,7 +35,7 @@ void FoxgloveConnection::on(fg::event::ClientAdvertised e) {
         // Not a writable wire or pipe: nothing now (Lichtblick advertises ROS topics of its own, e.g.
         // /clicked_point, whether anything is published there or not); its first message gets a status.
         if (!member || !member->writable) return;
-        if (auto denied = api_->check_access(address_of(*member), auth::Operation::write)) {
+        if (auto denied = api_->check_access(address_of(*member), gateway::auth::Operation::write)) {
             status("advertise: " + e.channel.topic + ": " + error_text(*denied) + "; messages on it are refused");
             return;
         }
@@ -58,16 +53,10 @@ void FoxgloveConnection::on(fg::event::ClientAdvertised e) {
         h.on_closed = [weak, cid, serial](const RRError& reason) {
             if (auto s = weak.lock()) s->publish_closed(cid, serial, reason.message);
         };
-        t.device->mirror_service()->shared_endpoints()->open_pipe(
-            t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
-            [weak, cid, serial, member](Result<std::uint64_t> r) {
-                auto s = weak.lock();
-                if (!s) {
-                    if (r) member->target->device->mirror_service()->shared_endpoints()->close_pipe(*r);
-                    return;
-                }
-                s->publish_opened(cid, serial, member, r ? std::optional<std::uint64_t>(*r) : std::nullopt, r ? "" : r.error().message);
-            });
+        open_pipe(member, std::move(h),
+                  [cid, serial, member](FoxgloveConnection& c, std::optional<std::uint64_t> id, const std::string& error) {
+                      c.publish_opened(cid, serial, member, id, error);
+                  });
         return;
     }
     const std::uint64_t upstream = t.device->subscribe(
@@ -257,7 +246,7 @@ void FoxgloveConnection::on(fg::event::ClientPublish e) {
     entry.elements.push_back(pack_timespec(wall_clock_timespec(), "packettime"));
     entry.elements.push_back(std::move(*packet));
     entry.service_path = t.path;
-    MemberAddress address = address_of(*member);
+    gateway::MemberAddress address = address_of(*member);
     // A command stream: refused while another client holds the motion, ended when it goes silent.
     auto motion = gateway::JsonApi::admit_motion(address, t, entry);
     if (auto* refused = std::get_if<gateway::ApiError>(&motion)) return report(error_text(*refused));

@@ -8,12 +8,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::ApiResult;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 namespace {
 
 
@@ -89,10 +83,10 @@ void FoxgloveConnection::start() {
     // auth: gateway — the dashboard's session cookie, or a token in the query (browsers cannot set
     // headers on a WebSocket; Foxglove and Lichtblick keep the URL's query).
     if (const auto& a = api_->auth(); a && a->enabled()) {
-        const std::string cookie = auth::cookie_value(socket_->cookie_header(), auth::kSessionCookie);
+        const std::string cookie = gateway::auth::cookie_value(socket_->cookie_header(), gateway::auth::kSessionCookie);
         if (!cookie.empty()) principal_ = a->session(cookie);
         if (const std::string token = query_value(target, "token"); !principal_ && !token.empty()) {
-            auto who = a->login_token(token, socket_->peer(), auth::LoginChannel::websocket);
+            auto who = a->login_token(token, socket_->peer(), gateway::auth::LoginChannel::websocket);
             if (!who) return refuse("login refused: " + who.error().message);
             principal_ = *who;
         }
@@ -229,8 +223,8 @@ void FoxgloveConnection::advertise_locked(const FoxgloveServer::Catalog& c) {
     }
 }
 
-MemberAddress FoxgloveConnection::address_of(const LiveMember& m) const {
-    MemberAddress a;
+gateway::MemberAddress FoxgloveConnection::address_of(const LiveMember& m) const {
+    gateway::MemberAddress a;
     a.device = m.target->device->config().name;
     a.object = m.object;
     a.member = m.target->member->name;

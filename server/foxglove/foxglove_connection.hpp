@@ -33,8 +33,11 @@
 #include "server/foxglove/foxglove_server.hpp"
 #include "server/gateway/auth/http_auth.hpp"
 #include "server/gateway/conversion_budget.hpp"
+#include "server/gateway/session_endpoints.hpp"
 
 namespace rr::server::foxglove {
+
+namespace fg = rr::foxglove;
 
 /// The gateway's wall clock in ns since the Unix epoch (messageData receive times).
 std::uint64_t now_ns();
@@ -103,6 +106,10 @@ private:
     // --- subscriptions (foxglove_subscriptions.cpp) ---
     void on(rr::foxglove::event::Subscribed e);
     void on(rr::foxglove::event::Unsubscribed e);
+    /// Opens a pipe endpoint of the gateway's shared session on `member`; `done` gets its id, or why not
+    /// (an endpoint that opens after this connection is gone is closed).
+    void open_pipe(const std::shared_ptr<const LiveMember>& member, gateway::GatewayPipeHandlers handlers,
+                   std::function<void(FoxgloveConnection&, std::optional<std::uint64_t>, const std::string&)> done);
     void start_upstream(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member);
     void open_upstream(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member);
     void upstream_opened(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member,
@@ -111,6 +118,8 @@ private:
     void end_upstream(Sub& s);
 
     // --- values (foxglove_values.cpp) ---
+    /// Under mutex_: the subscription `sid` while it is the one of `serial` and the connection is open.
+    Sub* live_sub(std::uint32_t sid, std::uint64_t serial);
     bool wire_congested() const;
     bool push_congested() const;
     void send_entry(const Sub& s, const SharedEntryPtr& e);

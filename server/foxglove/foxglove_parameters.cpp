@@ -5,12 +5,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::ApiResult;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 bool FoxgloveConnection::begin_parameter_request() {
     std::lock_guard lock(mutex_);
     if (parameter_requests_ >= options_.max_parameter_requests) {
@@ -38,7 +32,7 @@ void FoxgloveConnection::read_parameters(std::vector<std::shared_ptr<const LiveM
     auto self = shared_from_this();
     for (std::size_t i = 0; i < members.size(); ++i) {
         const std::string name = members[i]->topic;
-        api_->get_property(address_of(*members[i]), [self, g, i, name, done](ApiResult r) {
+        api_->get_property(address_of(*members[i]), [self, g, i, name, done](gateway::ApiResult r) {
             bool last = false;
             {
                 std::lock_guard lock(g->m);
@@ -146,7 +140,7 @@ void FoxgloveConnection::on(fg::event::SetParameters e) {
     if (writes.empty()) return finish();
     for (auto& [m, value] : writes) {
         std::shared_ptr<const LiveMember> member = m;
-        api_->set_property(address_of(*member), value, [g, member, finish](ApiResult r) {
+        api_->set_property(address_of(*member), value, [g, member, finish](gateway::ApiResult r) {
             bool last = false;
             {
                 std::lock_guard lock(g->m);

@@ -9,8 +9,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-
 FoxgloveServer::FoxgloveServer(std::shared_ptr<gateway::JsonApi> api, boost::asio::any_io_executor executor, FoxgloveOptions options)
     : api_(std::move(api)),
       executor_(executor),

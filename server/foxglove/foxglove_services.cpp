@@ -6,12 +6,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::ApiResult;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 void FoxgloveConnection::on(fg::event::ServiceCall e) {
     auto server = server_.lock();
     auto member = server ? server->service_member(e.service_id) : nullptr;
@@ -29,7 +23,7 @@ void FoxgloveConnection::on(fg::event::ServiceCall e) {
         if (args.is_discarded() || !(args.is_object() || args.is_array() || args.is_null()))
             return failed("the request is not a JSON object of the arguments by name (or an array of them in order)");
     }
-    api_->call_function(address_of(*member), args, 0, [self, service, call, failed, encoding = e.encoding](ApiResult r) {
+    api_->call_function(address_of(*member), args, 0, [self, service, call, failed, encoding = e.encoding](gateway::ApiResult r) {
         if (!r) return failed(error_text(*r.error));
         std::string frame = fg::service_call_response_head(service, call, encoding) + gateway::json_text(r.value);
         std::lock_guard lock(self->mutex_);

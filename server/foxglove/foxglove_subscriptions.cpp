@@ -10,12 +10,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::ApiResult;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 void FoxgloveConnection::on(fg::event::Subscribed e) {
     auto server = server_.lock();
     auto member = server ? server->channel_member(e.channel_id) : nullptr;
@@ -25,7 +19,7 @@ void FoxgloveConnection::on(fg::event::Subscribed e) {
         session_.end_subscription(e.subscription_id);
         return status("subscribe refused: channel " + std::to_string(e.channel_id) + " is gone");
     }
-    if (auto denied = api_->check_access(address_of(*member), auth::Operation::read)) {
+    if (auto denied = api_->check_access(address_of(*member), gateway::auth::Operation::read)) {
         session_.end_subscription(e.subscription_id);
         return status("subscribe refused: " + member->topic + ": " + error_text(*denied));
     }
@@ -55,16 +49,10 @@ void FoxgloveConnection::open_upstream(std::uint32_t sid, std::uint64_t serial, 
         h.on_closed = [weak, sid, serial](const RRError& reason) {
             if (auto s = weak.lock()) s->upstream_closed(sid, serial, reason.message);
         };
-        t.device->mirror_service()->shared_endpoints()->open_pipe(
-            t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(h),
-            [weak, sid, serial, member](Result<std::uint64_t> r) {
-                auto s = weak.lock();
-                if (!s) {
-                    if (r) member->target->device->mirror_service()->shared_endpoints()->close_pipe(*r);
-                    return;
-                }
-                s->upstream_opened(sid, serial, member, r ? std::optional<std::uint64_t>(*r) : std::nullopt, r ? "" : r.error().message);
-            });
+        open_pipe(member, std::move(h),
+                  [sid, serial, member](FoxgloveConnection& c, std::optional<std::uint64_t> id, const std::string& error) {
+                      c.upstream_opened(sid, serial, member, id, error);
+                  });
         return;
     }
     const bool is_wire = member->kind == LiveKind::wire;
@@ -89,6 +77,22 @@ void FoxgloveConnection::open_upstream(std::uint32_t sid, std::uint64_t serial, 
         }
     }
     if (drop) t.device->unsubscribe(upstream);
+}
+
+void FoxgloveConnection::open_pipe(const std::shared_ptr<const LiveMember>& member, gateway::GatewayPipeHandlers handlers,
+                                   std::function<void(FoxgloveConnection&, std::optional<std::uint64_t>, const std::string&)> done) {
+    const auto& t = *member->target;
+    std::weak_ptr<FoxgloveConnection> weak = weak_from_this();
+    t.device->mirror_service()->shared_endpoints()->open_pipe(
+        t.path, t.member->name, robdef::pipe_is_unreliable(*t.object, *t.member), std::move(handlers),
+        [weak, member, done = std::move(done)](Result<std::uint64_t> r) {
+            auto self = weak.lock();
+            if (!self) {
+                if (r) member->target->device->mirror_service()->shared_endpoints()->close_pipe(*r);
+                return;
+            }
+            done(*self, r ? std::optional<std::uint64_t>(*r) : std::nullopt, r ? std::string() : r.error().message);
+        });
 }
 
 void FoxgloveConnection::upstream_opened(std::uint32_t sid, std::uint64_t serial, const std::shared_ptr<const LiveMember>& member,

@@ -9,12 +9,6 @@
 
 namespace rr::server::foxglove {
 
-namespace fg = rr::foxglove;
-using gateway::ApiResult;
-using gateway::MemberAddress;
-using gateway::SharedEntryPtr;
-namespace auth = gateway::auth;
-
 bool FoxgloveConnection::wire_congested() const {
     return socket_->queued() >= options_.wire_queue_threshold || socket_->queued_bytes() >= options_.wire_bytes_threshold;
 }
@@ -47,26 +41,31 @@ void FoxgloveConnection::on_wire(std::uint32_t sid, std::uint64_t serial, const 
     if (e->entry().entry_type == MessageEntryType::WireClosed) return upstream_closed(sid, serial, "wire closed");
     if (image_subscription(sid)) return convert(sid, serial, e);
     std::lock_guard lock(mutex_);
-    auto it = subs_.find(sid);
-    if (closed_ || it == subs_.end() || it->second.serial != serial) return;
-    if (it->second.pending || wire_congested()) {
-        if (it->second.pending) ++stats_.wire_coalesced;
-        it->second.pending = e;  // newest wins
+    Sub* s = live_sub(sid, serial);
+    if (!s) return;
+    if (s->pending || wire_congested()) {
+        if (s->pending) ++stats_.wire_coalesced;
+        s->pending = e;  // newest wins
         arm_retry();
         return;
     }
-    send_entry(it->second, e);
+    send_entry(*s, e);
 }
 
 void FoxgloveConnection::on_event(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e) {
     std::lock_guard lock(mutex_);
-    auto it = subs_.find(sid);
-    if (closed_ || it == subs_.end() || it->second.serial != serial) return;
+    Sub* s = live_sub(sid, serial);
+    if (!s) return;
     if (push_congested()) {
         ++stats_.dropped;
         return;
     }
-    send_entry(it->second, e);
+    send_entry(*s, e);
+}
+
+FoxgloveConnection::Sub* FoxgloveConnection::live_sub(std::uint32_t sid, std::uint64_t serial) {
+    auto it = subs_.find(sid);
+    return closed_ || it == subs_.end() || it->second.serial != serial ? nullptr : &it->second;
 }
 
 bool FoxgloveConnection::image_subscription(std::uint32_t sid) const {
@@ -120,13 +119,13 @@ void FoxgloveConnection::convert(std::uint32_t sid, std::uint64_t serial, Shared
     std::shared_ptr<const LiveMember> member;
     {
         std::lock_guard lock(mutex_);
-        auto it = subs_.find(sid);
-        if (closed_ || it == subs_.end() || it->second.serial != serial) return;
+        Sub* s = live_sub(sid, serial);
+        if (!s) return;
         if (push_congested()) {
             ++stats_.dropped;
             return;
         }
-        member = it->second.member;
+        member = s->member;
     }
     std::size_t bytes = 0;
     for (const auto& el : entry->entry().elements) bytes += gateway::payload_bytes(el);
@@ -142,8 +141,7 @@ void FoxgloveConnection::convert(std::uint32_t sid, std::uint64_t serial, Shared
         if (!message) return;  // a frame Foxglove has no form of: nothing on the image channel
         std::string frame = fg::message_data_head(sid, received) + *message;
         std::lock_guard lock(self->mutex_);
-        auto it = self->subs_.find(sid);
-        if (self->closed_ || it == self->subs_.end() || it->second.serial != serial) return;
+        if (!self->live_sub(sid, serial)) return;
         self->socket_->send_binary(std::move(frame));
         ++self->stats_.messages_sent;
     });
