@@ -120,6 +120,8 @@ private:
     // --- values (foxglove_values.cpp) ---
     /// Under mutex_: the subscription `sid` while it is the one of `serial` and the connection is open.
     Sub* live_sub(std::uint32_t sid, std::uint64_t serial);
+    /// Under mutex_: live_sub, unless the socket is congested for events and pipe packets (one more dropped).
+    Sub* push_sub(std::uint32_t sid, std::uint64_t serial);
     bool wire_congested() const;
     bool push_congested() const;
     void send_entry(const Sub& s, const SharedEntryPtr& e);

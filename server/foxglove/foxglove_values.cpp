@@ -54,18 +54,21 @@ void FoxgloveConnection::on_wire(std::uint32_t sid, std::uint64_t serial, const 
 
 void FoxgloveConnection::on_event(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e) {
     std::lock_guard lock(mutex_);
-    Sub* s = live_sub(sid, serial);
-    if (!s) return;
-    if (push_congested()) {
-        ++stats_.dropped;
-        return;
-    }
-    send_entry(*s, e);
+    if (Sub* s = push_sub(sid, serial)) send_entry(*s, e);
 }
 
 FoxgloveConnection::Sub* FoxgloveConnection::live_sub(std::uint32_t sid, std::uint64_t serial) {
     auto it = subs_.find(sid);
     return closed_ || it == subs_.end() || it->second.serial != serial ? nullptr : &it->second;
+}
+
+FoxgloveConnection::Sub* FoxgloveConnection::push_sub(std::uint32_t sid, std::uint64_t serial) {
+    Sub* s = live_sub(sid, serial);
+    if (s && push_congested()) {
+        ++stats_.dropped;
+        return nullptr;
+    }
+    return s;
 }
 
 bool FoxgloveConnection::image_subscription(std::uint32_t sid) const {
@@ -119,12 +122,8 @@ void FoxgloveConnection::convert(std::uint32_t sid, std::uint64_t serial, Shared
     std::shared_ptr<const LiveMember> member;
     {
         std::lock_guard lock(mutex_);
-        Sub* s = live_sub(sid, serial);
+        Sub* s = push_sub(sid, serial);
         if (!s) return;
-        if (push_congested()) {
-            ++stats_.dropped;
-            return;
-        }
         member = s->member;
     }
     std::size_t bytes = 0;
