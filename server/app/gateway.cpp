@@ -407,6 +407,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         // The Foxglove WebSocket protocol at /foxglove (docs/foxglove.md).
         foxglove::FoxgloveOptions fo;
         fo.objects = c.foxglove_objects;
+        fo.clock = c.foxglove_clock;
         g->foxglove_ = foxglove::install_foxglove(*g->http_, json_api, std::move(fo));
     }
 
