@@ -5,7 +5,7 @@
 // names an objref of the object reached so far; `[key]` is its index (an int32 or a string, as the
 // objref's `{int32}` / `{string}` type says). `--object PATH` gives the same objref segments separately
 // and is prepended to the member path. Both are object paths, parsed by core's one parser
-// (core/names/object_path.hpp: its syntax and error messages; a key may hold any character but `]`).
+// (base/names/object_path.hpp: its syntax and error messages; a key may hold any character but `]`).
 #pragma once
 
 #include <cstdint>
@@ -14,8 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/object_path.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/object_path.hpp"
 
 namespace rr::cli {
 

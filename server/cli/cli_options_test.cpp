@@ -9,7 +9,7 @@ namespace {
 rr::Result<rr::cli::CommandLine> parse(std::vector<std::string> a) { return parse_command_line(a); }
 }  // namespace
 
-// Member paths and --object are object paths (core/names/object_path.hpp): the CLI keeps the core's
+// Member paths and --object are object paths (base/names/object_path.hpp): the CLI keeps the core's
 // segments and messages, so these check the hand-over, not the parser again.
 TEST_CASE("cli: member paths through objrefs go through core's object path parser") {
     auto q = parse({"get", "u", "child_by_name[with space.and dots].leaf.x"});

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/json/value_json.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/cli/cli_usb.hpp"
 #include "server/transport/websocket_connector.hpp"
 

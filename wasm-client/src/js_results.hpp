@@ -6,7 +6,7 @@
 
 #include <emscripten/val.h>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::wasm {
 

@@ -1,5 +1,5 @@
 // Object paths (`arms[left].tool`, `child_by_int[7]`): parsed by the C++ core's one parser
-// (core/names/object_path.hpp, compiled into the WebAssembly module), so JS reads a path exactly as the
+// (base/names/object_path.hpp, compiled into the WebAssembly module), so JS reads a path exactly as the
 // gateway, the service side and recording do, and fails with the same messages.
 import { toRRError } from "./errors.mjs";
 import { loadModule } from "./wasm_module.mjs";

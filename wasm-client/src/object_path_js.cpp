@@ -1,6 +1,6 @@
 #include "wasm-client/src/object_path_js.hpp"
 
-#include "core/names/object_path.hpp"
+#include "base/names/object_path.hpp"
 #include "wasm-client/src/js_results.hpp"
 
 namespace rr::wasm {

@@ -1,4 +1,4 @@
-// Object paths for JS: core's one parser (core/names/object_path.hpp), so the wasm client's
+// Object paths for JS: core's one parser (base/names/object_path.hpp), so the wasm client's
 // subscriptions read `a.b[3].c[key]` exactly as the gateway, the service side and recording do, with
 // the same error messages.
 #pragma once

@@ -1,4 +1,4 @@
-// Object paths in the wasm client: parseObjectPath (the C++ core's parser, core/names/object_path.hpp,
+// Object paths in the wasm client: parseObjectPath (the C++ core's parser, base/names/object_path.hpp,
 // compiled into the built package) on good paths and on every error the core gives for a path a user
 // types, with the core's messages; resolveObject (src/subscription.mjs, the subscriptions' walk through
 // objrefs) on a root whose objrefs record what they were asked for: indexes decoded, int32 indexes as
@@ -57,7 +57,7 @@ for (const [path, want] of good) {
   check(same(got, want), `parseObjectPath(${JSON.stringify(path)}) = ${JSON.stringify(got)}, want ${JSON.stringify(want)}`);
 }
 
-// Every error of a typed path (core/names/object_path.hpp lists them), with the core's message.
+// Every error of a typed path (base/names/object_path.hpp lists them), with the core's message.
 const bad = [
   ["", 'object path "" is empty'],
   ["a..b", 'object path "a..b": expected a member name at offset 2'],
