@@ -95,6 +95,7 @@ Result<MessageEntry> WireMember::pack_packet(const Value& value, TimeSpec time, 
 Result<void> WireMember::set_out_value(Value value) {
     if (direction() == robdef::MemberDirection::writeonly)
         return fail(MessageErrorType::ReadOnlyMember, "wire " + name() + " is [writeonly]: only clients send");
+    std::lock_guard order(send_order_mutex_);
     const TimeSpec time = next_time();
     auto entry = pack_packet(value, time, MessageEntryType::WirePacket);
     if (!entry) return entry.take_error();
@@ -129,6 +130,7 @@ Result<void> WireMember::set_out_value(Value value) {
 Result<void> WireMember::send_to(const WireConnection& connection, const Value& value) {
     if (direction() == robdef::MemberDirection::writeonly)
         return fail(MessageErrorType::ReadOnlyMember, "wire " + name() + " is [writeonly]: only clients send");
+    std::lock_guard order(send_order_mutex_);
     auto entry = pack_packet(value, next_time(), MessageEntryType::WirePacket);
     if (!entry) return entry.take_error();
     entry->service_path = connection.service_path();

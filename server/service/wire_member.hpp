@@ -115,6 +115,10 @@ private:
     void close_connection(const std::shared_ptr<WireConnection>& connection);
 
     const std::shared_ptr<const detail::MemberInfo> info_;
+    // Held from taking a time stamp until the packet is queued to every target: clients drop a packet
+    // older than the last one they got (wire.md §6.7), so two threads sending at once must not let the
+    // older stamp reach a client second.
+    std::mutex send_order_mutex_;
     // Guarded by mutex_ (MemberConnections'):
     std::optional<TimedValue> out_;
     std::optional<TimedValue> in_;

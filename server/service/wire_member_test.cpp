@@ -94,6 +94,42 @@ TEST_CASE("wires: out value fan-out, current value on connect, time stamps, disc
     CHECK(level->connections().empty());
 }
 
+TEST_CASE("wires: values set from two threads reach every client in time-stamp order") {
+    // A client drops a packet older than the last one it got (wire.md §6.7): two threads setting the out
+    // value at once must not let an older stamp reach a client after a newer one (issue 51: the official
+    // client missed a value sent while the service's periodic thread sent another).
+    ServiceFixture f;
+    auto level = f.root->wire("level").value();
+    REQUIRE(level->set_out_value(Value::array<double>({0})));
+    auto a = f.connect();
+    auto b = f.connect();
+    for (auto* c : {&a, &b}) {
+        c->ok(req(MessageEntryType::WireConnectReq, "level"));
+        REQUIRE(c->inbox->take(MessageEntryType::WirePacket));
+    }
+    constexpr int kValues = 300;
+    auto sender = [&](double who) {
+        for (int i = 0; i < kValues; ++i) (void)level->set_out_value(Value::array<double>({who, double(i)}));
+    };
+    std::thread t1(sender, 1.0), t2(sender, 2.0);
+    t1.join();
+    t2.join();
+    const auto newest = level->out_value();
+    REQUIRE(newest);
+    for (auto* c : {&a, &b}) {
+        // Every packet a client got, in arrival order, up to the newest value (newest wins, so some are
+        // skipped): strictly increasing stamps, ending with the wire's out value.
+        std::vector<TimeSpec> stamps;
+        while (stamps.empty() || stamps.back() != newest->time) {
+            auto p = c->inbox->take(MessageEntryType::WirePacket, 10000ms);  // a bound on a hang
+            REQUIRE(p);
+            stamps.push_back(*unpack_timespec(*p->find("packettime")));
+            if (stamps.size() > 1) REQUIRE(stamps[stamps.size() - 2] < stamps.back());
+        }
+        CHECK(c->inbox->count(MessageEntryType::WirePacket) == 0);
+    }
+}
+
 TEST_CASE("wires: in values, ordering by time stamp, peek out and poke") {
     ServiceFixture f;
     auto level = f.root->wire("level").value();

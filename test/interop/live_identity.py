@@ -117,11 +117,11 @@ def run_mode(mode, args, workdir, python):
     t0 = time.monotonic()
     try:
         svc = start([python, os.path.join(HERE, "official_service.py"), "--port", "0",
-                     "--heartbeat", HEARTBEAT_S, "--max-lifetime", "100"] + m["service"],
+                     "--heartbeat", HEARTBEAT_S, "--max-lifetime", "160"] + m["service"],
                     os.path.join(workdir, "service_%s.stderr" % mode))
         ready = read_json_line(svc, SERVICE_START_S, "official_service.py")
         proxy = start([python, os.path.join(HERE, "recording_proxy.py"), "--target", "127.0.0.1:%d" % ready["port"],
-                       "--capture", capture, "--max-lifetime", "100"],
+                       "--capture", capture, "--max-lifetime", "160"],
                       os.path.join(workdir, "proxy_%s.stderr" % mode))
         pready = read_json_line(proxy, PROXY_START_S, "recording_proxy.py")
         url = "rr+tcp://127.0.0.1:%d/?service=interop" % pready["port"]

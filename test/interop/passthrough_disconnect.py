@@ -96,6 +96,9 @@ def main():
     ap.add_argument("--service", help="our rr_interop_service as the device (default: the official service)")
     ap.add_argument("--rounds", type=int, default=250, help="rounds per transport (rr+tcp, rr+ws)")
     ap.add_argument("--timeout", type=float, default=60, help="seconds without progress that count as a hang")
+    ap.add_argument("--device-lifetime", type=float, default=900,
+                    help="the device exits after this many seconds if this script died without stopping it "
+                         "(a bound on an orphan, not on the run: ctest's TIMEOUT for this test)")
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="rr-pt-disconnect-")
@@ -106,7 +109,7 @@ def main():
     results = {}
     try:
         svc, ready = ll.start_device(args.service, os.path.join(tmp, "users.txt"), {GATEWAY_USER[0]: (GATEWAY_USER[1], "_")},
-                                     svc_err, args.timeout + 30)
+                                     svc_err, args.device_lifetime)
         config = os.path.join(tmp, "gateway.yaml")
         with open(config, "w") as fh:
             fh.write("gateway:\n  listen: 127.0.0.1\n  port: 0\ndemo:\n  enabled: false\ndevices:\n"
@@ -126,6 +129,9 @@ def main():
                 raise StepFailed("gateway device not connected: %s" % tail(gw_err))
             time.sleep(0.1)
         RRN.RegisterTransport(RR.TcpTransport())  # the official client's rr+tcp and rr+ws
+        # A request's answer may take long on a loaded machine; a request that never comes back is a hang,
+        # which the watchdog reports (args.timeout without a round).
+        RRN.RequestTimeout = max(RRN.RequestTimeout, 2 * args.timeout)
         for scheme in ("tcp", "ws"):
             t0 = time.monotonic()
             refused, first = run_rounds("rr+%s://127.0.0.1:%d/?service=interop" % (scheme, port), args.rounds)
@@ -146,4 +152,7 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    code = main()
+    sys.stdout.flush()
+    # Not the official node's shutdown at exit: after a failure it can wait on sessions left open.
+    os._exit(code)

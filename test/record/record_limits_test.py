@@ -36,7 +36,7 @@ import urllib.request
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "interop"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import die_with_parent, stop  # noqa: E402
-from record_checks import CheckFailed, expect, report_and_clean  # noqa: E402
+from record_checks import CheckFailed, expect, report_and_clean, wait_for  # noqa: E402
 from record_replay_test import start_gateway  # noqa: E402
 
 try:
@@ -109,10 +109,10 @@ def place_phase(exe, work, checks):
         os.symlink(outside, os.path.join(root, "lab"))
         status, reply = http(base, "POST", "/api/recordings", {"device": "create", "directory": "lab/run", "duration_s": 2})
         expect(status == 507 and "is a symbolic link" in error_of(reply), "folder link: %s %s" % (status, reply))
-        # File links where the next seconds' first files go: the file gets another name.
+        # File links where the next half minute's first files go: the file gets another name.
         os.makedirs(os.path.join(root, "cams"))
         now = int(time.time())
-        for s in range(6):
+        for s in range(30):  # a busy machine may start the recording seconds later
             stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime(now + s))
             os.symlink(victim, os.path.join(root, "cams", "cam-%s-001.mcap" % stamp))
         status, rec = http(base, "POST", "/api/recordings",
@@ -155,7 +155,15 @@ def burst_phase(exe, work, checks):
         expect(len(accepted) + len(refused) == 50, "every answer 201 or 429: %s" % sorted(s for s, _ in replies))
         expect(0 < len(accepted) <= 8, "at most recordings.max_active (8) accepted: %d" % len(accepted))
         expect(all("recordings.max_active" in error_of(r) for r in refused), "429 names the limit")
-        time.sleep(1.0)
+        # Each accepted recording has written messages before it is stopped (waited for, not slept: on a
+        # busy machine a recording's subscription can take seconds to open).
+        ids = {r["id"] for r in accepted}
+
+        def all_wrote():
+            status, listing = http(base, "GET", "/api/recordings")
+            got = {x["id"]: x.get("messages", 0) for x in listing.get("recordings", [])} if status == 200 else {}
+            return all(got.get(i, 0) > 0 for i in ids)
+        wait_for("every accepted recording wrote messages", all_wrote, timeout=60, interval=0.3)
         files = []
         for r in accepted:
             status, done = http(base, "POST", "/api/recordings/%d/stop" % r["id"])
@@ -270,7 +278,7 @@ def replay_phase(exe, work, checks):
             time.sleep(0.2)
         expect(st and st.get("state") == "failed" and "would take the reader over its memory limit of 67108864" in st.get("error", ""),
                "the understated chunk fails the replay: %s" % st)
-        deadline = time.monotonic() + 10
+        deadline = time.monotonic() + 30
         while time.monotonic() < deadline and "replay of crafted failed" not in open(log, errors="replace").read():
             time.sleep(0.1)
         expect("replay of crafted failed" in open(log, errors="replace").read(), "the failure is logged")

@@ -197,7 +197,7 @@ def record_phase(exe, work, seconds, checks):
         expect(status == 201, "POST /api/recordings: %s %s" % (status, rec))
         expect(rec["state"] == "recording", "state recording")
         wait_for("GET /api/recordings counts messages", lambda: http(base, "GET", "/api/recordings")[1]["recordings"][0]["messages"] > 0)
-        # The recording spans `seconds` (the replay below seeks 1.5 s and 2 s into it) and holds, on
+        # The recording spans `seconds` (the replay below seeks to its middle packet) and holds, on
         # disk, what check_recording counts: more than 20 packets, 3 polled values.
         time.sleep(seconds)
         path = rec["files"][0]
@@ -285,6 +285,15 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         # Start over with the listener connected, so every packet is seen.
         status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 0})
         expect(status == 200 and st["state"] == "paused", "pause at 0: %s %s" % (status, st))
+
+        def gateway_wire_seq():
+            status, w = http(base, "GET", "/api/devices/create/wires/packets")
+            d = bytes(w["value"]["Data"]) if status == 200 else b"\0\0\0\0"
+            return d[2] | (d[3] << 8)
+        # The seek is applied by the replay's own thread after the reply: wait until the wire holds the
+        # first recorded packet, so a packet played before the pause cannot reach the listener after it.
+        wait_for("pause at 0: the wire holds the first recorded packet %d" % recorded_seq[0][1],
+                 lambda: gateway_wire_seq() == recorded_seq[0][1], timeout=30)
         client = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
         listener = WireListener(client, "packets")
         played_at = time.monotonic()
@@ -296,8 +305,10 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         first_ns = recorded_seq[0][0]
         upto = max(i for i, (t, _) in enumerate(recorded_seq) if t - first_ns <= 4e9)
         later = {s for _, s in recorded_seq[upto:]}
-        wait_for("the replay played the packet recorded %.1f s in" % ((recorded_seq[upto][0] - first_ns) / 1e9),
-                 lambda: any(seq_of(v)[0] in later for t, v in listener.snapshot() if t >= played_at), timeout=90)
+        wait_for("the replay played the packet recorded %.1f s in, and more than 10 packets reached the client"
+                 % ((recorded_seq[upto][0] - first_ns) / 1e9),
+                 lambda: any(seq_of(v)[0] in later for t, v in listener.snapshot() if t >= played_at)
+                 and len([t for t, _ in listener.snapshot() if t >= played_at]) > 10, timeout=90)
         got = [(t, v) for t, v in listener.snapshot() if t >= played_at]
         expect(len(got) > 10, "replayed packets received (%d)" % len(got))
         # A wire keeps only the newest value for a client that is behind (docs/json-api.md), so the
@@ -336,16 +347,16 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
             expect(within >= 0.95 * len(errors), "95%% of intervals within %.0f ms: %s (%s)"
                    % (tolerance_ms, checks["spacing_error_ms"], checks["spacing_judged"]))
 
-        # Seek lands on the right value: the wire and the property at 1.5 s.
-        status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": 1.5})
+        # Seek lands on the right value: the wire and the property just after the middle packet (on a
+        # busy machine the device's first packets can come seconds after the recording started, so a
+        # fixed position could precede them all).
+        position_s = seek_position(recorded_seq, [m.log_time for m in props], st["start_ns"])
+        status, st = http(base, "POST", "/api/replays/create", {"state": "paused", "position_s": position_s})
         expect(status == 200, "seek: %s %s" % (status, st))
-        target = st["start_ns"] + 1_500_000_000
+        target = st["start_ns"] + round(position_s * 1e9)
         want_seq = [s for t, s in recorded_seq if t <= target][-1]
 
-        def wire_seq():
-            status, w = http(base, "GET", "/api/devices/create/wires/packets")
-            d = bytes(w["value"]["Data"]) if status == 200 else b"\0\0\0\0"
-            return d[2] | (d[3] << 8)
+        wire_seq = gateway_wire_seq
         # The seek's values reach the gateway's wire and the client's InValue as messages: waited for.
         wait_for("seek: wire value %d" % want_seq, lambda: wire_seq() == want_seq, timeout=30)
         wait_for("seek: official client's PeekInValue %d" % want_seq,
@@ -353,7 +364,7 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         want_prop = [json.loads(m.data)["value"] for m in props if m.log_time <= target][-1]
         status, p = http(base, "GET", "/api/devices/create/properties/DistanceTraveled")
         expect(status == 200 and p["value"] == want_prop, "seek: property %s, want %s" % (p, want_prop))
-        checks["seek"] = {"position_s": 1.5, "wire_seq": want_seq, "property": want_prop}
+        checks["seek"] = {"position_s": position_s, "wire_seq": want_seq, "property": want_prop}
 
         # Functions are refused with a clear error.
         try:
@@ -371,6 +382,14 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         checks["replay_gateway_exit"] = code
 
 
+def seek_position(packets, other_times, start_ns):
+    """A replay position (seconds from `start_ns`) 1 ms after the middle one of `packets` ([(log time
+    ns, seq)]) and after the first of `other_times` (ns), so that a value of each precedes it."""
+    expect(len(packets) > 0, "packets recorded")
+    at = max([packets[len(packets) // 2][0]] + ([min(other_times)] if other_times else [])) + 1_000_000
+    return (at - start_ns) / 1e9
+
+
 def mcap_core_phase(exe, work, path, checks):
     """The recording rewritten by the TypeScript reference writer (@mcap/core) replays: its wire value
     after a seek is the recorded one."""
@@ -384,15 +403,19 @@ def mcap_core_phase(exe, work, path, checks):
     expect(r.returncode == 0, "@mcap/core rewrite: %s" % r.stderr[-500:])
     proc, port, base = start_gateway(exe, ["--no-demo", "--replay", "ts_create=" + rewritten], os.path.join(work, "gateway3.log"))
     try:
-        status, st = http(base, "POST", "/api/replays/ts_create", {"state": "paused", "position_s": 2.0})
-        expect(status == 200, "seek in the @mcap/core file: %s %s" % (status, st))
-        target = st["start_ns"] + 2_000_000_000
-        want = None
+        recorded = []
         with open(path, "rb") as f:
             for _, ch, m in make_reader(f).iter_messages(topics=["create/packets"]):
-                if ch.message_encoding == "json" and m.log_time <= target:
+                if ch.message_encoding == "json":
                     d = bytes(json.loads(m.data)["value"]["Data"])
-                    want = d[2] | (d[3] << 8)
+                    recorded.append((m.log_time, d[2] | (d[3] << 8)))
+        status, st = http(base, "GET", "/api/replays/ts_create")
+        expect(status == 200, "status of the @mcap/core file's replay: %s %s" % (status, st))
+        position_s = seek_position(recorded, [], st["start_ns"])
+        status, st = http(base, "POST", "/api/replays/ts_create", {"state": "paused", "position_s": position_s})
+        expect(status == 200, "seek in the @mcap/core file: %s %s" % (status, st))
+        target = st["start_ns"] + round(position_s * 1e9)
+        want = [s for t, s in recorded if t <= target][-1]
 
         def wire_seq():
             status, w = http(base, "GET", "/api/devices/ts_create/wires/packets")
@@ -400,7 +423,7 @@ def mcap_core_phase(exe, work, path, checks):
             d = bytes(w["value"]["Data"])
             return d[2] | (d[3] << 8)
         wait_for("the @mcap/core file replays the recorded value %d" % want, lambda: wire_seq() == want, timeout=30)
-        checks["mcap_core_file"] = {"rewrite": json.loads(r.stdout), "wire_seq_at_2s": want}
+        checks["mcap_core_file"] = {"rewrite": json.loads(r.stdout), "position_s": position_s, "wire_seq": want}
     finally:
         stop(proc)
 
