@@ -7,7 +7,7 @@
 #include <boost/asio/read.hpp>
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/write.hpp>
-#include <boost/beast/base/error.hpp>
+#include <boost/beast/core/error.hpp>
 
 #include "core/session/starttls.hpp"
 #include "server/transport/tcp_connector.hpp"

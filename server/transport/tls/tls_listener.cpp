@@ -3,7 +3,7 @@
 #include <boost/asio/read.hpp>
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/write.hpp>
-#include <boost/beast/base/error.hpp>
+#include <boost/beast/core/error.hpp>
 
 #include "core/session/starttls.hpp"
 #include "server/transport/tls/tls_stream.hpp"
