@@ -2,7 +2,6 @@
 // (base/names/object_path.hpp, compiled into the WebAssembly module), so JS reads a path exactly as the
 // gateway, the service side and recording do, and fails with the same messages.
 import { toRRError } from "./errors.mjs";
-import { loadModule } from "./wasm_module.mjs";
 
 /**
  * Parses `path` (segments `name` or `name[index]` joined by '.'; an index is any text but ']', or in
@@ -11,6 +10,9 @@ import { loadModule } from "./wasm_module.mjs";
  * (`object path "a..b": expected a member name at offset 2`).
  */
 export async function parseObjectPath(path) {
+  // Imported on first use: subscription.mjs (and the dashboard's tests that run it from source, without
+  // a WebAssembly build) load this file without needing the module until a path is parsed.
+  const { loadModule } = await import("./wasm_module.mjs");
   const M = await loadModule();
   const r = M.parseObjectPath(String(path));
   if (!r.ok) throw toRRError(r.error);
