@@ -9,8 +9,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "core/names/connection_url.hpp"
-#include "core/names/node_id.hpp"
+#include "base/names/connection_url.hpp"
+#include "base/names/node_id.hpp"
 #include "server/http/forwarded.hpp"
 #include "server/record/recording_spec.hpp"
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/discovery/service_filter.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/record/recording_spec.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <ctime>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 
 namespace rr::server::gateway {

@@ -8,7 +8,7 @@
 
 #include <boost/asio/io_context.hpp>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/motion_guard.hpp"
 

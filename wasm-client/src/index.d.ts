@@ -199,6 +199,17 @@ export function connect<T extends ObjectBase = ObjectProxy>(url: string, options
 /** Loads the WebAssembly module (connect() does it on first use). */
 export function loadModule(): Promise<unknown>;
 
+/** One segment of an object path: the member name and, with brackets, the index's text (decoded). */
+export interface ObjectPathSegment {
+  name: string;
+  index?: string;
+}
+
+/** Parses an object path (`child_by_int[7].leaf`, `arms[left arm].tool`) with the C++ core's parser, the
+ *  gateway's. Rejects with RRError InvalidArgument and the core's message
+ *  (`object path "a..b": expected a member name at offset 2`). */
+export function parseObjectPath(path: string): Promise<ObjectPathSegment[]>;
+
 /** Subprotocol of RR over WebSocket. */
 export const WEBSOCKET_PROTOCOL: string;
 

@@ -1,35 +1,18 @@
 // Robot Raconteur client for browsers and node (>= 18): the C++ sans-IO client core compiled to
 // WebAssembly (robotraconteur_wasm.mjs), a WebSocket transport, and object proxies built from the
 // service's robdef. API and value mapping: README.md; types: index.d.ts.
-import createRRModule from "./robotraconteur_wasm.mjs";
 import { RRError, toRRError } from "./errors.mjs";
 import { makeProxy } from "./proxy.mjs";
 import { ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter } from "./subscription.mjs";
 import { DEFAULT_BACKOFF, backoffDelay } from "./backoff.mjs";
+import { loadModule } from "./wasm_module.mjs";
+import { parseObjectPath } from "./object_path.mjs";
 
-export { RRError, toRRError, ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter, DEFAULT_BACKOFF, backoffDelay };
+export { RRError, toRRError, ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter, DEFAULT_BACKOFF, backoffDelay,
+  loadModule, parseObjectPath };
 
 /** Subprotocol of RR over WebSocket (wire.md §8). */
 export const WEBSOCKET_PROTOCOL = "robotraconteur.robotraconteur.com";
-
-const isNode = typeof process !== "undefined" && !!process.versions?.node && typeof window === "undefined";
-
-let modulePromise = null;
-/** Loads and instantiates the WebAssembly module once. */
-export function loadModule() {
-  if (!modulePromise) {
-    modulePromise = (async () => {
-      const opts = {};
-      if (isNode) {
-        // The module is built for the web; in node it gets the bytes instead of fetching a file: URL.
-        const fs = await import("node:fs/promises");
-        opts.wasmBinary = await fs.readFile(new URL("./robotraconteur_wasm.wasm", import.meta.url));
-      }
-      return createRRModule(opts);
-    })();
-  }
-  return modulePromise;
-}
 
 const inNode = typeof process !== "undefined" && !!process.versions?.node;
 

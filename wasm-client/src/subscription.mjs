@@ -4,6 +4,7 @@
 // pipe endpoints, event handlers and callbacks the app asked for.
 import { RRError, toRRError } from "./errors.mjs";
 import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents, GOING_AWAY_WINDOW_MS } from "./backoff.mjs";
+import { parseObjectPath } from "./object_path.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
@@ -12,21 +13,27 @@ const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 
 const keepable = (e) => (e ? new RRError(e.errorName, e.message, e.code) : null);
 const invalid = (m) => new RRError("RobotRaconteur.InvalidArgument", m, 18);
 
+const INT32 = /^-?[0-9]+$/;
 
 /**
- * Walks `path` (an objref path relative to the root: "child", "child_by_int[7]", "a.b[x]"; "" = root)
- * from `root`, one objref request per segment. Resolves with the object's proxy.
+ * Walks `path` (an objref path relative to the root: "child", "child_by_int[7]", "a.b[x]"; "" = root;
+ * parsed by the core's parser, object_path.mjs) from `root`, one objref request per segment. Resolves
+ * with the object's proxy. Rejects with RRError InvalidArgument for a path that does not parse or an
+ * int32 objref's index that is not an int32, MemberNotFound for a segment that is not an objref.
  */
 export async function resolveObject(root, path) {
   let obj = root;
   if (!path) return obj;
-  for (const seg of path.split(".")) {
-    const m = /^([A-Za-z_][A-Za-z0-9_]*)(?:\[(.*)\])?$/.exec(seg);
-    if (!m) throw invalid(`bad object path segment "${seg}" in "${path}"`);
-    const member = obj.$members.find((x) => x.name === m[1]);
-    if (!member || member.kind !== "objref") throw new RRError("RobotRaconteur.MemberNotFound", `no objref "${m[1]}" on ${obj.$type}`, 9);
-    const index = m[2] === undefined ? undefined : member.index === "int32" ? Number(m[2]) : m[2];
-    obj = await obj[m[1]].get(index);
+  for (const seg of await parseObjectPath(path)) {
+    const member = obj.$members.find((x) => x.name === seg.name);
+    if (!member || member.kind !== "objref") throw new RRError("RobotRaconteur.MemberNotFound", `no objref "${seg.name}" on ${obj.$type}`, 9);
+    let index = seg.index;
+    if (index !== undefined && member.index === "int32") {
+      if (!INT32.test(index) || Number(index) !== (Number(index) | 0))
+        throw invalid(`object path "${path}": objref "${seg.name}" takes an int32 index, not "${index}"`);
+      index = Number(index);
+    }
+    obj = await obj[seg.name].get(index);
   }
   return obj;
 }
