@@ -37,6 +37,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "record"))
 from record_checks import CheckFailed, expect, recorded_so_far, report_and_clean, wait_for  # noqa: E402
 
@@ -350,7 +351,7 @@ def main():
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-cli-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     checks, ok = {}, False
     svc = subprocess.Popen([a.service, "--port", "0", "--max-lifetime", "280"], stdout=subprocess.PIPE,
                            stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)

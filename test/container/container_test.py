@@ -29,6 +29,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "test", "gateway"))
 import gwproc  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from gwproc import expect  # noqa: E402
 
 # runc with low ulimits: crun cannot set podman's default ones in these VMs (../shared/TOOLCHAIN.md §5).
@@ -148,7 +149,7 @@ def main():
         checks.run("/livez, /readyz and both demo devices through the published port", ready)
 
         def official_client():
-            RRN.RegisterTransport(RR.TcpTransport())
+            RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
             c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
             d = c.DistanceTraveled
             expect(isinstance(d, (int, float)), "create.DistanceTraveled = %r" % (d,))

@@ -25,6 +25,7 @@ import time
 import websocket  # websocket-client
 
 import gwproc
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from gwproc import expect
 
 JSON_PROTOCOL = "rr-gateway.json.v1"
@@ -55,7 +56,7 @@ def official_node():
     except ImportError:
         return None
     node = RR.RobotRaconteurNode.s
-    node.RegisterTransport(RR.TcpTransport())
+    node.RegisterTransport(official_transport.client_tcp_transport(RR))
     node.RequestTimeout = 10
     return node
 

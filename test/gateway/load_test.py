@@ -30,6 +30,7 @@ import RobotRaconteur as RR
 from prometheus_client.parser import text_string_to_metric_families
 
 import gwproc
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from gwproc import expect, wait_for
 
 RRN = RR.RobotRaconteurNode.s
@@ -259,7 +260,7 @@ def main():
     stats = {}
     dev, gw = start(a.gateway, a.devices)
     try:
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         RRN.RequestTimeout = 20
         if a.case == "fanout":
             case_fanout(checks, gw, a.clients, stats)

@@ -27,6 +27,7 @@ import websocket
 from prometheus_client.parser import text_string_to_metric_families
 
 import gwproc
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from gwproc import expect
 
 RR_SUBPROTOCOL = "robotraconteur.robotraconteur.com"
@@ -265,7 +266,7 @@ def case_metrics(checks, exe, doc):
                            device="create")[0].value
             hist0 = samples(family(before, "rr_gateway_request_duration_seconds"),
                             "rr_gateway_request_duration_seconds_count", device="create")[0].value
-            RRN.RegisterTransport(RR.TcpTransport())
+            RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
             c = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
             for _ in range(5):
                 c.DistanceTraveled

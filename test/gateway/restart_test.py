@@ -26,6 +26,7 @@ import time
 import RobotRaconteur as RR
 
 import gwproc
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from gwproc import expect, wait_for
 
 RRN = RR.RobotRaconteurNode.s
@@ -53,7 +54,7 @@ def main():
         gw = gwproc.start_gateway(a.gateway, ["--config", cfg.name])
         port = gw.port
         gwproc.wait_ready(port)
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         RRN.RequestTimeout = 10
         c_tcp = RRN.ConnectService("rr+tcp://127.0.0.1:%d/?service=create" % port)
         c_ws = RRN.ConnectService("rr+ws://127.0.0.1:%d/?service=create" % port)

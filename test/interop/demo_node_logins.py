@@ -39,6 +39,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import Checks, StepFailed, read_json_line, scratch_rr_env, start, stop, tail, write_password_file  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 # The official library reads its node folders from the environment: point this process (the client)
 # and the gateway (started with this environment) at one scratch tree before the library loads.
@@ -159,7 +160,7 @@ demo:
         summary["demo_nodename"] = node_name + ".demo"
         api_answers = [body]
 
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         RRN.RegisterTransport(RR.LocalTransport())
 
         def direct(scheme):

@@ -31,6 +31,7 @@ import traceback
 import numpy as np
 
 import RobotRaconteur as RR
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 RRN = RR.RobotRaconteurNode.s
 
@@ -483,7 +484,7 @@ def main(argv=None):
         summary.update({"create_url": create_url, "webcam_url": webcam_url})
 
         RRN.SetLogLevelFromEnvVariable()
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         if create_url.startswith("rr+local:"):
             RRN.RegisterTransport(RR.LocalTransport())
         r = Runner(create_url, webcam_url)

@@ -46,6 +46,7 @@ import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import StepFailed, read_json_line, start, stop, tail  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 try:
     import websocket  # websocket-client
@@ -135,7 +136,7 @@ def official_node():
         except ImportError as e:
             _official.append((None, str(e)))
         else:
-            RR.RobotRaconteurNode.s.RegisterTransport(RR.TcpTransport())
+            RR.RobotRaconteurNode.s.RegisterTransport(official_transport.client_tcp_transport(RR))
             _official.append((RR.RobotRaconteurNode.s, None))
     return _official[0]
 

@@ -49,6 +49,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from child_procs import Checks, StepFailed, read_json_line, start, stop, tail, write_password_file  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 try:
     import RobotRaconteur as RR
@@ -138,7 +139,7 @@ HOLDER = r"""
 import sys, time
 import RobotRaconteur as RR
 RRN = RR.RobotRaconteurNode.s
-RRN.RegisterTransport(RR.TcpTransport())
+RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
 c = RRN.ConnectService(sys.argv[1], sys.argv[2], {"password": RR.VarValue(sys.argv[3], "string")})
 RRN.MonitorEnter(c, -1)
 print("held", flush=True)
@@ -220,7 +221,7 @@ devices:
         except AssertionError as e:
             raise StepFailed("%s: %s" % (e, tail(os.path.join(work, "gateway.err"))))
 
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
 
         def connect(name, user):
             c = RRN.ConnectService(url(name), user, creds(user))

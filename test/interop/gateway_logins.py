@@ -52,6 +52,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import Checks, StepFailed, read_json_line, start, stop, tail, write_password_file  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 try:
     import RobotRaconteur as RR
@@ -213,7 +214,7 @@ devices:
                 raise StepFailed("gateway not ready: " + tail(os.path.join(work, "gateway.err")))
             time.sleep(0.2)
 
-        RRN.RegisterTransport(RR.TcpTransport())
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         conns = {}
 
         # ---- raw RR, the official client ----

@@ -42,6 +42,7 @@ import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import StepFailed, die_with_parent, read_json_line, start, stop, tail, write_password_file  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 try:
     import RobotRaconteur as RR
@@ -137,7 +138,7 @@ def connect(url, user, password=None):
 
 
 def register_transport():
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
 
 
 def child_lock(url, user, password):

@@ -26,6 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import interop_values as iv  # noqa: E402
 
 import RobotRaconteur as RR  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 RRN = RR.RobotRaconteurNode.s
 
@@ -611,7 +612,7 @@ def main(argv=None):
     watchdog.start()
 
     RRN.SetLogLevelFromEnvVariable()
-    t = RR.TcpTransport()
+    t = official_transport.client_tcp_transport(RR)
     t.DisableMessage4 = args.disable_message4
     t.DisableStringTable = args.disable_stringtable
     if args.heartbeat is not None:

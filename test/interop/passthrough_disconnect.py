@@ -31,6 +31,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import StepFailed, get_json, read_json_line, start, stop, tail  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 try:
     import RobotRaconteur as RR
@@ -128,7 +129,7 @@ def main():
             if time.monotonic() > deadline:
                 raise StepFailed("gateway device not connected: %s" % tail(gw_err))
             time.sleep(0.1)
-        RRN.RegisterTransport(RR.TcpTransport())  # the official client's rr+tcp and rr+ws
+        RRN.RegisterTransport(official_transport.client_tcp_transport(RR))  # the official client's rr+tcp and rr+ws
         # A request's answer may take long on a loaded machine; a request that never comes back is a hang,
         # which the watchdog reports (args.timeout without a round).
         RRN.RequestTimeout = max(RRN.RequestTimeout, 2 * args.timeout)

@@ -42,6 +42,7 @@ import traceback
 import numpy as np
 
 import RobotRaconteur as RR
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 
 RRN = RR.RobotRaconteurNode.s
 
@@ -392,7 +393,7 @@ def main(argv=None):
     watchdog.start()
 
     RRN.SetLogLevelFromEnvVariable()
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
 
     summary = {"ok": False, "url": args.url}
     try:

@@ -41,6 +41,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import die_with_parent, read_json_line, stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from record_checks import (CheckFailed, exit_status, expect, foxglove_check, http, recorded_so_far, report_and_clean,  # noqa: E402
                            stop_recording, wait_for)
 
@@ -495,7 +496,7 @@ def main():
                     help="report: measure the replay's spacing but leave judging it to a run on a quieter CPU")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-test-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     checks = {}
     ok = False
     try:

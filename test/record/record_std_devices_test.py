@@ -37,6 +37,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEVICES = os.path.join(HERE, "..", "browser", "devices")
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from record_checks import (CheckFailed, exit_status, expect, foxglove_check, http, official_foxglove_schemas,  # noqa: E402
                            recorded_so_far, report_and_clean, stop_recording, wait_for)
 
@@ -303,7 +304,7 @@ def main():
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-std-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     RRC.RegisterStdRobDefServiceTypes(RRN)
     checks, ok = {}, False
     try:

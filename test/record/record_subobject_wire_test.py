@@ -53,6 +53,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "interop"))
 sys.path.insert(0, HERE)
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from record_checks import (CheckFailed, exit_status, expect, foxglove_check, http, recorded_so_far, report_and_clean,  # noqa: E402
                            stop_recording, wait_for)
 import record_replay_test  # noqa: E402  (its gateway launcher)
@@ -427,7 +428,7 @@ def main():
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-subwire-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     RRC.RegisterStdRobDefServiceTypes(RRN)
     checks, ok = {}, False
     try:

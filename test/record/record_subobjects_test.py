@@ -33,6 +33,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "interop"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from child_procs import stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from record_checks import CheckFailed, expect, http, recorded_so_far, report_and_clean, stop_recording, wait_for  # noqa: E402
 from record_replay_test import start_gateway  # noqa: E402
 
@@ -188,7 +189,7 @@ def main():
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-record-sub-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     checks = {}
     ok = False
     try:

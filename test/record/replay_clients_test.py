@@ -40,6 +40,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "interop"))
 from child_procs import StepFailed, die_with_parent, read_json_line, stop  # noqa: E402
+import official_transport  # noqa: E402  (the official client's transport, its connect timeout)
 from record_checks import CheckFailed, expect, http, recorded_so_far, report_and_clean, wait_for  # noqa: E402
 
 try:
@@ -415,7 +416,7 @@ def main():
     ap.add_argument("--keep", action="store_true")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rr-replay-clients-")
-    RRN.RegisterTransport(RR.TcpTransport())
+    RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
     checks = {}
     ok, wasm_skip = False, None
     try:
