@@ -139,7 +139,9 @@ HOLDER = r"""
 import sys, time
 import RobotRaconteur as RR
 RRN = RR.RobotRaconteurNode.s
-RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
+t = RR.TcpTransport()
+t._SetDefaultConnectTimeout(60000)  # a bound on a hang (official_transport.py)
+RRN.RegisterTransport(t)
 c = RRN.ConnectService(sys.argv[1], sys.argv[2], {"password": RR.VarValue(sys.argv[3], "string")})
 RRN.MonitorEnter(c, -1)
 print("held", flush=True)
