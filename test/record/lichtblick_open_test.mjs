@@ -198,15 +198,22 @@ test("Lichtblick opens the recordings: topics, raw messages, a plot and the came
     `Raw Messages shows a packet of ${packetBytes} bytes`, 30000);
   assert.match(await panel("RawMessages!wire").innerText(), /experimental\.create\.Create\.packets/);
 
-  // Plot: a rising line, so its pixels (the series' colour) span many rows of the chart
-  await new Promise((r) => setTimeout(r, 2000));
-  const plot = await pixels(panel("Plot!dist"));
-  const rows = new Set();
-  for (let i = 0; i < plot.data.length; i += 4) {
-    const [r, g, b] = plot.data.slice(i, i + 3);
-    if (b > 150 && b - r > 60 && b - g > 20) rows.add(Math.floor(i / 4 / plot.width));
-  }
-  assert.ok(rows.size > plot.height / 4, `the plotted line spans ${rows.size} of ${plot.height} rows (rising data)`);
+  // Plot: a rising line, so its pixels (the series' colour) span many rows of the chart. Waited for
+  // (the bound is on a hang): under load Lichtblick draws it seconds later; a fixed 2 s wait failed.
+  let rows = new Set();
+  let plotHeight = 0;
+  const plotRows = async () => {
+    const plot = await pixels(panel("Plot!dist"));
+    rows = new Set();
+    plotHeight = plot.height;
+    for (let i = 0; i < plot.data.length; i += 4) {
+      const [r, g, b] = plot.data.slice(i, i + 3);
+      if (b > 150 && b - r > 60 && b - g > 20) rows.add(Math.floor(i / 4 / plot.width));
+    }
+    return rows.size > plot.height / 4;
+  };
+  await waitFor(plotRows, "the plotted line spans a quarter of the chart's rows", 60000, 500).catch(() => {});
+  assert.ok(rows.size > plotHeight / 4, `the plotted line spans ${rows.size} of ${plotHeight} rows (rising data)`);
 
   // Image panel: the synthetic camera's picture (many saturated colours), from the foxglove.* channel
   const img = await pixels(panel("Image!cam"));
