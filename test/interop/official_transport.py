@@ -9,10 +9,10 @@ at once on 2 vCPUs beside sanitizer builds) it took longer and `ConnectService` 
 CONNECT_TIMEOUT_S = 60
 
 
-def client_tcp_transport(RR, node=None):
-    """A TcpTransport (rr+tcp, rr+ws, rr+wss) for `node` (default: the node singleton) with the
-    test's connect timeout; the caller registers it."""
-    t = RR.TcpTransport(node) if node is not None else RR.TcpTransport()
+def client_tcp_transport(RR):
+    """A TcpTransport (rr+tcp, rr+ws, rr+wss) of the node singleton with the test's connect timeout;
+    the caller registers it."""
+    t = RR.TcpTransport()
     # (milliseconds as an int: the property's setter passes a float, which the binding refuses)
     t._SetDefaultConnectTimeout(int(CONNECT_TIMEOUT_S * 1000))
     return t

@@ -23,9 +23,9 @@ import xml.etree.ElementTree as ET
 SKIP_LINE = re.compile(r"\bSKIP(?:PED)?\b[:\s]", re.IGNORECASE)
 
 
-def cases(path, with_time=False):
-    """(name, status, output) for each test case of one JUnit file; status is pass, fail or skip.
-    with_time: (name, status, output, seconds)."""
+def cases(path):
+    """(name, status, output, seconds) for each test case of one JUnit file; status is pass, fail or
+    skip."""
     try:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as e:
@@ -40,14 +40,11 @@ def cases(path, with_time=False):
             status = "skip"
         else:
             status = "pass"
-        if with_time:
-            try:
-                seconds = float(case.get("time", "0"))
-            except ValueError:
-                seconds = 0.0
-            yield name, status, out, seconds
-        else:
-            yield name, status, out
+        try:
+            seconds = float(case.get("time", "0"))
+        except ValueError:
+            seconds = 0.0
+        yield name, status, out, seconds
 
 
 def skip_reason(output):
@@ -64,7 +61,7 @@ def safe_name(name):
 def cmd_skipped(files):
     seen = {}
     for path in files:
-        for name, status, out in cases(path):
+        for name, status, out, _ in cases(path):
             if status == "skip":
                 seen[name] = skip_reason(out)
     for name in sorted(seen):
@@ -74,7 +71,7 @@ def cmd_skipped(files):
 
 def cmd_failed(files, out_dir):
     for path in files:
-        for name, status, out in cases(path):
+        for name, status, out, _ in cases(path):
             if status != "fail":
                 continue
             where = ""
@@ -91,7 +88,7 @@ def cmd_failed(files, out_dir):
 def cmd_slowest(count, files):
     times = []
     for path in files:
-        for name, _, _, seconds in cases(path, with_time=True):
+        for name, _, _, seconds in cases(path):
             times.append((seconds, name))
     times.sort(key=lambda t: (-t[0], t[1]))
     for seconds, name in times[:count]:
@@ -105,7 +102,7 @@ def cmd_summary(runs_dir):
     totals = {}
     for path in runs:
         run = os.path.basename(os.path.dirname(path))
-        for name, status, _ in cases(path):
+        for name, status, _, _ in cases(path):
             totals[name] = totals.get(name, 0) + 1
             if status == "fail":
                 failures.setdefault(name, []).append(run)
