@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -480,7 +481,12 @@ private:
     // The subscribe reply: the id, the kind, and the rate and queue length it got.
     static nlohmann::json subscribe_result(std::uint64_t sid, const JsonSubscription& s) {
         nlohmann::json r{{"subscription", sid}, {"kind", kind_name(s.kind)}};
-        if (s.rate.limited()) r["max_rate_hz"] = s.max_rate_hz;
+        if (s.rate.limited()) {
+            // As the client wrote it: 2, not 2.0.
+            const double whole = std::floor(s.max_rate_hz);
+            if (whole == s.max_rate_hz) r["max_rate_hz"] = static_cast<std::int64_t>(whole);
+            else r["max_rate_hz"] = s.max_rate_hz;
+        }
         if (s.rate.limited() && s.kind == SubscriptionKind::pipe) r["queue_length"] = s.queue_length;
         return r;
     }
