@@ -70,7 +70,7 @@ struct JsonSocketStats {
     std::uint64_t socket_dropped = 0;          ///< dropped by the socket's queue limit
     std::uint64_t push_drops = 0;              ///< events / pipe packets dropped by this layer
     std::uint64_t wire_coalesced = 0;          ///< wire values replaced by a newer one before sending
-    std::size_t pending_wires = 0;             ///< subscriptions with a wire value waiting
+    std::size_t pending_wires = 0;             ///< subscriptions with a wire value (or rate-limited pipe packets) waiting
 };
 
 class JsonSocketSession;
