@@ -167,8 +167,6 @@ private:
         if (!v.is_array() || v.size() < 2 || v[1].get<double>() < 0) return;
         on_value(now, v[0].get<double>(), v[1].get<double>());
     }
-    // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array
-    // (a double[] such as Ticks, or a uint8[] frame whose first 16 bytes are those two doubles).
     // Foxglove: subscribe once the topic's channel is advertised.
     void on_foxglove_text(const nlohmann::json& msg) {
         if (subscribed_ || msg.is_discarded() || msg.value("op", "") != "advertise" || !msg["channels"].is_array()) return;
@@ -193,6 +191,8 @@ private:
         if (v.size() < 2 || !v[0].is_number() || !v[1].is_number()) return;
         on_value(now, v[0].get<double>(), v[1].get<double>());
     }
+    // A binary push (docs/json-api.md "Binary pushes"): the stamp and sequence straight from the array
+    // (a double[] such as Ticks, or a uint8[] frame whose first 16 bytes are those two doubles).
     void on_binary(std::string_view m) {
         const double now = rr::bench::wall_clock_us();
         if (!foxglove_topic_.empty()) return on_foxglove_binary(now, m);

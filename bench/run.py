@@ -625,6 +625,8 @@ def main(argv=None):
     ap.add_argument("--no-busy", action="store_true", help="do not start the two nice-19 busy loops")
     ap.add_argument("--skip-fanout", action="store_true")
     ap.add_argument("--skip-scale", action="store_true")
+    ap.add_argument("--fanout-clients", help="client counts of the fan-out rows, comma-separated (default 10,100,1000; "
+                    "--quick: 10,100); each count gets a JSON and a Foxglove row")
     ap.add_argument("--skip-calls", action="store_true", help="only fan-out and scale")
     ap.add_argument("--rr-fanout", action="store_true", help="also: N native RR clients on a wire through the gateway (rr+ws)")
     ap.add_argument("--rr-fanout-threads", type=int, default=1, help="IO threads of rr_bench_rr_fanout (default 1)")
@@ -768,7 +770,9 @@ def main(argv=None):
                 sg.stop()
                 procs.remove(sg)
             if not args.skip_fanout:
-                for n in ([10, 100] if args.quick else [10, 100, 1000]):
+                counts = [int(x) for x in args.fanout_clients.split(",")] if args.fanout_clients else (
+                    [10, 100] if args.quick else [10, 100, 1000])
+                for n in counts:
                     log("fan-out: %d WebSocket clients" % n)
                     sampler = Sampler(gpid)
                     sampler.start()

@@ -55,7 +55,7 @@ local_base=localhost/debian:bookworm-local
 [ -n "$base" ] || base=$local_base
 
 # What the image is built from (keep in step with the Containerfile's COPY and rootfs.sh).
-inputs=(CMakeLists.txt CMakePresets.json cmake core robdef server packaging gateway-config
+inputs=(CMakeLists.txt CMakePresets.json cmake base core robdef server packaging gateway-config
         docker/Containerfile docker/rootfs.sh docker/entrypoint.sh docker/build.sh)
 key() {
   {

@@ -21,7 +21,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "robdef/diagnostic.hpp"
 #include "robdef/service_definition.hpp"
 

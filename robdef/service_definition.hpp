@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/message/data_types.hpp"
+#include "base/message/data_types.hpp"
 
 namespace rr::robdef {
 

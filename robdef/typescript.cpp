@@ -144,9 +144,16 @@ private:
 
     const ServiceDefinition& def_;
     const TypeLookup& lookup_;
+    // Text of both forms: the .d.ts (declarations) and the .ts (declarations and values in one module).
+    void both(std::string_view text) {
+        body_ += text;
+        src_ += text;
+    }
+
     std::set<std::string> imported_services_;
-    std::string body_;  // declarations after the imports
-    std::string js_;
+    std::string body_;  // .d.ts: declarations after the imports
+    std::string src_;   // .ts: the same declarations, constants and enums as values
+    std::string js_;    // .js beside the .d.ts: constants and enums as values
 };
 
 std::string Generator::named_ref(const TypeDefinition& t) {
@@ -311,29 +318,32 @@ void Generator::doc(const std::vector<std::string>& lines, std::string_view inde
         while (!l.empty() && (l.back() == ' ' || l.back() == '\r')) l.pop_back();
     }
     if (all.size() == 1) {
-        body_ += std::string(indent) + "/** " + all[0] + " */\n";
+        both(std::string(indent) + "/** " + all[0] + " */\n");
         return;
     }
-    body_ += std::string(indent) + "/**\n";
-    for (const auto& l : all) body_ += std::string(indent) + (l.empty() ? " *" : " * " + l) + "\n";
-    body_ += std::string(indent) + " */\n";
+    both(std::string(indent) + "/**\n");
+    for (const auto& l : all) both(std::string(indent) + (l.empty() ? " *" : " * " + l) + "\n");
+    both(std::string(indent) + " */\n");
 }
 
 void Generator::emit_enum(const EnumDefinition& e) {
     doc(e.docstring, "", {"Enum `" + def_.name + "." + e.name + "`: travels as an int32; the package gives the number."});
     std::string values;
     for (const auto& v : e.values) values += (values.empty() ? "" : " | ") + std::to_string(v.value);
-    body_ += "export type " + e.name + " = " + (values.empty() ? "number" : values) + ";\n";
+    both("export type " + e.name + " = " + (values.empty() ? "number" : values) + ";\n");
     body_ += "export declare const " + e.name + ": {\n";
+    src_ += "export const " + e.name + " = Object.freeze({\n";
     js_ += "export const " + e.name + " = Object.freeze({";
     bool first = true;
     for (const auto& v : e.values) {
         doc(v.docstring, "  ");
         body_ += "  readonly " + v.name + ": " + std::to_string(v.value) + ";\n";
+        src_ += "  " + v.name + ": " + std::to_string(v.value) + ",\n";
         js_ += std::string(first ? " " : ", ") + v.name + ": " + std::to_string(v.value);
         first = false;
     }
     body_ += "};\n\n";
+    src_ += "} as const);\n\n";
     js_ += " });\n";
 }
 
@@ -397,9 +407,11 @@ void Generator::emit_constants(const std::vector<ConstantDefinition>& constants,
         doc(c.docstring, entry ? "  " : "", {"Constant `" + c.type.to_string() + " " + c.name + " " + trimmed(c.value) + "`."});
         if (entry) {
             body_ += "  readonly " + c.name + ": " + ts + ";\n";
+            src_ += "  " + c.name + ": " + js + " as " + ts + ",\n";
             js_ += "  " + c.name + ": " + js + ",\n";
         } else {
             body_ += "export declare const " + c.name + ": " + ts + ";\n";
+            src_ += "export const " + c.name + ": " + ts + " = " + js + ";\n";
             js_ += "export const " + c.name + " = " + js + ";\n";
         }
     }
@@ -422,7 +434,7 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
         }
     }
     doc(e.docstring, "", extra);
-    body_ += "export interface " + e.name + (e.kind == EntryKind::object ? " extends $rr.ObjectBase" : "") + " {\n";
+    both("export interface " + e.name + (e.kind == EntryKind::object ? " extends $rr.ObjectBase" : "") + " {\n");
     const DataTypes element = e.kind == EntryKind::namedarray ? namedarray_element(e) : DataTypes::void_t;
     bool then_member = false;
     for (const auto& m : e.members) {
@@ -440,41 +452,43 @@ void Generator::emit_entry(const ServiceEntryDefinition& e) {
         mextra.push_back("`" + sig + "`");
         doc(m.docstring, "  ", mextra);
         if (e.kind == EntryKind::namedarray)
-            body_ += "  " + m.name + ": " + namedarray_field_ts(m, element) + ";\n";
+            both("  " + m.name + ": " + namedarray_field_ts(m, element) + ";\n");
         else if (e.kind == EntryKind::pod)
-            body_ += "  " + m.name + ": " + value_ts(m.type) + ";\n";
+            both("  " + m.name + ": " + value_ts(m.type) + ";\n");
         else if (e.kind == EntryKind::object && m.name == "then") {
             // A proxy never has a `then` property (it would be a thenable: `await` would call it); the
             // package gives such a member by $member("then").
-            body_ += "  $member(name: \"then\"): " + member_type_ts(m) + ";\n";
+            both("  $member(name: \"then\"): " + member_type_ts(m) + ";\n");
             then_member = true;
         } else
-            body_ += "  " + member_ts(m) + ";\n";
+            both("  " + member_ts(m) + ";\n");
     }
-    if (then_member) body_ += "  $member(name: string): any;\n";
-    body_ += "}\n";
+    if (then_member) both("  $member(name: string): any;\n");
+    both("}\n");
     if (!e.constants.empty()) {
-        body_ += "/** Constants of `" + qualified + "`. */\n";
+        both("/** Constants of `" + qualified + "`. */\n");
         body_ += "export declare const " + e.name + ": {\n";
+        src_ += "export const " + e.name + " = Object.freeze({\n";
         js_ += "export const " + e.name + " = Object.freeze({\n";
         emit_constants(e.constants, &e);
         body_ += "};\n";
+        src_ += "});\n";
         js_ += "});\n";
     }
-    body_ += "\n";
+    both("\n");
 }
 
 TypeScriptModule Generator::run(const TypeScriptOptions& options) {
     std::vector<std::string> extra;
     if (def_.stdver) extra.push_back("stdver " + def_.stdver->to_string());
     doc(def_.docstring, "", extra);
-    if (!body_.empty()) body_ += "\n";
+    if (!body_.empty()) both("\n");
     emit_constants(def_.constants, nullptr);
-    if (!def_.constants.empty()) body_ += "\n";
+    if (!def_.constants.empty()) both("\n");
     for (const auto& e : def_.enums) emit_enum(e);
     for (const auto& ex : def_.exceptions) {
         doc(ex.docstring, "", {"Exception `" + def_.name + "." + ex.name + "`: an RRError with this errorName."});
-        body_ += "export type " + ex.name + "Name = \"" + def_.name + "." + ex.name + "\";\n\n";
+        both("export type " + ex.name + "Name = \"" + def_.name + "." + ex.name + "\";\n\n");
     }
     for (const auto* list : {&def_.structures, &def_.pods, &def_.namedarrays, &def_.objects})
         for (const auto& e : *list) emit_entry(e);
@@ -487,9 +501,16 @@ TypeScriptModule Generator::run(const TypeScriptOptions& options) {
     for (const auto& svc : imported_services_)
         head += "import type * as " + typescript_namespace_name(svc) + " from \"./" + svc + ".js\";\n";
     out.declarations = head + "\n" + body_;
-    while (out.declarations.size() > 1 && out.declarations.back() == '\n' &&
-           out.declarations[out.declarations.size() - 2] == '\n')
-        out.declarations.pop_back();
+    // The .ts imports only what it uses: an unused import fails builds with noUnusedLocals.
+    std::string src_head = "// Generated by `rr-robdef ts` from service definition " + def_.name +
+                           ": the types the robotraconteur-wasm package gives and takes, its enums and constants as values. Do not edit.\n";
+    if (src_.find("$rr.") != std::string::npos) src_head += "import type * as $rr from \"" + options.package + "\";\n";
+    for (const auto& svc : imported_services_)
+        src_head += "import type * as " + typescript_namespace_name(svc) + " from \"./" + svc + ".js\";\n";
+    out.source = src_head + "\n" + src_;
+    for (auto* text : {&out.declarations, &out.source})
+        while (text->size() > 1 && text->back() == '\n' && (*text)[text->size() - 2] == '\n') text->pop_back();
+    if (src_.empty()) out.source += "export {};\n";
     out.javascript = "// Generated by `rr-robdef ts` from service definition " + def_.name +
                      ": its enums and constants (the types are in the .d.ts). Do not edit.\n" +
                      (js_.empty() ? std::string("export {};\n") : js_);

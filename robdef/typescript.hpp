@@ -19,10 +19,14 @@ struct TypeScriptOptions {
     std::string package = "robotraconteur-wasm";
 };
 
-/// One definition as an ES module: `<service>.d.ts` (declarations) and `<service>.js` (its enums and
-/// constants as values; nothing else, so `import type` of the module costs nothing).
+/// One definition as an ES module, in two forms:
+///  - `<service>.ts` (`source`): types, enums and constants in one TypeScript module, for an app's own
+///    source tree (every build tool compiles or bundles it: tsc with outDir, esbuild, Vite, webpack);
+///  - `<service>.d.ts` + `<service>.js` (`declarations`, `javascript`): the same as a package ships them
+///    (the .js holds only the enums and constants, so `import type` of the module costs nothing).
 struct TypeScriptModule {
     std::string file_stem;     ///< the service name: `com.robotraconteur.robotics.robot`
+    std::string source;        ///< the .ts text
     std::string declarations;  ///< the .d.ts text
     std::string javascript;    ///< the .js text
 };

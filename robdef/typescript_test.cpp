@@ -154,6 +154,49 @@ TEST_CASE("ts: value types as the wasm package gives them (README Values)") {
     CHECK(has(d, "export declare const greeting: \"hi \\\"there\\\"\";"));
 }
 
+TEST_CASE("ts: the .ts form holds the declarations and the enums and constants as values") {
+    auto set = load({kValues});
+    auto mod = to_typescript(*set.find_service("t.values"), set);
+    const auto& src = mod.source;
+    INFO(src);
+    // the same interfaces and types as the .d.ts
+    CHECK(has(src, "import type * as $rr from \"robotraconteur-wasm\";"));
+    CHECK(has(src, "  i64: bigint;\n"));
+    CHECK(has(src, "  list: Array<S | null> | null;\n"));
+    CHECK(has(src, "export type Color = 0 | 1 | 16 | -5;"));
+    // values, not ambient declarations: a build emits them (tsc with outDir, bundlers)
+    CHECK_FALSE(has(src, "declare"));
+    CHECK(has(src, "export const Color = Object.freeze({\n  red: 0,\n  green: 1,\n  blue: 16,\n  minus: -5,\n} as const);"));
+    CHECK(has(src, "export const greeting: \"hi \\\"there\\\"\" = \"hi \\\"there\\\"\";"));
+    CHECK(has(src, "export const big: bigint = 0xFFFFFFFFFFFFFFFFn;"));
+    CHECK(has(src, "export const small: Int32Array = Int32Array.of(1, 2, -3);"));
+    CHECK(has(src, "export const S = Object.freeze({\n"));
+    CHECK(has(src, "  NAME: \"s\" as \"s\",\n});"));
+    // the `##` doc comments too
+    CHECK(has(src, "/**\n * A color.\n *\n * Enum `t.values.Color`"));
+}
+
+TEST_CASE("ts: the .ts form imports the package only when it uses it (noUnusedLocals builds)") {
+    auto set = load({R"(service t.plain
+
+stdver 0.10
+
+enum Mode
+    a = 1,
+    b
+end
+
+struct Point
+    field double x
+end
+)"});
+    auto src = to_typescript(*set.find_service("t.plain"), set).source;
+    INFO(src);
+    CHECK_FALSE(has(src, "import"));
+    CHECK(has(src, "export const Mode = Object.freeze({\n  a: 1,\n  b: 2,\n} as const);"));
+    CHECK(has(src, "export interface Point {"));
+}
+
 TEST_CASE("ts: objects as interfaces of member proxies, by kind and direction") {
     auto set = load({R"(service t.obj
 

@@ -31,7 +31,11 @@ mkdir -p "$dist"
 copy_if_changed() { cmp -s "$1" "$2" 2>/dev/null || { cp "$1" "$2.tmp$$" && mv -f "$2.tmp$$" "$2"; }; }
 copy_if_changed "$build/robotraconteur_wasm.mjs" "$dist/robotraconteur_wasm.mjs"
 copy_if_changed "$build/robotraconteur_wasm.wasm" "$dist/robotraconteur_wasm.wasm"
+# rr-robdef for node: the package's `rr-robdef` command (src/rr_robdef.mjs, package.json "bin") runs it
+copy_if_changed "$build/rr_robdef_node.cjs" "$dist/rr_robdef_node.cjs"
+copy_if_changed "$build/rr_robdef_node.wasm" "$dist/rr_robdef_node.wasm"
 for f in "$here"/src/*.mjs "$here"/src/*.d.ts; do copy_if_changed "$f" "$dist/$(basename "$f")"; done
+chmod +x "$dist/rr_robdef.mjs"
 copy_if_changed "$here/README.md" "$dist/README.md"
 # The dashboard's folders that are packages of their own, each copied whole with its declarations and
 # nothing else (they import nothing from outside their folder but each other: web/test/std_package.test.mjs):
@@ -64,7 +68,7 @@ if compgen -G "$std_robdefs/*.robdef" >/dev/null; then
   gen="$build/std-types.tmp"
   rm -rf "$gen"
   # --no-experimental-fetch: emscripten 3.1.6 would fetch() the .wasm by path under node 18+
-  node --no-experimental-fetch "$build/rr_robdef_node.cjs" ts -o "$gen" "$std_robdefs"/*.robdef
+  node --no-experimental-fetch "$build/rr_robdef_node.cjs" ts --dts -o "$gen" "$std_robdefs"/*.robdef
   mkdir -p "$dist/types/std"
   for f in "$gen"/*; do copy_if_changed "$f" "$dist/types/std/$(basename "$f")"; done
   for f in "$dist"/types/std/*; do [ -f "$gen/$(basename "$f")" ] || rm -f "$f"; done

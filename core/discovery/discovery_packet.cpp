@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 
 namespace rr::discovery {
 

@@ -21,8 +21,8 @@
 #include <variant>
 
 #include "core/discovery/ip_address.hpp"
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 
 namespace rr::discovery {
 

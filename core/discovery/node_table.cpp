@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 
 namespace rr::discovery {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 #include "core/value/value.hpp"
 
 namespace rr::discovery {

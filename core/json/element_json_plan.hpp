@@ -23,8 +23,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/codec/limits.hpp"
-#include "core/message/message.hpp"
+#include "base/codec/limits.hpp"
+#include "base/message/message.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"
 

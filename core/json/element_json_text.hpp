@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 #include "robdef/service_definition.hpp"
 
 namespace rr::element_json_text {

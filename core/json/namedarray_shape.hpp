@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/named_type.hpp"
 
 namespace rr {

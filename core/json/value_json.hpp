@@ -31,8 +31,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/codec/limits.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/codec/limits.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"

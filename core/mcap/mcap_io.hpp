@@ -12,7 +12,7 @@
 #include <span>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::mcap {
 

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/codec/endian.hpp"
+#include "base/codec/endian.hpp"
 #include "core/mcap/mcap_compression.hpp"
 #include "core/mcap/mcap_record_codec.hpp"
 

@@ -39,7 +39,7 @@
 #include <set>
 #include <string>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/mcap/mcap_io.hpp"
 #include "core/mcap/mcap_records.hpp"
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "core/codec/endian.hpp"
+#include "base/codec/endian.hpp"
 #include "core/mcap/mcap_record_codec.hpp"
 #include "core/mcap/mcap_test_files.hpp"
 

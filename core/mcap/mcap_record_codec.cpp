@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <optional>
 
-#include "core/codec/byte_reader.hpp"
-#include "core/codec/byte_writer.hpp"
+#include "base/codec/byte_reader.hpp"
+#include "base/codec/byte_writer.hpp"
 
 namespace rr::mcap::detail {
 namespace {

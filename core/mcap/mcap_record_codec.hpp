@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/mcap/mcap_records.hpp"
 
 namespace rr::mcap::detail {

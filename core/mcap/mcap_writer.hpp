@@ -35,7 +35,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/mcap/mcap_io.hpp"
 #include "core/mcap/mcap_records.hpp"
 

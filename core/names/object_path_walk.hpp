@@ -1,7 +1,7 @@
-// Walking an object path (object_path.hpp) through the objrefs' declared types over a definition set:
-// the type of the object at `arms[left].tool` below a `example.arm.Cell` is the type its last objref
-// declares, found without asking the device. Above core/names' own layer (it reads robdef's type
-// model): compiled into rr_core.
+// Walking an object path (base/names/object_path.hpp) through the objrefs' declared types over a
+// definition set: the type of the object at `arms[left].tool` below a `example.arm.Cell` is the type its
+// last objref declares, found without asking the device. Above robdef (it reads robdef's type model), so
+// in core/, compiled into rr_core; the parser is in base/.
 //
 // Errors (InvalidArgument), `P` the path's text as given to parse_object_path, `T` the type walked so far:
 //   unknown object type R                                    (the root type)
@@ -17,8 +17,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/object_path.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/object_path.hpp"
 #include "robdef/service_definition_set.hpp"
 
 namespace rr {

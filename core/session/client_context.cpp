@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "core/core_version.hpp"
-#include "core/names/service_path.hpp"
+#include "base/names/service_path.hpp"
 #include "core/session/client_state.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/named_type.hpp"

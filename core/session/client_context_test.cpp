@@ -5,7 +5,7 @@
 #include <deque>
 #include <functional>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/client_context.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"

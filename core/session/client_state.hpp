@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/client_context.hpp"
 
 namespace rr {

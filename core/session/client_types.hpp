@@ -12,7 +12,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/session/stream_connection.hpp"
 #include "core/value/timespec.hpp"
 #include "core/value/value.hpp"

@@ -12,8 +12,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/message/error_entry.hpp"
-#include "core/message/message.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/message/message.hpp"
 
 namespace rr {
 

@@ -2,8 +2,8 @@
 
 #include <utility>
 
-#include "core/message/error_entry.hpp"
-#include "core/names/service_path.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/names/service_path.hpp"
 #include "core/session/elements.hpp"
 
 namespace rr {

@@ -4,7 +4,7 @@
 
 #include <set>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/client_session.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/service_session.hpp"

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-#include "core/message/error_entry.hpp"
-#include "core/message/message_reader.hpp"
-#include "core/message/message_writer.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/message/message_reader.hpp"
+#include "base/message/message_writer.hpp"
 #include "core/session/elements.hpp"
 
 namespace rr {

@@ -26,9 +26,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/codec/limits.hpp"
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/codec/limits.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 #include "core/session/stream_connection.hpp"
 
 namespace rr {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string_view>
 
-#include "core/message/message_writer.hpp"
+#include "base/message/message_writer.hpp"
 #include "core/session/elements.hpp"
 
 namespace rr {

@@ -24,13 +24,13 @@
 #include <variant>
 #include <vector>
 
-#include "core/codec/gather_buffer.hpp"
-#include "core/codec/limits.hpp"
-#include "core/message/encoded_entry.hpp"
-#include "core/message/message.hpp"
-#include "core/message/message_reader.hpp"
-#include "core/message/entry_vector_pool.hpp"
-#include "core/message/message_stream_reader.hpp"
+#include "base/codec/gather_buffer.hpp"
+#include "base/codec/limits.hpp"
+#include "base/message/encoded_entry.hpp"
+#include "base/message/message.hpp"
+#include "base/message/message_reader.hpp"
+#include "base/message/entry_vector_pool.hpp"
+#include "base/message/message_stream_reader.hpp"
 
 namespace rr {
 

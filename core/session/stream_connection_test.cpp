@@ -3,8 +3,8 @@
 #include <fstream>
 #include <iterator>
 
-#include "core/message/message_writer.hpp"
-#include "core/message/string_table.hpp"
+#include "base/message/message_writer.hpp"
+#include "base/message/string_table.hpp"
 #include "core/session/elements.hpp"
 #include "core/session/stream_connection.hpp"
 #include "test/support/skip.hpp"

@@ -8,8 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "core/value/named_type.hpp"
 #include "core/value/numeric_array.hpp"
 

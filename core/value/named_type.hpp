@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"
 

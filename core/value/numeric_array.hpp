@@ -15,7 +15,7 @@
 // they share a buffer; one object must not be mutated while another thread reads it.
 #pragma once
 
-#include "core/codec/bit_cast.hpp"
+#include "base/codec/bit_cast.hpp"
 #include <array>
 #include <bit>
 #include <complex>
@@ -32,9 +32,9 @@
 #include <variant>
 #include <vector>
 
-#include "core/codec/shared_bytes.hpp"
-#include "core/error/rr_error.hpp"
-#include "core/message/data_types.hpp"
+#include "base/codec/shared_bytes.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/data_types.hpp"
 
 namespace rr {
 

@@ -29,9 +29,9 @@
 
 #include <string_view>
 
-#include "core/codec/limits.hpp"
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/codec/limits.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"

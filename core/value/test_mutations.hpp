@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 
 namespace rr::testing {
 

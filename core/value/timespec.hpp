@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "core/value/value.hpp"
 
 namespace rr {

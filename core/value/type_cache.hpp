@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/element_layout.hpp"
 #include "core/value/named_type.hpp"
 

@@ -27,7 +27,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/numeric_array.hpp"
 
 namespace rr {

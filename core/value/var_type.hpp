@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 

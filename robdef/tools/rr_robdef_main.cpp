@@ -5,9 +5,13 @@
 //                             `file:line: error: message` / `file:line: warning: message`;
 //                             exit status 1 on any error, else 0.
 //   rr-robdef format FILE     print the canonical text form (robdef.md §12).
-//   rr-robdef ts [-o DIR] [-I DIR]... [--builtin NAME]... FILE...
+//   rr-robdef ts [-o DIR] [-I DIR]... [--builtin NAME]... [--dts] FILE...
 //                             TypeScript for the robotraconteur-wasm package (robdef/typescript.hpp):
-//                             `<service>.d.ts` and `<service>.js` per definition into DIR (default .).
+//                             `<service>.ts` per definition into DIR (default .): types, enums and
+//                             constants in one module that every build tool compiles; --dts writes
+//                             `<service>.d.ts` + `<service>.js` instead (as a package ships them).
+//                             --url/--gateway/--definitions (fetching a running device's definitions)
+//                             belong to the package's node rr-robdef (wasm-client/src/rr_robdef.mjs).
 //                             Imports are followed: `<import>.robdef` is looked for in each FILE's
 //                             folder and the -I folders; one not found is an error naming it.
 //                             --builtin loads a built-in definition (experimental.create,
@@ -38,7 +42,7 @@ namespace {
 int usage() {
     std::cerr << "usage: rr-robdef check FILE...\n"
                  "       rr-robdef format FILE\n"
-                 "       rr-robdef ts [-o DIR] [-I DIR]... [--builtin NAME]... FILE...\n";
+                 "       rr-robdef ts [-o DIR] [-I DIR]... [--builtin NAME]... [--dts] FILE...\n";
     return 2;
 }
 
@@ -119,6 +123,7 @@ int typescript(const std::vector<std::string>& args) {
     namespace fs = std::filesystem;
     std::string out_dir = ".";
     std::vector<std::string> files, include_dirs, builtins;
+    bool dts = false;
     for (std::size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         const bool has_value = i + 1 < args.size();
@@ -128,6 +133,14 @@ int typescript(const std::vector<std::string>& args) {
             include_dirs.push_back(args[++i]);
         } else if (a == "--builtin" && has_value) {
             builtins.push_back(args[++i]);
+        } else if (a == "--dts") {
+            dts = true;
+        } else if (a == "--url" || a == "--gateway" || a == "--device" || a == "--definitions") {
+            // Fetching needs a client (WebSocket, HTTP): the package's rr-robdef (node) has one.
+            std::cerr << "rr-robdef ts: " << a << " is an option of the robotraconteur-wasm package's rr-robdef"
+                      << " (npx rr-robdef ts " << a << " ...; wasm-client/README.md \"TypeScript quickstart\");"
+                      << " this one reads definition files\n";
+            return 2;
         } else if (!a.empty() && a[0] == '-') {
             return usage();
         } else {
@@ -220,9 +233,11 @@ int typescript(const std::vector<std::string>& args) {
     fs::create_directories(out_dir, ec);
     for (const auto& name : generate) {
         auto mod = rr::robdef::to_typescript(*set.find_service(name), set);
-        fs::path base = fs::path(out_dir) / mod.file_stem;
-        if (!write_file(base.string() + ".d.ts", mod.declarations) || !write_file(base.string() + ".js", mod.javascript)) {
-            std::cout << base.string() << ".d.ts: error: cannot write file\n";
+        const std::string base = (fs::path(out_dir) / mod.file_stem).string();
+        const bool written = dts ? write_file(base + ".d.ts", mod.declarations) && write_file(base + ".js", mod.javascript)
+                                 : write_file(base + ".ts", mod.source);
+        if (!written) {
+            std::cout << base << (dts ? ".d.ts" : ".ts") << ": error: cannot write file\n";
             return 1;
         }
     }

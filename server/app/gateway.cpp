@@ -409,6 +409,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
         // The Foxglove WebSocket protocol at /foxglove (docs/foxglove.md).
         foxglove::FoxgloveOptions fo;
         fo.objects = c.foxglove_objects;
+        fo.clock = c.foxglove_clock;
         g->foxglove_ = foxglove::install_foxglove(*g->http_, json_api, std::move(fo));
     }
 
@@ -569,6 +570,10 @@ nlohmann::json Gateway::usb_problems() const {
 }
 
 void Gateway::stop() {
+    // JSON clients first, while everything still runs: every JSON WebSocket (the JSON API's, Foxglove's)
+    // gets 1001 Going Away (a restart, not a network failure). RR connections get theirs, over WebSocket
+    // as 1001 too, when the node shuts down below.
+    if (http_) http_->go_away();
     if (discovered_) discovered_->stop();
     if (local_source_) local_source_->stop();
 #ifdef RR_HAVE_USB

@@ -5,7 +5,7 @@
 #include <memory>
 #include <optional>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/app/gateway_config.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 

@@ -9,8 +9,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "core/names/connection_url.hpp"
-#include "core/names/node_id.hpp"
+#include "base/names/connection_url.hpp"
+#include "base/names/node_id.hpp"
 #include "server/http/forwarded.hpp"
 #include "server/record/recording_spec.hpp"
 
@@ -628,9 +628,11 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (!root.IsDefined() || root.IsNull()) return c;
     r.check_keys(root, "", {"gateway", "demo", "devices", "discovery", "discover", "usb", "record", "recordings", "safety", "foxglove"});
     if (auto n = root["recordings"]) parse_recordings(n, r, c.recordings);
-    // foxglove: (docs/foxglove.md): objects below a device's root advertised beside it.
+    // foxglove: (docs/foxglove.md): objects below a device's root advertised beside it; the device
+    // whose clock is Foxglove's time.
     if (auto f = root["foxglove"]) {
-        r.check_keys(f, "foxglove", {"objects"});
+        r.check_keys(f, "foxglove", {"objects", "clock"});
+        if (auto n = f["clock"]) c.foxglove_clock = r.string(n, "foxglove.clock");
         if (auto o = f["objects"]) {
             if (!o.IsMap()) r.error(o, "foxglove.objects", "expected a map of device name to a list of object paths");
             else

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/discovery/service_filter.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/record/recording_spec.hpp"
 
@@ -195,6 +195,8 @@ struct GatewayConfig {
     record::RecordingsSettings recordings;
     // foxglove: (docs/foxglove.md) objects below the root advertised to Foxglove clients, by device name
     std::map<std::string, std::vector<std::string>> foxglove_objects;
+    /// foxglove.clock: the device whose DeviceClock is the Foxglove WebSocket's time ("" = a clock device).
+    std::string foxglove_clock;
     // discovery: / discover:
     DiscoverySettings discovery;
     std::vector<DiscoverRule> discover;

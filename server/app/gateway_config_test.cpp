@@ -125,6 +125,9 @@ TEST_CASE("foxglove.objects: objects below a device's root for the Foxglove WebS
     CHECK(c->foxglove_objects.at("webcam") == std::vector<std::string>{"Webcams[0]", "Webcams[1]"});
     check_refused("foxglove:\n  objects: [1]\n", "bad.yaml:2: foxglove.objects: expected a map");
     check_refused("foxglove:\n  object: {}\n", "bad.yaml:2: foxglove.object: unknown key");
+    auto clock = parse_gateway_config("foxglove:\n  clock: sim\n", "t.yaml");
+    REQUIRE(clock);
+    CHECK(clock->foxglove_clock == "sim");
 }
 
 TEST_CASE("configuration errors name the key and the line") {

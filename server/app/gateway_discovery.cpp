@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/app/log.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/node/node.hpp"

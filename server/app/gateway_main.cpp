@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
               << "\", \"nodename\": \"" << (*gateway)->node()->node_name() << "\", \"tls\": " << (tls ? "true" : "false")
               << "}" << std::endl;
     while (!g_stop) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a stop is noticed within 20 ms
         if (g_reload.exchange(false)) reload_on_hangup(**gateway, *cmd);
     }
     log(LogLevel::info, "shutting down");

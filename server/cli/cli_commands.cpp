@@ -115,7 +115,7 @@ std::optional<Failure> run_info(Target& t, bool node_index, std::ostream& out) {
 }
 
 std::optional<Failure> run_get(const CommandLine& cl, Target& t, std::ostream& out) {
-    const std::string& name = cl.member->name;
+    const std::string& name = *cl.member;
     auto m = member_info(t.object, name);
     if (!m) return rr_failure(m.error());
     Result<Value> v = fail(MessageErrorType::InvalidOperation, "");
@@ -152,7 +152,7 @@ std::optional<Failure> run_get(const CommandLine& cl, Target& t, std::ostream& o
 }
 
 std::optional<Failure> run_set(const CommandLine& cl, Target& t, const nlohmann::json& json) {
-    const std::string& name = cl.member->name;
+    const std::string& name = *cl.member;
     auto m = member_info(t.object, name);
     if (!m) return rr_failure(m.error());
     if (m->def.kind != MemberKind::property && m->def.kind != MemberKind::wire)
@@ -169,7 +169,7 @@ std::optional<Failure> run_set(const CommandLine& cl, Target& t, const nlohmann:
 
 std::optional<Failure> run_call(const CommandLine& cl, Target& t, const std::vector<nlohmann::json>& json,
                                 std::ostream& out) {
-    const std::string& name = cl.member->name;
+    const std::string& name = *cl.member;
     auto m = member_info(t.object, name);
     if (!m) return rr_failure(m.error());
     if (m->def.kind != MemberKind::function)

@@ -6,7 +6,7 @@
 #include <atomic>
 #include <ostream>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/cli/cli_options.hpp"
 
 namespace rr::cli {

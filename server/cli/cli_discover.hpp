@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/cli/cli_options.hpp"
 
 namespace rr::cli {

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <iterator>
 #include <map>
 
 namespace rr::cli {
@@ -25,32 +26,6 @@ Result<double> parse_seconds(std::string_view flag, std::string_view text) {
 }
 
 }  // namespace
-
-Result<std::vector<PathSegment>> parse_member_path(std::string_view text) {
-    std::vector<PathSegment> out;
-    std::size_t i = 0;
-    auto bad = [&](std::string why) {
-        return usage("bad member path \"" + std::string(text) + "\": " + why);
-    };
-    if (text.empty()) return bad("empty");
-    for (;;) {
-        PathSegment seg;
-        while (i < text.size() && text[i] != '.' && text[i] != '[' && text[i] != ']') seg.name += text[i++];
-        if (seg.name.empty()) return bad("empty name at offset " + std::to_string(i));
-        if (i < text.size() && text[i] == ']') return bad("']' without '['");
-        if (i < text.size() && text[i] == '[') {
-            auto close = text.find(']', i + 1);
-            if (close == std::string_view::npos) return bad("unterminated '['");
-            seg.key = std::string(text.substr(i + 1, close - i - 1));
-            i = close + 1;
-            if (i < text.size() && text[i] != '.') return bad("'.' expected after ']'");
-        }
-        out.push_back(std::move(seg));
-        if (i == text.size()) return out;
-        ++i;  // the '.'
-        if (i == text.size()) return bad("ends with '.'");
-    }
-}
 
 Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
     CommandLine cl;
@@ -248,17 +223,18 @@ Result<CommandLine> parse_command_line(const std::vector<std::string>& args) {
     cl.url = positional[1];
 
     if (object_path) {
-        auto segs = parse_member_path(*object_path);
-        if (!segs) return segs.take_error();
-        cl.objects = std::move(*segs);
+        auto parsed = parse_object_path(*object_path);
+        if (!parsed) return parsed.take_error();
+        cl.objects = std::move(parsed->segments);
     }
     if (cl.kind != CommandKind::info) {
-        auto segs = parse_member_path(positional[2]);
-        if (!segs) return segs.take_error();
-        cl.member = segs->back();
-        segs->pop_back();
-        cl.objects.insert(cl.objects.end(), segs->begin(), segs->end());
-        if (cl.member->key) return usage("the member itself takes no [key]: \"" + positional[2] + "\"");
+        auto parsed = parse_object_path(positional[2]);
+        if (!parsed) return parsed.take_error();
+        auto& segments = parsed->segments;
+        if (segments.back().has_index) return usage("the member itself takes no [key]: \"" + positional[2] + "\"");
+        cl.member = std::move(segments.back().name);
+        segments.pop_back();
+        cl.objects.insert(cl.objects.end(), std::make_move_iterator(segments.begin()), std::make_move_iterator(segments.end()));
         cl.values.assign(positional.begin() + 3, positional.end());
     }
     if ((cl.count || cl.seconds) && cl.kind != CommandKind::watch)

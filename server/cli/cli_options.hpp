@@ -3,8 +3,9 @@
 //
 // Member paths: `member`, or `objref.member`, `objref[key].member`, … Each segment before the last
 // names an objref of the object reached so far; `[key]` is its index (an int32 or a string, as the
-// objref's `{int32}` / `{string}` type says; keys may hold any character except `]`). `--object PATH`
-// gives the same objref segments separately and is prepended to the member path.
+// objref's `{int32}` / `{string}` type says). `--object PATH` gives the same objref segments separately
+// and is prepended to the member path. Both are object paths, parsed by core's one parser
+// (base/names/object_path.hpp: its syntax and error messages; a key may hold any character but `]`).
 #pragma once
 
 #include <cstdint>
@@ -13,7 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/object_path.hpp"
 
 namespace rr::cli {
 
@@ -27,21 +29,13 @@ enum class ExitCode : int {
 
 enum class CommandKind { help, info, get, set, call, watch, discover, record, replay };
 
-/// One segment of a member path: an objref (or, last, the member) name and an optional index key.
-struct PathSegment {
-    std::string name;
-    std::optional<std::string> key;  ///< text between `[` and `]`
-
-    friend bool operator==(const PathSegment&, const PathSegment&) = default;
-};
-
 /// A parsed command line.
 struct CommandLine {
     CommandKind kind = CommandKind::help;
     std::string help_topic;            ///< command whose help was asked for ("" = general)
     std::string url;
-    std::vector<PathSegment> objects;  ///< objref segments (from --object and the member path)
-    std::optional<PathSegment> member; ///< the member (not for info)
+    std::vector<ObjectPathSegment> objects;  ///< objref segments (from --object and the member path)
+    std::optional<std::string> member;       ///< the member's name (not for info)
     std::vector<std::string> values;   ///< JSON texts: set's value, call's arguments
     double timeout_s = 15;             ///< connect and per-request timeout, seconds
     std::optional<std::uint64_t> count;  ///< watch: stop after this many values
@@ -71,10 +65,6 @@ struct CommandLine {
     double speed = 1.0;                    ///< --speed: playback speed factor
     bool loop = false;                     ///< --loop: start again at the end
 };
-
-/// Parses a member path (`a.b[3].c`). Errors: InvalidArgument (empty segment, unterminated `[`, text
-/// after `]` other than `.`).
-Result<std::vector<PathSegment>> parse_member_path(std::string_view text);
 
 /// Parses argv[1..]. Errors: InvalidArgument with a message for the user (unknown command or flag,
 /// missing argument, bad number).

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <thread>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/cli/cli_commands.hpp"
 #include "server/cli/cli_target.hpp"
 #include "server/gateway/device_mirror.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/json/value_json.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/cli/cli_usb.hpp"
 #include "server/transport/websocket_connector.hpp"
 
@@ -29,18 +29,18 @@ Result<std::string> url_with_service(const std::string& url, const std::string& 
 
 namespace {
 
-// An objref segment's index: by the objref's declared key type.
-Result<ObjRefIndex> objref_index(const MemberInfo& m, const PathSegment& seg) {
+// An objref segment's index (its decoded text) as the objref's declared key type asks.
+Result<ObjRefIndex> objref_index(const MemberInfo& m, const ObjectPathSegment& seg) {
     using robdef::ObjRefIndexKind;
     const auto c = robdef::objref_index_kind(m.def.type);
-    if (!seg.key) {
+    if (!seg.has_index) {
         if (c == ObjRefIndexKind::none) return ObjRefIndex{};
         return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " needs an index: " + seg.name + "[key]");
     }
-    if (c == ObjRefIndexKind::string) return ObjRefIndex{*seg.key};
+    if (c == ObjRefIndexKind::string) return ObjRefIndex{seg.index};
     if (c == ObjRefIndexKind::int32) {
         std::int32_t k = 0;
-        const auto& s = *seg.key;
+        const auto& s = seg.index;
         auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), k);
         if (ec != std::errc() || p != s.data() + s.size())
             return fail(MessageErrorType::InvalidArgument, "objref " + seg.name + " takes an int32 index, not \"" + s + "\"");

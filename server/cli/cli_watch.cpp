@@ -151,7 +151,7 @@ std::optional<Failure> watch_event(Target& t, const MemberInfo& m, std::ostream&
 }  // namespace
 
 std::optional<Failure> run_watch(const CommandLine& cl, Target& t, std::ostream& out, const std::atomic<bool>& stop) {
-    auto m = member_info(t.object, cl.member->name);
+    auto m = member_info(t.object, *cl.member);
     if (!m) return rr_failure(m.error());
     StopRule rule{stop, out, cl.count, std::nullopt};
     if (cl.seconds)
@@ -162,7 +162,7 @@ std::optional<Failure> run_watch(const CommandLine& cl, Target& t, std::ostream&
         case MemberKind::event: return watch_event(t, *m, out, rule);
         default:
             return rr_failure(make_error(MessageErrorType::InvalidOperation,
-                                         cl.member->name + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
+                                         *cl.member + " is " + robdef::with_article(robdef::member_kind_keyword(m->def.kind)) +
                                              "; rr watch streams wires, events and pipes"));
     }
 }

@@ -5,7 +5,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/transport/completion_guard.hpp"

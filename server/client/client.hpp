@@ -36,7 +36,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "core/session/client_context.hpp"
 #include "server/client/caller_io.hpp"
 #include "server/common/caller_runs_executor.hpp"

@@ -2,7 +2,7 @@
 
 #include <boost/asio/strand.hpp>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/request_map.hpp"
 #include "server/common/connection_strand.hpp"
 #include "server/common/random_ids.hpp"

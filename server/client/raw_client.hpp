@@ -14,7 +14,7 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "core/session/client_session.hpp"
 #include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/names/node_id.hpp"
+#include "base/names/node_id.hpp"
 
 namespace rr::server {
 

@@ -30,7 +30,7 @@
 
 #include <cstdint>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server::demo {
 

@@ -10,7 +10,7 @@
 #include <future>
 #include <thread>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
 #include "server/client/raw_client.hpp"

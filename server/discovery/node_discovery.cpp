@@ -11,7 +11,7 @@
 #include <boost/asio/post.hpp>
 
 #include "core/discovery/discovery_packet.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/client/client.hpp"
 #include "server/common/random_ids.hpp"
 #include "server/discovery/local_addresses.hpp"

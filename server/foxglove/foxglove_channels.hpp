@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/record/channel_mapping.hpp"
 #include "server/record/formats/foxglove_image_format.hpp"

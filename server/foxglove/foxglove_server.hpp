@@ -47,6 +47,9 @@ struct FoxgloveOptions {
     std::size_t max_pipe_conversion_bytes = 4u << 20;
     std::chrono::milliseconds wire_retry{10};    ///< how often waiting wire values retry
     std::size_t max_parameter_requests = 8;      ///< getParameters / setParameters being answered at once per connection
+    /// The device whose clock is Foxglove's time (foxglove_clock.hpp); "" = a standard clock device, if any.
+    std::string clock;
+    std::chrono::milliseconds time_interval{20};  ///< at most one `time` message per this
 };
 
 /// One connection's counts, for tests and diagnostics.
@@ -56,9 +59,11 @@ struct FoxgloveStats {
     std::uint64_t wire_coalesced = 0;   ///< wire values replaced by a newer one before sending
     std::uint64_t dropped = 0;          ///< events / pipe packets dropped while congested
     std::uint64_t statuses = 0;         ///< status messages (errors) sent
+    std::uint64_t times_sent = 0;       ///< time messages
 };
 
 class FoxgloveConnection;
+class FoxgloveClock;
 
 class FoxgloveServer : public std::enable_shared_from_this<FoxgloveServer> {
 public:
@@ -88,6 +93,11 @@ public:
     const std::string& session_id() const noexcept { return session_id_; }
     /// A parameter's new value, to every connection subscribed to it.
     void parameter_changed(const rr::foxglove::Parameter& p);
+    /// The clock followed for Foxglove's time (never null).
+    const std::shared_ptr<FoxgloveClock>& clock() const noexcept { return clock_; }
+    /// Whether a connection opened now gets the `time` capability: the configuration names a clock,
+    /// or a standard clock device is followed.
+    bool offers_time() const;
 
 private:
     FoxgloveServer(std::shared_ptr<gateway::JsonApi> api, boost::asio::any_io_executor executor, FoxgloveOptions options);
@@ -118,6 +128,7 @@ private:
     std::uint64_t devices_listener_ = 0;
     std::map<const http::JsonSocket*, std::shared_ptr<FoxgloveConnection>> connections_;
     boost::asio::strand<boost::asio::any_io_executor> convert_strand_;
+    std::shared_ptr<FoxgloveClock> clock_;
 };
 
 /// Registers both subprotocols on `http`; returns the server (kept alive by the handlers too).

@@ -6,7 +6,7 @@
 
 #include "core/json/json_numbers.hpp"
 #include "core/json/value_json.hpp"
-#include "core/message/data_types.hpp"
+#include "base/message/data_types.hpp"
 #include "core/value/numeric_array.hpp"
 
 namespace rr::server::gateway {

@@ -18,8 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/codec/shared_bytes.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/codec/shared_bytes.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server::gateway {
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <mutex>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 
 namespace rr::server::gateway {
 

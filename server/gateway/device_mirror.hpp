@@ -25,7 +25,7 @@
 
 #include <boost/asio/steady_timer.hpp>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/gateway/motion_rules.hpp"
 #include "server/gateway/passthrough_sessions.hpp"

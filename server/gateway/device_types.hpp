@@ -14,8 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/codec/limits.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/codec/limits.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/json/element_json_plan.hpp"
 #include "robdef/service_definition_set.hpp"
 

@@ -5,7 +5,7 @@
 
 #include "core/json/json_nesting.hpp"
 #include "core/json/value_json.hpp"
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/timespec.hpp"

@@ -22,9 +22,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/codec/limits.hpp"
+#include "base/codec/limits.hpp"
 #include "core/json/value_json.hpp"
-#include "core/names/object_path.hpp"
+#include "base/names/object_path.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 #include "server/gateway/device_mirror.hpp"
 #include "server/gateway/device_types.hpp"
@@ -80,7 +80,7 @@ struct JsonApiOptions {
     Limits limits;
 };
 
-/// A relative object path (`object=`) in RR service-path form: core/names/object_path.hpp.
+/// A relative object path (`object=`) in RR service-path form: base/names/object_path.hpp.
 using ::rr::normalize_object_path;
 
 class JsonApi : public std::enable_shared_from_this<JsonApi> {

@@ -1,7 +1,7 @@
 // JsonApi::call_function: FunctionCallReq with parameters by name, and generator functions collected
 // into a list (wire.md §6.7: GeneratorNextReq with `index` [+ `parameter`] until StopIteration; close =
 // a GeneratorNextReq carrying Error StopIteration).
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/json_api.hpp"
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "core/value/numeric_array.hpp"
 #include "core/value/pack_value.hpp"

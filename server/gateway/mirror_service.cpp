@@ -1,7 +1,7 @@
 #include "server/gateway/mirror_service.hpp"
 
-#include "core/message/error_entry.hpp"
-#include "core/names/service_path.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/names/service_path.hpp"
 #include "core/session/elements.hpp"
 #include "robdef/parser.hpp"
 #include "server/gateway/pipe_entries.hpp"

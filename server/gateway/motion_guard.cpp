@@ -2,7 +2,7 @@
 
 #include <ctime>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 
 namespace rr::server::gateway {
@@ -77,13 +77,20 @@ Result<MotionGuard::Ticket> MotionGuard::admit(const MotionClient& client, Messa
     if (entry.service_path != device_) return Ticket{};
     std::vector<std::function<void()>> after;
     std::string note;
+    std::string taken;
     Result<Ticket> out = Ticket{};
     {
         std::lock_guard lock(mutex_);
         const auto rules = rules_;
         if (!rules || rules->empty()) return Ticket{};
         const auto now = Clock::now();
-        const auto take = [&]() { return holds_.take(client, now, wall_clock_text(), device_); };
+        const auto take = [&]() {
+            const bool held = holds_.holder(now) != nullptr;
+            auto r = holds_.take(client, now, wall_clock_text(), device_);
+            // A hold starting (again): shows when a holder's hold lapsed and another client took over.
+            if (r && !held) taken = entry.member_name + ": motion of " + device_ + " taken by " + client.who();
+            return r;
+        };
         const std::string& member = entry.member_name;
         switch (entry.entry_type) {
             case MessageEntryType::FunctionCallReq: {
@@ -175,6 +182,7 @@ Result<MotionGuard::Ticket> MotionGuard::admit(const MotionClient& client, Messa
         arm_timer();
     }
     for (auto& f : after) f();
+    if (!taken.empty()) emit(taken);
     if (!note.empty()) emit(note);
     return out;
 }

@@ -24,7 +24,7 @@
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 #include "server/gateway/motion_holds.hpp"
 #include "server/gateway/motion_rules.hpp"
 

@@ -4,9 +4,11 @@
 // the client's passthrough session first), and when it turns the holder's liveness probe on and off.
 #include <catch2/catch.hpp>
 
+#include <thread>
+
 #include <boost/asio/io_context.hpp>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/motion_guard.hpp"
 
@@ -338,4 +340,30 @@ TEST_CASE("motion guard: a hold-to-run call refused by a lock or the device hold
     f.guard->on_reply(alice, *tb, fail(MessageErrorType::InvalidOperation, "Robot not in jog mode"));
     REQUIRE(f.guard->holder());
     CHECK(f.guard->holder()->user == "alice");
+}
+
+TEST_CASE("motion guard: the log tells when a hold starts and when another client takes over after it lapsed", "[motion]") {
+    Fixture f(50ms);
+    std::vector<std::string> events;
+    f.guard->set_event_listener([&](const std::string& what) { events.push_back(what); });
+    auto alice = client("ws:1", "alice");
+    auto bob = client("rr:2", "bob");
+    auto e = jog(0.05);
+    REQUIRE(f.guard->admit(alice, e));
+    auto renew = jog(0.05);
+    REQUIRE(f.guard->admit(alice, renew));  // a renewal starts nothing
+    auto taken = [&] {
+        std::vector<std::string> out;
+        for (const auto& s : events)
+            if (s.find(" taken by ") != std::string::npos) out.push_back(s);
+        return out;
+    };
+    REQUIRE(taken() == std::vector<std::string>{"jog_joint: motion of arm taken by alice (test client)"});
+    auto early = jog(0.05);
+    REQUIRE_FALSE(f.guard->admit(bob, early));
+    CHECK(taken().size() == 1);
+    std::this_thread::sleep_for(120ms);  // past alice's 50 ms hold: it has lapsed
+    auto later = jog(0.05);
+    REQUIRE(f.guard->admit(bob, later));
+    CHECK(taken().back() == "jog_joint: motion of arm taken by bob (test client)");
 }

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server::gateway {
 

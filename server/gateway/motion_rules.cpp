@@ -64,15 +64,16 @@ std::optional<MessageElement> make_number(DataTypes type, std::string name, doub
     }
 }
 
-// The standard robot's `halt` command mode: RobotCommandMode.halt of the device's own definition (0 in
-// the standard).
-double standard_halt_mode(const DeviceTypes* types) {
+// The value named `halt` of the enum type of property `property` of standard object `object_type`, in the
+// device's own definition (0 without it, as the standard defines RobotCommandMode, ServoMode and
+// ActuatorMode).
+double standard_halt_value(const DeviceTypes* types, std::string_view object_type, std::string_view property) {
     if (!types) return 0;
-    auto robot = types->find_object(kStandardRobotType);
-    if (!robot) return 0;
-    const auto* m = robot->entry->find_member("command_mode");
+    auto obj = types->find_object(object_type);
+    if (!obj) return 0;
+    const auto* m = obj->entry->find_member(property);
     if (!m) return 0;
-    auto ref = types->set().find(m->type.type_name, robot->service->name);
+    auto ref = types->set().find(m->type.type_name, obj->service->name);
     if (!ref.enumeration) return 0;
     for (const auto& v : ref.enumeration->values)
         if (v.name == "halt") return v.value;
@@ -132,12 +133,28 @@ MotionRules MotionRules::compile(const MotionSafety& settings, const ObjectTypeI
         r.untimed_ = {{"jog_freespace", "wait"}, {"execute_trajectory", ""}, {"home", ""}};
         r.streams_ = {"position_command", "velocity_command"};
         r.stop_functions_ = {"halt"};
-        r.stop_properties_.push_back(StopProperty{"command_mode", standard_halt_mode(types), DataTypes::int32_t});
+        r.stop_properties_.push_back(StopProperty{"command_mode", standard_halt_value(types, kStandardRobotType, "command_mode"), DataTypes::int32_t});
     }
     if (r.standard_tool_) {
         // each call starts a motion and returns: it lasts until halt() or its client's end
         r.untimed_ = {{"open", ""}, {"close", ""}, {"setf_command", ""}, {"home", ""}};
         r.stop_functions_ = {"halt"};
+    }
+    const bool other_standard = r.standard_robot_ || r.standard_tool_;
+    r.standard_servo_ = !other_standard && is(kStandardServoType) && settings.standard_robot;
+    r.standard_actuator_ = !other_standard && !r.standard_servo_ && is(kStandardActuatorType) && settings.standard_robot;
+    if (r.standard_servo_) {
+        // commands stream on the three command wires; trapezoidal_move() returns while the servo moves
+        r.untimed_ = {{"trapezoidal_move", ""}};
+        r.streams_ = {"position_command", "velocity_command", "effort_command"};
+        r.stop_functions_ = {"halt"};
+        r.stop_properties_.push_back(StopProperty{"mode", standard_halt_value(types, kStandardServoType, "mode"), DataTypes::int32_t});
+    }
+    if (r.standard_actuator_) {
+        // an actuator has no stop function: its mode set to halt stops it
+        r.streams_ = {"actuator_command"};
+        r.stop_properties_.push_back(
+            StopProperty{"actuator_mode", standard_halt_value(types, kStandardActuatorType, "actuator_mode"), DataTypes::int32_t});
     }
     for (const auto& h : settings.hold_to_run) r.hold_to_run_.push_back(h);
     for (const auto& m : settings.motions) r.untimed_.push_back(m);

@@ -12,8 +12,10 @@
 //     ended by the gateway when their sender goes silent for the bound;
 //   * stops: a function (halt) or a property value (command_mode = halt) that ends motion; they reach the
 //     device whatever lock another client holds, and they are what the gateway calls to end a motion.
-// The standard robot's set (com.robotraconteur.robotics.robot.Robot, as root type or implemented) and the
-// standard tool's (com.robotraconteur.robotics.tool.Tool) are built in; a configuration adds members of any device (safety.hold_to_run, .motions, .streams, .stops).
+// The standard robot's set (com.robotraconteur.robotics.robot.Robot, as root type or implemented), the
+// standard tool's (com.robotraconteur.robotics.tool.Tool), servo's (com.robotraconteur.servo.Servo) and
+// actuator's (com.robotraconteur.actuator.Actuator) are built in; a configuration adds members of any
+// device (safety.hold_to_run, .motions, .streams, .stops).
 #pragma once
 
 #include <chrono>
@@ -22,8 +24,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "core/session/service_host.hpp"
 
 namespace rr::server::gateway {
@@ -34,6 +36,11 @@ inline constexpr std::string_view kStandardRobotType = "com.robotraconteur.robot
 /// The standard tool (grippers): open(), close(), setf_command() and home() start a motion that lasts
 /// until halt() (its stop) or its client's end.
 inline constexpr std::string_view kStandardToolType = "com.robotraconteur.robotics.tool.Tool";
+/// The standard servo: command streams position_command, velocity_command and effort_command,
+/// trapezoidal_move() runs until halt() (or `mode` set to halt) or its client's end.
+inline constexpr std::string_view kStandardServoType = "com.robotraconteur.servo.Servo";
+/// The standard actuator: the actuator_command stream, stopped by `actuator_mode` set to halt.
+inline constexpr std::string_view kStandardActuatorType = "com.robotraconteur.actuator.Actuator";
 
 /// A function one of whose arguments is the motion's own timeout.
 struct HoldToRunMember {
@@ -60,8 +67,8 @@ struct MotionSafety {
     /// Longest timeout a hold-to-run call may ask for; also how long a command stream may stay silent,
     /// and how soon a client that stops answering is noticed while it holds a motion without a timeout.
     std::chrono::milliseconds hold_to_run_max{500};
-    /// The standard robot's (or standard tool's) members are guarded when the device is one (false: only
-    /// the lists below).
+    /// The standard robot's (or standard tool's, servo's, actuator's) members are guarded when the device
+    /// is one (false: only the lists below).
     bool standard_robot = true;
     std::vector<HoldToRunMember> hold_to_run;
     std::vector<UntimedMotionMember> motions;
@@ -83,6 +90,9 @@ public:
     }
     bool standard_robot() const noexcept { return standard_robot_; }
     bool standard_tool() const noexcept { return standard_tool_; }
+    /// The standard servo's or actuator's set applies (kStandardServoType, kStandardActuatorType).
+    bool standard_servo() const noexcept { return standard_servo_; }
+    bool standard_actuator() const noexcept { return standard_actuator_; }
     std::chrono::milliseconds bound() const noexcept { return bound_; }
 
     const HoldToRunMember* hold_to_run(std::string_view member) const;
@@ -106,6 +116,8 @@ private:
     };
     bool standard_robot_ = false;
     bool standard_tool_ = false;
+    bool standard_servo_ = false;
+    bool standard_actuator_ = false;
     std::chrono::milliseconds bound_{500};
     std::vector<HoldToRunMember> hold_to_run_;
     std::vector<UntimedMotionMember> untimed_;

@@ -1,12 +1,14 @@
 // MotionRules without a device: the standard robot's members found by its root type (or an implemented
-// type), configured members of any device, the timeout clamp in each numeric type, stops recognised by
-// their value, and the stop requests the gateway sends.
+// type), the standard tool's, servo's and actuator's, configured members of any device, the timeout
+// clamp in each numeric type, stops recognised by their value (a halt mode from the device's own enum),
+// and the stop requests the gateway sends.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <limits>
 
 #include "core/session/elements.hpp"
+#include "server/gateway/device_types.hpp"
 #include "server/gateway/motion_rules.hpp"
 
 using namespace rr;
@@ -116,6 +118,87 @@ TEST_CASE("motion rules: command_mode = halt is a stop, another mode is not", "[
     REQUIRE(stops[1].find("value"));
     CHECK(read_scalar(*stops[1].find("value"), mode));
     CHECK(mode == 0);
+}
+
+TEST_CASE("motion rules: the standard servo's command streams, trapezoidal_move, halt() and mode = halt", "[motion]") {
+    MotionSafety s;
+    auto r = MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardServoType), {}}, nullptr);
+    CHECK(r.standard_servo());
+    CHECK_FALSE(r.standard_robot());
+    CHECK_FALSE(r.standard_tool());
+    for (const char* w : {"position_command", "velocity_command", "effort_command"}) {
+        INFO(w);
+        CHECK(r.stream(w));
+    }
+    REQUIRE(r.untimed("trapezoidal_move"));
+    CHECK(r.untimed("trapezoidal_move")->wait_arg.empty());
+    CHECK(r.stop_function("halt"));
+    CHECK(r.stop_property("mode", make_scalar_element<std::int32_t>("value", 0)));
+    CHECK_FALSE(r.stop_property("mode", make_scalar_element<std::int32_t>("value", 2)));  // velocity_command
+    for (const char* m : {"servo_state", "position", "servo_info", "setf_param", "setf_signal", "isoch_downsample"}) {
+        INFO(m);
+        CHECK_FALSE(r.guards(m));
+    }
+    auto stops = r.stop_requests("servo");
+    REQUIRE(stops.size() == 2);
+    CHECK(stops[0].member_name == "halt");
+    CHECK(stops[1].entry_type == MessageEntryType::PropertySetReq);
+    CHECK(stops[1].member_name == "mode");
+
+    CHECK(MotionRules::compile(s, ObjectTypeInfo{"vendor.axis.Axis", {std::string(kStandardServoType)}}, nullptr).standard_servo());
+    s.standard_robot = false;
+    CHECK(MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardServoType), {}}, nullptr).empty());
+}
+
+TEST_CASE("motion rules: the standard actuator's command stream, stopped by actuator_mode = halt", "[motion]") {
+    MotionSafety s;
+    auto r = MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardActuatorType), {}}, nullptr);
+    CHECK(r.standard_actuator());
+    CHECK_FALSE(r.standard_servo());
+    CHECK(r.stream("actuator_command"));
+    CHECK_FALSE(r.stop_function("halt"));  // the standard actuator has none
+    CHECK(r.stop_property("actuator_mode", make_scalar_element<std::int32_t>("value", 0)));
+    CHECK_FALSE(r.stop_property("actuator_mode", make_scalar_element<std::int32_t>("value", 2)));  // normal
+    CHECK_FALSE(r.guards("actuator_state"));
+    CHECK_FALSE(r.guards("setf_param"));
+    auto stops = r.stop_requests("conveyor");
+    REQUIRE(stops.size() == 1);
+    CHECK(stops[0].entry_type == MessageEntryType::PropertySetReq);
+    CHECK(stops[0].member_name == "actuator_mode");
+    std::int32_t mode = -1;
+    REQUIRE(stops[0].find("value"));
+    CHECK(read_scalar(*stops[0].find("value"), mode));
+    CHECK(mode == 0);
+    s.standard_robot = false;
+    CHECK(MotionRules::compile(s, ObjectTypeInfo{std::string(kStandardActuatorType), {}}, nullptr).empty());
+}
+
+TEST_CASE("motion rules: the servo's halt mode is read from the device's own ServoMode", "[motion]") {
+    // a vendor release numbering its modes differently: the stop the gateway sends and recognises follows it
+    auto types = DeviceTypes::parse({R"(service com.robotraconteur.servo
+
+enum ServoMode
+    error = -2,
+    disabled = -1,
+    velocity_command = 0,
+    halt = 7
+end
+
+object Servo
+    property ServoMode mode [nolockread]
+    function void halt()
+end
+)"});
+    REQUIRE(types);
+    auto r = MotionRules::compile(MotionSafety{}, ObjectTypeInfo{std::string(kStandardServoType), {}}, types->get());
+    CHECK(r.stop_property("mode", make_scalar_element<std::int32_t>("value", 7)));
+    CHECK_FALSE(r.stop_property("mode", make_scalar_element<std::int32_t>("value", 0)));
+    auto stops = r.stop_requests("servo");
+    REQUIRE(stops.size() == 2);
+    std::int32_t mode = -1;
+    REQUIRE(stops[1].find("value"));
+    CHECK(read_scalar(*stops[1].find("value"), mode));
+    CHECK(mode == 7);
 }
 
 TEST_CASE("motion rules: a hold-to-run timeout is clamped in its own type and unit", "[motion]") {

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "core/message/error_entry.hpp"
-#include "core/names/service_path.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/names/service_path.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/device_mirror.hpp"
 

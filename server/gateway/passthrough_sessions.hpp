@@ -35,7 +35,7 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/client/raw_client.hpp"
 #include "server/node/service.hpp"
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 
 namespace rr::server::gateway {
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/pipe_entries.hpp"
 

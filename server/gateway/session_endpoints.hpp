@@ -25,8 +25,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "server/gateway/shared_entry.hpp"
 
 namespace rr::server::gateway {

@@ -5,7 +5,7 @@
 
 #include <deque>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "core/session/elements.hpp"
 #include "server/gateway/pipe_entries.hpp"
 #include "server/gateway/session_endpoints.hpp"

@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/codec/shared_bytes.hpp"
-#include "core/message/encoded_entry.hpp"
-#include "core/message/message.hpp"
+#include "base/codec/shared_bytes.hpp"
+#include "base/message/encoded_entry.hpp"
+#include "base/message/message.hpp"
 
 namespace rr::server::gateway {
 

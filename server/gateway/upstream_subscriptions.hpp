@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/shared_entry.hpp"
 #include "server/node/service.hpp"
 

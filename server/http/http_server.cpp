@@ -103,6 +103,30 @@ void HttpServer::add_watched_route(bhttp::verb method, std::string path, Watched
     routes_.push_back(Route{method, std::move(path), prefix, std::move(handler)});
 }
 
+void HttpServer::track_socket(const std::shared_ptr<JsonSocket>& socket) {
+    {
+        std::lock_guard lock(sockets_mutex_);
+        if (!going_away_) {
+            if (sockets_.size() >= 64 && sockets_.size() == sockets_.capacity())
+                std::erase_if(sockets_, [](const std::weak_ptr<JsonSocket>& w) { return w.expired(); });
+            sockets_.push_back(socket);
+            return;
+        }
+    }
+    socket->close_going_away();
+}
+
+void HttpServer::go_away() {
+    std::vector<std::weak_ptr<JsonSocket>> sockets;
+    {
+        std::lock_guard lock(sockets_mutex_);
+        going_away_ = true;
+        sockets.swap(sockets_);
+    }
+    for (auto& w : sockets)
+        if (auto s = w.lock()) s->close_going_away();
+}
+
 std::string HttpServer::subprotocol_names() const {
     std::string out;
     for (const auto& [name, handler] : subprotocols_) out += (out.empty() ? "" : ", ") + name;

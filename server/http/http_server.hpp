@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -92,6 +93,9 @@ public:
         send(std::move(text));
     }
     virtual void close() = 0;
+    /// close() because the server is stopping: the close frame says 1001 Going Away (a client that
+    /// reconnects can tell a restart from a network failure, which it sees as 1006).
+    virtual void close_going_away() { close(); }
     /// Remote address, for logs.
     virtual std::string peer() const = 0;
     /// The Cookie header of the upgrade request ("" without one), for handlers that authenticate the
@@ -189,8 +193,17 @@ public:
     /// The registered JSON subprotocols, comma-separated (for error messages).
     std::string subprotocol_names() const;
     std::shared_ptr<Node> node() const { return node_.lock(); }
+    /// A JSON WebSocket session that has started: go_away() closes it. A session started after
+    /// go_away() is closed at once. Thread-safe.
+    void track_socket(const std::shared_ptr<JsonSocket>& socket);
+    /// The server is stopping: every JSON WebSocket (the JSON API's, Foxglove's) is closed with 1001
+    /// Going Away. Returns at once; the close handshakes run on the sockets' threads. Thread-safe.
+    void go_away();
 
 private:
+    std::mutex sockets_mutex_;
+    std::vector<std::weak_ptr<JsonSocket>> sockets_;  // under sockets_mutex_; expired ones pruned as it grows
+    bool going_away_ = false;                         // under sockets_mutex_
     std::weak_ptr<Node> node_;
     HttpOptions options_;
     struct Route {

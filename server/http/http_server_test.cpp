@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <array>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -397,6 +398,33 @@ TEST_CASE("a JSON WebSocket's burst beyond its queue limit drops the oldest and 
     CHECK(socket->dropped() == dropped);
     CHECK(socket->queued() == 0);
     CHECK(socket->queued_bytes() == 0);
+}
+
+TEST_CASE("a stopping server ends a JSON WebSocket that is reading and writing at once, within the bound") {
+    // close_going_away meets a session with a read pending (always) and a write pending (a client that
+    // does not read a flood): the close handshake's bound must not touch the stream's expiry, which Beast
+    // refuses with both pending (an assertion: the process aborted in a CI run of issue 57's stop).
+    Fixture f({}, 1000);
+    auto kept = std::make_shared<Fixture::SocketSlot>();
+    auto closed = std::make_shared<std::atomic<bool>>(false);
+    f.server->add_subprotocol("test.flood.kept.v1",
+                              http::JsonSocketHandler{{},
+                                                      [kept](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                          for (int i = 0; i < 400; ++i) s->send(std::string(64 * 1024, 'f'));
+                                                          kept->set(s);
+                                                      },
+                                                      [closed](const std::shared_ptr<http::JsonSocket>&) { *closed = true; }});
+    SubprotocolClient client(f.port, "test.flood.kept.v1", "go");  // never reads
+    std::shared_ptr<http::JsonSocket> socket;
+    REQUIRE(rr::testing::eventually([&] { return (socket = kept->get()) != nullptr; }));
+    // The kernel's buffers are full (25 MiB queued against a few): a write stays pending.
+    REQUIRE(rr::testing::eventually([&] {
+        const auto before = socket->queued();
+        std::this_thread::sleep_for(50ms);
+        return before > 0 && socket->queued() == before;
+    }));
+    f.server->go_away();
+    CHECK(rr::testing::eventually([&] { return closed->load(); }));  // after the 1 s bound: the client never answers
 }
 
 TEST_CASE("an unknown subprotocol is refused with 426") {

@@ -143,7 +143,7 @@ public:
                          std::string target = {}, std::string subprotocol = {})
         : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), peer_(std::move(peer)),
           cookie_(std::move(cookie)), target_(std::move(target)), subprotocol_(std::move(subprotocol)),
-          pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()) {
+          pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()), goodbye_timer_(ws_.get_executor()) {
         const auto executor = ws_.get_executor();
         if (const auto* io = executor.template target<IoStrand>()) io_strand_ = *io;
     }
@@ -188,6 +188,15 @@ public:
             if (self->closed_) return;
             self->closed_ = true;
             self->ws_.async_close(websocket::close_code::normal, [self](beast::error_code) {});
+        });
+    }
+
+    void close_going_away() override {
+        auto self = shared_from_this();
+        asio::post(ws_.get_executor(), [self] {
+            if (self->closed_ || self->finished_) return;
+            // What is queued is not sent: the server is stopping. The handshake is bounded.
+            self->fail(websocket::close_code::going_away, "server stopping", std::chrono::seconds(1));
         });
     }
 
@@ -367,12 +376,24 @@ private:
         });
     }
 
-    // Ends the WebSocket with a close frame carrying `code` (the read side already stopped).
-    void fail(websocket::close_code code, const char* reason) {
+    // Ends the WebSocket with a close frame carrying `code`; after `bound` the socket is closed without
+    // waiting further. The bound is a timer of the session's own: the stream's expiry cannot be changed
+    // while a read and a write are both pending (Beast asserts), as when a stopping server ends an
+    // active socket (close_going_away) in the middle of a push.
+    void fail(websocket::close_code code, const char* reason, std::chrono::milliseconds bound = std::chrono::seconds(5)) {
         auto self = shared_from_this();
         closed_ = true;
-        beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(5));
-        ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) { self->finish(); });
+        goodbye_timer_.expires_after(bound);
+        goodbye_timer_.async_wait([self](beast::error_code ec) {
+            if (ec) return;
+            self->finish();
+            beast::error_code ignored;
+            beast::get_lowest_layer(self->ws_).socket().close(ignored);
+        });
+        ws_.async_close(websocket::close_reason(code, reason), [self](beast::error_code) {
+            self->goodbye_timer_.cancel();
+            self->finish();
+        });
     }
 
     void write() {
@@ -442,6 +463,7 @@ private:
     bool finished_ = false;
     // set_liveness_probe: the strand's.
     asio::steady_timer probe_timer_;
+    asio::steady_timer goodbye_timer_;  // bounds fail()'s close handshake
     std::optional<std::chrono::milliseconds> probe_timeout_;
     std::uint64_t probe_gen_ = 0;
     std::chrono::steady_clock::time_point probe_started_{}, last_receive_{};
@@ -656,6 +678,7 @@ private:
                                                                 server->node(), target, chosen);
                 s->keep(info.hold);
                 s->start();
+                server->track_socket(s);
                 return;
             }
             if (unnamed) return sniff_unnamed(holder, server, info);

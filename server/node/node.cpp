@@ -1,5 +1,9 @@
 #include "server/node/node.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
 #include <boost/asio/steady_timer.hpp>
 
 #include "robdef/builtin/service_index.hpp"
@@ -44,12 +48,28 @@ void Node::shutdown() {
     }
     for (auto& l : listeners) l->stop();
     for (auto& w : pumps)
-        if (auto p = w.lock()) p->close();
+        if (auto p = w.lock()) p->close_going_away();
     work_.reset();
-    // Give connections a moment to flush and close, then stop whatever is left (user timers etc.).
+    // Give connections a moment to flush and close, at most 200 ms, less once the io_context has run out
+    // of work (a stop with no client busy is quick). Then stop whatever is left (user timers etc.).
+    // Ending the moment as soon as the node's connections had gone was too early: what the closes and
+    // stops just asked for (a listener's acceptor closing, a client connection of the gateway's ending
+    // and freeing its device mirror) still had handlers to run, and stopped unrun they left the port
+    // bound and the mirror and its connection holding each other (LeakSanitizer, issue 57).
+    const bool on_own_thread = std::any_of(threads_.begin(), threads_.end(),
+                                           [](const std::thread& t) { return t.get_id() == std::this_thread::get_id(); });
     asio::steady_timer stop_timer(io_);
-    stop_timer.expires_after(std::chrono::milliseconds(200));
-    stop_timer.async_wait([this](boost::system::error_code) { io_.stop(); });
+    if (on_own_thread) {
+        // Cannot wait here (this thread runs the pumps): the moment is a timer, as before.
+        stop_timer.expires_after(std::chrono::milliseconds(200));
+        stop_timer.async_wait([this](boost::system::error_code) { io_.stop(); });
+    } else {
+        // io_context::run() returns on every thread, and stopped() turns true, once no work is left.
+        const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+        while (!io_.stopped() && std::chrono::steady_clock::now() < give_up)
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        io_.stop();
+    }
     for (auto& t : threads_)
         if (t.joinable() && t.get_id() != std::this_thread::get_id()) t.join();
     threads_.clear();

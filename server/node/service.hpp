@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/encoded_entry.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/encoded_entry.hpp"
+#include "base/message/message.hpp"
 #include "core/session/service_host.hpp"
 
 namespace boost::asio {
@@ -56,7 +56,7 @@ public:
     Result<void> send_wire_packet(MessageEntry entry) const;
     /// send() and send_wire_packet() for an entry many clients get unchanged (a wire value or event
     /// for every client of a member, non-null): its bytes are encoded once per message format
-    /// (core/message/encoded_entry.hpp) and copied into each client's message. Same errors.
+    /// (base/message/encoded_entry.hpp) and copied into each client's message. Same errors.
     Result<void> send(std::shared_ptr<const EncodedEntry> entry) const;
     Result<void> send_wire_packet(std::shared_ptr<const EncodedEntry> entry) const;
     /// Sends a request to the client (CallbackCallReq) and calls `done` with the reply entry or an

@@ -32,7 +32,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/record/channel_metadata.hpp"
 

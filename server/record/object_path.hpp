@@ -1,7 +1,7 @@
 // Members below a device's root object, for recording (docs/recording.md "Objects below the root"):
 // a recorded member is named by the object's path relative to the root, as the JSON API's `object=`
 // parameter names it (`Webcams[0]`, `arm.tool`), then `.` and the member: `Webcams[0].FrameStream`
-// (split_member_path, core/names/object_path.hpp). The object's type comes from the declared types of
+// (split_member_path, base/names/object_path.hpp). The object's type comes from the declared types of
 // the objrefs on the way (the device's robdef, core/names/object_path_walk.hpp), so a recording starts
 // without asking the device (RR's ObjectTypeName is asynchronous).
 #pragma once
@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/object_path.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/object_path.hpp"
 #include "server/gateway/device_types.hpp"
 
 namespace rr::server::record {

@@ -31,7 +31,7 @@ end
 
 }  // namespace
 
-// How a member path splits: core/names/object_path_test.cpp (split_member_path).
+// How a member path splits: base/names/object_path_test.cpp (split_member_path).
 
 TEST_CASE("record: an object below the root is found through the objrefs' declared types") {
     auto types = gateway::DeviceTypes::parse({kArmDef, kToolDef});

@@ -16,9 +16,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/mcap/mcap_records.hpp"
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 #include "server/gateway/json_api.hpp"
 #include "server/gateway/shared_entry.hpp"
 #include "server/record/channel_mapping.hpp"

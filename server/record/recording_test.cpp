@@ -15,7 +15,7 @@
 
 #include "core/mcap/mcap_reader.hpp"
 #include "server/gateway/json_api_test_fixture.hpp"
-#include "core/names/service_path.hpp"
+#include "base/names/service_path.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/mcap/mcap_file.hpp"

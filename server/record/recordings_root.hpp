@@ -26,7 +26,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/mcap/mcap_file.hpp"
 
 namespace rr::server::record {

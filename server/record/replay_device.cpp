@@ -5,7 +5,7 @@
 #include "core/mcap/mcap_reader.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/names/object_path_walk.hpp"
-#include "core/names/service_path.hpp"
+#include "base/names/service_path.hpp"
 #include "server/mcap/mcap_file.hpp"
 #include "server/record/recording_format.hpp"
 #include "server/service/pipe_member.hpp"

@@ -30,7 +30,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/value.hpp"
 #include "server/record/channel_metadata.hpp"
 #include "server/service/object_service.hpp"

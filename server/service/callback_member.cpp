@@ -1,6 +1,6 @@
 #include "server/service/callback_member.hpp"
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 #include "server/service/member_support.hpp"
 
 namespace rr::server {

@@ -21,7 +21,7 @@
 #include <functional>
 #include <optional>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/value.hpp"
 
 namespace rr::server {

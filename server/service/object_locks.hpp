@@ -34,7 +34,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server {
 

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <limits>
 
-#include "core/names/object_path.hpp"
+#include "base/names/object_path.hpp"
 #include "core/value/named_type.hpp"
 #include "server/service/member_support.hpp"
 
@@ -144,7 +144,7 @@ Result<std::shared_ptr<ServiceObject>> ObjectService::resolve(const SessionRef& 
     }
     if (path.size() <= name_.size() || path.compare(0, name_.size(), name_) != 0 || path[name_.size()] != '.')
         return fail(object_not_found(path));
-    // The objects below the root, segment by segment (core/names/object_path.hpp: indexes in
+    // The objects below the root, segment by segment (base/names/object_path.hpp: indexes in
     // service-path encoding); each prefix is resolved once and kept.
     auto below = parse_object_path(std::string_view(path).substr(name_.size() + 1), ObjectPathIndexes::encoded);
     if (!below) return fail(object_not_found(path));

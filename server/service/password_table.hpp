@@ -15,8 +15,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 
 namespace rr::server {
 

@@ -46,7 +46,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/message/message.hpp"
+#include "base/message/message.hpp"
 #include "core/value/value.hpp"
 #include "server/service/generator.hpp"
 #include "server/node/service.hpp"

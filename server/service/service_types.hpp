@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "robdef/service_definition_set.hpp"
 
 namespace rr::server {

@@ -107,6 +107,7 @@ Result<void> WireMember::set_out_value(Value value) {
         for (const auto& [k, c] : connections_) targets.push_back(c);
     }
     // Newest wins; a gone client is dropped on close.
+    for (const auto& t : targets) t->last_sent_ = time;
     if (targets.size() == 1) {
         entry->service_path = targets.front()->service_path();
         (void)targets.front()->session().send_wire_packet(std::move(*entry));
@@ -127,14 +128,33 @@ Result<void> WireMember::set_out_value(Value value) {
     return {};
 }
 
-Result<void> WireMember::send_to(const WireConnection& connection, const Value& value) {
+Result<void> WireMember::send_to(WireConnection& connection, const Value& value) {
     if (direction() == robdef::MemberDirection::writeonly)
         return fail(MessageErrorType::ReadOnlyMember, "wire " + name() + " is [writeonly]: only clients send");
     std::lock_guard order(send_order_mutex_);
-    auto entry = pack_packet(value, next_time(), MessageEntryType::WirePacket);
+    const TimeSpec time = next_time();
+    auto entry = pack_packet(value, time, MessageEntryType::WirePacket);
     if (!entry) return entry.take_error();
     entry->service_path = connection.service_path();
+    connection.last_sent_ = time;
     return connection.session().send_wire_packet(std::move(*entry));
+}
+
+void WireMember::send_current(WireConnection& connection) {
+    // Read under the order lock: a value set since the connection was added has reached it already,
+    // and the current one goes only if nothing newer did.
+    std::lock_guard order(send_order_mutex_);
+    std::optional<TimedValue> current;
+    {
+        std::lock_guard lock(mutex_);
+        current = out_;
+    }
+    if (!current || (connection.last_sent_ && current->time <= *connection.last_sent_)) return;
+    if (auto e = pack_packet(current->value, current->time, MessageEntryType::WirePacket)) {
+        e->service_path = connection.service_path();
+        connection.last_sent_ = current->time;
+        (void)connection.session().send_wire_packet(std::move(*e));
+    }
 }
 
 Result<TimedValue> WireMember::out_value() const {
@@ -162,7 +182,6 @@ void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry,
         case MessageEntryType::WireConnectReq: {
             std::shared_ptr<WireConnection> conn;
             std::shared_ptr<const ConnectHandler> on_connect;
-            std::optional<TimedValue> current;
             bool created = false;
             {
                 std::lock_guard lock(mutex_);
@@ -173,18 +192,12 @@ void WireMember::handle_request(const SessionRef& session, MessageEntry&& entry,
                 }
                 conn = slot;
                 on_connect = on_connect_;
-                if (dir != robdef::MemberDirection::writeonly) current = out_;
             }
             if (auto r = run_on_connect(on_connect, Key{session.endpoint(), entry.service_path}, conn, created); !r) {
                 responder.fail(r.error());
                 return;
             }
-            if (current) {
-                if (auto e = pack_packet(current->value, current->time, MessageEntryType::WirePacket)) {
-                    e->service_path = entry.service_path;
-                    (void)session.send_wire_packet(std::move(*e));
-                }
-            }
+            if (dir != robdef::MemberDirection::writeonly) send_current(*conn);
             responder.respond(MessageEntry{});
             return;
         }

@@ -68,6 +68,8 @@ private:
     const std::weak_ptr<WireMember> member_;
     mutable std::mutex mutex_;
     std::optional<TimedValue> in_;
+    // Time stamp of the newest packet queued to this client; guarded by the member's send_order_mutex_.
+    std::optional<TimeSpec> last_sent_;
 };
 
 /// Connections by (session endpoint, service path). on_connect (runs before the WireConnectRet; an
@@ -109,15 +111,17 @@ private:
     friend class WireConnection;
     using Key = std::pair<std::uint32_t, std::string>;  // session endpoint, service path
     Result<MessageEntry> pack_packet(const Value& value, TimeSpec time, MessageEntryType type) const;
-    Result<void> send_to(const WireConnection& connection, const Value& value);
+    Result<void> send_to(WireConnection& connection, const Value& value);
+    /// A new connection's first packet: the out value, unless something as new reached it already.
+    void send_current(WireConnection& connection);
     TimeSpec next_time();
     /// WireConnection::close: removed, with WireClosed to the client.
     void close_connection(const std::shared_ptr<WireConnection>& connection);
 
     const std::shared_ptr<const detail::MemberInfo> info_;
-    // Held from taking a time stamp until the packet is queued to every target: clients drop a packet
-    // older than the last one they got (wire.md §6.7), so two threads sending at once must not let the
-    // older stamp reach a client second.
+    // Held from taking a time stamp until the packet is queued to every target, and while a new
+    // connection gets the current value: clients drop a packet older than the last one they got
+    // (wire.md §6.7), so no client may get an older stamp after a newer one.
     std::mutex send_order_mutex_;
     // Guarded by mutex_ (MemberConnections'):
     std::optional<TimedValue> out_;

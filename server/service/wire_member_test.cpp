@@ -130,6 +130,31 @@ TEST_CASE("wires: values set from two threads reach every client in time-stamp o
     }
 }
 
+TEST_CASE("wires: a new connection gets the current value, never after a newer one") {
+    // The current value goes to a new client after on_connect; a value set or sent to it in between
+    // (here by on_connect itself) is newer, so the current one must not follow it (wire.md §6.7).
+    ServiceFixture f;
+    auto level = f.root->wire("level").value();
+    REQUIRE(level->set_out_value(Value::array<double>({0})));
+    bool to_connection = false;
+    level->on_connect([&](const std::shared_ptr<WireConnection>& c) -> Result<void> {
+        if (to_connection) return c->set_out_value(Value::array<double>({2}));
+        return level->set_out_value(Value::array<double>({1}));
+    });
+    for (bool per_connection : {false, true}) {
+        to_connection = per_connection;
+        auto c = f.connect();
+        c.ok(req(MessageEntryType::WireConnectReq, "level"));
+        (void)c.ok(req(MessageEntryType::WirePeekInValueReq, "level"));  // a round trip: all queued
+        std::vector<std::pair<TimeSpec, Value>> got;
+        while (auto p = c.inbox->take(MessageEntryType::WirePacket, 0ms))
+            got.emplace_back(*unpack_timespec(*p->find("packettime")), f.unpack(*p->find("packet"), "double[]"));
+        REQUIRE(!got.empty());
+        for (std::size_t i = 1; i < got.size(); ++i) CHECK(got[i - 1].first < got[i].first);
+        CHECK(got.back().second == Value::array<double>({per_connection ? 2.0 : 1.0}));
+    }
+}
+
 TEST_CASE("wires: in values, ordering by time stamp, peek out and poke") {
     ServiceFixture f;
     auto level = f.root->wire("level").value();

@@ -10,7 +10,7 @@
 #include <functional>
 #include <utility>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server {
 

@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "core/codec/gather_buffer.hpp"
-#include "core/error/rr_error.hpp"
+#include "base/codec/gather_buffer.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/session/stream_connection.hpp"
 
 namespace rr::server {

@@ -62,6 +62,9 @@ public:
     virtual bool known_off_strand() const { return false; }
     /// Closes the transport after flushing what is pending; reads nothing more meanwhile.
     virtual void close() = 0;
+    /// close() because the node is stopping: a transport that can say so tells its peer (a WebSocket's
+    /// close frame 1001 Going Away, so a client can tell a restart from a network failure).
+    virtual void close_going_away() { close(); }
     /// Closes the transport at once, unflushed, and reports it to the logic. Only for a caller that
     /// knows no thread runs the pump's executor: a node whose threads have stopped before a close()
     /// could finish (a peer still flooding it, a loaded machine), so that its peer sees the end.
@@ -172,7 +175,27 @@ public:
         });
     }
 
-    void close_now() override { shutdown(); }
+    void close_going_away() override {
+        auto self = this->shared_from_this();
+        asio::post(strand_, [self] {
+            self->going_away_ = true;
+            self->close_requested_ = true;
+            self->after_work();
+        });
+    }
+
+    void close_now() override {
+        shutdown();
+        // A close handshake still waiting for the peer's answer (no thread runs it any more) ends here.
+        if (goodbye_pending_) {
+            goodbye_pending_ = false;
+            boost::system::error_code ignored;
+            if constexpr (requires(Stream& s) { s.lowest_layer(); })
+                stream_.lowest_layer().close(ignored);
+            else
+                stream_.close(ignored);
+        }
+    }
 
     Stream& stream() { return stream_; }
     const Strand& strand() const { return strand_; }
@@ -342,6 +365,23 @@ private:
         timer_.cancel();
         if (throttle_timer_) throttle_timer_->cancel();
         boost::system::error_code ignored;
+        // The node stopping ends a WebSocket with a close frame 1001 Going Away rather than a bare TCP
+        // close, which a client reports as 1006 (abnormal: a crash, a cut network). The handshake is
+        // bounded; the socket closes when it ends (or at close_now()).
+        if constexpr (requires(Stream& s) { s.async_goodbye(true, [](boost::system::error_code) {}); }) {
+            if (going_away_) {
+                goodbye_pending_ = true;
+                auto self = this->shared_from_this();
+                stream_.async_goodbye(going_away_, asio::bind_executor(strand_, [self](boost::system::error_code) {
+                    self->goodbye_pending_ = false;
+                }));
+                if (!transport_reported_) {
+                    transport_reported_ = true;
+                    logic_->on_transport_closed(make_error(MessageErrorType::ConnectionError, "connection closed"));
+                }
+                return;
+            }
+        }
         if constexpr (requires(Stream& s) { s.lowest_layer(); }) {
             stream_.lowest_layer().shutdown(asio::socket_base::shutdown_both, ignored);
             stream_.lowest_layer().close(ignored);
@@ -394,6 +434,8 @@ private:
     bool read_paused_ = false;
     bool closed_ = false;
     bool close_requested_ = false;
+    bool going_away_ = false;       // close_going_away(): the node is stopping
+    bool goodbye_pending_ = false;  // a WebSocket close handshake is under way (shutdown())
     bool timer_armed_ = false;
     bool transport_reported_ = false;
     MonoTime armed_for_{};

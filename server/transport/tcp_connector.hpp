@@ -8,7 +8,7 @@
 
 #include <boost/asio/ip/tcp.hpp>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/transport/transport.hpp"
 
 namespace rr::server {

@@ -17,8 +17,8 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/transport/connection_logic.hpp"
 #include "server/transport/stream_pump.hpp"
 

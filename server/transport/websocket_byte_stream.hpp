@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 #include <boost/asio/associated_executor.hpp>
@@ -46,6 +47,19 @@ public:
     template <class ConstBuffers, class Handler>
     void async_write_some(const ConstBuffers& buffers, Handler&& handler) {
         ws_.async_write(boost::beast::buffers_prefix(kMaxFramePayload, buffers), std::forward<Handler>(handler));
+    }
+
+    /// Ends the WebSocket with a close frame: 1001 Going Away when `going_away` (the server is stopping),
+    /// else 1000 Normal Closure; Beast then waits for the peer's close frame and closes the socket, and
+    /// `handler(ec)` runs when that is over. Not bounded here: the stream's expiry cannot be changed while
+    /// a read and a write are both pending (Beast asserts), so the caller bounds it (Node::shutdown closes
+    /// every pump's socket after its moment: StreamPump::close_now).
+    template <class Handler>
+    void async_goodbye(bool going_away, Handler&& handler) {
+        namespace websocket = boost::beast::websocket;
+        ws_.async_close(going_away ? websocket::close_reason(websocket::close_code::going_away, "server stopping")
+                                   : websocket::close_reason(websocket::close_code::normal),
+                        std::forward<Handler>(handler));
     }
 
     auto& lowest_layer() noexcept { return boost::beast::get_lowest_layer(ws_).socket(); }

@@ -21,8 +21,17 @@ export function startDevice(script, args = [], options = {}) {
 export async function screenshot(target, name, { docs = true, ...options } = {}) {
   const s = settings();
   fs.mkdirSync(s.artifacts, { recursive: true });
-  await target.screenshot({ path: path.join(s.artifacts, name), ...options });
-  if (docs && process.env.RR_DOCS_SCREENSHOTS === "1") {
+  const forDocs = docs && process.env.RR_DOCS_SCREENSHOTS === "1";
+  try {
+    await target.screenshot({ path: path.join(s.artifacts, name), ...options });
+  } catch (e) {
+    // Outside a docs run the picture is only an artifact, not a check: a page starved of frames under
+    // load (Playwright waits for the element to be stable) must not fail the test it illustrates.
+    if (forDocs) throw e;
+    console.log(`# screenshot ${name} not taken: ${e.message.split("\n")[0]}`);
+    return;
+  }
+  if (forDocs) {
     fs.mkdirSync(path.join(ROOT, "docs/img"), { recursive: true });
     fs.copyFileSync(path.join(s.artifacts, name), path.join(ROOT, "docs/img", name));
   }

@@ -1,12 +1,13 @@
 // The gateway's Foxglove WebSocket (docs/foxglove.md) against the official client library
 // @foxglove/ws-protocol (FoxgloveClient over `ws`): rr-gateway with logins (an operator and a viewer
 // token), the demo devices as an external rr-demo-devices process (so that they can restart), and a
-// command sink on the official Python library (command_sink.py) for a client publish.
+// command sink on the official Python library (command_sink.py) for a client publish and a clock.
 //
 // Checked: serverInfo and both subprotocols; every wire, pipe and event advertised with a JSON Schema
 // that compiles (ajv), and the values received from the demo devices valid against their channel's
 // schema; parameters read and set (and the update to a client subscribed to it); a service called
-// (and a failure); a client publish reaching the device's wire; unadvertise and re-advertise (same
+// (and a failure); a client publish reaching the device's wire and pipe; `time` messages and receive
+// times from the sink's device clock (foxglove.clock); unadvertise and re-advertise (same
 // channel ids) when the devices restart; a viewer refused what needs write or call; no login, a bad
 // path and malformed messages answered with a status and nothing else.
 //
@@ -48,7 +49,7 @@ async function connect({ token, protocol = "foxglove.websocket.v1", target = "/f
   const ws = new WebSocket(url, [protocol]);
   const client = new FoxgloveClient({ ws });
   const got = { serverInfo: null, channels: new Map(), services: new Map(), statuses: [], messages: [], params: [],
-    responses: [], failures: [], unadvertised: [], closed: false };
+    responses: [], failures: [], unadvertised: [], times: [], closed: false };
   client.on("serverInfo", (m) => { got.serverInfo = m; });
   client.on("advertise", (cs) => { for (const c of cs) got.channels.set(c.id, c); });
   client.on("unadvertise", (ids) => { for (const id of ids) { got.channels.delete(id); got.unadvertised.push(id); } });
@@ -59,6 +60,7 @@ async function connect({ token, protocol = "foxglove.websocket.v1", target = "/f
   client.on("parameterValues", (m) => got.params.push(m));
   client.on("serviceCallResponse", (m) => got.responses.push(m));
   client.on("serviceCallFailure", (m) => got.failures.push(m));
+  client.on("time", (m) => got.times.push(m.timestamp));
   client.on("close", () => { got.closed = true; });
   client.on("error", () => {});
   clients.push(client);
@@ -100,6 +102,7 @@ before(async () => {
     `  - {name: webcam, url: "${demo.info.webcam_url}"}`,
     `  - {name: sink, url: "${sink.info.url}"}`,
     "foxglove:",
+    "  clock: sink",
     "  objects:",
     "    webcam: [\"Webcams[0]\"]",
     "",
@@ -118,10 +121,11 @@ after(async () => {
 test("serverInfo on both subprotocols, channels advertised with JSON Schemas", { skip: missing || false }, async () => {
   const c = await connect({ token: OPERATOR });
   assert.equal(c.ws.protocol, "foxglove.websocket.v1");
-  assert.deepEqual(new Set(c.got.serverInfo.capabilities), new Set(["clientPublish", "parameters", "parametersSubscribe", "services"]));
+  // `time`: the configuration names the sink's clock (foxglove.clock).
+  assert.deepEqual(new Set(c.got.serverInfo.capabilities), new Set(["clientPublish", "parameters", "parametersSubscribe", "services", "time"]));
   assert.deepEqual(c.got.serverInfo.supportedEncodings, ["json"]);
   assert.ok(c.got.serverInfo.sessionId);
-  const want = ["create/packets", "create/Bump", "webcam/Webcams[0]/FrameStream", "sink/command"];
+  const want = ["create/packets", "create/Bump", "webcam/Webcams[0]/FrameStream", "sink/command", "sink/command_packets"];
   await waitFor(() => want.every((t) => topicId(c.got, t) !== undefined), `advertised ${want.join(", ")}`, 30000);
   const ajv = new Ajv({ strict: false });
   for (const ch of c.got.channels.values()) {
@@ -238,6 +242,54 @@ test("a client publish reaches the device's wire", { skip: missing || false }, a
   assert.match(refused[0].message, /not a writable wire/);
 });
 
+test("a client publish reaches the device's pipe, packet by packet", { skip: missing || false }, async () => {
+  const c = await connect({ token: OPERATOR });
+  await waitFor(() => topicId(c.got, "sink/command_packets") !== undefined, "sink/command_packets advertised", 30000);
+  const readSink = async () => {
+    const id = `pipe-read-${c.got.params.length}`;
+    c.client.getParameters(["sink/packets", "sink/last_packet"], id);
+    const p = await waitFor(() => c.got.params.find((x) => x.id === id), id, 30000);
+    return Object.fromEntries(p.parameters.map((x) => [x.name, x.value]));
+  };
+  const before = (await readSink())["sink/packets"];
+  const channel = c.client.advertise({ topic: "sink/command_packets", encoding: "json",
+    schemaName: "experimental.foxglove_sink.Sink.command_packets" });
+  const send = (v) => c.client.sendMessage(channel, new TextEncoder().encode(JSON.stringify(v)));
+  // Sent at once after the advertise: they wait for the pipe endpoint, in order, none lost.
+  send({ value: [1, 2] });
+  send([3, 4, 5]);  // the bare value works too
+  await waitFor(async () => { const r = await readSink(); return r["sink/packets"] === before + 2 && JSON.stringify(r["sink/last_packet"]) === "[3,4,5]"; },
+    `two packets at the device (${JSON.stringify(c.got.statuses)})`, 30000, 200);
+  send({ value: "not numbers" });
+  await waitFor(() => c.got.statuses.some((x) => x.level === 2 && /sink\/command_packets/.test(x.message)), "a status for a bad packet", 30000);
+  send([6]);
+  await waitFor(async () => { const r = await readSink(); return r["sink/packets"] === before + 3 && JSON.stringify(r["sink/last_packet"]) === "[6]"; },
+    "the packet after the refused one", 30000, 200);
+  // Unadvertised: the gateway's pipe endpoint for it ends; a new advertise works again.
+  c.client.unadvertise(channel);
+  const again = c.client.advertise({ topic: "sink/command_packets", encoding: "json", schemaName: "x" });
+  c.client.sendMessage(again, new TextEncoder().encode("[7]"));
+  await waitFor(async () => (await readSink())["sink/packets"] === before + 4, "a packet on the channel advertised again", 30000, 200);
+  assert.equal(c.got.statuses.filter((x) => x.level === 2).length, 1, JSON.stringify(c.got.statuses));
+});
+
+test("time from the device's clock: time messages and receive times", { skip: missing || false }, async () => {
+  const EPOCH = 978307200n * 1000000000n;  // command_sink.py's clock starts at 2001-01-01
+  const DAY = 86400n * 1000000000n;
+  const c = await connect({ token: OPERATOR });
+  assert.ok(c.got.serverInfo.capabilities.includes("time"));
+  await waitFor(() => c.got.times.length >= 3, "three time messages", 60000);
+  const times = c.got.times.slice(0, 3);
+  for (const t of times) assert.ok(t >= EPOCH && t < EPOCH + DAY, `a time on the device's clock: ${t}`);
+  assert.ok(times[0] <= times[1] && times[1] <= times[2], `times in order: ${times}`);
+  // messageData receive times are on the same clock (Foxglove compares them with its current time).
+  await waitFor(() => topicId(c.got, "create/packets") !== undefined, "advertised", 30000);
+  const sub = c.client.subscribe(topicId(c.got, "create/packets"));
+  const m = await waitFor(() => c.got.messages.find((x) => x.subscriptionId === sub), "a value", 30000);
+  assert.ok(m.timestamp >= EPOCH && m.timestamp < EPOCH + DAY, `a receive time on the device's clock: ${m.timestamp}`);
+  assert.ok(m.timestamp >= times[0], `a receive time after the first time message: ${m.timestamp} < ${times[0]}`);
+});
+
 test("a viewer reads but may not set, call or publish; no login is refused", { skip: missing || false }, async () => {
   const v = await connect({ token: VIEWER });
   await waitFor(() => topicId(v.got, "create/packets") !== undefined && serviceId(v.got, "create/StartStreaming") !== undefined,
@@ -251,7 +303,10 @@ test("a viewer reads but may not set, call or publish; no login is refused", { s
   await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /not set: sink\/label: .*PermissionDenied/.test(x.message)),
     `setParameters refused (${JSON.stringify(v.got.statuses)})`, 30000);
   v.client.advertise({ topic: "sink/command", encoding: "json", schemaName: "x" });
-  await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /advertise: sink\/command/.test(x.message)), "publish refused", 30000);
+  await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /advertise: sink\/command:/.test(x.message)), "publish refused", 30000);
+  v.client.advertise({ topic: "sink/command_packets", encoding: "json", schemaName: "x" });
+  await waitFor(() => v.got.statuses.some((x) => x.level === 2 && /advertise: sink\/command_packets:/.test(x.message)),
+    "publish to a pipe refused", 30000);
   v.client.getParameters(["sink/label"], "v-get");
   const p = await waitFor(() => v.got.params.find((x) => x.id === "v-get"), "the viewer's read", 30000);
   assert.notEqual(p.parameters[0].value, "viewer-was-here");

@@ -15,18 +15,14 @@
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
-import http from "node:http";
 import os from "node:os";
 import path from "node:path";
 import { settings, startGateway, launchChromium, apiDevices, waitFor } from "../browser/harness.mjs";
 import { DEVICES, startDevice, screenshot } from "../browser/std_support.mjs";
+import { lichtblickWebOrSkip, serveLichtblick, gatewayApi, shotPixels } from "../browser/lichtblick_support.mjs";
 
 const s = settings();
-const web = process.env.LICHTBLICK_WEB;
-if (!web || !fs.existsSync(path.join(web || "", "index.html"))) {
-  console.log(`SKIP: LICHTBLICK_WEB ${web ? `(${web}) has no index.html` : "is not set"}: build the app with scripts/build-lichtblick.sh`);
-  process.exit(77);
-}
+const web = lichtblickWebOrSkip();
 
 const work = fs.mkdtempSync(path.join(os.tmpdir(), "rr-lichtblick-live-"));
 let camera, gateway, server, browser, page;
@@ -53,48 +49,9 @@ const LAYOUT = {
   },
 };
 
-/** Serves the app with LAYOUT as its default layout. */
-function serve() {
-  const index = fs.readFileSync(path.join(web, "index.html"), "utf8");
-  assert.ok(index.includes("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/"), "the app's index.html has the default-layout placeholder");
-  const indexWithLayout = index.replace("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/", JSON.stringify(LAYOUT));
-  const types = { ".js": "text/javascript", ".wasm": "application/wasm", ".html": "text/html", ".css": "text/css",
-    ".json": "application/json", ".png": "image/png", ".svg": "image/svg+xml", ".woff2": "font/woff2", ".ico": "image/x-icon" };
-  const srv = http.createServer((req, res) => {
-    const url = new URL(req.url, "http://x");
-    const rel = url.pathname === "/" ? "index.html" : path.normalize(decodeURIComponent(url.pathname)).replace(/^\/+/, "");
-    if (rel === "index.html") {
-      res.writeHead(200, { "Content-Type": "text/html" });
-      return res.end(indexWithLayout);
-    }
-    const p = path.join(web, rel);
-    if (!p.startsWith(web) || !fs.existsSync(p) || !fs.statSync(p).isFile()) { res.writeHead(404); return res.end(); }
-    res.writeHead(200, { "Content-Type": types[path.extname(p)] || "application/octet-stream" });
-    fs.createReadStream(p).pipe(res);
-  });
-  return new Promise((resolve) => srv.listen(0, "127.0.0.1", () => resolve(srv)));
-}
-
-async function api(method, p, body) {
-  const r = await fetch(`${gateway.base}${p}`, { method, headers: { "content-type": "application/json" }, body: body && JSON.stringify(body) });
-  const text = await r.text();
-  return { status: r.status, body: text ? JSON.parse(text) : null };
-}
-
-/** The RGBA pixels of a locator's screenshot, decoded by the page itself. */
-async function shotPixels(locator) {
-  const png = await locator.screenshot();
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = document.createElement("canvas");
-    c.width = img.width; c.height = img.height;
-    const g = c.getContext("2d");
-    g.drawImage(img, 0, 0);
-    return { width: c.width, height: c.height, data: Array.from(g.getImageData(0, 0, c.width, c.height).data) };
-  }, png.toString("base64"));
-}
+const serve = () => serveLichtblick(web, LAYOUT);
+const api = (method, p, body) => gatewayApi(gateway.base, method, p, body);
+const pixels = (locator) => shotPixels(page, locator);
 
 const panel = (id) => page.locator(`[data-testid="panel-mouseenter-container ${id}"]`);
 
@@ -142,7 +99,7 @@ test("Lichtblick live over the Foxglove WebSocket: the camera's picture, a plot 
 
   // Image panel: the synthetic camera's picture (many saturated colours) from the foxglove.RawImage channel
   await waitFor(async () => {
-    const img = await shotPixels(panel("Image!cam"));
+    const img = await pixels(panel("Image!cam"));
     const colours = new Map();
     for (let i = 0; i < img.data.length; i += 4) {
       const [r, g, b] = img.data.slice(i, i + 3);
@@ -155,7 +112,7 @@ test("Lichtblick live over the Foxglove WebSocket: the camera's picture, a plot 
 
   // Plot: the wire's field drawn as a line (the series' colour on many columns of the chart)
   await waitFor(async () => {
-    const plot = await shotPixels(panel("Plot!wire"));
+    const plot = await pixels(panel("Plot!wire"));
     const cols = new Set();
     for (let i = 0; i < plot.data.length; i += 4) {
       const [r, g, b] = plot.data.slice(i, i + 3);

@@ -1,4 +1,4 @@
-// libFuzzer target for connection URLs (core/names/connection_url.hpp) and NodeIDs (node_id.hpp):
+// libFuzzer target for connection URLs (base/names/connection_url.hpp) and NodeIDs (node_id.hpp):
 // what parses must print to text that parses back to the same URL, and NodeID text must round-trip.
 // Input: the URL text. Seeds: test/fuzz/seeds/fuzz_connection_url (the URLs of connection_url_test).
 #include <cstddef>
@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "core/names/connection_url.hpp"
-#include "core/names/node_id.hpp"
+#include "base/names/connection_url.hpp"
+#include "base/names/node_id.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 
 #include "core/discovery/discovery_packet.hpp"
 #include "core/discovery/node_table.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/names/connection_url.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer target for the message codec (core/message): arbitrary bytes through the reader, the
+// libFuzzer target for the message codec (base/message): arbitrary bytes through the reader, the
 // writer and the stream reader (the checks are in message_checks.hpp). Seeds:
 // test/fuzz/seeds/fuzz_message_reader (made by gen_message_seeds); the shared vectors can be added as a
 // second corpus directory:

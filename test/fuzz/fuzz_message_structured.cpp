@@ -17,7 +17,7 @@
 #include "core/json/element_json_plan.hpp"
 #include "core/json/element_json_text.hpp"
 #include "core/json/value_json.hpp"
-#include "core/message/string_table.hpp"
+#include "base/message/string_table.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/var_type.hpp"
 #include "robdef/service_definition_set.hpp"

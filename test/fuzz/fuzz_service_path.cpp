@@ -1,5 +1,5 @@
 // libFuzzer target for the name parsers of core/: service paths and objref indices
-// (core/names/service_path.hpp, wire.md §6.5) and the type strings of varvalues received from peers
+// (base/names/service_path.hpp, wire.md §6.5) and the type strings of varvalues received from peers
 // (core/value/var_type.hpp). Properties checked: a split path re-joins to the same path; an index
 // decodes back from its encoding; renaming the service keeps the rest of the path; a parsed type
 // string prints back to a type string that parses to the same type.
@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/names/service_path.hpp"
+#include "base/names/service_path.hpp"
 #include "core/value/var_type.hpp"
 
 namespace {

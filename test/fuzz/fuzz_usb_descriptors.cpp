@@ -1,4 +1,4 @@
-// libFuzzer target for the rr+usb descriptor parsers (core/usb/usb_descriptors.hpp): the first byte
+// libFuzzer target for the rr+usb descriptor parsers (base/usb/usb_descriptors.hpp): the first byte
 // picks the parser, the rest is the descriptor. Whatever parses must build again and parse to the
 // same value; nothing may read past the input (ASan) or loop (libFuzzer's timeout).
 // Seeds: test/fuzz/seeds/fuzz_usb_descriptors (a BOS with the RR capability, a descriptor set,
@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <span>
 
-#include "core/usb/usb_descriptors.hpp"
+#include "base/usb/usb_descriptors.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer target for the rr+usb bulk framing and both multiplexers (core/usb): the input is a
+// libFuzzer target for the rr+usb bulk framing and both multiplexers (base/usb): the input is a
 // sequence of records {uint8 op, uint16 length, bytes}; ops feed a host multiplexer (bulk IN), a
 // device function (bulk OUT, control requests), open and close streams, queue writes and move
 // transfers between the two. Invariants: parsed sub-packets match their transfer size, filled
@@ -11,9 +11,9 @@
 #include <span>
 #include <vector>
 
-#include "core/codec/endian.hpp"
-#include "core/usb/usb_device_function.hpp"
-#include "core/usb/usb_host_mux.hpp"
+#include "base/codec/endian.hpp"
+#include "base/usb/usb_device_function.hpp"
+#include "base/usb/usb_host_mux.hpp"
 
 namespace {
 

@@ -12,11 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/codec/endian.hpp"
+#include "base/codec/endian.hpp"
 #include "core/json/value_json.hpp"
-#include "core/message/error_entry.hpp"
-#include "core/message/message_writer.hpp"
-#include "core/message/string_table.hpp"
+#include "base/message/error_entry.hpp"
+#include "base/message/message_writer.hpp"
+#include "base/message/string_table.hpp"
 #include "core/session/stream_connection.hpp"
 #include "core/value/pack_value.hpp"
 #include "core/value/var_type.hpp"

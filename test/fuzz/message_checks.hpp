@@ -13,9 +13,9 @@
 #include <span>
 #include <vector>
 
-#include "core/message/message_reader.hpp"
-#include "core/message/message_stream_reader.hpp"
-#include "core/message/message_writer.hpp"
+#include "base/message/message_reader.hpp"
+#include "base/message/message_stream_reader.hpp"
+#include "base/message/message_writer.hpp"
 
 namespace rr::fuzz {
 

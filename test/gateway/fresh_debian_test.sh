@@ -6,10 +6,30 @@
 # that user with that file and answering /readyz, and `apt-get purge` removing it all.
 #
 #   fresh_debian_test.sh BUILD_DIR DOC CPACK     (RR_PACKAGE_BUILD=DIR overrides BUILD_DIR)
+#   fresh_debian_test.sh --prepare-root DIR      only makes the fresh root (with its package lists) in
+#                                                DIR, for a later run with RR_FRESH_DEBIAN_ROOT=DIR,
+#                                                which takes it (scripts/test.sh: the download runs
+#                                                while the package is still compiling)
 #
 # Downloads about 100 MB and takes minutes, so it runs only with RR_FRESH_DEBIAN=1 (and as root, with
 # mmdebstrap installed); otherwise it reports skipped (77) with the reason.
 set -euo pipefail
+# A minimal bookworm root with its package lists (an installed Debian machine has them) in $1.
+make_root() {
+  mmdebstrap --quiet --variant=apt bookworm "$1"
+  cp /etc/resolv.conf "$1/etc/resolv.conf"
+  chroot "$1" apt-get update -q >/dev/null
+}
+if [ "${1:-}" = --prepare-root ]; then
+  dir=${2:?--prepare-root DIR}
+  [ "$(id -u)" = 0 ] || { echo "SKIP: needs root (chroot)"; exit 77; }
+  command -v mmdebstrap >/dev/null || { echo "SKIP: mmdebstrap not installed (apt-get install mmdebstrap)"; exit 77; }
+  rm -rf "$dir"
+  make_root "$dir" || { rm -rf "$dir"; exit 1; }
+  touch "$dir/.rr-fresh-root-ready"
+  echo "ok: a fresh bookworm root in $dir"
+  exit 0
+fi
 build=$1 doc=$2 cpack=$3
 # RR_PACKAGE_BUILD: pack that build folder instead (scripts/test.sh: its Release package build, so that
 # what is installed is the package a user gets, not the sanitizer build the tests ran).
@@ -41,12 +61,16 @@ deb_path=$(echo "$install_cmd" | awk '{print $NF}')
 made=$(ls "$work"/pack/*.deb)
 [ "$(basename "$made")" = "$(basename "$deb_path")" ] || fail "the page installs $(basename "$deb_path"), cpack made $(basename "$made")"
 
-mmdebstrap --quiet --variant=apt bookworm "$root"
+# A root made beforehand (--prepare-root) is taken, once: it is fresh until this run installs into it.
+if [ -n "${RR_FRESH_DEBIAN_ROOT:-}" ] && [ -f "$RR_FRESH_DEBIAN_ROOT/.rr-fresh-root-ready" ]; then
+  rm "$RR_FRESH_DEBIAN_ROOT/.rr-fresh-root-ready"
+  mv "$RR_FRESH_DEBIAN_ROOT" "$root"
+  echo "using the root prepared in $RR_FRESH_DEBIAN_ROOT"
+else
+  make_root "$root"
+fi
 mkdir -p "$root/root/$(dirname "$deb_path")"
 cp "$made" "$root/root/$deb_path"
-cp /etc/resolv.conf "$root/etc/resolv.conf"
-# A minimal root has no package lists (an installed Debian machine has them).
-chroot "$root" apt-get update -q >/dev/null
 # -y: apt asks before installing (a person answers Y).
 chroot "$root" sh -c "cd /root && DEBIAN_FRONTEND=noninteractive ${install_cmd/apt-get install/apt-get install -y}" >"$work/install.log" 2>&1 ||
   { tail -20 "$work/install.log"; fail "$install_cmd"; }

@@ -29,11 +29,11 @@
 #include <string_view>
 #include <vector>
 
-#include "core/codec/limits.hpp"
-#include "core/codec/shared_bytes.hpp"
-#include "core/message/message.hpp"
-#include "core/message/message_reader.hpp"
-#include "core/message/message_writer.hpp"
+#include "base/codec/limits.hpp"
+#include "base/codec/shared_bytes.hpp"
+#include "base/message/message.hpp"
+#include "base/message/message_reader.hpp"
+#include "base/message/message_writer.hpp"
 
 namespace {
 

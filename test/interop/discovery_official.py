@@ -50,18 +50,28 @@ class Thing:
         self.label = "official thing"
 
 
+def ipv4_only_flags(flags):
+    """A node setup's `flags` with discovery (announce and listening) on IPv4 broadcast instead of IPv6."""
+    import RobotRaconteur as RR
+    return ((flags & ~RR.RobotRaconteurNodeSetupFlags_TCP_TRANSPORT_IPV6_DISCOVERY)
+            | RR.RobotRaconteurNodeSetupFlags_TCP_TRANSPORT_IPV4_DISCOVERY)
+
+
 def serve(args):
     import RobotRaconteur as RR
     RRN = RR.RobotRaconteurNode.s
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *a: stop.set())
     signal.signal(signal.SIGINT, lambda *a: stop.set())
-    with RR.ServerNodeSetup(args.name, args.port) as setup:
-        if args.ipv4_only:  # announce and listen on IPv4 broadcast only (the official IPV4_BROADCAST flag)
-            setup.tcp_transport.DisableNodeAnnounce()
-            setup.tcp_transport.DisableNodeDiscoveryListening()
-            setup.tcp_transport.EnableNodeAnnounce(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
-            setup.tcp_transport.EnableNodeDiscoveryListening(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
+    if args.ipv4_only:
+        # Announce and listen on IPv4 broadcast only (the official IPV4_BROADCAST flag), chosen by the node
+        # setup's flags: turning the IPv6 default off after the start (DisableNodeDiscoveryListening) threw
+        # "shutdown: Transport endpoint is not connected" now and then in the official library.
+        node_setup = RR.RobotRaconteurNodeSetup(args.name, args.port, ipv4_only_flags(RR.RobotRaconteurNodeSetupFlags_SERVER_DEFAULT))
+    else:
+        node_setup = RR.ServerNodeSetup(args.name, args.port)
+    with node_setup as setup:
+        if args.ipv4_only:
             # Announce every second (the default is 55 s): a listener that sends no IPv4 requests, such as
             # rr discover with default settings, hears it within its timeout.
             setup.tcp_transport.NodeAnnouncePeriod = 1000
@@ -76,10 +86,11 @@ def serve(args):
 def find(args):
     import RobotRaconteur as RR
     RRN = RR.RobotRaconteurNode.s
-    with RR.ClientNodeSetup() as setup:
-        if args.ipv4_only:  # listen on IPv4 broadcast only
-            setup.tcp_transport.DisableNodeDiscoveryListening()
-            setup.tcp_transport.EnableNodeDiscoveryListening(RR.IPNodeDiscoveryFlags_IPV4_BROADCAST)
+    if args.ipv4_only:  # listen on IPv4 broadcast only, by the setup's flags (see serve)
+        node_setup = RR.RobotRaconteurNodeSetup(None, 0, ipv4_only_flags(RR.RobotRaconteurNodeSetupFlags_CLIENT_DEFAULT))
+    else:
+        node_setup = RR.ClientNodeSetup()
+    with node_setup:
         time.sleep(args.wait)
         services = []
         for s in RRN.FindServiceByType(args.type, ["rr+tcp"]):

@@ -19,19 +19,15 @@
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
-import http from "node:http";
 import os from "node:os";
 import path from "node:path";
 import { createRequire } from "node:module";
 import { ROOT, settings, startGateway, launchChromium, apiDevices, waitFor } from "../browser/harness.mjs";
 import { DEVICES, startDevice, screenshot } from "../browser/std_support.mjs";
+import { lichtblickWebOrSkip, serveLichtblick, gatewayApi, shotPixels } from "../browser/lichtblick_support.mjs";
 
 const s = settings();
-const web = process.env.LICHTBLICK_WEB;
-if (!web || !fs.existsSync(path.join(web || "", "index.html"))) {
-  console.log(`SKIP: LICHTBLICK_WEB ${web ? `(${web}) has no index.html` : "is not set"}: build the app with scripts/build-lichtblick.sh`);
-  process.exit(77);
-}
+const web = lichtblickWebOrSkip();
 const mcapRequire = createRequire(path.join(ROOT, "test/mcap/package.json"));
 let McapIndexedReader, zstd;
 try {
@@ -72,46 +68,27 @@ const LAYOUT = {
 
 /** Serves the app (index.html with LAYOUT) and the recordings (/rec/<name>, with byte ranges). */
 function serve() {
-  const index = fs.readFileSync(path.join(web, "index.html"), "utf8");
-  assert.ok(index.includes("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/"), "the app's index.html has the default-layout placeholder");
-  const indexWithLayout = index.replace("/*LICHTBLICK_SUITE_DEFAULT_LAYOUT_PLACEHOLDER*/", JSON.stringify(LAYOUT));
-  const types = { ".js": "text/javascript", ".wasm": "application/wasm", ".html": "text/html", ".css": "text/css",
-    ".json": "application/json", ".png": "image/png", ".svg": "image/svg+xml", ".woff2": "font/woff2", ".ico": "image/x-icon" };
-  const srv = http.createServer((req, res) => {
-    const url = new URL(req.url, "http://x");
-    if (url.pathname.startsWith("/rec/")) {
-      const file = files[decodeURIComponent(url.pathname.slice(5))];
-      if (!file) { res.writeHead(404); return res.end(); }
-      const size = fs.statSync(file).size;
-      const range = /^bytes=(\d+)-(\d*)$/.exec(req.headers.range || "");
-      const headers = { "Accept-Ranges": "bytes", "Content-Type": "application/octet-stream" };
-      if (!range) {
-        res.writeHead(200, { ...headers, "Content-Length": size });
-        return fs.createReadStream(file).pipe(res);
-      }
-      const start = Number(range[1]), end = Math.min(range[2] ? Number(range[2]) : size - 1, size - 1);
-      if (start > end) { res.writeHead(416, { "Content-Range": `bytes */${size}` }); return res.end(); }
-      res.writeHead(206, { ...headers, "Content-Length": end - start + 1, "Content-Range": `bytes ${start}-${end}/${size}` });
-      return fs.createReadStream(file, { start, end }).pipe(res);
+  return serveLichtblick(web, LAYOUT, (req, res, url) => {
+    if (!url.pathname.startsWith("/rec/")) return false;
+    const file = files[decodeURIComponent(url.pathname.slice(5))];
+    if (!file) { res.writeHead(404); res.end(); return true; }
+    const size = fs.statSync(file).size;
+    const range = /^bytes=(\d+)-(\d*)$/.exec(req.headers.range || "");
+    const headers = { "Accept-Ranges": "bytes", "Content-Type": "application/octet-stream" };
+    if (!range) {
+      res.writeHead(200, { ...headers, "Content-Length": size });
+      fs.createReadStream(file).pipe(res);
+      return true;
     }
-    const rel = url.pathname === "/" ? "index.html" : path.normalize(decodeURIComponent(url.pathname)).replace(/^\/+/, "");
-    if (rel === "index.html") {
-      res.writeHead(200, { "Content-Type": "text/html" });
-      return res.end(indexWithLayout);
-    }
-    const p = path.join(web, rel);
-    if (!p.startsWith(web) || !fs.existsSync(p) || !fs.statSync(p).isFile()) { res.writeHead(404); return res.end(); }
-    res.writeHead(200, { "Content-Type": types[path.extname(p)] || "application/octet-stream" });
-    fs.createReadStream(p).pipe(res);
+    const start = Number(range[1]), end = Math.min(range[2] ? Number(range[2]) : size - 1, size - 1);
+    if (start > end) { res.writeHead(416, { "Content-Range": `bytes */${size}` }); res.end(); return true; }
+    res.writeHead(206, { ...headers, "Content-Length": end - start + 1, "Content-Range": `bytes ${start}-${end}/${size}` });
+    fs.createReadStream(file, { start, end }).pipe(res);
+    return true;
   });
-  return new Promise((resolve) => srv.listen(0, "127.0.0.1", () => resolve(srv)));
 }
 
-async function api(method, p, body) {
-  const r = await fetch(`${gateway.base}${p}`, { method, headers: { "content-type": "application/json" }, body: body && JSON.stringify(body) });
-  const text = await r.text();
-  return { status: r.status, body: text ? JSON.parse(text) : null };
-}
+const api = (method, p, body) => gatewayApi(gateway.base, method, p, body);
 
 /** Every message of `file` on topic `topic` with json encoding: [{logTime (bigint), data (parsed)}]. */
 async function jsonMessages(file, topic) {
@@ -192,20 +169,7 @@ function rfc3339(ns) {
   return `${iso.slice(0, 19)}.${String(ns % 1000000000n).padStart(9, "0")}Z`;
 }
 
-/** The RGBA pixels of a locator's screenshot, decoded by the page itself: { width, height, data }. */
-async function shotPixels(locator) {
-  const png = await locator.screenshot();
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = document.createElement("canvas");
-    c.width = img.width; c.height = img.height;
-    const g = c.getContext("2d");
-    g.drawImage(img, 0, 0);
-    return { width: c.width, height: c.height, data: Array.from(g.getImageData(0, 0, c.width, c.height).data) };
-  }, png.toString("base64"));
-}
+const pixels = (locator) => shotPixels(page, locator);
 
 const panel = (id) => page.locator(`[data-testid="panel-mouseenter-container ${id}"]`);
 
@@ -236,7 +200,7 @@ test("Lichtblick opens the recordings: topics, raw messages, a plot and the came
 
   // Plot: a rising line, so its pixels (the series' colour) span many rows of the chart
   await new Promise((r) => setTimeout(r, 2000));
-  const plot = await shotPixels(panel("Plot!dist"));
+  const plot = await pixels(panel("Plot!dist"));
   const rows = new Set();
   for (let i = 0; i < plot.data.length; i += 4) {
     const [r, g, b] = plot.data.slice(i, i + 3);
@@ -245,7 +209,7 @@ test("Lichtblick opens the recordings: topics, raw messages, a plot and the came
   assert.ok(rows.size > plot.height / 4, `the plotted line spans ${rows.size} of ${plot.height} rows (rising data)`);
 
   // Image panel: the synthetic camera's picture (many saturated colours), from the foxglove.* channel
-  const img = await shotPixels(panel("Image!cam"));
+  const img = await pixels(panel("Image!cam"));
   const colours = new Map();
   for (let i = 0; i < img.data.length; i += 4) {
     const [r, g, b] = img.data.slice(i, i + 3);

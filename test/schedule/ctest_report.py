@@ -6,6 +6,7 @@
   ctest_report.py failed FILE... [--out DIR]
                                          the failed tests, one line each; with --out, each one's whole
                                          output in DIR/<name>.log; exit 0
+  ctest_report.py slowest N FILE...      the N longest tests, "<seconds> s  <name>", longest first; exit 0
   ctest_report.py summary RUNS_DIR       the failures of every run of scripts/flaky.sh under RUNS_DIR
                                          (run-*/ctest.xml): each test that failed, how often, and
                                          where its output is; exit 1 when any test failed
@@ -22,8 +23,9 @@ import xml.etree.ElementTree as ET
 SKIP_LINE = re.compile(r"\bSKIP(?:PED)?\b[:\s]", re.IGNORECASE)
 
 
-def cases(path):
-    """(name, status, output) for each test case of one JUnit file; status is pass, fail or skip."""
+def cases(path, with_time=False):
+    """(name, status, output) for each test case of one JUnit file; status is pass, fail or skip.
+    with_time: (name, status, output, seconds)."""
     try:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as e:
@@ -33,11 +35,19 @@ def cases(path):
         name = case.get("name", "?")
         out = case.findtext("system-out") or ""
         if case.find("failure") is not None or case.get("status") == "fail":
-            yield name, "fail", out
+            status = "fail"
         elif case.find("skipped") is not None or case.get("status") in ("notrun", "disabled"):
-            yield name, "skip", out
+            status = "skip"
         else:
-            yield name, "pass", out
+            status = "pass"
+        if with_time:
+            try:
+                seconds = float(case.get("time", "0"))
+            except ValueError:
+                seconds = 0.0
+            yield name, status, out, seconds
+        else:
+            yield name, status, out
 
 
 def skip_reason(output):
@@ -78,6 +88,17 @@ def cmd_failed(files, out_dir):
     return 0
 
 
+def cmd_slowest(count, files):
+    times = []
+    for path in files:
+        for name, _, _, seconds in cases(path, with_time=True):
+            times.append((seconds, name))
+    times.sort(key=lambda t: (-t[0], t[1]))
+    for seconds, name in times[:count]:
+        print(f"{seconds:8.2f} s  {name}")
+    return 0
+
+
 def cmd_summary(runs_dir):
     runs = sorted(glob.glob(os.path.join(runs_dir, "run-*", "ctest.xml")))
     failures = {}
@@ -102,12 +123,17 @@ def cmd_summary(runs_dir):
 
 
 def main(argv):
-    if len(argv) < 2 or argv[0] not in ("skipped", "failed", "summary"):
+    if len(argv) < 2 or argv[0] not in ("skipped", "failed", "slowest", "summary"):
         print(__doc__, file=sys.stderr)
         return 2
     cmd, rest = argv[0], argv[1:]
     if cmd == "skipped":
         return cmd_skipped(rest)
+    if cmd == "slowest":
+        if not rest[0].isdigit():
+            print("ctest_report: slowest takes a count first", file=sys.stderr)
+            return 2
+        return cmd_slowest(int(rest[0]), rest[1:])
     if cmd == "failed":
         out_dir = None
         if "--out" in rest:

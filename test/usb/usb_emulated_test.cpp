@@ -20,12 +20,12 @@
 
 #include <sstream>
 
-#include "core/codec/endian.hpp"
+#include "base/codec/endian.hpp"
 #include "server/app/gateway.hpp"
 #include "server/cli/cli_commands.hpp"
 #include "server/cli/cli_options.hpp"
 #include "server/cli/cli_usb.hpp"
-#include "core/usb/usb_protocol.hpp"
+#include "base/usb/usb_protocol.hpp"
 #include "server/discovery/node_discovery.hpp"
 #include "server/discovery/usb_discovery.hpp"
 #include "test/usb/usb_world.hpp"

@@ -1,7 +1,7 @@
 // A USB device emulator for tests and benchmarks that stands behind the REAL libusb code path:
 // umockdev (Debian `umockdev`, `libumockdev-dev`) fakes the sysfs/udev view libusb enumerates and
 // routes the usbdevfs ioctls libusb issues on /dev/bus/usb/BBB/DDD to a handler here. The handler is
-// driven by core's DeviceFunction (core/usb/usb_device_function.hpp) and DescriptorTable, exactly as
+// driven by core's DeviceFunction (base/usb/usb_device_function.hpp) and DescriptorTable, exactly as
 // firmware would use them, and serves an ordinary node's services (server/node) over the RR streams:
 // every stream the host opens is served by the node (server::serve_stream over a UsbByteStream).
 //
@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "core/usb/usb_descriptor_table.hpp"
-#include "core/usb/usb_device_function.hpp"
+#include "base/usb/usb_descriptor_table.hpp"
+#include "base/usb/usb_device_function.hpp"
 #include "server/node/node.hpp"
 
 namespace rr::test::usb {

@@ -5,6 +5,10 @@ import { RRError } from "./errors.mjs";
 /** Defaults: 0.5 s, doubling up to 10 s, each delay spread ±25 % (README.md "Subscriptions"). */
 export const DEFAULT_BACKOFF = Object.freeze({ initialMs: 500, maxMs: 10000, factor: 2, jitter: 0.25 });
 
+/** After a server closed with 1001 Going Away (it is stopping, likely to restart), attempts this long
+ * after the close keep the first backoff delay instead of growing it. */
+export const GOING_AWAY_WINDOW_MS = 15000;
+
 /**
  * Checks and completes a backoff option `{initialMs, maxMs, factor, jitter}` (any field may be left out).
  * Throws RRError InvalidArgument for a field out of range.

@@ -1,8 +1,10 @@
-// The only place JS meets C++: embind registration of NativeClient (native_client.hpp). Method names
-// are the JS layer's (robotraconteur.mjs, proxy.mjs).
+// The only place JS meets C++: embind registration of NativeClient (native_client.hpp) and of the
+// object path parser (object_path_js.hpp). Names are the JS layer's (robotraconteur.mjs, proxy.mjs,
+// object_path.mjs).
 #include <emscripten/bind.h>
 
 #include "wasm-client/src/native_client.hpp"
+#include "wasm-client/src/object_path_js.hpp"
 
 EMSCRIPTEN_BINDINGS(robotraconteur) {
     using rr::wasm::NativeClient;
@@ -48,4 +50,5 @@ EMSCRIPTEN_BINDINGS(robotraconteur) {
         .function("memoryRead", &NativeClient::memory_read)
         .function("memoryWrite", &NativeClient::memory_write)
         .function("monitor", &NativeClient::monitor);
+    emscripten::function("parseObjectPath", &rr::wasm::parse_object_path_js);
 }

@@ -14,7 +14,8 @@ export function toRRError(e) {
   if (e instanceof RRError) return e;
   // an RR error from elsewhere (another copy of this module, a stand-in): its name is kept
   if (e && typeof e === "object" && typeof e.errorName === "string") return new RRError(e.errorName, e.message ?? "", e.code ?? 0);
-  if (e && typeof e === "object" && typeof e.name === "string" && "code" in e)
+  // (node's own errors have a text `code`, e.g. "ERR_MODULE_NOT_FOUND": not an RR error code)
+  if (e && typeof e === "object" && typeof e.name === "string" && typeof e.code === "number")
     return new RRError(e.name, e.message ?? "", e.code);
   return new RRError("RobotRaconteur.UnknownError", String(e?.message ?? e));
 }

@@ -11,6 +11,15 @@ export class RRError extends Error {
 /** Any RR value as JS (typed by the member's robdef; see README.md "Values"). */
 export type RRValue = any;
 
+/** A type-only mark on the member proxy types: the member's kind and value type, which the typed
+ *  subscription methods read (WireNames, ...). Never present at run time; not exported. */
+declare const memberMark: unique symbol;
+interface Mark<Kind extends string, Value, Direction extends "both" | "readonly" | "writeonly" = "both"> {
+  kind: Kind;
+  value: Value;
+  direction: Direction;
+}
+
 export interface TimeSpec {
   /** Seconds since 1970-01-01 UTC. */
   seconds: number;
@@ -44,6 +53,9 @@ export interface ClientHandle {
   readonly nodeName: string;
   readonly nodeId: string;
   readonly url: string;
+  /** The WebSocket close code once the server closed the socket (1001 Going Away: the server is
+   *  stopping, e.g. for a restart; 1006: no close frame, e.g. a crash or a cut network), else null. */
+  readonly closeCode: number | null;
 }
 
 export interface PropertyMember<T = RRValue> {
@@ -59,16 +71,19 @@ export interface Generator<T = RRValue, P = RRValue> extends AsyncIterable<T> {
 }
 
 export interface EventMember {
+  readonly [memberMark]?: Mark<"event", RRValue[]>;
   /** `fn(...params)` for every event; returns the function that unsubscribes. */
   on(fn: (...args: RRValue[]) => void): () => void;
 }
 
 export interface ObjRefMember {
+  readonly [memberMark]?: Mark<"objref", ObjectProxy>;
   /** The object (index: int32 or string for indexed objrefs). */
   get(index?: number | string): Promise<ObjectProxy>;
 }
 
 export interface CallbackMember {
+  readonly [memberMark]?: Mark<"callback", (...args: RRValue[]) => RRValue>;
   /** Sets the handler (may be async; a thrown RRError keeps its errorName); null clears it. */
   set(fn: ((...args: RRValue[]) => RRValue | Promise<RRValue>) | null): void;
 }
@@ -90,6 +105,7 @@ export interface PipeEndpoint<T = RRValue> extends AsyncIterable<T> {
 }
 
 export interface PipeMember<T = RRValue> {
+  readonly [memberMark]?: Mark<"pipe", T>;
   /** index −1 (default): the service chooses. */
   connect(index?: number): Promise<PipeEndpoint<T>>;
 }
@@ -113,6 +129,7 @@ export interface WireConnection<T = RRValue> {
 }
 
 export interface WireMember<T = RRValue> {
+  readonly [memberMark]?: Mark<"wire", T>;
   connect(): Promise<WireConnection<T>>;
   peekInValue(): Promise<T>;
   peekOutValue(): Promise<T>;
@@ -182,6 +199,17 @@ export function connect<T extends ObjectBase = ObjectProxy>(url: string, options
 /** Loads the WebAssembly module (connect() does it on first use). */
 export function loadModule(): Promise<unknown>;
 
+/** One segment of an object path: the member name and, with brackets, the index's text (decoded). */
+export interface ObjectPathSegment {
+  name: string;
+  index?: string;
+}
+
+/** Parses an object path (`child_by_int[7].leaf`, `arms[left arm].tool`) with the C++ core's parser, the
+ *  gateway's. Rejects with RRError InvalidArgument and the core's message
+ *  (`object path "a..b": expected a member name at offset 2`). */
+export function parseObjectPath(path: string): Promise<ObjectPathSegment[]>;
+
 /** Subprotocol of RR over WebSocket. */
 export const WEBSOCKET_PROTOCOL: string;
 
@@ -249,22 +277,26 @@ export interface WriteonlyProperty<T> {
 
 /** `event name(A...)`: `on(fn)` with the event's parameters, e.g. `Event<[seq: number, text: string]>`. */
 export interface Event<A extends unknown[]> {
+  readonly [memberMark]?: Mark<"event", A>;
   /** `fn(...params)` for every event; returns the function that unsubscribes. */
   on(fn: (...args: A) => void): () => void;
 }
 
 /** `callback R name(P...)`, e.g. `Callback<(x: number) => number>`: the handler may be async. */
 export interface Callback<F extends (...args: any[]) => any> {
+  readonly [memberMark]?: Mark<"callback", F>;
   /** Sets the handler (a thrown RRError keeps its errorName); null clears it. */
   set(fn: ((...args: Parameters<F>) => ReturnType<F> | Promise<ReturnType<F>>) | null): void;
 }
 
 /** `objref T name`: the object's proxy. */
 export interface ObjRef<T> {
+  readonly [memberMark]?: Mark<"objref", T>;
   get(): Promise<T>;
 }
 /** `objref T{int32} name` / `T[]` (K = number), `objref T{string} name` (K = string). */
 export interface IndexedObjRef<T, K extends number | string> {
+  readonly [memberMark]?: Mark<"indexed objref", T>;
   get(index: K): Promise<T>;
 }
 
@@ -276,10 +308,12 @@ export type ReadonlyPipeEndpoint<T> = Omit<PipeEndpoint<T>, "send">;
 export type WriteonlyPipeEndpoint<T> = Omit<PipeEndpoint<T>, "receive" | "onPacket" | typeof Symbol.asyncIterator>;
 /** `pipe T name [readonly]`. */
 export interface ReadonlyPipe<T> {
+  readonly [memberMark]?: Mark<"pipe", T, "readonly">;
   connect(index?: number): Promise<ReadonlyPipeEndpoint<T>>;
 }
 /** `pipe T name [writeonly]`. */
 export interface WriteonlyPipe<T> {
+  readonly [memberMark]?: Mark<"pipe", T, "writeonly">;
   connect(index?: number): Promise<WriteonlyPipeEndpoint<T>>;
 }
 
@@ -291,12 +325,14 @@ export type ReadonlyWireConnection<T> = Omit<WireConnection<T>, "outValue" | "ou
 export type WriteonlyWireConnection<T> = Omit<WireConnection<T>, "inValue" | "inValueTime" | "inValueValid" | "waitInValue" | "onChange">;
 /** `wire T name [readonly]`. */
 export interface ReadonlyWire<T> {
+  readonly [memberMark]?: Mark<"wire", T, "readonly">;
   connect(): Promise<ReadonlyWireConnection<T>>;
   peekInValue(): Promise<T>;
   peekInValueWithTime(): Promise<{ value: T; ts: TimeSpec }>;
 }
 /** `wire T name [writeonly]`. */
 export interface WriteonlyWire<T> {
+  readonly [memberMark]?: Mark<"wire", T, "writeonly">;
   connect(): Promise<WriteonlyWireConnection<T>>;
   peekOutValue(): Promise<T>;
   pokeOutValue(value: T): Promise<void>;
@@ -439,7 +475,78 @@ export interface PipeSubscription<P = RRValue> extends AsyncIterable<P>, MemberC
   close(): Promise<void>;
 }
 
-export interface ServiceSubscription<T = ObjectProxy> {
+// --- Subscriptions typed by the service type (`subscribe<Create>(url)`): member names are checked and
+// values typed from the generated interface; an untyped subscription (`subscribe(url)`) takes any name
+// and gives `any` values.
+
+/** Whether `T` is an untyped proxy (members by any name). */
+type IsUntyped<T> = string extends keyof T ? true : false;
+/** The mark of a member type, or never for anything else (a function, a property, ObjectBase's $…). */
+type MarkOf<M> = typeof memberMark extends keyof M ? Exclude<M[typeof memberMark], undefined> : never;
+/** Names of `T`'s members of kind `Kind` ("wire", "pipe", "event", "callback"); any name for an untyped proxy. */
+export type MemberNames<T, Kind extends string> = IsUntyped<T> extends true
+  ? string
+  : { [K in keyof T & string]: [MarkOf<T[K]>] extends [never] ? never : MarkOf<T[K]> extends { kind: Kind } ? K : never }[keyof T & string];
+/** Names of the wires of object type `T` (a generated interface), e.g. `"packets"`. */
+export type WireNames<T> = MemberNames<T, "wire">;
+/** Names of the pipes of object type `T`. */
+export type PipeNames<T> = MemberNames<T, "pipe">;
+/** Names of the events of object type `T`. */
+export type EventNames<T> = MemberNames<T, "event">;
+/** Names of the callbacks of object type `T`. */
+export type CallbackNames<T> = MemberNames<T, "callback">;
+/** The value type of wire or pipe `K` of `T` (`SensorPacket | null`); any for an untyped proxy. */
+export type MemberValue<T, K> = IsUntyped<T> extends true ? any : K extends keyof T ? (MarkOf<T[K]> extends { value: infer V } ? V : never) : never;
+
+/** The object type at objref path `P` ("child", "items[3]", "a.b[x]") below `T`; "" is `T` itself. An
+ *  untyped proxy, a path that is not a literal, or a varobject gives ObjectProxy; a name that is not an
+ *  objref of its object gives never (the subscribe methods then reject the path). */
+export type ObjectAtPath<T, P extends string> = IsUntyped<T> extends true
+  ? ObjectProxy
+  : string extends P
+    ? ObjectProxy
+    : P extends ""
+      ? T
+      : P extends `${infer Head}.${infer Rest}`
+        ? Head extends `${string}[${string}` ? (Head extends `${string}]` ? ObjectAtPath<ObjectAtSegment<T, Head>, Rest> : ObjectProxy) : ObjectAtPath<ObjectAtSegment<T, Head>, Rest>
+        : ObjectAtSegment<T, P>;
+type ObjectAtSegment<T, S extends string> = IsUntyped<T> extends true
+  ? ObjectProxy
+  : S extends `${infer Name}[${string}]`
+    ? Name extends keyof T ? (MarkOf<T[Name]> extends { kind: "indexed objref"; value: infer O } ? O : never) : never
+    : S extends keyof T ? (MarkOf<T[S]> extends { kind: "objref"; value: infer O } ? O : never) : never;
+/** `P` when it is an objref path of `T`; else a type no string has, so that a misspelled path is a
+ *  compile error naming it. */
+export type ServicePathOf<T, P extends string> = [ObjectAtPath<T, P>] extends [never] ? { "is not an objref path of the subscribed object": P } : P;
+
+type Directed<M, Full, Readonly> = MarkOf<M> extends { direction: "readonly" } ? Readonly : Full;
+/** The subscription of wire `K` at path `P` of `T`: `[readonly]` wires have no setOutValueAll. */
+export type WireSubscriptionOf<T, K, P extends string = ""> = IsUntyped<ObjectAtPath<T, P>> extends true
+  ? WireSubscription<any>
+  : K extends keyof ObjectAtPath<T, P>
+    ? Directed<ObjectAtPath<T, P>[K], WireSubscription<MemberValue<ObjectAtPath<T, P>, K>>, ReadonlyWireSubscription<MemberValue<ObjectAtPath<T, P>, K>>>
+    : never;
+/** The subscription of pipe `K` at path `P` of `T`: `[readonly]` pipes have no sendPacketAll. */
+export type PipeSubscriptionOf<T, K, P extends string = ""> = IsUntyped<ObjectAtPath<T, P>> extends true
+  ? PipeSubscription<any>
+  : K extends keyof ObjectAtPath<T, P>
+    ? Directed<ObjectAtPath<T, P>[K], PipeSubscription<MemberValue<ObjectAtPath<T, P>, K>>, ReadonlyPipeSubscription<MemberValue<ObjectAtPath<T, P>, K>>>
+    : never;
+/** The parameters of event `K` of `O` (a tuple); any[] for an untyped proxy. */
+export type EventArgs<O, K> = IsUntyped<O> extends true ? any[] : K extends keyof O ? (MarkOf<O[K]> extends { value: infer A extends unknown[] } ? A : never) : never;
+/** The handler type of callback `K` of `O`; `(...args: any[]) => any` for an untyped proxy. */
+export type CallbackFunction<O, K> = IsUntyped<O> extends true ? (...args: any[]) => any
+  : K extends keyof O ? (MarkOf<O[K]> extends { value: infer F extends (...args: any[]) => any } ? F : never) : never;
+
+/** A WireSubscription of a `[readonly]` wire: the service sends, so there is no OutValue to set. */
+export type ReadonlyWireSubscription<V = RRValue> = Omit<WireSubscription<V>, "setOutValueAll">;
+/** A PipeSubscription of a `[readonly]` pipe: nothing to send. */
+export type ReadonlyPipeSubscription<P = RRValue> = Omit<PipeSubscription<P>, "sendPacketAll">;
+
+/** A ServiceSubscription; `T` is the root object's type (`subscribe<Create>(url)`): member names and
+ *  values of subscribeWire / subscribePipe / subscribeEvent / setCallback are checked against it, also
+ *  at a literal objref path below the root. Untyped (`T` = ObjectProxy): any name, `any` values. */
+export interface ServiceSubscription<T extends ObjectBase = ObjectProxy> {
   /** "connected" while at least one service is connected. */
   readonly state: "connecting" | "connected" | "closed";
   readonly clients: SubscriptionClient<T>[];
@@ -451,22 +558,38 @@ export interface ServiceSubscription<T = ObjectProxy> {
   getDefaultClientWait(timeoutMs?: number): Promise<T>;
   /** `fn(client)` as each attempt to connect to a service starts (the first, and each after a drop or a failure). */
   onConnecting(fn: (client: SubscriptionClient<T>) => void): () => void;
+  /** `fn(client, proxy)` after every (re)connection: the place to restore device state (e.g. start streaming again). */
   onConnect(fn: (client: SubscriptionClient<T>, proxy: T) => void): () => void;
   onDisconnect(fn: (client: SubscriptionClient<T>, error: RRError | null) => void): () => void;
   onError(fn: (error: RRError, client: SubscriptionClient<T> | null) => void): () => void;
-  /** `servicePath`: objref path below the root ("child", "items[3]"); "" (default) is the root. */
-  subscribeWire<V = RRValue>(name: string, servicePath?: string): WireSubscription<V>;
-  subscribePipe<P = RRValue>(name: string, servicePath?: string, maxBacklog?: number): PipeSubscription<P>;
+  /** Wire `name` of the root object, or of the object at `servicePath` (objref path below the root:
+   *  "child", "items[3]"; "" (default) is the root). Typed: `WireSubscription<value type of the wire>`. */
+  subscribeWire<K extends WireNames<ObjectAtPath<T, P>>, P extends string = "">(name: K, servicePath?: P & ServicePathOf<T, P>): WireSubscriptionOf<T, K, P>;
+  /** Pipe `name` (at `servicePath`); `maxBacklog` packets wait for receivePacket (default 100, −1: no limit). */
+  subscribePipe<K extends PipeNames<ObjectAtPath<T, P>>, P extends string = "">(name: K, servicePath?: P & ServicePathOf<T, P>, maxBacklog?: number): PipeSubscriptionOf<T, K, P>;
   /** `fn(...params, client)` for every firing on every connected service; returns the remover. */
-  subscribeEvent(name: string, fn: (...args: any[]) => void, servicePath?: string): () => void;
-  /** Sets callback `name` on every service, also after reconnects; null clears it. */
-  setCallback(name: string, fn: ((...args: any[]) => RRValue | Promise<RRValue>) | null, servicePath?: string): void;
+  subscribeEvent<K extends EventNames<ObjectAtPath<T, P>>, P extends string = "">(
+    name: K,
+    fn: IsUntyped<ObjectAtPath<T, P>> extends true ? (...args: any[]) => void : (...args: [...EventArgs<ObjectAtPath<T, P>, K>, SubscriptionClient<T>]) => void,
+    servicePath?: P & ServicePathOf<T, P>,
+  ): () => void;
+  /** Sets callback `name` on every service, also after reconnects (`fn(...params, client)`); null clears it. */
+  setCallback<K extends CallbackNames<ObjectAtPath<T, P>>, P extends string = "">(
+    name: K,
+    fn: (IsUntyped<ObjectAtPath<T, P>> extends true ? (...args: any[]) => RRValue | Promise<RRValue>
+      : (...args: [...Parameters<CallbackFunction<ObjectAtPath<T, P>, K>>, SubscriptionClient<T>]) =>
+          ReturnType<CallbackFunction<ObjectAtPath<T, P>, K>> | Promise<ReturnType<CallbackFunction<ObjectAtPath<T, P>, K>>>) | null,
+    servicePath?: P & ServicePathOf<T, P>,
+  ): void;
   close(): Promise<void>;
 }
 
 /** Keeps connections to the services `target` names, reconnecting with backoff (README.md "Subscriptions"). */
-export function subscribe<T = ObjectProxy>(target: string | string[] | SubscriptionFilter, options?: SubscribeOptions): ServiceSubscription<T>;
+export function subscribe<T extends ObjectBase = ObjectProxy>(target: string | string[] | SubscriptionFilter, options?: SubscribeOptions): ServiceSubscription<T>;
 /** Whether `info` passes `filter`. */
 export function matchesFilter(info: ServiceInfo, filter: Omit<SubscriptionFilter, "gateway">): boolean;
 /** connect() takes the liveness options too (merged into ConnectOptions above). */
 export interface ConnectOptions extends LivenessOptions {}
+
+// Only the declarations marked `export` above are the package's (memberMark, Mark, IsUntyped, ... stay private).
+export {};

@@ -11,7 +11,7 @@
 
 #include <emscripten/val.h>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/numeric_array.hpp"
 
 namespace rr::wasm {

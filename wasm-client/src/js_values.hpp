@@ -25,7 +25,7 @@
 
 #include <emscripten/val.h>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "core/value/value.hpp"
 #include "robdef/service_definition.hpp"
 #include "robdef/type_lookup.hpp"

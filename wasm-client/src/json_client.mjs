@@ -3,7 +3,7 @@
 // the socket opened again with a jittered backoff after any drop, logging in and subscribing again.
 // Types: json_client.d.ts; guide: README.md "Subscriptions" → "The JSON client".
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents, GOING_AWAY_WINDOW_MS } from "./backoff.mjs";
 
 export { RRError };
 
@@ -131,7 +131,9 @@ export class JsonClient extends ConnectionEvents {
     ws.onerror = (ev) => this.drop(ws, connectionError(`WebSocket error (${this.url})${ev?.message ? `: ${ev.message}` : ""}`));
     ws.onclose = (ev) => {
       clearTimeout(openGuard);
-      this.drop(ws, connectionError(`WebSocket closed${ev?.code ? ` (code ${ev.code})` : ""}`));
+      // 1001 Going Away: the gateway is stopping (a restart); the next attempts keep the first delay
+      if (ev?.code === 1001 && ws === this.ws) this.goingAwayAt = performance.now();
+      this.drop(ws, connectionError(`WebSocket closed${ev?.code ? ` (code ${ev.code}${ev.code === 1001 ? ": the server is going away" : ""})` : ""}`));
     };
   }
 
@@ -191,7 +193,8 @@ export class JsonClient extends ConnectionEvents {
     this.state = "waiting";
     if (wasConnected) this.disconnectListeners.emit(error);
     else this.errorListeners.emit(error);
-    this.retryTimer = setTimeout(() => this.open(), backoffDelay(this.attempt++, this.backoff));
+    const soon = this.goingAwayAt !== undefined && performance.now() - this.goingAwayAt < GOING_AWAY_WINDOW_MS;
+    this.retryTimer = setTimeout(() => this.open(), backoffDelay(soon ? 0 : this.attempt++, this.backoff));
   }
 
   dispatch(msg) {

@@ -9,6 +9,7 @@
 
 #include "core/value/var_type.hpp"
 #include "robdef/canonical_text.hpp"
+#include "wasm-client/src/js_results.hpp"
 #include "wasm-client/src/js_values.hpp"
 
 namespace rr::wasm {
@@ -26,31 +27,6 @@ double mono_ms(MonoTime t) { return std::chrono::duration<double, std::milli>(t.
 TimeSpec wall(double ms) {
     double s = std::floor(ms / 1000.0);
     return TimeSpec{static_cast<std::int64_t>(s), static_cast<std::int32_t>((ms - s * 1000.0) * 1e6)};
-}
-
-val error_to_js(const RRError& e) {
-    val o = val::object();
-    std::string name = e.name;
-    if (name.empty()) name = std::string(error_name(e.type));
-    if (name.empty()) name = "RobotRaconteur.UnknownError";
-    o.set("name", u8(name));
-    o.set("message", u8(e.message));
-    o.set("code", static_cast<int>(e.type));
-    return o;
-}
-
-val ok(val v = val::undefined()) {
-    val o = val::object();
-    o.set("ok", true);
-    o.set("value", v);
-    return o;
-}
-
-val err(const RRError& e) {
-    val o = val::object();
-    o.set("ok", false);
-    o.set("error", error_to_js(e));
-    return o;
 }
 
 template <class T>

@@ -1,35 +1,18 @@
 // Robot Raconteur client for browsers and node (>= 18): the C++ sans-IO client core compiled to
 // WebAssembly (robotraconteur_wasm.mjs), a WebSocket transport, and object proxies built from the
 // service's robdef. API and value mapping: README.md; types: index.d.ts.
-import createRRModule from "./robotraconteur_wasm.mjs";
 import { RRError, toRRError } from "./errors.mjs";
 import { makeProxy } from "./proxy.mjs";
 import { ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter } from "./subscription.mjs";
 import { DEFAULT_BACKOFF, backoffDelay } from "./backoff.mjs";
+import { loadModule } from "./wasm_module.mjs";
+import { parseObjectPath } from "./object_path.mjs";
 
-export { RRError, toRRError, ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter, DEFAULT_BACKOFF, backoffDelay };
+export { RRError, toRRError, ServiceSubscription, WireSubscription, PipeSubscription, matchesFilter, DEFAULT_BACKOFF, backoffDelay,
+  loadModule, parseObjectPath };
 
 /** Subprotocol of RR over WebSocket (wire.md §8). */
 export const WEBSOCKET_PROTOCOL = "robotraconteur.robotraconteur.com";
-
-const isNode = typeof process !== "undefined" && !!process.versions?.node && typeof window === "undefined";
-
-let modulePromise = null;
-/** Loads and instantiates the WebAssembly module once. */
-export function loadModule() {
-  if (!modulePromise) {
-    modulePromise = (async () => {
-      const opts = {};
-      if (isNode) {
-        // The module is built for the web; in node it gets the bytes instead of fetching a file: URL.
-        const fs = await import("node:fs/promises");
-        opts.wasmBinary = await fs.readFile(new URL("./robotraconteur_wasm.wasm", import.meta.url));
-      }
-      return createRRModule(opts);
-    })();
-  }
-  return modulePromise;
-}
 
 const inNode = typeof process !== "undefined" && !!process.versions?.node;
 
@@ -38,8 +21,19 @@ async function webSocketClass(options) {
   // A given CA needs the `ws` package's TLS options: node's global WebSocket (node 22) takes none.
   if (typeof globalThis.WebSocket === "function" && (options.ca === undefined || !inNode)) return globalThis.WebSocket;
   const name = "ws";  // node: the `ws` package (kept out of bundlers' static analysis)
-  const m = await import(/* @vite-ignore */ name);
-  return m.WebSocket ?? m.default;
+  let m;
+  try {
+    m = await import(/* @vite-ignore */ name);
+  } catch (e) {
+    throw new RRError("RobotRaconteur.InvalidOperation",
+      `no WebSocket implementation: this runtime has no globalThis.WebSocket${options.ca !== undefined ? " usable with the ca option" : ""}` +
+      ` and the "ws" package could not be loaded (${e?.code ?? e?.message ?? e}); install it next to robotraconteur-wasm` +
+      " (npm install ws) or pass connect(url, { WebSocket })", 17);
+  }
+  const WS = m.WebSocket ?? m.default;
+  if (typeof WS !== "function")
+    throw new RRError("RobotRaconteur.InvalidOperation", 'the "ws" package gave no WebSocket class (install ws >= 8)', 17);
+  return WS;
 }
 
 /**
@@ -144,7 +138,11 @@ export class Connection {
       };
       // node's `ws` says why (e.g. "self-signed certificate"); browsers give no reason.
       this.ws.onerror = (ev) => this.fail(`WebSocket error (${this.url.wsUrl})${ev?.message ? `: ${ev.message}` : ""}`);
-      this.ws.onclose = (ev) => this.fail(`WebSocket closed${ev?.code ? ` (code ${ev.code})` : ""}`);
+      this.ws.onclose = (ev) => {
+        // 1001 Going Away: the server is stopping (a restart); subscriptions come back sooner then.
+        if (ev?.code) this.closeCode = ev.code;
+        this.fail(`WebSocket closed${ev?.code ? ` (code ${ev.code}${ev.code === 1001 ? ": the server is going away" : ""})` : ""}`);
+      };
     });
   }
 
@@ -287,6 +285,9 @@ export class Connection {
         get url() {
           return c.url.wsUrl;
         },
+        get closeCode() {
+          return c.closeCode ?? null;
+        },
       };
     }
     return this._clientApi;
@@ -303,6 +304,16 @@ export class Connection {
  * only: the PEM certificates an rr+wss server's chain must lead to, instead of node's own list).
  */
 export async function connect(url, options = {}) {
+  try {
+    return await connectOnce(url, options);
+  } catch (e) {
+    // Every failure reaches the caller as an RRError, also one from node or the runtime (a missing
+    // .wasm file, a refused import).
+    throw e instanceof RRError ? e : new RRError("RobotRaconteur.ConnectionError", String(e?.message ?? e), 1);
+  }
+}
+
+async function connectOnce(url, options) {
   const u = parseUrl(url);
   for (const k of ["timeoutMs", "heartbeatPeriodMs", "receiveTimeoutMs"]) {
     const v = options[k];

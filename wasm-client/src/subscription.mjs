@@ -3,7 +3,8 @@
 // connect again with a jittered backoff after any drop, and restore on the new connection the wires,
 // pipe endpoints, event handlers and callbacks the app asked for.
 import { RRError, toRRError } from "./errors.mjs";
-import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents } from "./backoff.mjs";
+import { backoffDelay, backoffOptions, later, Listeners, ConnectionEvents, GOING_AWAY_WINDOW_MS } from "./backoff.mjs";
+import { parseObjectPath } from "./object_path.mjs";
 
 const now = () => performance.now();
 const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 1);
@@ -12,20 +13,27 @@ const connectionError = (m) => new RRError("RobotRaconteur.ConnectionError", m, 
 const keepable = (e) => (e ? new RRError(e.errorName, e.message, e.code) : null);
 const invalid = (m) => new RRError("RobotRaconteur.InvalidArgument", m, 18);
 
+const INT32 = /^-?[0-9]+$/;
+
 /**
- * Walks `path` (an objref path relative to the root: "child", "child_by_int[7]", "a.b[x]"; "" = root)
- * from `root`, one objref request per segment. Resolves with the object's proxy.
+ * Walks `path` (an objref path relative to the root: "child", "child_by_int[7]", "a.b[x]"; "" = root;
+ * parsed by the core's parser, object_path.mjs) from `root`, one objref request per segment. Resolves
+ * with the object's proxy. Rejects with RRError InvalidArgument for a path that does not parse or an
+ * int32 objref's index that is not an int32, MemberNotFound for a segment that is not an objref.
  */
 export async function resolveObject(root, path) {
   let obj = root;
   if (!path) return obj;
-  for (const seg of path.split(".")) {
-    const m = /^([A-Za-z_][A-Za-z0-9_]*)(?:\[(.*)\])?$/.exec(seg);
-    if (!m) throw invalid(`bad object path segment "${seg}" in "${path}"`);
-    const member = obj.$members.find((x) => x.name === m[1]);
-    if (!member || member.kind !== "objref") throw new RRError("RobotRaconteur.MemberNotFound", `no objref "${m[1]}" on ${obj.$type}`, 17);
-    const index = m[2] === undefined ? undefined : member.index === "int32" ? Number(m[2]) : m[2];
-    obj = await obj[m[1]].get(index);
+  for (const seg of await parseObjectPath(path)) {
+    const member = obj.$members.find((x) => x.name === seg.name);
+    if (!member || member.kind !== "objref") throw new RRError("RobotRaconteur.MemberNotFound", `no objref "${seg.name}" on ${obj.$type}`, 9);
+    let index = seg.index;
+    if (index !== undefined && member.index === "int32") {
+      if (!INT32.test(index) || Number(index) !== (Number(index) | 0))
+        throw invalid(`object path "${path}": objref "${seg.name}" takes an int32 index, not "${index}"`);
+      index = Number(index);
+    }
+    obj = await obj[seg.name].get(index);
   }
   return obj;
 }
@@ -222,7 +230,8 @@ export class ServiceSubscription extends ConnectionEvents {
         c.state = "waiting";
         this.errorListeners.emit(toRRError(e), c);
         if (!c.fixed && !c.listed) break;
-        await this.sleep(c, backoffDelay(c.attempt++, this.backoff));
+        const soon = c.goingAwayAt !== undefined && now() - c.goingAwayAt < GOING_AWAY_WINDOW_MS;
+        await this.sleep(c, backoffDelay(soon ? 0 : c.attempt++, this.backoff));
         continue;
       }
       if (this.closed || c.removed) {
@@ -239,6 +248,8 @@ export class ServiceSubscription extends ConnectionEvents {
       this.connectListeners.emit(c, proxy);
       for (const w of this.defaultWaiters.splice(0)) w(proxy);
       const error = await lost;
+      // 1001: the server said it is going away (a restart): come back at the first delay for a while
+      c.goingAwayAt = proxy.$client.closeCode === 1001 ? now() : undefined;
       c.proxy = null;
       c.generation++;
       for (const s of [...this.wires, ...this.pipes]) s.detach(c, error ?? null);
@@ -268,7 +279,7 @@ export class ServiceSubscription extends ConnectionEvents {
   attachEvent(e, c, proxy, gen) {
     resolveObject(proxy, e.servicePath).then((obj) => {
       if (!this.current(c, gen) || !this.events.has(e)) return;
-      if (!obj[e.member]?.on) throw new RRError("RobotRaconteur.MemberNotFound", `no event "${e.member}" on ${obj.$type}`, 17);
+      if (!obj[e.member]?.on) throw new RRError("RobotRaconteur.MemberNotFound", `no event "${e.member}" on ${obj.$type}`, 9);
       const off = obj[e.member].on((...args) => {
         if (this.current(c, gen) && this.events.has(e)) e.fn(...args, c);
       });
@@ -279,7 +290,7 @@ export class ServiceSubscription extends ConnectionEvents {
   attachCallback(cb, c, proxy, gen) {
     resolveObject(proxy, cb.servicePath).then((obj) => {
       if (!this.current(c, gen) || this.callbacks.get(cb.key) !== cb) return;
-      if (!obj[cb.member]?.set) throw new RRError("RobotRaconteur.MemberNotFound", `no callback "${cb.member}" on ${obj.$type}`, 17);
+      if (!obj[cb.member]?.set) throw new RRError("RobotRaconteur.MemberNotFound", `no callback "${cb.member}" on ${obj.$type}`, 9);
       obj[cb.member].set(cb.fn ? (...args) => cb.fn(...args, c) : null);
     }).catch((err) => this.current(c, gen) && this.errorListeners.emit(toRRError(err), c));
   }
@@ -390,7 +401,7 @@ export class ServiceSubscription extends ConnectionEvents {
   }
 
   checkOpen() {
-    if (this.closed) throw new RRError("RobotRaconteur.InvalidOperation", "subscription closed", 13);
+    if (this.closed) throw new RRError("RobotRaconteur.InvalidOperation", "subscription closed", 17);
   }
 
   /** Stops reconnecting and closes every connection; resolves once they are closed. */
@@ -435,7 +446,7 @@ class MemberSubscription extends ConnectionEvents {
     const alive = () => !this.closed && this.sub.current(c, gen);
     resolveObject(proxy, this.servicePath)
       .then((obj) => {
-        if (!obj[this.member]?.connect) throw new RRError("RobotRaconteur.MemberNotFound", `no ${this.kind} "${this.member}" on ${obj.$type}`, 17);
+        if (!obj[this.member]?.connect) throw new RRError("RobotRaconteur.MemberNotFound", `no ${this.kind} "${this.member}" on ${obj.$type}`, 9);
         return this.open(obj[this.member]);
       })
       .then((link) => {

@@ -1,9 +1,11 @@
 // The client package as a user gets it: `npm pack` of wasm-client/dist gives a tarball holding every
 // file package.json lists; `npm install` of that tarball into an empty project works offline; index.d.ts
 // type-checks typecheck/usage.ts (tsc --noEmit, strict) and rejects every line of typecheck/misuse.ts;
-// the compiled usage.ts then runs against rr-gateway's demo devices (every member kind, errors).
+// the compiled usage.ts then runs against rr-gateway's demo devices (every member kind, errors); without
+// a WebSocket implementation connect() rejects with an RRError naming `ws`; the package's rr-robdef
+// command generates types from the running demo devices (--url, --gateway/--device, --definitions -).
 // Usage: node package_test.mjs --gateway PATH. Exit 77 (skipped) when dist/ or typescript is missing.
-import { execFileSync, spawn } from "node:child_process";
+import { execFileSync, spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
@@ -69,6 +71,16 @@ try {
   ok(/robot: ok/.test(robotOut), `import from "robotraconteur-wasm/robot/kinematics.js" (forward kinematics): ${robotOut.trim()}`);
   ok(fs.existsSync(path.join(installed, "dashboard/robot/view3d.js")) && fs.existsSync(path.join(installed, "dashboard/robot/view3d.d.ts")),
     "the package holds dashboard/robot/view3d.js and its declarations");
+  // without a WebSocket implementation (no global one, no ws package) connect() rejects with an RRError
+  // that says what to install
+  fs.writeFileSync(path.join(app, "no_ws_check.mjs"), [
+    'import { connect, RRError } from "robotraconteur-wasm";',
+    "delete globalThis.WebSocket;",
+    'try { await connect("rr+ws://127.0.0.1:9/?service=x"); console.log("no_ws: connected?"); }',
+    'catch (e) { console.log(e instanceof RRError && e.errorName === "RobotRaconteur.InvalidOperation" && /npm install ws/.test(e.message) ? `no_ws: ok ${e.message}` : `no_ws: wrong ${e?.constructor?.name} ${e?.errorName} ${e?.message}`); }',
+  ].join("\n"));
+  const noWs = run(process.execPath, [path.join(app, "no_ws_check.mjs")], { cwd: app }).trim();
+  ok(/^no_ws: ok/.test(noWs), `connect() without ws: an RRError naming the package (${noWs})`);
   // ws (the optional peer dependency for node) from this folder's node_modules
   fs.symlinkSync(path.join(pkgRoot, "node_modules/ws"), path.join(app, "node_modules/ws"), "dir");
 
@@ -108,6 +120,31 @@ try {
     if (devices.filter((d) => d.state === "connected").length >= 2) break;
     if (i > 200) throw new Error(`devices not connected: ${JSON.stringify(devices)}`);
     await new Promise((r) => setTimeout(r, 100));
+  }
+  // the package's rr-robdef command (node_modules/.bin, as npx runs it): a running device's definitions
+  // by rr+ws, through the gateway's JSON API, and from that API's answer on stdin
+  const rrRobdef = path.join(app, "node_modules/.bin/rr-robdef");
+  const definitionsJson = await (await fetch(`http://127.0.0.1:${port}/api/devices/webcam/definitions`)).text();
+  for (const [how, args, input] of [
+    ["--url", ["--url", `rr+ws://127.0.0.1:${port}/?service=create`], undefined],
+    ["--gateway --device", ["--gateway", `http://127.0.0.1:${port}`, "--device", "webcam"], undefined],
+    ["--definitions -", ["--definitions", "-"], definitionsJson],
+  ]) {
+    const out = path.join(app, "gen", how.replace(/[^a-z]+/g, "_"));
+    try {
+      run(rrRobdef, ["ts", "-o", out, ...args], { cwd: app, input, stdio: ["pipe", "pipe", "pipe"] });
+      const files = fs.readdirSync(out).sort();
+      const want = how === "--url" ? "experimental.create.ts" : "experimental.createwebcam.ts";
+      ok(files.includes(want) && /export interface/.test(fs.readFileSync(path.join(out, want), "utf8")),
+        `npx rr-robdef ts ${how}: ${files.join(", ")}`);
+    } catch (e) {
+      ok(false, `npx rr-robdef ts ${how}:\n${e.stdout ?? ""}${e.stderr ?? ""}`);
+    }
+  }
+  {
+    const r = spawnSync(rrRobdef, ["ts", "--gateway", `http://127.0.0.1:${port}`, "--device", "nope", "-o", path.join(app, "gen/none")], { encoding: "utf8" });
+    ok(r.status === 1 && /HTTP 404/.test(r.stderr) && !fs.existsSync(path.join(app, "gen/none")),
+      `npx rr-robdef ts --device of no device: exit ${r.status}, "${r.stderr.trim().split("\n")[0]}"`);
   }
   try {
     const r = run(process.execPath, [path.join(app, "out/usage.js"), `rr+ws://127.0.0.1:${port}/`], { cwd: app, timeout: 120000 });

@@ -101,6 +101,20 @@ test("standard objects get their panels: a camera its card and camera panel, a r
   assert.deepEqual(panels.panelsFor(camera, oldView).map((p) => p.name), ["camera"]);
 });
 
+test("every object type of the standard definitions opens as a panel of its own (issue 54), the abstract ones as parts", (t) => {
+  if (!defs) { t.skip(SKIP_REASON); return; }
+  const outline = new RobdefOutline(defs);
+  const view = viewContext(outline);
+  const panels = standardPanels();
+  // Device, DeviceClock and IsochDevice are implemented by the others (their card, clock and frame
+  // rate show there); every other object type must get more than the generic view.
+  const parts = new Set(["com.robotraconteur.device.Device", "com.robotraconteur.device.clock.DeviceClock", "com.robotraconteur.device.isoch.IsochDevice"]);
+  const objects = [...outline.types.values()].filter((d) => d.kind === "object").map((d) => d.qualified);
+  assert.ok(objects.length >= 40, `only ${objects.length} object types read`);
+  const without = objects.filter((q) => !parts.has(q) && !panels.panelsFor(proxyOf(outline, q), view).some((p) => p.name !== "device-card"));
+  assert.deepEqual(without, [], `standard object types shown only as the generic view: ${without.join(", ")}`);
+});
+
 test("members described once: flags of a camera's capabilities, generators by what they yield", (t) => {
   if (!defs) { t.skip(SKIP_REASON); return; }
   const outline = new RobdefOutline(defs);

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 
 namespace rr::server::gateway::auth {

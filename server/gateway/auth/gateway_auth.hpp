@@ -20,8 +20,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "server/gateway/auth/access_policy.hpp"
 #include "server/gateway/auth/login_limiter.hpp"
 #include "server/gateway/auth/token_auth.hpp"

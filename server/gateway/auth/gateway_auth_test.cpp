@@ -2,7 +2,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "core/message/error_entry.hpp"
+#include "base/message/error_entry.hpp"
 
 using namespace rr::server::gateway::auth;
 using namespace std::chrono_literals;

@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/message/message.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/message/message.hpp"
 #include "server/gateway/auth/gateway_auth.hpp"
 #include "server/node/service.hpp"
 

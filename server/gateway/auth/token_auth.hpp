@@ -22,7 +22,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 #include "server/gateway/auth/access_policy.hpp"
 
 namespace rr::server::gateway::auth {

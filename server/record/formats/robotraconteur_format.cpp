@@ -1,8 +1,8 @@
 // The `robotraconteur` format (docs/recording.md): each recorded entry as one RR message entry in
 // message format 4 (wire.md §2), the bytes the gateway sends its native clients (encoded once, shared).
 // Its channels refer to the service definition of their member's object. Replay plays these channels.
-#include "core/message/message_reader.hpp"
-#include "core/message/message_writer.hpp"
+#include "base/message/message_reader.hpp"
+#include "base/message/message_writer.hpp"
 #include "server/record/formats/formats.hpp"
 
 namespace rr::server::record {

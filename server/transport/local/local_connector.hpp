@@ -25,8 +25,8 @@
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/connection_url.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/connection_url.hpp"
 #include "server/transport/local/local_layout.hpp"
 #include "server/transport/local/node_directories.hpp"
 #include "server/transport/transport.hpp"

@@ -36,7 +36,7 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "core/names/node_id.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/local/node_directories.hpp"
 
 namespace rr::server::local {

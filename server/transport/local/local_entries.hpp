@@ -13,7 +13,7 @@
 
 #include <sys/types.h>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server::local {
 

@@ -20,9 +20,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/connection_url.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/connection_url.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/local/node_directories.hpp"
 
 namespace rr::server::local {

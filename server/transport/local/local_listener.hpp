@@ -32,8 +32,8 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/local/node_directories.hpp"
 #include "server/transport/local/node_identity.hpp"
 #include "server/transport/transport.hpp"

@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/local/local_entries.hpp"
 #include "server/transport/local/node_directories.hpp"
 

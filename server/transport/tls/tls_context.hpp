@@ -16,8 +16,8 @@
 #include <optional>
 #include <string>
 
-#include "core/error/rr_error.hpp"
-#include "core/names/node_id.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/names/node_id.hpp"
 
 typedef struct x509_store_ctx_st X509_STORE_CTX;
 typedef struct ssl_st SSL;

@@ -19,7 +19,7 @@
 
 #include <boost/asio/ip/tcp.hpp>
 
-#include "core/names/node_id.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/tls/tls_context.hpp"
 #include "server/transport/tls/tls_stream_fwd.hpp"
 #include "server/transport/transport.hpp"

@@ -16,7 +16,7 @@
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/write.hpp>
 
-#include "core/message/message_reader.hpp"
+#include "base/message/message_reader.hpp"
 #include "server/client/client.hpp"
 #include "server/node/node.hpp"
 #include "server/service/test_raw_service.hpp"

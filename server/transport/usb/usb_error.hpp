@@ -8,7 +8,7 @@
 
 #include <boost/system/error_code.hpp>
 
-#include "core/error/rr_error.hpp"
+#include "base/error/rr_error.hpp"
 
 namespace rr::server::usb {
 

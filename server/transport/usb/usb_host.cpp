@@ -11,7 +11,7 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 
-#include "core/usb/usb_descriptors.hpp"
+#include "base/usb/usb_descriptors.hpp"
 #include "server/transport/transport_registry.hpp"
 
 namespace rr::server::usb {

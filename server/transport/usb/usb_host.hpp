@@ -34,8 +34,8 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "core/names/connection_url.hpp"
-#include "core/names/node_id.hpp"
+#include "base/names/connection_url.hpp"
+#include "base/names/node_id.hpp"
 #include "server/transport/transport.hpp"
 #include "server/transport/transport_registry.hpp"
 #include "server/transport/usb/usb_host_link.hpp"

@@ -3,7 +3,7 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 
-#include "core/codec/endian.hpp"
+#include "base/codec/endian.hpp"
 
 namespace rr::server::usb {
 

@@ -30,7 +30,7 @@
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "core/usb/usb_host_mux.hpp"
+#include "base/usb/usb_host_mux.hpp"
 #include "server/transport/usb/usb_error.hpp"
 #include "server/transport/usb/usb_libusb.hpp"
 #include "server/transport/usb/usb_stream.hpp"

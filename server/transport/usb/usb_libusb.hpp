@@ -20,8 +20,8 @@
 
 #include <libusb.h>
 
-#include "core/error/rr_error.hpp"
-#include "core/usb/usb_protocol.hpp"
+#include "base/error/rr_error.hpp"
+#include "base/usb/usb_protocol.hpp"
 
 namespace rr::server::usb {
 

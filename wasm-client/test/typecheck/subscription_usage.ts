@@ -1,6 +1,6 @@
 // Subscriptions and the JSON client as a TypeScript user writes them (README.md "Subscriptions"):
 // type-checked (tsc --noEmit --strict) by package_test.mjs, never run (reconnect_test.mjs runs them).
-import { subscribe, RRError, type ObjectProxy, type ServiceSubscription, type WireSubscription, type TimeSpec } from "robotraconteur-wasm";
+import { subscribe, RRError, type ObjectProxy, type ServiceSubscription, type WireSubscription, type PipeSubscription, type TimeSpec } from "robotraconteur-wasm";
 import { connectJson, type JsonSubscription } from "robotraconteur-wasm/json";
 
 interface SensorPacket { ID: number; Data: Uint8Array }
@@ -12,11 +12,11 @@ export async function subscriptions(gateway: string): Promise<string> {
   const offConnect = sub.onConnect((client, proxy: ObjectProxy) => console.log(client.url, client.connectCount, proxy.$type));
   sub.onDisconnect((client, error: RRError | null) => console.log(client.state, error?.errorName));
   sub.onError((error, client) => console.log(error.message, client?.id));
-  const packets: WireSubscription<SensorPacket> = sub.subscribeWire<SensorPacket>("packets");
+  const packets: WireSubscription<SensorPacket> = sub.subscribeWire("packets");  // untyped: any, assigned to what it is
   packets.onValueChanged((v: SensorPacket, ts: TimeSpec) => console.log(v.ID, ts.seconds));
   const ok: boolean = await packets.waitInValueValid(5000);
   const id: number | undefined = packets.tryGetInValue()?.value.ID;
-  const frames = sub.subscribePipe<Uint8Array>("FrameStream", "Webcams[0]", 10);
+  const frames: PipeSubscription<Uint8Array> = sub.subscribePipe("FrameStream", "Webcams[0]", 10);
   const frame: Uint8Array | undefined = await frames.receivePacket(1000);
   const offBump = sub.subscribeEvent("Bump", () => console.log("bump"));
   sub.setCallback("play_callback", async (distance: number, angle: number) => new Uint8Array([distance, angle]));

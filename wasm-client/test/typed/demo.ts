@@ -3,7 +3,7 @@
 // what its declared type says (the assertion helpers take exactly the declared type, so tsc checks the
 // declaration and the run checks the value). `node demo.js rr+ws://HOST:PORT/` (rr-gateway's base URL).
 import WebSocket from "ws";
-import { connect } from "robotraconteur-wasm";
+import { connect, subscribe, type ReadonlyWireSubscription, type ReadonlyPipeSubscription, type SubscriptionClient } from "robotraconteur-wasm";
 import type { Create, SensorPacket } from "./gen/demo/experimental.create.js";
 import { Create as CreateConstants } from "./gen/demo/experimental.create.js";
 import type { WebcamHost, Webcam, WebcamImage, WebcamImage_size } from "./gen/demo/experimental.createwebcam.js";
@@ -65,6 +65,28 @@ async function main(base: string): Promise<void> {
   const md = await cam.multidimbuffer.read(dims.map(() => 0), dims.map(() => 1));
   check(md.array instanceof Uint8Array && md.dims.every((d) => d === 1), `memory multidimbuffer (uint8[*]): dims ${dims}, read {dims, array: Uint8Array}`);
   await host.$client.close();
+
+  // Subscriptions typed by the service: member names checked, values typed (misuse.ts has the wrong uses).
+  const sub = subscribe<Create>(`${base}?service=create`, { WebSocket });
+  sub.onConnect((_client, proxy: Create) => void proxy.StartStreaming());   // the device's state, restored on every connection
+  const packets: ReadonlyWireSubscription<SensorPacket | null> = sub.subscribeWire("packets");
+  check(await packets.waitInValueValid(10000), "subscribe<Create>().subscribeWire(\"packets\"): an InValue");
+  const value: SensorPacket | null = packets.inValue;
+  check(value !== null && Number.isInteger(value.ID) && value.Data instanceof Uint8Array, "its value is a SensorPacket");
+  const offBump: () => void = sub.subscribeEvent("Bump", (client: SubscriptionClient<Create>) => void client.url);
+  offBump();
+  sub.setCallback("play_callback", async (dist: number, angle: number, _client: SubscriptionClient<Create>) => Uint8Array.of(dist & 0xff, angle & 0xff));
+  await (await sub.getDefaultClientWait(10000)).StopStreaming();
+  await sub.close();
+
+  const hosts = subscribe<WebcamHost>(`${base}?service=webcam`, { WebSocket });
+  hosts.onConnect(async (_client, proxy: WebcamHost) => (await proxy.Webcams.get(0)).StartStreaming());
+  const stream: ReadonlyPipeSubscription<WebcamImage | null> = hosts.subscribePipe("FrameStream", "Webcams[0]", 4);
+  const image = await stream.receivePacket(10000);
+  check(image != null && image.data instanceof Uint8Array && image.data.length === image.step * image.height,
+    "subscribe<WebcamHost>().subscribePipe(\"FrameStream\", \"Webcams[0]\"): a WebcamImage");
+  await (await (await hosts.getDefaultClientWait(10000)).Webcams.get(0)).StopStreaming();
+  await hosts.close();
 }
 
 main(process.argv[2] ?? "rr+ws://127.0.0.1:8080/").then(

@@ -10,20 +10,23 @@ import { JogRepeater, JOG_TIMEOUT_S } from "../robot/jog_repeater.js";
 import { jogVelocity } from "../robot/joints.js";
 import { modeText, isStale } from "../robot/status.js";
 import { mayLock } from "../robot/access.js";
-import { holdButton, jogKey, jogKeysText } from "../robot/hold.js";
+import { jogKey, jogKeysText } from "../robot/hold.js";
+import { HoldToRun } from "../hold/hold_to_run.js";
+import { jointBindings } from "../hold/gamepad.js";
+import { createGamepadControl, hasGamepadApi } from "./gamepad_control.js";
 import { CARTESIAN_AXES, cartesianVelocity, isNotImplemented } from "../robot/cartesian.js";
 
 /**
  * The jog controls of one robot panel. `robot` is the panel's shared state (robot_panel.js); `parts`
  * the elements it fills: { el (the panel), jogBox, lockBox, lockHolder, cartBox }.
- * Returns { buttons (the joints table's jog buttons go here), jointCommand(i, dir), button(list, label,
- * dataset, makeCommand), build(), refresh(), release(reason), dispose() }.
+ * Returns { tableButtons (the joints table's jog buttons go here), jointCommand(i, dir), button(list,
+ * label, dataset, makeCommand), forget(list), build(), refresh(), release(reason), dispose() }.
  */
 export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox }) {
   const { obj } = robot;
-  let lockHeld = false, pressId = 0, heldKey = null;
+  let lockHeld = false, heldKey = null;
   let cartesianMissing = false;  // the driver answered jog_cartesian with NotImplementedError
-  const cleanups = [];
+  let gamepad = null;  // "jog with a gamepad" (panels/gamepad_control.js), once the user may jog
   const speed = h("input", { type: "range", min: "0.05", max: "1", step: "0.05", value: "0.25", name: "jog-speed" });
   const speedText = h("output", { class: "robot-speed" });
   const showSpeed = () => { speedText.textContent = `${Math.round(Number(speed.value) * 100)}% of the reduced velocity limit`; };
@@ -50,56 +53,40 @@ export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox
       }
       robot.showError(`${c.kind === "joint" ? "jog_joint" : "jog_cartesian"}: ${errorText(e)}`);
     },
-    onStop: (reason) => {
-      if (reason === "replaced") return;  // another control took over the hold
-      releaseLock();
-      el.dataset.jog = "off";
-      el.dataset.jogStop = reason;
-      for (const b of el.querySelectorAll("button.held")) b.classList.remove("held");
-    },
+    onStop: (reason) => hold.stopped(reason),
   });
-
-  /** Starts a hold of `makeCommand()` (taking the lock first when asked); nothing when jogging is not possible. */
-  async function press(makeCommand) {
-    const id = ++pressId;
-    let command;
-    try {
-      command = makeCommand();
-    } catch (e) {
-      robot.showError(`jog: ${e.message}`);
-      return;
-    }
-    if (lockCheck.checked && !lockHeld) {
+  // the page's end of every hold (hold/hold_to_run.js): pointer, keys, gamepad, blur, hidden, session
+  const hold = new HoldToRun({
+    motion: repeater,
+    client: obj.$client,
+    prepare: async () => {
+      if (!lockCheck.checked || lockHeld) return true;
       try {
         await obj.$monitorEnter(2000);
         lockHeld = true;
+        return true;
       } catch (e) {
         if (!robot.disposed) robot.showError(`lock: ${errorText(e)}`);
-        return;
+        return false;
       }
-      if (id !== pressId || robot.disposed) { releaseLock(); return; }  // let go while the lock was taken
-    }
-    robot.showError(null);
-    el.dataset.jog = "on";
-    el.dataset.jogHolds = String(Number(el.dataset.jogHolds ?? 0) + 1);  // for tests: a hold started
-    repeater.start(command);
-  }
-  const release = (reason) => { pressId++; heldKey = null; repeater.stop(reason); };
-  const jointCommand = (i, dir) => () => ({ kind: "joint", velocity: jogVelocity(robot.model, i, dir, Number(speed.value)) });
-
-  // Every way the page can lose the operator ends the hold.
-  const onBlur = () => release("blur");
-  const onHidden = () => { if (document.visibilityState === "hidden") release("hidden"); };
-  window.addEventListener("blur", onBlur);
-  window.addEventListener("pagehide", onBlur);
-  document.addEventListener("visibilitychange", onHidden);
-  cleanups.push(() => {
-    window.removeEventListener("blur", onBlur);
-    window.removeEventListener("pagehide", onBlur);
-    document.removeEventListener("visibilitychange", onHidden);
+    },
+    cancelled: releaseLock,
+    onError: (e) => robot.showError(`jog: ${e.message}`),
+    onStart: () => {
+      robot.showError(null);
+      el.dataset.jog = "on";
+      el.dataset.jogHolds = String(Number(el.dataset.jogHolds ?? 0) + 1);  // for tests: a hold started
+    },
+    onStop: (reason) => {
+      heldKey = null;
+      releaseLock();
+      el.dataset.jog = "off";
+      el.dataset.jogStop = reason;
+    },
   });
-  const offClose = obj.$client?.onClose?.(() => release("session closed"));
-  if (typeof offClose === "function") cleanups.push(offClose);
+  const press = (makeCommand, source) => hold.press(makeCommand, source);
+  const release = (reason) => { heldKey = null; hold.release(reason); };
+  const jointCommand = (i, dir) => () => ({ kind: "joint", velocity: jogVelocity(robot.model, i, dir, Number(speed.value)) });
 
   // Keyboard shortcuts, only while the panel has focus and not while typing in a field.
   el.addEventListener("keydown", (ev) => {
@@ -109,7 +96,7 @@ export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox
     ev.preventDefault();
     if (ev.repeat || heldKey === ev.key.toLowerCase()) return;
     heldKey = ev.key.toLowerCase();
-    press(jointCommand(k.joint, k.direction));
+    press(jointCommand(k.joint, k.direction), "key");
   });
   el.addEventListener("keyup", (ev) => { if (heldKey && ev.key.toLowerCase() === heldKey) release("keyup"); });
   el.addEventListener("focusout", (ev) => { if (heldKey && !el.contains(ev.relatedTarget)) release("blur"); });
@@ -119,8 +106,7 @@ export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox
   // the jog buttons now on the page: the Cartesian ones and the joint table's (rebuilt with the table)
   const cartButtons = [], tableButtons = [];
   function button(list, label, dataset, makeCommand) {
-    const b = h("button", { type: "button", class: "small jog", text: label, dataset });
-    holdButton(b, () => press(makeCommand), release);  // the listeners go with the button
+    const b = hold.button(h("button", { type: "button", class: "small jog", text: label, dataset }), makeCommand);
     list.push(b);
     return b;
   }
@@ -140,13 +126,20 @@ export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox
     if (jog) {
       jogBox.replaceChildren(h("label", {}, "jog speed ", speed), speedText,
         h("span", { class: "hint", text: `hold a − / + button (keys ${robot.model.slice(0, 7).map((_, i) => jogKeysText(i)).join(", ")} while the panel has focus)` }));
+      if (hasGamepadApi()) {
+        gamepad ??= createGamepadControl(hold, {
+          bindings: () => jointBindings(robot.model.length, jointCommand),
+          press: (b) => { if (!enabled()) return false; press(b.command, "gamepad"); return true; },
+        });
+        jogBox.append(gamepad.el);
+      }
     }
     buildCartesian(jog);
     return jog;
   }
 
   function buildCartesian(jog) {
-    cartButtons.length = 0;
+    forget(cartButtons);
     const cart = jog && robot.caps.has("jog_command") && robot.may("jog_cartesian");
     cartBox.hidden = !cart;
     cartBox.dataset.missing = String(cartesianMissing);
@@ -157,12 +150,12 @@ export function createRobotJog(robot, { el, jogBox, lockBox, lockHolder, cartBox
         () => ({ kind: "cartesian", velocity: cartesianVelocity(a.id, d, Number(speed.value)) }))))] : []));
   }
 
+  /** The buttons in `list` leave the page (the joints table is rebuilt). */
+  const forget = (list) => { hold.forgetButtons(list); list.length = 0; };
+
   return {
-    tableButtons, jointCommand, button, build, refresh, release,
+    tableButtons, jointCommand, button, forget, build, refresh, release,
     get shown() { return !jogBox.hidden; },
-    dispose() {
-      release("dispose");
-      for (const c of cleanups) c();
-    },
+    dispose() { gamepad?.dispose(); hold.dispose(); },
   };
 }

@@ -14,7 +14,7 @@ export function createJointsTable(robot, jog, table) {
     const withJog = jog.shown;
     if (rebuild || table.tBodies[0]?.rows.length !== rows.length) {
       if (buttons.some((b) => b.classList.contains("held"))) jog.release("table rebuilt");
-      buttons.length = 0;
+      jog.forget(buttons);
       table.replaceChildren(
         h("thead", {}, h("tr", {}, ...["joint", "position", "limits", "velocity", "effort", withJog ? "jog" : ""].map((t) => h("th", { text: t })))),
         h("tbody", {}, ...rows.map((r, i) => h("tr", { dataset: { joint: r.name } },

@@ -1,13 +1,15 @@
 // The tool panel's controls (panels/tool_panel.js): Enable, Disable, Reset errors and Halt, and the
 // hold-to-run motions Open, Close, Home and "move to" a position (setf_command), each only when the
 // gateway lets this user call its member (robot/access.js) and tool_info's capabilities offer it.
-// A motion runs only while its button is held: every way the hold ends (release, pointer lost, window
-// blur, hidden tab, page hide, the panel removed, the session closed, tool_state stale or closed, Halt)
-// calls halt() once the motion call was answered (tool/tool_state.js ToolHold). The gateway halts the
+// A motion runs only while its button is held (the shared hold-to-run helper hold/hold_to_run.js): every
+// way the hold ends (release, pointer lost, window blur, hidden tab, page hide, the panel removed, the
+// session closed, tool_state stale or closed, Halt) calls halt() once the motion call was answered
+// (tool/tool_state.js ToolHold). The gateway halts the
 // tool itself when the page goes away mid-motion (docs/security.md "Motion safety").
 
 import { h, errorText } from "../dom.js";
-import { holdButton } from "../robot/hold.js";
+import { HoldToRun } from "../hold/hold_to_run.js";
+import { createGamepadControl, hasGamepadApi } from "./gamepad_control.js";
 import { isStale } from "../robot/status.js";
 import { ToolHold, commandRange } from "../tool/tool_state.js";
 
@@ -17,43 +19,32 @@ import { ToolHold, commandRange } from "../tool/tool_state.js";
  */
 export function createToolControls(tool, { el, box, moveBox }) {
   const { obj } = tool;
-  const cleanups = [];
-  const holdButtons = [];
   const hold = new ToolHold({
     halt: () => obj.halt(),
     onError: (e, what) => { if (!tool.disposed) tool.showError(`${what}: ${errorText(e)}`); },
+    onStop: (reason) => run.stopped(reason),
+  });
+  // the page's end of every hold (hold/hold_to_run.js), shared with the robot panel's jog
+  const run = new HoldToRun({
+    motion: { start: (c) => hold.start(c.name, c.call), stop: (reason) => hold.stop(reason), get active() { return hold.active; } },
+    client: obj.$client,
+    onStart: (c) => {
+      tool.showError(null);
+      el.dataset.hold = c.name;
+      el.dataset.holds = String(Number(el.dataset.holds ?? 0) + 1);  // for tests: a hold started
+    },
     onStop: (reason) => {
       el.dataset.hold = "off";
       el.dataset.holdStop = reason;
-      for (const b of holdButtons) b.classList.remove("held");
     },
   });
-  const release = (reason) => hold.stop(reason);
-  const press = (name, call) => {
-    tool.showError(null);
-    el.dataset.hold = name;
-    el.dataset.holds = String(Number(el.dataset.holds ?? 0) + 1);  // for tests: a hold started
-    hold.start(name, call);
-  };
-
-  // every way the page can lose the operator ends the hold
-  const onBlur = () => release("blur");
-  const onHidden = () => { if (document.visibilityState === "hidden") release("hidden"); };
-  window.addEventListener("blur", onBlur);
-  window.addEventListener("pagehide", onBlur);
-  document.addEventListener("visibilitychange", onHidden);
-  cleanups.push(() => {
-    window.removeEventListener("blur", onBlur);
-    window.removeEventListener("pagehide", onBlur);
-    document.removeEventListener("visibilitychange", onHidden);
-  });
-  const offClose = obj.$client?.onClose?.(() => release("session closed"));
-  if (typeof offClose === "function") cleanups.push(offClose);
+  const release = (reason) => run.release(reason);
+  const holdButtons = [];
+  let gamepad = null;  // "move with a gamepad" (panels/gamepad_control.js)
 
   const canMove = () => !!tool.state && !isStale(tool.lastStateMs, Date.now());
   function holdControl(parent, name, label, call, dataset = {}) {
-    const b = h("button", { type: "button", class: "small jog tool-hold", text: label, dataset: { action: name, ...dataset } });
-    cleanups.push(holdButton(b, () => press(name, call), release));
+    const b = run.button(h("button", { type: "button", class: "small jog tool-hold", text: label, dataset: { action: name, ...dataset } }), () => ({ name, call }));
     holdButtons.push(b);
     parent.append(b);
     return b;
@@ -76,6 +67,8 @@ export function createToolControls(tool, { el, box, moveBox }) {
   }
 
   function build() {
+    run.forgetButtons(holdButtons);
+    holdButtons.length = 0;
     box.replaceChildren();
     action("enable", "Enable", "software_enable");
     action("disable", "Disable", "software_enable");
@@ -99,6 +92,15 @@ export function createToolControls(tool, { el, box, moveBox }) {
       });
       moveBox.append(h("span", { class: "hint", text: "the tool moves only while a (hold) button is held" }));
     }
+    const padBindings = toolBindings(tool, obj);
+    if (padBindings.length && hasGamepadApi()) {
+      gamepad ??= createGamepadControl(run, {
+        what: "move",
+        bindings: () => padBindings,
+        press: (b) => { if (!canMove()) return false; run.press(() => b.command, "gamepad"); return true; },
+      });
+      box.append(gamepad.el);
+    }
     refresh();
   }
 
@@ -112,9 +114,15 @@ export function createToolControls(tool, { el, box, moveBox }) {
   return {
     build, refresh, release,
     get holding() { return hold.active; },
-    dispose() {
-      release("dispose");
-      for (const c of cleanups) c();
-    },
+    dispose() { gamepad?.dispose(); run.dispose(); },
   };
+}
+
+/** The tool's motions on a standard gamepad: A holds Close, B holds Open (each when offered). */
+function toolBindings(tool, obj) {
+  const openClose = tool.caps.has("open_close_command") || tool.caps.has("continuous_command");
+  const out = [];
+  if (openClose && tool.may("close")) out.push({ id: "close", button: 0, command: { name: "close", call: () => obj.close() } });
+  if (openClose && tool.may("open")) out.push({ id: "open", button: 1, command: { name: "open", call: () => obj.open() } });
+  return out;
 }

@@ -230,3 +230,59 @@ export class ScanAssembler {
   stray: number;
   push(part: unknown): { scan_info: unknown; ranges: Float64Array; intensities: Float64Array | never[] } | null;
 }
+
+// stdpanels-c (issue 54): joint trajectories, PID gains, parameter infos
+/** A JointTrajectory as plot series: joint names, times (s), positions per joint (radians as degrees), units. */
+export function trajectorySeries(trajectory: unknown, unitEnum?: Array<{ name: string; value: number }> | null):
+  { names: string[]; times: Float64Array; series: Float64Array[]; units: string[]; unitText: string[]; cut: boolean } | null;
+/** "3 joints, 5 waypoints over 4.2 s (shoulder, elbow, wrist)". */
+export function trajectoryText(trajectory: unknown, ctx?: object): string;
+/** Draws trajectorySeries() as a plot (one line per joint, a legend) into a 2D context. */
+export function drawTrajectory(g: CanvasRenderingContext2D | OffscreenCanvasRenderingContext2D,
+  series: ReturnType<typeof trajectorySeries>, width: number, height: number): { min: number; max: number; t0: number; t1: number } | null;
+/** "P 1.2, I 0.05, D 0.01; integral -5 … 5; command -10 … 10" of a com.robotraconteur.pid.PIDParam, or null. */
+export function formatPid(value: unknown): string | null;
+/** One line of a com.robotraconteur.param.ParameterInfo: name, type, units, description, default, range. */
+export function formatParameterInfo(value: unknown, ctx?: { descriptor?: TypeDescriptor | null }): string | null;
+/** A varvalue as short text ("1, 2", "\"text\""); "" for null. */
+export function varText(value: unknown): string;
+// stdpanels-d (issue 54): point clouds
+/** A cloud's points as flat arrays: positions x, y, z per point (metres); intensity and packed rgb floats of PointCloud2 points, else null. */
+export interface PackedCloud { count: number; positions: Float32Array; intensity: Float32Array | null; rgb: Float32Array | null }
+/** A cloud ready to draw: finite points only, RGB bytes per point, bounds, the colour mode used and the span of the jet map (null for rgb). */
+export interface DrawableCloud { count: number; positions: Float32Array; colors: Uint8Array; min: [number, number, number] | null; max: [number, number, number] | null; mode: "rgb" | "intensity" | "height"; range: [number, number] | null }
+export const COLOR_MODES: readonly ["rgb", "intensity", "height"];
+/** The whole (PointCloud, PointCloudf, PointCloud2, PointCloud2f) and part cloud types of com.robotraconteur.pointcloud. */
+export const CLOUD_TYPES: readonly string[];
+export const CLOUD_PART_TYPES: readonly string[];
+/** The points of a PointCloud* value (points an Array of Point or PointCloud2Point objects) as flat arrays. */
+export function packCloud(cloud: unknown): PackedCloud;
+/** Holes dropped, bounds found, each point coloured by its rgb, intensity or height ("auto": the richest there is). */
+export function colorCloud(packed: PackedCloud, options?: { mode?: "auto" | "rgb" | "intensity" | "height"; range?: [number, number] }): DrawableCloud;
+/** The colour mode colorCloud uses for `packed` when `wanted` is asked for. */
+export function colorModeFor(packed: PackedCloud, wanted?: string): "rgb" | "intensity" | "height";
+/** [r, g, b] bytes of a PixelRGBFloatPacked float (its bits 0x00RRGGBB). */
+export function unpackRgb(f: number): [number, number, number];
+/** PointCloud*Part values back into whole packed clouds. */
+export class CloudAssembler {
+  constructor(maxPoints?: number);
+  dropped: number;
+  stray: number;
+  push(part: unknown): (PackedCloud & { part: unknown }) | null;
+}
+/** "1.2 × 0.8 × 0.4 m at (0, 0, 0.2)" of a BoundingBox, or null. */
+export function boundsText(box: unknown): string | null;
+/** "20000 points, dense, 1.2 × 0.8 × 0.4 m at (0, 0, 0.2)". */
+export function cloudText(cloud: unknown): string;
+/** A drawable cloud projected from the front-left above onto a 2D context; returns the points drawn. */
+export function drawCloud(g: CanvasRenderingContext2D | OffscreenCanvasRenderingContext2D, drawn: DrawableCloud, width: number, height: number,
+  options?: { background?: string; pointSize?: number }): number;
+/** Clouds made drawable in a Worker, the newest winning (one colouring, one waiting). */
+export class CloudDecoder {
+  constructor(options: { onResult: (result: (DrawableCloud & { ok: true; ms: number; packMs: number }) | { ok: false; error: { code: string; message: string } }, meta: Record<string, unknown> & { seq: number }) => void;
+    Worker?: typeof Worker | null; workerUrl?: string | URL });
+  readonly inWorker: boolean;
+  stats: { submitted: number; decoded: number; failed: number; dropped: number };
+  submit(input: { cloud: unknown } | { packed: PackedCloud }, options?: { mode?: string; range?: [number, number] }, meta?: Record<string, unknown>): void;
+  dispose(): void;
+}

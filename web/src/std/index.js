@@ -28,3 +28,9 @@ export { RobdefOutline } from "./robdef_outline.js";
 // stdpanels-a (issue 54): wrenches, laser scans
 export { formatWrench, wrenchParts } from "./wrench.js";
 export { scanGeometry, scanPoints, intensityRange, drawScan, scanText, ScanAssembler } from "./laserscan.js";
+// stdpanels-c (issue 54): joint trajectories, PID gains, parameter infos
+export { trajectorySeries, trajectoryText, drawTrajectory } from "./trajectory.js";
+export { formatPid, formatParameterInfo, varText } from "./param.js";
+// stdpanels-d (issue 54): point clouds
+export { packCloud, colorCloud, colorModeFor, unpackRgb, CloudAssembler, boundsText, cloudText, drawCloud, COLOR_MODES, CLOUD_TYPES, CLOUD_PART_TYPES } from "./pointcloud.js";
+export { CloudDecoder } from "./pointcloud_decoder.js";

@@ -16,12 +16,21 @@ import { renderers as datatype } from "./datatype.js";
 // stdpanels-a: sensors, laser scans, point clouds
 import { renderers as wrench } from "./wrench.js";
 import { renderers as laserscan } from "./laserscan.js";
+// stdpanels-c: joint trajectories, PID and parameter values
+import { renderers as trajectory } from "./trajectory.js";
+import { renderers as param } from "./param.js";
+// stdpanels-d: point clouds
+import { renderers as pointcloud } from "./pointcloud.js";
 
 /** A new registry holding the standard renderers (add your own with register()). */
 export function standardRegistry() {
   return new RendererRegistry().register(uuid, identifier, datetime, geometry, units, image, deviceInfo, datatype)
     // stdpanels-a: sensors, laser scans, point clouds
-    .register(wrench, laserscan);
+    .register(wrench, laserscan)
+    // stdpanels-c: joint trajectories, PID and parameter values
+    .register(trajectory, param)
+    // stdpanels-d: point clouds
+    .register(pointcloud);
 }
 
 /** The field annotators of the standard types: flag enums, enum codes in integer fields, units. */
