@@ -48,7 +48,7 @@ std::uint64_t add_rate_limited(JsonSubscriptions& subs, SubscriptionKind kind, R
 
 }  // namespace
 
-TEST_CASE("rate window: max_rate_hz from 0.01 to 1000; zero, negative, NaN, infinite and larger refused") {
+TEST_CASE("rate window: max_rate_hz from 0.01 to 1000, and zero, negative, NaN, infinite and larger refused") {
     CHECK(rate_period(10).period == 100ms);
     CHECK(rate_period(1000).period == 1ms);
     CHECK(rate_period(0.01).period == 100s);
