@@ -17,6 +17,10 @@
 //       line (or EOF) arrives on stdin, so that the caller can read the gateway's RSS meanwhile.
 //   --slow K --read-delay-ms D: the first K clients wait D ms before each read (slow consumers); the
 //       row's figures are the other clients', and "slow" holds theirs.
+//   --max-rate-hz R: subscribes with "max_rate_hz": R (docs/json-api.md "Rate and queue length"); the
+//       row's expected_per_s is then N × min(H, R).
+//   --deflate: the clients offer permessage-deflate (the gateway compresses when its configuration
+//       allows it: gateway.websocket_compression); the row says whether it was negotiated.
 //   --foxglove: the clients are Foxglove WebSocket clients (docs/foxglove.md: /foxglove, subprotocol
 //       foxglove.websocket.v1) subscribed to the channel `D/M`; the values are the messageData payloads
 //       ({"value": [stamp_us, sequence, ...], "time": …}).
@@ -75,6 +79,14 @@ public:
 
     /// Foxglove WebSocket instead of the JSON API: subscribes to the channel of this topic once advertised.
     void foxglove(std::string topic) { foxglove_topic_ = std::move(topic); }
+    /// Offers permessage-deflate in the handshake.
+    void offer_deflate() {
+        websocket::permessage_deflate pmd;
+        pmd.client_enable = true;
+        ws_.set_option(pmd);
+    }
+    /// Whether the handshake's response accepted permessage-deflate.
+    bool deflated() const { return deflated_; }
 
     void open(tcp::endpoint endpoint, std::string host, std::optional<nlohmann::json> subscribe) {
         subscribe_ = std::move(subscribe);
@@ -87,8 +99,10 @@ public:
             self->ws_.set_option(websocket::stream_base::decorator([fox](websocket::request_type& req) {
                 req.set(beast::http::field::sec_websocket_protocol, fox ? kFoxgloveSubprotocol : kJsonSubprotocol);
             }));
-            self->ws_.async_handshake(host, fox ? "/foxglove" : "/", [self](beast::error_code ec) {
+            self->ws_.async_handshake(self->response_, host, fox ? "/foxglove" : "/", [self](beast::error_code ec) {
                 if (ec) return self->failed("handshake: " + ec.message());
+                self->deflated_ = self->response_[beast::http::field::sec_websocket_extensions].find("permessage-deflate") !=
+                                  beast::string_view::npos;
                 ++self->stats_.opened;
                 self->opened_ = true;
                 self->opened_done();
@@ -223,6 +237,8 @@ private:
     bool got_value_ = false, opened_ = false;
     double first_seq_ = -1, last_seq_ = -1;
     std::uint64_t delivered_ = 0;
+    websocket::response_type response_;
+    bool deflated_ = false;
 };
 
 }  // namespace
@@ -232,7 +248,8 @@ int main(int argc, char** argv) {
     std::size_t clients = 10;
     double seconds = 5, hz = 100;
     std::string mode, device = "bench", member = "Ticks";
-    bool binary = false, foxglove = false;
+    bool binary = false, foxglove = false, deflate = false;
+    double max_rate_hz = 0;
     std::size_t slow = 0;
     long read_delay_ms = 0;
     for (int i = 1; i < argc; ++i) {
@@ -246,6 +263,8 @@ int main(int argc, char** argv) {
         else if (a == "--member") member = value();
         else if (a == "--binary") binary = true;
         else if (a == "--foxglove") foxglove = true;
+        else if (a == "--deflate") deflate = true;
+        else if (a == "--max-rate-hz") max_rate_hz = std::stod(value());
         else if (a == "--slow") slow = std::stoul(value());
         else if (a == "--read-delay-ms") read_delay_ms = std::stol(value());
         else if (a == "fanout" || a == "idle") mode = a;
@@ -268,6 +287,7 @@ int main(int argc, char** argv) {
     std::optional<nlohmann::json> subscribe;
     if (mode == "fanout")
         subscribe = nlohmann::json{{"id", 1}, {"op", "subscribe"}, {"device", device}, {"member", member}, {"binary", binary}};
+    if (subscribe && max_rate_hz > 0) (*subscribe)["max_rate_hz"] = max_rate_hz;
 
     // Open the connections, at most kMaxConnecting in progress.
     std::vector<std::shared_ptr<Connection>> conns;
@@ -283,6 +303,7 @@ int main(int argc, char** argv) {
             }, std::chrono::milliseconds(is_slow ? read_delay_ms : 0));
             conns.push_back(c);
             if (foxglove && mode == "fanout") c->foxglove(device + "/" + member);
+            if (deflate) c->offer_deflate();
             c->open(endpoint, host, subscribe);
         }
     };
@@ -319,7 +340,9 @@ int main(int argc, char** argv) {
     const auto cpu1 = rr::bench::CpuSnapshot::now();
     double device_sent = 0, slow_sent = 0;  // per client: values the device sent in its window (wires keep the newest only)
     std::vector<double> per_client, slow_per_client;
+    std::size_t deflated = 0;
     for (auto& c : conns) {
+        deflated += c->deflated() ? 1 : 0;
         (c->slow() ? slow_sent : device_sent) += c->sent_span();
         if (c->opened()) (c->slow() ? slow_per_client : per_client).push_back(double(c->delivered()) * 1e6 / wall);
         c->close();
@@ -344,7 +367,9 @@ int main(int argc, char** argv) {
                                 {"open_s", open_s},
                                 {"seconds", wall / 1e6},
                                 {"delivered_per_s", double(stats.delivered) * 1e6 / wall},
-                                {"expected_per_s", double(per_client.size()) * hz},
+                                {"expected_per_s", double(per_client.size()) * (max_rate_hz > 0 ? std::min(hz, max_rate_hz) : hz)},
+                                {"max_rate_hz", max_rate_hz},
+                                {"deflated_clients", deflated},
                                 {"delivered_of_sent", device_sent > 0 ? double(stats.delivered) / device_sent : 0.0},
                                 {"per_client_per_s_min", per_client.empty() ? 0.0 : per_client.front()},
                                 {"per_client_per_s_median", rr::bench::percentile(per_client, 0.5)},

@@ -209,19 +209,21 @@ class Sampler(threading.Thread):
                 "other_threads_minflt_per_s": (s[-1][5] - s[0][5]) / dt}
 
 
-SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record")
+SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record", "rate", "uring")
 # Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
 # allows by default (256); 0 lifts the limit.
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
 
 
-def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=()):
+def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=(), deflate=False):
     argv = [*prefix, exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning", "--device",
             "bench=" + device_url]
     if unlimited:
         path = os.path.join(tempfile.gettempdir(), "rr-bench-gateway-%d.yaml" % os.getpid())
         with open(path, "w") as f:
             f.write(UNLIMITED_CONFIG)
+            if deflate:
+                f.write("  websocket_compression:\n    enabled: true\n")
         argv += ["--config", path]
     gw = Proc(argv, name)
     time.sleep(1.0)  # the gateway connects to its device
@@ -329,6 +331,75 @@ def camera_section(exe, args, procs):
                          "hz": 30.0})
         gw.stop()
         procs.remove(gw)
+    dev.stop()
+    procs.remove(dev)
+    return rows
+
+
+def rate_section(exe, args, procs):
+    """Issue 56: what a client-chosen rate and compression cost. The device's Ticks wire at 100 Hz to N
+    JSON clients: subscribed without a rate, at max_rate_hz 100 and at 10 (1,000 clients; the target:
+    10 Hz at most 15 % of the gateway's CPU at 100 Hz), then 100 clients without and with
+    permessage-deflate negotiated (websocket_compression enabled, the clients offer it). A fresh
+    gateway per row; rows alternate within each round (--rate-rounds)."""
+    rows = []
+    dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
+    procs.append(dev)
+    seconds = "3" if args.quick else "5"
+    n_rate = 100 if args.quick else 1000
+    cases = [(n_rate, None, False), (n_rate, 100, False), (n_rate, 10, False), (100, None, False), (100, None, True)]
+    for rnd in range(args.rate_rounds):
+        for n, rate, deflate in cases:
+            log("rate (round %d): %d JSON clients, %s, deflate %s" % (rnd + 1, n, "max_rate_hz %s" % rate if rate else "no rate",
+                                                                     "on" if deflate else "off"))
+            gw = gateway_proc(exe, dev.ready["url"], unlimited=True, deflate=deflate)
+            procs.append(gw)
+            argv = [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout", "--hz", "100",
+                    "--seconds", seconds]
+            if rate:
+                argv += ["--max-rate-hz", str(rate)]
+            if deflate:
+                argv += ["--deflate"]
+            rows += sampled(gw.p.pid, argv, {"path": "device->gateway->N x JSON", "server": "gateway", "round": rnd + 1,
+                                             "deflate": deflate})
+            gw.stop()
+            procs.remove(gw)
+    dev.stop()
+    procs.remove(dev)
+    return rows
+
+
+def uring_section(exe, args, procs):
+    """Issue 56's io_uring lever: the device's Ticks wire at 100 Hz to N JSON clients through this build's
+    gateway (Asio on epoll) and through the gateway of --uring-build (configured with -DRR_IO_URING=ON),
+    alternating within each round (A B, then B A), the same load generator and device for both, and the
+    plain-TCP floor (rr_bench_floor --fanout) once per round. A fresh gateway per row."""
+    rows = []
+    uring_gateway = os.path.join(os.path.abspath(args.uring_build), "server", "app", "rr-gateway")
+    if not os.access(uring_gateway, os.X_OK):
+        raise SystemExit("--uring-build: %s is missing (cmake -DRR_IO_URING=ON, target rr-gateway)" % uring_gateway)
+    backends = [("epoll", exe), ("io_uring", dict(exe, **{"rr-gateway": uring_gateway}))]
+    dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
+    procs.append(dev)
+    seconds = "3" if args.quick else "5"
+    n = args.uring_clients
+    for rnd in range(args.uring_rounds):
+        for backend, gexe in (backends if rnd % 2 == 0 else list(reversed(backends))):
+            log("io_uring (round %d): %d JSON clients, gateway on %s" % (rnd + 1, n, backend))
+            gw = gateway_proc(gexe, dev.ready["url"], name="rr-gateway (%s)" % backend, unlimited=True)
+            procs.append(gw)
+            got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout",
+                                     "--hz", "100", "--seconds", seconds],
+                          {"path": "device->gateway->N x JSON", "server": "gateway", "backend": backend, "round": rnd + 1})
+            gw.stop()
+            procs.remove(gw)
+            rows += got
+        size = next((r.get("bytes_per_value") for r in rows if r.get("bytes_per_value")), 128)
+        floor = run_rows([exe["rr_bench_floor"], "--fanout", str(n), "--seconds", seconds, "--hz", "100",
+                          "--bytes", str(max(16, int(round(size))))])
+        for f in floor:
+            f.update({"backend": "floor (plain TCP writes)", "round": rnd + 1})
+            rows.append(f)
     dev.stop()
     procs.remove(dev)
     return rows
@@ -599,6 +670,13 @@ def main(argv=None):
     ap.add_argument("--browser", action="store_true", help="also: the wasm client in node and Chromium, with the native client")
     ap.add_argument("--record", action="store_true", help="also: the camera row and a 1,000 values/s wire with and without a recording")
     ap.add_argument("--record-rounds", type=int, default=2, help="rounds of the record section (default 2)")
+    ap.add_argument("--rate", action="store_true", help="also: 1,000 JSON clients without a rate, at max_rate_hz 100 and 10; "
+                    "100 clients without and with permessage-deflate (issue 56)")
+    ap.add_argument("--rate-rounds", type=int, default=2, help="rounds of the rate section (default 2)")
+    ap.add_argument("--uring-build", default="build/uring",
+                    help="the uring section's second build (cmake -DRR_IO_URING=ON; its rr-gateway is used)")
+    ap.add_argument("--uring-rounds", type=int, default=2, help="rounds of the uring section (default 2)")
+    ap.add_argument("--uring-clients", type=int, default=1000, help="JSON clients of the uring section (default 1000)")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
     ap.add_argument("--pairs", action="store_true", help="also: issue 14's ratios from short interleaved blocks")
     ap.add_argument("--pair-blocks", type=int, default=24, help="blocks of the pairs section (default 24)")
@@ -623,6 +701,8 @@ def main(argv=None):
         args.rr_fanout, args.camera, args.browser = "rr-fanout" in only, "camera" in only, "browser" in only
         args.pairs = "pairs" in only
         args.record = "record" in only
+        args.rate = "rate" in only
+        args.uring = "uring" in only
         stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
     browser_rounds = args.rounds
 
@@ -783,6 +863,8 @@ def main(argv=None):
         browser = browser_section(exe, args, browser_rounds, procs) if args.browser else []
         pairs = pairs_section(exe, args, procs) if args.pairs else {}
         record = record_section(exe, args, procs) if args.record else []
+        rate = rate_section(exe, args, procs) if args.rate else []
+        uring = uring_section(exe, args, procs) if getattr(args, "uring", False) else []
     finally:
         for p in reversed(procs):
             p.stop()
@@ -791,7 +873,7 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
-    result.update({"record": record})
+    result.update({"record": record, "rate": rate, "uring": uring})
     result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser,
                    "pairs": pairs.get("figures", []), "pairs_raw": pairs.get("raw", [])})
     result["load_average_end"] = list(os.getloadavg())
@@ -1009,6 +1091,38 @@ def markdown(res):
                 out.append("| %s | %s | %s | %s | %.1f %% | %s | %s | %s |" % (
                     fmt(f["clients"]), fmt(w["clients"]), fmt(w["read_delay_ms"]), fmt(w["per_client_per_s_median"]),
                     100 * w["delivered_of_sent"], fmt(w["p50_us"] / 1000), fmt(w["p99_us"] / 1000), fmt(w["max_us"] / 1000)))
+    if res.get("rate"):
+        out += ["", "Client-chosen rate and compression (issue 56): the device's `Ticks` wire at 100 Hz → gateway → N JSON "
+                "WebSocket clients (`rr_bench_ws_load`, one thread), a fresh gateway per row:", "",
+                "| round | clients | max_rate_hz | deflate (negotiated) | delivered/s | expected/s | p50 ms | p99 ms | gateway CPU % "
+                "| gateway CPU µs / value | bytes / value | load generator CPU % |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["rate"]:
+            out.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                f.get("round"), fmt(f["clients"]), fmt(f.get("max_rate_hz")) if f.get("max_rate_hz") else "none",
+                "%s (%s)" % ("on" if f.get("deflate") else "off", fmt(f.get("deflated_clients", 0))),
+                fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0), fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000),
+                fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")), fmt(f.get("bytes_per_value")),
+                fmt(f["loadgen_cpu_pct"])))
+    if res.get("uring"):
+        out += ["", "The io_uring lever (issue 56): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket clients, "
+                "the gateway built on epoll (this build) and on io_uring (`-DRR_IO_URING=ON`), alternating, a fresh gateway "
+                "per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", "",
+                "| round | backend | clients | delivered/s | expected/s | delivered of sent | p50 ms | p99 ms | gateway CPU % "
+                "| gateway CPU µs / value | load generator CPU % |",
+                "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["uring"]:
+            if f.get("backend", "").startswith("floor"):
+                sent = f.get("sent") or 0
+                out.append("| %s | %s | %s | %s | | %s | %s | %s | %s (writer) | %s (writer) | |" % (
+                    f.get("round"), f["backend"], fmt(f.get("clients")), fmt(f.get("delivered_per_s"), 0),
+                    "%.1f %%" % (100.0 * f.get("delivered", 0) / sent) if sent else "", fmt(f.get("p50_us", 0) / 1000),
+                    fmt(f.get("p99_us", 0) / 1000), fmt(f.get("writer_cpu_pct")), fmt(f.get("writer_cpu_us_per_value"))))
+                continue
+            out.append("| %s | %s | %s | %s | %s | %.1f %% | %s | %s | %s | %s | %s |" % (
+                f.get("round"), f["backend"], fmt(f["clients"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
+                100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000),
+                fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")), fmt(f["loadgen_cpu_pct"])))
     if res.get("record"):
         out += ["", "Recording while serving (issue 44): the camera row (640×480 RGB at 30 Hz, `robotraconteur` encoding) and a "
                 "1,000 values/s wire (`Ticks`, 16 doubles, both encodings), each to 10 JSON clients, without and with a recording "

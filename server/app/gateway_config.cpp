@@ -645,7 +645,7 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "max_message_size", "log_level", "log_format", "local", "tls", "auth", "limits"});
+                      "websocket_compression", "max_message_size", "log_level", "log_format", "local", "tls", "auth", "limits"});
         if (auto l = g["limits"]) parse_limits(l, r, c.limits);
         if (auto a = g["auth"]) parse_auth(a, r, c.auth);
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
@@ -672,6 +672,16 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
             for (const auto& p : c.trusted_proxies)
                 if (!http::parse_ip_network(p))
                     r.error(n, "gateway.trusted_proxies", "\"" + p + "\" is not an IP address or CIDR range (10.0.0.0/8)");
+        }
+        if (auto w = g["websocket_compression"]) {
+            r.check_keys(w, "gateway.websocket_compression", {"enabled", "paths"});
+            if (auto n = w["enabled"]) c.websocket_compression.enabled = r.boolean(n, "gateway.websocket_compression.enabled");
+            if (auto n = w["paths"]) {
+                c.websocket_compression.paths = r.string_list(n, "gateway.websocket_compression.paths");
+                for (const auto& p : c.websocket_compression.paths)
+                    if (p.empty() || p.front() != '/' || p.find_first_of("?# ") != std::string::npos)
+                        r.error(n, "gateway.websocket_compression.paths", "\"" + p + "\" is not a request path (\"/…\", no query)");
+            }
         }
         if (auto n = g["max_message_size"]) {
             c.max_message_size = r.unsigned_int(n, "gateway.max_message_size", 100u * 1024u * 1024u);

@@ -163,6 +163,13 @@ struct GatewayConfig {
     /// Reverse proxies whose X-Forwarded-For/-Proto are believed: addresses or CIDR ranges
     /// ("127.0.0.1", "10.0.0.0/8", "::1"); validated by the parser. Empty = none (the headers are ignored).
     std::vector<std::string> trusted_proxies;
+    /// permessage-deflate (RFC 7692) for JSON WebSockets whose client offers it: `enabled` for every
+    /// upgrade on the listener, else only for request paths under one of `paths` (docs/gateway-config.md).
+    /// Off by default; binary messages (binary pushes, images) are never compressed.
+    struct WebSocketCompression {
+        bool enabled = false;
+        std::vector<std::string> paths;
+    } websocket_compression;
     std::size_t max_message_size = 12u * 1024u * 1024u;
     std::string log_level = "info";
     /// "text" (one line per message) or "json" (one object per line: time, level, message, device,

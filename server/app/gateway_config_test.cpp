@@ -316,6 +316,25 @@ TEST_CASE("gateway.trusted_proxies and --trusted-proxy take addresses and CIDR r
     CHECK_THAT(applied.error().message, Catch::Contains("--trusted-proxy"));
 }
 
+TEST_CASE("gateway.websocket_compression: off by default, on for the listener or for paths, bad paths refused") {
+    auto none = parse_gateway_config("", "t.yaml");
+    REQUIRE(none);
+    CHECK_FALSE(none->websocket_compression.enabled);
+    CHECK(none->websocket_compression.paths.empty());
+    auto all = parse_gateway_config("gateway:\n  websocket_compression:\n    enabled: true\n", "t.yaml");
+    REQUIRE(all);
+    CHECK(all->websocket_compression.enabled);
+    auto some = parse_gateway_config("gateway:\n  websocket_compression:\n    paths: [/slow, /remote/]\n", "t.yaml");
+    REQUIRE(some);
+    CHECK_FALSE(some->websocket_compression.enabled);
+    CHECK(some->websocket_compression.paths == std::vector<std::string>{"/slow", "/remote/"});
+    auto bad = parse_gateway_config("gateway:\n  websocket_compression:\n    paths: [slow]\n", "t.yaml");
+    REQUIRE_FALSE(bad);
+    CHECK_THAT(bad.error().message, Catch::Contains("t.yaml:3") && Catch::Contains("gateway.websocket_compression.paths") &&
+                                        Catch::Contains("\"slow\" is not a request path"));
+    check_refused("gateway:\n  websocket_compression:\n    level: 9\n", "bad.yaml:3");
+}
+
 TEST_CASE("gateway.tls and the devices' TLS keys parse, incomplete TLS settings name the key") {
     auto c = parse_gateway_config(R"(
 gateway:

@@ -1,6 +1,8 @@
 #include "server/gateway/json_socket.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -15,6 +17,7 @@
 #include "server/gateway/json_socket_request.hpp"
 #include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/mirror_service.hpp"
+#include "server/gateway/rate_ticker.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
 
@@ -32,11 +35,13 @@ class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession>
 
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
-                      boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options)
+                      boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options,
+                      std::shared_ptr<RateTicker> ticker)
         : api_(std::move(api)),
           socket_(std::move(socket)),
           options_(options),
           timer_(executor),
+          ticker_(std::move(ticker)),
           subs_(options.max_subscriptions),
           convert_strand_(std::move(convert_strand)),
           pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {
@@ -198,13 +203,24 @@ private:
             case MemberOp::set: return api_->set_property(r.address, r.value, replier(id));
             case MemberOp::call: return api_->call_function(r.address, r.args, r.max_items, replier(id));
             case MemberOp::peek: return api_->peek_wire(r.address, replier(id));
-            case MemberOp::subscribe: return subscribe(id, std::move(r.address), r.binary);
+            case MemberOp::subscribe: {
+                SubscribeChoice choice{r.binary, r.max_rate_hz, r.rate_period, r.queue_length};
+                return subscribe(id, std::move(r.address), choice);
+            }
         }
     }
 
     // --- subscriptions ----------------------------------------------------------------------------
 
-    void subscribe(const nlohmann::json& id, MemberAddress address, bool binary) {
+    // What a subscribe request chose beside the member.
+    struct SubscribeChoice {
+        bool binary = false;
+        std::optional<double> max_rate_hz;
+        RateClock rate_period{0};
+        std::optional<std::size_t> queue_length;
+    };
+
+    void subscribe(const nlohmann::json& id, MemberAddress address, SubscribeChoice choice) {
         // Receiving (wire values, events, pipe packets) needs `read`; sending on the subscription
         // (set_out_value, send) needs `write`, decided here once.
         if (auto denied = api_->check_access(address, auth::Operation::read)) {
@@ -213,12 +229,12 @@ private:
         }
         const bool may_write = !api_->check_access(address, auth::Operation::write).has_value();
         auto self = shared_from_this();
-        api_->resolve(address, [self, id, may_write, binary](Resolved r) {
+        api_->resolve(address, [self, id, may_write, choice](Resolved r) {
             if (auto* e = std::get_if<ApiError>(&r)) {
                 self->fail(id, *e);
                 return self->end_request();
             }
-            self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write, binary);
+            self->start_subscription(id, std::get<MemberTarget>(std::move(r)), may_write, choice);
         });
     }
 
@@ -344,7 +360,7 @@ private:
         return it == device_logins_.end() ? nullptr : it->second.endpoints;
     }
 
-    void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write, bool binary) {
+    void start_subscription(const nlohmann::json& id, MemberTarget t, bool may_write, const SubscribeChoice& choice) {
         SubscriptionKind kind;
         switch (t.member->kind) {
             case robdef::MemberKind::wire: kind = SubscriptionKind::wire; break;
@@ -356,6 +372,14 @@ private:
                                        robdef::with_article(robdef::member_kind_keyword(t.member->kind)) +
                                        "; subscribe takes a wire, an event or a pipe"));
                 return end_request();
+        }
+        if (choice.max_rate_hz && kind == SubscriptionKind::event) {
+            fail(id, bad_request("\"max_rate_hz\" applies to wires and pipes; every event of \"" + t.member->name + "\" is delivered"));
+            return end_request();
+        }
+        if (choice.queue_length && kind != SubscriptionKind::pipe) {
+            fail(id, bad_request("\"queue_length\" applies to pipes; a wire keeps its newest value"));
+            return end_request();
         }
         // Opening a wire connection or a pipe endpoint is a request the locks held at the gateway
         // decide; events reach every client in RR, locked or not.
@@ -377,7 +401,13 @@ private:
             JsonSubscription s;
             s.kind = kind;
             s.may_write = may_write;
-            s.binary = binary;
+            s.binary = choice.binary;
+            if (choice.max_rate_hz) {
+                s.rate = RateWindow(choice.rate_period);
+                s.max_rate_hz = *choice.max_rate_hz;
+            }
+            if (choice.queue_length) s.queue_length = *choice.queue_length;
+            s.queue_bytes_limit = options_.max_pipe_conversion_bytes;
             s.target = std::make_shared<const MemberTarget>(t);
             s.own = own_endpoints(t.device->config().name);
             own = s.own;
@@ -439,13 +469,26 @@ private:
                 fail(id, std::move(*error));
             } else {
                 // Under the lock: the reply is queued before any push of this subscription.
-                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(s->kind)}}));
+                send_reply(id, ApiResult::ok(subscribe_result(sid, *s)));
                 s->active = true;
                 flush = s->pending_wire != nullptr;
             }
         }
         if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
         if (flush) flush_wires();
+    }
+
+    // The subscribe reply: the id, the kind, and the rate and queue length it got.
+    static nlohmann::json subscribe_result(std::uint64_t sid, const JsonSubscription& s) {
+        nlohmann::json r{{"subscription", sid}, {"kind", kind_name(s.kind)}};
+        if (s.rate.limited()) {
+            // As the client wrote it: 2, not 2.0.
+            const double whole = std::floor(s.max_rate_hz);
+            if (whole == s.max_rate_hz) r["max_rate_hz"] = static_cast<std::int64_t>(whole);
+            else r["max_rate_hz"] = s.max_rate_hz;
+        }
+        if (s.rate.limited() && s.kind == SubscriptionKind::pipe) r["queue_length"] = s.queue_length;
+        return r;
     }
 
     // What a wire or event subscription's values go to (either session).
@@ -532,7 +575,7 @@ private:
                 s->upstream_id = *r;
                 s->upstream_known = true;
                 // Under the lock: the reply is queued before any push of this subscription.
-                send_reply(id, ApiResult::ok(nlohmann::json{{"subscription", sid}, {"kind", kind_name(s->kind)}}));
+                send_reply(id, ApiResult::ok(subscribe_result(sid, *s)));
                 s->active = true;
                 flush = s->pending_wire != nullptr;
             }
@@ -697,18 +740,72 @@ private:
     // on the server's conversion strand; while this socket's packets waiting there fill its budget
     // (max_pipe_conversions, max_pipe_conversion_bytes), newer packets are dropped and counted.
     void on_pipe_packet(std::uint64_t sid, const MessageElement& packet) {
+        std::optional<PipeToSend> queued;
+        {
+            // A rate-limited pipe: the packet joins its queue, and the oldest goes when its window is open.
+            std::lock_guard lock(mutex_);
+            if (closed_) return;
+            const auto* s = subs_.find(sid);
+            if (!s) return;
+            if (s->rate.limited()) {
+                const Offered o = subs_.offer_pipe(sid, packet, push_congested(), rate_clock_now(), queued);
+                if (!o.send_now && o.wait.count() > 0) wake_at_locked(o.wait);
+                if (!queued) return;
+            }
+        }
+        if (queued) return convert(queued->subscription, std::move(queued->packet), std::move(queued->ticket));
         auto ticket = take_push(sid);
         if (!ticket) return;
+        convert(sid, packet, std::move(*ticket));
+    }
+
+    // Posts a pipe packet to the conversion strand, within this socket's budget (else dropped, counted).
+    void convert(std::uint64_t sid, MessageElement packet, PushTicket ticket) {
         const std::size_t bytes = payload_bytes(packet);
         if (!pipe_budget_.try_acquire(bytes)) {
             std::lock_guard lock(mutex_);
-            subs_.return_push(sid, ticket->dropped);
+            subs_.return_push(sid, ticket.dropped);
             return;
         }
-        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet, ticket = std::move(*ticket), bytes] {
+        boost::asio::post(convert_strand_, [self = shared_from_this(), sid, packet = std::move(packet), ticket = std::move(ticket), bytes] {
             self->convert_pipe_packet(sid, packet, ticket);
             self->pipe_budget_.release(bytes);
         });
+    }
+
+    // --- rate-limited subscriptions (rate_window.hpp, rate_ticker.hpp) ------------------------------
+
+    // Under mutex_: asks the server's ticker of `period` to wake this socket at its next window (once
+    // per period until it has).
+    void wake_at_locked(RateClock period) {
+        if (closed_ || std::find(wakes_.begin(), wakes_.end(), period) != wakes_.end()) return;
+        wakes_.push_back(period);
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        ticker_->wake(period, [weak, period] {
+            if (auto s = weak.lock()) s->on_rate_window(period);
+        });
+    }
+
+    // A window of `period` began: the wire values and pipe packets waiting for it go (the client's
+    // backpressure still applies), and the socket asks to be woken again for those still waiting.
+    void on_rate_window(RateClock period) {
+        {
+            std::lock_guard lock(mutex_);
+            wakes_.erase(std::remove(wakes_.begin(), wakes_.end(), period), wakes_.end());
+            if (closed_) return;
+        }
+        flush_wires();
+        std::vector<PipeToSend> packets;
+        {
+            std::lock_guard lock(mutex_);
+            if (closed_) return;
+            std::vector<RateClock> waiting;
+            const RateClock now = rate_clock_now();
+            subs_.take_pipe_packets(packets, push_congested(), now, waiting);
+            subs_.rate_waiting(now, waiting);
+            for (auto p : waiting) wake_at_locked(p);
+        }
+        for (auto& p : packets) convert(p.subscription, std::move(p.packet), std::move(p.ticket));
     }
 
     // On the conversion strand (packets of one socket stay in order).
@@ -753,7 +850,11 @@ private:
         }
         {
             std::lock_guard lock(mutex_);
-            if (!subs_.offer_wire(sid, e)) return;  // not open, or waits for its subscribe reply
+            const Offered o = subs_.offer_wire(sid, e, rate_clock_now());
+            if (!o.send_now) {
+                if (o.wait.count() > 0) wake_at_locked(o.wait);  // waits for its window
+                return;  // or not open, or waits for its subscribe reply
+            }
         }
         flush_wires();
     }
@@ -770,11 +871,13 @@ private:
             flushing_ = true;
         }
         std::vector<WireToSend>& batch = wire_batch_;  // the flusher's alone (flushing_)
+        RateClock now{0};
         for (;;) {
             {
                 std::lock_guard lock(mutex_);
                 flush_again_ = false;
-                if (closed_ || !subs_.wires_waiting()) {
+                now = rate_clock_now();
+                if (closed_ || !subs_.wires_waiting(now)) {
                     flushing_ = false;
                     return;
                 }
@@ -783,7 +886,7 @@ private:
                     flushing_ = false;
                     return;
                 }
-                subs_.take_wires(batch);
+                subs_.take_wires(batch, now);
             }
             for (const auto& w : batch) {
                 const MemberTarget& t = *w.target;
@@ -828,6 +931,8 @@ private:
     JsonSocketOptions options_;
     mutable std::mutex mutex_;
     boost::asio::steady_timer timer_;
+    std::shared_ptr<RateTicker> ticker_;  // the server's: wakes rate-limited subscriptions at their windows
+    std::vector<RateClock> wakes_;        // periods the ticker will wake this socket at (under mutex_)
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
     std::vector<WireToSend> wire_batch_;  // flush_wires()' batch: used by the one flusher, outside mutex_
     JsonSubscriptions subs_;
@@ -843,7 +948,11 @@ private:
 
 JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor,
                                    JsonSocketOptions options)
-    : api_(std::move(api)), executor_(executor), convert_strand_(boost::asio::make_strand(executor)), options_(options) {}
+    : api_(std::move(api)),
+      executor_(executor),
+      convert_strand_(boost::asio::make_strand(executor)),
+      ticker_(std::make_shared<RateTicker>(executor)),
+      options_(options) {}
 
 std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
                                                            boost::asio::any_io_executor executor,
@@ -920,7 +1029,7 @@ http::JsonSocketHandler JsonSocketServer::handler() {
 }
 
 void JsonSocketServer::on_open(const std::shared_ptr<http::JsonSocket>& socket) {
-    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_);
+    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_, ticker_);
     std::lock_guard lock(mutex_);
     sessions_[socket.get()] = std::move(session);
 }

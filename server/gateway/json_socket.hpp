@@ -19,6 +19,10 @@
 //     strand: a slow conversion (a camera frame) delays neither the device's replies nor other
 //     traffic, and takes at most one worker thread; a socket's packets are dropped (counted) while
 //     `max_pipe_conversions` of its own, or `max_pipe_conversion_bytes` of their payload, wait there;
+//   * a subscription made with "max_rate_hz" gets at most one value per window of 1/max_rate_hz, the
+//     windows on one grid for all sockets (rate_window.hpp), woken by one timer per rate
+//     (rate_ticker.hpp): a wire's newest value waits for the next window, a pipe's packets wait in a
+//     queue of "queue_length" (oldest dropped, counted);
 //   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
 //     answered at once, and messages over `max_message_bytes` are refused.
 // Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
@@ -66,10 +70,11 @@ struct JsonSocketStats {
     std::uint64_t socket_dropped = 0;          ///< dropped by the socket's queue limit
     std::uint64_t push_drops = 0;              ///< events / pipe packets dropped by this layer
     std::uint64_t wire_coalesced = 0;          ///< wire values replaced by a newer one before sending
-    std::size_t pending_wires = 0;             ///< subscriptions with a wire value waiting
+    std::size_t pending_wires = 0;             ///< subscriptions with a wire value (or rate-limited pipe packets) waiting
 };
 
 class JsonSocketSession;
+class RateTicker;
 
 /// Serves the subprotocol: one JsonSocketSession per socket.
 class JsonSocketServer : public std::enable_shared_from_this<JsonSocketServer> {
@@ -98,6 +103,7 @@ private:
     std::shared_ptr<JsonApi> api_;
     boost::asio::any_io_executor executor_;
     ConvertStrand convert_strand_;
+    std::shared_ptr<RateTicker> ticker_;  // one timer per rate for all sockets (rate_ticker.hpp)
     JsonSocketOptions options_;
     std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
     mutable std::mutex mutex_;

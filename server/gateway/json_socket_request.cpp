@@ -142,6 +142,19 @@ Parsed parse_member(const Json& msg) {
             if (!b->is_boolean()) return bad_request("\"binary\" must be true or false");
             r.binary = b->get<bool>();
         }
+        if (auto m = msg.find("max_rate_hz"); m != msg.end()) {
+            if (!m->is_number()) return bad_request("\"max_rate_hz\" must be a number (values per second)");
+            auto period = rate_period(m->get<double>());
+            if (!period.error.empty()) return bad_request(period.error);
+            r.max_rate_hz = m->get<double>();
+            r.rate_period = period.period;
+        }
+        if (auto q = msg.find("queue_length"); q != msg.end()) {
+            if (!q->is_number_unsigned() || q->get<std::uint64_t>() < 1 || q->get<std::uint64_t>() > kMaxQueueLength)
+                return bad_request("\"queue_length\" must be an integer from 1 to " + std::to_string(kMaxQueueLength));
+            if (!r.max_rate_hz) return bad_request("\"queue_length\" needs \"max_rate_hz\" (a pipe's packets wait for their window)");
+            r.queue_length = q->get<std::size_t>();
+        }
     }
     return r;
 }

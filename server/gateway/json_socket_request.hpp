@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "server/gateway/json_api.hpp"
+#include "server/gateway/rate_window.hpp"
 
 namespace rr::server::gateway {
 
@@ -88,7 +89,16 @@ struct MemberRequest {
     nlohmann::json args;         ///< call: the arguments (null when absent)
     std::size_t max_items = 0;   ///< call: how many items of a generator to read (0: the default)
     bool binary = false;         ///< subscribe: numeric arrays as binary pushes (binary_push.hpp)
+    /// subscribe: "max_rate_hz" (wires and pipes: at most one value per 1/max_rate_hz, rate_window.hpp),
+    /// from kMinRateHz to kMaxRateHz; `rate_period` is its period (0: not given).
+    std::optional<double> max_rate_hz;
+    RateClock rate_period{0};
+    /// subscribe: "queue_length" (rate-limited pipes: packets waiting, 1 to kMaxQueueLength; needs max_rate_hz).
+    std::optional<std::size_t> queue_length;
 };
+
+/// The longest "queue_length" of a rate-limited pipe subscription.
+inline constexpr std::size_t kMaxQueueLength = 64;
 
 using SocketRequest = std::variant<LoginRequest, DeviceLoginRequest, DeviceLogoutRequest, DevicesRequest, DeviceRequest,
                                    AccessRequest, UnsubscribeRequest, SetOutValueRequest, SendRequest, MemberRequest>;

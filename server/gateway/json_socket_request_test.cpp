@@ -173,6 +173,39 @@ TEST_CASE("socket request: member operations") {
           "\"binary\" must be true or false");
 }
 
+TEST_CASE("socket request: subscribe's max_rate_hz and queue_length, bad values refused") {
+    auto sub = [](json more) {
+        json j{{"id", 1}, {"op", "subscribe"}, {"device", "a"}, {"member", "p"}};
+        j.update(more);
+        return j;
+    };
+    auto plain = std::get<MemberRequest>(request(sub({})));
+    CHECK_FALSE(plain.max_rate_hz);
+    CHECK(plain.rate_period == RateClock(0));
+    CHECK_FALSE(plain.queue_length);
+
+    auto limited = std::get<MemberRequest>(request(sub({{"max_rate_hz", 10}, {"queue_length", 5}})));
+    CHECK(limited.max_rate_hz == 10.0);
+    CHECK(limited.rate_period == std::chrono::milliseconds(100));
+    CHECK(limited.queue_length == 5u);
+    CHECK(std::get<MemberRequest>(request(sub({{"max_rate_hz", 2.5}}))).rate_period == std::chrono::milliseconds(400));
+
+    const std::string range = "\"max_rate_hz\" must be a number from 0.01 to 1000";
+    for (const json& bad : {json(0), json(-5), json(1000.5), json(1e300), json(0.001)}) {
+        INFO(bad.dump());
+        CHECK(error(sub({{"max_rate_hz", bad}})).message == range);
+    }
+    CHECK(error(sub({{"max_rate_hz", "10"}})).message == "\"max_rate_hz\" must be a number (values per second)");
+    CHECK(error(sub({{"max_rate_hz", nullptr}})).message == "\"max_rate_hz\" must be a number (values per second)");
+    const std::string length = "\"queue_length\" must be an integer from 1 to 64";
+    for (const json& bad : {json(0), json(65), json(-1), json(2.5), json("3")}) {
+        INFO(bad.dump());
+        CHECK(error(sub({{"max_rate_hz", 1}, {"queue_length", bad}})).message == length);
+    }
+    CHECK(error(sub({{"queue_length", 3}})).message ==
+          "\"queue_length\" needs \"max_rate_hz\" (a pipe's packets wait for their window)");
+}
+
 TEST_CASE("socket request: operations on a subscription") {
     CHECK(std::get<UnsubscribeRequest>(request(json{{"id", 1}, {"op", "unsubscribe"}, {"subscription", 4}})).subscription == 4);
     const std::string need_sid = "\"subscription\" (a subscription id) is required";

@@ -1,9 +1,11 @@
 #include "server/gateway/json_subscriptions.hpp"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
 #include "robdef/service_definition.hpp"
+#include "server/gateway/conversion_budget.hpp"
 
 namespace rr::server::gateway {
 
@@ -86,29 +88,86 @@ void JsonSubscriptions::return_push(std::uint64_t sid, std::uint64_t ticket_drop
     ++push_drops_;
 }
 
-bool JsonSubscriptions::offer_wire(std::uint64_t sid, SharedEntryPtr value) {
+Offered JsonSubscriptions::offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now) {
     auto* s = find(sid);
-    if (!s) return false;
+    if (!s) return {};
     if (s->pending_wire) ++wire_coalesced_;
     s->pending_wire = std::move(value);  // newest wins
-    return s->active;
+    if (!s->active) return {};
+    if (s->rate.open(now)) return {true, {}};
+    return {false, s->rate.period()};
 }
 
-bool JsonSubscriptions::wires_waiting() const {
+bool JsonSubscriptions::wires_waiting(RateClock now) const {
     for (const auto& [sid, s] : subs_)
-        if (s.active && s.pending_wire) return true;
+        if (s.active && s.pending_wire && s.rate.open(now)) return true;
     return false;
 }
 
-void JsonSubscriptions::take_wires(std::vector<WireToSend>& out) {
+void JsonSubscriptions::take_wires(std::vector<WireToSend>& out, RateClock now) {
     out.clear();
-    for (auto& [sid, s] : subs_)
-        if (s.active && s.pending_wire) out.push_back(WireToSend{sid, std::exchange(s.pending_wire, nullptr), s.target, s.binary});
+    for (auto& [sid, s] : subs_) {
+        if (!s.active || !s.pending_wire || !s.rate.open(now)) continue;
+        s.rate.sent(now);
+        out.push_back(WireToSend{sid, std::exchange(s.pending_wire, nullptr), s.target, s.binary});
+    }
+}
+
+void JsonSubscriptions::rate_waiting(RateClock now, std::vector<RateClock>& out) const {
+    for (const auto& [sid, s] : subs_)
+        if (s.active && s.pending_wire && !s.rate.open(now)) out.push_back(s.rate.period());
+}
+
+namespace {
+
+// The oldest queued packet of `s` with its push ticket.
+PipeToSend pop_packet(std::uint64_t sid, JsonSubscription& s) {
+    PipeToSend p{sid, std::move(s.pipe_queue.front()), PushTicket{s.target, std::exchange(s.dropped, 0), s.binary}};
+    s.pipe_queue.pop_front();
+    s.queued_bytes -= std::min(s.queued_bytes, payload_bytes(p.packet));
+    return p;
+}
+
+}  // namespace
+
+Offered JsonSubscriptions::offer_pipe(std::uint64_t sid, MessageElement packet, bool congested, RateClock now,
+                                      std::optional<PipeToSend>& out) {
+    out.reset();
+    auto* s = find(sid);
+    if (!s || !s->active) return {};
+    s->queued_bytes += payload_bytes(packet);
+    s->pipe_queue.push_back(std::move(packet));
+    // Newest kept: the oldest go while the queue is over its length or its bytes (one packet always stays).
+    while (s->pipe_queue.size() > 1 && (s->pipe_queue.size() > s->queue_length || s->queued_bytes > s->queue_bytes_limit)) {
+        s->queued_bytes -= std::min(s->queued_bytes, payload_bytes(s->pipe_queue.front()));
+        s->pipe_queue.pop_front();
+        ++s->dropped;
+        ++push_drops_;
+    }
+    if (congested || !s->rate.open(now)) return {false, s->rate.period()};
+    s->rate.sent(now);
+    out = pop_packet(sid, *s);
+    return {true, {}};
+}
+
+void JsonSubscriptions::take_pipe_packets(std::vector<PipeToSend>& out, bool congested, RateClock now,
+                                          std::vector<RateClock>& waiting) {
+    out.clear();
+    for (auto& [sid, s] : subs_) {
+        if (!s.active || s.pipe_queue.empty()) continue;
+        if (congested || !s.rate.open(now)) {
+            waiting.push_back(s.rate.period());
+            continue;
+        }
+        s.rate.sent(now);
+        out.push_back(pop_packet(sid, s));
+        if (!s.pipe_queue.empty()) waiting.push_back(s.rate.period());
+    }
 }
 
 std::size_t JsonSubscriptions::pending_wires() const {
     std::size_t n = 0;
-    for (const auto& [sid, s] : subs_) n += s.pending_wire ? 1 : 0;
+    for (const auto& [sid, s] : subs_) n += (s.pending_wire || !s.pipe_queue.empty()) ? 1 : 0;
     return n;
 }
 

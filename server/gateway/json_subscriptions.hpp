@@ -1,12 +1,16 @@
 // A JSON WebSocket's subscriptions (docs/json-api.md §WebSocket): their ids, their state from
 // "subscribe" to "closed", and the push policy of each: the newest wire value waiting while the client
 // is behind (older ones coalesced), event and pipe pushes dropped and counted while it is congested.
+// A subscription with a maximum rate (rate_window.hpp) sends at most one value per window: a wire's
+// newest waits for the next window, a pipe's packets wait in a queue of `queue_length` (oldest dropped,
+// counted) and leave one per window.
 // No sockets and no locks: JsonSocketSession (json_socket.cpp) calls it under its own mutex, which
 // also keeps a subscription's reply ahead of its pushes.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,6 +19,7 @@
 #include <vector>
 
 #include "server/gateway/json_api.hpp"
+#include "server/gateway/rate_window.hpp"
 #include "server/gateway/session_endpoints.hpp"
 #include "server/gateway/shared_entry.hpp"
 
@@ -37,6 +42,12 @@ struct JsonSubscription {
     bool failed = false;            ///< subscribe failed before upstream_id was known
     SharedEntryPtr pending_wire;    ///< the newest wire value not yet sent
     std::uint64_t dropped = 0;      ///< pushes dropped since the last one sent
+    RateWindow rate;                ///< "max_rate_hz": one value per window (unlimited by default)
+    double max_rate_hz = 0;         ///< as the client asked (echoed in the reply)
+    std::size_t queue_length = 1;   ///< a rate-limited pipe's waiting packets, at most
+    std::size_t queue_bytes_limit = 4u << 20;  ///< and their payload bytes (one packet alone always waits)
+    std::deque<MessageElement> pipe_queue;     ///< a rate-limited pipe's packets waiting for their window
+    std::size_t queued_bytes = 0;              ///< pipe_queue's payload bytes
 };
 
 /// What one event or pipe push of a subscription needs.
@@ -44,6 +55,19 @@ struct PushTicket {
     std::shared_ptr<const MemberTarget> target;
     std::uint64_t dropped = 0;  ///< dropped before this one: the push's "dropped" field
     bool binary = false;
+};
+
+/// A rate-limited pipe's packet taken from its queue for sending.
+struct PipeToSend {
+    std::uint64_t subscription = 0;
+    MessageElement packet;
+    PushTicket ticket;
+};
+
+/// What happens to a wire value or pipe packet offered to a subscription.
+struct Offered {
+    bool send_now = false;   ///< it may go now (flush_wires / the ticket)
+    RateClock wait{0};       ///< else, when rate-limited and waiting: the rate's period (wake at its next window)
 };
 
 /// A waiting wire value taken for sending.
@@ -84,16 +108,33 @@ public:
     /// A push taken with take_push was dropped after all: its ticket's `dropped` goes back to `sid`,
     /// plus one for itself.
     void return_push(std::uint64_t sid, std::uint64_t ticket_dropped);
-    /// A new wire value for `sid` replaces any still waiting (counted as coalesced). True when `sid` is
-    /// answered, so the value may be sent now; false when it waits for the reply, or `sid` is not open.
-    bool offer_wire(std::uint64_t sid, SharedEntryPtr value);
-    /// Whether an answered subscription has a wire value waiting.
-    bool wires_waiting() const;
-    /// Moves the waiting wire values of answered subscriptions into `out` (cleared first), in id order.
-    void take_wires(std::vector<WireToSend>& out);
+    /// A new wire value for `sid` replaces any still waiting (counted as coalesced). `send_now` when
+    /// `sid` is answered and its rate window is open at `now`; `wait` is the period of a rate-limited
+    /// subscription whose value waits for its next window; neither when it waits for the reply, or
+    /// `sid` is not open.
+    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {});
+    /// Whether an answered subscription has a wire value that may go at `now`.
+    bool wires_waiting(RateClock now = {}) const;
+    /// Moves the wire values of answered subscriptions that may go at `now` into `out` (cleared first),
+    /// in id order; their rate windows count them as sent.
+    void take_wires(std::vector<WireToSend>& out, RateClock now = {});
+    /// Appends the periods of rate-limited answered subscriptions with a wire value waiting for a later
+    /// window than `now`'s.
+    void rate_waiting(RateClock now, std::vector<RateClock>& out) const;
+
+    /// A packet for rate-limited pipe subscription `sid` joins its queue (the oldest dropped and counted
+    /// beyond queue_length or queue_bytes_limit). When the window is open at `now` and the client not
+    /// `congested`, the oldest queued packet is taken into `out` with its ticket (`send_now`); else
+    /// `wait` is the period to wake at. Neither when `sid` is not answered.
+    Offered offer_pipe(std::uint64_t sid, MessageElement packet, bool congested, RateClock now,
+                       std::optional<PipeToSend>& out);
+    /// At a window's start: the oldest queued packet of each rate-limited pipe whose window is open at
+    /// `now` (none while `congested`) into `out` (cleared first); `waiting` gets the periods of those
+    /// with packets still queued.
+    void take_pipe_packets(std::vector<PipeToSend>& out, bool congested, RateClock now, std::vector<RateClock>& waiting);
 
     std::size_t size() const noexcept { return subs_.size(); }
-    /// Subscriptions with a wire value waiting.
+    /// Subscriptions with a wire value or pipe packets waiting.
     std::size_t pending_wires() const;
     /// Event and pipe pushes dropped so far.
     std::uint64_t push_drops() const noexcept { return push_drops_; }

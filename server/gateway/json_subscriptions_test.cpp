@@ -104,17 +104,17 @@ TEST_CASE("json subscriptions: pushes dropped while congested are counted and re
 TEST_CASE("json subscriptions: the newest wire value waits, older ones are coalesced") {
     JsonSubscriptions subs(8);
     const auto sid = add(subs, subscription(SubscriptionKind::wire), false);
-    CHECK_FALSE(subs.offer_wire(42, wire_value(0)));  // not a subscription
+    CHECK_FALSE(subs.offer_wire(42, wire_value(0)).send_now);  // not a subscription
 
-    CHECK_FALSE(subs.offer_wire(sid, wire_value(1)));  // kept until the subscribe reply
-    CHECK_FALSE(subs.offer_wire(sid, wire_value(2)));
+    CHECK_FALSE(subs.offer_wire(sid, wire_value(1)).send_now);  // kept until the subscribe reply
+    CHECK_FALSE(subs.offer_wire(sid, wire_value(2)).send_now);
     CHECK(subs.wire_coalesced() == 1);
     CHECK(subs.pending_wires() == 1);
     CHECK_FALSE(subs.wires_waiting());  // not answered yet: nothing to send
 
     subs.find(sid)->active = true;
     CHECK(subs.wires_waiting());
-    CHECK(subs.offer_wire(sid, wire_value(3)));
+    CHECK(subs.offer_wire(sid, wire_value(3)).send_now);
     CHECK(subs.wire_coalesced() == 2);
 
     std::vector<WireToSend> batch{WireToSend{}};

@@ -25,6 +25,17 @@ bool same_origin(std::string_view origin, std::string_view host, std::string_vie
     return false;
 }
 
+bool websocket_deflate_allowed(const HttpOptions& options, std::string_view target) {
+    if (options.websocket_deflate) return true;
+    const std::string_view path = target.substr(0, target.find_first_of("?#"));
+    for (const auto& p : options.websocket_deflate_paths) {
+        const std::string_view base = p.size() > 1 && p.back() == '/' ? std::string_view(p).substr(0, p.size() - 1) : std::string_view(p);
+        if (path == base || base == "/" || (path.size() > base.size() && path.substr(0, base.size()) == base && path[base.size()] == '/'))
+            return true;
+    }
+    return false;
+}
+
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin) {
     for (const auto& entry : allowlist) {
         std::string_view e(entry);

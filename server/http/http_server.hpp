@@ -140,6 +140,11 @@ struct HttpOptions {
     std::size_t json_socket_queue_limit = 1024;
     /// Peers whose X-Forwarded-For / X-Forwarded-Proto are believed (forwarded.hpp). Empty = none.
     std::vector<IpNetwork> trusted_proxies;
+    /// permessage-deflate (RFC 7692) for JSON-subprotocol WebSockets whose client offers it: on every
+    /// upgrade, or (false) only on those whose request path is one of `websocket_deflate_paths` or
+    /// below one. Never for raw RR WebSockets; binary messages are never compressed.
+    bool websocket_deflate = false;
+    std::vector<std::string> websocket_deflate_paths;
     /// Called once per accepted WebSocket with a line for the log: kind, client, and the proxy when the
     /// client came through a trusted one (`WebSocket rr from 198.51.100.1 (https, via 10.0.0.1:5123)`).
     std::function<void(const std::string&)> on_websocket;
@@ -150,6 +155,9 @@ struct HttpOptions {
 };
 
 bool origin_allowed(const std::vector<std::string>& allowlist, std::string_view origin);
+/// Whether a WebSocket upgrade for request `target` ("/path?query") may negotiate permessage-deflate
+/// (HttpOptions::websocket_deflate, websocket_deflate_paths: a path matches itself and what is below it).
+bool websocket_deflate_allowed(const HttpOptions& options, std::string_view target);
 /// True when `origin` is "http://" or "https://" followed by the request's Host header: a page served
 /// by this server (also behind a reverse proxy that forwards Host). Always allowed.
 /// With `scheme` ("http"/"https", from a trusted proxy's X-Forwarded-Proto) only that scheme matches.

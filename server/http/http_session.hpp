@@ -402,6 +402,7 @@ private:
         auto self = shared_from_this();
         const Outgoing& next = queue_.front();
         ws_.binary(next.binary);  // the message type of the next write
+        ws_.compress(!next.binary);  // binary pushes (numeric arrays, images) are never deflated
         ws_.async_write(next.buffers(), asio::bind_allocator(allocator(), [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
             if (ec) {
@@ -656,6 +657,13 @@ private:
             if (!chosen.empty()) res.set(bhttp::field::sec_websocket_protocol, chosen);
         }));
         ws.read_message_max(64u * 1024u * 1024u);
+        if (json && websocket_deflate_allowed(server_->options(), std::string_view(req.target().data(), req.target().size()))) {
+            // Negotiated only when the client offers it (the response then names the extension).
+            websocket::permessage_deflate pmd;
+            pmd.server_enable = true;
+            pmd.msg_size_threshold = 64;  // a smaller message does not get shorter
+            ws.set_option(pmd);
+        }
         auto server = server_;
         auto holder = std::make_shared<websocket::stream<Stream>>(std::move(ws));
         const bool unnamed = protocols.empty();

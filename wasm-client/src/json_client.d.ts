@@ -66,6 +66,16 @@ export interface JsonSubscribeOptions {
   object?: string;
   /** Numeric arrays as typed arrays (binary pushes). */
   binary?: boolean;
+  /**
+   * Wires and pipes: at most this many values per second (0.01 to 1000), the newest of each window;
+   * the last value is always delivered (at the start of the next window). Events refuse it.
+   */
+  maxRateHz?: number;
+  /**
+   * Pipes with `maxRateHz`: packets waiting for their window (1 to 64, default 1); the oldest are
+   * dropped beyond it and counted in the next push's `dropped`.
+   */
+  queueLength?: number;
 }
 
 /** Operations on one device (T: a map of member name → value type, for typed use). */

@@ -268,7 +268,11 @@ export class JsonClient extends ConnectionEvents {
   /** Subscribes to wire, event or pipe `member` (see JsonDevice.subscribe). */
   subscribe(device, member, handler, options = {}) {
     if (typeof handler !== "function") return Promise.reject(invalid("subscribe needs a handler function"));
-    const s = new JsonSubscription(this, { device, member, object: options.object, binary: !!options.binary }, handler);
+    const spec = { device, member, object: options.object, binary: !!options.binary };
+    // Checked by the gateway (a bad value rejects with its InvalidArgument); kept for every resubscription.
+    if (options.maxRateHz !== undefined) spec.maxRateHz = options.maxRateHz;
+    if (options.queueLength !== undefined) spec.queueLength = options.queueLength;
+    const s = new JsonSubscription(this, spec, handler);
     // Kept (and subscribed again on later sockets) only once the gateway accepted it the first time.
     return this.request({ op: "subscribe", ...s.fields() }).then((r) => {
       s.kind = r.kind;
@@ -400,6 +404,8 @@ class JsonSubscription {
     const f = { device: this.spec.device, member: this.spec.member };
     if (this.spec.object !== undefined) f.object = this.spec.object;
     if (this.spec.binary) f.binary = true;
+    if (this.spec.maxRateHz !== undefined) f.max_rate_hz = this.spec.maxRateHz;
+    if (this.spec.queueLength !== undefined) f.queue_length = this.spec.queueLength;
     return f;
   }
   push(msg) {

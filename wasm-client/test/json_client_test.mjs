@@ -119,6 +119,46 @@ try {
     `a request made during the cut is answered after it: ${answer.e ? `${answer.e.errorName}: ${answer.e.message}` : answer.v}; connectCount ${c1} -> ${client.connectCount}`);
   await works("after the cut");
 
+  // maxRateHz / queueLength (docs/json-api.md "Rate and queue length"): values arrive thinned, in
+  // order, the last one always; compared once that last value arrived (an event, not a pause). Paced:
+  // each value is sent once the unlimited subscriber got the one before, so the socket is never behind
+  // and only the rate (not backpressure's coalescing) thins the limited subscriber.
+  const limitedSeen = [];
+  const senderSeen = [];
+  await dev.subscribe("w_both", (v) => limitedSeen.push(v[0]), { maxRateHz: 1 });
+  const sender = await dev.subscribe("w_both", (v) => senderSeen.push(v[0]));
+  const N = 30;  // at 1 value/s these would need 30 s to all go
+  for (let i = 0; i < N; ++i) {
+    await sender.setOutValue([i]);
+    await until(() => senderSeen.at(-1) === i, `value ${i} at the unlimited subscriber`);
+  }
+  await until(() => limitedSeen.at(-1) === N - 1, "the last value through maxRateHz 1");
+  const increasing = limitedSeen.every((v, i) => i === 0 || v > limitedSeen[i - 1]);
+  ok(limitedSeen.length < N / 2 && increasing,
+    `wire at maxRateHz 1: ${limitedSeen.length} of ${N} values (the unlimited subscriber got them all), in order, the last one: ${JSON.stringify(limitedSeen)}`);
+  const pipeSeen = [];
+  let pipeDropped = 0;
+  const limitedPipe = await dev.subscribe("p_stream", (p, push) => {
+    pipeSeen.push(p[0]);
+    pipeDropped += push.dropped ?? 0;
+  }, { maxRateHz: 2, queueLength: 2 });
+  await dev.call("send_stream", [30]);
+  await until(() => pipeSeen.at(-1) === 29, "the last packet through maxRateHz 2, queueLength 2");
+  ok(pipeSeen.length < 30 && pipeSeen.length + pipeDropped === 30 && pipeSeen.at(-2) === 28,
+    `pipe at maxRateHz 2, queueLength 2: ${JSON.stringify(pipeSeen)}, ${pipeDropped} dropped (counted in push.dropped)`);
+  await limitedPipe.close();
+  const refusal = async (member, options) => {
+    try {
+      await dev.subscribe(member, () => {}, options);
+      return "accepted";
+    } catch (e) {
+      return e.errorName;
+    }
+  };
+  const refusals = [await refusal("w_both", { maxRateHz: 0 }), await refusal("w_both", { maxRateHz: 5000 }),
+    await refusal("p_stream", { queueLength: 3 }), await refusal("ev_values", { maxRateHz: 1 })];
+  ok(refusals.every((r) => r === "RobotRaconteur.InvalidArgument"), `bad maxRateHz / queueLength refused: ${refusals.join(", ")}`);
+
   const json = new TextEncoder().encode('{"v":{"$binary":0,"type":"uint8","length":3,"offset":0}}');
   const buf = new Uint8Array(8 + json.length + 16);
   buf.set([0x52, 0x52, 0x4a, 0x42]);
