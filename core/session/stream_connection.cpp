@@ -41,7 +41,7 @@ Message single_entry_message(MessageEntry entry) {
 
 StreamConnection::StreamConnection(StreamRole role, StreamConfig config, MonoTime now)
     : role_(role), config_(std::move(config)), reader_(config_.limits), started_(now), last_send_(now),
-      last_receive_(now) {
+      last_receive_(now), silent_since_(now) {
     reader_.set_max_message_size(std::min(config_.limits.max_message_size, config_.limits.max_pre_session_message_size));
     if (role_ == StreamRole::client) queue_create_connection(now);
 }
@@ -70,6 +70,8 @@ Result<void> StreamConnection::feed(std::span<const std::byte> bytes, MonoTime n
     if (state_ == State::closed) return fail(MessageErrorType::ConnectionError, "connection closed");
     if (bytes.empty()) return {};
     last_receive_ = now;
+    silent_since_ = now;
+    stall_credited_ = false;
     if (auto r = reader_.feed(bytes); !r) {
         close(r.error());
         return r.take_error();
@@ -502,7 +504,7 @@ std::optional<MonoTime> StreamConnection::next_deadline() const {
         case State::closed: return std::nullopt;
         case State::negotiating: return started_ + config_.connect_timeout;
         case State::connected: {
-            MonoTime next = std::min(last_send_ + config_.heartbeat_period, last_receive_ + config_.receive_timeout);
+            MonoTime next = std::min(last_send_ + config_.heartbeat_period, silent_since_ + config_.receive_timeout);
             if (probe_timeout_)
                 next = std::min({next, last_probe_ + *probe_timeout_ / 5,
                                  std::max(last_receive_, probe_started_) + *probe_timeout_});
@@ -519,7 +521,13 @@ void StreamConnection::on_timer(MonoTime now) {
         return;
     }
     if (state_ != State::connected) return;
-    if (now - last_receive_ > config_.receive_timeout) {
+    if (!stall_credited_) {
+        if (auto due = next_deadline(); due && now > *due + kStallTolerance) {
+            silent_since_ = std::min(now, silent_since_ + (now - *due));
+            stall_credited_ = true;
+        }
+    }
+    if (now - silent_since_ > config_.receive_timeout) {
         close(make_error(MessageErrorType::ConnectionError, "receive timeout: peer silent"));
         return;
     }

@@ -153,7 +153,13 @@ public:
     void take_events(std::vector<StreamEvent>& batch);
 
     std::optional<MonoTime> next_deadline() const;
+    /// Heartbeat, receive timeout, liveness probe. A call more than kStallTolerance after
+    /// next_deadline() means this process did not run meanwhile (a stalled or starved host): that time
+    /// is not the peer's silence, so once per silence (until something arrives) the receive timeout
+    /// gives the peer the missed time back, and bytes already waiting in the socket are read before it
+    /// can run out. The liveness probe (motion safety) gets no such credit.
     void on_timer(MonoTime now);
+    static constexpr std::chrono::milliseconds kStallTolerance{1000};
 
     /// A short liveness probe of the peer (the gateway while a client holds a motion without a timeout
     /// of its own: docs/security.md "Motion safety"): from `now` on, a ConnectionTest is sent every
@@ -220,6 +226,9 @@ private:
     MonoTime started_;
     MonoTime last_send_;
     MonoTime last_receive_;
+    // The receive timeout counts from here: last_receive_, or later once on_timer credited a stall.
+    MonoTime silent_since_;
+    bool stall_credited_ = false;
     std::optional<std::chrono::milliseconds> probe_timeout_;  // set_liveness_probe
     MonoTime probe_started_{};
     MonoTime last_probe_{};

@@ -176,12 +176,76 @@ TEST_CASE("heartbeats keep a connection alive, silence closes it") {
     REQUIRE(client.feed(pong, t0 + 10s));
     CHECK_FALSE(next_event<StreamMessage>(client));  // heartbeats never reach the layer above
 
-    // Nothing received for more than 15 s: closed.
-    client.on_timer(t0 + 26s);
+    // At 20 s another ConnectionTest, unanswered; nothing received for more than 15 s: closed.
+    REQUIRE(client.next_deadline());
+    CHECK(*client.next_deadline() == t0 + 20s);
+    client.on_timer(t0 + 20s);
+    REQUIRE_FALSE(drain(client).empty());
+    REQUIRE(client.next_deadline());
+    CHECK(*client.next_deadline() == t0 + 25s);
+    client.on_timer(t0 + 25s);
+    CHECK(client.is_connected());  // 15 s exactly: not more than the timeout yet
+    client.on_timer(t0 + 25s + 1ms);
     auto closed = next_event<StreamClosed>(client);
     REQUIRE(closed);
     CHECK(closed->error.type == MessageErrorType::ConnectionError);
     CHECK(client.is_closed());
+}
+
+TEST_CASE("a timer that fires late (this process stalled) does not count the stall as the peer's silence") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    REQUIRE(client.is_connected());
+    // Due at 10 s (the heartbeat); the host ran it only at 30 s: 20 s late, more than the 15 s receive
+    // timeout. Not closed: the heartbeat goes out and the peer's answer (waiting in the socket) is read.
+    REQUIRE(client.next_deadline());
+    CHECK(*client.next_deadline() == t0 + 10s);
+    client.on_timer(t0 + 30s);
+    CHECK(client.is_connected());
+    auto ping = drain(client);
+    REQUIRE_FALSE(ping.empty());
+    REQUIRE(server.feed(ping, t0 + 30s));
+    REQUIRE(client.feed(drain(server), t0 + 30s));
+    CHECK(client.is_connected());
+
+    // A late timer within the tolerance gets no credit: silent from 30 s, checked at 45 s + 500 ms.
+    client.on_timer(t0 + 40s);  // heartbeat due at 40 s, on time
+    (void)drain(client);
+    REQUIRE(client.next_deadline());
+    CHECK(*client.next_deadline() == t0 + 45s);
+    client.on_timer(t0 + 45s + 500ms);
+    CHECK(client.is_closed());
+}
+
+TEST_CASE("a stall is credited once per silence: a peer that stays silent is closed at the next deadline") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    client.on_timer(t0 + 30s);  // 20 s late: credited, still connected, heartbeat sent
+    CHECK(client.is_connected());
+    (void)drain(client);
+    REQUIRE(client.next_deadline());
+    const MonoTime due = *client.next_deadline();
+    CHECK(due > t0 + 30s);
+    client.on_timer(due + 60s);  // late again, nothing arrived since: no second credit
+    CHECK(client.is_closed());
+}
+
+TEST_CASE("the liveness probe gets no stall credit: a late timer closes a probed connection without answers") {
+    MonoTime t0{};
+    StreamConnection client(StreamRole::client, client_config(), t0);
+    StreamConnection server(StreamRole::server, server_config(), t0);
+    pump(client, server, t0);
+    server.set_liveness_probe(500ms, t0 + 1s);
+    server.on_timer(t0 + 1s);  // the first probe, on time
+    (void)drain(server);
+    server.on_timer(t0 + 5s);  // 3.9 s late, no answer since the probe started
+    auto closed = next_event<StreamClosed>(server);
+    REQUIRE(closed);
+    CHECK(closed->error.message.find("liveness probe") != std::string::npos);
 }
 
 TEST_CASE("the liveness probe: a ConnectionTest every bound / 5 whatever else is sent, closed without answers") {
