@@ -179,7 +179,7 @@ TEST_CASE("socket request: subscribe's max_rate_hz and queue_length, bad values 
         j.update(more);
         return j;
     };
-    auto plain = std::get<MemberRequest>(request(sub({})));
+    auto plain = std::get<MemberRequest>(request(sub(json::object())));
     CHECK_FALSE(plain.max_rate_hz);
     CHECK(plain.rate_period == RateClock(0));
     CHECK_FALSE(plain.queue_length);

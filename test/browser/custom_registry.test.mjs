@@ -56,7 +56,7 @@ before(async () => {
   page = await (await browser.newContext({ viewport: { width: 1366, height: 900 } })).newPage();
   page.on("pageerror", (e) => pageErrors.push(e));
   await page.goto(`${gateway.base}/custom.html#/webcam`);
-  await page.locator('.device-view[data-device="webcam"] .badge').nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await page.locator('.device-view[data-device="webcam"] .badge').nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
 });
 
 after(async () => {

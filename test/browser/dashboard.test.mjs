@@ -38,7 +38,7 @@ function card(member, within = page) {
 
 async function openDevice(name) {
   await page.goto(`${gateway.base}/#/${name}`);
-  await page.locator(`.device-view[data-device="${name}"] .badge`).nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await page.locator(`.device-view[data-device="${name}"] .badge`).nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
 }
 
 async function readout(locatorCard, series) {
@@ -103,7 +103,7 @@ afterEach(() => {
 test("lists the devices with their live state", async () => {
   await page.goto(`${gateway.base}/`);
   for (const name of ["create", "webcam", "reynard"]) {
-    await page.locator(`#device-list li[data-device="${name}"][data-state="connected"]`).waitFor({ timeout: 15000 });
+    await page.locator(`#device-list li[data-device="${name}"][data-state="connected"]`).waitFor({ timeout: 60000 });
   }
   assert.equal(await page.locator("#device-list li[data-device]").count(), 3);
   assert.match(await page.locator('#device-list li[data-device="reynard"] .device-type').textContent(),
@@ -162,7 +162,7 @@ test("reynard: say shows in the event log (new_message)", async () => {
   await callFunction(card("say"), { message: text });
   await waitFor(() => chat.said.includes(text), "Reynard saying it in its web UI");
   const entry = page.locator('.event-log li[data-member="new_message"]', { hasText: text });
-  await entry.waitFor({ timeout: 15000 });
+  await entry.waitFor({ timeout: 60000 });
   assert.equal(await card("new_message").locator("output.count").textContent(), "1");
   await shot("04-reynard-event-log");
   await page.evaluate(() => window.scrollTo(0, 0));
@@ -234,7 +234,7 @@ test("create: driving moves the plotted distance; play_callback is answered", as
 test("a device the gateway does not have shows the connect error in place", async () => {
   await page.goto(`${gateway.base}/#/nosuch`);
   const banner = page.locator('.device-view[data-device="nosuch"] .device-error');
-  await banner.waitFor({ state: "visible", timeout: 20000 });
+  await banner.waitFor({ state: "visible", timeout: 60000 });
   assert.match(await banner.textContent(), /rr\+ws:\/\/127\.0\.0\.1:\d+\/\?service=nosuch: RobotRaconteur\.\w+/);
   await page.locator('.event-log li[data-kind="error"]').first().waitFor();
 });
@@ -271,7 +271,7 @@ test("a page from a disallowed Origin is refused", async () => {
 test("keeps working when a device drops and comes back", async () => {
   await openDevice("reynard");
   await relay.drop();
-  await page.locator('#device-list li[data-device="reynard"]:not([data-state="connected"])').waitFor({ timeout: 30000 });
+  await page.locator('#device-list li[data-device="reynard"]:not([data-state="connected"])').waitFor({ timeout: 60000 });
   await page.locator(".device-error").waitFor({ state: "visible" });
   // a request while the device is away fails in place
   const color = card("color");
@@ -281,7 +281,7 @@ test("keeps working when a device drops and comes back", async () => {
   await shot("07-reynard-down");
   await relay.listen();
   await page.locator('#device-list li[data-device="reynard"][data-state="connected"]').waitFor({ timeout: 60000 });
-  await page.locator(".device-error").waitFor({ state: "hidden", timeout: 30000 });
+  await page.locator(".device-error").waitFor({ state: "hidden", timeout: 60000 });
   const samples = async () => Number(await card("state").locator(".plot").getAttribute("data-samples"));
   const n = await waitFor(samples, "state samples after the return", 30000);
   await waitFor(async () => (await samples()) > n + 5, "the state wire streaming again", 30000);
@@ -296,10 +296,10 @@ test("reconnects when the gateway itself restarts", async () => {
   const port = gateway.port;
   const status = await gateway.child.stop();
   assert.equal(status.code, 0, `rr-gateway exited with ${JSON.stringify(status)}`);
-  await page.locator('#gateway-status[data-state="failed"]').waitFor({ timeout: 15000 });
+  await page.locator('#gateway-status[data-state="failed"]').waitFor({ timeout: 60000 });
   await waitFor(async () => (await session.textContent()) !== "connected", "the page's session down");
   gateway = await startGateway(s, { reynard: `rr+tcp://127.0.0.1:${relay.port}/?service=reynard` }, port);
-  await page.locator('#gateway-status[data-state="connected"]').waitFor({ timeout: 15000 });
+  await page.locator('#gateway-status[data-state="connected"]').waitFor({ timeout: 60000 });
   await waitFor(async () => (await session.textContent()) === "connected", "the page's session back", 30000);
   const dist = card("DistanceTraveled");
   const samples = async () => Number(await dist.locator(".plot").getAttribute("data-samples"));

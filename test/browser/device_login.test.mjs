@@ -147,7 +147,7 @@ afterEach(() => assert.deepEqual(pageErrors.splice(0).map(String), [], "uncaught
 
 test("the device refuses the page without a login: the form shows the device's error and nothing retries", async () => {
   await page.goto(`${gateway.base}/#/interop`);
-  await form().waitFor({ state: "visible", timeout: 20000 });
+  await form().waitFor({ state: "visible", timeout: 60000 });
   await formError().waitFor({ state: "visible" });
   assert.match(await formError().textContent(), /^RobotRaconteur\.AuthenticationError: /);
   assert.equal(await sessionBadge("interop").textContent(), "login required");
@@ -173,8 +173,8 @@ test("a wrong password shows the device's error again in the form", async () => 
 
 test("the right password: the device's members, a property read on the user's own upstream session", async () => {
   await logIn("alice", USERS.alice[0]);
-  await form().waitFor({ state: "hidden", timeout: 20000 });
-  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await form().waitFor({ state: "hidden", timeout: 60000 });
+  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
   assert.equal(await view("interop").locator(".device-user-name").textContent(), "alice");
   const baseName = card("interop", "base_name").locator("output.value");
   await waitFor(async () => (await baseName.textContent()) === '"interop root"', "base_name read through the session");
@@ -202,13 +202,13 @@ test("a lock taken through the gateway shows its holder on the card; the locking
 
 test("log out of the device: the form again; logged in as bob the page gets the device's lock error", async () => {
   await view("interop").locator("button.device-logout").click();
-  await form().waitFor({ state: "visible", timeout: 20000 });
+  await form().waitFor({ state: "visible", timeout: 60000 });
   assert.equal(await formError().isHidden(), true);
   assert.equal(await view("interop").locator(".member").count(), 0);
   assert.equal(await view("interop").locator(".device-user").isHidden(), true);
   await waitFor(async () => (await device("interop")).passthrough_sessions === 1, "the page's upstream session closed (the locker's stays)");
   await logIn("bob", USERS.bob[0]);
-  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
   assert.equal(await view("interop").locator(".device-user-name").textContent(), "bob");
   const r = await read("interop", "base_name");
   assert.match(r.error ?? "", /ObjectLockedError.*alice/, JSON.stringify(r));
@@ -220,13 +220,13 @@ test("log out of the device: the form again; logged in as bob the page gets the 
 
 test("a device without logins opens as before: no form", async () => {
   await page.goto(`${gateway.base}/#/plain`);
-  await sessionBadge("plain").filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await sessionBadge("plain").filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
   await waitFor(async () => (await card("plain", "base_name").locator("output.value").textContent()) === '"interop root"', "plain base_name");
   assert.equal(await view("plain").locator("form.device-login").isHidden(), true);
   assert.equal(await view("plain").locator(".device-user").isHidden(), true);
   // Back to the device with logins: this page still holds bob's login (in memory), no form.
   await page.goto(`${gateway.base}/#/interop`);
-  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 20000 });
+  await sessionBadge("interop").filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
   assert.equal(await view("interop").locator(".device-user-name").textContent(), "bob");
   assert.equal(await form().isHidden(), true);
 });

@@ -43,10 +43,10 @@ test("lists a local node's services and adds one as a device", async () => {
   // B's gateway node by its exact NodeName (its demo devices' node NAME.demo is listed too).
   const exact = new RegExp(`^${nameB.replace(/\./g, "\\.")}$`);
   const node = page.locator(".discovered-node").filter({ has: page.locator(".discovered-head .device-name", { hasText: exact }) });
-  await node.waitFor({ timeout: 30000 });
+  await node.waitFor({ timeout: 60000 });
   assert.equal(await node.getAttribute("data-source"), "local");
   const webcam = node.locator('li[data-service="webcam"]');
-  await webcam.locator("button.add").waitFor({ timeout: 30000 });
+  await webcam.locator("button.add").waitFor({ timeout: 60000 });
   assert.equal(await node.locator('li[data-service="create"] button.add').count(), 1);
   fs.mkdirSync(s.artifacts, { recursive: true });
   await page.screenshot({ path: path.join(s.artifacts, "discovered.png"), fullPage: true });
@@ -56,10 +56,10 @@ test("lists a local node's services and adds one as a device", async () => {
   const dev = await waitFor(async () => (await apiDevices(a.base)).find((d) => d.name === "webcam" && d.state === "connected"),
     "webcam added and connected", 30000);
   assert.match(dev.url, /^rr\+local:\/\/\/\?nodeid=[0-9a-f-]{36}&service=webcam$/);
-  await page.locator('.devices li[data-device="webcam"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('.devices li[data-device="webcam"][data-state="connected"]').waitFor({ timeout: 60000 });
   await waitFor(async () => (await page.evaluate(() => location.hash)) === "#/webcam", "the page opened the new device");
   // The discovered list now names the device serving the service instead of offering "Add".
-  await webcam.locator("a.served-by", { hasText: "webcam" }).waitFor({ timeout: 20000 });
+  await webcam.locator("a.served-by", { hasText: "webcam" }).waitFor({ timeout: 60000 });
   assert.equal(await webcam.locator("button.add").count(), 0);
   await page.screenshot({ path: path.join(s.artifacts, "discovered-added.png"), fullPage: true });
   assert.deepEqual(pageErrors, []);

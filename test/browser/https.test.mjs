@@ -44,7 +44,7 @@ test("the dashboard over HTTPS from the gateway: rr+wss to the same origin", { s
   page.on("websocket", (ws) => sockets.push(ws.url()));
   await page.goto(`${base}/#/create`);
   assert.equal(await page.evaluate(() => location.protocol), "https:");
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   const session = page.locator('.device-view[data-device="create"] .badge').nth(1);
   await waitFor(async () => (await session.textContent()) === "connected", "the page's RR session", 30000);
   assert.match(await page.locator(".event-log").textContent(),
@@ -72,6 +72,6 @@ test("the same port still serves the dashboard over plain HTTP", { skip: SKIP },
   const context = await browser.newContext();
   const page = await context.newPage();
   await page.goto(`http://127.0.0.1:${gateway.port}/#/create`);
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   await context.close();
 });

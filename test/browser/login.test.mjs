@@ -44,7 +44,7 @@ async function logIn(page, user, password) {
 }
 
 async function liveData(page) {
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   const dist = page.locator('.member[data-member="DistanceTraveled"]');
   const samples = async () => Number(await dist.locator(".plot").getAttribute("data-samples"));
   const n = await waitFor(samples, "distance samples", 30000);
@@ -61,7 +61,7 @@ test("no session: login page; wrong password: error; right one: dashboard; log o
 
   await logIn(page, "alice", "not-her-password");
   const error = page.locator("#login-error");
-  await error.waitFor({ state: "visible", timeout: 20000 });
+  await error.waitFor({ state: "visible", timeout: 60000 });
   assert.match(await error.textContent(), /invalid username or password/i);
   assert.match(page.url(), /\/login\.html/);
   assert.equal((await context.cookies()).filter((c) => c.name === "rrgw_session").length, 0);
@@ -74,7 +74,7 @@ test("no session: login page; wrong password: error; right one: dashboard; log o
   assert.equal(cookie.httpOnly, true);
   assert.equal(cookie.sameSite, "Strict");
   await page.goto(`${base}/#/create`);
-  await page.locator("#user-name").waitFor({ timeout: 20000 });
+  await page.locator("#user-name").waitFor({ timeout: 60000 });
   assert.equal(await page.locator("#user-name").textContent(), "alice");
   await liveData(page);
   const me = await page.evaluate(async () => (await fetch("api/whoami")).json());
@@ -104,7 +104,7 @@ test("a viewer sees live data but cannot write", async () => {
   await logIn(page, "bob", "bob-pw");
   await page.waitForURL((u) => !u.pathname.endsWith("login.html"), { timeout: 20000 });
   await page.goto(`${base}/#/create`);
-  await page.locator("#user-name").waitFor({ timeout: 20000 });
+  await page.locator("#user-name").waitFor({ timeout: 60000 });
   assert.equal(await page.locator("#user-name").textContent(), "bob");
   await liveData(page);
   // Reading is allowed, calling a function (driving the robot) is not: 403 PermissionDenied.
@@ -125,7 +125,7 @@ test("a viewer sees live data but cannot write", async () => {
   await drive.locator('[aria-label="radius"]').fill("32767");
   await drive.locator("button[type=submit]").click();
   const refusal = drive.locator(".member-error");
-  await refusal.waitFor({ state: "visible", timeout: 15000 });
+  await refusal.waitFor({ state: "visible", timeout: 60000 });
   assert.match(await refusal.textContent(), /PermissionDenied|may not call/i);
   await page.screenshot({ path: path.join(s.artifacts, "51-login-viewer.png") });
   await context.close();

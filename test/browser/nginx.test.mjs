@@ -93,7 +93,7 @@ test("with a login the dashboard works over TLS (rr+wss through nginx)", { skip:
     page.on("response", (r) => console.log("response:", r.status(), r.url()));
   }
   await page.goto(`${site}/#/create`);
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   const session = page.locator('.device-view[data-device="create"] .badge').nth(1);
   await waitFor(async () => (await session.textContent()) === "connected", "the page's RR session", 30000);
   assert.match(await page.locator(".event-log").textContent(), new RegExp(`connected to rr\\+wss://${HOST}:\\d+/\\?service=create`));

@@ -90,7 +90,7 @@ test("Chromium: the dashboard under /rr/ over TLS shows a device with live data 
     }
   });
   await page.goto(`${site}/rr/#/create`);
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   const session = page.locator('.device-view[data-device="create"] .badge').nth(1);
   await waitFor(async () => (await session.textContent()) === "connected", "the page's RR session", 30000);
   assert.match(await page.locator(".event-log").textContent(),

@@ -47,7 +47,7 @@ async function callFunction(c) {
 
 async function openDevice(base, name) {
   await page.goto(`${base}/#/${name}`);
-  await view(name).locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 30000 });
+  await view(name).locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
 }
 
 /**
@@ -135,7 +135,7 @@ test("records the create device's members from the page; the file reads", async 
   await c.locator('input[name="record-directory"]').fill("rec");
 
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 60000 });
   assert.equal(await c.getAttribute("data-state"), "recording");
   // the live line grows: duration, size and messages
   const live = c.locator(".record-live");
@@ -154,7 +154,7 @@ test("records the create device's members from the page; the file reads", async 
   assert.equal(second.drops, 0);
 
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
+  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 60000 });
   await callFunction(card("StopStreaming"));
   const item = c.locator(".recordings > li").first();
   await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 20000);
@@ -196,7 +196,7 @@ test("a directory the gateway cannot create: the reason on the page, the recordi
   await c.locator('input[name="record-directory"]').fill("blocked/dir");
   await c.locator(".record-button").click();
   const error = c.locator(".record-error");
-  await error.waitFor({ state: "visible", timeout: 20000 });
+  await error.waitFor({ state: "visible", timeout: 60000 });
   assert.match(await error.textContent(), /blocked is not a folder/);
   const item = c.locator(".recordings > li").first();
   await waitFor(async () => (await item.getAttribute("data-state")) === "failed", "the recording listed as failed", 20000);
@@ -214,11 +214,11 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   const status = async () => (await api(replayGateway.base, "GET", "api/replays/create_replay")).body;
   await openDevice(replayGateway.base, "create_replay");
   const t = timeline();
-  await t.waitFor({ timeout: 20000 });
+  await t.waitFor({ timeout: 60000 });
   assert.equal(await view("create_replay").locator(".record-control").count(), 1, "a replayed device can be recorded too");
   // ... and its Record section says so (docs/recording.md "Recording a replay")
   const replayRecord = view("create_replay").locator(".record-control");
-  await replayRecord.locator(".record-replay-note").waitFor({ timeout: 20000 });
+  await replayRecord.locator(".record-replay-note").waitFor({ timeout: 60000 });
   assert.equal(await replayRecord.locator("h3").textContent(), "Record this replay");
   assert.ok((await replayRecord.locator(".record-replay-note").textContent()).includes(recordedFile), "the note names the replayed file");
   assert.equal(await t.locator(".replay-file").textContent(), recordedFile);
@@ -268,7 +268,7 @@ test("a replayed file: play, pause, seek, speed and loop from the timeline", asy
   await t.locator(".replay-loop").uncheck();
   await waitFor(async () => (await status()).loop === false, "loop off at the gateway");
   // the replayed device's packets reach the page like a live device's
-  await card("packets").locator(".plot-readout [data-series]").first().waitFor({ timeout: 15000 });
+  await card("packets").locator(".plot-readout [data-series]").first().waitFor({ timeout: 60000 });
 });
 
 test("with logins: a viewer's timeline is read only, an operator's is not", async () => {
@@ -293,7 +293,7 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
     await p.click("#login-submit");
     await p.waitForURL((u) => !u.pathname.endsWith("login.html"), { timeout: 20000 });
     const t = p.locator('.device-view[data-device="create_replay"] .replay-timeline');
-    await t.waitFor({ timeout: 20000 });
+    await t.waitFor({ timeout: 60000 });
     return { context, p, t };
   };
   const bob = await as("bob", "bob-pw");
@@ -306,8 +306,8 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.equal(refused, 403, "the gateway refuses a viewer's control");
   // recording needs write on the device too: a viewer's Record button is disabled, the gateway refuses
   const bobRecord = bob.p.locator('.device-view[data-device="create_replay"] .record-button');
-  await bobRecord.waitFor({ timeout: 20000 });
-  await bob.p.locator('.device-view[data-device="create_replay"] .record-refused').waitFor({ timeout: 20000 });
+  await bobRecord.waitFor({ timeout: 60000 });
+  await bob.p.locator('.device-view[data-device="create_replay"] .record-refused').waitFor({ timeout: 60000 });
   assert.equal(await bobRecord.isDisabled(), true, "Record disabled for a viewer");
   const refusedRecording = await bob.p.evaluate(async () => (await fetch("api/recordings", { method: "POST", body: JSON.stringify({ device: "create_replay" }) })).status);
   assert.equal(refusedRecording, 403, "the gateway refuses a viewer's recording");
@@ -317,7 +317,7 @@ test("with logins: a viewer's timeline is read only, an operator's is not", asyn
   assert.equal(await alice.t.locator(".replay-play").isDisabled(), false, "an operator may control the replay");
   assert.equal(await alice.t.locator(".hint").count(), 0);
   await alice.t.locator(".replay-play").click();
-  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 20000 });
+  await alice.t.locator(".replay-play", { hasText: "Pause" }).waitFor({ timeout: 60000 });
   assert.equal(await alice.p.locator('.device-view[data-device="create_replay"] .record-button').isDisabled(), false, "an operator may record");
   assert.equal(await alice.p.locator(".record-refused").count(), 0);
   await alice.context.close();
@@ -338,10 +338,10 @@ test("members below the root object typed into the Record control (the webcam's 
   await paths.fill("Webcams[0].Name, Webcams[1].Name");
   await c.locator('input[name="record-directory"]').fill("sub");
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 20000 });
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 60000 });
   await waitFor(async () => /[1-9]\d* messages/.test(await c.locator(".record-live").textContent()), "the cameras' names recorded", 15000);
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
+  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 60000 });
   const item = c.locator(".recordings > li").first();
   await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the recording listed as stopped", 20000);
   const id = Number(await item.getAttribute("data-id"));

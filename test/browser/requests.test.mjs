@@ -38,7 +38,7 @@ async function watch(gateway) {
   page.on("pageerror", (e) => problems.push(`uncaught: ${e}`));
   page.on("requestfailed", (r) => problems.push(`failed: ${r.method()} ${r.url()}: ${r.failure()?.errorText}`));
   await page.goto(`${gateway.base}/`);
-  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 20000 });
+  await page.locator('#device-list li[data-device="create"][data-state="connected"]').waitFor({ timeout: 60000 });
   await page.waitForTimeout(WATCH_MS);
   // What was seen until now (closing the page aborts requests in flight, which is not the page's doing).
   const seen = { answers: answers.slice(), problems: problems.slice() };
@@ -85,8 +85,8 @@ test("the dashboard asks for what each gateway serves, and nothing answers 404 o
       };
     });
     await page.goto(`${g.base}/`);
-    await page.locator('#device-list li[data-device="create"]').waitFor({ timeout: 20000 });
-    if (shown) await page.locator("section.discovered").waitFor({ state: "visible", timeout: 20000 });
+    await page.locator('#device-list li[data-device="create"]').waitFor({ timeout: 60000 });
+    if (shown) await page.locator("section.discovered").waitFor({ state: "visible", timeout: 60000 });
     else {
       await page.waitForFunction(() => window.__featuresRead === true, null, { timeout: 20000 });
       assert.ok(await page.locator("section.discovered").isHidden(), "the Discovered section is hidden without discovery");

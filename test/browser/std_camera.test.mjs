@@ -43,7 +43,7 @@ before(async () => {
   page = await (await browser.newContext({ viewport: { width: 1366, height: 1000 } })).newPage();
   page.on("pageerror", (e) => pageErrors.push(e));
   await page.goto(`${gateway.base}/#/camera`);
-  await panel().waitFor({ timeout: 20000 });
+  await panel().waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -123,7 +123,7 @@ test("start streaming from the panel: preview, raw and compressed streams show t
   const pipeCard = view().locator('.member[data-member="frame_stream"]');
   await pipeCard.locator("button", { hasText: /^Connect$/ }).click();
   const pipeFig = pipeCard.locator(".frame-view").first();
-  await pipeFig.waitFor({ timeout: 15000 });
+  await pipeFig.waitFor({ timeout: 60000 });
   const fromCard = await framesMatch(pipeFig, 2, 0, "frame_stream card");
   assert.equal(fromCard.max, 0, `the pipe card's frame ${fromCard.k} equal to the frame sent`);
   assert.equal(await pipeFig.getAttribute("data-encoding"), "bgr888");

@@ -37,7 +37,7 @@ before(async () => {
   ({ gateway, tmp } = await gatewayWithLogins({ rig: cams.info.url, parts: cams.info.parts_url, trimmed: trimmed.info.url }));
   browser = await launchChromium();
   operator = await loggedInPage(browser, gateway.base, "alice", "rig", pageErrors);
-  await panelOf(operator, "rig", "multicamera").waitFor({ timeout: 30000 });
+  await panelOf(operator, "rig", "multicamera").waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -89,7 +89,7 @@ test("Trigger all and Capture all: the operator's, the viewer has neither", asyn
 test("an ImagePartCamera: the preview after Start streaming, capture_frame's parts put back into the frame", async () => {
   await operator.goto(`${gateway.base}/#/parts`);
   const p = panelOf(operator, "parts", "image-part-camera");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   await p.locator('button[data-action="start_streaming"]').click();
   await waitFor(async () => /streaming/.test((await p.locator(".camera-state").getAttribute("data-flags")) || ""), "streaming", 30000);
   await centreIs(p.locator(".camera-live"), cams.info.colors[3], "the part camera's preview");
@@ -97,7 +97,7 @@ test("an ImagePartCamera: the preview after Start streaming, capture_frame's par
   await p.locator('button[data-action="capture_frame"]').click();
   const { captured_parts: n } = await captured;
   const view = p.locator('.camera-capture .frame-view[data-capture="capture_frame"]');
-  await view.waitFor({ timeout: 30000 });
+  await view.waitFor({ timeout: 60000 });
   assert.equal(await view.getAttribute("data-parts"), String(n));
   await centreIs(p.locator(".camera-capture"), cams.info.colors[3], "the captured frame");
   assert.equal(await p.locator(".camera-error").isHidden(), true);
@@ -109,9 +109,9 @@ test("an ImagePartCamera: the preview after Start streaming, capture_frame's par
 test("a MultiCamera without its picture pipes: one line and the generic view", async () => {
   await operator.goto(`${gateway.base}/#/trimmed`);
   const p = panelOf(operator, "trimmed", "multicamera");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   assert.equal(await p.getAttribute("data-fallback"), "true");
   assert.match(await p.locator(".multicamera-fallback").textContent(), /no camera picture pipe/);
-  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_frame_all"]').waitFor({ timeout: 20000 });
+  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_frame_all"]').waitFor({ timeout: 60000 });
   assert.deepEqual(pageErrors, []);
 });

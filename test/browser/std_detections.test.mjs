@@ -99,6 +99,6 @@ test("a fiducial sensor without its pipe: one line and the generic view", async 
   await p.waitFor({ timeout: 60000 });
   assert.equal(await p.getAttribute("data-fallback"), "true");
   assert.match(await p.locator(".detections-fallback").textContent(), /no fiducials_sensor_data pipe of the standard type/);
-  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_fiducials"]').waitFor({ timeout: 30000 });
+  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_fiducials"]').waitFor({ timeout: 60000 });
   assert.deepEqual(pageErrors, []);
 });

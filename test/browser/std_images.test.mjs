@@ -61,7 +61,7 @@ before(async () => {
   page = await (await browser.newContext({ viewport: { width: 1366, height: 1000 } })).newPage();
   page.on("pageerror", (e) => pageErrors.push(e));
   await page.goto(`${gateway.base}/#/images`);
-  await card("image").waitFor({ timeout: 20000 });
+  await card("image").waitFor({ timeout: 60000 });
   await card("compressed").waitFor();
 });
 

@@ -126,7 +126,7 @@ test("joystick: a viewer sees the values and no control; a joystick without joys
   const old = panelOf(page, "oldpad", "joystick");
   await old.waitFor({ timeout: 60000 });
   assert.equal(await old.getAttribute("data-fallback"), "true");
-  await page.locator('.device-view[data-device="oldpad"] .member[data-member="gamepad_state"]').first().waitFor({ timeout: 20000 });
+  await page.locator('.device-view[data-device="oldpad"] .member[data-member="gamepad_state"]').first().waitFor({ timeout: 60000 });
   await page.context().close();
   assert.deepEqual(pageErrors, []);
 });

@@ -26,7 +26,7 @@ before(async () => {
   ({ gateway, tmp } = await gatewayWithLogins({ scanner: scanner.info.url, parts: scanner.info.parts_url }));
   browser = await launchChromium();
   operator = await loggedInPage(browser, gateway.base, "alice", "scanner", pageErrors);
-  await panel(operator).waitFor({ timeout: 30000 });
+  await panel(operator).waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -96,7 +96,7 @@ test("the drawing changes as the person walks (newest scan wins)", async () => {
 test("a LaserScanPartScanner: three parts put back into the whole scan", async () => {
   await operator.goto(`${gateway.base}/#/parts`);
   const p = panel(operator, "parts");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   await waitFor(async () => Number(await p.getAttribute("data-scans")) >= 3, "three whole scans drawn", 20000);
   assert.equal(await p.getAttribute("data-points"), "541");
   assert.match(await p.locator(".scan-status").textContent(), /^541 ranges, -135° to 135° by 0\.5°/);

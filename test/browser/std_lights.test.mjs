@@ -135,6 +135,6 @@ test("lights without on_off fall back to the generic view, with no page error", 
   const p = panel(operator, "oldlamp");
   await p.waitFor({ timeout: 60000 });
   assert.equal(await p.getAttribute("data-fallback"), "true");
-  await operator.locator('.device-view[data-device="oldlamp"] .member[data-member="intensity"]').first().waitFor({ timeout: 20000 });
+  await operator.locator('.device-view[data-device="oldlamp"] .member[data-member="intensity"]').first().waitFor({ timeout: 60000 });
   assert.deepEqual(pageErrors, []);
 });

@@ -122,7 +122,7 @@ test("a viewer gets the live messages (the stored ones need the call right); a c
   for (const [device, name, member] of [["oldclock", "clock", "clock_info"], ["oldlog", "eventlog", "eventlog_info"]]) {
     const old = await open(page, device, name);
     assert.equal(await old.getAttribute("data-fallback"), "true", device);
-    await page.locator(`.device-view[data-device="${device}"] .member[data-member="${member}"]`).first().waitFor({ timeout: 20000 });
+    await page.locator(`.device-view[data-device="${device}"] .member[data-member="${member}"]`).first().waitFor({ timeout: 60000 });
   }
   await page.context().close();
   assert.deepEqual(pageErrors, []);

@@ -59,7 +59,7 @@ before(async () => {
     trimmed: trimmed.info.urls.cloud, trimmed2: trimmed.info.urls.cloud2 }));
   browser = await launchChromium();
   operator = await loggedInPage(browser, gateway.base, "alice", "cloud2", pageErrors);
-  await panel(operator, "cloud2").waitFor({ timeout: 30000 });
+  await panel(operator, "cloud2").waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -203,12 +203,12 @@ test("Capture and parameters: the operator's work, the viewer has none", async (
 test("a sensor without its pipe: the generic view; without the PointCloud2 pipe: the other one", async () => {
   await operator.goto(`${gateway.base}/#/trimmed`);
   const p = panel(operator, "trimmed");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   await waitFor(async () => (await p.getAttribute("data-fallback")) === "true", "fallback", 20000);
   assert.match(await p.locator(".cloud-fallback").textContent(), /no point cloud pipe of a standard cloud type/);
   assert.equal(await p.locator("canvas.cloud-canvas").count(), 0);
   // the generic member view below still lists the sensor's members
-  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_point_cloud"]').waitFor({ timeout: 20000 });
+  await operator.locator('.device-view[data-device="trimmed"] section.member[data-member="capture_point_cloud"]').waitFor({ timeout: 60000 });
 
   await operator.goto(`${gateway.base}/#/trimmed2`);
   const q = panel(operator, "trimmed2");

@@ -33,7 +33,7 @@ before(async () => {
   page = await (await browser.newContext({ viewport: { width: 1366, height: 1000 } })).newPage();
   page.on("pageerror", (e) => pageErrors.push(e));
   await page.goto(`${gateway.base}/#/robot`);
-  await card("robot_state").waitFor({ timeout: 20000 });
+  await card("robot_state").waitFor({ timeout: 60000 });
 });
 
 after(async () => {

@@ -85,7 +85,7 @@ before(async () => {
   page.on("pageerror", (e) => pageErrors.push(e));
   page.on("console", (m) => consoleLines.push(`${m.type()}: ${m.text()}`));
   await page.goto(`${gateway.base}/#/robot`);
-  await view3d("robot").waitFor({ timeout: 30000 });
+  await view3d("robot").waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -124,7 +124,7 @@ for (const [device, seed] of [["robot", 11], ["rail", 23]]) {
     const robot = device === "robot" ? arm : rail;
     if (device !== "robot") {
       await page.goto(`${gateway.base}/#/${device}`);
-      await view3d(device).waitFor({ timeout: 30000 });
+      await view3d(device).waitFor({ timeout: 60000 });
     }
     assert.equal(await view3d(device).getAttribute("data-state"), "ready", await view3d(device).textContent());
     let worst = { distance: 0, angle: 0 };

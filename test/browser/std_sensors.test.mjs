@@ -33,7 +33,7 @@ before(async () => {
   }));
   browser = await launchChromium();
   operator = await loggedInPage(browser, gateway.base, "alice", "wrench", pageErrors);
-  await panel(operator).waitFor({ timeout: 30000 });
+  await panel(operator).waitFor({ timeout: 60000 });
 });
 
 after(async () => {
@@ -116,7 +116,7 @@ test("parameters: the operator gets and sets filter_cutoff; the viewer has no co
 test("a two-value Sensor: each value with its unit from sensor_info", async () => {
   await operator.goto(`${gateway.base}/#/climate`);
   const p = panel(operator, "climate");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   assert.equal(await p.getAttribute("data-source"), "sensor_value");
   await waitFor(async () => (await p.locator("tr[data-axis]").count()) === 2, "two values");
   await waitFor(async () => (await cell(operator, "[0]", "unit", "climate").textContent()) === "°C", "units from sensor_info");
@@ -133,7 +133,7 @@ test("a two-value Sensor: each value with its unit from sensor_info", async () =
 test("an older WrenchSensor definition (no wrench_sensor_value, no sensor_info): its sensor_value unnamed, the generic view, no page error", async () => {
   await operator.goto(`${gateway.base}/#/wrench_old`);
   const p = panel(operator, "wrench_old");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   // the panel takes the next standard wire the definition has: six numbers, no names or units to give them
   assert.equal(await p.getAttribute("data-source"), "sensor_value");
   await waitFor(async () => (await p.locator("tr[data-axis]").count()) === 6, "six values");
@@ -160,7 +160,7 @@ const changedPixels = (canvas) => canvas.evaluate((c) => {
 test("IMU: orientation as roll, pitch, yaw and a gizmo that turns with it; rates and accelerations with units", async () => {
   await operator.goto(`${gateway.base}/#/imu`);
   const p = panelOf(operator, "imu", "imu");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   const row = (k) => p.locator(`dd[data-row="${k}"]`).textContent();
   await command(sensors, { imu_hold: 90 }, "imu_held");
   await waitFor(async () => (await row("orientation")) === "rpy (0, 0, 90)°", "yaw 90° shown", 15000);
@@ -186,7 +186,7 @@ test("IMU: orientation as roll, pitch, yaw and a gizmo that turns with it; rates
 test("GPS: position, fix, satellites and accuracy as sent; the track grows", async () => {
   await operator.goto(`${gateway.base}/#/gps`);
   const p = panelOf(operator, "gps", "gps");
-  await p.waitFor({ timeout: 30000 });
+  await p.waitFor({ timeout: 60000 });
   const row = (k) => p.locator(`dd[data-row="${k}"]`).textContent();
   await waitFor(async () => (await row("fix")) === "dgps_fix", "the fix by name", 15000);
   assert.equal(await row("altitude"), "120.5 m");

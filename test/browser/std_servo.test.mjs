@@ -145,7 +145,7 @@ test("a viewer sees servo and actuator state and no control; a servo without ser
   const old = panelOf(page, "oldstage", "servo");
   await old.waitFor({ timeout: 60000 });
   assert.equal(await old.getAttribute("data-fallback"), "true");
-  await page.locator('.device-view[data-device="oldstage"] .member[data-member="servo_info"]').first().waitFor({ timeout: 20000 });
+  await page.locator('.device-view[data-device="oldstage"] .member[data-member="servo_info"]').first().waitFor({ timeout: 60000 });
   await page.context().close();
   assert.deepEqual(pageErrors, []);
 });

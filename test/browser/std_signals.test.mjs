@@ -121,7 +121,7 @@ test("a viewer sees every value and no control; a device without signal_groups f
   const old = panelOf(page, "oldio", "signal");
   await old.waitFor({ timeout: 60000 });
   assert.equal(await old.getAttribute("data-fallback"), "true");
-  await page.locator('.device-view[data-device="oldio"] .member[data-member="signal_group_info"]').first().waitFor({ timeout: 20000 });
+  await page.locator('.device-view[data-device="oldio"] .member[data-member="signal_group_info"]').first().waitFor({ timeout: 60000 });
   await page.context().close();
   assert.deepEqual(pageErrors, []);
 });

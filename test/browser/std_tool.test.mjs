@@ -247,7 +247,7 @@ test("a Tool without tool_state falls back to the generic view, with no page err
   assert.match(await p.textContent(), /no tool_state wire of the standard layout/);
   assert.equal(await p.locator("button").count(), 0);
   const card = page.locator('.device-view[data-device="oldgripper"] .member[data-member="tool_info"]').first();
-  await card.waitFor({ timeout: 20000 });
+  await card.waitFor({ timeout: 60000 });
   assert.equal(await page.locator('.device-view[data-device="oldgripper"] .member[data-member="tool_state"]').count(), 0);
   await page.context().close();
   assert.deepEqual(pageErrors, []);

@@ -8,7 +8,8 @@ demo robot's packets, so pushes are flowing), an RR WebSocket (subprotocol robot
 the wasm client's transport) and an official Python client over rr+ws. Then SIGTERM:
   - each raw WebSocket reads a close frame with code 1001 (read after the event: the close frame, not a
     timer, ends the wait; the bound is only against a hang);
-  - the gateway exits with status 0 within --exit-bound seconds. The default (20 s) only bounds a hang;
+  - the gateway exits with status 0 within --exit-bound seconds. The default (60 s) only bounds a hang
+    (an exit under load waits for the kernel to close the inotify descriptor: over 20 s once at load 30);
     `--exit-bound 1 --runs 3` is the measured promise of docs/deployment.md ("exits within 1 s with no
     clients busy"), registered with LABELS timing.
 
@@ -90,9 +91,11 @@ def one_run(exe, exit_bound, checks, run, official):
         gw.p.send_signal(signal.SIGTERM)
         codes = {name: close_code_of(ws, 20) for name, ws in sockets.items()}
         try:
-            status = gw.p.wait(max(exit_bound, 20))
+            status = gw.p.wait(max(exit_bound, 60))
         except Exception:
             status = "hung"
+            sys.stderr.write("gateway pid %d did not end after SIGTERM; its threads:\n%s\n"
+                             % (gw.p.pid, gwproc.threads_of(gw.p.pid)))
         took = time.monotonic() - started
 
         def close_codes():
@@ -121,7 +124,7 @@ def one_run(exe, exit_bound, checks, run, official):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--gateway", required=True)
-    ap.add_argument("--exit-bound", type=float, default=20.0)
+    ap.add_argument("--exit-bound", type=float, default=60.0)
     ap.add_argument("--runs", type=int, default=1)
     a = ap.parse_args()
     checks = gwproc.Checks()

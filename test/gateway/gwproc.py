@@ -21,7 +21,11 @@ from child_procs import threads_of  # noqa: E402,F401 (where a hung gateway's th
 class Proc:
     """A child process whose first JSON line on stdout is `info`; later stdout lines are drained."""
 
-    def __init__(self, argv, env=None, timeout=30.0):
+    # Bounds on a hang, not expected durations: under a CI-like load (load average 20-30 on 2 vCPUs) an
+    # ASan gateway has taken over 30 s to print its ready line, and over 20 s to exit after SIGTERM while
+    # the kernel closed its inotify descriptor (close() waits for an SRCU grace period: 10 ms idle,
+    # 1.5 s measured at load 19; docs/development.md "What a test may wait on").
+    def __init__(self, argv, env=None, timeout=60.0):
         self.argv = argv
         self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=sys.stderr, text=True, env=env)
         self.info = None
@@ -41,6 +45,9 @@ class Proc:
 
         threading.Thread(target=read, daemon=True).start()
         if not got.wait(timeout) or self.info is None:
+            if self.p.poll() is None:
+                sys.stderr.write("%s (pid %d) printed no ready line in %.0f s; its threads:\n%s\n"
+                                 % (argv[0], self.p.pid, timeout, threads_of(self.p.pid)))
             self.kill()
             raise RuntimeError("%s printed no ready line (exit %s)" % (argv[0], self.p.poll()))
 
@@ -55,7 +62,7 @@ class Proc:
     def alive(self):
         return self.p.poll() is None
 
-    def stop(self, timeout=20.0):
+    def stop(self, timeout=60.0):
         """SIGTERM, wait; SIGKILL when it does not end. Returns the exit status ("killed" if it hung)."""
         if self.p.poll() is not None:
             return self.p.returncode
@@ -82,7 +89,7 @@ def gateway_env():
     return env
 
 
-def start_gateway(exe, args, timeout=30.0):
+def start_gateway(exe, args, timeout=60.0):
     return Proc([exe, "--listen", "127.0.0.1", "--port", "0", "--log-level", "warning", "--no-local"] + list(args),
                 env=gateway_env(), timeout=timeout)
 
@@ -103,7 +110,7 @@ def http_status(url, headers=None, timeout=5.0):
         return e.code, e.read().decode("utf-8", "replace")
 
 
-def wait_ready(port, timeout=30.0):
+def wait_ready(port, timeout=60.0):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         try:

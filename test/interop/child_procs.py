@@ -92,10 +92,11 @@ def threads_of(pid):
     return "\n".join(lines)
 
 
-def stop(proc, wait_s=20):
+def stop(proc, wait_s=60):
     """SIGTERM, wait up to `wait_s`, then SIGKILL (printing where the process's threads were). Returns
-    the exit status (None for no process). 20 s: ASan gateways beside a full CI run (load about 20) took
-    over 10 s to end twice in one run; a real hang still fails, and names itself."""
+    the exit status (None for no process). 60 s: ASan gateways beside a full CI run (load about 20) took
+    over 10 s to end twice in one run, and one took over 20 s at load 30 in close() of its inotify
+    descriptor (the kernel waits for an SRCU grace period); a real hang still fails, and names itself."""
     if proc is None:
         return None
     if proc.poll() is None:

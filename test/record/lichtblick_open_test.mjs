@@ -128,21 +128,21 @@ before(async () => {
   // ... and create from the dashboard's Record control, both encodings (its default members + the property)
   await page.goto(`${gateway.base}/#/create`);
   const view = page.locator('.device-view[data-device="create"]');
-  await view.locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 30000 });
+  await view.locator(".badge").nth(1).filter({ hasText: "connected" }).waitFor({ timeout: 60000 });
   const c = view.locator(".record-control");
   await c.locator("details.record-options summary").click();
   await c.locator("button", { hasText: "none" }).click();
   for (const m of ["packets", "Bump", "DistanceTraveled"]) await c.locator(`input[value="${m}"]`).check();
   await c.locator('select[name="record-encoding"]').selectOption("both");
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 10000 });
+  await c.locator('.record-button[data-action="stop"]').waitFor({ timeout: 60000 });
   // Driven once the recording runs, so the recorded distance rises (the demo Create stops at a wall
   // after about 7 s: driven earlier, a slow start recorded it standing there)
   const drive = await api("POST", "/api/devices/create/functions/Drive", { args: { velocity: 200, radius: 32767 } });
   assert.equal(drive.status, 200, `Drive: ${JSON.stringify(drive.body)}`);
   await new Promise((r) => setTimeout(r, 7000));  // the property is polled every second
   await c.locator(".record-button").click();
-  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 15000 });
+  await c.locator('.record-button[data-action="record"]').waitFor({ timeout: 60000 });
   const item = c.locator(".recordings > li").first();
   await waitFor(async () => (await item.getAttribute("data-state")) === "stopped", "the dashboard lists the recording as stopped", 10000);
   files["create.mcap"] = path.resolve((await item.locator(".recording-files code").allTextContents())[0]);
