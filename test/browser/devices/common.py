@@ -19,11 +19,20 @@ def die_with_parent():
         pass
 
 
+# The official library refuses to listen on 48653 ("reserved for Robot Raconteur port sharer"), which is
+# in Linux's ephemeral range: a flaky.sh run drew it once and the device exited at start.
+RR_PORT_SHARER_PORT = 48653
+
+
 def free_port():
-    """A TCP port free on 127.0.0.1 now (the RR node's options take a port, not a socket)."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A TCP port free on 127.0.0.1 now (the RR node's options take a port, not a socket), never the
+    port sharer's 48653."""
+    while True:
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        if port != RR_PORT_SHARER_PORT:
+            return port
 
 
 def node_flags(port):
