@@ -39,7 +39,7 @@ function startJson(cmd, argv, key) {
     rl.on("line", (l) => { lines.push(l); try { const j = JSON.parse(l); if (key in j) resolve(j); } catch { /* not JSON */ } });
     proc.once("error", (e) => reject(new Error(`${cmd}: ${e.message}`)));
     proc.once("exit", (code) => reject(new Error(`${cmd} exited (${code}) before printing ${key}\n${err}`)));
-    setTimeout(() => reject(new Error(`${cmd}: no ${key} line\n${err}`)), 30000);
+    setTimeout(() => reject(new Error(`${cmd}: no ${key} line\n${err}`)), 60000);
   });
   return { proc, value, lines, stderr: () => err };
 }
@@ -50,7 +50,7 @@ async function gateway(extra = []) {
   return { ...g, port, base: `http://127.0.0.1:${port}` };
 }
 
-async function waitDevices(base, names, timeoutMs = 30000) {
+async function waitDevices(base, names, timeoutMs = 60000) {
   const deadline = Date.now() + timeoutMs;
   for (;;) {
     const devices = await (await fetch(`${base}/api/devices`)).json();
@@ -176,14 +176,14 @@ RRN.DisconnectService(c)
       const errors = [];
       page.on("pageerror", (e) => errors.push(String(e)));
       await page.goto(`${g.base}/`);
-      await page.waitForFunction(() => Number(document.getElementById("packet").dataset.count ?? 0) >= 3, null, { timeout: 30000 })
+      await page.waitForFunction(() => Number(document.getElementById("packet").dataset.count ?? 0) >= 3, null, { timeout: 60000 })
         .catch(async (e) => { throw new Error(`${e.message}; page: ${await page.textContent("body")}; errors: ${errors}`); });
       ok(/^connected \(experimental\.create\.Create\)$/.test(await page.textContent("#state")), "the page connected");
       const before = Number(await page.textContent("#distance"));
       ok(Number.isInteger(before), `distance ${before}`);
       // the button drives and then reads the distance: pressed again (each press reads it anew) until the
       // robot's move shows, bounded against a hang only (the demo's clock advances the robot, not the press)
-      const deadline = Date.now() + 30000;
+      const deadline = Date.now() + 60000;
       for (;;) {
         await page.click("#drive");
         const moved = await page.waitForFunction((b) => Number(document.getElementById("distance").textContent) > b, before, { timeout: 1000 })
@@ -230,10 +230,10 @@ RRN.DisconnectService(c)
       const packetAfter = async (what, connects) => {
         await page.waitForFunction((n) => document.getElementById("state")?.textContent === "connected"
           && Number(document.getElementById("connects").textContent) >= n && /^ID \d+/.test(document.getElementById("packet").textContent),
-        connects, { timeout: 30000 })
+        connects, { timeout: 60000 })
           .catch(async (e) => { throw new Error(`${e.message}; page: ${await page.textContent("body")}; errors: ${errors}`); });
         const first = Number(await page.textContent("#count"));
-        await page.waitForFunction((n) => Number(document.getElementById("count").textContent) >= n + 2, first, { timeout: 10000 });
+        await page.waitForFunction((n) => Number(document.getElementById("count").textContent) >= n + 2, first, { timeout: 60000 });
         ok(true, `${what}: ${await page.textContent("#packet")}, connections ${await page.textContent("#connects")}`);
       };
       await packetAfter("the hook shows the wire", 1);

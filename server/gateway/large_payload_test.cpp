@@ -66,7 +66,13 @@ Value large_array(double offset) {
 }
 
 std::shared_ptr<Client> connect_client(rr::client::IoThreads& io, const std::string& url) {
-    auto c = Client::connect(io.executor(), url, {});
+    // Bounds on a hang (a WebSocket handshake to an ASan node took over the 5 s default at load 40;
+    // an 8 MiB echo under such a load takes longer than the default 15 s per request).
+    rr::client::ClientOptions o;
+    o.connect_timeout = 60s;
+    o.request_timeout = 120s;
+    o.receive_timeout = 60s;
+    auto c = Client::connect(io.executor(), url, o);
     INFO(url << ": " << (c ? std::string() : c.error().message));
     REQUIRE(c);
     return *c;
