@@ -126,15 +126,24 @@ class Net:
         return ["ip", "netns", "exec", ns] + list(argv)
 
 
+SLOWEST_HTTP = [0.0, ""]  # the longest a request waited for the gateway's answer (logged at the end)
+
+
 def http(net, python, url, method="GET", body=None):
-    """An HTTP request from inside namespace A (the gateway's loopback is there)."""
-    code = ("import json,sys,urllib.request,urllib.error\n"
+    """An HTTP request from inside namespace A (the gateway's loopback is there). The urllib timeout
+    (60 s, per socket operation) bounds a hang of the gateway; the time it waited is kept."""
+    code = ("import json,sys,time,urllib.request,urllib.error\n"
             "req=urllib.request.Request(sys.argv[1],method=sys.argv[2],data=(sys.argv[3].encode() if sys.argv[3] else None),"
             "headers={'Content-Type':'application/json'})\n"
-            "try:\n r=urllib.request.urlopen(req,timeout=60); print(json.dumps({'status':r.status,'body':r.read().decode()}))\n"
-            "except urllib.error.HTTPError as e:\n print(json.dumps({'status':e.code,'body':e.read().decode()}))\n")
+            "t0=time.monotonic()\n"
+            "try:\n r=urllib.request.urlopen(req,timeout=60); out={'status':r.status,'body':r.read().decode()}\n"
+            "except urllib.error.HTTPError as e:\n out={'status':e.code,'body':e.read().decode()}\n"
+            "out['waited']=time.monotonic()-t0; print(json.dumps(out))\n")
     r = run(net.cmd(net.a, [python, "-c", code, url, method, json.dumps(body) if body is not None else ""]))
-    return json.loads(r.stdout)
+    out = json.loads(r.stdout)
+    if out["waited"] > SLOWEST_HTTP[0]:
+        SLOWEST_HTTP[:] = [out["waited"], "%s %s" % (method, url)]
+    return out
 
 
 def wait_until(what, fn, timeout):
@@ -404,10 +413,12 @@ def main():
         status = child_procs.stop(gw, 20)
         if status != 0:
             raise Failed("rr-gateway exited with %s" % status)
+        log("slowest HTTP answer: %.2f s (%s)" % tuple(SLOWEST_HTTP))
         log("PASS")
         return 0
     except (Failed, child_procs.StepFailed, subprocess.TimeoutExpired) as e:
         log("FAIL:", e)
+        log("slowest HTTP answer before: %.2f s (%s)" % tuple(SLOWEST_HTTP))
         for name in ("gateway.err", "official.err", "official4.err"):
             p = os.path.join(tmp, name)
             if os.path.exists(p):
