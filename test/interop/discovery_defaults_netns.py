@@ -36,16 +36,19 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import child_procs  # noqa: E402
-from discovery_netns import (EVENT_S, IPV4_A, START_S, Failed, Net, http, netns_skip_reason, retry, run,  # noqa: E402
-                             wait_until)
+from discovery_netns import (EVENT_S, EXIT_S, IPV4_A, START_S, Failed, Net, http,  # noqa: E402
+                             netns_skip_reason, retry, run, wait_until)
 
 SKIP = 77
 NAME = "rr.gateway"  # the default NodeName
 CREATE = "experimental.create.Create"
 
 
+T0 = time.monotonic()
+
+
 def log(*a):
-    print("[discovery_defaults]", *a, flush=True)
+    print("[discovery_defaults +%.0fs]" % (time.monotonic() - T0), *a, flush=True)
 
 
 def node_dir_env(root):
@@ -146,7 +149,7 @@ def main():
         return gw, err
 
     def stop(gw):
-        status = child_procs.stop(gw, 20)
+        status = child_procs.stop(gw, EXIT_S)
         if status != 0:
             raise Failed("rr-gateway exited with %s" % status)
 

@@ -52,6 +52,7 @@ START_S = 180    # a process's ready line
 STEP_S = 180     # one process run to its end (the official client's find, rr discover, an HTTP request)
 EVENT_S = 180    # an event that needs discovery rounds and connects (a device connected, a node heard)
 RETRY_S = 240    # a query asked again until it is answered (datagrams may be lost or late)
+EXIT_S = 60      # a gateway's exit after SIGTERM, LeakSanitizer's check included (over 20 s at load 26)
 # The gateway's URL expiry (discovery.node_expiry_ms). The gateway asks live nodes to announce again at
 # 3/4 of it, so a node that answers within a quarter of it (15 s) stays; a shorter expiry made that
 # answer a deadline of a few seconds on a loaded machine. The removal step waits for this expiry.
@@ -62,8 +63,11 @@ class Failed(Exception):
     pass
 
 
+T0 = time.monotonic()
+
+
 def log(*a):
-    print("[discovery_netns]", *a, flush=True)
+    print("[discovery_netns +%.0fs]" % (time.monotonic() - T0), *a, flush=True)
 
 
 def netns_skip_reason(python):
@@ -410,7 +414,8 @@ def main():
                    "official_index" not in devices(net, args.python, port), EXPIRY_MS / 1000 + EVENT_S)
         log("devices removed after the node expired: ok")
 
-        status = child_procs.stop(gw, 20)
+        # 60 s: the exit includes LeakSanitizer's check, which took over 20 s at load 26 here; a bound on a hang.
+        status = child_procs.stop(gw, EXIT_S)
         if status != 0:
             raise Failed("rr-gateway exited with %s" % status)
         log("slowest HTTP answer: %.2f s (%s)" % tuple(SLOWEST_HTTP))
