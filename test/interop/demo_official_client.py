@@ -43,6 +43,8 @@ import official_transport  # noqa: E402  (the official client's transport, its c
 RRN = RR.RobotRaconteurNode.s
 
 WAIT_S = 60.0  # a bound on a hang, never an expected time
+START_S = 180.0  # rr-demo-devices' ready line: an ASan start at load 30-50 took over 30 s here
+PROGRESS = {"step": "starting rr-demo-devices"}  # what the overall timeout interrupted
 DRIVE_STRAIGHT = 32767
 SPIN_CLOCKWISE = -1
 SPIN_COUNTERCLOCKWISE = 1
@@ -123,6 +125,7 @@ class Runner:
         self.stats = {}
 
     def check(self, name, fn):
+        PROGRESS["step"] = "%s/%s" % (self.section, name)
         if self.verbose:
             print("... %s/%s" % (self.section, name), file=sys.stderr, flush=True)
         try:
@@ -472,6 +475,7 @@ class Runner:
     def run(self):
         for s in self.SECTIONS:
             self.section = s
+            PROGRESS["step"] = "%s: connect" % s
             try:
                 getattr(self, s)()
             except Exception as e:
@@ -479,9 +483,9 @@ class Runner:
                 self.results.append((s, "connect", False, "%s: %s" % (type(e).__name__, e)))
 
 
-def start_devices(exe, timeout=30.0, local=False):
+def start_devices(exe, timeout=START_S, local=False):
     extra = ["--local", "--node-name", "rr.demo.official_client.%d" % os.getpid()] if local else []
-    p = subprocess.Popen([exe, "--port", "0", "--play-period", "1", "--max-lifetime", "300"] + extra,
+    p = subprocess.Popen([exe, "--port", "0", "--play-period", "1", "--max-lifetime", "600"] + extra,
                          stdout=subprocess.PIPE, stderr=sys.stderr, text=True)
     line = [None]
 
@@ -500,7 +504,7 @@ def start_devices(exe, timeout=30.0, local=False):
 def stop_devices(p):
     p.send_signal(signal.SIGTERM)
     try:
-        return p.wait(20)
+        return p.wait(60)  # a bound on a hang: the exit includes LeakSanitizer's check, slow under load
     except subprocess.TimeoutExpired:
         p.kill()
         p.wait()
@@ -524,7 +528,8 @@ def main(argv=None):
         ap.error("give --devices, or --create and --webcam")
 
     def overall_timeout():
-        print(json.dumps({"ok": False, "error": "overall timeout %.0f s" % args.timeout}), flush=True)
+        print(json.dumps({"ok": False, "error": "overall timeout %.0f s" % args.timeout, "during": PROGRESS["step"]}),
+              flush=True)
         os._exit(3)
 
     watchdog = threading.Timer(args.timeout, overall_timeout)
@@ -549,6 +554,7 @@ def main(argv=None):
             create_url, webcam_url = args.create, args.webcam
         summary.update({"create_url": create_url, "webcam_url": webcam_url})
 
+        PROGRESS["step"] = "connecting"
         RRN.SetLogLevelFromEnvVariable()
         RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         if create_url.startswith("rr+local:"):
@@ -558,6 +564,7 @@ def main(argv=None):
         r.timing = args.timing
         r.run()
         if proc is not None:
+            PROGRESS["step"] = "stopping rr-demo-devices (SIGTERM)"
             status = stop_devices(proc)
             proc = None
             r.results.append(("devices", "exit status 0 on SIGTERM", status == 0,
