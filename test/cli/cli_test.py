@@ -397,11 +397,11 @@ def node_index_checks(rr, service_url, name, root_type):
 def local_error_checks(exe, node_name):
     """rr+local errors: each a clear message and a non-zero exit, nothing hangs."""
     missing = f"rr+local:///?nodename=no.such.{node_name}&service=interop"
-    p = subprocess.run([exe, "get", missing, "p_int32"], capture_output=True, text=True, timeout=30)
+    p = subprocess.run([exe, "get", missing, "p_int32"], capture_output=True, text=True, timeout=HANG_S)
     check(p.returncode == CONNECT and "no local node named" in p.stderr, "rr+local: an unknown NodeName is a connect error",
           f"rc={p.returncode} stderr={p.stderr.strip()}")
     p = subprocess.run([exe, "get", "rr+local://somehost/?nodename=x&service=interop", "p_int32"], capture_output=True,
-                       text=True, timeout=30)
+                       text=True, timeout=HANG_S)
     check(p.returncode != OK and "host must be empty" in p.stderr, "rr+local: a host other than localhost is refused",
           f"rc={p.returncode} stderr={p.stderr.strip()}")
 
@@ -432,7 +432,7 @@ def local_discover_checks(exe, node_name, root_type):
 
 def stale_checks(exe, url):
     """After an official node stopped (it leaves its entries behind), its entry is reported stale."""
-    p = subprocess.run([exe, "get", url, "p_int32"], capture_output=True, text=True, timeout=30)
+    p = subprocess.run([exe, "get", url, "p_int32"], capture_output=True, text=True, timeout=HANG_S)
     check(p.returncode == CONNECT and "stale" in p.stderr, "rr+local: a stopped official node's entry is reported stale",
           f"rc={p.returncode} stderr={p.stderr.strip()}")
 
