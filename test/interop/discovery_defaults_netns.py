@@ -36,15 +36,19 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import child_procs  # noqa: E402
-from discovery_netns import IPV4_A, Failed, Net, http, netns_skip_reason, run, wait_until  # noqa: E402
+from discovery_netns import (EVENT_S, EXIT_S, IPV4_A, START_S, Failed, Net, http,  # noqa: E402
+                             netns_skip_reason, retry, run, wait_until)
 
 SKIP = 77
 NAME = "rr.gateway"  # the default NodeName
 CREATE = "experimental.create.Create"
 
 
+T0 = time.monotonic()
+
+
 def log(*a):
-    print("[discovery_defaults]", *a, flush=True)
+    print("[discovery_defaults +%.0fs]" % (time.monotonic() - T0), *a, flush=True)
 
 
 def node_dir_env(root):
@@ -104,12 +108,12 @@ def start(cmd, stderr_path, env, preexec=child_procs.die_with_parent):
 
 def find(net, python, official_py, call):
     argv = [python, official_py, "find", "--type", CREATE, "--name", NAME, "--also-name", NAME + ".demo", "--wait", "5"]
-    r = run(net.cmd(net.b, argv + (["--call"] if call else [])), timeout=90)
+    r = run(net.cmd(net.b, argv + (["--call"] if call else [])))
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
 def call_url(net, python, official_py, url):
-    r = run(net.cmd(net.b, [python, official_py, "call", "--url", url]), timeout=60)
+    r = run(net.cmd(net.b, [python, official_py, "call", "--url", url]))
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
@@ -137,15 +141,15 @@ def main():
         logs.append(err)
         gw = start(net.cmd(net.a, [args.gateway] + list(extra)), err, node_dir_env(os.path.join(tmp, "gw-" + tag)), preexec)
         procs.append(gw)
-        ready = child_procs.read_json_line(gw, 60, "rr-gateway " + " ".join(extra))
+        ready = child_procs.read_json_line(gw, START_S, "rr-gateway " + " ".join(extra))
         if ready.get("port") != 8080 or ready.get("nodename") != NAME:
             raise Failed("ready line %r: expected port 8080 and NodeName %s (the defaults)" % (ready, NAME))
         wait_until("the demo devices connected (/readyz)",
-                   lambda: http(net, args.python, "http://127.0.0.1:8080/readyz")["status"] == 200, 60)
+                   lambda: http(net, args.python, "http://127.0.0.1:8080/readyz")["status"] == 200, EVENT_S)
         return gw, err
 
     def stop(gw):
-        status = child_procs.stop(gw, 20)
+        status = child_procs.stop(gw, EXIT_S)
         if status != 0:
             raise Failed("rr-gateway exited with %s" % status)
 
@@ -158,17 +162,23 @@ def main():
 
         # --- 1. no options: found by type and by NodeName, and called --------------------------------
         gw, _ = gateway("defaults")
-        res = find(net, args.python, official_py, call=True)
-        creates = [s for s in res["services"] if s["nodename"] == NAME and s["name"] == "create"]
-        if not creates or not any(u.startswith("rr+tcp://[fe80:") for u in creates[0]["urls"]):
-            raise Failed("FindServiceByType(%s) did not list the gateway's create at a link-local URL: %s" % (CREATE, res))
-        if not any(n["nodename"] == NAME and n["urls"] for n in res["nodes"]):
-            raise Failed("FindNodeByName(%s) did not find the gateway: %s" % (NAME, res))
-        if not any(n["nodename"] == NAME + ".demo" and n["urls"] for n in res["nodes2"]):
-            raise Failed("FindNodeByName(%s.demo) did not find the demo node: %s" % (NAME, res))
-        call = res.get("call", {})
-        if "error" in call or not isinstance(call.get("DistanceTraveled"), int):
-            raise Failed("the official client's call to the create it found: %s" % call)
+
+        def found_and_called():
+            # Asked again until answered: announces come by datagram, and the services by a connect to
+            # the gateway's service index, either of which a loaded machine may not finish in one search.
+            res = find(net, args.python, official_py, call=True)
+            creates = [s for s in res["services"] if s["nodename"] == NAME and s["name"] == "create"]
+            if not creates or not any(u.startswith("rr+tcp://[fe80:") for u in creates[0]["urls"]):
+                raise Failed("FindServiceByType(%s) did not list the gateway's create at a link-local URL: %s" % (CREATE, res))
+            if not any(n["nodename"] == NAME and n["urls"] for n in res["nodes"]):
+                raise Failed("FindNodeByName(%s) did not find the gateway: %s" % (NAME, res))
+            if not any(n["nodename"] == NAME + ".demo" and n["urls"] for n in res["nodes2"]):
+                raise Failed("FindNodeByName(%s.demo) did not find the demo node: %s" % (NAME, res))
+            call = res.get("call", {})
+            if "error" in call or not isinstance(call.get("DistanceTraveled"), int):
+                raise Failed("the official client's call to the create it found: %s" % call)
+            return call
+        call = retry("the official client finds the gateway (type, NodeName, demo node) and calls it", found_and_called)
         log("defaults: found by type and NodeName (and the demo node), called at %s: ok" % call["urls"])
         stop(gw)
 

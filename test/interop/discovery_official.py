@@ -7,14 +7,17 @@
         Prints {"port": N, "nodeid": "..."} when ready; runs until SIGTERM. --ipv4-only: announce and
         listen on IPv4 broadcast only (IPNodeDiscoveryFlags_IPV4_BROADCAST), not IPv6.
     discovery_official.py find --type T --name NODENAME --wait S
-        ClientNodeSetup(), waits S seconds for announces, then RRN.FindServiceByType(T, ["rr+tcp"]) and
-        RRN.FindNodeByName(NODENAME, ["rr+tcp"]); prints {"services": [...], "nodes": [...]}.
+        ClientNodeSetup(), waits S seconds for announces, then RRN.AsyncFindServiceByType(T, ["rr+tcp"])
+        and RRN.FindNodeByName(NODENAME, ["rr+tcp"]); prints {"services": [...], "nodes": [...]}. The
+        search's timeout and the transport's connect timeout are FIND_TIMEOUT_S and 60 s, not the
+        official 5 s: a node's services are read by connecting to its service index, which a loaded
+        machine did not finish in 5 s (the node was listed, its services not).
         --ipv4-only: listens on IPv4 broadcast only. --also-name NAME2: FindNodeByName(NAME2) too
         ("nodes2"). --call: connects to the first service found on node NODENAME with the URLs the
         search gave and, for an experimental.create.Create, reads DistanceTraveled and calls Drive(0, 0)
         ("call": {"urls", "DistanceTraveled"} or {"error"}).
     discovery_official.py call --url URL
-        ClientNodeSetup(), ConnectService(URL) of an experimental.create.Create, reads DistanceTraveled and
+        ClientNodeSetup() (connect timeout 60 s), ConnectService(URL) of an experimental.create.Create, reads DistanceTraveled and
         calls Drive(0, 0); prints {"DistanceTraveled": N} or {"error": "..."}.
     discovery_official.py hostile --iface IF --flood N
         Sends hostile datagrams to FF02::BA86%IF port 48653: truncated, oversized, a bad UUID, a lying
@@ -23,12 +26,20 @@
 
 import argparse
 import json
+import os
 import signal
 import socket
 import sys
 import threading
 import time
 import uuid
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import official_transport  # noqa: E402  (the test's connect timeout)
+
+# AsyncFindServiceByType's timeout: a quarter of it listens for nodes, then each node's service index
+# is read within it. A bound on a hang; the search ends as soon as every node answered.
+FIND_TIMEOUT_S = 30
 
 ROBDEF = """service experimental.discovery_test
 
@@ -90,10 +101,20 @@ def find(args):
         node_setup = RR.RobotRaconteurNodeSetup(None, 0, ipv4_only_flags(RR.RobotRaconteurNodeSetupFlags_CLIENT_DEFAULT))
     else:
         node_setup = RR.ClientNodeSetup()
-    with node_setup:
+    with node_setup as setup:
+        official_transport.set_connect_timeout(setup.tcp_transport)
         time.sleep(args.wait)
+        found = []
+        done = threading.Event()
+
+        def handler(result):
+            found.extend(result or [])
+            done.set()
+        RRN.AsyncFindServiceByType(args.type, ["rr+tcp"], handler, FIND_TIMEOUT_S)
+        if not done.wait(FIND_TIMEOUT_S * 2):
+            raise RuntimeError("AsyncFindServiceByType did not return within %d s" % (FIND_TIMEOUT_S * 2))
         services = []
-        for s in RRN.FindServiceByType(args.type, ["rr+tcp"]):
+        for s in found:
             services.append({"name": s.Name, "nodename": s.NodeName, "nodeid": str(s.NodeID),
                              "root_object_type": s.RootObjectType,
                              "implements": list(s.RootObjectImplements), "urls": list(s.ConnectionURL)})
@@ -124,7 +145,8 @@ def find(args):
 def call(args):
     import RobotRaconteur as RR
     RRN = RR.RobotRaconteurNode.s
-    with RR.ClientNodeSetup():
+    with RR.ClientNodeSetup() as setup:
+        official_transport.set_connect_timeout(setup.tcp_transport)
         try:
             c = RRN.ConnectService(args.url)
             try:

@@ -9,10 +9,14 @@ at once on 2 vCPUs beside sanitizer builds) it took longer and `ConnectService` 
 CONNECT_TIMEOUT_S = 60
 
 
+def set_connect_timeout(transport):
+    """Gives a TcpTransport (e.g. a node setup's `tcp_transport`) the test's connect timeout."""
+    # (milliseconds as an int: the property's setter passes a float, which the binding refuses)
+    transport._SetDefaultConnectTimeout(int(CONNECT_TIMEOUT_S * 1000))
+    return transport
+
+
 def client_tcp_transport(RR):
     """A TcpTransport (rr+tcp, rr+ws, rr+wss) of the node singleton with the test's connect timeout;
     the caller registers it."""
-    t = RR.TcpTransport()
-    # (milliseconds as an int: the property's setter passes a float, which the binding refuses)
-    t._SetDefaultConnectTimeout(int(CONNECT_TIMEOUT_S * 1000))
-    return t
+    return set_connect_timeout(RR.TcpTransport())

@@ -30,6 +30,10 @@ import urllib.request
 
 from child_procs import stop
 
+# A bound on a hang of a start (the device's and the gateway's ready lines, /readyz), never an expected
+# time: ASan processes beside a loaded CI run (load 30-50) took over 30 s to print their ready line.
+START_S = 180
+
 
 def forget_node_names(names, nodeids):
     """Removes what nodes of these NodeNames / NodeIDs leave in this user's node directories (the
@@ -95,7 +99,7 @@ def main():
     ready, dev_info = {}, {}
     try:
         device = subprocess.Popen(shlex.split(a.device_cmd.replace("{unique}", unique)), stdout=subprocess.PIPE, text=True)
-        dev_info = read_json_line(device, keys[0], 60)
+        dev_info = read_json_line(device, keys[0], START_S)
         flags = []
         if a.auth == "passthrough":
             import json
@@ -114,12 +118,12 @@ def main():
         local = ["--robotraconteur-nodename", gateway_name] if scheme.startswith("local") else ["--no-local"]
         gateway = subprocess.Popen([a.gateway, "--no-demo", "--listen", "127.0.0.1", "--port", "0", "--log-level",
                                     "warning"] + local + flags, stdout=subprocess.PIPE, text=True)
-        ready = read_json_line(gateway, "port", 30)
+        ready = read_json_line(gateway, "port", START_S)
         port = ready["port"]
-        deadline = time.time() + 20
+        deadline = time.time() + START_S
         while True:
             try:
-                with urllib.request.urlopen("http://127.0.0.1:%d/readyz" % port, timeout=2) as r:
+                with urllib.request.urlopen("http://127.0.0.1:%d/readyz" % port, timeout=30) as r:
                     if r.status == 200:
                         break
             except Exception:
