@@ -20,7 +20,6 @@ Usage: ws_conformance_test.py --gateway PATH [--group N ...]
 Prints one line per check and a JSON summary; exit status 0 only if every check passed.
 """
 import argparse
-import base64
 import json
 import os
 import socket
@@ -31,6 +30,7 @@ import uuid
 
 import gwproc
 from gwproc import expect
+from ws_handshake import open_handshake
 
 RR_SUBPROTOCOL = "robotraconteur.robotraconteur.com"
 JSON_SUBPROTOCOL = "rr-gateway.json.v1"
@@ -52,28 +52,7 @@ class RawWs:
 
     def __init__(self, port, subprotocol, extensions=None, timeout=10.0):
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
-        key = base64.b64encode(os.urandom(16)).decode()
-        lines = ["GET / HTTP/1.1", "Host: 127.0.0.1:%d" % port, "Upgrade: websocket", "Connection: Upgrade",
-                 "Sec-WebSocket-Key: " + key, "Sec-WebSocket-Version: 13"]
-        if subprotocol:
-            lines.append("Sec-WebSocket-Protocol: " + subprotocol)
-        if extensions:
-            lines.append("Sec-WebSocket-Extensions: " + extensions)
-        self.sock.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
-        head = b""
-        while b"\r\n\r\n" not in head:
-            chunk = self.sock.recv(4096)
-            if not chunk:
-                raise AssertionError("connection closed during the handshake: %r" % head)
-            head += chunk
-        head, self.buf = head.split(b"\r\n\r\n", 1)
-        status = head.split(b"\r\n")[0]
-        if b" 101 " not in status + b" ":
-            raise AssertionError("handshake refused: %r" % status)
-        self.headers = {}
-        for line in head.split(b"\r\n")[1:]:
-            k, _, v = line.decode("latin-1").partition(":")
-            self.headers[k.strip().lower()] = v.strip()
+        self.headers, self.buf = open_handshake(self.sock, port, "/", subprotocol, extensions)
         self.close_code = None
 
     # -- writing

@@ -14,7 +14,6 @@ Usage: ws_deflate_test.py --gateway PATH
 Exit: 0 all checks passed, 1 a check failed.
 """
 import argparse
-import base64
 import json
 import os
 import socket
@@ -25,6 +24,7 @@ import zlib
 
 import gwproc
 from gwproc import expect
+from ws_handshake import open_handshake
 
 JSON_SUBPROTOCOL = "rr-gateway.json.v1"
 OP_TEXT, OP_BIN, OP_CLOSE, OP_PING = 1, 2, 8, 9
@@ -36,23 +36,7 @@ class DeflateWs:
 
     def __init__(self, port, path, offer=True, timeout=30.0):
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
-        lines = ["GET %s HTTP/1.1" % path, "Host: 127.0.0.1:%d" % port, "Upgrade: websocket",
-                 "Connection: Upgrade", "Sec-WebSocket-Key: " + base64.b64encode(os.urandom(16)).decode(),
-                 "Sec-WebSocket-Version: 13", "Sec-WebSocket-Protocol: " + JSON_SUBPROTOCOL]
-        if offer:
-            lines.append("Sec-WebSocket-Extensions: " + OFFER)
-        self.sock.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
-        head = b""
-        while b"\r\n\r\n" not in head:
-            chunk = self.sock.recv(4096)
-            expect(chunk, "connection closed during the handshake: %r" % head)
-            head += chunk
-        head, self.buf = head.split(b"\r\n\r\n", 1)
-        expect(b" 101 " in head.split(b"\r\n")[0] + b" ", "handshake refused: %r" % head[:200])
-        self.headers = {}
-        for line in head.split(b"\r\n")[1:]:
-            k, _, v = line.decode("latin-1").partition(":")
-            self.headers[k.strip().lower()] = v.strip()
+        self.headers, self.buf = open_handshake(self.sock, port, path, JSON_SUBPROTOCOL, OFFER if offer else None)
         # Context takeover: one inflater for every compressed message of the connection (RFC 7692 §7.2.2).
         self.inflater = zlib.decompressobj(-zlib.MAX_WBITS)
         self.next_id = 1
