@@ -318,6 +318,10 @@ def replay_phase(exe, work, path, rr_packets, props, tolerance_ms, checks):
         index, pos = [], 0
         for _, v in got:
             s = seq_of(v)[0]
+            # The pause at 0 left the first recorded packet on the wire; a listener that got it late (after
+            # played_at) then gets it again when play starts at 0: once, at the start, it is not disorder.
+            if index == [0] and s == seqs[0]:
+                continue
             while pos < len(seqs) and seqs[pos] != s:
                 pos += 1
             expect(pos < len(seqs), "replayed packet %d is a recorded one, in the recorded order" % s)
