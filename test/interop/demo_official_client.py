@@ -554,7 +554,7 @@ def main(argv=None):
         RRN.SetLogLevelFromEnvVariable()
         # The official client's request timeout (15 s) bounds a hang here, not a speed: a 230 KB
         # CaptureFrame under ASan at load 30+ exceeded it.
-        RRN.RequestTimeout = WAIT_S
+        RRN.RequestTimeout = int(WAIT_S)  # (an int: the setter multiplies by 1000, the binding wants uint32)
         RRN.RegisterTransport(official_transport.client_tcp_transport(RR))
         if create_url.startswith("rr+local:"):
             RRN.RegisterTransport(RR.LocalTransport())
