@@ -209,7 +209,8 @@ class Sampler(threading.Thread):
                 "other_threads_minflt_per_s": (s[-1][5] - s[0][5]) / dt}
 
 
-SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record", "rate", "uring")
+SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record", "rate", "uring", "ab",
+            "scale10k")
 # Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
 # allows by default (256); 0 lifts the limit.
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
@@ -369,23 +370,19 @@ def rate_section(exe, args, procs):
     return rows
 
 
-def uring_section(exe, args, procs):
-    """Issue 56's io_uring lever: the device's Ticks wire at 100 Hz to N JSON clients through this build's
-    gateway (Asio on epoll) and through the gateway of --uring-build (configured with -DRR_IO_URING=ON),
-    alternating within each round (A B, then B A), the same load generator and device for both, and the
-    plain-TCP floor (rr_bench_floor --fanout) once per round. A fresh gateway per row."""
+def gateway_pair_section(exe, other_exe, names, rounds, n, args, procs, what):
+    """Two gateways under the same load: the device's Ticks wire at 100 Hz to N JSON clients through this
+    build's gateway and through `other_exe`'s, alternating within each round (A B, then B A), the same
+    load generator and device for both, and the plain-TCP floor (rr_bench_floor --fanout) once per round.
+    A fresh gateway per row. Rows carry `backend` (the build's name in `names`) and `round`."""
     rows = []
-    uring_gateway = os.path.join(os.path.abspath(args.uring_build), "server", "app", "rr-gateway")
-    if not os.access(uring_gateway, os.X_OK):
-        raise SystemExit("--uring-build: %s is missing (cmake -DRR_IO_URING=ON, target rr-gateway)" % uring_gateway)
-    backends = [("epoll", exe), ("io_uring", dict(exe, **{"rr-gateway": uring_gateway}))]
+    backends = [(names[0], exe), (names[1], other_exe)]
     dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
     procs.append(dev)
     seconds = "3" if args.quick else "5"
-    n = args.uring_clients
-    for rnd in range(args.uring_rounds):
+    for rnd in range(rounds):
         for backend, gexe in (backends if rnd % 2 == 0 else list(reversed(backends))):
-            log("io_uring (round %d): %d JSON clients, gateway on %s" % (rnd + 1, n, backend))
+            log("%s (round %d): %d JSON clients, gateway %s" % (what, rnd + 1, n, backend))
             gw = gateway_proc(gexe, dev.ready["url"], name="rr-gateway (%s)" % backend, unlimited=True)
             procs.append(gw)
             got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout",
@@ -402,6 +399,85 @@ def uring_section(exe, args, procs):
             rows.append(f)
     dev.stop()
     procs.remove(dev)
+    return rows
+
+
+def uring_section(exe, args, procs):
+    """Issue 56's io_uring lever: this build's gateway (Asio on epoll) against the gateway of --uring-build
+    (configured with -DRR_IO_URING=ON), gateway_pair_section."""
+    uring_gateway = os.path.join(os.path.abspath(args.uring_build), "server", "app", "rr-gateway")
+    if not os.access(uring_gateway, os.X_OK):
+        raise SystemExit("--uring-build: %s is missing (cmake -DRR_IO_URING=ON, target rr-gateway)" % uring_gateway)
+    return gateway_pair_section(exe, dict(exe, **{"rr-gateway": uring_gateway}), ("epoll", "io_uring"), args.uring_rounds,
+                                args.uring_clients, args, procs, "io_uring")
+
+
+def ab_section(exe, args, procs):
+    """This build's gateway against another build's (--ab-gateway: e.g. a copy of the gateway from before a
+    change), gateway_pair_section: issue 56's gathered writes were measured so."""
+    other = os.path.abspath(args.ab_gateway)
+    if not os.access(other, os.X_OK):
+        raise SystemExit("--ab-gateway: %s is missing (copy an rr-gateway built from the base commit there)" % other)
+    names = tuple(x.strip() for x in args.ab_names.split(","))
+    if len(names) != 2:
+        raise SystemExit("--ab-names: two names, comma-separated")
+    return gateway_pair_section(exe, dict(exe, **{"rr-gateway": other}), names, args.ab_rounds, args.ab_clients, args,
+                                procs, "A/B")
+
+
+def scale10k_section(exe, args, procs):
+    """Issue 56's 10,000-connection row: N (default 10,000) idle JSON WebSockets on a fresh gateway (its
+    RSS before and with them), then N clients subscribed to a 1 Hz wire on another fresh gateway (CPU per
+    value, RSS per connection), then the plain-TCP floor of that traffic (N sockets, 1 write each per
+    second)."""
+    n = args.scale10k_clients
+    seconds = str(args.scale10k_seconds)
+    rows = []
+    dev = Proc([exe["rr_bench_service"], "--tick-hz", "1"], "bench_service (1 Hz)")
+    procs.append(dev)
+    gw = gateway_proc(exe, dev.ready["url"], "rr-gateway (idle %d)" % n, unlimited=True)
+    procs.append(gw)
+    log("scale10k: %d idle WebSocket connections" % n)
+    time.sleep(1.0)
+    base = proc_sample(gw.p.pid)[1]
+    lg = subprocess.Popen([exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "idle"],
+                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    row = json.loads(lg.stdout.readline())
+    time.sleep(2.0)
+    cpu0, loaded = proc_sample(gw.p.pid)
+    time.sleep(5.0)
+    cpu1, loaded_later = proc_sample(gw.p.pid)
+    lg.stdin.write("\n")
+    lg.stdin.flush()
+    lg.wait(120)
+    row.update({"mode": "idle", "gateway_rss_base_kib": base, "gateway_rss_kib": max(loaded, loaded_later),
+                "rss_per_connection_kib": (max(loaded, loaded_later) - base) / row["opened"] if row["opened"] else None,
+                "idle_cpu_pct": 100 * (cpu1 - cpu0) / 5.0})
+    rows.append(row)
+    gw.stop()
+    procs.remove(gw)
+
+    log("scale10k: %d JSON clients on a 1 Hz wire" % n)
+    gw = gateway_proc(exe, dev.ready["url"], "rr-gateway (1 Hz x %d)" % n, unlimited=True)
+    procs.append(gw)
+    time.sleep(1.0)
+    base = proc_sample(gw.p.pid)[1]
+    got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout",
+                             "--hz", "1", "--seconds", seconds],
+                  {"mode": "1 Hz", "path": "device->gateway->N x JSON", "server": "gateway", "gateway_rss_base_kib": base})
+    for r in got:
+        if r.get("server_rss_kib") and r.get("opened"):
+            r["rss_per_connection_kib"] = (r["server_rss_kib"] - base) / r["opened"]
+    rows += got
+    gw.stop()
+    procs.remove(gw)
+    dev.stop()
+    procs.remove(dev)
+    size = next((r.get("bytes_per_value") for r in rows if r.get("bytes_per_value")), 128)
+    for f in run_rows([exe["rr_bench_floor"], "--fanout", str(n), "--seconds", seconds, "--hz", "1",
+                       "--bytes", str(max(16, int(round(size))))], timeout=600):
+        f["mode"] = "floor (plain TCP writes)"
+        rows.append(f)
     return rows
 
 
@@ -677,6 +753,13 @@ def main(argv=None):
                     help="the uring section's second build (cmake -DRR_IO_URING=ON; its rr-gateway is used)")
     ap.add_argument("--uring-rounds", type=int, default=2, help="rounds of the uring section (default 2)")
     ap.add_argument("--uring-clients", type=int, default=1000, help="JSON clients of the uring section (default 1000)")
+    ap.add_argument("--ab-gateway", default="build/base/server/app/rr-gateway",
+                    help="the ab section's other gateway (an rr-gateway built from the base commit)")
+    ap.add_argument("--ab-names", default="this build,base", help="the ab section's two names, comma-separated")
+    ap.add_argument("--ab-rounds", type=int, default=4, help="rounds of the ab section (default 4)")
+    ap.add_argument("--ab-clients", type=int, default=1000, help="JSON clients of the ab section (default 1000)")
+    ap.add_argument("--scale10k-clients", type=int, default=10000, help="connections of the scale10k section (default 10000)")
+    ap.add_argument("--scale10k-seconds", type=int, default=10, help="measuring window of its 1 Hz row (default 10)")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
     ap.add_argument("--pairs", action="store_true", help="also: issue 14's ratios from short interleaved blocks")
     ap.add_argument("--pair-blocks", type=int, default=24, help="blocks of the pairs section (default 24)")
@@ -703,6 +786,8 @@ def main(argv=None):
         args.record = "record" in only
         args.rate = "rate" in only
         args.uring = "uring" in only
+        args.ab = "ab" in only
+        args.scale10k = "scale10k" in only
         stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
     browser_rounds = args.rounds
 
@@ -711,7 +796,13 @@ def main(argv=None):
                                                     "rr_bench_rr_fanout")}
     exe["rr-gateway"] = os.path.join(b, "server", "app", "rr-gateway")
     soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
-    resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))  # children inherit it (10,000 sockets)
+    try:
+        # 10,000 sockets in one process, and the fan-out floor's 2 x 10,000: above a 20,000 hard limit
+        # when the bench may raise it (root, CAP_SYS_RESOURCE); children inherit it.
+        resource.setrlimit(resource.RLIMIT_NOFILE, (max(hard, 65536), max(hard, 65536)))
+    except (ValueError, OSError):
+        resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))
+    fd_limit = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
 
     started = time.time()
     result = {"started": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -865,6 +956,8 @@ def main(argv=None):
         record = record_section(exe, args, procs) if args.record else []
         rate = rate_section(exe, args, procs) if args.rate else []
         uring = uring_section(exe, args, procs) if getattr(args, "uring", False) else []
+        ab = ab_section(exe, args, procs) if getattr(args, "ab", False) else []
+        scale10k = scale10k_section(exe, args, procs) if getattr(args, "scale10k", False) else []
     finally:
         for p in reversed(procs):
             p.stop()
@@ -873,7 +966,7 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
-    result.update({"record": record, "rate": rate, "uring": uring})
+    result.update({"record": record, "rate": rate, "uring": uring, "ab": ab, "scale10k": scale10k, "fd_limit": fd_limit})
     result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser,
                    "pairs": pairs.get("figures", []), "pairs_raw": pairs.get("raw", [])})
     result["load_average_end"] = list(os.getloadavg())
@@ -1104,25 +1197,58 @@ def markdown(res):
                 fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0), fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000),
                 fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")), fmt(f.get("bytes_per_value")),
                 fmt(f["loadgen_cpu_pct"])))
-    if res.get("uring"):
-        out += ["", "The io_uring lever (issue 56): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket clients, "
-                "the gateway built on epoll (this build) and on io_uring (`-DRR_IO_URING=ON`), alternating, a fresh gateway "
-                "per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", "",
-                "| round | backend | clients | delivered/s | expected/s | delivered of sent | p50 ms | p99 ms | gateway CPU % "
-                "| gateway CPU µs / value | load generator CPU % |",
-                "|---|---|---|---|---|---|---|---|---|---|---|"]
-        for f in res["uring"]:
+    def pair_table(rows):
+        t = ["| round | backend | clients | delivered/s | expected/s | delivered of sent | p50 ms | p99 ms | gateway CPU % "
+             "| gateway CPU µs / value | load generator CPU % |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in rows:
             if f.get("backend", "").startswith("floor"):
                 sent = f.get("sent") or 0
-                out.append("| %s | %s | %s | %s | | %s | %s | %s | %s (writer) | %s (writer) | |" % (
+                t.append("| %s | %s | %s | %s | | %s | %s | %s | %s (writer) | %s (writer) | |" % (
                     f.get("round"), f["backend"], fmt(f.get("clients")), fmt(f.get("delivered_per_s"), 0),
                     "%.1f %%" % (100.0 * f.get("delivered", 0) / sent) if sent else "", fmt(f.get("p50_us", 0) / 1000),
                     fmt(f.get("p99_us", 0) / 1000), fmt(f.get("writer_cpu_pct")), fmt(f.get("writer_cpu_us_per_value"))))
                 continue
-            out.append("| %s | %s | %s | %s | %s | %.1f %% | %s | %s | %s | %s | %s |" % (
+            t.append("| %s | %s | %s | %s | %s | %.1f %% | %s | %s | %s | %s | %s |" % (
                 f.get("round"), f["backend"], fmt(f["clients"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
                 100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000),
                 fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")), fmt(f["loadgen_cpu_pct"])))
+        return t
+
+    if res.get("uring"):
+        out += ["", "The io_uring lever (issue 56): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket clients, "
+                "the gateway built on epoll (this build) and on io_uring (`-DRR_IO_URING=ON`), alternating, a fresh gateway "
+                "per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", ""] + pair_table(res["uring"])
+    if res.get("ab"):
+        out += ["", "Two gateways alternating (`--only ab`): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket "
+                "clients, this build's gateway and `--ab-gateway`, a fresh gateway per row; the floor is `rr_bench_floor "
+                "--fanout` (plain TCP writes) once per round:", ""] + pair_table(res["ab"])
+    if res.get("scale10k"):
+        out += ["", "10,000 connections (issue 56, `--only scale10k`; file-descriptor limit %s): idle JSON WebSockets on a "
+                "fresh gateway, then as many subscribed to a 1 Hz wire on another, then the plain-TCP floor of that traffic:"
+                % fmt(res.get("fd_limit")), "",
+                "| row | connections | delivered/s | expected/s | delivered of sent | p50 ms | p99 ms | gateway CPU % "
+                "| gateway CPU µs / value | gateway RSS before MiB | with them MiB | KiB per connection |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for f in res["scale10k"]:
+            mode = f.get("mode")
+            if mode == "idle":
+                out.append("| idle | %s | | | | | | %s | | %s | %s | %s |" % (
+                    fmt(f.get("opened")), fmt(f.get("idle_cpu_pct")), fmt(f["gateway_rss_base_kib"] / 1024),
+                    fmt(f["gateway_rss_kib"] / 1024), fmt(f.get("rss_per_connection_kib"))))
+            elif mode == "1 Hz":
+                out.append("| 1 Hz | %s | %s | %s | %.1f %% | %s | %s | %s | %s | %s | %s | %s |" % (
+                    fmt(f.get("opened", f.get("clients"))), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
+                    100 * f.get("delivered_of_sent", 0), fmt(f["p50_us"] / 1000), fmt(f["p99_us"] / 1000),
+                    fmt(f.get("server_cpu_pct")), fmt(f.get("server_cpu_us_per_value")),
+                    fmt(f.get("gateway_rss_base_kib", 0) / 1024), fmt(f.get("server_rss_kib", 0) / 1024),
+                    fmt(f.get("rss_per_connection_kib"))))
+            else:
+                sent = f.get("sent") or 0
+                out.append("| %s | %s | %s | | %s | %s | %s | %s (writer) | %s (writer) | | | |" % (
+                    mode, fmt(f.get("clients")), fmt(f.get("delivered_per_s"), 0),
+                    "%.1f %%" % (100.0 * f.get("delivered", 0) / sent) if sent else "", fmt(f.get("p50_us", 0) / 1000),
+                    fmt(f.get("p99_us", 0) / 1000), fmt(f.get("writer_cpu_pct")), fmt(f.get("writer_cpu_us_per_value"))))
     if res.get("record"):
         out += ["", "Recording while serving (issue 44): the camera row (640×480 RGB at 30 Hz, `robotraconteur` encoding) and a "
                 "1,000 values/s wire (`Ticks`, 16 doubles, both encodings), each to 10 JSON clients, without and with a recording "
