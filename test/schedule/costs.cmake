@@ -20,7 +20,7 @@ set_tests_properties("wasm-client: subscriptions reconnect (Chromium, straight t
 set_tests_properties("browser: two replicas behind nginx and HAProxy, one killed (Chromium)" PROPERTIES COST 48)
 set_tests_properties("docs: deployment.md steps run" PROPERTIES COST 48)
 set_tests_properties("wasm-client: rr-robdef ts types: tsc --strict, misuse rejected, typed programs against live services" PROPERTIES COST 47)
-set_tests_properties("interop: discovery between network namespaces" PROPERTIES COST 47)
+set_tests_properties("interop: discovery between network namespaces" PROPERTIES COST 95)
 set_tests_properties("gateway: official clients -> gateway (auth passthrough) -> official service: logins and locks" PROPERTIES COST 44)
 set_tests_properties("cli: rr -> our service" PROPERTIES COST 43)
 set_tests_properties("browser: dashboard asks only for what the gateway serves, no 404 in 30 s (Chromium)" PROPERTIES COST 43)
