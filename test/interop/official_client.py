@@ -655,7 +655,7 @@ def main(argv=None):
         rc = 0 if not failures else 1
         return rc
     finally:
-        watchdog2 = threading.Timer(10.0, lambda: os._exit(rc if rc else 4))
+        watchdog2 = threading.Timer(50.0, lambda: os._exit(rc if rc else 4))  # bounds Shutdown's hang (official_service.py)
         watchdog2.daemon = True
         watchdog2.start()
         RRN.Shutdown()
