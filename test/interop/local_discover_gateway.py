@@ -113,7 +113,7 @@ discover:
                     return d
             return None
 
-        d = wait_for(device, 30, "device local_interop connected")
+        d = wait_for(device, 60, "device local_interop connected")
         print("gateway picked up %s over rr+local in %.1f s: %s" % (name, time.monotonic() - t0, d["url"]), flush=True)
         if d["url"] != "rr+local:///?nodeid=%s&service=interop" % nodeid:
             fail("device URL %r" % d["url"])
@@ -142,16 +142,16 @@ discover:
         # The service stops: its entry is closed, the device goes (long before the 60 s expiry).
         t1 = time.monotonic()
         child_procs.stop(svc)
-        wait_for(lambda: all(x["name"] != "local_interop" for x in get_json(port, "/api/devices")), 20,
+        wait_for(lambda: all(x["name"] != "local_interop" for x in get_json(port, "/api/devices")), 45,
                  "device local_interop removed after the service stopped")
         print("device removed %.1f s after the service stopped" % (time.monotonic() - t1), flush=True)
         wait_for(lambda: any(m.get("kind") == "device_removed" and m["device"]["name"] == "local_interop"
-                             for m in pushes), 10, "device_removed for local_interop on the JSON WebSocket")
+                             for m in pushes), 30, "device_removed for local_interop on the JSON WebSocket")
         print("JSON WebSocket told: device_removed local_interop", flush=True)
 
         # The service comes back (same NodeName; the official node keeps its NodeID): so does the device.
         svc, sready = official(name, "official-again")
-        d = wait_for(device, 30, "device local_interop connected again after the service restarted")
+        d = wait_for(device, 60, "device local_interop connected again after the service restarted")
         if d["url"] != "rr+local:///?nodeid=%s&service=interop" % sready["nodeid"].strip("{}"):
             fail("device URL after the restart %r" % d["url"])
         print("device back after the service restarted: %s" % d["url"], flush=True)
@@ -165,7 +165,7 @@ discover:
         for i in (1, 2):
             p, r = official("%s.other%d" % (name, i), "other%d" % i)
             others[r["nodeid"].strip("{}")] = p
-        wait_for(lambda: one_devices() or None, 30, "a one_ device for the max: 1 entry")
+        wait_for(lambda: one_devices() or None, 60, "a one_ device for the max: 1 entry")
         time.sleep(3)  # both nodes are in the node directories by now; the second must not be added
         held = one_devices()
         if len(held) != 1:
@@ -176,7 +176,7 @@ discover:
         print("max: 1 holds one of two matching services: %s" % held[0]["url"], flush=True)
         child_procs.stop(others.pop(first_id))
         (second_id,) = others
-        wait_for(lambda: [x for x in one_devices() if second_id in x["url"] and x["state"] == "connected"] or None, 30,
+        wait_for(lambda: [x for x in one_devices() if second_id in x["url"] and x["state"] == "connected"] or None, 60,
                  "the max: 1 entry taking the other service after the first stopped")
         if len(one_devices()) != 1:
             fail("max: 1 entry after the switch: %r" % one_devices())

@@ -49,6 +49,7 @@ import gateway_front  # noqa: E402
 import testsvc_values as tv  # noqa: E402
 from testsvc_values import Lfsr, SEED, lfsr_json, to_json, from_json  # noqa: E402
 
+SERVICE_PATH_RELEASED = 5  # ClientServiceListenerEventType_ServicePathReleased
 TS1, TS2, TS3, TS5 = ("com.robotraconteur.testing.TestService%d" % i for i in (1, 2, 3, 5))
 
 
@@ -117,7 +118,30 @@ def check_table_properties(types, c, object_type, specials, log):
 
 def check_testroot(types, urls, log):
     url = urls["url"] + "?service=RobotRaconteurTestService"
-    c = RRN.ConnectService(url)
+    # The official client starts its next receive before it handles a message, so a
+    # ServicePathReleasedReq and the function reply sent after it can be handled on two threads in
+    # either order: o6_op() may return while get_o6() still finds the released proxy. Its listener
+    # reports the release once the proxy is gone; the o6 checks wait for that event.
+    released = []
+    released_cv = threading.Condition()
+
+    def on_client_event(_client, event, param):
+        if event == SERVICE_PATH_RELEASED:
+            with released_cv:
+                released.append(str(param))
+                released_cv.notify_all()
+
+    def o6_op(op, replaces_proxy=True):
+        with released_cv:
+            before = len(released)
+        c.o6_op(op)
+        if not replaces_proxy:
+            return
+        with released_cv:
+            if not released_cv.wait_for(lambda: any(p.endswith(".o6") for p in released[before:]), BOUND):
+                raise Failed("o6_op(%d): no ServicePathReleased for o6 within %.0f s" % (op, BOUND))
+
+    c = RRN.ConnectService(url, None, None, on_client_event)
     try:
         attrs = RRN.GetServiceAttributes(c)
         equal(attrs["test"].data, "This is a test attribute", "attribute test")
@@ -180,15 +204,15 @@ def check_testroot(types, urls, log):
         equal(o3.add(1.5), 43.5, "sub3.add")
         equal(o1.get_o2_3("x").s_ind, "x", "o2_3[x].s_ind")
         equal(c.get_o5().add_val(2), 3, "o5.add_val")
-        c.o6_op(0)
+        o6_op(0, replaces_proxy=False)  # no o6 proxy yet: maybe nothing to release
         o6 = c.get_o6()
         o6.d1 = [0.0]
         o6.get_o2_1().data = "Hello world!"
-        c.o6_op(1)
+        o6_op(1)
         raises(Exception, lambda: setattr(o6, "d1", [0.0]), "released o6 (sub1)")
         o6b = c.get_o6()
         o6b.data = "now a sub2"
-        c.o6_op(2)
+        o6_op(2)
         raises(Exception, lambda: setattr(o6b, "data", "x"), "released o6 (sub2)")
         equal(c.get_o6().add_val(2), 3, "o6 as subobj")
         raises(RR.InvalidArgumentException, lambda: c.o6_op(7), "o6_op(7)")
