@@ -33,7 +33,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <vector>
+#include <list>
 #include <memory>
 #include <type_traits>
 #include <utility>
@@ -253,7 +253,10 @@ private:
         std::uint64_t accepted = 0, written = 0;  // bytes ever gathered / handed to the layer below from them
         bool in_flight = false;
         error_code error;
-        std::vector<Waiter> waiters;  // by `end` (one or two: Beast writes one frame at a time)
+        // By `end`; one or two (Beast writes one frame at a time). A list: Asio 1.81's any_completion_handler
+        // must not be move-assigned (its move assignment wraps the handler in another), as erasing from a
+        // vector would.
+        std::list<Waiter> waiters;
         std::size_t max_gathered = kDefaultMaxGathered;
         std::atomic<std::uint64_t> writes{0};
 
@@ -305,7 +308,7 @@ private:
             State& s = *self;
             while (!s.waiters.empty() && (s.error || s.waiters.front().end <= s.written)) {
                 Waiter w = std::move(s.waiters.front());
-                s.waiters.erase(s.waiters.begin());
+                s.waiters.pop_front();
                 if (w.flush) {
                     auto ex = boost::asio::get_associated_executor(w.on_flushed);
                     boost::asio::dispatch(ex, boost::asio::append(std::move(w.on_flushed), s.error));
