@@ -282,7 +282,7 @@ TEST_CASE("GatherStream: what the kernel does not take at once is written asynch
     CHECK(layer.idle());
 }
 
-TEST_CASE("GatherStream: the first write error is kept and given once to each waiter; later writes fail at once") {
+TEST_CASE("GatherStream: the first write error is kept and given once to each waiter, later writes fail at once") {
     WsPair<websocket::stream<GatherStream<beast::tcp_stream>>> pair;
     auto& layer = pair.server->next_layer();
     // The client resets the connection (SO_LINGER 0): the server's writes fail from the next one on.
@@ -344,7 +344,7 @@ TEST_CASE("GatherStream: a batch whose asynchronous write fails gives the error 
     CHECK(layer.error() == flush_ec);
 }
 
-TEST_CASE("GatherStream: a buffer that reaches max_gathered starts its write by itself; the rest follows in order") {
+TEST_CASE("GatherStream: a buffer that reaches max_gathered starts its write by itself, the rest follows in order") {
     WsPair<websocket::stream<GatherStream<beast::tcp_stream>>> pair;
     auto& layer = pair.server->next_layer();
     layer.max_gathered(100);
