@@ -19,14 +19,16 @@
 
 #include "server/http/gather_stream.hpp"
 
-namespace {
-
+// At namespace scope, as the other server tests (a unity build may put them in one translation unit).
 namespace asio = boost::asio;
 namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
-using error_code = boost::system::error_code;
+namespace websocket = boost::beast::websocket;
+using tcp = boost::asio::ip::tcp;
 using rr::server::http::GatherStream;
+
+namespace {
+
+using error_code = boost::system::error_code;
 
 /// A layer that takes at most `max_write` bytes per write (a kernel that takes part of what it is
 /// given, every time) and counts its writes.
