@@ -210,13 +210,13 @@ class Sampler(threading.Thread):
 
 
 SECTIONS = ("calls", "fanout", "scale", "rr-fanout", "camera", "browser", "pairs", "record", "rate", "uring", "ab",
-            "scale10k")
+            "gather", "scale10k")
 # Fan-out and scale open more connections from 127.0.0.1 than gateway.limits.connections_per_address
 # allows by default (256); 0 lifts the limit.
 UNLIMITED_CONFIG = "gateway:\n  limits:\n    connections_per_address: 0\n"
 
 
-def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=(), deflate=False):
+def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=(), deflate=False, gathered=None):
     argv = [*prefix, exe["rr-gateway"], "--no-demo", "--no-local", "--port", "0", "--log-level", "warning", "--device",
             "bench=" + device_url]
     if unlimited:
@@ -225,6 +225,8 @@ def gateway_proc(exe, device_url, name="rr-gateway", unlimited=False, prefix=(),
             f.write(UNLIMITED_CONFIG)
             if deflate:
                 f.write("  websocket_compression:\n    enabled: true\n")
+            if gathered is not None:
+                f.write("  websocket_gathered_writes: %s\n" % ("true" if gathered else "false"))
         argv += ["--config", path]
     gw = Proc(argv, name)
     time.sleep(1.0)  # the gateway connects to its device
@@ -370,20 +372,21 @@ def rate_section(exe, args, procs):
     return rows
 
 
-def gateway_pair_section(exe, other_exe, names, rounds, n, args, procs, what):
+def gateway_pair_section(exe, other_exe, names, rounds, n, args, procs, what, gathered=(None, None)):
     """Two gateways under the same load: the device's Ticks wire at 100 Hz to N JSON clients through this
-    build's gateway and through `other_exe`'s, alternating within each round (A B, then B A), the same
-    load generator and device for both, and the plain-TCP floor (rr_bench_floor --fanout) once per round.
-    A fresh gateway per row. Rows carry `backend` (the build's name in `names`) and `round`."""
+    build's gateway and through `other_exe`'s (or the same one configured two ways: `gathered`, the
+    gateway.websocket_gathered_writes of each, None = its default), alternating within each round (A B,
+    then B A), the same load generator and device for both, and the plain-TCP floor (rr_bench_floor
+    --fanout) once per round. A fresh gateway per row. Rows carry `backend` (the name in `names`) and `round`."""
     rows = []
-    backends = [(names[0], exe), (names[1], other_exe)]
+    backends = [(names[0], exe, gathered[0]), (names[1], other_exe, gathered[1])]
     dev = Proc([exe["rr_bench_service"], "--tick-hz", "100"], "bench_service (100 Hz)")
     procs.append(dev)
     seconds = "3" if args.quick else "5"
     for rnd in range(rounds):
-        for backend, gexe in (backends if rnd % 2 == 0 else list(reversed(backends))):
+        for backend, gexe, gather in (backends if rnd % 2 == 0 else list(reversed(backends))):
             log("%s (round %d): %d JSON clients, gateway %s" % (what, rnd + 1, n, backend))
-            gw = gateway_proc(gexe, dev.ready["url"], name="rr-gateway (%s)" % backend, unlimited=True)
+            gw = gateway_proc(gexe, dev.ready["url"], name="rr-gateway (%s)" % backend, unlimited=True, gathered=gather)
             procs.append(gw)
             got = sampled(gw.p.pid, [exe["rr_bench_ws_load"], "--port", str(gw.ready["port"]), "--clients", str(n), "fanout",
                                      "--hz", "100", "--seconds", seconds],
@@ -423,6 +426,13 @@ def ab_section(exe, args, procs):
         raise SystemExit("--ab-names: two names, comma-separated")
     return gateway_pair_section(exe, dict(exe, **{"rr-gateway": other}), names, args.ab_rounds, args.ab_clients, args,
                                 procs, "A/B")
+
+
+def gather_section(exe, args, procs):
+    """Issue 56's gathered writes: this build's gateway with gateway.websocket_gathered_writes true and
+    false (one write per message, as before the lever), gateway_pair_section."""
+    return gateway_pair_section(exe, exe, ("gathered", "one write per message"), args.gather_rounds, args.gather_clients,
+                                args, procs, "gather", gathered=(True, False))
 
 
 def scale10k_section(exe, args, procs):
@@ -758,6 +768,8 @@ def main(argv=None):
     ap.add_argument("--ab-names", default="this build,base", help="the ab section's two names, comma-separated")
     ap.add_argument("--ab-rounds", type=int, default=4, help="rounds of the ab section (default 4)")
     ap.add_argument("--ab-clients", type=int, default=1000, help="JSON clients of the ab section (default 1000)")
+    ap.add_argument("--gather-rounds", type=int, default=4, help="rounds of the gather section (default 4)")
+    ap.add_argument("--gather-clients", type=int, default=1000, help="JSON clients of the gather section (default 1000)")
     ap.add_argument("--scale10k-clients", type=int, default=10000, help="connections of the scale10k section (default 10000)")
     ap.add_argument("--scale10k-seconds", type=int, default=10, help="measuring window of its 1 Hz row (default 10)")
     ap.add_argument("--browser-count", type=int, default=2000, help="calls per op and round in the browser row")
@@ -787,6 +799,7 @@ def main(argv=None):
         args.rate = "rate" in only
         args.uring = "uring" in only
         args.ab = "ab" in only
+        args.gather = "gather" in only
         args.scale10k = "scale10k" in only
         stem = "latest-" + "-".join(only)  # a partial run does not replace the suite's latest.*
     browser_rounds = args.rounds
@@ -957,6 +970,7 @@ def main(argv=None):
         rate = rate_section(exe, args, procs) if args.rate else []
         uring = uring_section(exe, args, procs) if getattr(args, "uring", False) else []
         ab = ab_section(exe, args, procs) if getattr(args, "ab", False) else []
+        gather = gather_section(exe, args, procs) if getattr(args, "gather", False) else []
         scale10k = scale10k_section(exe, args, procs) if getattr(args, "scale10k", False) else []
     finally:
         for p in reversed(procs):
@@ -966,7 +980,8 @@ def main(argv=None):
             p.wait()
 
     result.update(summarize(raw, fanout, scale))
-    result.update({"record": record, "rate": rate, "uring": uring, "ab": ab, "scale10k": scale10k, "fd_limit": fd_limit})
+    result.update({"record": record, "rate": rate, "uring": uring, "ab": ab, "gather": gather, "scale10k": scale10k,
+                   "fd_limit": fd_limit})
     result.update({"rr_fanout": rr_fanout, "camera": camera, "browser": summarize_browser(browser), "browser_raw": browser,
                    "pairs": pairs.get("figures", []), "pairs_raw": pairs.get("raw", [])})
     result["load_average_end"] = list(os.getloadavg())
@@ -1223,6 +1238,11 @@ def markdown(res):
         out += ["", "Two gateways alternating (`--only ab`): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket "
                 "clients, this build's gateway and `--ab-gateway`, a fresh gateway per row; the floor is `rr_bench_floor "
                 "--fanout` (plain TCP writes) once per round:", ""] + pair_table(res["ab"])
+    if res.get("gather"):
+        out += ["", "Gathered writes (issue 56, `--only gather`): the device's `Ticks` wire at 100 Hz → gateway → N JSON "
+                "WebSocket clients, the same gateway with `gateway.websocket_gathered_writes` true and false, alternating, a "
+                "fresh gateway per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", ""] + \
+            pair_table(res["gather"])
     if res.get("scale10k"):
         out += ["", "10,000 connections (issue 56, `--only scale10k`; file-descriptor limit %s): idle JSON WebSockets on a "
                 "fresh gateway, then as many subscribed to a 1 Hz wire on another, then the plain-TCP floor of that traffic:"

@@ -363,6 +363,7 @@ Result<std::unique_ptr<Gateway>> Gateway::start(GatewayConfig config, DemoStarte
     hopts.static_root = c.web_root;
     hopts.websocket_deflate = c.websocket_compression.enabled;
     hopts.websocket_deflate_paths = c.websocket_compression.paths;
+    hopts.websocket_gathered_writes = c.websocket_gathered_writes;
     for (const auto& p : c.trusted_proxies)
         if (auto n = http::parse_ip_network(p)) hopts.trusted_proxies.push_back(*n);
     hopts.on_websocket = [](const std::string& line) { log(LogLevel::info, line); };

@@ -645,7 +645,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
     if (auto g = root["gateway"]) {
         r.check_keys(g, "gateway",
                      {"listen", "port", "node_name", "node_id", "threads", "web_root", "allowed_origins", "trusted_proxies",
-                      "websocket_compression", "max_message_size", "log_level", "log_format", "local", "tls", "auth", "limits"});
+                      "websocket_compression", "websocket_gathered_writes", "max_message_size", "log_level", "log_format",
+                      "local", "tls", "auth", "limits"});
         if (auto l = g["limits"]) parse_limits(l, r, c.limits);
         if (auto a = g["auth"]) parse_auth(a, r, c.auth);
         if (auto n = g["listen"]) c.listen = r.string(n, "gateway.listen");
@@ -683,6 +684,8 @@ GatewayConfig parse(const YAML::Node& root, const Reader& r) {
                         r.error(n, "gateway.websocket_compression.paths", "\"" + p + "\" is not a request path (\"/…\", no query)");
             }
         }
+        if (auto n = g["websocket_gathered_writes"])
+            c.websocket_gathered_writes = r.boolean(n, "gateway.websocket_gathered_writes");
         if (auto n = g["max_message_size"]) {
             c.max_message_size = r.unsigned_int(n, "gateway.max_message_size", 100u * 1024u * 1024u);
             if (c.max_message_size < 16 * 1024) r.error(n, "gateway.max_message_size", "must be at least 16384");

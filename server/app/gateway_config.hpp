@@ -170,6 +170,10 @@ struct GatewayConfig {
         bool enabled = false;
         std::vector<std::string> paths;
     } websocket_compression;
+    /// Gathered writes on JSON WebSockets (issue 56): the messages waiting for one client leave in one
+    /// kernel write (http::HttpOptions::websocket_gathered_writes). On by default; false writes each
+    /// message with its own asynchronous write (the A/B switch of bench/run.py --only gather).
+    bool websocket_gathered_writes = true;
     std::size_t max_message_size = 12u * 1024u * 1024u;
     std::string log_level = "info";
     /// "text" (one line per message) or "json" (one object per line: time, level, message, device,

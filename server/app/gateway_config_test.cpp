@@ -316,6 +316,16 @@ TEST_CASE("gateway.trusted_proxies and --trusted-proxy take addresses and CIDR r
     CHECK_THAT(applied.error().message, Catch::Contains("--trusted-proxy"));
 }
 
+TEST_CASE("gateway.websocket_gathered_writes: on by default, off when set false, a boolean only") {
+    auto none = parse_gateway_config("gateway:\n  port: 8080\n", "t.yaml");
+    REQUIRE(none);
+    CHECK(none->websocket_gathered_writes);
+    auto off = parse_gateway_config("gateway:\n  websocket_gathered_writes: false\n", "t.yaml");
+    REQUIRE(off);
+    CHECK_FALSE(off->websocket_gathered_writes);
+    check_refused("gateway:\n  websocket_gathered_writes: sometimes\n", "bad.yaml:2");
+}
+
 TEST_CASE("gateway.websocket_compression: off by default, on for the listener or for paths, bad paths refused") {
     auto none = parse_gateway_config("", "t.yaml");
     REQUIRE(none);

@@ -112,6 +112,10 @@ public:
     virtual std::size_t queued_bytes() const { return 0; }
     /// Messages dropped because the queue was full (HttpOptions::json_socket_queue_limit).
     virtual std::uint64_t dropped() const { return 0; }
+    /// Writes handed to the kernel (or the TLS layer) for this socket's messages and control frames,
+    /// since it opened (HttpOptions::websocket_gathered_writes: fewer than the messages when several
+    /// waited together). Thread-safe; for tests and diagnostics.
+    virtual std::uint64_t writes() const { return 0; }
     /// Probes the client (the gateway while it holds a motion without a timeout of its own): a ping every
     /// `timeout` / 5, and the socket ends (on_close) when no frame at all, pong or message, arrives for
     /// `timeout`. nullopt: off. Thread-safe.
@@ -145,6 +149,10 @@ struct HttpOptions {
     /// below one. Never for raw RR WebSockets; binary messages are never compressed.
     bool websocket_deflate = false;
     std::vector<std::string> websocket_deflate_paths;
+    /// Gathered writes on JSON-subprotocol WebSockets (issue 56): every message waiting for one socket
+    /// (up to 64 KiB of them, each of at most 16 KiB) is framed by Beast into one buffer and handed to
+    /// the kernel with one non-blocking write, instead of one asynchronous write per message (gather_stream.hpp).
+    bool websocket_gathered_writes = true;
     /// Called once per accepted WebSocket with a line for the log: kind, client, and the proxy when the
     /// client came through a trusted one (`WebSocket rr from 198.51.100.1 (https, via 10.0.0.1:5123)`).
     std::function<void(const std::string&)> on_websocket;

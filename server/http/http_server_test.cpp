@@ -77,7 +77,8 @@ struct Fixture {
     std::shared_ptr<SocketSlot> burst_socket = std::make_shared<SocketSlot>();
 
     explicit Fixture(std::vector<std::string> trusted_proxies = {},
-                     std::size_t queue_limit = http::HttpOptions{}.json_socket_queue_limit) {
+                     std::size_t queue_limit = http::HttpOptions{}.json_socket_queue_limit,
+                     bool gathered_writes = http::HttpOptions{}.websocket_gathered_writes) {
         std::filesystem::create_directories(root / "sub");
         std::ofstream(root / "index.html") << "<h1>dash</h1>";
         std::ofstream(root / "sub" / "app.wasm") << "wasm";
@@ -85,6 +86,7 @@ struct Fixture {
         opts.allowed_origins = {"http://localhost:8080", "http://*.example.org"};
         opts.static_root = root.string();
         opts.json_socket_queue_limit = queue_limit;
+        opts.websocket_gathered_writes = gathered_writes;
         for (const auto& p : trusted_proxies) opts.trusted_proxies.push_back(*http::parse_ip_network(p));
         opts.on_websocket = [log = ws_log, m = ws_log_mutex](const std::string& line) {
             std::lock_guard lock(*m);
@@ -425,6 +427,67 @@ TEST_CASE("a stopping server ends a JSON WebSocket that is reading and writing a
     }));
     f.server->go_away();
     CHECK(rr::testing::eventually([&] { return closed->load(); }));  // after the 1 s bound: the client never answers
+}
+
+namespace {
+
+/// Registers "test.push.many.v1": on a message, `count` small pushes ("m<n>") at once (the handler
+/// runs on the socket's strand: they reach its queue together), then close() when `close_after`;
+/// the socket is kept in `kept` after the pushes.
+void add_many_pushes(Fixture& f, int count, bool close_after, std::shared_ptr<Fixture::SocketSlot> kept) {
+    f.server->add_subprotocol("test.push.many.v1",
+                              http::JsonSocketHandler{{},
+                                                      [count, close_after, kept](const std::shared_ptr<http::JsonSocket>& s, std::string) {
+                                                          for (int i = 0; i < count; ++i) s->send("m" + std::to_string(i));
+                                                          if (close_after) s->close();
+                                                          kept->set(s);
+                                                      },
+                                                      {}});
+}
+
+/// Reads `count` pushes of add_many_pushes in order; false at the first one out of order.
+bool read_many_in_order(SubprotocolClient& client, int count) {
+    for (int i = 0; i < count; ++i)
+        if (client.read() != "m" + std::to_string(i)) return false;
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("a JSON WebSocket's pushes waiting together leave in fewer writes than messages, Beast's frames in order") {
+    for (bool gathered : {true, false}) {
+        INFO("websocket_gathered_writes " << gathered);
+        Fixture f({}, 1024, gathered);
+        auto kept = std::make_shared<Fixture::SocketSlot>();
+        add_many_pushes(f, 500, false, kept);
+        SubprotocolClient client(f.port, "test.push.many.v1", "go");
+        beast::get_lowest_layer(client.ws).expires_after(60s);  // a bound on a hang
+        CHECK(read_many_in_order(client, 500));
+        std::shared_ptr<http::JsonSocket> socket;
+        REQUIRE(rr::testing::eventually([&] { return (socket = kept->get()) != nullptr; }));
+        // The handshake's response, then the pushes: gathered, ~4 KiB of frames in a write or two (one
+        // batch, or two when the strand took the first pushes before the rest arrived); without the
+        // gathering, one write each.
+        if (gathered)
+            CHECK(socket->writes() < 10);
+        else
+            CHECK(socket->writes() >= 500);
+        CHECK(rr::testing::eventually([&] { return socket->queued() == 0 && socket->queued_bytes() == 0; }));
+    }
+}
+
+TEST_CASE("a JSON WebSocket closed right after a batch of pushes sends the batch, then the close frame") {
+    Fixture f;
+    auto kept = std::make_shared<Fixture::SocketSlot>();
+    add_many_pushes(f, 300, true, kept);
+    SubprotocolClient client(f.port, "test.push.many.v1", "go");
+    beast::get_lowest_layer(client.ws).expires_after(60s);  // a bound on a hang
+    CHECK(read_many_in_order(client, 300));
+    beast::flat_buffer b;
+    beast::error_code ec;
+    client.ws.read(b, ec);
+    CHECK(ec == websocket::error::closed);
+    CHECK(client.ws.reason().code == websocket::close_code::normal);
 }
 
 TEST_CASE("an unknown subprotocol is refused with 426") {

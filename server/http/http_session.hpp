@@ -29,6 +29,7 @@
 
 #include "server/common/handler_memory.hpp"
 #include "server/common/read_throttle.hpp"
+#include "server/http/gather_stream.hpp"
 #include "server/http/http_server.hpp"
 #include "server/node/node.hpp"
 #include "server/transport/websocket_byte_stream.hpp"
@@ -133,19 +134,34 @@ private:
 /// them, woken once per batch: a value fanned out to many sockets costs each one a queued message and
 /// at most one wake, not a closure per message. The wake and the asynchronous write live in the
 /// session's HandlerMemory (issue 14: Asio's per-thread cache missed on every cross-thread hand-off).
+///
+/// Gathered writes (HttpOptions::websocket_gathered_writes, issue 56): every message waiting, up to
+/// kGatherBytes, is framed by Beast's synchronous write into the GatherStream below the WebSocket
+/// (a copy, no kernel call), then all of them leave in one non-blocking write; what the kernel does not
+/// take at once is written asynchronously before the next batch. Messages over kGatherMessageMax (camera
+/// frames, binary pushes of large arrays) keep Beast's asynchronous write from their own buffers.
 template <class Stream>
 class JsonWebSocketSession : public JsonSocket, public std::enable_shared_from_this<JsonWebSocketSession<Stream>> {
 public:
     using std::enable_shared_from_this<JsonWebSocketSession<Stream>>::shared_from_this;
 
-    JsonWebSocketSession(websocket::stream<Stream> ws, const JsonSocketHandler* handler, std::size_t limit,
+    using WebSocket = websocket::stream<GatherStream<Stream>>;
+    /// A message of at most this many bytes is gathered (copied); a larger one is written from its own buffers.
+    static constexpr std::size_t kGatherMessageMax = 16 * 1024;
+    /// A batch stops gathering once this many bytes wait (then flushes): at most this plus one message.
+    static constexpr std::size_t kGatherBytes = 64 * 1024;
+
+    JsonWebSocketSession(WebSocket ws, const JsonSocketHandler* handler, std::size_t limit, bool gather,
                          std::string peer, std::string cookie = {}, const std::shared_ptr<Node>& node = {},
                          std::string target = {}, std::string subprotocol = {})
-        : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), peer_(std::move(peer)),
+        : ws_(std::move(ws)), handler_(handler), limit_(std::max<std::size_t>(limit, 1)), gather_(gather), peer_(std::move(peer)),
           cookie_(std::move(cookie)), target_(std::move(target)), subprotocol_(std::move(subprotocol)),
           pacer_(node, ws_.get_executor()), probe_timer_(ws_.get_executor()), goodbye_timer_(ws_.get_executor()) {
         const auto executor = ws_.get_executor();
         if (const auto* io = executor.template target<IoStrand>()) io_strand_ = *io;
+        // The layer's own flush threshold stays above a batch (kGatherBytes plus one message and its
+        // frame header): a batch leaves with write_now(), not with a write the layer starts itself.
+        ws_.next_layer().max_gathered(kGatherBytes + kGatherMessageMax + 64);
     }
 
     void start() {
@@ -181,6 +197,7 @@ public:
     std::size_t queued() const override { return queued_count_.load(); }
     std::size_t queued_bytes() const override { return queued_bytes_.load(); }
     std::uint64_t dropped() const override { return dropped_.load(); }
+    std::uint64_t writes() const override { return ws_.next_layer().writes(); }
 
     void close() override {
         auto self = shared_from_this();
@@ -285,7 +302,7 @@ private:
             return;
         }
         // Slow reader: the oldest waiting push (else the oldest waiting message) is dropped, and counted.
-        const std::size_t busy = writing_ ? 1 : 0;
+        const std::size_t busy = front_in_flight_ ? 1 : 0;
         if (queue_.size() >= limit_ && queue_.size() > busy) drop_one(queue_, busy);
         if (queue_.full()) queue_.set_capacity(std::min(std::max<std::size_t>(8, 2 * queue_.capacity()), limit_ + 1));
         if (out.urgent)
@@ -398,13 +415,19 @@ private:
 
     void write() {
         if (writing_ || queue_.empty() || closed_) return;
+        // Gathered only while nothing else is on its way through the layer (a pong, a ping: Beast's own
+        // writes) and the WebSocket is open (no close frame sent: nothing may follow one).
+        if (gather_ && queue_.front().size() <= kGatherMessageMax && ws_.is_open() && ws_.next_layer().idle())
+            return write_gathered();
         writing_ = true;
+        front_in_flight_ = true;
         auto self = shared_from_this();
         const Outgoing& next = queue_.front();
         ws_.binary(next.binary);  // the message type of the next write
         ws_.compress(!next.binary);  // binary pushes (numeric arrays, images) are never deflated
         ws_.async_write(next.buffers(), asio::bind_allocator(allocator(), [self](beast::error_code ec, std::size_t) {
             self->writing_ = false;
+            self->front_in_flight_ = false;
             if (ec) {
                 self->finish();
                 while (!self->queue_.empty()) {  // the message whose write just ended, if finish() kept it
@@ -419,6 +442,60 @@ private:
         }));
     }
 
+    // Frames every small message waiting (up to kGatherBytes) into the layer, then writes them with one
+    // non-blocking write; the rest of that write, if any, asynchronously. The messages stay counted in
+    // queued() until their bytes are written.
+    void write_gathered() {
+        auto& layer = ws_.next_layer();
+        for (;;) {
+            std::size_t count = 0, bytes = 0;
+            beast::error_code ec;
+            while (!queue_.empty() && queue_.front().size() <= kGatherMessageMax && layer.gathered() < kGatherBytes) {
+                const Outgoing& m = queue_.front();
+                ws_.binary(m.binary);
+                ws_.compress(!m.binary);
+                ws_.write(m.buffers(), ec);  // Beast's frame, into the layer (never blocks)
+                if (ec) break;
+                ++count;
+                bytes += m.size();
+                queue_.pop_front();  // its bytes are in the layer now
+            }
+            if (!ec && layer.write_now(ec) && !ec) {
+                release(count, bytes);
+                if (queue_.empty() || closed_) return;
+                if (queue_.front().size() > kGatherMessageMax || !layer.idle()) return write();
+                continue;  // more than one batch was waiting
+            }
+            if (ec) {
+                release(count, bytes);
+                return fail_write();
+            }
+            writing_ = true;
+            auto self = shared_from_this();
+            layer.async_flush(asio::bind_allocator(allocator(), [self, count, bytes](beast::error_code ec) {
+                self->writing_ = false;
+                self->release(count, bytes);
+                if (ec) return self->fail_write();
+                self->write();
+            }));
+            return;
+        }
+    }
+
+    // A write failed: the session ends, and what waits is given back.
+    void fail_write() {
+        finish();
+        while (queue_.size() > (front_in_flight_ ? 1u : 0u)) {
+            unqueue(queue_.back());
+            queue_.pop_back();
+        }
+    }
+
+    void release(std::size_t count, std::size_t bytes) {
+        queued_count_.fetch_sub(count);
+        queued_bytes_.fetch_sub(bytes);
+    }
+
     void unqueue(const Outgoing& out) {
         queued_count_.fetch_sub(1);
         queued_bytes_.fetch_sub(out.size());
@@ -429,7 +506,7 @@ private:
         finished_ = true;
         closed_ = true;
         // A write in flight still reads the front message: it is released when that write completes.
-        while (queue_.size() > (writing_ ? 1u : 0u)) {
+        while (queue_.size() > (front_in_flight_ ? 1u : 0u)) {
             unqueue(queue_.back());
             queue_.pop_back();
         }
@@ -441,10 +518,11 @@ private:
     HandlerAllocator<void> allocator() const noexcept { return handler_memory_.allocator(); }
 
     ConnectionHandlerMemory handler_memory_;  // first member: see ConnectionHandlerMemory
-    websocket::stream<Stream> ws_;
+    WebSocket ws_;
     std::optional<IoStrand> io_strand_;  // the socket's strand, when it is one over an io_context
     const JsonSocketHandler* handler_;
     std::size_t limit_;
+    bool gather_;  // HttpOptions::websocket_gathered_writes
     std::string peer_;
     std::shared_ptr<const void> hold_;
     std::string cookie_;
@@ -454,11 +532,12 @@ private:
     std::vector<Outgoing> incoming_;  // sent, not yet taken by the strand; under incoming_mutex_
     bool wake_pending_ = false;       // under incoming_mutex_
     std::vector<Outgoing> taken_;     // the strand's: what the last wake took (its capacity is kept)
-    boost::circular_buffer<Outgoing> queue_;  // front: being written while writing_; grows to limit_ + 1
+    boost::circular_buffer<Outgoing> queue_;  // front: being written while front_in_flight_; grows to limit_ + 1
     std::atomic<std::size_t> queued_count_{0}, queued_bytes_{0};
     std::atomic<std::uint64_t> dropped_{0};
     ReadPacer pacer_;
-    bool writing_ = false;
+    bool writing_ = false;          // a write (Beast's asynchronous one, or a gathered batch's flush) is on its way
+    bool front_in_flight_ = false;  // that write reads queue_.front() (Beast's asynchronous write)
     bool closed_ = false;
     bool finished_ = false;
     // set_liveness_probe: the strand's.
@@ -652,35 +731,46 @@ private:
         info.web_login.assign(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
         info.hold = hold_;
         beast::get_lowest_layer(stream_).expires_never();
-        websocket::stream<Stream> ws(std::move(stream_));
-        ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
-            if (!chosen.empty()) res.set(bhttp::field::sec_websocket_protocol, chosen);
-        }));
-        ws.read_message_max(64u * 1024u * 1024u);
-        if (json && websocket_deflate_allowed(server_->options(), std::string_view(req.target().data(), req.target().size()))) {
-            // Negotiated only when the client offers it (the response then names the extension).
-            websocket::permessage_deflate pmd;
-            pmd.server_enable = true;
-            pmd.msg_size_threshold = 64;  // a smaller message does not get shorter
-            ws.set_option(pmd);
-        }
+        const bool deflate =
+            json && websocket_deflate_allowed(server_->options(), std::string_view(req.target().data(), req.target().size()));
+        auto setup = [&chosen, deflate](auto& ws) {
+            ws.set_option(websocket::stream_base::decorator([chosen](websocket::response_type& res) {
+                if (!chosen.empty()) res.set(bhttp::field::sec_websocket_protocol, chosen);
+            }));
+            ws.read_message_max(64u * 1024u * 1024u);
+            if (deflate) {
+                // Negotiated only when the client offers it (the response then names the extension).
+                websocket::permessage_deflate pmd;
+                pmd.server_enable = true;
+                pmd.msg_size_threshold = 64;  // a smaller message does not get shorter
+                ws.set_option(pmd);
+            }
+        };
         auto server = server_;
-        auto holder = std::make_shared<websocket::stream<Stream>>(std::move(ws));
-        const bool unnamed = protocols.empty();
         std::string cookie(req[bhttp::field::cookie].data(), req[bhttp::field::cookie].size());
         std::string target(req.target().data(), req.target().size());
-        holder->async_accept(req, [holder, server, json, peer, info, unnamed, cookie = std::move(cookie),
-                                   target = std::move(target), chosen](beast::error_code ec) {
-            if (ec) return;
-            if (json) {
-                auto s = std::make_shared<JsonWebSocketSession<Stream>>(std::move(*holder), json,
-                                                                server->options().json_socket_queue_limit, peer, cookie,
-                                                                server->node(), target, chosen);
+        if (json) {
+            // A JSON subprotocol: the session's writes go through the gather layer (JsonWebSocketSession).
+            using Session = JsonWebSocketSession<Stream>;
+            auto holder = std::make_shared<typename Session::WebSocket>(std::move(stream_));
+            setup(*holder);
+            holder->async_accept(req, [holder, server, json, peer, info, cookie = std::move(cookie),
+                                       target = std::move(target), chosen](beast::error_code ec) {
+                if (ec) return;
+                const auto& o = server->options();
+                auto s = std::make_shared<Session>(std::move(*holder), json, o.json_socket_queue_limit,
+                                                   o.websocket_gathered_writes, peer, cookie, server->node(), target, chosen);
                 s->keep(info.hold);
                 s->start();
                 server->track_socket(s);
-                return;
-            }
+            });
+            return;
+        }
+        auto holder = std::make_shared<websocket::stream<Stream>>(std::move(stream_));
+        setup(*holder);
+        const bool unnamed = protocols.empty();
+        holder->async_accept(req, [holder, server, info, unnamed](beast::error_code ec) {
+            if (ec) return;
             if (unnamed) return sniff_unnamed(holder, server, info);
             auto node = server->node();
             if (!node) return;
