@@ -5,6 +5,8 @@
 #
 #   scripts/build-lichtblick.sh SRC_DIR [OUT_DIR]
 #     SRC_DIR  a git work tree of Lichtblick (tested: 1.10.8, `git clone <lichtblick repo> SRC_DIR`)
+#              (1.28.1 did not install here: the npm registry reachable from these machines lacks
+#              flatbuffers_reflection 1.3.0 and @lichtblick/rosbag2 1.0.7, which 1.10.8 does not need)
 #     OUT_DIR  where the built app is copied (replaced if present); default ~/.cache/rr-gateway/lichtblick-web,
 #              where the test finds it without LICHTBLICK_WEB
 #   ctest --preset debug -R lichtblick     (or LICHTBLICK_WEB=OUT_DIR ctest ... for another folder)
