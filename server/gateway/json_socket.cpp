@@ -18,6 +18,7 @@
 #include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/rate_ticker.hpp"
+#include "server/gateway/wire_rate_groups.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
 
@@ -36,12 +37,13 @@ class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession>
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
                       boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options,
-                      std::shared_ptr<RateTicker> ticker)
+                      std::shared_ptr<RateTicker> ticker, std::shared_ptr<WireRateGroups> groups)
         : api_(std::move(api)),
           socket_(std::move(socket)),
           options_(options),
           timer_(executor),
           ticker_(std::move(ticker)),
+          groups_(std::move(groups)),
           subs_(options.max_subscriptions),
           convert_strand_(std::move(convert_strand)),
           pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {
@@ -425,11 +427,15 @@ private:
             return start_endpoint_subscription(id, sid, kind, t, t.device->mirror_service()->shared_endpoints());
 
         const bool is_wire = kind == SubscriptionKind::wire;
-        const std::uint64_t upstream = t.device->subscribe(
-            t.path, t.member->name, is_wire, value_handler(sid, is_wire),
-            [weak, sid, id](Result<void> r) {
-                if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
-            });
+        auto done = [weak, sid, id](Result<void> r) {
+            if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
+        };
+        // A rate-limited wire joins the rate group of its wire and rate (wire_rate_groups.hpp): one
+        // upstream subscription and one pending value for all of them, handed out once per window.
+        const bool grouped = is_wire && choice.max_rate_hz.has_value();
+        const std::uint64_t upstream =
+            grouped ? groups_->join(group_upstream(t), choice.rate_period, value_handler(sid, true), std::move(done))
+                    : t.device->subscribe(t.path, t.member->name, is_wire, value_handler(sid, is_wire), std::move(done));
         bool drop = false;
         {
             // `subscribed` may have run already (inside subscribe), or the socket closed meanwhile.
@@ -443,13 +449,28 @@ private:
             } else {
                 s->upstream_id = upstream;
                 s->upstream_known = true;
+                s->rate_group = grouped;
             }
         }
-        if (drop) t.device->unsubscribe(upstream);
+        if (drop) grouped ? groups_->leave(upstream) : t.device->unsubscribe(upstream);
+    }
+
+    // Where a rate group of `t`'s wire gets its values: the device's shared session.
+    static WireRateGroups::Upstream group_upstream(const MemberTarget& t) {
+        WireRateGroups::Upstream up;
+        up.source = t.device.get();
+        up.path = t.path;
+        up.member = t.member->name;
+        up.subscribe = [device = t.device, path = t.path, member = t.member->name](WireRateGroups::OnEntry on_entry,
+                                                                                  WireRateGroups::Done done) {
+            return device->subscribe(path, member, true, std::move(on_entry), std::move(done));
+        };
+        up.unsubscribe = [device = t.device](std::uint64_t id) { device->unsubscribe(id); };
+        return up;
     }
 
     void subscribed(std::uint64_t sid, const nlohmann::json& id, std::optional<ApiError> error) {
-        std::optional<std::pair<MemberTarget, std::uint64_t>> unsubscribe;
+        std::optional<JsonSubscription> unsubscribe;
         bool flush = false;
         {
             std::lock_guard lock(mutex_);
@@ -461,7 +482,7 @@ private:
             }
             if (error) {
                 if (s->upstream_known) {
-                    unsubscribe.emplace(*s->target, s->upstream_id);
+                    unsubscribe.emplace(*s);
                     subs_.erase(sid);
                 } else {
                     s->failed = true;
@@ -474,7 +495,7 @@ private:
                 flush = s->pending_wire != nullptr;
             }
         }
-        if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
+        if (unsubscribe) unsubscribe_upstream(*unsubscribe);
         if (flush) flush_wires();
     }
 
@@ -590,7 +611,9 @@ private:
     }
 
     void unsubscribe_upstream(const JsonSubscription& s) {
-        if (s.kind == SubscriptionKind::pipe)
+        if (s.rate_group)
+            groups_->leave(s.upstream_id);
+        else if (s.kind == SubscriptionKind::pipe)
             pipe_endpoints(*s.target, s.own)->close_pipe(s.upstream_id);
         else if (s.own)
             s.own->unsubscribe(s.upstream_id);
@@ -932,6 +955,7 @@ private:
     mutable std::mutex mutex_;
     boost::asio::steady_timer timer_;
     std::shared_ptr<RateTicker> ticker_;  // the server's: wakes rate-limited subscriptions at their windows
+    std::shared_ptr<WireRateGroups> groups_;  // the server's: rate-limited wires' shared values
     std::vector<RateClock> wakes_;        // periods the ticker will wake this socket at (under mutex_)
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
     std::vector<WireToSend> wire_batch_;  // flush_wires()' batch: used by the one flusher, outside mutex_
@@ -952,6 +976,7 @@ JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::an
       executor_(executor),
       convert_strand_(boost::asio::make_strand(executor)),
       ticker_(std::make_shared<RateTicker>(executor)),
+      groups_(WireRateGroups::create(executor)),
       options_(options) {}
 
 std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
@@ -1029,7 +1054,7 @@ http::JsonSocketHandler JsonSocketServer::handler() {
 }
 
 void JsonSocketServer::on_open(const std::shared_ptr<http::JsonSocket>& socket) {
-    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_, ticker_);
+    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_, ticker_, groups_);
     std::lock_guard lock(mutex_);
     sessions_[socket.get()] = std::move(session);
 }

@@ -75,6 +75,7 @@ struct JsonSocketStats {
 
 class JsonSocketSession;
 class RateTicker;
+class WireRateGroups;
 
 /// Serves the subprotocol: one JsonSocketSession per socket.
 class JsonSocketServer : public std::enable_shared_from_this<JsonSocketServer> {
@@ -104,6 +105,7 @@ private:
     boost::asio::any_io_executor executor_;
     ConvertStrand convert_strand_;
     std::shared_ptr<RateTicker> ticker_;  // one timer per rate for all sockets (rate_ticker.hpp)
+    std::shared_ptr<WireRateGroups> groups_;  // rate-limited wires: one value per wire and rate (wire_rate_groups.hpp)
     JsonSocketOptions options_;
     std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
     mutable std::mutex mutex_;

@@ -38,6 +38,7 @@ struct JsonSubscription {
     std::shared_ptr<SessionEndpoints> own;  ///< made on the socket's device_login session; null: the gateway's shared one
     std::uint64_t upstream_id = 0;  ///< DeviceMirror subscription id, internal pipe id, or `own`'s id
     bool upstream_known = false;    ///< upstream_id is set: ending the subscription must undo it
+    bool rate_group = false;        ///< a rate-limited wire: upstream_id is its WireRateGroups member id
     bool active = false;            ///< subscribe answered: pushes may go
     bool failed = false;            ///< subscribe failed before upstream_id was known
     SharedEntryPtr pending_wire;    ///< the newest wire value not yet sent
