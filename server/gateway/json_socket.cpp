@@ -434,7 +434,7 @@ private:
         // upstream subscription and one pending value for all of them, handed out once per window.
         const bool grouped = is_wire && choice.max_rate_hz.has_value();
         const std::uint64_t upstream =
-            grouped ? groups_->join(group_upstream(t), choice.rate_period, value_handler(sid, true), std::move(done))
+            grouped ? groups_->join(group_upstream(t), choice.rate_period, group_value_handler(sid), std::move(done))
                     : t.device->subscribe(t.path, t.member->name, is_wire, value_handler(sid, is_wire), std::move(done));
         bool drop = false;
         {
@@ -522,6 +522,14 @@ private:
                 s->on_wire(sid, e);
             else
                 s->on_event(sid, e);
+        };
+    }
+
+    // A rate group's member handler (wire_rate_groups.hpp): made once per subscription.
+    WireRateGroups::OnValue group_value_handler(std::uint64_t sid) {
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        return [weak, sid](const SharedEntryPtr& e, std::uint64_t coalesced) {
+            if (auto s = weak.lock()) s->on_wire(sid, e, coalesced);
         };
     }
 
@@ -866,14 +874,15 @@ private:
             send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
     }
 
-    void on_wire(std::uint64_t sid, const SharedEntryPtr& e) {
+    // `coalesced`: values its rate group replaced before this one (counted as this socket's too).
+    void on_wire(std::uint64_t sid, const SharedEntryPtr& e, std::uint64_t coalesced = 0) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) {
             on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));
             return;
         }
         {
             std::lock_guard lock(mutex_);
-            const Offered o = subs_.offer_wire(sid, e, rate_clock_now());
+            const Offered o = subs_.offer_wire(sid, e, rate_clock_now(), coalesced);
             if (!o.send_now) {
                 if (o.wait.count() > 0) wake_at_locked(o.wait);  // waits for its window
                 return;  // or not open, or waits for its subscribe reply
@@ -978,6 +987,8 @@ JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::an
       ticker_(std::make_shared<RateTicker>(executor)),
       groups_(WireRateGroups::create(executor)),
       options_(options) {}
+
+std::size_t JsonSocketServer::rate_groups() const { return groups_->groups(); }
 
 std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
                                                            boost::asio::any_io_executor executor,

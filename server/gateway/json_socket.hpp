@@ -91,6 +91,8 @@ public:
     /// One entry per open socket.
     std::vector<JsonSocketStats> stats() const;
     const JsonSocketOptions& options() const noexcept { return options_; }
+    /// Rate groups now: rate-limited wires' distinct (wire, max_rate_hz) pairs (wire_rate_groups.hpp).
+    std::size_t rate_groups() const;
 
 private:
     JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor, JsonSocketOptions options);

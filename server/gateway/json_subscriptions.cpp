@@ -88,9 +88,10 @@ void JsonSubscriptions::return_push(std::uint64_t sid, std::uint64_t ticket_drop
     ++push_drops_;
 }
 
-Offered JsonSubscriptions::offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now) {
+Offered JsonSubscriptions::offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now, std::uint64_t coalesced) {
     auto* s = find(sid);
     if (!s) return {};
+    wire_coalesced_ += coalesced;
     if (s->pending_wire) ++wire_coalesced_;
     s->pending_wire = std::move(value);  // newest wins
     if (!s->active) return {};

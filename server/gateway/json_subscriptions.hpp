@@ -113,7 +113,8 @@ public:
     /// `sid` is answered and its rate window is open at `now`; `wait` is the period of a rate-limited
     /// subscription whose value waits for its next window; neither when it waits for the reply, or
     /// `sid` is not open.
-    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {});
+    /// `coalesced`: values replaced before this one elsewhere (its rate group), counted here too.
+    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {}, std::uint64_t coalesced = 0);
     /// Whether an answered subscription has a wire value that may go at `now`.
     bool wires_waiting(RateClock now = {}) const;
     /// Moves the wire values of answered subscriptions that may go at `now` into `out` (cleared first),

@@ -13,7 +13,7 @@ namespace rr::server::gateway {
 struct WireRateGroups::Group {
     struct Member {
         std::uint64_t id = 0;
-        OnEntry on_value;
+        OnValue on_value;
     };
     using Members = std::shared_ptr<const std::vector<Member>>;  // copied on write: a hand-out takes a reference
 
@@ -31,6 +31,7 @@ struct WireRateGroups::Group {
     bool upstream_known = false;
     std::uint64_t upstream_id = 0;
     SharedEntryPtr pending;  // the newest value not handed out yet (waiting for the next window)
+    std::uint64_t replaced = 0;  // values replaced since the previous hand-out
     SharedEntryPtr last;     // the newest value, for members joining later
     boost::asio::steady_timer timer;
     bool armed = false;
@@ -63,9 +64,9 @@ namespace {
 
 // A value to every answered member of a group (outside its locks).
 template <class Members>
-void hand_out(const Members& members, const SharedEntryPtr& e, std::atomic<std::uint64_t>& handed) {
+void hand_out(const Members& members, const SharedEntryPtr& e, std::uint64_t coalesced, std::atomic<std::uint64_t>& handed) {
     handed.fetch_add(members.size(), std::memory_order_relaxed);
-    for (const auto& m : members) m.on_value(e);
+    for (const auto& m : members) m.on_value(e, coalesced);
 }
 
 }  // namespace
@@ -79,7 +80,7 @@ WireRateGroups::~WireRateGroups() {
     }
 }
 
-std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnEntry on_value, Done done) {
+std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue on_value, Done done) {
     std::shared_ptr<Group> g;
     bool create = false, ready_now = false;
     SharedEntryPtr last;
@@ -105,7 +106,7 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnEntry 
         }
     }
     if (ready_now) {
-        if (last) on_value(last);
+        if (last) on_value(last, 0);
         if (done) done({});
         return id;
     }
@@ -151,6 +152,7 @@ void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r)
             g->add(std::move(joined));
             last = g->last;
             g->pending = nullptr;  // `last` goes to every member now
+            g->replaced = 0;
         } else {
             g->ended = true;
             unsubscribe = g->upstream_known;
@@ -162,7 +164,7 @@ void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r)
         if (unsubscribe && g->unsubscribe) g->unsubscribe(up);
     }
     for (auto& [member, done] : waiting) {
-        if (r && last) member.on_value(last);
+        if (r && last) member.on_value(last, 0);
         if (done) done(r);
     }
 }
@@ -181,13 +183,14 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
             g->timer.cancel();
         }
         forget(g);
-        for (const auto& m : *members) m.on_value(e);
+        for (const auto& m : *members) m.on_value(e, 0);
         for (auto& [member, done] : waiting)
             if (done) done(fail(MessageErrorType::ConnectionError, "wire closed by the device"));
         return;
     }
     offers_.fetch_add(1, std::memory_order_relaxed);
     Group::Members members;
+    std::uint64_t replaced = 0;
     {
         std::lock_guard glock(g->mutex);
         if (g->ended) return;
@@ -196,13 +199,18 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
         if (g->ready && g->rate.open(now)) {
             g->rate.sent(now);
             g->pending = nullptr;
+            replaced = std::exchange(g->replaced, 0);
             members = g->members;
         } else {
-            g->pending = e;  // newest wins; before the wire holds, `last` goes to the members that wait
+            if (g->pending) {  // newest wins
+                ++g->replaced;
+                coalesced_.fetch_add(1, std::memory_order_relaxed);
+            }
+            g->pending = e;  // before the wire holds, `last` goes to the members that wait
             if (g->ready) arm(g);
         }
     }
-    if (members) hand_out(*members, e, handed_);
+    if (members) hand_out(*members, e, replaced, handed_);
 }
 
 void WireRateGroups::arm(const std::shared_ptr<Group>& g) {
@@ -223,6 +231,7 @@ void WireRateGroups::arm(const std::shared_ptr<Group>& g) {
 void WireRateGroups::on_window(const std::shared_ptr<Group>& g) {
     Group::Members members;
     SharedEntryPtr e;
+    std::uint64_t replaced = 0;
     {
         std::lock_guard glock(g->mutex);
         g->armed = false;
@@ -234,9 +243,10 @@ void WireRateGroups::on_window(const std::shared_ptr<Group>& g) {
         }
         g->rate.sent(now);
         e = std::exchange(g->pending, nullptr);
+        replaced = std::exchange(g->replaced, 0);
         members = g->members;
     }
-    hand_out(*members, e, handed_);
+    hand_out(*members, e, replaced, handed_);
 }
 
 void WireRateGroups::leave(std::uint64_t member) {
@@ -275,5 +285,6 @@ std::size_t WireRateGroups::groups() const {
 
 std::uint64_t WireRateGroups::offers() const noexcept { return offers_.load(std::memory_order_relaxed); }
 std::uint64_t WireRateGroups::handed() const noexcept { return handed_.load(std::memory_order_relaxed); }
+std::uint64_t WireRateGroups::coalesced() const noexcept { return coalesced_.load(std::memory_order_relaxed); }
 
 }  // namespace rr::server::gateway

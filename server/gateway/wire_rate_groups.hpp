@@ -35,6 +35,9 @@ class WireRateGroups : public std::enable_shared_from_this<WireRateGroups> {
 public:
     using OnEntry = std::function<void(const SharedEntryPtr&)>;
     using Done = std::function<void(Result<void>)>;
+    /// A member's handler: a value handed to it, with the number of values the group replaced unseen
+    /// since its previous hand-out (the same for every member; 0 with the WireClosed).
+    using OnValue = std::function<void(const SharedEntryPtr&, std::uint64_t coalesced)>;
 
     /// Where a group's values come from: the wire `member` at `path` of `source` (a DeviceMirror; only
     /// its address is the key), subscribed once per group (DeviceMirror::subscribe's contract: `done`
@@ -56,7 +59,7 @@ public:
     /// member). `done` is called once: at once when the group's wire holds (after `on_value` got the
     /// newest value, if any), else when it does or fails (the member is gone then). Returns the member's
     /// id for leave(). Call without holding locks `on_value` or `done` take.
-    std::uint64_t join(Upstream upstream, RateClock period, OnEntry on_value, Done done);
+    std::uint64_t join(Upstream upstream, RateClock period, OnValue on_value, Done done);
     /// The member leaves (unknown ids ignored); the last one's leaving unsubscribes the group upstream.
     /// A hand-out already under way may still call its `on_value` once (the members' list it walks is
     /// a snapshot): the handler must ignore a value for a subscription that has ended.
@@ -68,6 +71,8 @@ public:
     std::uint64_t offers() const noexcept;
     /// Values handed to members so far (one per window and member at most).
     std::uint64_t handed() const noexcept;
+    /// Values replaced in a group before they were handed out.
+    std::uint64_t coalesced() const noexcept;
 
 private:
     struct Group;
@@ -84,7 +89,7 @@ private:
     std::map<Key, std::shared_ptr<Group>> groups_;
     std::map<std::uint64_t, std::shared_ptr<Group>> members_;
     std::uint64_t next_member_ = 1;
-    std::atomic<std::uint64_t> offers_{0}, handed_{0};
+    std::atomic<std::uint64_t> offers_{0}, handed_{0}, coalesced_{0};
 };
 
 }  // namespace rr::server::gateway

@@ -69,8 +69,10 @@ struct Member {
     int done = 0;
     bool ok = false;
     bool closed = false;
-    WireRateGroups::OnEntry on_value() {
-        return [this](const SharedEntryPtr& e) {
+    std::uint64_t coalesced = 0;
+    WireRateGroups::OnValue on_value() {
+        return [this](const SharedEntryPtr& e, std::uint64_t n) {
+            coalesced += n;
             if (e->entry().entry_type == MessageEntryType::WireClosed) closed = true;
             else got.push_back(value_of(e));
         };
@@ -121,6 +123,9 @@ TEST_CASE("wire rate groups: 100 members of one wire and rate: one upstream subs
         CHECK(m.got.size() <= max_windows);
     }
     CHECK(groups->handed() == members.size() * members.front().got.size());
+    // What a member did not see was replaced in the group, and each member is told so.
+    CHECK(groups->coalesced() == 50 - members.front().got.size());
+    for (auto& m : members) CHECK(m.got.size() + m.coalesced == 50);
 
     // Every member leaving: the upstream subscription ends with the last.
     for (std::size_t i = 0; i + 1 < ids.size(); ++i) groups->leave(ids[i]);
