@@ -160,5 +160,5 @@ TEST_CASE("json socket rate: subscriptions of one wire at one rate form one rate
     CHECK(a.request(json{{"op", "unsubscribe"}, {"subscription", a5["result"]["subscription"]}}).contains("result"));
     CHECK(gw.sockets().rate_groups() == 1);
     b.close();
-    CHECK(eventually([&] { return gw.sockets().rate_groups() == 0; }));
+    CHECK(rr::testing::eventually([&] { return gw.sockets().rate_groups() == 0; }));
 }
