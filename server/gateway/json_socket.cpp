@@ -528,8 +528,8 @@ private:
     // A rate group's member handler (wire_rate_groups.hpp): made once per subscription.
     WireRateGroups::OnValue group_value_handler(std::uint64_t sid) {
         std::weak_ptr<JsonSocketSession> weak = weak_from_this();
-        return [weak, sid](const SharedEntryPtr& e, std::uint64_t coalesced) {
-            if (auto s = weak.lock()) s->on_wire(sid, e, coalesced);
+        return [weak, sid](const SharedEntryPtr& e, std::uint64_t coalesced, std::uint64_t seq) {
+            if (auto s = weak.lock()) s->on_wire(sid, e, coalesced, seq);
         };
     }
 
@@ -874,15 +874,16 @@ private:
             send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
     }
 
-    // `coalesced`: values its rate group replaced before this one (counted as this socket's too).
-    void on_wire(std::uint64_t sid, const SharedEntryPtr& e, std::uint64_t coalesced = 0) {
+    // `coalesced`: values its rate group replaced before this one (counted as this socket's too); `seq`:
+    // the value's place in its rate group's order (an older one handed out late is dropped), 0 outside one.
+    void on_wire(std::uint64_t sid, const SharedEntryPtr& e, std::uint64_t coalesced = 0, std::uint64_t seq = 0) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) {
             on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));
             return;
         }
         {
             std::lock_guard lock(mutex_);
-            const Offered o = subs_.offer_wire(sid, e, rate_clock_now(), coalesced);
+            const Offered o = subs_.offer_wire(sid, e, rate_clock_now(), coalesced, seq);
             if (!o.send_now) {
                 if (o.wait.count() > 0) wake_at_locked(o.wait);  // waits for its window
                 return;  // or not open, or waits for its subscribe reply

@@ -42,6 +42,7 @@ struct JsonSubscription {
     bool active = false;            ///< subscribe answered: pushes may go
     bool failed = false;            ///< subscribe failed before upstream_id was known
     SharedEntryPtr pending_wire;    ///< the newest wire value not yet sent
+    std::uint64_t wire_seq = 0;     ///< a rate group's member: the `seq` of the newest value it was offered
     std::uint64_t dropped = 0;      ///< pushes dropped since the last one sent
     RateWindow rate;                ///< "max_rate_hz": one value per window (unlimited by default)
     double max_rate_hz = 0;         ///< as the client asked (echoed in the reply)
@@ -114,7 +115,10 @@ public:
     /// subscription whose value waits for its next window; neither when it waits for the reply, or
     /// `sid` is not open.
     /// `coalesced`: values replaced before this one elsewhere (its rate group), counted here too.
-    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {}, std::uint64_t coalesced = 0);
+    /// `seq`: a rate group's order of its values (wire_rate_groups.hpp), 0 for none: a value whose `seq`
+    /// is not above that of one offered before is older than it and is dropped (counted as coalesced).
+    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {}, std::uint64_t coalesced = 0,
+                       std::uint64_t seq = 0);
     /// Whether an answered subscription has a wire value that may go at `now`.
     bool wires_waiting(RateClock now = {}) const;
     /// Moves the wire values of answered subscriptions that may go at `now` into `out` (cleared first),

@@ -30,6 +30,7 @@ struct WireRateGroups::Group {
     bool ended = false;  // failed, closed by the device, or left by its last member: forgotten
     bool upstream_known = false;
     std::uint64_t upstream_id = 0;
+    std::uint64_t seq = 0;   // values offered so far: the newest's place in the group's order
     SharedEntryPtr pending;  // the newest value not handed out yet (waiting for the next window)
     std::uint64_t replaced = 0;  // values replaced since the previous hand-out
     SharedEntryPtr last;     // the newest value, for members joining later
@@ -64,9 +65,10 @@ namespace {
 
 // A value to every answered member of a group (outside its locks).
 template <class Members>
-void hand_out(const Members& members, const SharedEntryPtr& e, std::uint64_t coalesced, std::atomic<std::uint64_t>& handed) {
+void hand_out(const Members& members, const SharedEntryPtr& e, std::uint64_t coalesced, std::uint64_t seq,
+              std::atomic<std::uint64_t>& handed) {
     handed.fetch_add(members.size(), std::memory_order_relaxed);
-    for (const auto& m : members) m.on_value(e, coalesced);
+    for (const auto& m : members) m.on_value(e, coalesced, seq);
 }
 
 }  // namespace
@@ -84,7 +86,7 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue 
     std::shared_ptr<Group> g;
     bool create = false, ready_now = false;
     SharedEntryPtr last;
-    std::uint64_t id = 0;
+    std::uint64_t id = 0, last_seq = 0;
     {
         std::lock_guard lock(mutex_);
         id = next_member_++;
@@ -100,13 +102,14 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue 
         if (g->ready) {
             g->add({Group::Member{id, on_value}});
             last = g->last;
+            last_seq = g->seq;
             ready_now = true;
         } else {
             g->waiting.emplace_back(Group::Member{id, on_value}, std::move(done));
         }
     }
     if (ready_now) {
-        if (last) on_value(last, 0);
+        if (last) on_value(last, 0, last_seq);  // a newer value's hand-out may have reached it already
         if (done) done({});
         return id;
     }
@@ -139,6 +142,7 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue 
 void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r) {
     std::vector<std::pair<Group::Member, Done>> waiting;
     SharedEntryPtr last;
+    std::uint64_t last_seq = 0;
     bool unsubscribe = false;
     std::uint64_t up = 0;
     {
@@ -151,6 +155,7 @@ void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r)
             for (const auto& w : waiting) joined.push_back(w.first);
             g->add(std::move(joined));
             last = g->last;
+            last_seq = g->seq;
             g->pending = nullptr;  // `last` goes to every member now
             g->replaced = 0;
         } else {
@@ -164,7 +169,7 @@ void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r)
         if (unsubscribe && g->unsubscribe) g->unsubscribe(up);
     }
     for (auto& [member, done] : waiting) {
-        if (r && last) member.on_value(last, 0);
+        if (r && last) member.on_value(last, 0, last_seq);  // (a newer one may have reached it already)
         if (done) done(r);
     }
 }
@@ -174,27 +179,30 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
         // The wire and its upstream subscription are gone: every member is told, the group forgotten.
         Group::Members members;
         std::vector<std::pair<Group::Member, Done>> waiting;
+        std::uint64_t seq = 0;
         {
             std::lock_guard glock(g->mutex);
             if (g->ended) return;
             g->ended = true;
+            seq = ++g->seq;
             members = g->members;
             waiting.swap(g->waiting);
             g->timer.cancel();
         }
         forget(g);
-        for (const auto& m : *members) m.on_value(e, 0);
+        for (const auto& m : *members) m.on_value(e, 0, seq);
         for (auto& [member, done] : waiting)
             if (done) done(fail(MessageErrorType::ConnectionError, "wire closed by the device"));
         return;
     }
     offers_.fetch_add(1, std::memory_order_relaxed);
     Group::Members members;
-    std::uint64_t replaced = 0;
+    std::uint64_t replaced = 0, seq = 0;
     {
         std::lock_guard glock(g->mutex);
         if (g->ended) return;
         g->last = e;
+        seq = ++g->seq;
         const RateClock now = rate_clock_now();
         if (g->ready && g->rate.open(now)) {
             g->rate.sent(now);
@@ -210,7 +218,7 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
             if (g->ready) arm(g);
         }
     }
-    if (members) hand_out(*members, e, replaced, handed_);
+    if (members) hand_out(*members, e, replaced, seq, handed_);
 }
 
 void WireRateGroups::arm(const std::shared_ptr<Group>& g) {
@@ -231,7 +239,7 @@ void WireRateGroups::arm(const std::shared_ptr<Group>& g) {
 void WireRateGroups::on_window(const std::shared_ptr<Group>& g) {
     Group::Members members;
     SharedEntryPtr e;
-    std::uint64_t replaced = 0;
+    std::uint64_t replaced = 0, seq = 0;
     {
         std::lock_guard glock(g->mutex);
         g->armed = false;
@@ -243,10 +251,11 @@ void WireRateGroups::on_window(const std::shared_ptr<Group>& g) {
         }
         g->rate.sent(now);
         e = std::exchange(g->pending, nullptr);
+        seq = g->seq;  // `pending` is always the newest value
         replaced = std::exchange(g->replaced, 0);
         members = g->members;
     }
-    hand_out(*members, e, replaced, handed_);
+    hand_out(*members, e, replaced, seq, handed_);
 }
 
 void WireRateGroups::leave(std::uint64_t member) {

@@ -10,6 +10,11 @@
 // last value always handed out (a value waiting arms the group's timer); a member joining a group
 // whose wire is connected gets the newest value at once. What a member does with a value (its socket's
 // backpressure, coalescing while it is behind) is its own affair: a slow socket never holds up the group.
+// Order: values are handed out outside the group's locks, from the device's strand (a value in an open
+// window), the group's timer (a window's start) and join() (the newest, to the member joining), so one
+// member can be handed an older value after a newer one (a member joining while a value arrives: the
+// value's own hand-out may reach it before join() hands it the one before). Each value carries its
+// place in the group's order (`seq`), and a member keeps only values newer than the newest it kept.
 // Thread-safe: values arrive on the device's strand, the timers run on `executor`, members join and
 // leave from their sockets.
 #pragma once
@@ -36,8 +41,11 @@ public:
     using OnEntry = std::function<void(const SharedEntryPtr&)>;
     using Done = std::function<void(Result<void>)>;
     /// A member's handler: a value handed to it, with the number of values the group replaced unseen
-    /// since its previous hand-out (the same for every member; 0 with the WireClosed).
-    using OnValue = std::function<void(const SharedEntryPtr&, std::uint64_t coalesced)>;
+    /// since its previous hand-out (the same for every member; 0 with the WireClosed), and `seq`, the
+    /// value's place in the group's order (its first value 1, each later one more; the WireClosed after
+    /// them all). A member may be handed an older value after a newer one (see Order above): it keeps a
+    /// value only when its `seq` is above that of every value it kept before.
+    using OnValue = std::function<void(const SharedEntryPtr&, std::uint64_t coalesced, std::uint64_t seq)>;
 
     /// Where a group's values come from: the wire `member` at `path` of `source` (a DeviceMirror; only
     /// its address is the key), subscribed once per group (DeviceMirror::subscribe's contract: `done`
