@@ -126,7 +126,7 @@ TEST_CASE("json socket rate: max_rate_hz on an event and queue_length on a wire 
     CHECK(stats[0].subscriptions == 1);
 }
 
-TEST_CASE("json socket rate: subscriptions of one wire at one rate form one rate group across sockets; each gets the last value; leaving ends the group") {
+TEST_CASE("json socket rate: subscriptions of one wire at one rate form one rate group across sockets, each gets the last value, leaving ends the group") {
     RR_SKIP_WITHOUT_INTEROP_SERVICE();
     InteropProcess device;
     TestGateway gw(device.url());

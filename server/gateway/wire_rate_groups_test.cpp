@@ -142,7 +142,7 @@ TEST_CASE("wire rate groups: 100 members of one wire and rate: one upstream subs
     CHECK(wire.subscribers.empty());
 }
 
-TEST_CASE("wire rate groups: two rates of one wire are two groups; a member joining later gets the newest value at once") {
+TEST_CASE("wire rate groups: two rates of one wire are two groups, and a member joining later gets the newest value at once") {
     boost::asio::io_context io;
     auto groups = WireRateGroups::create(io.get_executor());
     FakeWire wire;
@@ -173,7 +173,7 @@ TEST_CASE("wire rate groups: two rates of one wire are two groups; a member join
     CHECK(wire.unsubscribes == 1);  // `late` still holds the 1 s group
 }
 
-TEST_CASE("wire rate groups: members joining before the wire holds are answered together; a failure or the device's WireClosed ends the group") {
+TEST_CASE("wire rate groups: members joining before the wire holds are answered together, and a failure or the device's WireClosed ends the group") {
     boost::asio::io_context io;
     auto groups = WireRateGroups::create(io.get_executor());
     FakeWire wire;
@@ -209,7 +209,7 @@ TEST_CASE("wire rate groups: members joining before the wire holds are answered 
     CHECK(wire.unsubscribes == before + 1);
 }
 
-TEST_CASE("wire rate groups: a value arriving while the group hands its newest to joining members reaches some before the older one; its seq tells, and their socket sends only the newer") {
+TEST_CASE("wire rate groups: a value arriving while the group hands its newest to joining members reaches some before the older one: its seq tells, and their socket sends only the newer") {
     boost::asio::io_context io;
     auto groups = WireRateGroups::create(io.get_executor());
     FakeWire wire;
