@@ -17,9 +17,11 @@ using namespace rr;
 using namespace rr::server::gateway;
 using namespace std::chrono_literals;
 
-namespace {
+// Named, not anonymous: the TSan preset builds the tests as unity files (json_subscriptions_test.cpp
+// has a wire_value of its own).
+namespace wire_rate_groups_test {
 
-SharedEntryPtr wire_value(double v) {
+SharedEntryPtr packet_value(double v) {
     MessageEntry e;
     e.entry_type = MessageEntryType::WirePacket;
     e.elements.push_back(make_scalar_element<double>("packet", v));
@@ -99,7 +101,8 @@ void run_until(boost::asio::io_context& io, Pred until, std::chrono::millisecond
     }
 }
 
-}  // namespace
+}  // namespace wire_rate_groups_test
+using namespace wire_rate_groups_test;
 
 TEST_CASE("wire rate groups: 100 members of one wire and rate: one upstream subscription, each value offered once, the newest handed to every member once per window") {
     boost::asio::io_context io;
@@ -116,7 +119,7 @@ TEST_CASE("wire rate groups: 100 members of one wire and rate: one upstream subs
     // value waiting at its end (the windows on rate_window.hpp's grid).
     const RateWindow grid(100ms);
     const auto first_window = grid.window_start(rate_clock_now());
-    for (int i = 0; i < 50; ++i) wire.deliver(wire_value(i));
+    for (int i = 0; i < 50; ++i) wire.deliver(packet_value(i));
     const auto last_window = grid.window_start(rate_clock_now());
     CHECK(wire.calls == 50);        // the device called one subscriber per value, not 100
     CHECK(groups->offers() == 50);  // and the group took each once
@@ -151,8 +154,8 @@ TEST_CASE("wire rate groups: two rates of one wire are two groups, and a member 
     const auto b = groups->join(wire.upstream(), 20ms, fast.on_value(), fast.on_done());
     CHECK(wire.subscribes == 2);
     CHECK(groups->groups() == 2);
-    wire.deliver(wire_value(1));
-    wire.deliver(wire_value(2));
+    wire.deliver(packet_value(1));
+    wire.deliver(packet_value(2));
     CHECK(groups->offers() == 4);  // one per value and group
     CHECK(slow.got == std::vector<double>{1});  // each group's window was open: the first value at once
     CHECK(fast.got == std::vector<double>{1});
@@ -182,7 +185,7 @@ TEST_CASE("wire rate groups: members joining before the wire holds are answered 
     groups->join(wire.upstream(), 50ms, m1.on_value(), m1.on_done());
     groups->join(wire.upstream(), 50ms, m2.on_value(), m2.on_done());
     REQUIRE(wire.waiting.size() == 1);
-    wire.deliver(wire_value(7));  // before the wire holds: kept as the newest
+    wire.deliver(packet_value(7));  // before the wire holds: kept as the newest
     CHECK(m1.got.empty());
     wire.waiting.front()({});
     CHECK((m1.done == 1 && m1.ok && m2.done == 1 && m2.ok));
@@ -232,7 +235,7 @@ TEST_CASE("wire rate groups: a value arriving while the group hands its newest t
             // first has it, the second not yet.
             if (!second_delivered) {
                 second_delivered = true;
-                wire.deliver(wire_value(2));
+                wire.deliver(packet_value(2));
             }
         };
     };
@@ -248,7 +251,7 @@ TEST_CASE("wire rate groups: a value arriving while the group hands its newest t
     }
     for (auto sid : sids) groups->join(wire.upstream(), 50ms, socket_member(sid), [](Result<void>) {});
     REQUIRE(wire.waiting.size() == 1);
-    wire.deliver(wire_value(1));  // before the wire holds: the newest, for the members when it does
+    wire.deliver(packet_value(1));  // before the wire holds: the newest, for the members when it does
     wire.waiting.front()({});     // the wire holds: value 1 to each member, and value 2 arrives meanwhile
 
     CHECK(second_delivered);
