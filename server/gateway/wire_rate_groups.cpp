@@ -206,7 +206,11 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
         const RateClock now = rate_clock_now();
         if (g->ready && g->rate.open(now)) {
             g->rate.sent(now);
-            g->pending = nullptr;
+            if (g->pending) {  // a new window began before its timer handed the waiting value out
+                ++g->replaced;
+                coalesced_.fetch_add(1, std::memory_order_relaxed);
+                g->pending = nullptr;
+            }
             replaced = std::exchange(g->replaced, 0);
             members = g->members;
         } else {
