@@ -18,6 +18,7 @@
 #include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/mirror_service.hpp"
 #include "server/gateway/rate_ticker.hpp"
+#include "server/gateway/wire_rate_groups.hpp"
 #include "server/node/node.hpp"
 #include "server/service/wire_member.hpp"
 
@@ -36,12 +37,13 @@ class JsonSocketSession : public std::enable_shared_from_this<JsonSocketSession>
 public:
     JsonSocketSession(std::shared_ptr<JsonApi> api, std::shared_ptr<http::JsonSocket> socket,
                       boost::asio::any_io_executor executor, ConvertStrand convert_strand, const JsonSocketOptions& options,
-                      std::shared_ptr<RateTicker> ticker)
+                      std::shared_ptr<RateTicker> ticker, std::shared_ptr<WireRateGroups> groups)
         : api_(std::move(api)),
           socket_(std::move(socket)),
           options_(options),
           timer_(executor),
           ticker_(std::move(ticker)),
+          groups_(std::move(groups)),
           subs_(options.max_subscriptions),
           convert_strand_(std::move(convert_strand)),
           pipe_budget_(options.max_pipe_conversions, options.max_pipe_conversion_bytes) {
@@ -425,11 +427,15 @@ private:
             return start_endpoint_subscription(id, sid, kind, t, t.device->mirror_service()->shared_endpoints());
 
         const bool is_wire = kind == SubscriptionKind::wire;
-        const std::uint64_t upstream = t.device->subscribe(
-            t.path, t.member->name, is_wire, value_handler(sid, is_wire),
-            [weak, sid, id](Result<void> r) {
-                if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
-            });
+        auto done = [weak, sid, id](Result<void> r) {
+            if (auto s = weak.lock()) s->subscribed(sid, id, r ? std::nullopt : std::optional(device_error(r.error())));
+        };
+        // A rate-limited wire joins the rate group of its wire and rate (wire_rate_groups.hpp): one
+        // upstream subscription and one pending value for all of them, handed out once per window.
+        const bool grouped = is_wire && choice.max_rate_hz.has_value();
+        const std::uint64_t upstream =
+            grouped ? groups_->join(group_upstream(t), choice.rate_period, group_value_handler(sid), std::move(done))
+                    : t.device->subscribe(t.path, t.member->name, is_wire, value_handler(sid, is_wire), std::move(done));
         bool drop = false;
         {
             // `subscribed` may have run already (inside subscribe), or the socket closed meanwhile.
@@ -443,13 +449,28 @@ private:
             } else {
                 s->upstream_id = upstream;
                 s->upstream_known = true;
+                s->rate_group = grouped;
             }
         }
-        if (drop) t.device->unsubscribe(upstream);
+        if (drop) grouped ? groups_->leave(upstream) : t.device->unsubscribe(upstream);
+    }
+
+    // Where a rate group of `t`'s wire gets its values: the device's shared session.
+    static WireRateGroups::Upstream group_upstream(const MemberTarget& t) {
+        WireRateGroups::Upstream up;
+        up.source = t.device.get();
+        up.path = t.path;
+        up.member = t.member->name;
+        up.subscribe = [device = t.device, path = t.path, member = t.member->name](WireRateGroups::OnEntry on_entry,
+                                                                                  WireRateGroups::Done done) {
+            return device->subscribe(path, member, true, std::move(on_entry), std::move(done));
+        };
+        up.unsubscribe = [device = t.device](std::uint64_t id) { device->unsubscribe(id); };
+        return up;
     }
 
     void subscribed(std::uint64_t sid, const nlohmann::json& id, std::optional<ApiError> error) {
-        std::optional<std::pair<MemberTarget, std::uint64_t>> unsubscribe;
+        std::optional<JsonSubscription> unsubscribe;
         bool flush = false;
         {
             std::lock_guard lock(mutex_);
@@ -461,7 +482,7 @@ private:
             }
             if (error) {
                 if (s->upstream_known) {
-                    unsubscribe.emplace(*s->target, s->upstream_id);
+                    unsubscribe.emplace(*s);
                     subs_.erase(sid);
                 } else {
                     s->failed = true;
@@ -474,7 +495,7 @@ private:
                 flush = s->pending_wire != nullptr;
             }
         }
-        if (unsubscribe) unsubscribe->first.device->unsubscribe(unsubscribe->second);
+        if (unsubscribe) unsubscribe_upstream(*unsubscribe);
         if (flush) flush_wires();
     }
 
@@ -501,6 +522,14 @@ private:
                 s->on_wire(sid, e);
             else
                 s->on_event(sid, e);
+        };
+    }
+
+    // A rate group's member handler (wire_rate_groups.hpp): made once per subscription.
+    WireRateGroups::OnValue group_value_handler(std::uint64_t sid) {
+        std::weak_ptr<JsonSocketSession> weak = weak_from_this();
+        return [weak, sid](const SharedEntryPtr& e, std::uint64_t coalesced, std::uint64_t seq) {
+            if (auto s = weak.lock()) s->on_wire(sid, e, coalesced, seq);
         };
     }
 
@@ -590,7 +619,9 @@ private:
     }
 
     void unsubscribe_upstream(const JsonSubscription& s) {
-        if (s.kind == SubscriptionKind::pipe)
+        if (s.rate_group)
+            groups_->leave(s.upstream_id);
+        else if (s.kind == SubscriptionKind::pipe)
             pipe_endpoints(*s.target, s.own)->close_pipe(s.upstream_id);
         else if (s.own)
             s.own->unsubscribe(s.upstream_id);
@@ -843,14 +874,16 @@ private:
             send_text(nlohmann::json{{"subscription", sid}, {"kind", "closed"}, {"error", error_object(device_error(reason))}});
     }
 
-    void on_wire(std::uint64_t sid, const SharedEntryPtr& e) {
+    // `coalesced`: values its rate group replaced before this one (counted as this socket's too); `seq`:
+    // the value's place in its rate group's order (an older one handed out late is dropped), 0 outside one.
+    void on_wire(std::uint64_t sid, const SharedEntryPtr& e, std::uint64_t coalesced = 0, std::uint64_t seq = 0) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) {
             on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));
             return;
         }
         {
             std::lock_guard lock(mutex_);
-            const Offered o = subs_.offer_wire(sid, e, rate_clock_now());
+            const Offered o = subs_.offer_wire(sid, e, rate_clock_now(), coalesced, seq);
             if (!o.send_now) {
                 if (o.wait.count() > 0) wake_at_locked(o.wait);  // waits for its window
                 return;  // or not open, or waits for its subscribe reply
@@ -932,6 +965,7 @@ private:
     mutable std::mutex mutex_;
     boost::asio::steady_timer timer_;
     std::shared_ptr<RateTicker> ticker_;  // the server's: wakes rate-limited subscriptions at their windows
+    std::shared_ptr<WireRateGroups> groups_;  // the server's: rate-limited wires' shared values
     std::vector<RateClock> wakes_;        // periods the ticker will wake this socket at (under mutex_)
     bool timer_armed_ = false, flushing_ = false, flush_again_ = false, closed_ = false;
     std::vector<WireToSend> wire_batch_;  // flush_wires()' batch: used by the one flusher, outside mutex_
@@ -952,7 +986,10 @@ JsonSocketServer::JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::an
       executor_(executor),
       convert_strand_(boost::asio::make_strand(executor)),
       ticker_(std::make_shared<RateTicker>(executor)),
+      groups_(WireRateGroups::create(executor)),
       options_(options) {}
+
+std::size_t JsonSocketServer::rate_groups() const { return groups_->groups(); }
 
 std::shared_ptr<JsonSocketServer> JsonSocketServer::create(std::shared_ptr<JsonApi> api,
                                                            boost::asio::any_io_executor executor,
@@ -1029,7 +1066,7 @@ http::JsonSocketHandler JsonSocketServer::handler() {
 }
 
 void JsonSocketServer::on_open(const std::shared_ptr<http::JsonSocket>& socket) {
-    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_, ticker_);
+    auto session = std::make_shared<JsonSocketSession>(api_, socket, executor_, convert_strand_, options_, ticker_, groups_);
     std::lock_guard lock(mutex_);
     sessions_[socket.get()] = std::move(session);
 }

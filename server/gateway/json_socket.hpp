@@ -20,9 +20,10 @@
 //     traffic, and takes at most one worker thread; a socket's packets are dropped (counted) while
 //     `max_pipe_conversions` of its own, or `max_pipe_conversion_bytes` of their payload, wait there;
 //   * a subscription made with "max_rate_hz" gets at most one value per window of 1/max_rate_hz, the
-//     windows on one grid for all sockets (rate_window.hpp), woken by one timer per rate
-//     (rate_ticker.hpp): a wire's newest value waits for the next window, a pipe's packets wait in a
-//     queue of "queue_length" (oldest dropped, counted);
+//     windows on one grid for all sockets (rate_window.hpp): the subscriptions of one wire at one rate
+//     form a rate group (wire_rate_groups.hpp) that is offered each device value once and hands its
+//     newest to them at each window; a pipe's packets wait in a queue of "queue_length" (oldest
+//     dropped, counted), woken by one timer per rate (rate_ticker.hpp);
 //   * replies are never dropped by this layer; at most `max_in_flight` requests per socket are being
 //     answered at once, and messages over `max_message_bytes` are refused.
 // Subscriptions end when the socket closes (wires/events unsubscribed, pipe endpoints disconnected).
@@ -75,6 +76,7 @@ struct JsonSocketStats {
 
 class JsonSocketSession;
 class RateTicker;
+class WireRateGroups;
 
 /// Serves the subprotocol: one JsonSocketSession per socket.
 class JsonSocketServer : public std::enable_shared_from_this<JsonSocketServer> {
@@ -90,6 +92,8 @@ public:
     /// One entry per open socket.
     std::vector<JsonSocketStats> stats() const;
     const JsonSocketOptions& options() const noexcept { return options_; }
+    /// Rate groups now: rate-limited wires' distinct (wire, max_rate_hz) pairs (wire_rate_groups.hpp).
+    std::size_t rate_groups() const;
 
 private:
     JsonSocketServer(std::shared_ptr<JsonApi> api, boost::asio::any_io_executor executor, JsonSocketOptions options);
@@ -104,6 +108,7 @@ private:
     boost::asio::any_io_executor executor_;
     ConvertStrand convert_strand_;
     std::shared_ptr<RateTicker> ticker_;  // one timer per rate for all sockets (rate_ticker.hpp)
+    std::shared_ptr<WireRateGroups> groups_;  // rate-limited wires: one value per wire and rate (wire_rate_groups.hpp)
     JsonSocketOptions options_;
     std::vector<std::pair<std::shared_ptr<DeviceMirror>, std::uint64_t>> listeners_;
     mutable std::mutex mutex_;

@@ -125,3 +125,40 @@ TEST_CASE("json socket rate: max_rate_hz on an event and queue_length on a wire 
     REQUIRE(stats.size() == 1);
     CHECK(stats[0].subscriptions == 1);
 }
+
+TEST_CASE("json socket rate: subscriptions of one wire at one rate form one rate group across sockets, each gets the last value, leaving ends the group") {
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
+    InteropProcess device;
+    TestGateway gw(device.url());
+    WsClient a(gw.port()), b(gw.port());
+    auto plain = a.request(member("subscribe", "w_both"));
+    REQUIRE(plain.contains("result"));
+    const auto sender = plain["result"]["subscription"].get<std::uint64_t>();
+    auto a5 = a.request(member("subscribe", "w_both", {{"max_rate_hz", 5}}));
+    auto a2 = a.request(member("subscribe", "w_both", {{"max_rate_hz", 2}}));  // the same socket at a second rate
+    auto b5 = b.request(member("subscribe", "w_both", {{"max_rate_hz", 5}}));
+    INFO(a5.dump() << " " << a2.dump() << " " << b5.dump());
+    REQUIRE((a5.contains("result") && a2.contains("result") && b5.contains("result")));
+    CHECK(gw.sockets().rate_groups() == 2);  // (w_both, 5 Hz) shared by both sockets, (w_both, 2 Hz)
+
+    // A burst: every rate-limited subscription ends with the last value.
+    constexpr int kValues = 20;
+    for (int i = 0; i < kValues; ++i)
+        a.send(json{{"id", 20000 + i}, {"op", "set_out_value"}, {"subscription", sender}, {"value", {double(i)}}});
+    auto last_of = [&](WsClient& ws, std::uint64_t sid) {
+        return ws.wait_push([&](const json& j) {
+            return j.value("subscription", std::uint64_t{0}) == sid && j.value("kind", "") == "wire" && j["value"].is_array() &&
+                   !j["value"].empty() && j["value"][0].get<double>() == kValues - 1;
+        });
+    };
+    CHECK(last_of(b, b5["result"]["subscription"].get<std::uint64_t>()).has_value());
+    CHECK(last_of(a, a2["result"]["subscription"].get<std::uint64_t>()).has_value());
+
+    // The 2 Hz group ends with its only member; the 5 Hz one when both of its members are gone.
+    CHECK(a.request(json{{"op", "unsubscribe"}, {"subscription", a2["result"]["subscription"]}}).contains("result"));
+    CHECK(gw.sockets().rate_groups() == 1);
+    CHECK(a.request(json{{"op", "unsubscribe"}, {"subscription", a5["result"]["subscription"]}}).contains("result"));
+    CHECK(gw.sockets().rate_groups() == 1);
+    b.close();
+    CHECK(rr::testing::eventually([&] { return gw.sockets().rate_groups() == 0; }));
+}

@@ -38,9 +38,11 @@ struct JsonSubscription {
     std::shared_ptr<SessionEndpoints> own;  ///< made on the socket's device_login session; null: the gateway's shared one
     std::uint64_t upstream_id = 0;  ///< DeviceMirror subscription id, internal pipe id, or `own`'s id
     bool upstream_known = false;    ///< upstream_id is set: ending the subscription must undo it
+    bool rate_group = false;        ///< a rate-limited wire: upstream_id is its WireRateGroups member id
     bool active = false;            ///< subscribe answered: pushes may go
     bool failed = false;            ///< subscribe failed before upstream_id was known
     SharedEntryPtr pending_wire;    ///< the newest wire value not yet sent
+    std::uint64_t wire_seq = 0;     ///< a rate group's member: the `seq` of the newest value it was offered
     std::uint64_t dropped = 0;      ///< pushes dropped since the last one sent
     RateWindow rate;                ///< "max_rate_hz": one value per window (unlimited by default)
     double max_rate_hz = 0;         ///< as the client asked (echoed in the reply)
@@ -112,7 +114,11 @@ public:
     /// `sid` is answered and its rate window is open at `now`; `wait` is the period of a rate-limited
     /// subscription whose value waits for its next window; neither when it waits for the reply, or
     /// `sid` is not open.
-    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {});
+    /// `coalesced`: values replaced before this one elsewhere (its rate group), counted here too.
+    /// `seq`: a rate group's order of its values (wire_rate_groups.hpp), 0 for none: a value whose `seq`
+    /// is not above that of one offered before is older than it and is dropped (counted as coalesced).
+    Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {}, std::uint64_t coalesced = 0,
+                       std::uint64_t seq = 0);
     /// Whether an answered subscription has a wire value that may go at `now`.
     bool wires_waiting(RateClock now = {}) const;
     /// Moves the wire values of answered subscriptions that may go at `now` into `out` (cleared first),

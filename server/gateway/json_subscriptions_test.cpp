@@ -129,6 +129,30 @@ TEST_CASE("json subscriptions: the newest wire value waits, older ones are coale
     CHECK(batch.empty());
 }
 
+TEST_CASE("json subscriptions: a rate group's value older than one offered before (its seq not above) is dropped and counted") {
+    JsonSubscriptions subs(8);
+    const auto sid = add(subs, subscription(SubscriptionKind::wire));
+    std::vector<WireToSend> batch;
+    auto sent = [&] {
+        subs.take_wires(batch);
+        REQUIRE(batch.size() == 1);
+        double v = 0;
+        REQUIRE(read_scalar(*batch[0].value->entry().find("packet"), v));
+        return v;
+    };
+    CHECK(subs.offer_wire(sid, wire_value(5), {}, 0, 5).send_now);
+    CHECK(sent() == 5);
+    CHECK_FALSE(subs.offer_wire(sid, wire_value(4), {}, 2, 4).send_now);  // handed out late: older than 5
+    CHECK_FALSE(subs.offer_wire(sid, wire_value(5), {}, 0, 5).send_now);  // the same one again
+    CHECK(subs.pending_wires() == 0);
+    CHECK(subs.wire_coalesced() == 4);  // the 2 its group replaced before value 4, and the two dropped here
+    CHECK(subs.offer_wire(sid, wire_value(7), {}, 1, 7).send_now);
+    CHECK(sent() == 7);
+    CHECK(subs.wire_coalesced() == 5);
+    CHECK(subs.offer_wire(sid, wire_value(8)).send_now);  // no group (seq 0): no order to keep
+    CHECK(sent() == 8);
+}
+
 TEST_CASE("json subscriptions: a device login's subscriptions end with it, the shared ones stay") {
     JsonSubscriptions subs(8);
     // The login's session: never called here, only compared.

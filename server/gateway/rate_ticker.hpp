@@ -1,8 +1,10 @@
 // The timers of rate-limited subscriptions (rate_window.hpp), one per rate: every JSON socket with a
 // value waiting for the next window of period P asks this to wake it then; at that window's start the
-// one timer of P wakes all of them, and they send the newest value they hold, the same one for
-// subscribers of the same wire (rendered once, shared_entry.hpp). A rate with nobody waiting has no
-// timer. Thread-safe.
+// one timer of P wakes all of them, and they send the newest value they hold. Rate-limited pipes wait
+// here; rate-limited wires are handed their values by their rate group (wire_rate_groups.hpp, no
+// registration per socket and window) and come here only when a value reaches the socket after its
+// window already had one (a slow socket's late write). A rate with nobody waiting has no timer.
+// Thread-safe.
 #pragma once
 
 #include <functional>
