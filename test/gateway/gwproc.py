@@ -101,7 +101,7 @@ def start_devices(exe, port=0, play_period=None):
     return Proc(argv)
 
 
-def http_status(url, headers=None, timeout=5.0):
+def http_status(url, headers=None, timeout=30.0):
     req = urllib.request.Request(url, headers=headers or {})
     try:
         with urllib.request.urlopen(req, timeout=timeout) as r:
@@ -114,7 +114,7 @@ def wait_ready(port, timeout=60.0):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         try:
-            if http_status("http://127.0.0.1:%d/readyz" % port, timeout=2)[0] == 200:
+            if http_status("http://127.0.0.1:%d/readyz" % port, timeout=10)[0] == 200:
                 return
         except OSError:
             pass

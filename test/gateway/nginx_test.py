@@ -103,7 +103,7 @@ def main():
         def get(path, headers=None):
             req = urllib.request.Request(base + path, headers=headers or {})
             try:
-                with urllib.request.urlopen(req, context=ctx, timeout=5) as r:
+                with urllib.request.urlopen(req, context=ctx, timeout=30) as r:
                     return r.status, r.read().decode()
             except urllib.error.HTTPError as e:
                 return e.code, e.read().decode()
@@ -136,7 +136,7 @@ def main():
 
         def json_ws():
             ws = websocket.create_connection("wss://127.0.0.1:%d/" % https_port, subprotocols=["rr-gateway.json.v1"],
-                                             origin=SITE, header=["Authorization: " + login], timeout=10,
+                                             origin=SITE, header=["Authorization: " + login], timeout=30,
                                              sslopt={"ca_certs": cert, "check_hostname": False})
             try:
                 ws.send(json.dumps({"id": 1, "op": "subscribe", "device": "create", "member": "packets"}))
@@ -161,7 +161,7 @@ def main():
         def rr_ws():
             ws = websocket.create_connection("wss://127.0.0.1:%d/?service=create" % https_port,
                                              subprotocols=["robotraconteur.robotraconteur.com"], origin=SITE,
-                                             header=["Authorization: " + login], timeout=10,
+                                             header=["Authorization: " + login], timeout=30,
                                              sslopt={"ca_certs": cert, "check_hostname": False})
             expect(ws.getsubprotocol() == "robotraconteur.robotraconteur.com", "subprotocol %r" % ws.getsubprotocol())
             ws.close()
@@ -173,7 +173,7 @@ def main():
             url = "rr+wss://localhost:%d/?service=create" % https_port
 
             def rr(*extra):
-                return subprocess.run([a.rr, "info", url, "--timeout", "10"] + list(extra), capture_output=True,
+                return subprocess.run([a.rr, "info", url, "--timeout", "30"] + list(extra), capture_output=True,
                                       text=True, timeout=60)
 
             def rr_wss():
@@ -200,7 +200,7 @@ def main():
             checks.run("rr over rr+wss not trusting the certificate: connect failure (3)", rr_wss_untrusted)
 
         def redirect():
-            c = http.client.HTTPConnection("127.0.0.1", http_port, timeout=5)
+            c = http.client.HTTPConnection("127.0.0.1", http_port, timeout=30)
             c.request("GET", "/api/devices", headers={"Host": "lab.example.org"})
             r = c.getresponse()
             c.close()

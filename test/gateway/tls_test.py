@@ -46,7 +46,7 @@ except ImportError:
     websocket = None
 
 
-def https_get(port, path, cafile, cert=None, timeout=5):
+def https_get(port, path, cafile, cert=None, timeout=30):
     """(status, body) of GET https://127.0.0.1:port/path, verified against cafile (the certificates made
     here name 127.0.0.1 and localhost)."""
     import http.client
@@ -95,7 +95,7 @@ def closed_within(sock, seconds):
 
 def json_ws_subscribe(port, cafile, origin=None):
     """A wss JSON API WebSocket subscribed to the demo Create's packets wire (streaming started)."""
-    ws = websocket.create_connection("wss://localhost:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=10,
+    ws = websocket.create_connection("wss://localhost:%d/" % port, subprotocols=["rr-gateway.json.v1"], timeout=30,
                                      origin=origin or "https://localhost:%d" % port, sslopt={"ca_certs": cafile})
     ws.send(json.dumps({"id": 1, "op": "subscribe", "device": "create", "member": "packets"}))
     ws.send(json.dumps({"id": 2, "op": "call", "device": "create", "member": "StartStreaming"}))
@@ -149,13 +149,13 @@ def case_serve(a, checks, tmp):
         for scheme in ("rrs+tcp", "rr+wss"):
             def rr_ok(scheme=scheme):
                 p = rr_cli(a.rr, "get", "%s://localhost:%d/?service=create" % (scheme, port), "DistanceTraveled",
-                           "--tls-ca", ca.cert, "--timeout", "10")
+                           "--tls-ca", ca.cert, "--timeout", "30")
                 expect(p.returncode == 0 and p.stdout.strip().lstrip("-").isdigit(), "exit %d: %s %s" % (p.returncode, p.stdout, p.stderr))
 
             checks.run("rr get over %s with --tls-ca" % scheme, rr_ok)
 
         def rr_untrusted():
-            p = rr_cli(a.rr, "get", "rrs+tcp://localhost:%d/?service=create" % port, "DistanceTraveled", "--timeout", "10")
+            p = rr_cli(a.rr, "get", "rrs+tcp://localhost:%d/?service=create" % port, "DistanceTraveled", "--timeout", "30")
             expect(p.returncode == 3 and "certificate verify failed" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr))
 
         checks.run("rr over rrs+tcp not trusting the certificate: connect failure (3)", rr_untrusted)
@@ -165,7 +165,7 @@ def case_serve(a, checks, tmp):
             # test CA here, as update-ca-certificates would put it in /etc/ssl/certs.
             for scheme in ("rrs+tcp", "rr+wss"):
                 p = rr_cli(a.rr, "get", "%s://localhost:%d/?service=create" % (scheme, port), "DistanceTraveled",
-                           "--timeout", "10", env=dict(os.environ, SSL_CERT_FILE=ca.cert))
+                           "--timeout", "30", env=dict(os.environ, SSL_CERT_FILE=ca.cert))
                 expect(p.returncode == 0 and p.stdout.strip().lstrip("-").isdigit(),
                        "%s: exit %d: %s %s" % (scheme, p.returncode, p.stdout, p.stderr))
 
@@ -186,7 +186,7 @@ def case_serve(a, checks, tmp):
             try:
                 gwproc.wait_ready(g2.port)
                 c = http.client.HTTPSConnection("127.0.0.1", g2.port, context=ssl.create_default_context(cafile=ca.cert),
-                                                timeout=10)
+                                                timeout=30)
                 try:
                     c.request("POST", "/api/login", json.dumps({"username": "ann", "password": "ann-pw"}),
                               {"Content-Type": "application/json"})
@@ -202,7 +202,7 @@ def case_serve(a, checks, tmp):
         checks.run("with logins on, the session cookie is Secure over the gateway's own HTTPS", secure_cookie)
 
         def rr_plain():
-            p = rr_cli(a.rr, "get", "rr+tcp://127.0.0.1:%d/?service=create" % port, "DistanceTraveled", "--timeout", "10")
+            p = rr_cli(a.rr, "get", "rr+tcp://127.0.0.1:%d/?service=create" % port, "DistanceTraveled", "--timeout", "30")
             expect(p.returncode == 0, "exit %d: %s" % (p.returncode, p.stderr))
 
         checks.run("plain rr+tcp on the same port", rr_plain)
@@ -328,11 +328,11 @@ def case_mtls(a, checks, tmp):
 
         def rr_with():
             p = rr_cli(a.rr, "get", url, "DistanceTraveled", "--tls-ca", ca.cert, "--tls-cert", client.cert,
-                       "--tls-key", client.key, "--timeout", "10")
+                       "--tls-key", client.key, "--timeout", "30")
             expect(p.returncode == 0, "exit %d: %s" % (p.returncode, p.stderr))
 
         def rr_without():
-            p = rr_cli(a.rr, "get", url, "DistanceTraveled", "--tls-ca", ca.cert, "--timeout", "10")
+            p = rr_cli(a.rr, "get", url, "DistanceTraveled", "--tls-ca", ca.cert, "--timeout", "30")
             expect(p.returncode == 3, "exit %d: %s" % (p.returncode, p.stderr))
 
         checks.run("rr over rrs+tcp with a client certificate", rr_with)
@@ -356,7 +356,7 @@ def case_mtls(a, checks, tmp):
             if cert:
                 sslopt.update(certfile=cert.cert, keyfile=cert.key)
             ws = websocket.create_connection("wss://localhost:%d/" % port, subprotocols=["rr-gateway.json.v1"],
-                                             timeout=10, origin="https://localhost:%d" % port, sslopt=sslopt)
+                                             timeout=30, origin="https://localhost:%d" % port, sslopt=sslopt)
             try:
                 ws.send(json.dumps({"id": 1, "op": "devices"}))
                 return json.loads(ws.recv())
@@ -379,7 +379,7 @@ def case_mtls(a, checks, tmp):
         def rr_wss(cert, status):
             extra = ["--tls-cert", cert.cert, "--tls-key", cert.key] if cert else []
             p = rr_cli(a.rr, "get", "rr+wss://localhost:%d/?service=create" % port, "DistanceTraveled",
-                       "--tls-ca", ca.cert, "--timeout", "10", *extra)
+                       "--tls-ca", ca.cert, "--timeout", "30", *extra)
             expect(p.returncode == status, "exit %d (expected %d): %s" % (p.returncode, status, p.stderr))
 
         checks.run("wss (JSON API) with a client certificate", lambda: wss_with(client))
@@ -406,7 +406,7 @@ def case_mtls(a, checks, tmp):
 
         def rr_rrs(cert, status):
             p = rr_cli(a.rr, "get", url, "DistanceTraveled", "--tls-ca", ca.cert, "--tls-cert", cert.cert,
-                       "--tls-key", cert.key, "--timeout", "10")
+                       "--tls-key", cert.key, "--timeout", "30")
             expect(p.returncode == status, "exit %d (expected %d): %s" % (p.returncode, status, p.stderr))
 
         checks.run("SIGHUP with a new client_ca file: its certificates are accepted", swapped)
@@ -448,7 +448,7 @@ def case_device(a, checks, tmp):
 
         def read_through():
             p = rr_cli(a.rr, "get", "rr+tcp://127.0.0.1:%d/?service=far_create" % near.port, "DistanceTraveled",
-                       "--timeout", "10")
+                       "--timeout", "30")
             expect(p.returncode == 0 and p.stdout.strip().lstrip("-").isdigit(), "exit %d: %s %s" % (p.returncode, p.stdout, p.stderr))
 
         checks.run("a value read through gateway -> rrs+tcp -> gateway -> demo device", read_through)
