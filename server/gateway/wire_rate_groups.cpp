@@ -13,7 +13,7 @@ namespace rr::server::gateway {
 struct WireRateGroups::Group {
     struct Member {
         std::uint64_t id = 0;
-        OnValue on_value;
+        std::shared_ptr<const OnValue> on_value;  // shared: the copy-on-write member lists copy pointers
     };
     using Members = std::shared_ptr<const std::vector<Member>>;  // copied on write: a hand-out takes a reference
 
@@ -68,7 +68,7 @@ template <class Members>
 void hand_out(const Members& members, const SharedEntryPtr& e, std::uint64_t coalesced, std::uint64_t seq,
               std::atomic<std::uint64_t>& handed) {
     handed.fetch_add(members.size(), std::memory_order_relaxed);
-    for (const auto& m : members) m.on_value(e, coalesced, seq);
+    for (const auto& m : members) (*m.on_value)(e, coalesced, seq);
 }
 
 }  // namespace
@@ -87,6 +87,7 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue 
     bool create = false, ready_now = false;
     SharedEntryPtr last;
     std::uint64_t id = 0, last_seq = 0;
+    auto handler = std::make_shared<const OnValue>(std::move(on_value));
     {
         std::lock_guard lock(mutex_);
         id = next_member_++;
@@ -100,16 +101,16 @@ std::uint64_t WireRateGroups::join(Upstream upstream, RateClock period, OnValue 
         members_[id] = g;
         std::lock_guard glock(g->mutex);
         if (g->ready) {
-            g->add({Group::Member{id, on_value}});
+            g->add({Group::Member{id, handler}});
             last = g->last;
             last_seq = g->seq;
             ready_now = true;
         } else {
-            g->waiting.emplace_back(Group::Member{id, on_value}, std::move(done));
+            g->waiting.emplace_back(Group::Member{id, handler}, std::move(done));
         }
     }
     if (ready_now) {
-        if (last) on_value(last, 0, last_seq);  // a newer value's hand-out may have reached it already
+        if (last) (*handler)(last, 0, last_seq);  // a newer value's hand-out may have reached it already
         if (done) done({});
         return id;
     }
@@ -169,7 +170,7 @@ void WireRateGroups::subscribed(const std::shared_ptr<Group>& g, Result<void> r)
         if (unsubscribe && g->unsubscribe) g->unsubscribe(up);
     }
     for (auto& [member, done] : waiting) {
-        if (r && last) member.on_value(last, 0, last_seq);  // (a newer one may have reached it already)
+        if (r && last) (*member.on_value)(last, 0, last_seq);  // (a newer one may have reached it already)
         if (done) done(r);
     }
 }
@@ -190,7 +191,7 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
             g->timer.cancel();
         }
         forget(g);
-        for (const auto& m : *members) m.on_value(e, 0, seq);
+        for (const auto& m : *members) (*m.on_value)(e, 0, seq);
         for (auto& [member, done] : waiting)
             if (done) done(fail(MessageErrorType::ConnectionError, "wire closed by the device"));
         return;
