@@ -4,6 +4,7 @@
 
 #include "core/session/elements.hpp"
 #include "server/gateway/json_subscriptions.hpp"
+#include "server/gateway/wire_value_test_support.hpp"
 
 using namespace rr;
 using namespace rr::server::gateway;
@@ -26,12 +27,7 @@ std::uint64_t add(JsonSubscriptions& subs, JsonSubscription s, bool active = tru
     return sid;
 }
 
-SharedEntryPtr wire_value(double v) {
-    MessageEntry e;
-    e.entry_type = MessageEntryType::WirePacket;
-    e.elements.push_back(make_scalar_element<double>("packet", v));
-    return std::make_shared<const SharedEntry>(std::move(e));
-}
+constexpr auto wire_value = rr::server::gateway::testing::wire_packet_value;
 
 }  // namespace
 

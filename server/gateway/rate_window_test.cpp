@@ -8,6 +8,7 @@
 #include "core/session/elements.hpp"
 #include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/rate_window.hpp"
+#include "server/gateway/wire_value_test_support.hpp"
 
 using namespace rr;
 using namespace rr::server::gateway;
@@ -15,17 +16,8 @@ using namespace std::chrono_literals;
 
 namespace {
 
-SharedEntryPtr wire_value(double v) {
-    MessageEntry e;
-    e.entry_type = MessageEntryType::WirePacket;
-    e.elements.push_back(make_scalar_element<double>("packet", v));
-    return std::make_shared<const SharedEntry>(std::move(e));
-}
-double value_of(const SharedEntryPtr& e) {
-    double v = -1;
-    REQUIRE(read_scalar(*e->entry().find("packet"), v));
-    return v;
-}
+constexpr auto wire_value = rr::server::gateway::testing::wire_packet_value;
+double value_of(const SharedEntryPtr& e) { return rr::server::gateway::testing::packet_value_of(e); }
 MessageElement packet(double v) { return make_scalar_element<double>("packet", v); }
 double value_of(const MessageElement& e) {
     double v = -1;

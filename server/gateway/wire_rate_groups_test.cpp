@@ -12,6 +12,7 @@
 #include "server/gateway/json_subscriptions.hpp"
 #include "server/gateway/rate_ticker.hpp"
 #include "server/gateway/wire_rate_groups.hpp"
+#include "server/gateway/wire_value_test_support.hpp"
 
 using namespace rr;
 using namespace rr::server::gateway;
@@ -21,17 +22,8 @@ using namespace std::chrono_literals;
 // has a wire_value of its own).
 namespace wire_rate_groups_test {
 
-SharedEntryPtr packet_value(double v) {
-    MessageEntry e;
-    e.entry_type = MessageEntryType::WirePacket;
-    e.elements.push_back(make_scalar_element<double>("packet", v));
-    return std::make_shared<const SharedEntry>(std::move(e));
-}
-double value_of(const SharedEntryPtr& e) {
-    double v = -1;
-    REQUIRE(read_scalar(*e->entry().find("packet"), v));
-    return v;
-}
+constexpr auto packet_value = rr::server::gateway::testing::wire_packet_value;
+constexpr auto value_of = rr::server::gateway::testing::packet_value_of;
 
 // The device's side: upstream subscriptions of one wire, each called for every value.
 struct FakeWire {
