@@ -41,6 +41,10 @@ after(async () => {
 const row = (page, device, name) => panelOf(page, device, "signal").locator(`tr[data-signal="${name}"]`);
 const value = (page, device, name) => row(page, device, name).locator(".signal-value");
 const cells = async (page, device, name) => (await row(page, device, name).locator("td").allTextContents()).slice(0, 4);
+async function cellsShown(page, device, name, expected) {
+  await waitFor(async () => (await value(page, device, name).textContent()) !== "", `${name} value shown`, 30000);
+  assert.deepEqual(await cells(page, device, name), expected);
+}
 const logged = (name) => log.filter((x) => x.signal === name);
 
 async function open(page, device) {
@@ -56,9 +60,10 @@ test("signal device: groups, values with units, types and access as the device s
   assert.deepEqual(await p.locator(".signal-group h4").allTextContents(), ["inputs: Cell inputs", "outputs: Cell outputs"]);
   assert.equal(await p.getAttribute("data-signals"), "8");
   await waitFor(async () => (await value(operator, "io", "cell_temperature").textContent()) === "21.5 °C", "cell_temperature shown", 30000);
-  assert.deepEqual(await cells(operator, "io", "door_closed"), ["door_closed", "digital", "on", "readonly"]);
-  assert.deepEqual(await cells(operator, "io", "safety_relay"), ["safety_relay", "digital", "on", "restricted"]);
-  assert.deepEqual(await cells(operator, "io", "conveyor_speed"), ["conveyor_speed", "analog", "0 m/s", "all"]);
+  // each signal has its own signal_value wire, so each value arrives on its own: wait for each one
+  await cellsShown(operator, "io", "door_closed", ["door_closed", "digital", "on", "readonly"]);
+  await cellsShown(operator, "io", "safety_relay", ["safety_relay", "digital", "on", "restricted"]);
+  await cellsShown(operator, "io", "conveyor_speed", ["conveyor_speed", "analog", "0 m/s", "all"]);
   // live: the pressure moves, the part sensor goes on and off
   const pressure = async () => Number((await value(operator, "io", "air_pressure").textContent()).replace(" bar", ""));
   const first = await pressure();
