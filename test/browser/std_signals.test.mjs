@@ -66,6 +66,8 @@ test("signal device: groups, values with units, types and access as the device s
   await cellsShown(operator, "io", "conveyor_speed", ["conveyor_speed", "analog", "0 m/s", "all"]);
   // live: the pressure moves, the part sensor goes on and off
   const pressure = async () => Number((await value(operator, "io", "air_pressure").textContent()).replace(" bar", ""));
+  // air_pressure's value comes on its own wire too: wait for it before reading the first one
+  await waitFor(async () => (await value(operator, "io", "air_pressure").textContent()) !== "", "air_pressure shown", 30000);
   const first = await pressure();
   assert.ok(first >= 5.8 && first <= 6.2, `air_pressure ${first} bar`);
   await waitFor(async () => (await pressure()) !== first, "air_pressure moving");
