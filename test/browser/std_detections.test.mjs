@@ -59,6 +59,8 @@ test("object recognition: each object with its class, pose and confidence", asyn
   await operator.goto(`${gateway.base}/#/objects`);
   const p = panel(operator, "objects");
   await waitFor(async () => Number(await p.getAttribute("data-updates")) >= 2, "objects shown", 60000);
+  // the templates row comes from the sensor's info property, read apart from the pipe: wait for that read
+  await waitFor(async () => (await p.getAttribute("data-info")) === "read", "object_recognition_sensor_info read", 60000);
   assert.equal(await p.locator('dd[data-row="templates"]').textContent(), "mug, gearbox");
   assert.deepEqual(await rows(p), [
     ["mug", "cup", "position (0.3, -0.1, 0.75) m, rpy (0, 0, 0)°", "camera_link", "87 %"],
