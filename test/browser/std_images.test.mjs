@@ -133,12 +133,14 @@ test("pictures in a property, a function result and a map of images", async () =
   const good = await showGood("rgb888");  // the service's last raw frame (still, capture, capture_pair[0])
   // property: read (again) after the frame was set
   const still = card("still");
+  const stillFig = still.locator(".frame-view").first();
   const reads = await num(still.locator("output.value"), "data-reads");
+  // the card read the property once when it opened: wait for the picture of this read, not that one's
+  const stillDrawn = await num(stillFig, "data-drawn");
   await still.locator("button", { hasText: /^Read$/ }).click();
   await waitFor(async () => (await num(still.locator("output.value"), "data-reads")) > reads, "still read");
   assert.match(await still.locator("output.value").textContent(), /^16×12 rgb888, 600 bytes$/);
-  const stillFig = still.locator(".frame-view").first();
-  await waitFor(async () => (await num(stillFig, "data-drawn")) >= 1, "the property's picture");
+  await waitFor(async () => (await num(stillFig, "data-drawn")) > stillDrawn, "the property's picture of this read");
   await assertPicture(stillFig, good, "property still");
   // function result
   const capture = card("capture");
