@@ -48,7 +48,8 @@ async function open(page, device, name) {
 test("clock: the device's time, its offset from the browser's clock, local time and zone", async () => {
   const p = await open(operator, "clock", "clock");
   const row = (k) => p.locator(`dd[data-row="${k}"]`);
-  await waitFor(async () => (await row("offset").count()) === 1 && (await row("timezone").count()) === 1, "clock rows", 30000);
+  // time_utc (offset), time_local and clock_info (timezone) each come on their own: wait for every row asserted
+  await waitFor(async () => (await row("offset").count()) === 1 && (await row("time_local").count()) === 1 && (await row("timezone").count()) === 1, "clock rows", 30000);
   // the device runs 30 s ahead; its time is older than that by the delivery when it arrives
   const offsetMs = Number(await p.getAttribute("data-offset-ms"));
   assert.ok(offsetMs > (OFFSET_S - 3) * 1000 && offsetMs <= OFFSET_S * 1000 + 50, `offset ${offsetMs} ms`);
@@ -66,7 +67,8 @@ test("clock: the device's time, its offset from the browser's clock, local time 
 
 test("event log: the device's messages, new ones live, filtered by words and level", async () => {
   const p = await open(operator, "log", "eventlog");
-  await waitFor(async () => Number(await p.getAttribute("data-messages")) >= 50, "the stored messages", 30000);
+  // the stored messages come from getf_eventlog_messages (data-ready once added), the live ones from the pipe
+  await waitFor(async () => (await p.getAttribute("data-ready")) === "true" && Number(await p.getAttribute("data-messages")) >= 50, "the stored messages", 30000);
   const row = (n) => p.locator(`tr[data-number="${n}"] td`);
   assert.deepEqual(await row(30).allTextContents().then((c) => [c[0], c[2], c[3], c[4], c[5]]),
     ["30", "error", "cell3_plc / line / station3", "conveyor jam at station 3", "belt stopped: part stuck at the transfer"]);
@@ -139,7 +141,10 @@ test("renderers: a JointTrajectory drawn per joint over time (a property and a f
   const drawn = await canvasPixels(figure);
   const colored = (px) => { let n = 0; for (let i = 0; i < px.data.length; i += 4) if (px.data[i] !== px.data[i + 1] || px.data[i + 1] !== px.data[i + 2]) n++; return n; };
   assert.ok(colored(drawn) > 300, `the joints' coloured lines: ${colored(drawn)} pixels`);
-  assert.equal(await card("gains").locator("output.value").textContent(), "P 2.5, I 0.1, D 0.02; integral -5 … 5; command -10 … 10");
+  // gains is a property of its own, read by its card apart from last_plan: wait for that read
+  const gains = card("gains").locator("output.value");
+  await waitFor(async () => Number(await gains.getAttribute("data-reads")) >= 1, "gains read", 30000);
+  assert.equal(await gains.textContent(), "P 2.5, I 0.1, D 0.02; integral -5 … 5; command -10 … 10");
   // another trajectory (twice the swing over 4 s) drawn from a function's result: other pixels
   await card("plan").locator('input[aria-label="duration"]').fill("4");
   await card("plan").getByRole("button", { name: "Call" }).click();
