@@ -116,6 +116,8 @@ test("a plain Light shows on/off only; a dimmer adds brightness but no colour", 
   await open(operator, "dimmer");
   assert.equal(await panel(operator, "dimmer").locator('input[name="light-intensity"]').count(), 1);
   assert.equal(await panel(operator, "dimmer").locator('input[name="light-color"]').count(), 0);
+  // light_info is read apart from the properties open() waited for: wait for its row, as for the lamp
+  await waitFor(async () => (await row(operator, "dimmer", "max_lumens").count()) === 1, "dimmer max lumens", 30000);
   assert.equal(await row(operator, "dimmer", "max_lumens").textContent(), "1200 lm");
   assert.deepEqual(pageErrors, []);
 });
