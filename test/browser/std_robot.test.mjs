@@ -105,7 +105,8 @@ test("no plot series per UUID byte or clock field; times as dates", async () => 
   const clock = card("device_clock_now");
   await waitFor(async () => (await seriesOf(clock)).length > 0, "device_clock_now plotted");
   assert.deepEqual(await seriesOf(clock), ["device_seqno"]);
-  const clockText = await clock.locator(".stream output.value").textContent();
+  // the plot's readout is set when a value arrives, the card's text at the next animation frame: wait for the text
+  const clockText = await waitFor(async () => (await clock.locator(".stream output.value").textContent()) || false, "device_clock_now's text", 30000);
   assert.match(clockText, new RegExp(`device_ts: ${ISO.source} `));
   assert.match(clockText, new RegExp(`device_utc: ${ISO.source} `));
   // robot_state_sensor_data (a pipe): the sensor header's source identifier as text, not 16 series
@@ -114,7 +115,8 @@ test("no plot series per UUID byte or clock field; times as dates", async () => 
   await waitFor(async () => (await seriesOf(pipe)).includes("robot_state.joint_position[2]"), "sensor data plotted", 15000);
   const pipeSeries = await seriesOf(pipe);
   assert.ok(!pipeSeries.some((n) => /uuid|source_info|\bts\b/.test(n)), `sensor data series: ${pipeSeries}`);
-  const pipeText = await pipe.locator(".stream output.value").textContent();
+  // as above: the series come with the packet, the card's text with the next animation frame
+  const pipeText = await waitFor(async () => (await pipe.locator(".stream output.value").textContent()) || false, "sensor data's text", 30000);
   const source = /source: sim_arm \(([0-9a-f-]+)\)/.exec(pipeText);
   assert.ok(source, `the source identifier as text: ${pipeText.slice(0, 300)}`);
   assert.match(source[1], UUID_TEXT);
