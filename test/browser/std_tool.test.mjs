@@ -127,7 +127,10 @@ test("state and tool_info with units, as the device sent them", async () => {
   assert.equal(await row(operator, "tcp").textContent(), "translation (0, 0, 0.15) m, rpy (0, 0, 0)°");
   assert.match(await row(operator, "ts").textContent(), /^\d{4}-\d\d-\d\dT/);
   // the device card is there too, and the generic view below
-  assert.equal(await operator.locator('.device-view[data-device="gripper"] [data-panel="device-card"] dd[data-row="name"]').textContent(), "sim_gripper");
+  // the card reads device_info itself, apart from the tool panel's reads: wait for that read
+  const deviceCard = operator.locator('.device-view[data-device="gripper"] [data-panel="device-card"]');
+  await waitFor(async () => (await deviceCard.getAttribute("data-loaded")) === "true", "device_info read", 30000);
+  assert.equal(await deviceCard.locator('dd[data-row="name"]').textContent(), "sim_gripper");
   // the motor is off: the tool refuses, the page says so
   for (const name of ["Enable", "Disable", "Reset errors", "Halt", "Open (hold)", "Close (hold)", "Home (hold)", "Move (hold)"]) {
     assert.equal(await p.getByRole("button", { name, exact: true }).count(), 1, `the operator lacks ${name}`);
