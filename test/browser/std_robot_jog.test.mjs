@@ -276,7 +276,9 @@ test("status chips and joint table match the driver; the wrist warns near its up
   assert.deepEqual(await rows.evaluateAll((r) => r.map((x) => x.dataset.near)), ["", "", "upper"]);
   assert.equal(await p.locator('tr[data-joint="shoulder"] .joint-velocity').textContent(), "0.0000 rad/s");
   assert.match(await p.locator(".robot-tool").textContent(), /^tool: position \([-\d.]+, [-\d.]+, [-\d.]+\) m, rpy \([-\d.]+, [-\d.]+, [-\d.]+\)°$/);
-  // what the official client reads is what the table shows
+  // what the official client reads is what the table shows (its states come on its own wire connection:
+  // wait for the first one, the page's having arrived says nothing of the probe's)
+  await waitFor(() => samples.length > 0, "the official client's first robot_state", 30000);
   assert.deepEqual(latest().q.map((x) => Number(x.toFixed(4))), [0, 0, WRIST_START]);
   // the operator's controls: jog buttons for every joint, the mode switch, the lock offer, the move form
   assert.equal(await p.locator("button.jog[data-joint]").count(), 6);
