@@ -519,7 +519,7 @@ private:
             auto s = weak.lock();
             if (!s) return;
             if (is_wire)
-                s->on_wire(sid, e);
+                s->on_wire(sid, e, 0, e->arrival());  // the wire's newest, handed out on joining, may come late
             else
                 s->on_event(sid, e);
         };
@@ -875,7 +875,8 @@ private:
     }
 
     // `coalesced`: values its rate group replaced before this one (counted as this socket's too); `seq`:
-    // the value's place in its rate group's order (an older one handed out late is dropped), 0 outside one.
+    // the value's place in its wire's order (an older one handed out late is dropped): its rate group's
+    // seq, or its arrival (shared_entry.hpp) for a subscription of its own.
     void on_wire(std::uint64_t sid, const SharedEntryPtr& e, std::uint64_t coalesced = 0, std::uint64_t seq = 0) {
         if (e->entry().entry_type == MessageEntryType::WireClosed) {
             on_subscription_closed(sid, make_error(MessageErrorType::ConnectionError, "wire closed by the device"));

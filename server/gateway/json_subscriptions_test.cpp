@@ -166,3 +166,19 @@ TEST_CASE("json subscriptions: a device login's subscriptions end with it, the s
     CHECK(all.size() == 1);
     CHECK(subs.size() == 0);
 }
+
+TEST_CASE("json subscriptions: a wire's newest handed out on joining after a newer value (ordered by arrival) is dropped") {
+    JsonSubscriptions subs(8);
+    const auto sid = add(subs, subscription(SubscriptionKind::wire));
+    const auto joined_newest = wire_value(1);  // the wire's newest when the subscriber joined
+    const auto newer = wire_value(2);          // arrived from the device after it
+    REQUIRE(newer->arrival() > joined_newest->arrival());
+    std::vector<WireToSend> batch;
+    CHECK(subs.offer_wire(sid, newer, {}, 0, newer->arrival()).send_now);  // fanned out first
+    subs.take_wires(batch);
+    REQUIRE(batch.size() == 1);
+    CHECK(batch[0].value == newer);
+    CHECK_FALSE(subs.offer_wire(sid, joined_newest, {}, 0, joined_newest->arrival()).send_now);
+    CHECK(subs.pending_wires() == 0);
+    CHECK(subs.wire_coalesced() == 1);
+}

@@ -5,6 +5,8 @@
 // once, not N times.
 #pragma once
 
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -19,7 +21,13 @@ namespace rr::server::gateway {
 
 class SharedEntry : public EncodedEntry {
 public:
-    explicit SharedEntry(MessageEntry entry) : EncodedEntry(std::move(entry)) {}
+    explicit SharedEntry(MessageEntry entry) : EncodedEntry(std::move(entry)), arrival_(next_arrival()) {}
+
+    /// Its place in the order the gateway made values in (process-wide, increasing, never 0). A device
+    /// connection delivers a wire's values in order, so of two values of one wire the one with the larger
+    /// arrival is the newer: a subscriber handed the wire's newest value on joining, while a newer one is
+    /// fanned out to it, keeps the newer (the ordering native clients get from the packets' timestamps).
+    std::uint64_t arrival() const noexcept { return arrival_; }
 
     /// The text `render(entry())` returns, computed once; callers on other threads wait for it. Every
     /// subscriber must pass an equivalent `render` (the same conversion for the same member).
@@ -44,6 +52,12 @@ public:
     }
 
 private:
+    static std::uint64_t next_arrival() noexcept {
+        static std::atomic<std::uint64_t> counter{0};
+        return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+    }
+
+    std::uint64_t arrival_;
     mutable std::once_flag once_, binary_once_;
     mutable std::string rendered_;
     mutable BinaryRendering binary_;

@@ -202,6 +202,12 @@ void WireRateGroups::offer(const std::shared_ptr<Group>& g, const SharedEntryPtr
     {
         std::lock_guard glock(g->mutex);
         if (g->ended) return;
+        if (g->last && e->arrival() <= g->last->arrival()) {
+            // the wire's newest, handed to the group's upstream subscription on joining, came after a
+            // newer value: replaced unseen
+            coalesced_.fetch_add(1, std::memory_order_relaxed);
+            return;
+        }
         g->last = e;
         seq = ++g->seq;
         const RateClock now = rate_clock_now();

@@ -171,6 +171,23 @@ TEST_CASE("wire rate groups: two rates of one wire are two groups, and a member 
     CHECK(wire.unsubscribes == 1);  // `late` still holds the 1 s group
 }
 
+TEST_CASE("wire rate groups: the wire's newest reaching the group's upstream subscription after a newer value (by arrival) is dropped") {
+    boost::asio::io_context io;
+    auto groups = WireRateGroups::create(io.get_executor());
+    FakeWire wire;
+    Member m;
+    groups->join(wire.upstream(), 20ms, m.on_value(), m.on_done());
+    const auto joined_newest = packet_value(1);  // the wire's newest when the group subscribed upstream
+    const auto newer = packet_value(2);          // arrived from the device after it, fanned out first
+    wire.deliver(newer);
+    wire.deliver(joined_newest);
+    CHECK(groups->offers() == 2);
+    CHECK(groups->coalesced() == 1);
+    CHECK(m.got == std::vector<double>{2});  // the first window was open: handed out at once
+    io.run_for(30000ms);  // returns once no timer waits (the older value would have armed one)
+    CHECK(m.got == std::vector<double>{2});
+}
+
 TEST_CASE("wire rate groups: members joining before the wire holds are answered together, and a failure or the device's WireClosed ends the group") {
     boost::asio::io_context io;
     auto groups = WireRateGroups::create(io.get_executor());
