@@ -480,18 +480,28 @@ void MirrorService::forward(const SessionRef& session, MessageEntry&& entry, Res
 void MirrorService::wire_connect(const SessionRef& session, MessageEntry&& entry, Responder responder) {
     MemberKey key{entry.service_path, entry.member_name};
     auto shared = std::make_shared<Responder>(std::move(responder));
-    auto joined = subscriptions_.join_wire(key, session, [shared](Result<void> r) {
-        if (r)
-            shared->respond(MessageEntry{});
-        else
+    std::weak_ptr<MirrorService> weak = shared_from_this();
+    auto joined = subscriptions_.join_wire(key, session, [shared, weak, key, session](Result<void> r) {
+        if (!r) {
             shared->fail(r.error());
+            return;
+        }
+        shared->respond(MessageEntry{});
+        // The device sends a wire's value before its WireConnectRet: sent again after ours, a client
+        // that took no value for a wire it had not connected yet has it (a client keeps one value per
+        // timestamp, so one it took is not taken twice).
+        if (auto self = weak.lock()) self->send_newest(key, session, self->subscriptions_.newest(key));
     });
     if (!joined.ready) return ensure_upstream_wire(key);
     shared->respond(MessageEntry{});
-    // The newest value, at once, under the same rule as live values: a session that may only send
-    // (auth: gateway, `write` without `read`) receives no InValue, cached or not.
-    if (joined.last && (!access_.active() || access_.may(session, key.first, key.second, auth::Operation::read)))
-        (void)session.send_wire_packet(joined.last);
+    send_newest(key, session, joined.last);
+}
+
+void MirrorService::send_newest(const MemberKey& key, const SessionRef& session, const SharedEntryPtr& newest) {
+    // Under the same rule as live values: a session that may only send (auth: gateway, `write` without
+    // `read`) receives no InValue, cached or not.
+    if (newest && (!access_.active() || access_.may(session, key.first, key.second, auth::Operation::read)))
+        (void)session.send_wire_packet(newest);
 }
 
 void MirrorService::ensure_upstream_wire(const MemberKey& key) {
@@ -829,6 +839,9 @@ std::uint64_t MirrorService::add_internal_subscriber(std::string path, std::stri
     MemberKey key{std::move(path), std::move(member)};
     auto [id, joined] = subscriptions_.add_internal(key, is_wire, on_entry, done);
     if (!joined.ready) {
+        // A value that came while the wire connects (before its WireConnectRet) went to the subscribers
+        // of then: this one has it now.
+        if (joined.last) on_entry(joined.last);
         ensure_upstream_wire(key);
         return id;
     }

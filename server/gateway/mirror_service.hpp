@@ -129,6 +129,7 @@ private:
     /// Connects the wire upstream unless it is connected or being connected (or fails its waiting
     /// subscriptions when the device is away).
     void ensure_upstream_wire(const MemberKey& key);
+    void send_newest(const MemberKey& key, const SessionRef& session, const SharedEntryPtr& newest);
     /// WireDisconnectReq to the device for wires nobody here subscribes to any more.
     void disconnect_upstream_wires(std::vector<MemberKey> keys);
     static void deliver(const UpstreamSubscriptions::InternalSubs& subs, const SharedEntryPtr& entry);

@@ -108,7 +108,7 @@ std::pair<std::uint64_t, UpstreamSubscriptions::Joined> UpstreamSubscriptions::a
     w.internal = with_subscriber(w.internal, InternalSub{id, std::move(on_entry)});
     if (w.upstream_connected) return {id, Joined{true, w.last}};
     w.waiting.push_back(std::move(on_ready));
-    return {id, Joined{}};
+    return {id, Joined{false, w.last}};
 }
 
 std::vector<UpstreamSubscriptions::MemberKey> UpstreamSubscriptions::remove_internal(std::uint64_t id) {
@@ -205,6 +205,12 @@ std::optional<UpstreamSubscriptions::Targets> UpstreamSubscriptions::wire_closed
     Targets t{it->second.sessions, std::move(it->second.internal)};
     wires_.erase(it);
     return t;
+}
+
+SharedEntryPtr UpstreamSubscriptions::newest(const MemberKey& key) const {
+    std::lock_guard lock(mutex_);
+    auto it = wires_.find(key);
+    return it == wires_.end() ? nullptr : it->second.last;
 }
 
 UpstreamSubscriptions::InternalSubs UpstreamSubscriptions::event_subscribers(const MemberKey& key) const {

@@ -51,12 +51,16 @@ public:
     struct Joined {
         /// The upstream wire is connected: the subscription holds now (its Ready was not kept).
         bool ready = false;
-        /// The wire's newest value when ready (null when none has arrived yet), for the subscriber at once.
+        /// The wire's newest value (null when none has arrived yet), for the subscriber at once. An
+        /// internal subscriber gets it also while the upstream connect is in flight: a device sends a
+        /// wire's value before its WireConnectRet, so a subscriber joining between the two would otherwise
+        /// wait for the next change.
         SharedEntryPtr last;
     };
 
     /// A native client's WireConnectReq: `session` joins the wire `key` (once, however often it asks).
-    /// Not ready: `on_ready` is kept until the upstream connect completes; call begin_connect(key).
+    /// Not ready: `on_ready` is kept until the upstream connect completes; call begin_connect(key). Such
+    /// a session is sent newest(key) after its WireConnectRet (values may come before it).
     Joined join_wire(const MemberKey& key, const SessionRef& session, Ready on_ready);
     /// A native client's WireDisconnectReq. True when it was the wire's last subscriber and the wire is
     /// connected upstream: the caller disconnects it there (the wire is forgotten here).
@@ -97,6 +101,9 @@ public:
     std::optional<Targets> wire_closed(const MemberKey& key);
     /// The internal subscribers of the event `key` (null when none).
     InternalSubs event_subscribers(const MemberKey& key) const;
+
+    /// The newest value of the wire `key` (null when none has arrived or the wire has no subscription).
+    SharedEntryPtr newest(const MemberKey& key) const;
 
     /// Wires with a subscription here (for tests and status).
     std::size_t wire_count() const;

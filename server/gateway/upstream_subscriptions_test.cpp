@@ -192,3 +192,36 @@ TEST_CASE("upstream subscriptions: events and WireClosed reach their subscribers
     CHECK_FALSE(subs.wire_closed(key));
     CHECK(subs.wire_count() == 0);
 }
+
+TEST_CASE("upstream subscriptions: a value that came while the wire connects is the newest for a subscriber joining then",
+          "[gateway][subscriptions]") {
+    // A device sends a wire's value before its WireConnectRet: subscribers joining between the two
+    // (the JSON API's, a recording's) must not wait for the next change.
+    UpstreamSubscriptions subs;
+    SubscriberSessions s;
+    const SubKey key{"dev", "w"};
+    ReadyOutcomes outcomes;
+    auto first = subs.add_internal(key, true, [](const SharedEntryPtr&) {}, outcomes.ready());
+    CHECK_FALSE(first.second.ready);
+    CHECK_FALSE(first.second.last);
+    CHECK(subs.begin_connect(key));
+    CHECK_FALSE(subs.newest(key));
+    auto targets = subs.wire_value(wire_value_entry(key, 5));  // before the WireConnectRet
+    REQUIRE(targets);
+    REQUIRE(targets->internal);
+    CHECK(targets->internal->size() == 1);
+    auto second = subs.add_internal(key, true, [](const SharedEntryPtr&) {}, outcomes.ready());
+    CHECK_FALSE(second.second.ready);
+    REQUIRE(second.second.last);
+    CHECK(second.second.last->entry().request_id == 5);
+    // A native session joining now gets no value before its WireConnectRet; newest() is sent after it.
+    const SessionRef native = s.make(1);
+    auto joined = subs.join_wire(key, native, outcomes.ready());
+    CHECK_FALSE(joined.ready);
+    CHECK_FALSE(joined.last);
+    answer_all(subs.connect_done(key, {}), {});
+    CHECK(outcomes.got.size() == 3);
+    REQUIRE(subs.newest(key));
+    CHECK(subs.newest(key)->entry().request_id == 5);
+    CHECK_FALSE(subs.newest({"dev", "other"}));
+}
