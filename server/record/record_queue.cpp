@@ -15,12 +15,26 @@ std::size_t elements_weight(const std::vector<MessageElement>& elements) noexcep
 std::size_t RecordQueue::weight(const MessageEntry& entry) noexcept { return 128 + elements_weight(entry.elements); }
 
 RecordQueue::Offered RecordQueue::offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry) {
+    return offer(member, log_ns, std::move(entry), false);
+}
+
+RecordQueue::Offered RecordQueue::offer_newest(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry) {
+    return offer(member, log_ns, std::move(entry), true);
+}
+
+RecordQueue::Offered RecordQueue::offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry,
+                                        bool newest_only) {
     const std::size_t bytes = weight(entry->entry());
     const std::size_t half = budget_ / 2;
     bool wake = false;
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (closed_) return Offered::closed;
+        if (newest_only) {
+            if (newest_arrival_.size() <= member) newest_arrival_.resize(member + 1u, 0);  // once per member
+            if (entry->arrival() <= newest_arrival_[member]) return Offered::stale;
+            newest_arrival_[member] = entry->arrival();
+        }
         if (queued_bytes_ + bytes > budget_) {
             ++drops_;
             return Offered::dropped;

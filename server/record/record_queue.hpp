@@ -32,7 +32,7 @@ public:
         gateway::SharedEntryPtr entry; ///< the entry the live path shares (not a copy)
         std::size_t bytes = 0;         ///< its weight in the budget (weight())
     };
-    enum class Offered : std::uint8_t { queued, dropped, closed };
+    enum class Offered : std::uint8_t { queued, dropped, closed, stale };
 
     /// `budget_bytes`: the most the waiting items may weigh (RecordingSpec::queue_bytes).
     explicit RecordQueue(std::size_t budget_bytes) : budget_(budget_bytes) {}
@@ -40,6 +40,10 @@ public:
     /// From the live path: queues `entry` (the reference is kept, the bytes are not copied), or drops
     /// it (counted in drops()) when it would exceed the budget, or ignores it once closed.
     Offered offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry);
+    /// offer() for a wire's value: `stale` (not queued, not a drop) when it arrived before the newest
+    /// value offered for `member` (SharedEntry::arrival): a wire's newest, handed to a subscriber joining
+    /// it, can come after a newer value, and a wire keeps only its newest.
+    Offered offer_newest(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry);
 
     /// From the writer: the previous batch is done (its weight leaves the budget; `batch` must be empty,
     /// its capacity is reused); waits until `period` has passed, the queue is half full or closed, then
@@ -61,6 +65,8 @@ public:
     static std::size_t weight(const MessageEntry& entry) noexcept;
 
 private:
+    Offered offer(std::uint16_t member, std::uint64_t log_ns, gateway::SharedEntryPtr entry, bool newest_only);
+
     const std::size_t budget_;
     mutable std::mutex mutex_;
     std::condition_variable wake_;
@@ -68,6 +74,7 @@ private:
     std::size_t queued_bytes_ = 0;  // items_ and the writer's batch
     std::size_t taken_bytes_ = 0;   // the writer's batch
     std::uint64_t drops_ = 0;
+    std::vector<std::uint64_t> newest_arrival_;  // per member, for offer_newest()
     bool closed_ = false;
 };
 

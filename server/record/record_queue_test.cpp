@@ -157,3 +157,22 @@ TEST_CASE("record queue: the writer is woken at half the budget, not per value")
     CHECK(std::chrono::steady_clock::now() - t0 < 20s);
     CHECK(batch.size() == 6);  // the wake comes with the sixth
 }
+
+TEST_CASE("record queue: a wire's value that arrived before the newest one offered is stale, not a drop") {
+    RecordQueue q(1 << 20);
+    const auto older = entry_of_bytes(8);  // the wire's newest when the recording joined it
+    const auto newer = entry_of_bytes(8);  // came from the device after it, fanned out first
+    REQUIRE(newer->arrival() > older->arrival());
+    CHECK(q.offer_newest(0, 1, newer) == RecordQueue::Offered::queued);
+    CHECK(q.offer_newest(0, 2, older) == RecordQueue::Offered::stale);
+    CHECK(q.offer_newest(0, 3, newer) == RecordQueue::Offered::stale);  // the same one again
+    CHECK(q.offer_newest(1, 4, older) == RecordQueue::Offered::queued);  // another member's order
+    CHECK(q.offer(0, 5, older) == RecordQueue::Offered::queued);          // events and pipes keep every value
+    CHECK(q.drops() == 0);
+    std::vector<RecordQueue::Item> batch;
+    q.take(batch, 0ms);
+    REQUIRE(batch.size() == 3);
+    CHECK(batch[0].entry == newer);
+    CHECK(batch[1].member == 1);
+    CHECK(batch[2].log_ns == 5);
+}

@@ -185,6 +185,10 @@ void Recording::wait() {
 
 void Recording::offer(std::uint16_t member, SharedEntryPtr entry) { (void)queue_.offer(member, now_ns(), std::move(entry)); }
 
+void Recording::offer_wire(std::uint16_t member, SharedEntryPtr entry) {
+    (void)queue_.offer_newest(member, now_ns(), std::move(entry));
+}
+
 void Recording::subscribe_members() {
     std::weak_ptr<Recording> weak = weak_from_this();
     {
@@ -201,10 +205,15 @@ void Recording::subscribe_members() {
         if (m.kind == RecordedMember::Kind::wire || m.kind == RecordedMember::Kind::event) {
             auto sid = device_->subscribe(
                 t.path, t.member->name, m.kind == RecordedMember::Kind::wire,
-                [weak, index](const SharedEntryPtr& e) {
+                [weak, index, is_wire = m.kind == RecordedMember::Kind::wire](const SharedEntryPtr& e) {
                     // WireClosed has no value: only values are recorded.
                     if (e->entry().entry_type == MessageEntryType::WireClosed) return;
-                    if (auto self = weak.lock()) self->offer(index, e);
+                    auto self = weak.lock();
+                    if (!self) return;
+                    if (is_wire)
+                        self->offer_wire(index, e);
+                    else
+                        self->offer(index, e);
                 },
                 [weak](Result<void>) {  // a wire not connected now is connected when the device is back
                     if (auto self = weak.lock()) self->member_answered();

@@ -130,6 +130,8 @@ private:
               std::vector<std::string> definition_names, const RecordingFormats& formats);
     /// From the live path: queue (the reference) or drop.
     void offer(std::uint16_t member, gateway::SharedEntryPtr entry);
+    /// A wire's value: not recorded when it arrived before the newest one recorded (RecordQueue::offer_newest).
+    void offer_wire(std::uint16_t member, gateway::SharedEntryPtr entry);
     /// The open file's size into files_ and the root's budget (once per batch: the writer does not take
     /// mutex_ per item). False: the root's budget is used up.
     bool note_file_size();
