@@ -79,6 +79,7 @@ private:
         bool active = false;      // the upstream subscription is open
         bool cancelled = false;   // ended before its upstream answered
         SharedEntryPtr pending;   // the newest wire value waiting while the socket is behind
+        std::uint64_t newest_arrival = 0;  // a wire: the SharedEntry arrival of the newest value taken
     };
 
     struct PublishTarget {
@@ -127,6 +128,7 @@ private:
     void send_entry(const Sub& s, const SharedEntryPtr& e);
     void on_wire(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e);
     void on_event(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e);
+    bool take_newer(Sub& s, const gateway::SharedEntry& e);
     bool image_subscription(std::uint32_t sid) const;
     void arm_retry();
     void flush_locked();

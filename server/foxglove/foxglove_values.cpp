@@ -42,7 +42,7 @@ void FoxgloveConnection::on_wire(std::uint32_t sid, std::uint64_t serial, const 
     if (image_subscription(sid)) return convert(sid, serial, e);
     std::lock_guard lock(mutex_);
     Sub* s = live_sub(sid, serial);
-    if (!s) return;
+    if (!s || !take_newer(*s, *e)) return;
     if (s->pending || wire_congested()) {
         if (s->pending) ++stats_.wire_coalesced;
         s->pending = e;  // newest wins
@@ -50,6 +50,18 @@ void FoxgloveConnection::on_wire(std::uint32_t sid, std::uint64_t serial, const 
         return;
     }
     send_entry(*s, e);
+}
+
+// Under mutex_: whether a wire value is newer than the last one this subscription took. The
+// wire's newest, handed to a joining subscription outside the fan-out tables' lock, can come after
+// a newer value; it is dropped (counted coalesced), as the JSON subscriptions and recordings do.
+bool FoxgloveConnection::take_newer(Sub& s, const gateway::SharedEntry& e) {
+    if (e.arrival() <= s.newest_arrival) {
+        ++stats_.wire_coalesced;
+        return false;
+    }
+    s.newest_arrival = e.arrival();
+    return true;
 }
 
 void FoxgloveConnection::on_event(std::uint32_t sid, std::uint64_t serial, const SharedEntryPtr& e) {
@@ -140,7 +152,9 @@ void FoxgloveConnection::convert(std::uint32_t sid, std::uint64_t serial, Shared
         if (!message) return;  // a frame Foxglove has no form of: nothing on the image channel
         std::string frame = fg::message_data_head(sid, received) + *message;
         std::lock_guard lock(self->mutex_);
-        if (!self->live_sub(sid, serial)) return;
+        Sub* s = self->live_sub(sid, serial);
+        // An image wire's frames are ordered here, where they are sent (conversions finish in post order).
+        if (!s || (member->kind == LiveKind::wire && !self->take_newer(*s, *entry))) return;
         self->socket_->send_binary(std::move(frame));
         ++self->stats_.messages_sent;
     });
