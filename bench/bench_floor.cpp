@@ -14,8 +14,11 @@
 //               for S seconds (default 5), one blocking write per message as the gateway makes one
 //               WebSocket write per value and client; another thread reads them all (one io_context).
 //               Reports the writer's CPU µs and context switches per message (its thread's getrusage):
-//               what the kernel alone charges the sender, with no protocol on top; and the latency from
-//               the write to the read (p50/p99/max µs), delivered messages/s. When one process may not
+//               what the kernel alone charges the sender, with no protocol on top; the latency from
+//               the write to the read (p50/p99/max µs), delivered messages/s; and the latency from the
+//               tick (p50_tick_us/p99_tick_us/max_tick_us: one stamp per tick, taken before its first
+//               write, as a device value is stamped once and then fanned out), which includes the time
+//               the writer takes to reach the socket, as the gateway's fan-out rows do. When one process may not
 //               hold 2N sockets (RLIMIT_NOFILE: 10,000 clients under a 20,000 limit), the reader runs in a
 //               forked child with its N sockets and sends its figures back through a pipe ("split": true).
 #include <csignal>
@@ -129,8 +132,8 @@ std::int64_t now_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
 }
 
-/// One blocking write of a `bytes`-byte message (its first 8 bytes the steady clock in ns) to every
-/// socket, `hz` times a second for `seconds`; the writer's CPU per message and its wall time.
+/// One blocking write of a `bytes`-byte message (its first 8 bytes the clock in ns at the write, the
+/// next 8 the clock at the tick's start) to every socket, `hz` times a second for `seconds`; the writer's CPU per message and its wall time.
 struct WriterFigures {
     rr::bench::CpuSnapshot before, after;
     double wall_us = 0;
@@ -144,6 +147,8 @@ WriterFigures write_ticks(std::vector<tcp::socket>& writers, double seconds, dou
     const auto start = clock_type::now();
     for (std::size_t t = 0; t < ticks; ++t) {
         std::this_thread::sleep_until(start + t * period);
+        const std::int64_t tick = now_ns();
+        std::memcpy(message.data() + sizeof tick, &tick, sizeof tick);
         for (auto& w : writers) {
             const std::int64_t stamp = now_ns();
             std::memcpy(message.data(), &stamp, sizeof stamp);
@@ -156,30 +161,48 @@ WriterFigures write_ticks(std::vector<tcp::socket>& writers, double seconds, dou
     return f;
 }
 
-/// Reads whole messages from every socket until EOF on all; the latency of each (µs).
-std::vector<double> read_all(asio::io_context& io, std::vector<tcp::socket>& readers, std::size_t bytes, std::size_t expected) {
+/// Each message's latency (µs) from its write and from its tick.
+struct Latencies {
+    std::vector<double> write_us, tick_us;
+};
+
+/// Reads whole messages from every socket until EOF on all; the latencies of each, sorted.
+Latencies read_all(asio::io_context& io, std::vector<tcp::socket>& readers, std::size_t bytes, std::size_t expected) {
     std::vector<std::vector<char>> buffers(readers.size(), std::vector<char>(bytes));
-    std::vector<double> latency_us;
-    latency_us.reserve(expected);
+    Latencies latency;
+    latency.write_us.reserve(expected);
+    latency.tick_us.reserve(expected);
     std::function<void(std::size_t)> arm = [&](std::size_t i) {
         asio::async_read(readers[i], asio::buffer(buffers[i]), [&, i](boost::system::error_code ec, std::size_t) {
             if (ec) return;  // EOF: the writer is done
-            std::int64_t stamp = 0;
+            std::int64_t stamp = 0, tick = 0;
             std::memcpy(&stamp, buffers[i].data(), sizeof stamp);
-            latency_us.push_back(double(now_ns() - stamp) / 1000.0);
+            std::memcpy(&tick, buffers[i].data() + sizeof stamp, sizeof tick);
+            const std::int64_t now = now_ns();
+            latency.write_us.push_back(double(now - stamp) / 1000.0);
+            latency.tick_us.push_back(double(now - tick) / 1000.0);
             arm(i);
         });
     };
     for (std::size_t i = 0; i < readers.size(); ++i) arm(i);
     io.run();
-    return latency_us;
+    std::sort(latency.write_us.begin(), latency.write_us.end());
+    std::sort(latency.tick_us.begin(), latency.tick_us.end());
+    return latency;
+}
+
+/// p50/p99/max of sorted latencies under `suffix`'s names (p50_us, p50_tick_us, ...).
+void put_latencies(nlohmann::json& row, const std::vector<double>& sorted_us, const std::string& suffix) {
+    row["p50" + suffix] = rr::bench::percentile(sorted_us, 0.50);
+    row["p99" + suffix] = rr::bench::percentile(sorted_us, 0.99);
+    row["max" + suffix] = sorted_us.empty() ? 0.0 : sorted_us.back();
 }
 
 nlohmann::json floor_row(std::size_t clients, double seconds, double hz, std::size_t bytes, const WriterFigures& w,
-                         const std::vector<double>& latency_us, double reader_cpu_us) {
+                         const Latencies& latency, double reader_cpu_us) {
     const double sent = double(static_cast<std::size_t>(seconds * hz) * clients);
-    const double delivered = double(latency_us.size());
-    return {{"op", "fanout_floor"},
+    const double delivered = double(latency.write_us.size());
+    nlohmann::json row = {{"op", "fanout_floor"},
             {"clients", clients},
             {"hz", hz},
             {"bytes", bytes},
@@ -187,13 +210,13 @@ nlohmann::json floor_row(std::size_t clients, double seconds, double hz, std::si
             {"sent", sent},
             {"delivered", delivered},
             {"delivered_per_s", w.wall_us > 0 ? delivered * 1e6 / w.wall_us : 0.0},
-            {"p50_us", rr::bench::percentile(latency_us, 0.50)},
-            {"p99_us", rr::bench::percentile(latency_us, 0.99)},
-            {"max_us", latency_us.empty() ? 0.0 : *std::max_element(latency_us.begin(), latency_us.end())},
             {"writer_cpu_pct", w.wall_us > 0 ? 100 * (w.after.cpu_us - w.before.cpu_us) / w.wall_us : 0.0},
             {"writer_cpu_us_per_value", sent > 0 ? (w.after.cpu_us - w.before.cpu_us) / sent : 0.0},
             {"writer_vcsw_per_value", sent > 0 ? double(w.after.vcsw - w.before.vcsw) / sent : 0.0},
             {"reader_cpu_us_per_value", delivered > 0 ? reader_cpu_us / delivered : 0.0}};
+    put_latencies(row, latency.write_us, "_us");
+    put_latencies(row, latency.tick_us, "_tick_us");
+    return row;
 }
 
 /// The fan-out floor with the reader in a forked child (its own N sockets): for N too large for one
@@ -216,15 +239,12 @@ nlohmann::json fanout_floor_split(std::size_t clients, double seconds, double hz
         readers.reserve(clients);
         for (std::size_t i = 0; i < clients; ++i) readers.emplace_back(child_io).connect(endpoint);
         const auto before = rr::bench::CpuSnapshot::now();
-        auto latency_us = read_all(child_io, readers, bytes, static_cast<std::size_t>(seconds * hz) * clients);
+        const auto latency = read_all(child_io, readers, bytes, static_cast<std::size_t>(seconds * hz) * clients);
         const auto after = rr::bench::CpuSnapshot::now();
-        std::sort(latency_us.begin(), latency_us.end());
-        const std::string out = nlohmann::json{{"delivered", latency_us.size()},
-                                               {"p50_us", rr::bench::percentile(latency_us, 0.50)},
-                                               {"p99_us", rr::bench::percentile(latency_us, 0.99)},
-                                               {"max_us", latency_us.empty() ? 0.0 : latency_us.back()},
-                                               {"reader_cpu_us", after.cpu_us - before.cpu_us}}
-                                    .dump();
+        nlohmann::json figures = {{"delivered", latency.write_us.size()}, {"reader_cpu_us", after.cpu_us - before.cpu_us}};
+        put_latencies(figures, latency.write_us, "_us");
+        put_latencies(figures, latency.tick_us, "_tick_us");
+        const std::string out = figures.dump();
         (void)!::write(pipe_fds[1], out.data(), out.size());
         ::close(pipe_fds[1]);
         _exit(0);
@@ -249,7 +269,7 @@ nlohmann::json fanout_floor_split(std::size_t clients, double seconds, double hz
     const double delivered = reader.value("delivered", 0.0);
     row["delivered"] = delivered;
     row["delivered_per_s"] = w.wall_us > 0 ? delivered * 1e6 / w.wall_us : 0.0;
-    for (const char* k : {"p50_us", "p99_us", "max_us"}) row[k] = reader.value(k, 0.0);
+    for (const char* k : {"p50_us", "p99_us", "max_us", "p50_tick_us", "p99_tick_us", "max_tick_us"}) row[k] = reader.value(k, 0.0);
     row["reader_cpu_us_per_value"] = delivered > 0 ? reader.value("reader_cpu_us", 0.0) / delivered : 0.0;
     row["split"] = true;
     return row;
@@ -257,7 +277,7 @@ nlohmann::json fanout_floor_split(std::size_t clients, double seconds, double hz
 
 nlohmann::json fanout_floor_row(std::size_t clients, double seconds, double hz, std::size_t bytes) {
     rr::bench::raise_fd_limit();
-    bytes = std::max<std::size_t>(bytes, sizeof(std::int64_t));
+    bytes = std::max<std::size_t>(bytes, 2 * sizeof(std::int64_t));  // the write's and the tick's stamps
     rlimit limit{};
     getrlimit(RLIMIT_NOFILE, &limit);
     if (2 * clients + 64 > limit.rlim_cur) return fanout_floor_split(clients, seconds, hz, bytes);
@@ -275,10 +295,10 @@ nlohmann::json fanout_floor_row(std::size_t clients, double seconds, double hz, 
     WriterFigures w;
     std::thread writer([&] { w = write_ticks(writers, seconds, hz, bytes); });
     const auto reader_before = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
-    const auto latency_us = read_all(io, readers, bytes, static_cast<std::size_t>(seconds * hz) * clients);
+    const auto latency = read_all(io, readers, bytes, static_cast<std::size_t>(seconds * hz) * clients);
     const auto reader_after = rr::bench::CpuSnapshot::now(RUSAGE_THREAD);
     writer.join();
-    return floor_row(clients, seconds, hz, bytes, w, latency_us, reader_after.cpu_us - reader_before.cpu_us);
+    return floor_row(clients, seconds, hz, bytes, w, latency, reader_after.cpu_us - reader_before.cpu_us);
 }
 
 }  // namespace

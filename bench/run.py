@@ -1223,6 +1223,9 @@ def markdown(res):
                     f.get("round"), f["backend"], fmt(f.get("clients")), fmt(f.get("delivered_per_s"), 0),
                     "%.1f %%" % (100.0 * f.get("delivered", 0) / sent) if sent else "", fmt(f.get("p50_us", 0) / 1000),
                     fmt(f.get("p99_us", 0) / 1000), fmt(f.get("writer_cpu_pct")), fmt(f.get("writer_cpu_us_per_value"))))
+                if "p99_tick_us" in f:  # the same messages' latency from their tick, as the gateway's rows count it
+                    t.append("| %s | floor, latency from the tick | | | | | %s | %s | | | |" % (
+                        f.get("round"), fmt(f["p50_tick_us"] / 1000), fmt(f["p99_tick_us"] / 1000)))
                 continue
             t.append("| %s | %s | %s | %s | %s | %.1f %% | %s | %s | %s | %s | %s |" % (
                 f.get("round"), f["backend"], fmt(f["clients"]), fmt(f["delivered_per_s"], 0), fmt(f["expected_per_s"], 0),
@@ -1233,15 +1236,15 @@ def markdown(res):
     if res.get("uring"):
         out += ["", "The io_uring lever (issue 56): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket clients, "
                 "the gateway built on epoll (this build) and on io_uring (`-DRR_IO_URING=ON`), alternating, a fresh gateway "
-                "per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", ""] + pair_table(res["uring"])
+                "per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round, its latency from each write and from the tick (one stamp per tick before its first write, as the gateway's rows count from the device's one stamp per value):", ""] + pair_table(res["uring"])
     if res.get("ab"):
         out += ["", "Two gateways alternating (`--only ab`): the device's `Ticks` wire at 100 Hz → gateway → N JSON WebSocket "
                 "clients, this build's gateway and `--ab-gateway`, a fresh gateway per row; the floor is `rr_bench_floor "
-                "--fanout` (plain TCP writes) once per round:", ""] + pair_table(res["ab"])
+                "--fanout` (plain TCP writes) once per round, its latency from each write and from the tick (one stamp per tick before its first write, as the gateway's rows count from the device's one stamp per value):", ""] + pair_table(res["ab"])
     if res.get("gather"):
         out += ["", "Gathered writes (issue 56, `--only gather`): the device's `Ticks` wire at 100 Hz → gateway → N JSON "
                 "WebSocket clients, the same gateway with `gateway.websocket_gathered_writes` true and false, alternating, a "
-                "fresh gateway per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round:", ""] + \
+                "fresh gateway per row; the floor is `rr_bench_floor --fanout` (plain TCP writes) once per round, its latency from each write and from the tick (one stamp per tick before its first write, as the gateway's rows count from the device's one stamp per value):", ""] + \
             pair_table(res["gather"])
     if res.get("scale10k"):
         out += ["", "10,000 connections (issue 56, `--only scale10k`; file-descriptor limit %s): idle JSON WebSockets on a "
