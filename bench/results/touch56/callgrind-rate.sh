@@ -26,17 +26,19 @@ kill -TERM $gw; wait $gw; kill -TERM $dev; wait $dev
 total_ir() { callgrind_annotate "$1" 2>/dev/null | awk '/PROGRAM TOTALS/ && !done { gsub(",", "", $1); print $1; done = 1 }'; }
 dumps=($(ls -v $T/gw.out.*))
 i=0
-declare -A IR N M
+declare -A IR N M L
 for tag in r10a r10b r100a r100b; do
   d=${dumps[$i]}; i=$((i+1))
   IR[$tag]=$(total_ir $d)
   N[$tag]=$(python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(int(r['delivered_per_s'] * r['seconds']))" $T/$tag.json)
   M[$tag]=$(bench/callgrind_calls.py $d malloc | awk '{print $2}')
-  echo "$NAME $tag delivered=${N[$tag]} instructions=${IR[$tag]} mallocs=${M[$tag]}"
+  # pthread_mutex_lock under whichever of its glibc names callgrind recorded (aliases: one is found)
+  L[$tag]=$(bench/callgrind_calls.py $d pthread_mutex_lock ___pthread_mutex_lock 'pthread_mutex_lock@@GLIBC_2.2.5' | awk '{s += $2} END {print s}')
+  echo "$NAME $tag delivered=${N[$tag]} instructions=${IR[$tag]} mallocs=${M[$tag]} mutex_locks=${L[$tag]}"
 done
 for r in 10 100; do
   a=r${r}a; b=r${r}b
   python3 -c "
-ir=${IR[$b]}-${IR[$a]}; n=${N[$b]}-${N[$a]}; m=${M[$b]}-${M[$a]}
-print('$NAME steady rate=$r: +3 s: %d values, %d instructions (%d per value, %.1f M per s), %.2f mallocs per value' % (n, ir, ir/n, ir/3e6, m/n))"
+ir=${IR[$b]}-${IR[$a]}; n=${N[$b]}-${N[$a]}; m=${M[$b]}-${M[$a]}; l=${L[$b]}-${L[$a]}
+print('$NAME steady rate=$r: +3 s: %d values, %d instructions (%d per value, %.1f M per s), %.2f mallocs per value, %.2f mutex locks per value' % (n, ir, ir/n, ir/3e6, m/n, l/n))"
 done
