@@ -884,35 +884,13 @@ private:
         }
         {
             std::lock_guard lock(mutex_);
-            const RateClock now = rate_clock_now();
-            const Offered o = subs_.offer_wire(sid, e, now, coalesced, seq);
+            const Offered o = subs_.offer_wire(sid, e, rate_clock_now(), coalesced, seq);
             if (!o.send_now) {
                 if (o.wait.count() > 0) wake_at_locked(o.wait);  // waits for its window
                 return;  // or not open, or waits for its subscribe reply
             }
-            // The common case in this one critical section (issue 56, docs/benchmarks.md): no flusher,
-            // no retry armed, the client keeps up. The value goes at once, sent under the lock, so no
-            // later value of its subscription (taken under the lock after this) can overtake it. Its
-            // rendering, made once per value for all sockets, may then be made under this socket's lock.
-            if (!flushing_ && !timer_armed_ && !closed_ && !wire_congested()) {
-                if (auto w = subs_.take_wire(sid, now)) send_wire(*w);
-                return;
-            }
         }
         flush_wires();
-    }
-
-    // A wire value's push: the text or binary rendering shared by all the wire's sockets.
-    void send_wire(const WireToSend& w) {
-        const MemberTarget& t = *w.target;
-        if (w.binary) {
-            send_push(w.subscription, "wire", 0, w.value->rendered_binary([&](const MessageEntry& e) {
-                return render_binary_body([&](BinaryArrays* b) { return wire_push_body(*api_, e, t, b); });
-            }));
-            return;
-        }
-        const std::string& body = w.value->rendered([&](const MessageEntry& e) { return wire_push_text(*api_, e, t); });
-        send_text_push(w.subscription, "wire", 0, w.value, body);
     }
 
     // Sends the waiting wire values unless the client is behind; then they wait (coalescing) and retry.
@@ -944,7 +922,18 @@ private:
                 }
                 subs_.take_wires(batch, now);
             }
-            for (const auto& w : batch) send_wire(w);
+            for (const auto& w : batch) {
+                const MemberTarget& t = *w.target;
+                if (w.binary) {
+                    send_push(w.subscription, "wire", 0, w.value->rendered_binary([&](const MessageEntry& e) {
+                        return render_binary_body([&](BinaryArrays* b) { return wire_push_body(*api_, e, t, b); });
+                    }));
+                    continue;
+                }
+                const std::string& body =
+                    w.value->rendered([&](const MessageEntry& e) { return wire_push_text(*api_, e, t); });
+                send_text_push(w.subscription, "wire", 0, w.value, body);
+            }
             batch.clear();  // the values go now, the capacity stays
             std::lock_guard lock(mutex_);
             if (!flush_again_) {

@@ -122,13 +122,6 @@ void JsonSubscriptions::take_wires(std::vector<WireToSend>& out, RateClock now) 
     }
 }
 
-std::optional<WireToSend> JsonSubscriptions::take_wire(std::uint64_t sid, RateClock now) {
-    auto* s = find(sid);
-    if (!s || !s->active || !s->pending_wire || !s->rate.open(now)) return std::nullopt;
-    s->rate.sent(now);
-    return WireToSend{sid, std::exchange(s->pending_wire, nullptr), s->target, s->binary};
-}
-
 void JsonSubscriptions::rate_waiting(RateClock now, std::vector<RateClock>& out) const {
     for (const auto& [sid, s] : subs_)
         if (s.active && s.pending_wire && !s.rate.open(now)) out.push_back(s.rate.period());

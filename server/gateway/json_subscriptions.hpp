@@ -119,9 +119,6 @@ public:
     /// is not above that of one offered before is older than it and is dropped (counted as coalesced).
     Offered offer_wire(std::uint64_t sid, SharedEntryPtr value, RateClock now = {}, std::uint64_t coalesced = 0,
                        std::uint64_t seq = 0);
-    /// The wire value of `sid` alone when it may go at `now` (as take_wires would take it; its rate window
-    /// counts it as sent): the one-subscription form of take_wires for a value just offered.
-    std::optional<WireToSend> take_wire(std::uint64_t sid, RateClock now = {});
     /// Whether an answered subscription has a wire value that may go at `now`.
     bool wires_waiting(RateClock now = {}) const;
     /// Moves the wire values of answered subscriptions that may go at `now` into `out` (cleared first),

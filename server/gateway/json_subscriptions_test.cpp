@@ -125,41 +125,6 @@ TEST_CASE("json subscriptions: the newest wire value waits, older ones are coale
     CHECK(batch.empty());
 }
 
-TEST_CASE("json subscriptions: take_wire takes the one subscription's value when it may go, and counts it against its rate") {
-    using namespace std::chrono_literals;
-    JsonSubscriptions subs(8);
-    const auto other = add(subs, subscription(SubscriptionKind::wire));
-    auto limited = subscription(SubscriptionKind::wire);
-    limited.rate = RateWindow(100ms);
-    const auto sid = add(subs, std::move(limited));
-    const auto unanswered = add(subs, subscription(SubscriptionKind::wire), false);
-
-    CHECK_FALSE(subs.take_wire(sid, 1s));  // nothing waiting
-    CHECK_FALSE(subs.take_wire(42, 1s));   // not a subscription
-    CHECK_FALSE(subs.offer_wire(unanswered, wire_value(0), 1s).send_now);
-    CHECK_FALSE(subs.take_wire(unanswered, 1s));  // waits for its reply
-
-    CHECK(subs.offer_wire(other, wire_value(1), 1s).send_now);
-    CHECK(subs.offer_wire(sid, wire_value(2), 1s).send_now);
-    auto w = subs.take_wire(sid, 1s);
-    REQUIRE(w);
-    CHECK(w->subscription == sid);
-    double v = 0;
-    REQUIRE(read_scalar(*w->value->entry().find("packet"), v));
-    CHECK(v == 2);
-    CHECK(subs.pending_wires() == 2);  // the other subscription's value and the unanswered one stay
-
-    // Counted as sent: the next value waits for the next window, as after take_wires.
-    CHECK_FALSE(subs.offer_wire(sid, wire_value(3), 1s + 10ms).send_now);
-    CHECK_FALSE(subs.take_wire(sid, 1s + 10ms));
-    REQUIRE(subs.take_wire(sid, 1s + 100ms));
-
-    std::vector<WireToSend> batch;
-    subs.take_wires(batch, 1s + 100ms);
-    REQUIRE(batch.size() == 1);
-    CHECK(batch[0].subscription == other);
-}
-
 TEST_CASE("json subscriptions: a rate group's value older than one offered before (its seq not above) is dropped and counted") {
     JsonSubscriptions subs(8);
     const auto sid = add(subs, subscription(SubscriptionKind::wire));
