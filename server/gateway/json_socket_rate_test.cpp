@@ -3,6 +3,8 @@
 // value arrives) and counts that hold at any speed (fewer than sent, in order, drops accounted for).
 // How close the spacing is to 1/max_rate_hz is not checked here (that would be a `timing` test).
 #include <algorithm>
+#include <functional>
+#include <map>
 
 #include "server/gateway/json_api_test_fixture.hpp"
 #include "test/support/eventually.hpp"
@@ -74,6 +76,50 @@ TEST_CASE("json socket rate: a wire at max_rate_hz 1: fewer values than an unlim
     const auto stats = gw.sockets().stats();
     REQUIRE(stats.size() == 1);
     CHECK(stats[0].wire_coalesced > 0);
+}
+
+TEST_CASE("json socket rate: a burst to a socket often behind: each wire subscription's values arrive in order, the last one too") {
+    // A value for a socket that keeps up is sent in the critical section that offers it (on the
+    // device's thread); one for a socket that is behind waits for the retry timer's flusher, and a
+    // rate-limited one for its window's. A queue threshold of one message makes a fast burst mix them.
+    using namespace std::chrono_literals;
+    RR_SKIP_WITHOUT_INTEROP_SERVICE();
+    InteropProcess device;
+    JsonSocketOptions options;
+    options.wire_queue_threshold = 1;
+    options.wire_retry = 1ms;
+    TestGateway gw(device.url(), true, options);
+    WsClient driver(gw.port());
+    WsClient ws(gw.port());
+    auto own = driver.request(member("subscribe", "w_both"));
+    REQUIRE(own.contains("result"));
+    const auto sender = own["result"]["subscription"].get<std::uint64_t>();
+    std::vector<std::uint64_t> sids;
+    for (const json& more : {json::object(), json{{"max_rate_hz", 200}}, json::object()}) {
+        auto r = ws.request(member("subscribe", "w_both", more));
+        INFO(r.dump());
+        REQUIRE(r.contains("result"));
+        sids.push_back(r["result"]["subscription"].get<std::uint64_t>());
+    }
+
+    constexpr int kValues = 400;
+    for (int i = 1; i <= kValues; ++i)
+        driver.send(json{{"id", i}, {"op", "set_out_value"}, {"subscription", sender}, {"value", {double(i)}}});
+    std::map<std::uint64_t, std::vector<double>> got;
+    auto all_last = [&] {
+        return std::all_of(sids.begin(), sids.end(), [&](auto sid) { return !got[sid].empty() && got[sid].back() == kValues; });
+    };
+    while (!all_last()) {
+        auto m = ws.next();
+        REQUIRE(m);
+        if (m->value("kind", "") == "wire" && (*m)["value"].is_array() && !(*m)["value"].empty())
+            got[m->value("subscription", std::uint64_t{0})].push_back((*m)["value"][0].get<double>());
+    }
+    for (auto sid : sids) {
+        const auto& v = got[sid];
+        INFO("subscription " << sid << ": " << v.size() << " values: " << json(v).dump());
+        CHECK(std::adjacent_find(v.begin(), v.end(), std::greater_equal<>()) == v.end());  // strictly increasing
+    }
 }
 
 TEST_CASE("json socket rate: a pipe at max_rate_hz 2 with queue_length 3 keeps the newest packets, drops are counted") {
