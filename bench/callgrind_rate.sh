@@ -1,11 +1,13 @@
 #!/bin/bash
 # callgrind of rr-gateway while 100 JSON clients get the device's 100 Hz wire at max_rate_hz 10, then without a
 # rate: runs of 3 s and 6 s each, the steady cost is their difference (instructions and mallocs per delivered
-# value). Usage: callgrind-rate.sh BUILD NAME; BUILD is a build dir or a copy of its server/app/rr-gateway and
-# bench/rr_bench_service, bench/rr_bench_ws_load. Copied from bench/results/rate56e (issue 56), for touch56.
+# value). Usage: bench/callgrind_rate.sh BUILD NAME; BUILD is a build dir or a copy of its server/app/rr-gateway and
+# bench/rr_bench_service, bench/rr_bench_ws_load; NAME names the dumps' folder, /tmp/callgrind-rate/NAME.
+# Issue 56's rate groups (bench/results/rate56e, whose runs did not count mutex locks yet) and the
+# once-per-value lever (bench/results/touch56) were measured with it.
 set -u
-cd /work/wt/touch56
-B=$1; NAME=$2; T=/tmp/touch56-cg/$NAME; rm -rf $T; mkdir -p $T
+B=$(realpath "$1"); NAME=$2; T=/tmp/callgrind-rate/$NAME; rm -rf $T; mkdir -p $T
+cd "$(dirname "$0")/.."
 $B/bench/rr_bench_service --tick-hz 100 --memory-mib 0.01 > $T/dev &
 dev=$!
 for _ in $(seq 1 600); do [ -s $T/dev ] && break; sleep 0.1; done
