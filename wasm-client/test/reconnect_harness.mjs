@@ -103,12 +103,13 @@ export async function interopService(binary, port) {
   return s;
 }
 
-/** rr-gateway on a fixed port with device "interop" at `deviceUrl`; restart() kills it and starts it again. */
-export async function gateway(binary, port, deviceUrl, auth = "shared") {
+/** rr-gateway on a fixed port with device "interop" at `deviceUrl` (and `extraConfig`, YAML appended to
+ *  its configuration file); restart() kills it and starts it again. */
+export async function gateway(binary, port, deviceUrl, auth = "shared", extraConfig = "") {
   const dir = mkdtempSync(join(tmpdir(), "rr-wasm-reconnect-"));
   process.on("exit", () => rmSync(dir, { recursive: true, force: true }));
   const config = join(dir, "gateway.yaml");
-  writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: ${auth}\n`);
+  writeFileSync(config, `devices:\n  - name: interop\n    url: ${JSON.stringify(deviceUrl)}\n    auth: ${auth}\n${extraConfig}`);
   const g = {
     port,
     http: `http://127.0.0.1:${port}`,
