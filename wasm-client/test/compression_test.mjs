@@ -10,7 +10,7 @@
 // Exit: 0 passed, 1 a check failed, 2 setup failed, 77 skipped (no `ws` package: run ./scripts/setup.sh).
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
-import { arg, freePort, gateway, interopService, sleep, stopAll } from "./reconnect_harness.mjs";
+import { arg, checks, freePort, gateway, interopService, stopAll, until } from "./reconnect_harness.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const { connectJson } = await import(join(here, "..", "src", "json_client.mjs"));
@@ -30,18 +30,7 @@ class RecordingWebSocket extends (ws.WebSocket ?? ws.default) {
   }
 }
 
-let failed = 0;
-const ok = (cond, what) => {
-  console.log(`  ${cond ? "ok  " : "FAIL"} ${what}`);
-  if (!cond) failed++;
-};
-async function until(cond, what, timeoutMs = 30000) {
-  const end = Date.now() + timeoutMs;
-  while (!cond()) {
-    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
-    await sleep(10);
-  }
-}
+const { ok, failed } = checks();
 
 /** A request, a wire value as JSON and as a binary push through a client of `gw`; the extensions its socket got. */
 async function exchange(gw, what) {
@@ -95,5 +84,5 @@ try {
   ok(false, e.message);
 }
 stopAll();
-console.log(failed ? `${failed} check(s) failed` : "all checks passed");
-process.exit(failed ? 1 : 0);
+console.log(failed() ? `FAILED: ${failed()} checks` : "all checks passed");
+process.exit(failed() ? 1 : 0);

@@ -9,7 +9,7 @@
 // Exit: 0 passed, 1 a check failed, 2 setup failed.
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
-import { arg, cutProxy, freePort, gateway, interopService, sleep, stopAll } from "./reconnect_harness.mjs";
+import { arg, checks, cutProxy, freePort, gateway, interopService, sleep, stopAll, until } from "./reconnect_harness.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 // The source module: it needs no build (no wasm), and dist/json_client.mjs is a copy of it.
@@ -18,18 +18,7 @@ const { connectJson, decodeBinaryPush } = await import(join(here, "..", "src", "
 // Quick reconnects; the receive timeout well above a stall of node or the gateway under CI load (a
 // spurious one is one reconnect too many), the request timeout a bound on a hang.
 const FAST = { backoff: { initialMs: 50, maxMs: 400 }, heartbeatPeriodMs: 500, receiveTimeoutMs: 6000, timeoutMs: 30000 };
-let failed = 0;
-const ok = (cond, what) => {
-  console.log(`  ${cond ? "ok  " : "FAIL"} ${what}`);
-  if (!cond) failed++;
-};
-async function until(cond, what, timeoutMs = 30000) {
-  const end = Date.now() + timeoutMs;
-  while (!cond()) {
-    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
-    await sleep(10);
-  }
-}
+const { ok, failed } = checks();
 
 let svc;
 let gw;
@@ -185,5 +174,5 @@ try {
 }
 stopAll();
 proxy?.close();
-console.log(failed ? `FAILED: ${failed} checks` : "all checks passed");
-process.exit(failed ? 1 : 0);
+console.log(failed() ? `FAILED: ${failed()} checks` : "all checks passed");
+process.exit(failed() ? 1 : 0);

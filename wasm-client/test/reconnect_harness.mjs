@@ -10,6 +10,28 @@ import { createInterface } from "node:readline";
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+/** Resolves once cond() holds, polled every 10 ms; throws after `timeoutMs` (a bound on a hang, not the
+ *  expected time). */
+export async function until(cond, what, timeoutMs = 30000) {
+  const end = Date.now() + timeoutMs;
+  while (!cond()) {
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await sleep(10);
+  }
+}
+
+/** A test's checks: ok(cond, what) prints each and counts the failed ones (failed()). */
+export function checks() {
+  let failed = 0;
+  return {
+    ok(cond, what) {
+      console.log(`  ${cond ? "ok  " : "FAIL"} ${what}`);
+      if (!cond) failed++;
+    },
+    failed: () => failed,
+  };
+}
+
 export function arg(name, fallback = null) {
   const i = process.argv.indexOf(name);
   return i > 0 && i + 1 < process.argv.length ? process.argv[i + 1] : fallback;
