@@ -6,6 +6,7 @@
 
 import { h, errorText } from "../dom.js";
 import { formatSeconds, timeSpan, replayStatus, controlReplay } from "./recording_api.js";
+import { StatusOrder } from "./status_order.js";
 
 const POLL_MS = 500;
 /** Speed factors offered (any positive factor is accepted by the gateway). */
@@ -21,6 +22,7 @@ export class ReplayTimeline {
     this.name = name;
     this.fetchImpl = fetchImpl;
     this.mayControl = mayControl;
+    this.order = new StatusOrder();
     this.playButton = h("button", { type: "button", class: "replay-play", text: "Play", onclick: () => this.send({ state: this.status?.state === "playing" ? "paused" : "playing" }) });
     // the slider works in milliseconds; while it is dragged the polled position does not move it
     this.slider = h("input", { type: "range", class: "replay-seek", min: 0, max: 0, step: 1, value: 0, "aria-label": "replay position" });
@@ -56,19 +58,31 @@ export class ReplayTimeline {
   }
 
   async poll() {
+    const ticket = this.order.beginPoll();
+    if (!ticket) return;
     try {
-      this.show(await replayStatus(this.name, this.fetchImpl));
+      const s = await replayStatus(this.name, this.fetchImpl);
+      if (this.order.accept(ticket)) this.show(s);
     } catch (e) {
-      if (e.status) this.showError(errorText(e));
+      if (e.status && this.order.accept(ticket)) this.showError(errorText(e));
     }
   }
 
+  // The controls keep the user's change on screen until the gateway's reply to it (StatusOrder).
   async send(change) {
     this.showError("");
+    const ticket = this.order.beginChange();
+    let failed = null;
     try {
-      this.show(await controlReplay(this.name, change, this.fetchImpl));
+      const s = await controlReplay(this.name, change, this.fetchImpl);
+      if (this.order.accept(ticket)) this.show(s);
     } catch (e) {
-      this.showError(errorText(e));
+      failed = e;
+    } finally {
+      this.order.endChange();
+    }
+    if (failed) {
+      this.showError(errorText(failed));
       this.poll();
     }
   }
