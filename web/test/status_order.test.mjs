@@ -1,8 +1,8 @@
-// The replay timeline's rule for which status to show (src/record/status_order.js): a poll that
+// The replay timeline's rule for which status to show (src/status_order.js): a poll that
 // overlapped a user's change never undoes it, and a slow reply never replaces a newer one.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { StatusOrder } from "../src/record/status_order.js";
+import { StatusOrder } from "../src/status_order.js";
 
 test("a poll issued before a change and answered after it is dropped (the loop box stays unticked)", () => {
   const o = new StatusOrder();

@@ -9,6 +9,7 @@ import { h, errorText } from "../dom.js";
 import { describeMember } from "../views/context.js";
 import { fetchAccess, allows } from "../robot/access.js";
 import { rgba, colorHex, hexColor, percentText, glowColor } from "../lighting/light_state.js";
+import { StatusOrder } from "../status_order.js";
 
 const L = "com.robotraconteur.lighting";
 export const LIGHT_TYPES = [`${L}.Light`, `${L}.DimmableLight`, `${L}.ColorTunableLight`];
@@ -55,28 +56,41 @@ export function createLightPanel(parent, ctx) {
     el.dataset.on = String(state.on);
     syncControls();
   }
-  async function read() {
-    if (busy || disposed) return;
+  // a read that overlapped a write may hold the values from before it: StatusOrder drops it, and the
+  // write's own read (which does not wait for a poll in flight) shows the result
+  const order = new StatusOrder();
+  async function read(afterWrite = false) {
+    if ((busy && !afterWrite) || disposed) return;
+    const ticket = order.beginPoll();
+    if (!ticket) return;
     busy = true;
     try {
-      state.on = !!(await obj.on_off.get());
-      if (intensity) state.intensity = Number(await obj.intensity.get());
-      if (color) state.color = await obj.color.get();
-      if (!disposed) { draw(); el.dataset.reads = String(Number(el.dataset.reads ?? 0) + 1); }
+      const on = !!(await obj.on_off.get());
+      const level = intensity ? Number(await obj.intensity.get()) : undefined;
+      const c = color ? await obj.color.get() : undefined;
+      if (disposed || !order.accept(ticket)) return;
+      state.on = on;
+      if (intensity) state.intensity = level;
+      if (color) state.color = c;
+      draw();
+      el.dataset.reads = String(Number(el.dataset.reads ?? 0) + 1);
     } catch (e) {
-      if (!disposed) showError(`read: ${errorText(e)}`);
+      if (!disposed && order.accept(ticket)) showError(`read: ${errorText(e)}`);
     } finally {
       busy = false;
     }
   }
   async function write(member, value) {
+    order.beginChange();
     try {
       await obj[member].set(value);
       if (!disposed) showError(null);
     } catch (e) {
       if (!disposed) showError(`${member}: ${errorText(e)}`);
+    } finally {
+      order.endChange();
     }
-    await read();
+    await read(true);
   }
 
   // controls, once the gateway said what this user may write

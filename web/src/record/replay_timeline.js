@@ -6,7 +6,7 @@
 
 import { h, errorText } from "../dom.js";
 import { formatSeconds, timeSpan, replayStatus, controlReplay } from "./recording_api.js";
-import { StatusOrder } from "./status_order.js";
+import { StatusOrder } from "../status_order.js";
 
 const POLL_MS = 500;
 /** Speed factors offered (any positive factor is accepted by the gateway). */

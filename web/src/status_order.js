@@ -1,8 +1,8 @@
-// Which replay status the timeline may show (docs/recording.md "Replay"). The timeline polls the
-// gateway and also sends the user's changes; a polled status read while a change was on its way may
-// predate the change and would undo it on screen (the loop box ticks itself back on), so such a poll
-// is dropped: the change's own reply is the status after it. Of overlapping requests only the newest
-// issued is shown, whatever order their replies come back in.
+// Which polled state a view may show when it also sends the user's changes (the replay timeline,
+// the light panel). A state read while a change was on its way may predate the change and would undo
+// it on screen (the replay's loop box ticks itself back on, a light shows "off" after "Turn on"), so
+// such a poll is dropped: the change's own reply, or a read after it, shows instead. Of overlapping
+// requests only the newest issued is shown, whatever order their replies come back in.
 
 export class StatusOrder {
   constructor() {
