@@ -74,7 +74,11 @@ for ((i = 1; i <= runs; i++)); do
   TMPDIR=$tmp ctest --test-dir build/debug -j "$jobs" "${select[@]}" --output-on-failure \
     --test-output-size-passed 65536 --test-output-size-failed 4194304 \
     --output-junit "$PWD/$dir/ctest.xml" >"$dir/ctest.log" 2>&1 || true
-  summary=$(grep -E 'tests passed|tests failed' "$dir/ctest.log" | tail -n 1)
+  if grep -q 'No tests were found' "$dir/ctest.log"; then
+    echo "flaky: no test matches$([ -n "$regex" ] && echo " -R '$regex'") in the $([ -n "$timing" ] && echo timing || echo main) phase (the browser tests and other \`timing\` ones need --timing)" >&2
+    exit 2
+  fi
+  summary=$(grep -E 'tests passed|tests failed' "$dir/ctest.log" | tail -n 1 || true)
   echo "flaky: run $i/$runs: ${summary:-no ctest summary (see $dir/ctest.log)} ($((SECONDS - t0)) s, load average $(cut -d' ' -f1-3 /proc/loadavg))"
   python3 test/schedule/ctest_report.py failed "$dir/ctest.xml" --out "$dir/failed"
 done
