@@ -45,9 +45,22 @@ function threadsOf(pid) {
   }
 }
 
+// Every child this test file started: when the file fails, the last of each one's stderr is printed
+// as the process exits (after the after() hooks stopped them), so a failure under load can be read
+// afterwards (docs/development.md "Tests that hold under load": on failure a test prints its logs).
+const started = [];
+process.on("exit", (code) => {
+  if (!code && !process.exitCode) return;
+  for (const c of started) {
+    const tail = c.stderr.join("").slice(-4000);
+    fs.writeSync(2, `\n--- ${c.name} (pid ${c.proc.pid}), the last of its stderr ---\n${tail || "(nothing)"}\n`);
+  }
+});
+
 /** A child process whose stdout lines are read for a JSON object holding `key`. */
 class Child {
   constructor(name, cmd, args, env = undefined, stdin = "ignore") {
+    started.push(this);
     this.name = name;
     this.proc = spawn(cmd, args, { stdio: [stdin, "pipe", "pipe"], env });
     this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
