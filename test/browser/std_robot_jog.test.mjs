@@ -53,15 +53,17 @@ const consoleLines = [];   // the pages' console errors and warnings, shown when
 const relays = [];         // TcpRelays to drop in after() should a scenario fail before its own finally
 
 before(async () => {
+  // the robot's and the probe's --max-lifetime (an orphan's bound) outlast ctest's TIMEOUT (300 s): a
+  // slow run is ended by ctest, never by its robot quitting midway (which fails every later scenario)
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), "rr-web-jog-"));
-  robot = await startDevice("sim_robot.py", ["--max-lifetime", "280", "--start-position", `0,0,${WRIST_START}`, "--log-jog"]);
+  robot = await startDevice("sim_robot.py", ["--max-lifetime", "330", "--start-position", `0,0,${WRIST_START}`, "--log-jog"]);
   robot.child.lines.on("line", (line) => {
     try {
       const v = JSON.parse(line);
       if (typeof v.jog_joint === "number") jogCalls.push(v.jog_joint);
     } catch { /* not a jog line */ }
   });
-  probe = await startProcess("robot_probe", s.python, ["-u", path.join(DEVICES, "robot_probe.py"), "--url", robot.info.url, "--max-lifetime", "280"], "probe", 60000);
+  probe = await startProcess("robot_probe", s.python, ["-u", path.join(DEVICES, "robot_probe.py"), "--url", robot.info.url, "--max-lifetime", "330"], "probe", 60000);
   probe.child.lines.on("line", (line) => {
     try {
       const v = JSON.parse(line);
